@@ -1,0 +1,1 @@
+"""Post-processing over results: convergence order and rates."""

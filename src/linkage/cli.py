@@ -1,0 +1,291 @@
+"""The ``linkage`` command line: parses, calls the engine, renders. No numerics here.
+
+Exit codes: 0 converged, 1 ran but did not converge (the rows are still shown),
+2 bad input (one line on stderr, never a traceback).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from fractions import Fraction
+from pathlib import Path
+from typing import Annotated, Any, Optional
+
+import typer
+
+from .errors import InputError, LinkageError
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    epilog="Example: linkage solve --method all",
+)
+
+@app.callback()
+def _root() -> None:
+    """Position analysis of planar mechanisms by numerical root finding.
+
+    Example: linkage solve --method all
+    """
+
+
+# --- output options, shared by every command ---------------------------------------------
+
+FormatOpt = Annotated[
+    Optional[str],
+    typer.Option("--format", "-f", help="table (rich, default on a terminal), plain (default "
+                 "when piped), csv, json, or any tabulate format (github, grid, latex, ...)."),
+]
+OutputOpt = Annotated[
+    Optional[Path],
+    typer.Option("--output", "-o", help="Write to this file instead of standard output; "
+                 "the format follows the suffix (.csv, .json) unless --format is given."),
+]
+DigitsOpt = Annotated[
+    int, typer.Option("--digits", min=3, max=17, help="Significant digits printed in tables.")
+]
+
+
+def choose_format(fmt: str | None, output: Path | None) -> str:
+    from .render.report import FORMATS_OWN, tabulate_formats
+
+    if fmt is None:
+        if output is not None:
+            return {".csv": "csv", ".json": "json"}.get(output.suffix.lower(), "plain")
+        return "table" if sys.stdout.isatty() else "plain"
+    if fmt in FORMATS_OWN or fmt in tabulate_formats():
+        return fmt
+    raise InputError(f"unknown format {fmt!r}; use table, plain, csv, json or a tabulate format "
+                     f"({', '.join(tabulate_formats()[:8])}, ...)")
+
+
+def emit(fmt: str, output: Path | None, *, blocks: Any, json_obj: Any,
+         csv_table: tuple[Any, Any]) -> None:
+    """Write one command's output in the chosen format, to stdout or ``output``."""
+    from .render.export import to_csv, to_json
+    from .render.report import print_rich, render_text
+
+    if fmt == "json":
+        text = to_json(json_obj)
+    elif fmt == "csv":
+        text = to_csv(*csv_table)
+    elif fmt == "table":
+        if output is None:
+            print_rich(blocks)
+            return
+        text = render_text(blocks, "simple")
+    else:
+        text = render_text(blocks, fmt)
+    if output is None:
+        sys.stdout.write(text)
+        return
+    try:
+        output.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise InputError(f"cannot write {output}: {exc.strerror or exc}") from None
+    typer.echo(f"wrote {output}", err=True)
+
+
+def parse_number(name: str, text: str) -> float:
+    """A finite number; fractions such as 5/3 are accepted."""
+    try:
+        value = float(Fraction(text.strip()))
+    except (ValueError, ZeroDivisionError):
+        raise InputError(f"{name} must be a finite number or a fraction like 5/3, got {text!r}") from None
+    return value
+
+
+# --- solve ----------------------------------------------------------------------------------
+
+@app.command(
+    epilog="Examples:  linkage solve  |  linkage solve --method all  |  "
+    "linkage solve --method bisection --alpha 40  |  "
+    "linkage solve --equation 'x**2 - 4*x + 1' --x0 5 --format csv",
+)
+def solve(
+    *,
+    method: Annotated[str, typer.Option("--method", "-m", help="bisection, regula-falsi, "
+                      "hybrid, secant, newton, fixed-point, or all.")] = "newton",
+    alpha: Annotated[Optional[float], typer.Option(help="Four-bar input angle alpha (deg); "
+                     "default 70.")] = None,
+    r1: Annotated[Optional[str], typer.Option("--r1", help="R1 (default 5/3).")] = None,
+    r2: Annotated[Optional[str], typer.Option("--r2", help="R2 (default 5/2).")] = None,
+    r3: Annotated[Optional[str], typer.Option("--r3", help="R3 (default 11/6).")] = None,
+    links: Annotated[Optional[tuple[str, str, str, str]], typer.Option(
+        help="Link lengths: input, coupler, output, ground (sets R1, R2, R3).")] = None,
+    equation: Annotated[Optional[str], typer.Option("--equation", "-e", help="Solve this "
+                        "equation in x instead, e.g. 'x**2 - 4*x + 1'.")] = None,
+    g: Annotated[Optional[str], typer.Option("--g", help="Iteration function for "
+                 "fixed-point on --equation: x = g(x).")] = None,
+    x0: Annotated[Optional[float], typer.Option(help="Starting point (deg for the four-bar).")] = None,
+    x1: Annotated[Optional[float], typer.Option(help="Second starting point (secant).")] = None,
+    bracket: Annotated[Optional[tuple[float, float]], typer.Option(
+        help="Bracket A B with a sign change (bisection, regula-falsi, hybrid).")] = None,
+    tol: Annotated[float, typer.Option(help="Step tolerance epsilon_s (absolute).")] = 1e-6,
+    rtol: Annotated[float, typer.Option(help="Relative step tolerance.")] = 0.0,
+    ftol: Annotated[Optional[float], typer.Option(help="Residual tolerance epsilon_e "
+                    "(off unless given).")] = None,
+    max_iter: Annotated[int, typer.Option("--max-iter", help="Iteration cap.")] = 100,
+    fmt: FormatOpt = None,
+    output: OutputOpt = None,
+    digits: DigitsOpt = 12,
+) -> None:
+    """Solve one equation in one unknown and print every iteration.
+
+    Without options: Newton's method on the seed-002 four-bar equation at alpha = 70 deg
+    from phi = 50 deg.
+
+    Example: linkage solve --method secant --x0 50 --x1 60
+    """
+    from .analysis.convergence import analyze
+    from .methods import BRACKETING, SCALAR_METHODS
+    from .render.export import result_dict
+    from .solve import check_criteria, check_number, solve_scalar
+
+    out_fmt = choose_format(fmt, output)
+    check_criteria(tol, rtol, ftol, max_iter)
+    for name, v in (("x0", x0), ("x1", x1), ("alpha", alpha)):
+        if v is not None:
+            check_number(name, v)
+    if bracket is not None:
+        check_number("bracket start", bracket[0])
+        check_number("bracket end", bracket[1])
+    problem = _scalar_problem(equation, g, alpha, r1, r2, r3, links)
+    if method == "all":
+        names = [m for m in SCALAR_METHODS if _applicable(m, problem, equation, x0, x1, bracket)]
+        if not names:
+            raise InputError("no method applies: give --x0 (newton), --x0 and --x1 (secant), "
+                             "--bracket (bracketing) or --g with --x0 (fixed-point)")
+    elif method in SCALAR_METHODS:
+        names = [method]
+    else:
+        raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}, all")
+
+    runs = []
+    for name in names:
+        kwargs: dict[str, Any] = dict(method=name, tol=tol, rtol=rtol, ftol=ftol, max_iter=max_iter)
+        if name in BRACKETING:
+            kwargs["bracket"] = bracket
+        else:
+            kwargs["x0"], kwargs["x1"] = x0, x1
+        result = solve_scalar(problem, **kwargs)
+        if result.status.value == "invalid_bracket" and len(names) == 1:
+            raise InputError(result.detail)
+        conv = analyze(result, problem)
+        seconds = _time_solve(problem, kwargs) if method == "all" else None
+        runs.append((result, conv, seconds))
+
+    from .render.scalar import scalar_blocks, summary_blocks
+
+    var = problem.var
+    if method != "all":
+        result, conv, _ = runs[0]
+        blocks = scalar_blocks(problem, result, conv, digits)
+        json_obj: Any = result_dict(result, {var: result.x}, conv.as_dict() if conv else None,
+                                    {"problem": problem.title, "units": {var: problem.unit}})
+        h = result.history
+        csv_table = (h.columns, h.rows) if h is not None else ((), ())
+    else:
+        blocks, csv_table = summary_blocks(problem, runs, digits)
+        json_obj = [result_dict(r, {var: r.x}, c.as_dict() if c else None,
+                                {"problem": problem.title, "units": {var: problem.unit},
+                                 "seconds_per_solve": s})
+                    for r, c, s in runs]
+    emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=csv_table)
+    if not all(r.converged for r, _, _ in runs):
+        raise typer.Exit(1)
+
+
+def _scalar_problem(equation: str | None, g: str | None, alpha: float | None, r1: str | None,
+                    r2: str | None, r3: str | None, links: tuple[str, ...] | None) -> Any:
+    if equation is not None:
+        given = [n for n, v in (("--alpha", alpha), ("--r1", r1), ("--r2", r2), ("--r3", r3),
+                                ("--links", links)) if v is not None]
+        if given:
+            raise InputError(f"{', '.join(given)} belong to the four-bar equation; "
+                             "they cannot be combined with --equation")
+        from .problems.expression import equation_problem
+
+        return equation_problem(equation, g)
+    if g is not None:
+        raise InputError("--g applies to --equation; the four-bar has its own g = acos(u)")
+    from .problems.freudenstein import SEED_R, coefficients_from_links, fourbar_equation
+
+    if links is not None:
+        if any(v is not None for v in (r1, r2, r3)):
+            raise InputError("give either --links or --r1/--r2/--r3, not both")
+        lengths = [parse_number(f"link {n}", t) for n, t in zip("abcd", links)]
+        c = coefficients_from_links(*lengths)
+        rs = (c.r1, c.r2, c.r3)
+    else:
+        rs = tuple(parse_number(n, t) if t is not None else d
+                   for n, t, d in (("R1", r1, SEED_R[0]), ("R2", r2, SEED_R[1]), ("R3", r3, SEED_R[2])))
+    return fourbar_equation(70.0 if alpha is None else alpha, *rs)
+
+
+def _applicable(name: str, problem: Any, equation: str | None, x0: Any, x1: Any, bracket: Any) -> bool:
+    if equation is None:
+        return problem.guess is not None or x0 is not None or bracket is not None
+    if name in ("bisection", "regula-falsi", "hybrid"):
+        return bracket is not None
+    if name == "secant":
+        return x0 is not None and x1 is not None
+    if name == "fixed-point":
+        return x0 is not None and problem.g is not None
+    return x0 is not None
+
+
+def _time_solve(problem: Any, kwargs: dict[str, Any]) -> float:
+    """Seconds per solve with recording off, the median of short timed batches."""
+    from .solve import solve_scalar
+
+    kw = dict(kwargs, record=False)
+    times = []
+    for _ in range(5):
+        n = 0
+        t0 = time.perf_counter()
+        while True:
+            solve_scalar(problem, **kw)
+            n += 1
+            dt = time.perf_counter() - t0
+            if dt > 0.002:
+                break
+        times.append(dt / n)
+    times.sort()
+    return times[len(times) // 2]
+
+
+# --- entry point ----------------------------------------------------------------------------
+
+def run_cli(argv: list[str] | None = None) -> int:
+    """Run the app and turn every error into one stderr line and an exit code."""
+    try:
+        rv = app(args=argv, prog_name="linkage", standalone_mode=False)
+    except typer.Exit as exc:
+        return exc.exit_code
+    except typer.Abort:
+        typer.echo("error: aborted", err=True)
+        return 1
+    except LinkageError as exc:
+        typer.echo(f"error: {exc}", err=True)
+        return 2
+    except KeyboardInterrupt:
+        typer.echo("error: interrupted", err=True)
+        return 1
+    except BrokenPipeError:
+        return 0
+    except Exception as exc:
+        if hasattr(exc, "format_message") and hasattr(exc, "exit_code"):
+            # A usage error from typer's (or click's) parser: bad option, bad value.
+            message = " ".join(exc.format_message().split())
+            typer.echo(f"error: {message}", err=True)
+            return 2
+        typer.echo(f"internal error: {type(exc).__name__}: {exc} (please report this)", err=True)
+        return 1
+    return rv if isinstance(rv, int) else 0
+
+
+def main() -> None:
+    sys.exit(run_cli())

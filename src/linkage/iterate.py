@@ -1,0 +1,148 @@
+"""The one generic iteration loop. Methods supply ``init``/``step``/``row``; this owns the rest.
+
+Stopping tests run after every step, in this fixed order (first match wins):
+
+1. a failure the step itself reported (zero derivative, domain error, invalid or
+   exhausted bracket, singular Jacobian);
+2. a non-finite error or residual                                   -> ``NON_FINITE``;
+3. an exact zero of the residual                                    -> ``CONVERGED_EXACT``;
+4. the residual test ``|f| <= ftol`` (only when ``ftol`` is given)  -> ``CONVERGED_RESIDUAL``;
+5. the step test ``err <= tol + rtol * |x|``                        -> ``CONVERGED_STEP``
+   (for methods that minimise a residual, a small step with the residual still above
+   ``ftol`` is ``NO_SOLUTION`` instead);
+6. growth of the error for ``DIVERGE_STREAK`` steps in a row        -> ``DIVERGED``
+   (open methods only: a bracket cannot diverge);
+7. an error at rounding level that stops shrinking (twice), or six
+   rounding-level steps, while still above the tolerance            -> ``PRECISION_LIMIT``;
+8. the iteration cap                                                -> ``MAX_ITER``.
+
+The step test mirrors seed 001 section 3.9 (epsilon_s on the step, epsilon_e on the
+residual) and, with ``ftol=None``, reproduces the seed-002 tables row for row.
+Recording is off unless asked for: with ``record=False`` no row is built.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from .result import Status
+
+DIVERGE_STREAK = 5
+"""Consecutive growing steps after which an open method is declared diverged."""
+
+ROUNDING = 4.0 * sys.float_info.epsilon
+"""Relative size of a step that is indistinguishable from rounding noise."""
+
+_isfinite = math.isfinite
+
+
+@dataclass(frozen=True)
+class Criteria:
+    """Stopping rules. ``tol``/``rtol``: step tolerances; ``ftol``: residual tolerance."""
+
+    tol: float = 1e-6
+    rtol: float = 0.0
+    ftol: float | None = None
+    max_iter: int = 100
+
+
+Outcome = tuple  # (final state, Status, detail, iterations, rows or None)
+
+
+def explain(exc: BaseException) -> tuple[Status, str]:
+    if isinstance(exc, OverflowError):
+        return Status.NON_FINITE, f"overflow: {exc}"
+    if isinstance(exc, ZeroDivisionError):
+        return Status.DOMAIN_ERROR, "division by zero"
+    return Status.DOMAIN_ERROR, str(exc) or type(exc).__name__
+
+
+def run(
+    method: Any,
+    problem: Any,
+    state: Any,
+    crit: Criteria,
+    *,
+    record: bool,
+    magnitude: Callable[[Any], float] = abs,
+) -> Outcome:
+    """Iterate ``method.step`` from ``state`` until a stopping test fires.
+
+    States are tuples with at least the fields ``x``, ``fx`` (residual, ``None`` when
+    not evaluated), ``err`` (the method's error measure, >= 0) and ``stop`` (``None`` or
+    a ``(Status, detail)`` pair set by the step).
+    """
+    rows: list[tuple[Any, ...]] | None = None
+    if record:
+        rows = []
+        first = method.initial_row(problem, state)
+        if first is not None:
+            rows.append(first)
+    step = method.step
+    row = method.row
+    index0 = method.first_index - 1
+    tol, rtol, ftol = crit.tol, crit.rtol, crit.ftol
+    needs_residual = method.needs_residual
+    can_diverge = method.can_diverge
+    prev_err = math.inf
+    growth = 0
+    stalls = 0
+    rounding_steps = 0
+    status = Status.MAX_ITER
+    detail = ""
+    k = 0
+    for k in range(1, crit.max_iter + 1):
+        try:
+            new = step(problem, state)
+        except (ArithmeticError, ValueError) as exc:
+            status, detail = explain(exc)
+            k -= 1
+            break
+        state = new
+        if rows is not None:
+            rows.append(row(problem, state, k + index0))
+        if state.stop is not None:
+            status, detail = state.stop
+            break
+        err = state.err
+        fx = state.fx
+        if not _isfinite(err) or (fx is not None and not _isfinite(fx)):
+            status, detail = Status.NON_FINITE, f"error = {err!r}, residual = {fx!r}"
+            break
+        if fx is not None:
+            if fx == 0.0:
+                status, detail = Status.CONVERGED_EXACT, ""
+                break
+            if ftol is not None and abs(fx) <= ftol:
+                status = Status.CONVERGED_RESIDUAL
+                break
+        x = state.x
+        limit = tol + rtol * magnitude(x) if rtol else tol
+        if err <= limit:
+            if needs_residual and (fx is None or abs(fx) > (ftol if ftol is not None else tol)):
+                status = Status.NO_SOLUTION
+                detail = f"the step stopped at residual {abs(fx or math.nan):.3g}"
+            else:
+                # The detail is formatted later from the result's fields: formatting here
+                # would cost more than a whole Newton step.
+                status = Status.CONVERGED_STEP
+            break
+        if can_diverge:
+            growth = growth + 1 if err > prev_err else 0
+            if growth >= DIVERGE_STREAK:
+                status, detail = Status.DIVERGED, f"{growth} growing steps, last {err:.3g}"
+                break
+        if err <= ROUNDING * magnitude(x):
+            # Rounding noise: the error can no longer shrink in double precision.
+            rounding_steps += 1
+            stalls += err >= prev_err
+            if stalls >= 2 or rounding_steps >= 6:
+                status = Status.PRECISION_LIMIT
+                detail = f"error {err:.3g} is rounding noise; tolerance {limit:.3g} is out of reach"
+                break
+        prev_err = err
+    return state, status, detail, k, rows

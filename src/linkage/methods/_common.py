@@ -1,0 +1,27 @@
+"""Shared pieces of the scalar methods."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..result import Status
+
+new_state = tuple.__new__
+"""Build a NamedTuple state without its Python-level ``__new__``.
+
+NamedTuple construction costs about 0.5 us against 0.15 us for this; a sweep makes
+millions of steps, so states are built with ``new_state(Cls, (fields...))``.
+"""
+
+
+def same_sign(a: float, b: float) -> bool:
+    """True when a and b are both > 0 or both < 0 (no product, so no underflow)."""
+    return (a > 0.0 and b > 0.0) or (a < 0.0 and b < 0.0)
+
+
+def failure(status: Status, detail: str) -> tuple[Status, str]:
+    return (status, detail)
+
+
+def nan_to_none(v: Any) -> Any:
+    return None if isinstance(v, float) and v != v else v

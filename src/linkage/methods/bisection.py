@@ -1,0 +1,99 @@
+"""Bisection: halve a bracket [a, b] with f(a) f(b) < 0, keeping the half with the sign change.
+
+Update: c = (a + b) / 2; keep [a, c] if f(a) and f(c) differ in sign, else [c, b].
+Order 1, rate 1/2: e_{k+1} = e_k / 2 with e_k = (b_k - a_k) / 2. One evaluation per
+step (two to start). A-priori count: (b - a) / 2^(n+1) <= tol gives
+n >= log2((b - a) / tol) - 1 (seed 002, bisection convergence analysis).
+Never fails on a valid bracket; it finds *a* root of odd multiplicity, or a pole
+where f changes sign (the residual then does not shrink: check it).
+Rows follow seed 002: the interval being bisected, its midpoint c, e = (b - a) / 2.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar, NamedTuple
+
+from ..problems.scalar import ScalarProblem
+from ..result import Column, Status
+from ._common import new_state, same_sign
+
+
+class BisectionState(NamedTuple):
+    x: float
+    fx: float | None
+    err: float
+    stop: tuple[Status, str] | None
+    a: float
+    fa: float
+    b: float
+    fb: float
+    row_a: float
+    row_fa: float
+    row_b: float
+    row_fb: float
+
+
+def init_bracket(problem: ScalarProblem, a: float,
+                 b: float) -> tuple[float, float, tuple[Status, str] | None]:
+    """Evaluate f at both ends; return (f(a), f(b), stop) where stop is set when the
+    bracket is unusable (same sign, non-finite) or an end is already an exact root."""
+    fa = problem.f(a)
+    fb = problem.f(b)
+    v = problem.var
+    if not (fa == fa and fb == fb and abs(fa) != float("inf") and abs(fb) != float("inf")):
+        return fa, fb, (Status.NON_FINITE, f"f({v}={a:g}) = {fa!r}, f({v}={b:g}) = {fb!r}")
+    if fa == 0.0:
+        return fa, fb, (Status.CONVERGED_EXACT, f"f is zero at the bracket end {v} = {a!r}")
+    if fb == 0.0:
+        return fa, fb, (Status.CONVERGED_EXACT, f"f is zero at the bracket end {v} = {b!r}")
+    if same_sign(fa, fb):
+        return fa, fb, (
+            Status.INVALID_BRACKET,
+            f"f(a) and f(b) must have different signs: f({a:g}) = {fa:.6g}, f({b:g}) = {fb:.6g}",
+        )
+    return fa, fb, None
+
+
+@dataclass(frozen=True)
+class Bisection:
+    name: ClassVar[str] = "bisection"
+    bracketing: ClassVar[bool] = True
+    can_diverge: ClassVar[bool] = False
+    needs_residual: ClassVar[bool] = False
+    first_index: ClassVar[int] = 0
+    init_evals: ClassVar[int] = 2
+    step_evals: ClassVar[int] = 1
+
+    def columns(self, problem: ScalarProblem) -> tuple[Column, ...]:
+        return (
+            Column("i", "index"),
+            Column("a", "x"),
+            Column("f(a)", "f"),
+            Column("b", "x"),
+            Column("f(b)", "f"),
+            Column("c", "x"),
+            Column("e", "x"),
+        )
+
+    def init(self, problem: ScalarProblem, a: float, b: float) -> BisectionState:
+        if a > b:
+            a, b = b, a
+        fa, fb, stop = init_bracket(problem, a, b)
+        x = a if stop and fa == 0.0 else b if stop and fb == 0.0 else 0.5 * a + 0.5 * b
+        return BisectionState(x, fa if x == a else fb if x == b else None, 0.5 * (b - a), stop,
+                              a, fa, b, fb, a, fa, b, fb)
+
+    def step(self, problem: ScalarProblem, s: BisectionState) -> BisectionState:
+        a, fa, b, fb = s.a, s.fa, s.b, s.fb
+        c = 0.5 * a + 0.5 * b
+        fc = problem.f(c)
+        if same_sign(fc, fa):
+            return new_state(BisectionState, (c, fc, 0.5 * (b - a), None, c, fc, b, fb, a, fa, b, fb))
+        return new_state(BisectionState, (c, fc, 0.5 * (b - a), None, a, fa, c, fc, a, fa, b, fb))
+
+    def initial_row(self, problem: ScalarProblem, s: BisectionState) -> None:
+        return None
+
+    def row(self, problem: ScalarProblem, s: BisectionState, i: int) -> tuple[Any, ...]:
+        return (i, s.row_a, s.row_fa, s.row_b, s.row_fb, s.x, s.err)

@@ -1,0 +1,79 @@
+"""Fixed-point iteration: x_{i+1} = g(x_i), for a root of f written as x = g(x).
+
+Linear convergence with rate |g'(r)| when |g'(r)| < 1 (contraction); diverges or
+oscillates when |g'(r)| > 1. One evaluation of g per step; f is evaluated at the new
+point only when the run records rows or tests the residual. For the seed-002 four-bar,
+g(phi) = acos(u(phi)) with u = (R1 cos(alpha) + R3 - cos(alpha - phi)) / R2, and
+g'(phi) = sin(alpha - phi) / (R2 sqrt(1 - u^2)) ~ 0.1275 at the root (seed 002,
+fixed-point analysis). Fails with a domain error when |u| > 1 (acos undefined).
+Rows follow seed 002: i, x_i, u(x_i) (when the problem has u), x_{i+1}, f(x_{i+1}),
+g'(x_i), error = x_i - x_{i+1} (signed).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar, NamedTuple
+
+from ..problems.scalar import ScalarProblem
+from ..result import Column, Status
+from ._common import new_state
+
+
+class FixedPointState(NamedTuple):
+    x: float
+    fx: float | None
+    err: float
+    stop: tuple[Status, str] | None
+    xp: float
+
+
+@dataclass(frozen=True)
+class FixedPoint:
+    """``evaluate_f``: compute f(x_{i+1}) each step (for the table or a residual test)."""
+
+    evaluate_f: bool = True
+
+    name: ClassVar[str] = "fixed-point"
+    bracketing: ClassVar[bool] = False
+    can_diverge: ClassVar[bool] = True
+    needs_residual: ClassVar[bool] = False
+    first_index: ClassVar[int] = 1
+    init_evals: ClassVar[int] = 0
+
+    @property
+    def step_evals(self) -> int:
+        return 2 if self.evaluate_f else 1
+
+    def columns(self, problem: ScalarProblem) -> tuple[Column, ...]:
+        cols = [Column("i", "index"), Column("{v}_i", "x")]
+        if problem.u is not None:
+            cols.append(Column("u({v}_i)", "ratio"))
+        cols += [Column("{v}_i+1", "x"), Column("f({v}_i+1)", "f")]
+        if problem.gprime is not None:
+            cols.append(Column("g'({v}_i)", "ratio"))
+        cols.append(Column("error", "x"))
+        return tuple(cols)
+
+    def init(self, problem: ScalarProblem, x0: float) -> FixedPointState:
+        return FixedPointState(x0, None, float("inf"), None, x0)
+
+    def step(self, problem: ScalarProblem, s: FixedPointState) -> FixedPointState:
+        x = s.x
+        x1 = problem.g(x)  # type: ignore[misc]
+        fx1 = problem.f(x1) if self.evaluate_f else None
+        return new_state(FixedPointState, (x1, fx1, abs(x - x1), None, x))
+
+    def initial_row(self, problem: ScalarProblem, s: FixedPointState) -> None:
+        return None
+
+    def row(self, problem: ScalarProblem, s: FixedPointState, i: int) -> tuple[Any, ...]:
+        xp = s.xp
+        out: list[Any] = [i, xp]
+        if problem.u is not None:
+            out.append(problem.u(xp))
+        out += [s.x, s.fx]
+        if problem.gprime is not None:
+            out.append(problem.gprime(xp))
+        out.append(xp - s.x)
+        return tuple(out)

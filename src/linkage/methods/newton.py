@@ -1,0 +1,79 @@
+"""Newton's method: x_{i+1} = x_i - f(x_i) / f'(x_i).
+
+Order 2 near a simple root: e_{i+1} ~ (f''(r) / (2 f'(r))) e_i^2 (seed 002, Newton
+convergence analysis; seed 001 section 3.9, eq. 4). Two evaluations per step (f and
+f'), one more to start. Fails at f'(x) = 0 (stalls), near a local extremum (huge
+jumps, P1 with x0 = 2.5), at inflection points (may cycle: x^3 - 2x + 2 from 0) and
+where f flattens toward infinity (atan(x) from 1.5 diverges); multiple roots reduce
+it to linear convergence. Which root it finds depends on x0 (P1).
+Rows follow seed 002: i, x_i, f(x_i), f'(x_i), x_{i+1}, |x_{i+1} - x_i|.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar, NamedTuple
+
+from ..problems.scalar import ScalarProblem
+from ..result import Column, Status
+from ._common import new_state
+
+
+class NewtonState(NamedTuple):
+    x: float
+    fx: float
+    err: float
+    stop: tuple[Status, str] | None
+    xp: float
+    fxp: float
+    dfxp: float
+
+
+@dataclass(frozen=True)
+class Newton:
+    name: ClassVar[str] = "newton"
+    bracketing: ClassVar[bool] = False
+    can_diverge: ClassVar[bool] = True
+    needs_residual: ClassVar[bool] = False
+    first_index: ClassVar[int] = 1
+    init_evals: ClassVar[int] = 1
+    step_evals: ClassVar[int] = 2
+
+    def columns(self, problem: ScalarProblem) -> tuple[Column, ...]:
+        return (
+            Column("i", "index"),
+            Column("{v}_i", "x"),
+            Column("f({v}_i)", "f"),
+            Column("f'({v}_i)", "df"),
+            Column("{v}_i+1", "x"),
+            Column("error", "x"),
+        )
+
+    def init(self, problem: ScalarProblem, x0: float) -> NewtonState:
+        fx = problem.f(x0)
+        stop = None
+        if fx == 0.0:
+            stop = (Status.CONVERGED_EXACT, f"f is zero at the start {problem.var} = {x0!r}")
+        elif fx != fx or abs(fx) == float("inf"):
+            stop = (Status.NON_FINITE, f"f({problem.var}={x0:g}) = {fx!r}")
+        return NewtonState(x0, fx, float("inf"), stop, x0, fx, float("nan"))
+
+    def step(self, problem: ScalarProblem, s: NewtonState) -> NewtonState:
+        x = s.x
+        fx = s.fx
+        d = problem.fprime(x)  # type: ignore[misc]
+        if d == 0.0:
+            return new_state(NewtonState, (
+                x, fx, float("nan"),
+                (Status.ZERO_DERIVATIVE, f"f'({problem.var}) = 0 at {problem.var} = {x!r}, f = {fx:.6g}"),
+                x, fx, d))
+        x1 = x - fx / d
+        return new_state(NewtonState, (x1, problem.f(x1), abs(x1 - x), None, x, fx, d))
+
+    def initial_row(self, problem: ScalarProblem, s: NewtonState) -> None:
+        return None
+
+    def row(self, problem: ScalarProblem, s: NewtonState, i: int) -> tuple[Any, ...]:
+        if s.stop is not None:
+            return (i, s.xp, s.fxp, s.dfxp, None, None)
+        return (i, s.xp, s.fxp, s.dfxp, s.x, s.err)

@@ -1,0 +1,85 @@
+"""Secant method: x_{i+1} = x_i - f(x_i) (x_i - x_{i-1}) / (f(x_i) - f(x_{i-1})).
+
+Order (1 + sqrt 5) / 2 = 1.618 near a simple root:
+e_{i+1} ~ |f''(r) / (2 f'(r))|^0.618 e_i^1.618 (seed 002, secant convergence analysis).
+One evaluation per step, two to start; no derivative needed. Fails where the slope
+is zero (f(x_i) = f(x_{i-1})) and, like Newton, may wander to another root or diverge.
+Rows follow seed 002: row 0 is the first point; then i, x_i, f(x_i), the slope,
+x_{i+1}, |x_{i+1} - x_i|.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar, NamedTuple
+
+from ..problems.scalar import ScalarProblem
+from ..result import Column, Status
+from ._common import new_state
+
+_NAN = float("nan")
+
+
+class SecantState(NamedTuple):
+    x: float
+    fx: float
+    err: float
+    stop: tuple[Status, str] | None
+    xp: float
+    fxp: float
+    slope: float
+
+
+@dataclass(frozen=True)
+class Secant:
+    name: ClassVar[str] = "secant"
+    bracketing: ClassVar[bool] = False
+    can_diverge: ClassVar[bool] = True
+    needs_residual: ClassVar[bool] = False
+    first_index: ClassVar[int] = 1
+    init_evals: ClassVar[int] = 2
+    step_evals: ClassVar[int] = 1
+
+    def columns(self, problem: ScalarProblem) -> tuple[Column, ...]:
+        return (
+            Column("i", "index"),
+            Column("{v}_i", "x"),
+            Column("f({v}_i)", "f"),
+            Column("slope", "df"),
+            Column("{v}_i+1", "x"),
+            Column("error", "x"),
+        )
+
+    def init(self, problem: ScalarProblem, x0: float, x1: float) -> SecantState:
+        f0 = problem.f(x0)
+        f1 = problem.f(x1)
+        v = problem.var
+        stop = None
+        x, fx = x1, f1
+        if f1 == 0.0:
+            stop = (Status.CONVERGED_EXACT, f"f is zero at the start {v} = {x1!r}")
+        elif f0 == 0.0:
+            x, fx = x0, f0
+            stop = (Status.CONVERGED_EXACT, f"f is zero at the start {v} = {x0!r}")
+        elif any(f != f or abs(f) == float("inf") for f in (f0, f1)):
+            stop = (Status.NON_FINITE, f"f({v}={x0:g}) = {f0!r}, f({v}={x1:g}) = {f1!r}")
+        return SecantState(x, fx, float("inf"), stop, x0, f0, _NAN)
+
+    def step(self, problem: ScalarProblem, s: SecantState) -> SecantState:
+        x, fx = s.x, s.fx
+        slope = (fx - s.fxp) / (x - s.xp)
+        if slope == 0.0:
+            return new_state(SecantState, (
+                x, fx, _NAN,
+                (Status.ZERO_DERIVATIVE, f"the secant slope is zero at {problem.var} = {x!r}"),
+                x, fx, slope))
+        x1 = x - fx / slope
+        return new_state(SecantState, (x1, problem.f(x1), abs(x1 - x), None, x, fx, slope))
+
+    def initial_row(self, problem: ScalarProblem, s: SecantState) -> tuple[Any, ...]:
+        return (0, s.xp, s.fxp, None, None, None)
+
+    def row(self, problem: ScalarProblem, s: SecantState, i: int) -> tuple[Any, ...]:
+        if s.stop is not None:
+            return (i, s.xp, s.fxp, s.slope, None, None)
+        return (i, s.xp, s.fxp, s.slope, s.x, s.err)

@@ -1,0 +1,1 @@
+"""Equations and mechanisms: what the solvers are pointed at."""

@@ -1,0 +1,118 @@
+"""The four-bar input-output equation of seed 002 (Freudenstein form), posed in degrees.
+
+    f(phi) = R1 cos(alpha) - R2 cos(phi) + R3 - cos(alpha - phi) = 0
+
+alpha is the input angle, phi the output angle. The seed works in degrees throughout,
+derivative included (f' is per degree), so this problem's unknown is phi in degrees
+and tolerances are in degrees; trigonometry is evaluated in radians inside.
+
+From link lengths (a input link, b coupler, c output link, d ground, both angles
+measured from the line of centres, pointing from the output pivot to the input
+pivot): R1 = d/c, R2 = d/a, R3 = (a^2 - b^2 + c^2 + d^2) / (2 a c). The seed's
+R1, R2, R3 = 5/3, 5/2, 11/6 are links (a, b, c, d) = (2, 4, 3, 5).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from ..errors import InputError
+from .scalar import ScalarProblem
+
+DEG = math.pi / 180.0
+
+SEED_R = (5.0 / 3.0, 5.0 / 2.0, 11.0 / 6.0)
+SEED_ALPHA_DEG = 70.0
+
+
+@dataclass(frozen=True)
+class FourBarCoefficients:
+    r1: float
+    r2: float
+    r3: float
+
+
+def coefficients_from_links(a: float, b: float, c: float, d: float) -> FourBarCoefficients:
+    """R1, R2, R3 from the link lengths (input a, coupler b, output c, ground d)."""
+    for name, v in zip("abcd", (a, b, c, d)):
+        if not math.isfinite(v) or v <= 0.0:
+            raise InputError(f"link length {name} must be a finite number > 0, got {v!r}")
+    return FourBarCoefficients(d / c, d / a, (a * a - b * b + c * c + d * d) / (2.0 * a * c))
+
+
+def fourbar_equation(
+    alpha_deg: float = SEED_ALPHA_DEG,
+    r1: float = SEED_R[0],
+    r2: float = SEED_R[1],
+    r3: float = SEED_R[2],
+) -> ScalarProblem:
+    """The seed-002 equation at input angle ``alpha_deg``, unknown phi in degrees.
+
+    Supplies f, f' and f'' (per degree), the fixed-point form g(phi) = acos(u(phi))
+    with u(phi) = (R1 cos(alpha) + R3 - cos(alpha - phi)) / R2, its derivative
+    g'(phi) = sin(alpha - phi) / (R2 sqrt(1 - u^2)), and a default start/bracket: the
+    first sign change of f on a 10-degree grid over [0, 180] (see default_start).
+    """
+    for name, v in (("alpha", alpha_deg), ("R1", r1), ("R2", r2), ("R3", r3)):
+        if not math.isfinite(v):
+            raise InputError(f"{name} must be finite, got {v!r}")
+    if r2 == 0.0:
+        raise InputError("R2 must be non-zero (it divides in the fixed-point form)")
+    alpha = alpha_deg * DEG
+    k = r1 * math.cos(alpha) + r3
+    cos, sin, acos, sqrt = math.cos, math.sin, math.acos, math.sqrt
+
+    def f(phi: float) -> float:
+        p = phi * DEG
+        return k - r2 * cos(p) - cos(alpha - p)
+
+    def fprime(phi: float) -> float:
+        p = phi * DEG
+        return DEG * (r2 * sin(p) - sin(alpha - p))
+
+    def fsecond(phi: float) -> float:
+        p = phi * DEG
+        return DEG * DEG * (r2 * cos(p) + cos(alpha - p))
+
+    def u(phi: float) -> float:
+        return (k - cos(alpha - phi * DEG)) / r2
+
+    def g(phi: float) -> float:
+        uu = (k - cos(alpha - phi * DEG)) / r2
+        if not -1.0 <= uu <= 1.0:
+            raise ValueError(f"acos(u) undefined: u = {uu:.9g} at phi = {phi:.9g} deg")
+        return acos(uu) / DEG
+
+    def gprime(phi: float) -> float:
+        uu = (k - cos(alpha - phi * DEG)) / r2
+        return sin(alpha - phi * DEG) / (r2 * sqrt(1.0 - uu * uu))
+
+    return ScalarProblem(
+        f=f, fprime=fprime, fsecond=fsecond, g=g, gprime=gprime, u=u,
+        var="phi", unit="deg",
+        title=(f"four-bar input-output equation, alpha = {alpha_deg:g} deg, "
+               f"R1 = {r1:.10g}, R2 = {r2:.10g}, R3 = {r3:.10g}"),
+        guess=default_start(f, fprime),
+    )
+
+
+def default_start(f: Callable[[float], float],
+                  fprime: Callable[[float], float]) -> tuple[float, float] | None:
+    """The first sign change of f on a 10-degree grid over [0, 180], as (x0, x1).
+
+    x0 is the end whose Newton step stays inside the bracket (so open methods stay
+    on the branch the bracket holds), x1 the other end; None if f never changes sign.
+    At alpha = 70 this is the seed's (50, 60).
+    """
+    prev, fprev = 0.0, f(0.0)
+    for i in range(1, 19):
+        x = 10.0 * i
+        fx = f(x)
+        if fprev == 0.0 or fx == 0.0 or (fprev < 0.0) != (fx < 0.0):
+            d = fprime(prev)
+            step_inside = d != 0.0 and prev <= prev - fprev / d <= x
+            return (prev, x) if step_inside else (x, prev)
+        prev, fprev = x, fx
+    return None

@@ -1,0 +1,1 @@
+"""Renderers: turn results into tables, CSV and JSON. They read records, never recompute."""

@@ -1,0 +1,59 @@
+"""CSV and JSON writers. Full double precision: scripts and spreadsheets do their own rounding."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from ..result import Result, finite_or_none
+
+
+def clean(v: Any) -> Any:
+    """JSON-safe values: NaN and infinities become null, tuples become lists."""
+    if isinstance(v, dict):
+        return {str(k): clean(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [clean(x) for x in v]
+    return finite_or_none(v)
+
+
+def result_dict(result: Result, solution: dict[str, Any], convergence: dict[str, Any] | None,
+                extra: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The JSON contract for one solve: method, status, converged, solution,
+    iterations (row objects keyed by column label with units), convergence, nfev."""
+    out: dict[str, Any] = {
+        "method": result.method,
+        "status": result.status.value,
+        "converged": result.converged,
+        "message": result.message,
+        "solution": solution,
+        "iterations": result.history.as_dicts() if result.history is not None else [],
+        "convergence": convergence or {"order": None},
+        "nfev": result.nfev,
+        "njev": result.njev,
+        "iteration_count": result.iterations,
+        "error": result.error,
+        "residual": result.residual,
+    }
+    if extra:
+        out.update(extra)
+    return clean(out)
+
+
+def to_json(obj: Any) -> str:
+    return json.dumps(clean(obj), indent=2, allow_nan=False) + "\n"
+
+
+def to_csv(headers: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:
+    """A header row, then one row per record; empty cells for missing or non-finite values."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(headers)
+    for r in rows:
+        w.writerow(["" if v is None or (isinstance(v, float) and not math.isfinite(v))
+                    else repr(v) if isinstance(v, float) else v for v in r])
+    return buf.getvalue()

@@ -1,0 +1,109 @@
+"""A report is a list of blocks; backends print it with rich or tabulate.
+
+Numbers are formatted here, once, to ``digits`` significant digits: the engine keeps
+full double precision and rounding happens only on the way to the screen.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+FORMATS_OWN = ("table", "plain", "csv", "json")
+
+
+@dataclass(frozen=True)
+class Text:
+    text: str
+    style: str = ""
+
+
+@dataclass(frozen=True)
+class Table:
+    title: str
+    headers: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+
+Block = Text | Table
+
+
+def fmt(v: Any, digits: int = 12) -> str:
+    """One cell: integers as they are, floats to ``digits`` significant digits."""
+    if v is None:
+        return "—"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "NaN"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        if v == 0.0:
+            return "0"
+        s = f"{v:.{digits}g}"
+        return s
+    return str(v)
+
+
+def table(title: str, headers: Sequence[str], rows: Sequence[Sequence[Any]], digits: int,
+          notes: Sequence[str] = ()) -> Table:
+    return Table(title, tuple(headers), tuple(tuple(fmt(v, digits) for v in r) for r in rows),
+                 tuple(notes))
+
+
+def tabulate_formats() -> list[str]:
+    from tabulate import tabulate_formats as names
+
+    return list(names)
+
+
+def render_text(blocks: Sequence[Block], tablefmt: str) -> str:
+    """Render with tabulate (``plain`` is tabulate's ``simple``: headers over a rule)."""
+    from tabulate import tabulate
+
+    fmt_name = "simple" if tablefmt == "plain" else tablefmt
+    out: list[str] = []
+    for b in blocks:
+        if isinstance(b, Text):
+            out.append(b.text)
+        else:
+            if b.title:
+                out.append(b.title)
+            out.append(tabulate(b.rows, headers=b.headers, tablefmt=fmt_name,
+                                disable_numparse=True, stralign="right"))
+            out.extend(b.notes)
+            out.append("")
+    return "\n".join(out).rstrip("\n") + "\n"
+
+
+def print_rich(blocks: Sequence[Block], file: Any = None) -> None:
+    """Render to a terminal with rich (imported only here)."""
+    import sys
+
+    from rich import box
+    from rich.console import Console
+    from rich.table import Table as RichTable
+
+    out = file or sys.stdout
+    # Off a terminal there is no width to respect; never let rich elide digits.
+    width = None if getattr(out, "isatty", lambda: False)() else 240
+    console = Console(file=out, highlight=False, width=width)
+    for b in blocks:
+        if isinstance(b, Text):
+            console.print(b.text, style=b.style or None, markup=False)
+        else:
+            t = RichTable(title=b.title or None, box=box.SIMPLE_HEAVY, title_justify="left",
+                          title_style="bold")
+            for h in b.headers:
+                t.add_column(h, justify="right", overflow="fold")
+            for r in b.rows:
+                t.add_row(*r)
+            console.print(t)
+            for n in b.notes:
+                console.print(n, markup=False)

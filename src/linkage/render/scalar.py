@@ -1,0 +1,106 @@
+"""Report blocks for scalar solves: the iteration table, the outcome, the convergence analysis."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from ..analysis.convergence import Convergence
+from ..problems.scalar import ScalarProblem
+from ..result import Result
+from .report import Block, Table, Text, fmt, table
+
+_CONSTANT_HEADER = {
+    "newton": "e_k+1/e_k^2",
+    "secant": "e_k+1/e_k^1.618",
+    "regula-falsi": "e_k+1/e_k^1.442",
+    "hybrid": "e_k+1/e_k^1.839",
+}
+
+
+def _with_unit(v: Any, unit: str, digits: int) -> str:
+    return f"{fmt(v, digits)} {unit}".rstrip()
+
+
+def scalar_blocks(problem: ScalarProblem, result: Result, conv: Convergence | None,
+                  digits: int) -> list[Block]:
+    var, unit = problem.var, problem.unit
+    start = {k: v for k, v in (result.meta or {}).items() if k in ("x0", "x1", "bracket")}
+    start_text = ", ".join(
+        f"{k} = [{fmt(v[0], digits)}, {fmt(v[1], digits)}]" if k == "bracket" else f"{k} = {fmt(v, digits)}"
+        for k, v in start.items())
+    blocks: list[Block] = [
+        Text(problem.title, "bold"),
+        Text(f"method: {result.method}" + (f", {start_text}" if start_text else "")
+             + f", tol = {fmt((result.meta or {}).get('tol'), 3)}"
+             + (f" {unit}" if unit else "")),
+        Text(""),
+    ]
+    h = result.history
+    if h is not None and h.rows:
+        blocks.append(table("", h.columns, h.rows, digits))
+    style = "green" if result.converged else "red"
+    blocks.append(Text(result.message, style))
+    blocks.append(Text(
+        f"{var} = {_with_unit(result.x, unit, max(digits, 15))}   ({result.iterations} iterations, "
+        f"{result.nfev} evaluations, f({var}) = {fmt(result.residual, 3)})", "bold"))
+    if conv is not None and len(conv.rows) >= 2:
+        blocks.append(Text(""))
+        blocks.extend(convergence_blocks(conv, unit, digits, result.converged))
+    return blocks
+
+
+def convergence_blocks(conv: Convergence, unit: str, digits: int, converged: bool = True) -> list[Block]:
+    c_head = _CONSTANT_HEADER.get(conv.method)
+    headers = ["i", f"error e_k ({unit})" if unit else "error e_k", "e_k+1/e_k", "order q_k"]
+    if c_head:
+        headers.append(c_head)
+    rows = []
+    for r in conv.rows:
+        row = [r.index, r.error, r.ratio, r.order]
+        if c_head:
+            row.append(r.constant)
+        rows.append(tuple(fmt(v, 6) for v in row) + (("rounding",) if r.rounding else ("",)))
+    headers.append("")
+    t = Table("Convergence", tuple(headers), tuple(rows))
+    lines = [t, Text(_summary_line(conv))]
+    if not converged:
+        lines.append(Text("the run did not converge: these figures describe its steps, "
+                          "not convergence to a root"))
+    lines.extend(Text(n) for n in conv.notes)
+    return lines
+
+
+def _summary_line(conv: Convergence) -> str:
+    th = conv.theory
+    parts = [f"estimated order {fmt(conv.order, 4)} (theory {fmt(conv.theory_order, 4)})"]
+    if conv.theory_order == 1.0 or conv.method in ("bisection", "fixed-point"):
+        parts.append(f"rate e_k+1/e_k = {fmt(conv.rate, 5)} (theory {fmt(th.get('rate'), 5)})")
+    elif conv.constant is not None:
+        parts.append(f"constant {fmt(conv.constant, 5)} (theory {fmt(th.get('constant'), 5)})")
+    return "; ".join(parts)
+
+
+SUMMARY_HEADERS = ("method", "status", "iterations", "evaluations", "root", "final error",
+                   "residual", "order", "time per solve (us)")
+
+
+def summary_blocks(problem: ScalarProblem, runs: Sequence[tuple[Result, Convergence | None, float | None]],
+                   digits: int) -> tuple[list[Block], tuple[tuple[str, ...], list[tuple[Any, ...]]]]:
+    unit = problem.unit
+    headers = list(SUMMARY_HEADERS)
+    if unit:
+        headers[4] = f"{problem.var} ({unit})"
+        headers[5] = f"final error ({unit})"
+    rows = []
+    for r, c, s in runs:
+        rows.append((r.method, r.status.value, r.iterations, r.nfev, r.x, r.error,
+                     r.residual, c.order if c else None, s * 1e6 if s is not None else None))
+    blocks: list[Block] = [
+        Text(problem.title, "bold"),
+        Text("every applicable method, side by side (time: median per solve, history off)"),
+        Text(""),
+        table("", headers, [(*row[:5], fmt(row[5], 3), fmt(row[6], 3), fmt(row[7], 4),
+                             fmt(row[8], 4)) for row in rows], digits),
+    ]
+    return blocks, (tuple(headers), rows)

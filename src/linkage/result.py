@@ -1,0 +1,180 @@
+"""What a solve returns: a named stop reason, the iteration history, the answer."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import Enum
+from typing import Any
+
+from .errors import NotConvergedError
+
+
+class Status(Enum):
+    """Why an iteration stopped. ``value`` is the stable name used in JSON and CSV."""
+
+    CONVERGED_STEP = "converged_step"
+    CONVERGED_RESIDUAL = "converged_residual"
+    CONVERGED_EXACT = "converged_exact"
+    MAX_ITER = "max_iter"
+    DIVERGED = "diverged"
+    ZERO_DERIVATIVE = "zero_derivative"
+    NON_FINITE = "non_finite"
+    INVALID_BRACKET = "invalid_bracket"
+    DOMAIN_ERROR = "domain_error"
+    PRECISION_LIMIT = "precision_limit"
+    SINGULAR_JACOBIAN = "singular_jacobian"
+    NO_SOLUTION = "no_solution"
+
+    @property
+    def converged(self) -> bool:
+        return self in _CONVERGED
+
+    @property
+    def message(self) -> str:
+        return _MESSAGES[self]
+
+
+_CONVERGED = frozenset({Status.CONVERGED_STEP, Status.CONVERGED_RESIDUAL, Status.CONVERGED_EXACT})
+
+_MESSAGES = {
+    Status.CONVERGED_STEP: "converged: the step is within the tolerance",
+    Status.CONVERGED_RESIDUAL: "converged: the residual is within the tolerance",
+    Status.CONVERGED_EXACT: "converged: the function is exactly zero",
+    Status.MAX_ITER: "stopped: iteration cap reached before the tolerance",
+    Status.DIVERGED: "diverged: the steps kept growing",
+    Status.ZERO_DERIVATIVE: "stalled: the derivative (or slope) is zero",
+    Status.NON_FINITE: "failed: a value became infinite or NaN",
+    Status.INVALID_BRACKET: "invalid bracket: f has the same sign at both ends",
+    Status.DOMAIN_ERROR: "failed: a function was evaluated outside its domain",
+    Status.PRECISION_LIMIT: "stopped at the limit of double precision before reaching the tolerance",
+    Status.SINGULAR_JACOBIAN: "stalled: the Jacobian is singular",
+    Status.NO_SOLUTION: "no solution: the residual stays above the tolerance",
+}
+
+
+@dataclass(frozen=True)
+class Column:
+    """One column of an iteration table: a label template and the kind of quantity.
+
+    ``template`` uses ``{v}`` for the unknown's name (``{v}_i`` becomes ``phi_i``);
+    ``kind`` decides the unit: ``x`` (unit of the unknown), ``f`` (unit of the
+    function), ``df`` (f per x), ``ratio`` (dimensionless), ``index`` and ``text``.
+    """
+
+    template: str
+    kind: str
+
+    def label(self, var: str, x_unit: str, f_unit: str = "") -> str:
+        name = self.template.format(v=var)
+        unit = {
+            "x": x_unit,
+            "f": f_unit,
+            "df": _per(f_unit, x_unit),
+        }.get(self.kind, "")
+        return f"{name} ({unit})" if unit else name
+
+
+def _per(num: str, den: str) -> str:
+    if not den:
+        return num
+    return f"{num or '1'}/{den}"
+
+
+@dataclass(frozen=True)
+class History:
+    """The recorded iterations: column labels (with units) and one tuple per row.
+
+    ``error_column`` indexes the column holding the method's error measure, which
+    the convergence analysis reads; renderers read rows and never recompute them.
+    """
+
+    columns: tuple[str, ...]
+    rows: tuple[tuple[Any, ...], ...]
+    error_column: int
+
+    def errors(self) -> list[float | None]:
+        k = self.error_column
+        return [r[k] for r in self.rows]
+
+    def as_dicts(self) -> list[dict[str, Any]]:
+        return [dict(zip(self.columns, r)) for r in self.rows]
+
+
+@dataclass(frozen=True)
+class IterationRecord:
+    """One row of a history as a mapping, for callers who prefer names to positions."""
+
+    index: int
+    values: dict[str, Any]
+
+
+@dataclass(frozen=True)
+class Result:
+    """The outcome of one solve. The same type for every method and every outcome.
+
+    ``x`` is the final estimate (a float for scalar problems, a tuple for systems);
+    ``error`` the last error measure the stopping test saw; ``residual`` the function
+    value at ``x`` when it was evaluated (``None`` if the method never needed it).
+    """
+
+    method: str
+    x: Any
+    status: Status
+    iterations: int
+    nfev: int
+    error: float
+    residual: Any
+    detail: str = ""
+    history: History | None = None
+    njev: int = 0
+    meta: dict[str, Any] | None = None
+
+    @property
+    def root(self) -> Any:
+        return self.x
+
+    @property
+    def converged(self) -> bool:
+        return self.status.converged
+
+    @property
+    def message(self) -> str:
+        detail = self.detail or self._default_detail()
+        return f"{self.status.message} ({detail})" if detail else self.status.message
+
+    def _default_detail(self) -> str:
+        meta = self.meta or {}
+        if self.status is Status.CONVERGED_STEP and "tol" in meta:
+            limit = meta["tol"] + meta.get("rtol", 0.0) * _magnitude(self.x)
+            return f"error {self.error:.3g} <= {limit:.3g}"
+        if self.status is Status.CONVERGED_RESIDUAL and meta.get("ftol") is not None:
+            return f"residual {_magnitude(self.residual):.3g} <= {meta['ftol']:.3g}"
+        if self.status is Status.MAX_ITER:
+            return f"{self.iterations} iterations, last error {self.error:.3g}"
+        return ""
+
+    @property
+    def records(self) -> list[IterationRecord]:
+        if self.history is None:
+            return []
+        return [IterationRecord(r[0], d) for r, d in zip(self.history.rows, self.history.as_dicts())]
+
+    def raise_for_status(self) -> Result:
+        """Return self when converged, raise :class:`NotConvergedError` otherwise."""
+        if not self.converged:
+            raise NotConvergedError(self, self.message)
+        return self
+
+
+def _magnitude(v: Any) -> float:
+    if isinstance(v, (int, float)):
+        return abs(v)
+    return max((abs(c) for c in v), default=0.0)
+
+
+def finite_or_none(v: Any) -> Any:
+    """JSON has no NaN or infinity: map them to None, keep everything else."""
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    return v

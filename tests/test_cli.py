@@ -1,0 +1,188 @@
+"""The command line: exit codes, one-line errors, formats, help."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+
+import pytest
+
+from conftest import run_process
+
+BAD_INPUT = {
+    "unknown method": (["--method", "golden"], "unknown method 'golden'"),
+    "tolerance zero": (["--tol", "0"], "tol must be > 0"),
+    "tolerance negative": (["--tol", "-1e-6"], "tol must be > 0"),
+    "tolerance nan": (["--tol", "nan"], "tol must be finite"),
+    "tolerance inf": (["--tol", "inf"], "tol must be finite"),
+    "tolerance not a number": (["--tol", "abc"], "--tol"),
+    "max-iter zero": (["--max-iter", "0"], "max_iter must be an integer >= 1"),
+    "bracket without sign change": (["--method", "bisection", "--bracket", "60", "70"],
+                                    "f(60) = 0.168559, f(70) = 0.548317"),
+    "equal secant points": (["--method", "secant", "--x0", "50", "--x1", "50"],
+                            "two different starting points"),
+    "nan start": (["--x0", "nan"], "x0 must be finite"),
+    "inf start": (["--x0", "inf"], "x0 must be finite"),
+    "nan alpha": (["--alpha", "nan"], "alpha must be finite"),
+    "nan bracket": (["--method", "bisection", "--bracket", "nan", "60"], "bracket start must be finite"),
+    "equation does not parse": (["--equation", "x**", "--x0", "1"], "could not parse the equation"),
+    "unknown name": (["--equation", "y + 1", "--x0", "1"], "unknown name 'y'"),
+    "unsafe call": (["--equation", "__import__('os').system('true')", "--x0", "1"], "unknown function"),
+    "attribute access": (["--equation", "x.real", "--x0", "1"], "is not allowed"),
+    "unknown format": (["--format", "xml"], "unknown format 'xml'"),
+    "bad fraction": (["--r1", "5/0"], "R1 must be a finite number"),
+    "negative link": (["--links", "2", "4", "3", "-5"], "link length d must be a finite number > 0"),
+    "newton without start on an equation": (["--equation", "x - 1"], "needs a starting point"),
+    "bisection without bracket on an equation": (["--equation", "x - 1", "--method", "bisection"],
+                                                 "needs a bracket"),
+    "fixed-point without g": (["--equation", "x - 1", "--method", "fixed-point", "--x0", "1"],
+                              "fixed-point needs the iteration function"),
+    "four-bar options with an equation": (["--equation", "x", "--alpha", "3", "--x0", "1"],
+                                          "cannot be combined with --equation"),
+    "unknown option": (["--bogus"], "--bogus"),
+    "missing option value": (["--bracket", "1"], "--bracket"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_INPUT))
+def test_bad_input_is_one_line_and_exit_2(cli, case):
+    args, expected = BAD_INPUT[case]
+    run = cli("solve", *args)
+    assert run.code == 2, (run.code, run.out, run.err)
+    lines = run.err.strip().splitlines()
+    assert len(lines) == 1, run.err
+    assert lines[0].startswith("error: ")
+    assert expected in lines[0]
+    assert "Traceback" not in run.err + run.out
+
+
+def test_missing_output_directory_is_bad_input(cli, tmp_path):
+    run = cli("solve", "--output", str(tmp_path / "no" / "such" / "dir.csv"))
+    assert run.code == 2 and "cannot write" in run.err
+
+
+def test_diverging_newton_exits_1_and_shows_its_rows(cli):
+    run = cli("solve", "--equation", "atan(x)", "--x0", "1.5", "--format", "json")
+    assert run.code == 1
+    doc = json.loads(run.out)
+    assert doc["status"] == "diverged" and doc["converged"] is False
+    assert len(doc["iterations"]) >= 5
+    xs = [abs(r["x_i+1"]) for r in doc["iterations"]]
+    assert xs == sorted(xs)  # each iterate further out than the last
+
+
+def test_zero_derivative_is_named_and_exits_1(cli):
+    run = cli("solve", "--equation", "x**2 + 1", "--x0", "0")
+    assert run.code == 1
+    assert "stalled: the derivative (or slope) is zero" in run.out
+
+
+def test_domain_error_at_the_start_exits_1_without_traceback(cli):
+    run = cli("solve", "--equation", "sqrt(x)", "--x0", "-1")
+    assert run.code == 1
+    assert "outside its domain" in run.out
+    assert "Traceback" not in run.err
+
+
+def test_max_iter_stop_shows_rows_and_exits_1(cli):
+    run = cli("solve", "--method", "bisection", "--max-iter", "5", "--format", "json")
+    assert run.code == 1
+    doc = json.loads(run.out)
+    assert doc["status"] == "max_iter" and len(doc["iterations"]) == 5
+
+
+def test_json_contract_and_round_trip_with_csv(cli):
+    j = cli("solve", "--method", "secant", "--format", "json")
+    c = cli("solve", "--method", "secant", "--format", "csv")
+    assert j.code == c.code == 0
+    doc = json.loads(j.out)
+    for key in ("method", "status", "converged", "solution", "iterations", "convergence", "nfev"):
+        assert key in doc
+    assert doc["method"] == "secant" and doc["status"].startswith("converged")
+    assert set(doc["solution"]) == {"phi"} and doc["units"] == {"phi": "deg"}
+    assert doc["convergence"]["order"] == pytest.approx(1.65, abs=0.1)
+    rows = list(csv.reader(io.StringIO(c.out)))
+    header, body = rows[0], rows[1:]
+    assert header == list(doc["iterations"][0].keys())
+    assert all("(deg)" in h or h in ("i", "f(phi_i)") or "1/deg" in h for h in header)
+    assert len(body) == len(doc["iterations"])
+    for line, obj in zip(body, doc["iterations"]):
+        for cell, (key, value) in zip(line, obj.items()):
+            if value is None:
+                assert cell == ""
+            else:  # CSV keeps full precision: the exact same double comes back
+                assert float(cell) == value, key
+
+
+def test_method_all_lists_every_method(cli):
+    run = cli("solve", "--method", "all", "--format", "json")
+    assert run.code == 0
+    docs = json.loads(run.out)
+    assert [d["method"] for d in docs] == ["bisection", "regula-falsi", "hybrid", "secant", "newton",
+                                           "fixed-point"]
+    for d in docs:
+        assert d["solution"]["phi"] == pytest.approx(54.887763188779143, abs=1e-6)
+        assert d["seconds_per_solve"] > 0
+    table = cli("solve", "--method", "all")
+    assert "time per solve (us)" in table.out and "fixed-point" in table.out
+
+
+def test_method_all_on_an_equation_runs_only_what_applies(cli):
+    run = cli("solve", "--equation", "x**2 - 2", "--x0", "1", "--method", "all", "--format", "json")
+    assert [d["method"] for d in json.loads(run.out)] == ["newton"]
+
+
+@pytest.mark.parametrize("fmt", ["table", "plain", "github", "grid", "latex"])
+def test_human_formats_render_the_same_numbers(cli, fmt):
+    run = cli("solve", "--format", fmt)
+    assert run.code == 0
+    assert "55.2191411577" in run.out and "54.8877631888" in run.out
+
+
+def test_output_file_follows_the_suffix(cli, tmp_path):
+    target = tmp_path / "run.json"
+    run = cli("solve", "--output", str(target))
+    assert run.code == 0 and run.out == ""
+    assert json.loads(target.read_text())["solution"]["phi"] == pytest.approx(54.8877631888, abs=1e-9)
+
+
+def test_links_give_the_seed_coefficients(cli):
+    a = cli("solve", "--links", "2", "4", "3", "5", "--format", "json")
+    b = cli("solve", "--format", "json")
+    assert json.loads(a.out)["solution"] == json.loads(b.out)["solution"]
+
+
+@pytest.mark.parametrize("command", [[], ["solve"]])
+def test_every_command_has_help_with_an_example(cli, command):
+    run = cli(*command, "--help")
+    assert run.code == 0
+    assert "Example" in run.out and "linkage solve" in run.out
+
+
+def test_help_lists_all_methods(cli):
+    out = cli("solve", "--help").out
+    for name in ("bisection", "regula-falsi", "hybrid", "secant", "newton", "fixed-point"):
+        assert name in out
+
+
+def test_entry_point_in_a_subprocess_prints_no_traceback():
+    proc = run_process("solve", "--tol", "-1")
+    assert proc.returncode == 2
+    assert proc.stderr.strip() == "error: tol must be > 0, got -1.0"
+
+
+def test_a_scalar_solve_does_not_import_numpy():
+    code = (
+        "import sys, runpy\n"
+        "sys.argv = ['linkage', 'solve', '--method', 'all']\n"
+        "try:\n"
+        "    runpy.run_module('linkage', run_name='__main__')\n"
+        "except SystemExit as e:\n"
+        "    assert e.code == 0, e.code\n"
+        "heavy = [m for m in ('numpy', 'scipy', 'matplotlib') if m in sys.modules]\n"
+        "print('HEAVY', heavy)\n"
+    )
+    proc = run_process(code=code)
+    assert proc.returncode == 0, proc.stderr
+    assert "HEAVY []" in proc.stdout
