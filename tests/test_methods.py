@@ -6,7 +6,7 @@ import math
 
 import mpmath as mp
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from linkage import Status, fourbar_equation, solve_scalar
@@ -160,6 +160,8 @@ def test_a_converged_result_satisfies_its_stopping_test(c, lo, width, method, to
 
 @settings(max_examples=100, deadline=None)
 @given(st.floats(1, 179), st.floats(0.2, 5), st.floats(0.2, 5), st.floats(-3, 3))
+@example(63.0, 1.0, 1.0, 1.0)  # regression: the table's f(x) once stopped fixed-point on an exact zero
+@example(1.0, 1.0, 1.0, 1.0)   # regression: g'(x) at u = 1 (display only) once crashed the solve
 def test_recording_does_not_change_the_answer(alpha, r1, r2, r3):
     p = fourbar_equation(alpha, r1, r2, r3)
     if p.guess is None:

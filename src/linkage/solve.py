@@ -128,7 +128,7 @@ def solve_scalar(
         else:
             if problem.g is None:
                 raise InputError("fixed-point needs the iteration function g (x = g(x))")
-            m = FixedPoint(evaluate_f=record or crit.ftol is not None)
+            m = FixedPoint(evaluate_f=crit.ftol is not None)
             args = (x0,)
             start = {"x0": x0}
     try:

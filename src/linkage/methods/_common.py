@@ -19,6 +19,14 @@ def same_sign(a: float, b: float) -> bool:
     return (a > 0.0 and b > 0.0) or (a < 0.0 and b < 0.0)
 
 
+def display(fn: Any, x: float) -> float | None:
+    """A value computed only for the table: a failure there must not end the solve."""
+    try:
+        return fn(x)
+    except (ArithmeticError, ValueError):
+        return None
+
+
 def failure(status: Status, detail: str) -> tuple[Status, str]:
     return (status, detail)
 

@@ -1,8 +1,9 @@
 """Fixed-point iteration: x_{i+1} = g(x_i), for a root of f written as x = g(x).
 
 Linear convergence with rate |g'(r)| when |g'(r)| < 1 (contraction); diverges or
-oscillates when |g'(r)| > 1. One evaluation of g per step; f is evaluated at the new
-point only when the run records rows or tests the residual. For the seed-002 four-bar,
+oscillates when |g'(r)| > 1. One evaluation of g per step; f at the new point enters the
+stopping tests only when a residual tolerance is given (otherwise the table computes
+it for display), so recording never changes where a run stops. For the seed-002 four-bar,
 g(phi) = acos(u(phi)) with u = (R1 cos(alpha) + R3 - cos(alpha - phi)) / R2, and
 g'(phi) = sin(alpha - phi) / (R2 sqrt(1 - u^2)) ~ 0.1275 at the root (seed 002,
 fixed-point analysis). Fails with a domain error when |u| > 1 (acos undefined).
@@ -17,7 +18,7 @@ from typing import Any, ClassVar, NamedTuple
 
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
-from ._common import new_state
+from ._common import display, new_state
 
 
 class FixedPointState(NamedTuple):
@@ -30,7 +31,7 @@ class FixedPointState(NamedTuple):
 
 @dataclass(frozen=True)
 class FixedPoint:
-    """``evaluate_f``: compute f(x_{i+1}) each step (for the table or a residual test)."""
+    """``evaluate_f``: compute f(x_{i+1}) each step, for a residual test."""
 
     evaluate_f: bool = True
 
@@ -71,9 +72,9 @@ class FixedPoint:
         xp = s.xp
         out: list[Any] = [i, xp]
         if problem.u is not None:
-            out.append(problem.u(xp))
-        out += [s.x, s.fx]
+            out.append(display(problem.u, xp))
+        out += [s.x, s.fx if s.fx is not None else display(problem.f, s.x)]
         if problem.gprime is not None:
-            out.append(problem.gprime(xp))
+            out.append(display(problem.gprime, xp))
         out.append(xp - s.x)
         return tuple(out)
