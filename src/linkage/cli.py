@@ -105,9 +105,13 @@ def parse_number(name: str, text: str) -> float:
     "linkage solve --equation 'x**2 - 4*x + 1' --x0 5 --format csv",
 )
 def solve(
+    file: Annotated[Optional[Path], typer.Argument(
+        help="A mechanism file (TOML, see sample_inputs/): solve its loop-closure equations.",
+        show_default=False)] = None,
     *,
     method: Annotated[str, typer.Option("--method", "-m", help="bisection, regula-falsi, "
-                      "hybrid, secant, newton, fixed-point, or all.")] = "newton",
+                      "hybrid, secant, newton, fixed-point, or all; with FILE: newton, "
+                      "newton-fd, lm.")] = "newton",
     alpha: Annotated[Optional[float], typer.Option(help="Four-bar input angle alpha (deg); "
                      "default 70.")] = None,
     r1: Annotated[Optional[str], typer.Option("--r1", help="R1 (default 5/3).")] = None,
@@ -128,6 +132,17 @@ def solve(
     ftol: Annotated[Optional[float], typer.Option(help="Residual tolerance epsilon_e "
                     "(off unless given).")] = None,
     max_iter: Annotated[int, typer.Option("--max-iter", help="Iteration cap.")] = 100,
+    set_: Annotated[Optional[list[str]], typer.Option("--set", help="With FILE: override a "
+                    "parameter or the driver, name=value in the file's units (repeatable).")] = None,
+    guess: Annotated[Optional[list[str]], typer.Option(help="With FILE: initial guess "
+                     "name=value in the file's units (repeatable).")] = None,
+    show_jacobian: Annotated[bool, typer.Option("--show-jacobian", help="With FILE: add the "
+                             "Jacobian entries (with units) to the table.")] = False,
+    fd_step: Annotated[Optional[float], typer.Option(help="With FILE and newton-fd: the "
+                       "finite-difference step h (rad or length units; default "
+                       "sqrt(eps)*max(1,|q|)).")] = None,
+    damped: Annotated[bool, typer.Option("--damped", help="With FILE: Newton with a "
+                      "backtracking line search, for poor guesses.")] = False,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 12,
@@ -135,9 +150,11 @@ def solve(
     """Solve one equation in one unknown and print every iteration.
 
     Without options: Newton's method on the seed-002 four-bar equation at alpha = 70 deg
-    from phi = 50 deg.
+    from phi = 50 deg. With FILE: Newton-Raphson on the mechanism's loop equations.
 
     Example: linkage solve --method secant --x0 50 --x1 60
+
+    Example: linkage solve sample_inputs/fourbar_me581.toml --set theta2=80
     """
     from .analysis.convergence import analyze
     from .methods import BRACKETING, SCALAR_METHODS
@@ -146,6 +163,21 @@ def solve(
 
     out_fmt = choose_format(fmt, output)
     check_criteria(tol, rtol, ftol, max_iter)
+    scalar_only = {"--alpha": alpha, "--r1": r1, "--r2": r2, "--r3": r3, "--links": links,
+                   "--equation": equation, "--g": g, "--x0": x0, "--x1": x1, "--bracket": bracket}
+    system_only = {"--set": set_, "--guess": guess, "--fd-step": fd_step,
+                   "--show-jacobian": show_jacobian or None, "--damped": damped or None}
+    if file is not None:
+        given = [k for k, v in scalar_only.items() if v is not None]
+        if given:
+            raise InputError(f"{', '.join(given)} apply to a single equation, not to a mechanism file")
+        _solve_file(file, method, set_ or [], guess or [], tol, rtol, ftol,
+                    max_iter if max_iter != 100 else 50, fd_step, damped, show_jacobian,
+                    out_fmt, output, digits)
+        return
+    given = [k for k, v in system_only.items() if v is not None]
+    if given:
+        raise InputError(f"{', '.join(given)} apply to a mechanism FILE")
     for name, v in (("x0", x0), ("x1", x1), ("alpha", alpha)):
         if v is not None:
             check_number(name, v)
@@ -195,6 +227,45 @@ def solve(
                     for r, c, s in runs]
     emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=csv_table)
     if not all(r.converged for r, _, _ in runs):
+        raise typer.Exit(1)
+
+
+def parse_assignments(option: str, items: list[str]) -> dict[str, float]:
+    out = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            raise InputError(f"{option} expects name=value, got {item!r}")
+        out[name.strip()] = parse_number(f"{option} {name.strip()}", value)
+    return out
+
+
+def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: float, rtol: float,
+                ftol: float | None, max_iter: int, fd_step: float | None, damped: bool,
+                show_jacobian: bool, out_fmt: str, output: Path | None, digits: int) -> None:
+    from .analysis.convergence import analyze
+    from .problems.loops import load
+    from .render.export import result_dict
+    from .render.system import branch_label, system_blocks, system_extra, system_solution
+    from .solve import SYSTEM_METHODS, solve_system
+
+    if method not in SYSTEM_METHODS:
+        raise InputError(f"unknown method {method!r} for a mechanism file; choose from "
+                         f"{', '.join(SYSTEM_METHODS)}")
+    mechanism = load(file).with_values(parse_assignments("--set", set_),
+                                       parse_assignments("--guess", guess))
+    problem = mechanism.problem()
+    result = solve_system(problem, method=method, tol=tol, rtol=rtol, ftol=ftol, max_iter=max_iter,
+                          fd_step=fd_step, damped=damped, show_jacobian=show_jacobian)
+    conv = analyze(result)
+    branch = branch_label(problem, result) if result.converged else None
+    blocks = system_blocks(problem, result, conv, digits, branch)
+    json_obj = result_dict(result, system_solution(problem, result), conv.as_dict() if conv else None,
+                           system_extra(problem, result, branch))
+    h = result.history
+    emit(out_fmt, output, blocks=blocks, json_obj=json_obj,
+         csv_table=(h.columns, h.rows) if h is not None else ((), ()))
+    if not result.converged:
         raise typer.Exit(1)
 
 

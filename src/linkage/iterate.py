@@ -7,9 +7,11 @@ Stopping tests run after every step, in this fixed order (first match wins):
 2. a non-finite error or residual                                   -> ``NON_FINITE``;
 3. an exact zero of the residual                                    -> ``CONVERGED_EXACT``;
 4. the residual test ``|f| <= ftol`` (only when ``ftol`` is given)  -> ``CONVERGED_RESIDUAL``;
-5. the step test ``err <= tol + rtol * |x|``                        -> ``CONVERGED_STEP``
-   (for methods that minimise a residual, a small step with the residual still above
-   ``ftol`` is ``NO_SOLUTION`` instead);
+5. the step test ``err <= tol + rtol * |x|``                        -> ``CONVERGED_STEP``.
+   Methods with ``needs_residual`` (the systems) converge only when the step *and* the
+   residual pass (P3: max|Phi| < eps and max|dq| < eps; ``ftol`` defaults to ``tol``);
+   a small step with the residual above it continues, or, for methods that minimise
+   the residual (``minimizes``), is ``NO_SOLUTION``;
 6. growth of the error for ``DIVERGE_STREAK`` steps in a row        -> ``DIVERGED``
    (open methods only: a bracket cannot diverge);
 7. an error at rounding level that stops shrinking (twice), or six
@@ -87,6 +89,8 @@ def run(
     index0 = method.first_index - 1
     tol, rtol, ftol = crit.tol, crit.rtol, crit.ftol
     needs_residual = method.needs_residual
+    minimizes = getattr(method, "minimizes", False)
+    gate = (ftol if ftol is not None else tol) if needs_residual else math.inf
     can_diverge = method.can_diverge
     prev_err = math.inf
     growth = 0
@@ -117,20 +121,23 @@ def run(
             if fx == 0.0:
                 status, detail = Status.CONVERGED_EXACT, ""
                 break
-            if ftol is not None and abs(fx) <= ftol:
+            if ftol is not None and not needs_residual and abs(fx) <= ftol:
                 status = Status.CONVERGED_RESIDUAL
                 break
         x = state.x
         limit = tol + rtol * magnitude(x) if rtol else tol
         if err <= limit:
-            if needs_residual and (fx is None or abs(fx) > (ftol if ftol is not None else tol)):
-                status = Status.NO_SOLUTION
-                detail = f"the step stopped at residual {abs(fx or math.nan):.3g}"
+            if needs_residual and (fx is None or abs(fx) > gate):
+                if minimizes:
+                    status = Status.NO_SOLUTION
+                    detail = (f"the least-squares residual stalls at {abs(fx or math.nan):.3g}, "
+                              f"above the tolerance {gate:.3g}")
+                    break
             else:
                 # The detail is formatted later from the result's fields: formatting here
                 # would cost more than a whole Newton step.
                 status = Status.CONVERGED_STEP
-            break
+                break
         if can_diverge:
             growth = growth + 1 if err > prev_err else 0
             if growth >= DIVERGE_STREAK:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from typing import Any
 
 from .errors import InputError
@@ -40,8 +41,6 @@ def _problem(f: Callable[[float], float] | ScalarProblem, fprime: Any, g: Any) -
     if isinstance(f, ScalarProblem):
         p = f
         if fprime is not None or g is not None:
-            from dataclasses import replace
-
             p = replace(p, fprime=fprime or p.fprime, g=g or p.g)
         return p
     if not callable(f):
@@ -179,3 +178,143 @@ def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: b
         meta={"var": problem.var, "unit": problem.unit, "title": problem.title,
               "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, **start},
     )
+
+
+# --- systems ------------------------------------------------------------------------------
+
+SYSTEM_METHODS: tuple[str, ...] = ("newton", "newton-fd", "lm")
+
+
+def solve_system(
+    F: Callable[..., list[float]] | Any,
+    x0: Sequence[float] | None = None,
+    *,
+    jac: Callable[..., list[list[float]]] | None = None,
+    method: str = "newton",
+    tol: float = 1e-6,
+    rtol: float = 0.0,
+    ftol: float | None = None,
+    max_iter: int = 50,
+    record: bool = True,
+    fd_step: float | None = None,
+    damped: bool = False,
+    show_jacobian: bool = False,
+) -> Result:
+    """Solve Phi(q) = 0 for n unknowns: ``newton`` (analytic Jacobian ``jac``),
+    ``newton-fd`` (forward differences with step ``fd_step``) or ``lm``
+    (Levenberg-Marquardt on the sum of squares).
+
+    ``F`` is a callable of a sequence, or a :class:`~linkage.problems.system.SystemProblem`
+    (for instance ``linkage.load_mechanism(path).problem()``), which supplies the
+    Jacobian, names, units and a default ``x0``. ``x0`` is in internal units (radians).
+    Converges when max|dq| <= tol + rtol max|q| and max|Phi| <= ftol (ftol defaults to
+    tol), as in PROBLEMS.md P3; ``damped`` adds a line search to Newton.
+    Returns a :class:`Result` with ``x`` (a tuple), ``nfev`` and ``njev``.
+    """
+    from .methods.least_squares import LevenbergMarquardt
+    from .methods.newton_system import NewtonSystem, max_abs
+    from .problems.system import SystemProblem, generic_system
+
+    if method not in SYSTEM_METHODS:
+        raise InputError(f"unknown method {method!r} for a system; choose from {', '.join(SYSTEM_METHODS)}")
+    crit = check_criteria(tol, rtol, ftol, max_iter)
+    if fd_step is not None:
+        fd_step = check_number("fd_step", fd_step, positive=True, allow_zero=False)
+    if isinstance(F, SystemProblem):
+        problem = F if jac is None else replace(F, J=jac)
+        if x0 is None:
+            x0 = problem.x0
+    else:
+        if not callable(F):
+            raise InputError(f"F must be callable or a SystemProblem, got {type(F).__name__}")
+        if x0 is None:
+            raise InputError("x0 is required for a bare residual function")
+        problem = generic_system(F, len(x0), jac)
+    if x0 is None or len(x0) != problem.n:
+        raise InputError(f"x0 needs {problem.n} values ({', '.join(problem.names)}), "
+                         f"got {0 if x0 is None else len(x0)}")
+    q0 = tuple(check_number(f"x0[{n}]", v) for n, v in zip(problem.names, x0))
+    if method == "newton" and problem.J is None:
+        raise InputError("newton needs the Jacobian jac; use method='newton-fd' to difference it")
+    kind = "fd" if method == "newton-fd" or problem.J is None else "analytic"
+    m: Any = (LevenbergMarquardt(kind, fd_step, diagnostics=record) if method == "lm"
+              else NewtonSystem(kind, fd_step, damped, diagnostics=record))
+    try:
+        phi0 = problem.F(list(q0))
+    except (ArithmeticError, ValueError) as exc:
+        raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
+    if len(phi0) != problem.n:
+        raise InputError(f"the system has {len(phi0)} equations for {problem.n} unknowns")
+    state = m.init(problem, q0)
+    final, status, detail, iterations, rows = run(m, problem, state, crit, record=record,
+                                                  magnitude=max_abs)
+    x = tuple(final.x)
+    nfev, njev = final.nfev, final.njev
+    try:
+        residual = max_abs(problem.F(list(x)))
+        nfev += 1
+    except (ArithmeticError, ValueError):
+        residual = math.nan
+    gate = crit.ftol if crit.ftol is not None else crit.tol
+    if status.converged and not residual <= gate:
+        status, detail = Status.NO_SOLUTION, f"max|Phi| = {residual:.3g} at the end, above {gate:.3g}"
+    meta: dict[str, Any] = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names,
+                            "kinds": problem.kinds, "title": problem.title, **problem.meta}
+    reference = problem.reference() if problem.reference is not None else None
+    if reference is not None:
+        meta["reference"] = reference
+        if not reference and not status.converged:
+            reason = detail if status is Status.NO_SOLUTION else status.message
+            driver = f"{problem.meta.get('driver')} = {problem.meta.get('driver_value'):g}"
+            status, detail = (Status.NO_SOLUTION,
+                              f"the linkage cannot be assembled at {driver} "
+                              f"{problem.meta.get('driver_unit', '')} (the closed form has no real "
+                              f"solution); {m.name}: {reason}")
+    history = None
+    if rows is not None:
+        history = _system_history(m, problem, rows, show_jacobian, reference, x)
+    return Result(method=m.name, x=x, status=status, iterations=iterations, nfev=nfev, error=final.err,
+                  residual=residual, detail=detail, history=history, njev=njev, meta=meta)
+
+
+def _system_history(m: Any, problem: Any, rows: list[tuple[Any, ...]], show_jacobian: bool,
+                    reference: dict[str, dict[str, float]] | None, x: tuple[float, ...]) -> History:
+    from .problems.closed_form import wrap_degrees
+
+    labels = [c.template for c in m.columns(problem, show_jacobian)]
+    out = []
+    for r in rows:
+        *head, jac, err = r
+        body = list(head)
+        if show_jacobian:
+            body += [v for jr in jac for v in jr] if jac else [None] * (problem.n * problem.n)
+        out.append((*body, err))
+    branch = nearest_branch(problem, reference, x)
+    if branch is not None:
+        ref = reference[branch]  # type: ignore[index]
+        labels.insert(-1, f"true error ({', '.join(sorted(set(problem.unit(i) for i in range(problem.n))))})"
+                      f" vs {branch}")
+        fixed = []
+        for r in out:
+            qd = r[1:1 + problem.n]
+            errs = [abs(wrap_degrees(v - ref[n])) if k == "angle" else abs(v - ref[n])
+                    for v, n, k in zip(qd, problem.names, problem.kinds)]
+            fixed.append((*r[:-1], max(errs), r[-1]))
+        out = fixed
+    return History(tuple(labels), tuple(out), len(labels) - 1)
+
+
+def nearest_branch(problem: Any, reference: dict[str, dict[str, float]] | None,
+                   x: Sequence[float]) -> str | None:
+    """The closed-form branch nearest to x (display units, angles compared mod 360)."""
+    if not reference:
+        return None
+    from .problems.closed_form import wrap_degrees
+
+    shown = problem.to_display(x)
+
+    def distance(sol: dict[str, float]) -> float:
+        return max(abs(wrap_degrees(v - sol[n])) if k == "angle" else abs(v - sol[n])
+                   for v, n, k in zip(shown, problem.names, problem.kinds))
+
+    return min(reference, key=lambda b: distance(reference[b]))

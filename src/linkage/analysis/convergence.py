@@ -31,6 +31,8 @@ THEORETICAL_ORDER: dict[str, float] = {
     "hybrid": 1.839,
     "secant": GOLDEN,
     "newton": 2.0,
+    "newton-fd": 2.0,
+    "lm": 2.0,
 }
 
 

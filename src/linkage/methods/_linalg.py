@@ -1,0 +1,95 @@
+"""Small dense linear algebra in pure Python, for loop-closure systems of a few unknowns.
+
+Mechanism systems have 2 to ~8 unknowns; at that size a Python LU beats numpy's
+per-call overhead, and a single solve keeps numpy out of the import graph.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+Matrix = list[list[float]]
+
+
+class SingularMatrix(ArithmeticError):
+    """Raised by :func:`lu` when a pivot is exactly zero."""
+
+
+def lu(a: Sequence[Sequence[float]]) -> tuple[Matrix, list[int], int]:
+    """LU factorisation with partial pivoting: returns (LU packed, row order, sign)."""
+    n = len(a)
+    m = [list(map(float, row)) for row in a]
+    perm = list(range(n))
+    sign = 1
+    for k in range(n):
+        p = max(range(k, n), key=lambda i: abs(m[i][k]))
+        if m[p][k] == 0.0:
+            raise SingularMatrix(f"zero pivot in column {k + 1}")
+        if p != k:
+            m[k], m[p] = m[p], m[k]
+            perm[k], perm[p] = perm[p], perm[k]
+            sign = -sign
+        pivot = m[k][k]
+        row_k = m[k]
+        for i in range(k + 1, n):
+            row_i = m[i]
+            factor = row_i[k] / pivot
+            if factor != 0.0:
+                row_i[k] = factor
+                for j in range(k + 1, n):
+                    row_i[j] -= factor * row_k[j]
+            else:
+                row_i[k] = 0.0
+    return m, perm, sign
+
+
+def lu_solve(factors: tuple[Matrix, list[int], int], b: Sequence[float]) -> list[float]:
+    m, perm, _ = factors
+    n = len(m)
+    y = [float(b[perm[i]]) for i in range(n)]
+    for i in range(n):
+        row = m[i]
+        s = y[i]
+        for j in range(i):
+            s -= row[j] * y[j]
+        y[i] = s
+    for i in range(n - 1, -1, -1):
+        row = m[i]
+        s = y[i]
+        for j in range(i + 1, n):
+            s -= row[j] * y[j]
+        y[i] = s / row[i]
+    return y
+
+
+def det_from_lu(factors: tuple[Matrix, list[int], int]) -> float:
+    m, _, sign = factors
+    d = float(sign)
+    for i in range(len(m)):
+        d *= m[i][i]
+    return d
+
+
+def norm1(a: Sequence[Sequence[float]]) -> float:
+    n = len(a)
+    return max(sum(abs(a[i][j]) for i in range(n)) for j in range(len(a[0])))
+
+
+def cond1(a: Sequence[Sequence[float]], factors: tuple[Matrix, list[int], int] | None = None) -> float:
+    """The 1-norm condition number ||A|| ||A^-1||, from n solves (exact for small n)."""
+    n = len(a)
+    try:
+        f = factors or lu(a)
+    except SingularMatrix:
+        return float("inf")
+    inv_cols = [lu_solve(f, [1.0 if i == j else 0.0 for i in range(n)]) for j in range(n)]
+    inv_norm = max(sum(abs(v) for v in col) for col in inv_cols)
+    return norm1(a) * inv_norm
+
+
+def pivot_ratio(factors: tuple[Matrix, list[int], int]) -> float:
+    """min |u_ii| / max |u_ii|: a cheap warning of near-singularity."""
+    m = factors[0]
+    diag = [abs(m[i][i]) for i in range(len(m))]
+    top = max(diag)
+    return min(diag) / top if top > 0.0 else 0.0

@@ -1,0 +1,116 @@
+"""Levenberg-Marquardt: minimise sum Phi_i(q)^2, the analogue of the seed's spreadsheet solver.
+
+Step: (J^T J + mu diag(J^T J)) dq = -J^T Phi, accepted only if it lowers the sum of
+squares; mu shrinks by 3 after a success and doubles after a failure (Marquardt,
+SIAM J. Appl. Math. 11, 1963). Near a zero-residual solution it behaves like
+Gauss-Newton (fast, about quadratic); where the loops cannot close it settles on a
+least-squares point with residual above the tolerance, and the loop then reports
+``no_solution`` rather than success (seed 001: the spreadsheet's Solver stops at a
+minimum, which is a solution only if the minimum is zero).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, ClassVar, NamedTuple
+
+from ..problems.system import SystemProblem
+from ..result import Column, Status
+from ._common import new_state
+from ._linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve
+from .newton_system import fd_jacobian, max_abs, system_columns, system_row
+
+MU_MAX = 1e16
+
+
+class LMState(NamedTuple):
+    x: tuple[float, ...]
+    fx: float | None
+    err: float
+    stop: tuple[Status, str] | None
+    q: tuple[float, ...]
+    phi: tuple[float, ...]
+    jac: tuple[tuple[float, ...], ...]
+    dq: tuple[float, ...]
+    det: float
+    cond: float
+    mu: float
+    cost: float
+    phi_new: tuple[float, ...]
+    nfev: int
+    njev: int
+
+
+@dataclass(frozen=True)
+class LevenbergMarquardt:
+    jacobian: str = "analytic"
+    fd_step: float | None = None
+    diagnostics: bool = True
+
+    name: ClassVar[str] = "lm"
+    bracketing: ClassVar[bool] = False
+    can_diverge: ClassVar[bool] = False
+    needs_residual: ClassVar[bool] = True
+    minimizes: ClassVar[bool] = True
+    first_index: ClassVar[int] = 1
+
+    def columns(self, problem: SystemProblem, show_jacobian: bool = False) -> tuple[Column, ...]:
+        return system_columns(problem, show_jacobian, step_label="dq")
+
+    def init(self, problem: SystemProblem, q0: tuple[float, ...]) -> LMState:
+        phi = problem.F(list(q0))
+        cost = sum(v * v for v in phi)
+        nan = math.nan
+        return LMState(tuple(q0), max_abs(phi), math.inf, None, tuple(q0), tuple(phi), (), (), nan,
+                       nan, 1e-3, cost, tuple(phi), 1, 0)
+
+    def step(self, problem: SystemProblem, s: LMState) -> LMState:
+        q = list(s.x)
+        phi = list(s.phi_new)
+        nfev, njev = s.nfev, s.njev
+        if self.jacobian == "fd":
+            jac = fd_jacobian(problem, q, phi, self.fd_step)
+            nfev += len(q)
+        else:
+            jac = problem.J(q)  # type: ignore[misc]
+            njev += 1
+        n, m = len(q), len(phi)
+        jtj = [[sum(jac[k][i] * jac[k][j] for k in range(m)) for j in range(n)] for i in range(n)]
+        g = [sum(jac[k][i] * phi[k] for k in range(m)) for i in range(n)]
+        try:
+            fj = lu(jac)
+            det, cond = det_from_lu(fj), (cond1(jac, fj) if self.diagnostics else math.nan)
+        except SingularMatrix:
+            det, cond = 0.0, math.inf
+        mu = s.mu
+        while True:
+            a = [row[:] for row in jtj]
+            for i in range(n):
+                a[i][i] += mu * max(jtj[i][i], 1e-12)
+            try:
+                dq = lu_solve(lu(a), [-v for v in g])
+            except SingularMatrix:
+                dq = None
+            if dq is not None:
+                trial = [qi + di for qi, di in zip(q, dq)]
+                phi_t = problem.F(trial)
+                nfev += 1
+                cost_t = sum(v * v for v in phi_t)
+                if cost_t < s.cost:
+                    return new_state(LMState, (
+                        tuple(trial), max_abs(phi_t), max_abs(dq), None, tuple(q), tuple(phi),
+                        tuple(map(tuple, jac)), tuple(dq), det, cond, max(mu / 3.0, 1e-12), cost_t,
+                        tuple(phi_t), nfev, njev))
+            mu *= 2.0
+            if mu > MU_MAX:
+                # No step lowers the residual: a local minimum of |Phi|^2.
+                return new_state(LMState, (
+                    tuple(q), max_abs(phi), 0.0, None, tuple(q), tuple(phi), tuple(map(tuple, jac)),
+                    tuple(0.0 for _ in q), det, cond, mu, s.cost, tuple(phi), nfev, njev))
+
+    def initial_row(self, problem: SystemProblem, s: LMState) -> None:
+        return None
+
+    def row(self, problem: SystemProblem, s: LMState, i: int) -> tuple[Any, ...]:
+        return system_row(problem, i, s.q, s.phi, s.dq, s.det, s.cond, s.jac, s.err)

@@ -1,0 +1,124 @@
+"""Closed-form position solutions, the independent reference for the iterative solvers.
+
+Four-bar (names r1..r4, theta1..theta4; loop r2 e^(i t2) + r3 e^(i t3) = r1 e^(i t1) +
+r4 e^(i t4)): with theta2 or theta4 given, the free joint lies on one circle at a
+fixed distance from a known point, so it is a circle-circle intersection with two
+solutions, labelled by assembly branch: open where sin(theta4 - theta3) > 0 (as in
+PROBLEMS.md P3), crossed where it is < 0. No real intersection: the linkage cannot be
+assembled at that input.
+
+Slider-crank (names r2, r3, e, theta2, theta3, s; loop r2 e^(i t2) + r3 e^(i t3) =
+s + i e): sin(theta3) = (e - r2 sin(theta2)) / r3, s = r2 cos(theta2) + r3 cos(theta3);
+open where cos(theta3) > 0 (the slider on the far side of the crank pivot from the
+coupler's turn), crossed otherwise.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+from collections.abc import Callable
+from typing import Any
+
+REQUIRED_NAMES = {
+    "fourbar": ("r1", "r2", "r3", "r4", "theta1", "theta2", "theta3", "theta4"),
+    "slider_crank": ("r2", "r3", "e", "theta2", "theta3", "s"),
+}
+
+Solutions = dict[str, dict[str, float]]
+
+
+class Indeterminate(ValueError):
+    """Coincident circles: every point of the circle is a solution (a change point)."""
+
+
+def circle_points(center: complex, radius: float, other: complex, distance: float) -> list[complex]:
+    """Points X with |X - center| = radius and |X - other| = distance (0, 1 or 2 of them);
+    raises Indeterminate when the two circles coincide."""
+    d = abs(other - center)
+    if d == 0.0:
+        if radius == distance:
+            raise Indeterminate("the two circles coincide")
+        return []
+    if d > radius + distance or d < abs(radius - distance):
+        return []
+    a = (radius * radius - distance * distance + d * d) / (2.0 * d)
+    h2 = radius * radius - a * a
+    h = math.sqrt(max(h2, 0.0))
+    u = (other - center) / d
+    base = center + a * u
+    return [base + h * 1j * u, base - h * 1j * u]
+
+
+def fourbar_positions(r1: float, r2: float, r3: float, r4: float, theta1: float,
+                      theta2: float | None = None, theta4: float | None = None) -> Solutions:
+    """Both assembly branches, angles in radians; {} when it cannot be assembled.
+    Raises Indeterminate at a change point where a joint lies on the opposite pivot."""
+    o4 = r1 * cmath.exp(1j * theta1)
+    out: Solutions = {}
+    if theta2 is not None:
+        a = r2 * cmath.exp(1j * theta2)
+        for b in circle_points(o4, r4, a, r3):
+            t3 = cmath.phase(b - a)
+            t4 = cmath.phase(b - o4)
+            out[_fourbar_branch(t3, t4)] = {"theta2": theta2, "theta3": t3, "theta4": t4}
+    elif theta4 is not None:
+        b = o4 + r4 * cmath.exp(1j * theta4)
+        for a in circle_points(0j, r2, b, r3):
+            t2 = cmath.phase(a)
+            t3 = cmath.phase(b - a)
+            out[_fourbar_branch(t3, theta4)] = {"theta2": t2, "theta3": t3, "theta4": theta4}
+    else:
+        raise ValueError("give theta2 or theta4")
+    return out
+
+
+def _fourbar_branch(t3: float, t4: float) -> str:
+    return "open" if math.sin(t4 - t3) > 0.0 else "crossed"
+
+
+def slider_crank_positions(r2: float, r3: float, e: float, theta2: float) -> Solutions:
+    v = (e - r2 * math.sin(theta2)) / r3
+    if abs(v) > 1.0:
+        return {}
+    out: Solutions = {}
+    for branch, t3 in (("open", math.asin(v)), ("crossed", math.pi - math.asin(v))):
+        out[branch] = {"theta3": t3, "s": r2 * math.cos(theta2) + r3 * math.cos(t3)}
+    return out
+
+
+def reference_for(m: Any) -> Callable[[], Solutions | None]:
+    """A function giving the closed-form solutions for a mechanism's current values,
+    in display units (degrees for angles), keyed by branch, restricted to its unknowns;
+    None where the closed form is indeterminate."""
+    values = {k: q.value for k, q in m.parameters.items()}
+    values[m.driver.name] = m.driver.value
+    unknown_names = [u.name for u in m.unknowns]
+    kinds = {u.name: u.kind for u in m.unknowns}
+
+    def solve() -> Solutions | None:
+        if m.closed_form == "fourbar":
+            given = {k: values.get(k) for k in ("theta2", "theta4")}
+            try:
+                sols = fourbar_positions(values["r1"], values["r2"], values["r3"], values["r4"],
+                                         values["theta1"], theta2=given["theta2"],
+                                         theta4=given["theta4"] if given["theta2"] is None else None)
+            except Indeterminate:
+                return None
+        else:
+            sols = slider_crank_positions(values["r2"], values["r3"], values["e"], values["theta2"])
+        return {branch: {k: (math.degrees(v) if kinds[k] == "angle" else v)
+                         for k, v in sol.items() if k in unknown_names}
+                for branch, sol in sols.items()}
+
+    return solve
+
+
+def wrap_degrees(a: float) -> float:
+    """An angle in degrees brought to (-180, 180]."""
+    w = math.fmod(a, 360.0)
+    if w <= -180.0:
+        w += 360.0
+    elif w > 180.0:
+        w -= 360.0
+    return w

@@ -1,0 +1,368 @@
+"""Mechanisms as data: vector loops read from TOML, turned into loop equations and Jacobians.
+
+A loop is a list of planar vectors that sums to zero. Each vector is
+``sign * length * e^(i * angle)``; ``length`` and ``angle`` each name a parameter,
+the driver or an unknown, or give a number; an angle may add a fixed ``offset``
+(rigid ternary links). Each loop gives two real equations (x and y). Derivatives are
+exact: d/d(angle) of r e^(i t) is i r e^(i t), d/d(length) is e^(i t).
+
+File layout (see sample_inputs/ for complete, commented examples)::
+
+    name = "..."
+    length_unit = "cm"                      # every length shares it
+    closed_form = "fourbar"                 # optional: "fourbar" or "slider_crank"
+    [parameters]                            # fixed values; angles in deg unless unit = "rad"
+    r1 = { value = 90, unit = "cm" }        # a link: must be > 0
+    e = { value = 0, unit = "cm", signed = true }   # an offset: any sign
+    theta1 = { value = 0, unit = "deg" }
+    [driver]                                # the input: a name and a value
+    name = "theta2"
+    value = 65
+    unit = "deg"
+    [unknowns]                              # each with its kind and initial guess
+    theta3 = { guess = 0, unit = "deg" }
+    [[loops]]
+    name = "ABCD"
+    vectors = [ { length = "r2", angle = "theta2" }, { length = "r4", angle = "theta4", sign = -1 } ]
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..errors import ParseError
+from .system import SystemProblem
+
+ANGLE_UNITS = {"deg": math.pi / 180.0, "rad": 1.0}
+
+
+@dataclass(frozen=True)
+class Quantity:
+    name: str
+    kind: str  # "angle" or "length"
+    value: float  # internal units (rad for angles)
+    unit: str  # as written in the file
+    signed: bool = False  # an offset: may be zero or negative (links must be > 0)
+
+
+@dataclass(frozen=True)
+class VectorTerm:
+    sign: float
+    length: str | float  # a name or a number (in the file's length unit)
+    angle: str | float  # a name or a number (internal: rad)
+    offset: float = 0.0  # rad
+
+
+@dataclass(frozen=True)
+class Loop:
+    name: str
+    vectors: tuple[VectorTerm, ...]
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """A mechanism read from a file: parameters, driver, unknowns and vector loops."""
+
+    name: str
+    source: str
+    length_unit: str
+    parameters: dict[str, Quantity]
+    driver: Quantity
+    unknowns: tuple[Quantity, ...]  # value = initial guess
+    loops: tuple[Loop, ...]
+    closed_form: str | None = None
+    description: str = ""
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def value_of(self, name: str) -> Quantity:
+        if name == self.driver.name:
+            return self.driver
+        return self.parameters[name]
+
+    def with_values(self, overrides: Mapping[str, float], guesses: Mapping[str, float]) -> Mechanism:
+        """Override parameters/driver (``--set``) and guesses (``--guess``), in file units."""
+        params = dict(self.parameters)
+        driver = self.driver
+        for key, v in overrides.items():
+            if key == driver.name:
+                driver = _requantify(driver, v)
+            elif key in params:
+                params[key] = _requantify(params[key], v)
+                if params[key].kind == "length" and not params[key].signed and params[key].value <= 0.0:
+                    raise ParseError(f"--set {key}: a length must be > 0, got {v!r} "
+                                     "(declare signed = true for an offset)")
+            else:
+                known = ", ".join([driver.name, *params])
+                raise ParseError(f"--set {key}: no parameter or driver named {key!r} in "
+                                 f"{self.source} (known: {known})")
+        unknowns = list(self.unknowns)
+        for key, v in guesses.items():
+            idx = next((i for i, u in enumerate(unknowns) if u.name == key), None)
+            if idx is None:
+                raise ParseError(f"--guess {key}: no unknown named {key!r} in {self.source} "
+                                 f"(unknowns: {', '.join(u.name for u in unknowns)})")
+            unknowns[idx] = _requantify(unknowns[idx], v)
+        return Mechanism(self.name, self.source, self.length_unit, params, driver, tuple(unknowns),
+                         self.loops, self.closed_form, self.description, self.extra)
+
+    def problem(self) -> SystemProblem:
+        return build_problem(self)
+
+
+def _requantify(q: Quantity, value: float) -> Quantity:
+    if not math.isfinite(value):
+        raise ParseError(f"{q.name} must be finite, got {value!r}")
+    scale = ANGLE_UNITS[q.unit] if q.kind == "angle" else 1.0
+    return Quantity(q.name, q.kind, value * scale, q.unit, q.signed)
+
+
+# --- loading ------------------------------------------------------------------------------
+
+def load(path: str | Path) -> Mechanism:
+    """Read and validate a mechanism file; every error names the file and the key."""
+    p = Path(path)
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover
+        import tomli as tomllib
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ParseError(f"no such file: {p}") from None
+    except IsADirectoryError:
+        raise ParseError(f"{p} is a directory, not a mechanism file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ParseError(f"cannot read {p}: {exc}") from None
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ParseError(f"{p}: not valid TOML: {exc}") from None
+    return parse_mechanism(doc, str(p))
+
+
+def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:
+    def fail(key: str, msg: str) -> ParseError:
+        return ParseError(f"{source}: {key}: {msg}")
+
+    allowed = {"name", "description", "length_unit", "closed_form", "parameters", "driver",
+               "unknowns", "loops", "notes"}
+    for key in doc:
+        if key not in allowed:
+            raise fail(key, f"unknown key (expected one of {', '.join(sorted(allowed))})")
+    name = doc.get("name")
+    if not isinstance(name, str) or not name:
+        raise fail("name", "missing or not a string")
+    length_unit = doc.get("length_unit")
+    if not isinstance(length_unit, str) or not length_unit:
+        raise fail("length_unit", "missing: give the unit every length uses, e.g. \"mm\"")
+    closed_form = doc.get("closed_form")
+    if closed_form is not None and closed_form not in ("fourbar", "slider_crank"):
+        raise fail("closed_form", f"unknown closed form {closed_form!r} (fourbar or slider_crank)")
+
+    def quantity(key: str, qname: str, spec: Any, field_name: str) -> Quantity:
+        if not isinstance(spec, Mapping):
+            raise fail(key, f"expected a table like {{ {field_name} = 1.0, unit = \"deg\" }}")
+        for k in spec:
+            if k not in (field_name, "unit", "note", "signed"):
+                raise fail(f"{key}.{k}", f"unknown key (expected {field_name}, unit, signed)")
+        signed = spec.get("signed", False)
+        if not isinstance(signed, bool):
+            raise fail(f"{key}.signed", "must be true or false")
+        if field_name not in spec:
+            raise fail(key, f"missing {field_name!r}")
+        value = spec[field_name]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise fail(f"{key}.{field_name}", f"must be a finite number, got {value!r}")
+        unit = spec.get("unit")
+        if unit in ANGLE_UNITS:
+            return Quantity(qname, "angle", float(value) * ANGLE_UNITS[unit], unit)
+        if unit == length_unit:
+            return Quantity(qname, "length", float(value), unit, signed)
+        raise fail(f"{key}.unit", f"unit {unit!r} is neither an angle unit (deg, rad) nor the "
+                                  f"file's length_unit {length_unit!r}")
+
+    params_doc = doc.get("parameters", {})
+    if not isinstance(params_doc, Mapping):
+        raise fail("parameters", "must be a table")
+    parameters = {k: quantity(f"parameters.{k}", k, v, "value") for k, v in params_doc.items()}
+    for k, q in parameters.items():
+        if q.kind == "length" and not q.signed and q.value <= 0.0:
+            raise fail(f"parameters.{k}.value", f"a length must be > 0, got {q.value!r} "
+                                                "(declare signed = true for an offset)")
+
+    drv = doc.get("driver")
+    if not isinstance(drv, Mapping) or "name" not in drv:
+        raise fail("driver", "missing: give [driver] with name, value and unit")
+    drv_name = drv["name"]
+    if not isinstance(drv_name, str):
+        raise fail("driver.name", "must be a string")
+    driver = quantity("driver", drv_name, {k: v for k, v in drv.items() if k != "name"}, "value")
+    if drv_name in parameters:
+        raise fail("driver.name", f"{drv_name!r} is also listed under [parameters]")
+
+    unk_doc = doc.get("unknowns")
+    if not isinstance(unk_doc, Mapping) or not unk_doc:
+        raise fail("unknowns", "missing: list each unknown with its guess and unit")
+    unknowns = tuple(quantity(f"unknowns.{k}", k, v, "guess") for k, v in unk_doc.items())
+    clash = [u.name for u in unknowns if u.name in parameters or u.name == drv_name]
+    if clash:
+        raise fail(f"unknowns.{clash[0]}", "is also a parameter or the driver")
+
+    known = {**parameters, drv_name: driver, **{u.name: u for u in unknowns}}
+    loops_doc = doc.get("loops")
+    if not isinstance(loops_doc, list) or not loops_doc:
+        raise fail("loops", "missing: give at least one [[loops]] with its vectors")
+    loops = []
+    used: set[str] = set()
+    for li, loop in enumerate(loops_doc):
+        lkey = f"loops[{li}]"
+        if not isinstance(loop, Mapping) or not isinstance(loop.get("vectors"), list):
+            raise fail(lkey, "needs a list 'vectors'")
+        terms = []
+        for vi, vec in enumerate(loop["vectors"]):
+            vkey = f"{lkey}.vectors[{vi}]"
+            if not isinstance(vec, Mapping):
+                raise fail(vkey, "must be a table like { length = \"r2\", angle = \"theta2\" }")
+            for k in vec:
+                if k not in ("length", "angle", "offset", "sign"):
+                    raise fail(f"{vkey}.{k}", "unknown key (expected length, angle, offset, sign)")
+            sign = vec.get("sign", 1)
+            if sign not in (1, -1):
+                raise fail(f"{vkey}.sign", f"must be 1 or -1, got {sign!r}")
+            length = _ref(vec.get("length"), f"{vkey}.length", "length", known, fail, used)
+            angle = _ref(vec.get("angle"), f"{vkey}.angle", "angle", known, fail, used)
+            offset = vec.get("offset", 0.0)
+            if isinstance(offset, bool) or not isinstance(offset, (int, float)):
+                raise fail(f"{vkey}.offset", "must be a number of degrees")
+            terms.append(VectorTerm(float(sign), length, angle, math.radians(offset)))
+        loops.append(Loop(str(loop.get("name", f"loop {li + 1}")), tuple(terms)))
+
+    n_eq = 2 * len(loops)
+    if n_eq != len(unknowns):
+        raise fail("unknowns", f"{len(loops)} loop(s) give {n_eq} equations but there are "
+                               f"{len(unknowns)} unknowns ({', '.join(u.name for u in unknowns)})")
+    if closed_form is not None:
+        from .closed_form import REQUIRED_NAMES
+
+        missing = [k for k in REQUIRED_NAMES[closed_form] if k not in known]
+        if missing:
+            raise fail("closed_form", f"{closed_form} needs the names {', '.join(missing)}")
+    unused = [u.name for u in unknowns if u.name not in used]
+    if unused:
+        raise fail(f"unknowns.{unused[0]}", "appears in no loop")
+    if drv_name not in used:
+        raise fail("driver.name", f"{drv_name!r} appears in no loop")
+    return Mechanism(name, source, length_unit, parameters, driver, unknowns, tuple(loops),
+                     closed_form, str(doc.get("description", "")),
+                     {"notes": doc.get("notes", "")})
+
+
+def _ref(value: Any, key: str, kind: str, known: Mapping[str, Quantity], fail: Any,
+         used: set[str]) -> str | float:
+    if value is None:
+        raise fail(key, "missing")
+    if isinstance(value, bool):
+        raise fail(key, f"must be a name or a number, got {value!r}")
+    if isinstance(value, (int, float)):
+        if not math.isfinite(value):
+            raise fail(key, "must be finite")
+        return math.radians(value) if kind == "angle" else float(value)
+    if not isinstance(value, str):
+        raise fail(key, f"must be a name or a number, got {value!r}")
+    q = known.get(value)
+    if q is None:
+        raise fail(key, f"unknown name {value!r} (parameters, driver and unknowns: "
+                        f"{', '.join(known)})")
+    if q.kind != kind:
+        raise fail(key, f"{value!r} is a {q.kind}, not a {kind}")
+    used.add(value)
+    return value
+
+
+# --- equations ----------------------------------------------------------------------------
+
+def build_problem(m: Mechanism) -> SystemProblem:
+    """Compile the loops into Phi(q) and its exact Jacobian, constants resolved once."""
+    index = {u.name: i for i, u in enumerate(m.unknowns)}
+    fixed = {**{k: q.value for k, q in m.parameters.items()}, m.driver.name: m.driver.value}
+    n = len(m.unknowns)
+    # Each term: (sign, length constant or None, length index, angle constant or None,
+    # angle index, offset). Index -1 means "fixed".
+    compiled: list[list[tuple[float, float, int, float, int, float]]] = []
+    for loop in m.loops:
+        terms = []
+        for t in loop.vectors:
+            if isinstance(t.length, str) and t.length in index:
+                lc, li = 0.0, index[t.length]
+            else:
+                lc, li = (fixed[t.length] if isinstance(t.length, str) else t.length), -1
+            if isinstance(t.angle, str) and t.angle in index:
+                ac, ai = 0.0, index[t.angle]
+            else:
+                ac, ai = (fixed[t.angle] if isinstance(t.angle, str) else t.angle), -1
+            terms.append((t.sign, lc, li, ac, ai, t.offset))
+        compiled.append(terms)
+    cos, sin = math.cos, math.sin
+
+    def F(q: Any) -> list[float]:
+        out = []
+        for terms in compiled:
+            x = y = 0.0
+            for sign, lc, li, ac, ai, off in terms:
+                r = q[li] if li >= 0 else lc
+                th = (q[ai] if ai >= 0 else ac) + off
+                x += sign * r * cos(th)
+                y += sign * r * sin(th)
+            out.append(x)
+            out.append(y)
+        return out
+
+    def J(q: Any) -> list[list[float]]:
+        rows = []
+        for terms in compiled:
+            jx = [0.0] * n
+            jy = [0.0] * n
+            for sign, lc, li, ac, ai, off in terms:
+                r = q[li] if li >= 0 else lc
+                th = (q[ai] if ai >= 0 else ac) + off
+                c, s = cos(th), sin(th)
+                if ai >= 0:
+                    jx[ai] -= sign * r * s
+                    jy[ai] += sign * r * c
+                if li >= 0:
+                    jx[li] += sign * c
+                    jy[li] += sign * s
+            rows.append(jx)
+            rows.append(jy)
+        return rows
+
+    eq_names = []
+    for loop in m.loops:
+        eq_names += [f"{loop.name}.x", f"{loop.name}.y"]
+    reference = None
+    if m.closed_form is not None:
+        from .closed_form import reference_for
+
+        reference = reference_for(m)
+    driver_text = f"{m.driver.name} = {_display(m.driver):g} {m.driver.unit}"
+    return SystemProblem(
+        F=F, J=J,
+        names=tuple(u.name for u in m.unknowns),
+        kinds=tuple(u.kind for u in m.unknowns),
+        length_unit=m.length_unit,
+        equation_names=tuple(eq_names),
+        x0=tuple(u.value for u in m.unknowns),
+        title=f"{m.name}: {driver_text}",
+        reference=reference,
+        meta={"driver": m.driver.name, "driver_value": _display(m.driver),
+              "driver_unit": m.driver.unit, "source": m.source},
+    )
+
+
+def _display(q: Quantity) -> float:
+    return q.value / ANGLE_UNITS[q.unit] if q.kind == "angle" else q.value

@@ -1,0 +1,57 @@
+"""A system of n equations in n unknowns, with what the tables need to show it."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+Vector = Sequence[float]
+Residual = Callable[[Vector], list[float]]
+Jacobian = Callable[[Vector], list[list[float]]]
+
+
+@dataclass(frozen=True)
+class SystemProblem:
+    """Phi(q) = 0. Unknowns are held in internal units (radians for angles).
+
+    ``kinds`` says, per unknown, ``angle`` or ``length`` (or ``""`` for plain numbers);
+    tables show angles in degrees and steps in radians and degrees. ``reference``
+    optionally returns closed-form solutions, one per assembly branch.
+    """
+
+    F: Residual
+    J: Jacobian | None = None
+    names: tuple[str, ...] = ()
+    kinds: tuple[str, ...] = ()
+    length_unit: str = ""
+    equation_names: tuple[str, ...] = ()
+    x0: tuple[float, ...] | None = None
+    title: str = ""
+    reference: Callable[[], dict[str, dict[str, float]] | None] | None = None
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def n(self) -> int:
+        return len(self.names)
+
+    def to_display(self, q: Vector) -> list[float]:
+        """Internal values to interface units: radians become degrees."""
+        return [math.degrees(v) if k == "angle" else v for v, k in zip(q, self.kinds)]
+
+    def from_display(self, values: Vector) -> list[float]:
+        return [math.radians(v) if k == "angle" else v for v, k in zip(values, self.kinds)]
+
+    def unit(self, i: int) -> str:
+        return "deg" if self.kinds[i] == "angle" else self.length_unit
+
+    def step_unit(self, i: int) -> str:
+        return "rad" if self.kinds[i] == "angle" else self.length_unit
+
+
+def generic_system(F: Residual, n: int, J: Jacobian | None = None) -> SystemProblem:
+    """Wrap a bare residual function of n unknowns (no units, names x1..xn)."""
+    names = tuple(f"x{i + 1}" for i in range(n))
+    return SystemProblem(F=F, J=J, names=names, kinds=("",) * n,
+                         equation_names=tuple(f"F{i + 1}" for i in range(n)))

@@ -1,0 +1,293 @@
+"""Loop-closure systems: P3, P5, the sample mechanisms, closed forms, failures, files."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from conftest import matches
+from linkage import Status, load_mechanism, solve_system
+from linkage.problems.closed_form import (
+    Indeterminate,
+    fourbar_positions,
+    slider_crank_positions,
+    wrap_degrees,
+)
+from linkage.problems.loops import parse_mechanism
+
+SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
+ME581 = str(SAMPLES / "fourbar_me581.toml")
+
+# PROBLEMS.md P3: k, theta3, theta4 (deg), Phi1, Phi2 (cm), det J, dtheta3, dtheta4 (rad)
+P3_ROWS = (
+    ("1", "0", "90", "-17.3215", "-17.8108", "-2700.0", "0.2968461", "0.3849212"),
+    ("2", "17.0080", "112.0544", "-3.04875", "3.03231", "-2689.53", "-0.0661765", "0.0452519"),
+    ("3", "13.2164", "114.6471", "-0.14438", "0.00679", "-2646.45", "-0.0011287", "0.0031514"),
+    ("4", "13.1517", "114.8277", "-0.00013", "0.00019", "-2644.13", "-3.9e-06", "1.9e-06"),
+    ("5", "13.1515", "114.8278", "-4.9e-10", "-3.3e-11", "-2644.13", "-3.0e-12", "1.1e-11"),
+)
+
+
+def matches_sig(value: float, printed: str) -> bool:
+    """For figures printed in e-notation: agree to the printed significant digits."""
+    if "e" not in printed:
+        return matches(value, printed)
+    mantissa = printed.split("e")[0]
+    digits = len(mantissa.replace("-", "").replace(".", "").lstrip("0"))
+    return abs(value - float(printed)) <= 0.5 * 10 ** (math.floor(math.log10(abs(float(printed))))
+                                                       - digits + 1) * (1 + 1e-9)
+
+
+def p3_view(doc_rows: list[dict]) -> list[tuple[float, ...]]:
+    keys = ("k", "theta3 (deg)", "theta4 (deg)", "Phi1 (cm)", "Phi2 (cm)",
+            "det J (cm^2/rad^2)", "dtheta3 (rad)", "dtheta4 (rad)")
+    return [tuple(r[k] for k in keys) for r in doc_rows]
+
+
+def test_p3_table_from_the_cli(cli):
+    run = cli("solve", ME581, "--format", "json")
+    assert run.code == 0, run.err
+    doc = json.loads(run.out)
+    rows = p3_view(doc["iterations"])
+    assert len(rows) == len(P3_ROWS)
+    for got, want in zip(rows, P3_ROWS):
+        for g, w in zip(got, want):
+            assert matches_sig(g, w), (want[0], g, w)
+    assert matches(doc["solution"]["theta3"], "13.151499346")
+    assert matches(doc["solution"]["theta4"], "114.827770616")
+    assert doc["branch"] == "open" and doc["nfev"] >= 5 and doc["njev"] == 5
+
+
+def test_p3_from_the_api_and_the_crossed_branch():
+    problem = load_mechanism(ME581).problem()
+    result = solve_system(problem, tol=1e-12)
+    t3, t4 = problem.to_display(result.x)
+    assert (t3, t4) == (pytest.approx(13.151499346, abs=5e-10), pytest.approx(114.827770616, abs=5e-10))
+    crossed = solve_system(problem, [math.radians(-50), math.radians(200)], tol=1e-12)
+    c3, c4 = problem.to_display(crossed.x)
+    assert wrap_degrees(c3 - -51.898819255) == pytest.approx(0, abs=5e-9)
+    assert wrap_degrees(c4 - 206.424909476) == pytest.approx(0, abs=5e-9)
+    assert math.sin(math.radians(c4 - c3)) < 0 < math.sin(math.radians(t4 - t3))
+
+
+def test_newton_fd_shows_the_notes_numerical_jacobian(cli):
+    run = cli("solve", ME581, "--method", "newton-fd", "--fd-step", "0.001", "--show-jacobian",
+              "--format", "json")
+    assert run.code == 0
+    doc = json.loads(run.out)
+    first = doc["iterations"][0]
+    j = [first[f"dPhi{e}/d{q} (cm/rad)"] for e in (1, 2) for q in ("theta3", "theta4")]
+    # column theta3 = {-0.0300, 60.0000}, column theta4 = {45.0000, 0.0225}
+    for got, want in zip(j, ("-0.0300", "45.0000", "60.0000", "0.0225")):
+        assert matches(got, want), (got, want)
+    assert matches(doc["solution"]["theta3"], "13.151499346")
+    assert matches(doc["solution"]["theta4"], "114.827770616")
+    table = cli("solve", ME581, "--method", "newton-fd", "--fd-step", "0.001", "--show-jacobian")
+    assert "dPhi1/dtheta3 (cm/rad)" in table.out
+
+
+def test_theta4_driven_file_returns_theta2_65(cli):
+    doc = json.loads(cli("solve", str(SAMPLES / "fourbar_me581_theta4.toml"), "--format", "json").out)
+    assert matches(doc["solution"]["theta2"], "65.000000000")
+    assert matches(doc["solution"]["theta3"], "13.151499346")
+
+
+def test_rapier_drive_reaches_p5_from_the_books_guess():
+    problem = load_mechanism(SAMPLES / "rapier_drive.toml").problem()
+    result = solve_system(problem, tol=1e-6)
+    assert result.converged and result.iterations <= 6
+    got = problem.to_display(result.x)
+    for g, w in zip(got, ("188.572556", "67.394934", "175.143712", "-216.940343")):
+        assert matches(g, w), (g, w)
+
+
+@pytest.mark.parametrize("path", sorted(SAMPLES.glob("*.toml")), ids=lambda p: p.name)
+@pytest.mark.parametrize("method", ["newton", "newton-fd", "lm"])
+def test_every_sample_converges_with_every_method(path, method):
+    problem = load_mechanism(path).problem()
+    result = solve_system(problem, method=method, tol=1e-10, max_iter=100)
+    assert result.converged, result.message
+    assert max(abs(v) for v in problem.F(list(result.x))) < 1e-8
+
+
+@pytest.mark.parametrize("path", sorted(SAMPLES.glob("*.toml")), ids=lambda p: p.name)
+@settings(max_examples=40, deadline=None)
+@given(data=st.data())
+def test_analytic_jacobian_matches_central_differences(path, data):
+    problem = load_mechanism(path).problem()
+    q = [data.draw(st.floats(-math.pi, math.pi)) if k == "angle" else data.draw(st.floats(-500, 500))
+         for k in problem.kinds]
+    analytic = problem.J(q)
+    for j in range(problem.n):
+        h = 1e-6 * max(1.0, abs(q[j]))
+        up, down = list(q), list(q)
+        up[j] += h
+        down[j] -= h
+        fu, fd = problem.F(up), problem.F(down)
+        for i in range(problem.n):
+            central = (fu[i] - fd[i]) / (2 * h)
+            scale = max(1.0, max(abs(v) for row in analytic for v in row))
+            assert analytic[i][j] == pytest.approx(central, abs=1e-6 * scale)
+
+
+def fourbar_doc(r1, r2, r3, r4, theta2, g3, g4):
+    return {
+        "name": "random four-bar", "length_unit": "mm", "closed_form": "fourbar",
+        "parameters": {k: {"value": v, "unit": "mm"} for k, v in
+                       (("r1", r1), ("r2", r2), ("r3", r3), ("r4", r4))} | {
+                           "theta1": {"value": 0, "unit": "deg"}},
+        "driver": {"name": "theta2", "value": theta2, "unit": "deg"},
+        "unknowns": {"theta3": {"guess": g3, "unit": "deg"}, "theta4": {"guess": g4, "unit": "deg"}},
+        "loops": [{"name": "L", "vectors": [
+            {"length": "r2", "angle": "theta2"}, {"length": "r3", "angle": "theta3"},
+            {"length": "r4", "angle": "theta4", "sign": -1},
+            {"length": "r1", "angle": "theta1", "sign": -1}]}],
+    }
+
+
+links = st.floats(0.2, 5.0)
+
+
+@settings(max_examples=120, deadline=None)
+@given(links, links, links, links, st.floats(-180, 180), st.sampled_from(["open", "crossed"]),
+       st.floats(-3, 3), st.floats(-3, 3))
+def test_newton_finds_the_closed_form_on_both_branches(r1, r2, r3, r4, theta2, branch, n3, n4):
+    try:
+        sols = fourbar_positions(r1, r2, r3, r4, 0.0, theta2=math.radians(theta2))
+    except Indeterminate:
+        return
+    if branch not in sols:
+        return
+    exact = sols[branch]
+    if abs(math.sin(exact["theta4"] - exact["theta3"])) < 0.05:
+        return  # near a toggle position: the closed form itself is ill-conditioned there
+    g3 = math.degrees(exact["theta3"]) + n3
+    g4 = math.degrees(exact["theta4"]) + n4
+    problem = parse_mechanism(fourbar_doc(r1, r2, r3, r4, theta2, g3, g4)).problem()
+    result = solve_system(problem, tol=1e-12, max_iter=60)
+    assert result.converged, result.message
+    t3, t4 = result.x
+    assert abs(math.remainder(t3 - exact["theta3"], 2 * math.pi)) < 1e-9
+    assert abs(math.remainder(t4 - exact["theta4"], 2 * math.pi)) < 1e-9
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.floats(0.5, 3), st.floats(3.5, 8), st.floats(-0.4, 0.4), st.floats(-180, 180),
+       st.sampled_from(["open", "crossed"]))
+def test_slider_crank_matches_its_closed_form(r2, r3, e, theta2, branch):
+    exact = slider_crank_positions(r2, r3, e, math.radians(theta2))[branch]
+    mech = load_mechanism(SAMPLES / "slider_crank.toml").with_values(
+        {"r2": r2, "r3": r3, "e": e, "theta2": theta2},
+        {"theta3": math.degrees(exact["theta3"]) + 2.0, "s": exact["s"] + 0.1})
+    result = solve_system(mech.problem(), tol=1e-12)
+    assert result.converged
+    assert abs(math.remainder(result.x[0] - exact["theta3"], 2 * math.pi)) < 1e-9
+    assert result.x[1] == pytest.approx(exact["s"], abs=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(links, links, links, links, st.floats(-180, 180))
+def test_lm_never_claims_success_above_tolerance(r1, r2, r3, r4, theta2):
+    problem = parse_mechanism(fourbar_doc(r1, r2, r3, r4, theta2, 10.0, 80.0)).problem()
+    result = solve_system(problem, method="lm", tol=1e-9, max_iter=200)
+    if result.converged:
+        assert max(abs(v) for v in problem.F(list(result.x))) <= 1e-9
+    try:
+        sols = fourbar_positions(r1, r2, r3, r4, 0.0, theta2=math.radians(theta2))
+    except Indeterminate:
+        return
+    if sols == {}:
+        assert not result.converged and result.status is Status.NO_SOLUTION
+
+
+def test_a_change_point_is_indeterminate_not_unassemblable():
+    """Regression: r1 = r2 = r3 = r4 at theta2 = 0 puts A on O4, where every theta4
+    works; the closed form once called that 'cannot be assembled' while LM solved it."""
+    with pytest.raises(Indeterminate):
+        fourbar_positions(1.0, 1.0, 1.0, 1.0, 0.0, theta2=0.0)
+    problem = parse_mechanism(fourbar_doc(1, 1, 1, 1, 0.0, 10.0, 80.0)).problem()
+    result = solve_system(problem, method="lm", tol=1e-9)
+    assert result.converged and problem.reference() is None
+
+
+def test_non_assemblable_input_is_no_solution_with_rows(cli):
+    run = cli("solve", ME581, "--set", "theta2=180", "--format", "json")
+    assert run.code == 1
+    doc = json.loads(run.out)
+    assert doc["status"] == "no_solution" and "cannot be assembled at theta2 = 180" in doc["message"]
+    assert len(doc["iterations"]) > 0
+    lm = json.loads(cli("solve", ME581, "--set", "theta2=180", "--method", "lm", "--format", "json").out)
+    assert lm["status"] == "no_solution" and lm["converged"] is False
+
+
+def test_singular_start_is_a_named_stop(cli):
+    run = cli("solve", ME581, "--guess", "theta3=30", "--guess", "theta4=30", "--format", "json")
+    assert run.code == 1
+    doc = json.loads(run.out)
+    assert doc["status"] == "singular_jacobian"
+    assert "det J = " in doc["message"] and "cond J = " in doc["message"]
+    assert len(doc["iterations"]) == 1
+
+
+MALFORMED = {
+    "unknown unit": ('r1 = { value = 1, unit = "in" }', "parameters.r1.unit"),
+    "unknown name in a loop": ('r1 = { value = 1, unit = "cm" }', "loops[0].vectors[3].length"),
+    "missing guess": ("", "unknowns.theta4"),
+    "bad sign": ("", "loops[0].vectors[0].sign"),
+    "negative length": ('r1 = { value = -1, unit = "cm" }', "parameters.r1.value"),
+    "unknown top-level key": ("", "colour"),
+}
+
+
+def malformed_text(case: str) -> str:
+    text = Path(ME581).read_text()
+    if case == "unknown unit":
+        return text.replace('r1 = { value = 90, unit = "cm" }', 'r1 = { value = 90, unit = "in" }')
+    if case == "unknown name in a loop":
+        return text.replace('{ length = "r1", angle = "theta1", sign = -1 }',
+                            '{ length = "r9", angle = "theta1", sign = -1 }')
+    if case == "missing guess":
+        return text.replace('theta4 = { guess = 90, unit = "deg" }', 'theta4 = { unit = "deg" }')
+    if case == "bad sign":
+        return text.replace('{ length = "r2", angle = "theta2" }',
+                            '{ length = "r2", angle = "theta2", sign = 2 }')
+    if case == "negative length":
+        return text.replace('r1 = { value = 90, unit = "cm" }', 'r1 = { value = -90, unit = "cm" }')
+    return 'colour = "red"\n' + text
+
+
+@pytest.mark.parametrize("case", list(MALFORMED))
+def test_malformed_files_exit_2_naming_the_key(cli, tmp_path, case):
+    path = tmp_path / "bad.toml"
+    path.write_text(malformed_text(case))
+    run = cli("solve", str(path))
+    assert run.code == 2
+    assert len(run.err.strip().splitlines()) == 1
+    assert MALFORMED[case][1] in run.err and str(path) in run.err
+
+
+def test_invalid_toml_names_the_line(cli, tmp_path):
+    path = tmp_path / "broken.toml"
+    path.write_text('name = "x"\n[[loops]\n')
+    run = cli("solve", str(path))
+    assert run.code == 2 and "line 2" in run.err
+
+
+def test_equation_count_must_match_unknowns(tmp_path, cli):
+    extra = 'theta4 = { guess = 90, unit = "deg" }\nr5 = { guess = 1, unit = "cm" }'
+    text = Path(ME581).read_text().replace('theta4 = { guess = 90, unit = "deg" }', extra)
+    path = tmp_path / "count.toml"
+    path.write_text(text)
+    run = cli("solve", str(path))
+    assert run.code == 2 and "2 equations but there are 3 unknowns" in run.err
+
+
+def test_csv_for_a_mechanism_has_units_in_every_header(cli):
+    run = cli("solve", ME581, "--format", "csv")
+    header = run.out.splitlines()[0].split(",")
+    assert all("(" in h for h in header if h not in ("k", "cond J")), header
