@@ -328,6 +328,102 @@ def _time_solve(problem: Any, kwargs: dict[str, Any]) -> float:
     return times[len(times) // 2]
 
 
+# --- sweep ----------------------------------------------------------------------------------
+
+@app.command(
+    epilog="Examples:  linkage sweep sample_inputs/fourbar_me581.toml --from 0 --to 359 --step 1  |  "
+    "linkage sweep sample_inputs/crank_rocker.toml --branch crossed --format csv -o cycle.csv",
+)
+def sweep(
+    file: Annotated[Path, typer.Argument(help="A mechanism file (TOML, see sample_inputs/).",
+                                         show_default=False)],
+    *,
+    start: Annotated[float, typer.Option("--from", help="First driver value (driver's unit).")] = 0.0,
+    stop: Annotated[float, typer.Option("--to", help="Last driver value.")] = 360.0,
+    step: Annotated[Optional[float], typer.Option(help="Driver increment (default 1).")] = None,
+    points: Annotated[Optional[int], typer.Option(help="Number of evenly spaced positions "
+                      "instead of --step.")] = None,
+    method: Annotated[str, typer.Option("--method", "-m", help="newton, newton-fd or lm.")] = "newton",
+    branch: Annotated[Optional[str], typer.Option(help="Assembly branch to follow: open or "
+                      "crossed (mechanisms with a closed form); default: the branch of the "
+                      "file's guess.")] = None,
+    set_: Annotated[Optional[list[str]], typer.Option("--set", help="Override a parameter, "
+                    "name=value in the file's units (repeatable).")] = None,
+    tol: Annotated[float, typer.Option(help="Step and residual tolerance per position.")] = 1e-12,
+    fmt: FormatOpt = None,
+    output: OutputOpt = None,
+    digits: DigitsOpt = 10,
+) -> None:
+    """Solve a mechanism over a range of its driver, each position from the previous one.
+
+    Reports every position (solved, or no_solution where the linkage cannot be assembled),
+    the branch, det J, the feasible ranges and the limit/toggle positions.
+
+    Example: linkage sweep sample_inputs/rapier_drive.toml --step 5
+    """
+    from .analysis.sweep import driver_values
+    from .analysis.sweep import sweep as run_sweep
+    from .problems.loops import load
+    from .render.sweep import sweep_blocks, sweep_dict, sweep_headers, sweep_rows
+    from .solve import SYSTEM_METHODS, check_criteria, check_number
+
+    out_fmt = choose_format(fmt, output)
+    check_criteria(tol, 0.0, None, 50)
+    a = check_number("--from", start)
+    b = check_number("--to", stop)
+    if step is not None and points is not None:
+        raise InputError("give --step or --points, not both")
+    if points is not None and points < 1:
+        raise InputError(f"--points must be >= 1, got {points}")
+    if step is not None and not check_number("--step", step) > 0:
+        raise InputError(f"--step must be > 0, got {step!r}")
+    if b < a:
+        raise InputError(f"--to ({b:g}) must not be below --from ({a:g})")
+    if points is None and step is None:
+        step = 1.0
+    if points is None and (b - a) / step > 10_000_000:  # type: ignore[operator]
+        raise InputError("that is more than ten million positions; use a larger --step")
+    if method not in SYSTEM_METHODS:
+        raise InputError(f"unknown method {method!r}; choose from {', '.join(SYSTEM_METHODS)}")
+    mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
+    if branch is not None:
+        if branch not in ("open", "crossed"):
+            raise InputError(f"--branch must be open or crossed, got {branch!r}")
+        if mechanism.closed_form is None:
+            raise InputError(f"--branch needs a mechanism with a closed form; {file} has none "
+                             "(its branch follows the file's guess)")
+    values = driver_values(a, b, step, points)
+    with _progress(len(values)) as advance:
+        result = run_sweep(mechanism, values, method=method, branch=branch, tol=tol,
+                           progress=advance)
+    emit(out_fmt, output, blocks=sweep_blocks(result, digits), json_obj=sweep_dict(result),
+         csv_table=(sweep_headers(result), sweep_rows(result)))
+    if result.summary.get("failed"):
+        raise typer.Exit(1)
+
+
+class _progress:
+    """A rich progress bar on a terminal for long runs; nothing when piped."""
+
+    def __init__(self, total: int) -> None:
+        self.total = total
+        self.bar: Any = None
+
+    def __enter__(self) -> Any:
+        if self.total < 2000 or not sys.stderr.isatty():
+            return None
+        from rich.progress import Progress
+
+        self.bar = Progress(transient=True)
+        self.bar.start()
+        task = self.bar.add_task("solving", total=self.total)
+        return lambda done: self.bar.update(task, completed=done)
+
+    def __exit__(self, *exc: object) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+
+
 # --- entry point ----------------------------------------------------------------------------
 
 def run_cli(argv: list[str] | None = None) -> int:

@@ -122,3 +122,117 @@ def wrap_degrees(a: float) -> float:
     elif w > 180.0:
         w -= 360.0
     return w
+
+
+def branch_rule(m: Any) -> Callable[[dict[str, float]], str]:
+    """The branch label of a solution given in display units (degrees)."""
+    values = {k: q.value for k, q in m.parameters.items()}
+
+    if m.closed_form == "fourbar":
+        def fourbar(sol: dict[str, float]) -> str:
+            t3 = math.radians(sol["theta3"]) if "theta3" in sol else values["theta3"]
+            t4 = math.radians(sol["theta4"]) if "theta4" in sol else (
+                m.driver.value if m.driver.name == "theta4" else values["theta4"])
+            return _fourbar_branch(t3, t4)
+        return fourbar
+
+    def slider(sol: dict[str, float]) -> str:
+        return "open" if math.cos(math.radians(sol["theta3"])) > 0.0 else "crossed"
+    return slider
+
+
+# --- assembly: classification and feasible driver ranges ---------------------------------
+
+def fourbar_class(r1: float, r2: float, r3: float, r4: float) -> dict[str, Any]:
+    """Grashof classification with r1 ground, r2 input, r3 coupler, r4 output (Norton 2.8)."""
+    links = {"ground": r1, "input": r2, "coupler": r3, "output": r4}
+    s_name = min(links, key=links.__getitem__)
+    s, longest = min(links.values()), max(links.values())
+    others = sorted(links.values())[1:3]
+    p_q = sum(others)
+    total = s + longest
+    if math.isclose(total, p_q, rel_tol=1e-12):
+        return {"grashof": True, "type": "change point", "s_plus_l": total, "p_plus_q": p_q}
+    if total > p_q:
+        return {"grashof": False, "type": "non-Grashof triple rocker", "s_plus_l": total, "p_plus_q": p_q}
+    kind = {"ground": "double crank", "input": "crank-rocker", "coupler": "double rocker",
+            "output": "rocker-crank"}[s_name]
+    return {"grashof": True, "type": f"Grashof {kind}", "shortest": s_name, "s_plus_l": total,
+            "p_plus_q": p_q}
+
+
+Arc = tuple[float, float]
+
+
+def cos_band_arcs(c_lo: float, c_hi: float, shift: float) -> list[Arc] | None:
+    """Angles phi (deg, as phi + shift) with c_lo <= cos(phi) <= c_hi: arcs, [] if none,
+    None for the whole circle."""
+    if c_lo > c_hi or c_hi < -1.0 or c_lo > 1.0:
+        return []
+    if c_lo <= -1.0 and c_hi >= 1.0:
+        return None
+    a_hi = math.degrees(math.acos(min(c_hi, 1.0)))  # smallest |phi|
+    a_lo = math.degrees(math.acos(max(c_lo, -1.0)))  # largest |phi|
+    if c_hi >= 1.0:
+        return [(shift - a_lo, shift + a_lo)]
+    if c_lo <= -1.0:
+        return [(shift + a_hi, shift + 360.0 - a_hi)]
+    return [(shift - a_lo, shift - a_hi), (shift + a_hi, shift + a_lo)]
+
+
+def feasible_arcs(m: Any) -> list[Arc] | None:
+    """Driver values (deg) where the mechanism can be assembled, from its closed form.
+
+    Four-bar driven by theta2: |A - O4|^2 = r1^2 + r2^2 - 2 r1 r2 cos(theta2 - theta1)
+    must lie in [(r3 - r4)^2, (r3 + r4)^2]; driven by theta4, the same with r2 and r4
+    exchanged and the sign of the cosine flipped. Slider-crank:
+    |e - r2 sin(theta2)| <= r3. None: the whole circle.
+    """
+    v = {k: q.value for k, q in m.parameters.items()}
+    drv = m.driver.name
+    if m.closed_form == "fourbar":
+        r1, r2, r3, r4, t1 = v["r1"], v["r2"], v["r3"], v["r4"], math.degrees(v["theta1"])
+        if drv == "theta2":
+            lo, hi = (r3 - r4) ** 2, (r3 + r4) ** 2
+            # cos(phi) = (r1^2 + r2^2 - d^2) / (2 r1 r2): decreasing in d
+            return cos_band_arcs((r1 * r1 + r2 * r2 - hi) / (2 * r1 * r2),
+                                 (r1 * r1 + r2 * r2 - lo) / (2 * r1 * r2), t1)
+        if drv == "theta4":
+            lo, hi = (r2 - r3) ** 2, (r2 + r3) ** 2
+            return cos_band_arcs((lo - r1 * r1 - r4 * r4) / (2 * r1 * r4),
+                                 (hi - r1 * r1 - r4 * r4) / (2 * r1 * r4), t1)
+        return None
+    if m.closed_form == "slider_crank" and drv == "theta2":
+        r2, r3, e = v["r2"], v["r3"], v["e"]
+        # sin(theta2) = cos(theta2 - 90) in [(e - r3)/r2, (e + r3)/r2]
+        return cos_band_arcs((e - r3) / r2, (e + r3) / r2, 90.0)
+    return None
+
+
+def arcs_within(arcs: list[Arc] | None, lo: float, hi: float) -> list[Arc]:
+    """Intersect circle arcs (deg) with the interval [lo, hi], unwrapping by 360s."""
+    if arcs is None:
+        return [(lo, hi)]
+    out: list[Arc] = []
+    for a, b in arcs:
+        k = math.floor((lo - b) / 360.0)
+        while a + 360.0 * k <= hi:
+            s, t = max(a + 360.0 * k, lo), min(b + 360.0 * k, hi)
+            if s <= t:
+                out.append((s, t))
+            k += 1
+    return sorted(out)
+
+
+def arc_limits(arcs: list[Arc] | None, lo: float, hi: float) -> list[float]:
+    """Ends of the feasible arcs (limit positions) that fall inside [lo, hi]."""
+    if not arcs:
+        return []
+    out = []
+    for a, b in arcs:
+        for end in (a, b):
+            k = math.ceil((lo - end) / 360.0)
+            while end + 360.0 * k <= hi:
+                out.append(end + 360.0 * k)
+                k += 1
+    return sorted(set(out))

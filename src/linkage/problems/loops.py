@@ -286,82 +286,132 @@ def _ref(value: Any, key: str, kind: str, known: Mapping[str, Quantity], fail: A
 
 # --- equations ----------------------------------------------------------------------------
 
-def build_problem(m: Mechanism) -> SystemProblem:
-    """Compile the loops into Phi(q) and its exact Jacobian, constants resolved once."""
-    index = {u.name: i for i, u in enumerate(m.unknowns)}
-    fixed = {**{k: q.value for k, q in m.parameters.items()}, m.driver.name: m.driver.value}
-    n = len(m.unknowns)
-    # Each term: (sign, length constant or None, length index, angle constant or None,
-    # angle index, offset). Index -1 means "fixed".
-    compiled: list[list[tuple[float, float, int, float, int, float]]] = []
-    for loop in m.loops:
-        terms = []
-        for t in loop.vectors:
-            if isinstance(t.length, str) and t.length in index:
-                lc, li = 0.0, index[t.length]
-            else:
-                lc, li = (fixed[t.length] if isinstance(t.length, str) else t.length), -1
-            if isinstance(t.angle, str) and t.angle in index:
-                ac, ai = 0.0, index[t.angle]
-            else:
-                ac, ai = (fixed[t.angle] if isinstance(t.angle, str) else t.angle), -1
-            terms.append((t.sign, lc, li, ac, ai, t.offset))
-        compiled.append(terms)
-    cos, sin = math.cos, math.sin
+DRIVER = -2
+"""Index marking a term that refers to the driver (``-1``: a fixed value)."""
 
-    def F(q: Any) -> list[float]:
+
+@dataclass(frozen=True)
+class LoopModel:
+    """The loops compiled once: each term is (sign, length constant, length index, angle
+    constant, angle index, offset); an index >= 0 is an unknown, DRIVER the driver."""
+
+    mechanism: Mechanism
+    terms: tuple[tuple[tuple[float, float, int, float, int, float], ...], ...]
+    n: int
+
+    @classmethod
+    def compile(cls, m: Mechanism) -> LoopModel:
+        index = {u.name: i for i, u in enumerate(m.unknowns)}
+        fixed = {k: q.value for k, q in m.parameters.items()}
+
+        def resolve(ref: str | float) -> tuple[float, int]:
+            if isinstance(ref, str):
+                if ref in index:
+                    return 0.0, index[ref]
+                if ref == m.driver.name:
+                    return 0.0, DRIVER
+                return fixed[ref], -1
+            return ref, -1
+
+        loops = []
+        for loop in m.loops:
+            terms = []
+            for t in loop.vectors:
+                lc, li = resolve(t.length)
+                ac, ai = resolve(t.angle)
+                terms.append((t.sign, lc, li, ac, ai, t.offset))
+            loops.append(tuple(terms))
+        return cls(m, tuple(loops), len(m.unknowns))
+
+    def functions(self, driver: float) -> tuple[Any, Any]:
+        """Phi(q) and J(q) at one driver value (internal units)."""
+        n = self.n
+        # Resolve the driver into constants once, so the closures see only fixed terms.
+        loops = [[(s, driver if li == DRIVER else lc, -1 if li == DRIVER else li,
+                   driver if ai == DRIVER else ac, -1 if ai == DRIVER else ai, off)
+                  for s, lc, li, ac, ai, off in terms] for terms in self.terms]
+        cos, sin = math.cos, math.sin
+
+        def F(q: Any) -> list[float]:
+            out = []
+            for terms in loops:
+                x = y = 0.0
+                for sign, lc, li, ac, ai, off in terms:
+                    r = q[li] if li >= 0 else lc
+                    th = (q[ai] if ai >= 0 else ac) + off
+                    x += sign * r * cos(th)
+                    y += sign * r * sin(th)
+                out.append(x)
+                out.append(y)
+            return out
+
+        def J(q: Any) -> list[list[float]]:
+            rows = []
+            for terms in loops:
+                jx = [0.0] * n
+                jy = [0.0] * n
+                for sign, lc, li, ac, ai, off in terms:
+                    r = q[li] if li >= 0 else lc
+                    th = (q[ai] if ai >= 0 else ac) + off
+                    c, s = cos(th), sin(th)
+                    if ai >= 0:
+                        jx[ai] -= sign * r * s
+                        jy[ai] += sign * r * c
+                    if li >= 0:
+                        jx[li] += sign * c
+                        jy[li] += sign * s
+                rows.append(jx)
+                rows.append(jy)
+            return rows
+
+        return F, J
+
+    def points(self, q: Any, driver: float) -> list[list[complex]]:
+        """Cumulative vector sums along each loop from the origin: the joints to draw."""
         out = []
-        for terms in compiled:
-            x = y = 0.0
+        for terms in self.terms:
+            p = 0j
+            pts = [p]
             for sign, lc, li, ac, ai, off in terms:
-                r = q[li] if li >= 0 else lc
-                th = (q[ai] if ai >= 0 else ac) + off
-                x += sign * r * cos(th)
-                y += sign * r * sin(th)
-            out.append(x)
-            out.append(y)
+                r = q[li] if li >= 0 else (driver if li == DRIVER else lc)
+                th = (q[ai] if ai >= 0 else (driver if ai == DRIVER else ac)) + off
+                p += sign * r * complex(math.cos(th), math.sin(th))
+                pts.append(p)
+            out.append(pts)
         return out
 
-    def J(q: Any) -> list[list[float]]:
-        rows = []
-        for terms in compiled:
-            jx = [0.0] * n
-            jy = [0.0] * n
-            for sign, lc, li, ac, ai, off in terms:
-                r = q[li] if li >= 0 else lc
-                th = (q[ai] if ai >= 0 else ac) + off
-                c, s = cos(th), sin(th)
-                if ai >= 0:
-                    jx[ai] -= sign * r * s
-                    jy[ai] += sign * r * c
-                if li >= 0:
-                    jx[li] += sign * c
-                    jy[li] += sign * s
-            rows.append(jx)
-            rows.append(jy)
-        return rows
+    def problem_at(self, driver: float, x0: tuple[float, ...] | None = None) -> SystemProblem:
+        m = self.mechanism
+        F, J = self.functions(driver)
+        eq_names = []
+        for loop in m.loops:
+            eq_names += [f"{loop.name}.x", f"{loop.name}.y"]
+        shown = driver / ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else driver
+        reference = branch_of = None
+        if m.closed_form is not None:
+            from .closed_form import branch_rule, reference_for
 
-    eq_names = []
-    for loop in m.loops:
-        eq_names += [f"{loop.name}.x", f"{loop.name}.y"]
-    reference = None
-    if m.closed_form is not None:
-        from .closed_form import reference_for
+            mm = m.with_values({m.driver.name: shown}, {})
+            reference = reference_for(mm)
+            branch_of = branch_rule(m)
+        return SystemProblem(
+            F=F, J=J,
+            names=tuple(u.name for u in m.unknowns),
+            kinds=tuple(u.kind for u in m.unknowns),
+            length_unit=m.length_unit,
+            equation_names=tuple(eq_names),
+            x0=x0 if x0 is not None else tuple(u.value for u in m.unknowns),
+            title=f"{m.name}: {m.driver.name} = {shown:g} {m.driver.unit}",
+            reference=reference,
+            branch_of=branch_of,
+            meta={"driver": m.driver.name, "driver_value": shown, "driver_unit": m.driver.unit,
+                  "source": m.source},
+        )
 
-        reference = reference_for(m)
-    driver_text = f"{m.driver.name} = {_display(m.driver):g} {m.driver.unit}"
-    return SystemProblem(
-        F=F, J=J,
-        names=tuple(u.name for u in m.unknowns),
-        kinds=tuple(u.kind for u in m.unknowns),
-        length_unit=m.length_unit,
-        equation_names=tuple(eq_names),
-        x0=tuple(u.value for u in m.unknowns),
-        title=f"{m.name}: {driver_text}",
-        reference=reference,
-        meta={"driver": m.driver.name, "driver_value": _display(m.driver),
-              "driver_unit": m.driver.unit, "source": m.source},
-    )
+
+def build_problem(m: Mechanism) -> SystemProblem:
+    """Phi(q) and its exact Jacobian at the mechanism's own driver value."""
+    return LoopModel.compile(m).problem_at(m.driver.value)
 
 
 def _display(q: Quantity) -> float:

@@ -30,6 +30,8 @@ class SystemProblem:
     x0: tuple[float, ...] | None = None
     title: str = ""
     reference: Callable[[], dict[str, dict[str, float]] | None] | None = None
+    branch_of: Callable[[dict[str, float]], str] | None = None
+    """Names the assembly branch of a solution (display units); None: use the sign of det J."""
     meta: dict[str, Any] = field(default_factory=dict)
 
     @property

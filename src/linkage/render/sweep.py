@@ -1,0 +1,90 @@
+"""Report blocks, CSV and JSON for sweeps."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..analysis.sweep import SweepResult
+from .report import Block, Text, fmt, table
+
+
+def sweep_headers(s: SweepResult) -> list[str]:
+    u = s.driver_unit
+    headers = [f"{s.driver} ({u})", "status"]
+    headers += [f"{n} ({unit})" for n, unit in zip(s.names, s.units)]
+    headers += ["branch", "iterations", "det J"]
+    if s.classification:
+        headers.append("transmission angle (deg)")
+    return headers
+
+
+def sweep_rows(s: SweepResult) -> list[tuple[Any, ...]]:
+    rows = []
+    for p in s.positions:
+        sol = p.solution or {}
+        row: list[Any] = [p.input, p.status, *[sol.get(n) for n in s.names], p.branch, p.iterations, p.det]
+        if s.classification:
+            row.append(p.transmission)
+        rows.append(tuple(row))
+    return rows
+
+
+def ranges_of(s: SweepResult) -> dict[str, dict[str, float]]:
+    """Per unknown: min and max over solved positions, where they occur, and the stroke."""
+    out = {}
+    for name in s.names:
+        pts = [(p.solution[name], p.input) for p in s.positions if p.solution]
+        if not pts:
+            continue
+        lo, hi = min(pts), max(pts)
+        out[name] = {"min": lo[0], "at_min": lo[1], "max": hi[0], "at_max": hi[1], "stroke": hi[0] - lo[0]}
+    return out
+
+
+def sweep_dict(s: SweepResult) -> dict[str, Any]:
+    return {
+        "mechanism": s.mechanism,
+        "driver": {"name": s.driver, "unit": s.driver_unit},
+        "method": s.method,
+        "branch": s.branch,
+        "classification": s.classification or None,
+        "units": dict(zip(s.names, s.units)),
+        "positions": [
+            {"input": p.input, "status": p.status, "solution": p.solution, "branch": p.branch,
+             "iterations": p.iterations, "det": p.det, "transmission": p.transmission,
+             **({"note": p.note} if p.note else {})}
+            for p in s.positions
+        ],
+        "feasible_ranges": [list(r) for r in s.feasible_ranges],
+        "toggles": list(s.toggles),
+        "ranges": ranges_of(s),
+        "summary": s.summary,
+    }
+
+
+def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400) -> list[Block]:
+    u = s.driver_unit
+    blocks: list[Block] = [Text(f"{s.mechanism}: sweep of {s.driver} over {len(s.positions)} positions "
+                                f"({s.method}, continuation)", "bold")]
+    if s.classification:
+        c = s.classification
+        blocks.append(Text(f"four-bar: {c['type']} (s + l = {fmt(c['s_plus_l'], 6)}, "
+                           f"p + q = {fmt(c['p_plus_q'], 6)})"))
+    rows = sweep_rows(s)
+    shown = rows if len(rows) <= max_rows else rows[:: max(1, len(rows) // max_rows)]
+    note = [] if shown is rows else [f"(every {len(rows) // len(shown)}th of {len(rows)} rows shown; "
+                                     "--format csv or json gives all)"]
+    blocks.append(Text(""))
+    blocks.append(table("", sweep_headers(s), shown, digits, notes=note))
+    counts = ", ".join(f"{k}: {v}" for k, v in sorted(s.summary.items()))
+    blocks.append(Text(f"positions: {counts}; branch: {s.branch}", "bold"))
+    blocks.append(Text("feasible ranges: " + (", ".join(f"[{fmt(a, 12)}, {fmt(b, 12)}] {u}"
+                                                        for a, b in s.feasible_ranges) or "none")))
+    blocks.append(Text("limit and toggle positions: " + (", ".join(f"{fmt(t, 13)} {u}" for t in s.toggles)
+                                                         or "none")))
+    for name, r in ranges_of(s).items():
+        unit = dict(zip(s.names, s.units))[name]
+        blocks.append(Text(f"{name}: min {fmt(r['min'], 10)} {unit} at {s.driver} = {fmt(r['at_min'], 8)}, "
+                           f"max {fmt(r['max'], 10)} {unit} at {fmt(r['at_max'], 8)}, "
+                           f"range {fmt(r['stroke'], 10)} {unit}"))
+    return blocks

@@ -1,0 +1,138 @@
+"""Whole-cycle sweeps: continuation, branches, no-solution gaps, limit positions."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from linkage import load_mechanism
+from linkage.analysis.sweep import driver_values, sweep
+from linkage.problems.closed_form import fourbar_positions, wrap_degrees
+
+SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
+ME581 = str(SAMPLES / "fourbar_me581.toml")
+
+
+def test_me581_full_turn_matches_the_issue(cli):
+    run = cli("sweep", ME581, "--from", "0", "--to", "359", "--step", "1", "--format", "json")
+    assert run.code == 0, run.err
+    doc = json.loads(run.out)
+    assert doc["classification"]["grashof"] is False
+    assert doc["summary"] == {"converged": 225, "no_solution": 135}
+    limit = math.degrees(math.acos(-0.375))  # |A - O4| = r3 + r4: cos(theta2) = -3/8
+    assert limit == pytest.approx(112.02, abs=5e-3)
+    assert doc["feasible_ranges"] == [[0, pytest.approx(limit, abs=1e-12)],
+                                      [pytest.approx(360 - limit, abs=1e-12), 359]]
+    assert len(doc["toggles"]) == 2
+    assert abs(doc["toggles"][0] - limit) < 1e-9 and abs(doc["toggles"][1] - (360 - limit)) < 1e-9
+    worst = 0.0
+    for p in doc["positions"]:
+        inside = p["input"] <= limit or p["input"] >= 360 - limit
+        if not inside:
+            assert p["status"] == "no_solution" and p["solution"] is None and p["branch"] is None
+            continue
+        assert p["status"] == "converged" and p["branch"] == "open"
+        exact = fourbar_positions(90, 30, 60, 45, 0, theta2=math.radians(p["input"]))["open"]
+        for name in ("theta3", "theta4"):
+            worst = max(worst, abs(wrap_degrees(p["solution"][name] - math.degrees(exact[name]))))
+        assert math.sin(math.radians(p["solution"]["theta4"] - p["solution"]["theta3"])) > 0
+    assert worst < 1e-10
+
+
+@pytest.mark.parametrize("branch", [None, "crossed"])
+def test_crank_rocker_turns_fully_on_one_branch(cli, branch):
+    args = ["sweep", str(SAMPLES / "crank_rocker.toml"), "--from", "0", "--to", "360", "--format", "json"]
+    if branch:
+        args += ["--branch", branch]
+    doc = json.loads(cli(*args).out)
+    assert doc["summary"] == {"converged": 361}
+    assert {p["branch"] for p in doc["positions"]} == {branch or "open"}
+    assert doc["toggles"] == []
+    assert doc["classification"]["type"] == "Grashof crank-rocker"
+    for p in doc["positions"]:
+        exact = fourbar_positions(100, 40, 120, 80, 0, theta2=math.radians(p["input"]))[branch or "open"]
+        assert abs(wrap_degrees(p["solution"]["theta3"] - math.degrees(exact["theta3"]))) < 1e-10
+
+
+def test_rapier_drive_sweeps_a_full_turn_and_reports_the_stroke(cli):
+    run = cli("sweep", str(SAMPLES / "rapier_drive.toml"), "--step", "0.5", "--format", "json")
+    doc = json.loads(run.out)
+    assert doc["summary"] == {"converged": 721}
+    s16 = doc["ranges"]["s16"]
+    # P5: "between about -304.2 and 54.7 mm" (four significant digits)
+    assert s16["min"] == pytest.approx(-304.2, abs=0.1) and s16["max"] == pytest.approx(54.7, abs=0.1)
+    assert s16["stroke"] == pytest.approx(s16["max"] - s16["min"])
+    # every solved position closes both loops
+    m = load_mechanism(SAMPLES / "rapier_drive.toml")
+    for p in doc["positions"][::40]:
+        problem = m.with_values({"theta12": p["input"]}, {}).problem()
+        q = problem.from_display([p["solution"][n] for n in problem.names])
+        assert max(abs(v) for v in problem.F(q)) < 1e-9
+    table = cli("sweep", str(SAMPLES / "rapier_drive.toml"), "--step", "5").out
+    assert "s16: min" in table and "range" in table
+
+
+def test_a_large_step_does_not_jump_branches():
+    """Seed 001: too large a step can land on the other branch; the sweep halves it."""
+    m = load_mechanism(SAMPLES / "fourbar_me581.toml")
+    coarse = sweep(m, driver_values(-110, 110, 55, None))
+    assert {p.branch for p in coarse.positions} == {"open"}
+    assert all(p.status == "converged" for p in coarse.positions)
+
+
+def test_offset_slider_gap_and_limits_are_found_numerically():
+    """No closed form: limits by bisection on solvability, to 1e-9 deg."""
+    from linkage import solve_system
+
+    m = load_mechanism(SAMPLES / "offset_slider.toml")
+    s = sweep(m, driver_values(0, 360, 2, None))
+    assert s.summary["no_solution"] > 0 and "failed" not in s.summary
+    assert len(s.toggles) == 2
+    lo, hi = s.toggles
+    assert 130 < lo < 134 and 184 < hi < 188
+    for limit, inward in ((lo, -1), (hi, +1)):
+        near = min((p for p in s.positions if p.status == "converged"), key=lambda p: abs(p.input - limit))
+        start = [math.radians(near.solution[n]) if k == "angle" else near.solution[n]
+                 for n, k in zip(("theta14", "theta15", "s4", "s6"), ("angle", "angle", "", ""))]
+        inside = m.with_values({"theta12": limit + inward * 1e-6}, {}).problem()
+        outside = m.with_values({"theta12": limit - inward * 1e-6}, {}).problem()
+        assert solve_system(inside, start, tol=1e-10, max_iter=200).converged
+        floor = solve_system(outside, start, method="lm", tol=1e-10, max_iter=500)
+        assert not floor.converged
+
+
+def test_sweep_csv_has_units_and_one_row_per_position(cli):
+    run = cli("sweep", ME581, "--step", "10", "--format", "csv")
+    rows = list(csv.reader(io.StringIO(run.out)))
+    assert rows[0][:4] == ["theta2 (deg)", "status", "theta3 (deg)", "theta4 (deg)"]
+    assert len(rows) == 1 + 37
+    gap = [r for r in rows[1:] if r[1] == "no_solution"]
+    assert gap and all(r[2] == "" and r[3] == "" for r in gap)
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--step", "0"], "--step must be > 0"),
+    (["--step", "1", "--points", "3"], "not both"),
+    (["--from", "10", "--to", "0"], "must not be below"),
+    (["--branch", "sideways"], "--branch must be open or crossed"),
+    (["--method", "bisection"], "unknown method"),
+    (["--from", "nan"], "--from must be finite"),
+])
+def test_sweep_bad_input(cli, args, message):
+    run = cli("sweep", ME581, *args)
+    assert run.code == 2 and message in run.err and len(run.err.strip().splitlines()) == 1
+
+
+def test_branch_needs_a_closed_form(cli):
+    run = cli("sweep", str(SAMPLES / "rapier_drive.toml"), "--branch", "open")
+    assert run.code == 2 and "closed form" in run.err
+
+
+def test_sweep_help_has_an_example(cli):
+    out = cli("sweep", "--help").out
+    assert "Example" in out and "linkage sweep" in out
