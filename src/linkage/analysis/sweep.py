@@ -14,6 +14,7 @@ the closed form where it gives them exactly.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -266,7 +267,7 @@ def _walk_to(solver: _Solver, m: Mechanism, v: float,
     q = tuple(r.x)
     n = max(1, math.ceil(abs(v - v0) / 2.0))
     for k in range(1, n + 1):
-        p, r = solver.solve(v0 + (v - v0) * k / n, q)
+        _p, r = solver.solve(v0 + (v - v0) * k / n, q)
         if not r.converged:
             return None, None
         q = tuple(r.x)
@@ -308,7 +309,7 @@ def _toggles(solver: _Solver, positions: Sequence[Position], arcs: Any, lo: floa
     found: list[float] = []
     if have_closed:
         found += arc_limits(arcs, lo, hi)
-    pairs = list(zip(positions, positions[1:]))
+    pairs = list(itertools.pairwise(positions))
     for a, b in pairs:
         if a.status == "converged" and b.status == "converged" and a.det and b.det \
                 and (a.det > 0) != (b.det > 0):
@@ -343,7 +344,7 @@ def _bisect_limit(solver: _Solver, a: Position, b: Position) -> float:
     vg, vb = good.input, bad.input
     while abs(vb - vg) > LOCATE_TOL:
         vm = 0.5 * (vg + vb)
-        p, r = solver.solve(vm, q)
+        _p, r = solver.solve(vm, q)
         if r.converged:
             vg, q = vm, tuple(r.x)
         else:
@@ -364,5 +365,5 @@ def driver_values(start: float, stop: float, step: float | None, points: int | N
             return [start]
         return [start + (stop - start) * k / (points - 1) for k in range(points)]
     assert step is not None
-    n = int(math.floor((stop - start) / step + 1e-9))
+    n = math.floor((stop - start) / step + 1e-9)
     return [start + k * step for k in range(n + 1)]
