@@ -261,7 +261,7 @@ def _walk_to(solver: _Solver, m: Mechanism, v: float,
              guess: tuple[float, ...]) -> tuple[tuple[float, ...] | None, float | None]:
     """Solve at the file's own driver value, then continue to v in steps of <= 2 units."""
     v0 = m.driver.value / solver.scale
-    p, r = solver.solve(v0, guess)
+    _p, r = solver.solve(v0, guess)
     if not r.converged:
         return None, None
     q = tuple(r.x)
