@@ -85,25 +85,51 @@ def test_a_large_step_does_not_jump_branches():
     assert all(p.status == "converged" for p in coarse.positions)
 
 
-def test_offset_slider_gap_and_limits_are_found_numerically():
-    """No closed form: limits by bisection on solvability, to 1e-9 deg."""
+def test_offset_slider_fold_gap_and_limits_are_found_numerically():
+    """No closed form. The followed assembly ends at a fold near 28.62 deg (det J -> 0):
+    beyond it another assembly exists but is not connected (off_branch, no numbers,
+    never a silent jump); 132.4..185.75 has no assembly at all (no_solution); the
+    backward pass over the full turn brings the branch back from 360 down to 185.75."""
+    import random
+
     from linkage import solve_system
+    from linkage.methods._linalg import det_from_lu, lu
 
     m = load_mechanism(SAMPLES / "offset_slider.toml")
     s = sweep(m, driver_values(0, 360, 2, None))
-    assert s.summary["no_solution"] > 0 and "failed" not in s.summary
-    assert len(s.toggles) == 2
-    lo, hi = s.toggles
-    assert 130 < lo < 134 and 184 < hi < 188
-    for limit, inward in ((lo, -1), (hi, +1)):
-        near = min((p for p in s.positions if p.status == "converged"), key=lambda p: abs(p.input - limit))
-        start = [math.radians(near.solution[n]) if k == "angle" else near.solution[n]
-                 for n, k in zip(("theta14", "theta15", "s4", "s6"), ("angle", "angle", "", ""))]
-        inside = m.with_values({"theta12": limit + inward * 1e-6}, {}).problem()
-        outside = m.with_values({"theta12": limit - inward * 1e-6}, {}).problem()
-        assert solve_system(inside, start, tol=1e-10, max_iter=200).converged
-        floor = solve_system(outside, start, method="lm", tol=1e-10, max_iter=500)
-        assert not floor.converged
+    assert set(s.summary) == {"converged", "off_branch", "no_solution"}
+    fold, limit = s.toggles
+    assert fold == pytest.approx(28.6228, abs=1e-3) and limit == pytest.approx(185.7509, abs=1e-3)
+    for p in s.positions:
+        expected = ("converged" if p.input < fold or p.input > limit else
+                    "off_branch" if p.input < 132.4 else "no_solution" if p.input > 132.5 else p.status)
+        assert p.status == expected, (p.input, p.status)
+    # both located limits are singular points of the branch: det J -> 0 there
+    for t in (fold, limit):
+        near = min((p for p in s.positions if p.status == "converged"), key=lambda p: abs(p.input - t))
+        q = [math.radians(near.solution[n]) if n.startswith("theta") else near.solution[n]
+             for n in ("theta14", "theta15", "s4", "s6")]
+        inside = t - 1e-5 if near.input < t else t + 1e-5  # |det J| ~ sqrt(distance)
+        for k in range(1, 41):  # walk up to the limit along the branch, ever closer
+            v = inside + (near.input - inside) * (1 - k / 40) ** 3
+            r = solve_system(m.with_values({"theta12": v}, {}).problem(), q, tol=1e-10, max_iter=200)
+            assert r.converged, v
+            q = list(r.x)
+        det = det_from_lu(lu(m.with_values({"theta12": inside}, {}).problem().J(q)))
+        assert abs(det) < 5.0  # against |det J| of about 1000 away from the limits
+    # independent check of the two kinds of gap: multi-start Newton
+    rng = random.Random(7)
+
+    def some_assembly(theta12):
+        problem = m.with_values({"theta12": theta12}, {}).problem()
+        for _ in range(200):
+            g = [rng.uniform(-math.pi, math.pi), rng.uniform(-math.pi, math.pi),
+                 rng.uniform(-200, 200), rng.uniform(-200, 200)]
+            if solve_system(problem, g, tol=1e-10, max_iter=60, record=False).converged:
+                return True
+        return False
+
+    assert some_assembly(80.0) and not some_assembly(160.0)
 
 
 def test_sweep_csv_has_units_and_one_row_per_position(cli):
@@ -136,3 +162,53 @@ def test_branch_needs_a_closed_form(cli):
 def test_sweep_help_has_an_example(cli):
     out = cli("sweep", "--help").out
     assert "Example" in out and "linkage sweep" in out
+
+
+# --- the batch engine ------------------------------------------------------------------
+
+BATCH_CASES = [("crank_rocker", 0, 360), ("fourbar_me581", 0, 359), ("rapier_drive", 0, 360),
+               ("offset_slider", 0, 360), ("slider_crank", 0, 360), ("fourbar_me581_theta4", 100, 260)]
+
+
+@pytest.mark.parametrize("name,lo,hi", BATCH_CASES, ids=[c[0] for c in BATCH_CASES])
+def test_batch_engine_matches_the_one_at_a_time_path(name, lo, hi):
+    import numpy as np
+
+    from linkage.analysis.batch import STATUS_CODES, batch_sweep
+
+    m = load_mechanism(SAMPLES / f"{name}.toml")
+    values = driver_values(lo, hi, None, 1201)
+    one = sweep(m, values)
+    many = batch_sweep(m, values)
+    codes = [STATUS_CODES[p.status] for p in one.positions]
+    assert list(many.status) == codes
+    assert many.branch == one.branch
+    kinds = [u.kind for u in m.unknowns]
+    for i, p in enumerate(one.positions):
+        if p.solution is None:
+            assert np.isnan(many.solution[i]).all()
+            continue
+        for j, (n, k) in enumerate(zip(one.names, kinds)):
+            diff = p.solution[n] - many.solution[i, j]
+            diff = math.radians(diff) if k == "angle" else diff / 1000.0  # rad, or m for mm
+            assert abs(diff) <= 1e-12, (name, p.input, n, diff)
+
+
+def test_large_sweeps_use_the_batch_engine(cli):
+    run = cli("sweep", str(SAMPLES / "crank_rocker.toml"), "--points", "30001", "--format", "json")
+    doc = json.loads(run.out)
+    assert doc["method"] == "newton (batch)" and doc["summary"] == {"converged": 30001}
+    small = json.loads(cli("sweep", str(SAMPLES / "crank_rocker.toml"), "--points", "31", "--batch",
+                           "--format", "json").out)
+    assert small["method"] == "newton (batch)"
+
+
+def test_benchmark_script_runs_on_a_few_positions():
+    import subprocess
+    import sys
+
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "sweep_batch.py"
+    proc = subprocess.run([sys.executable, str(script), "-n", "2000", "--repeats", "1"],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "ratio batch / closed form" in proc.stdout and "all converged: True" in proc.stdout

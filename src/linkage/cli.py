@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import replace
 from fractions import Fraction
 from pathlib import Path
 from typing import Annotated, Any, Optional
@@ -350,6 +351,8 @@ def sweep(
     set_: Annotated[Optional[list[str]], typer.Option("--set", help="Override a parameter, "
                     "name=value in the file's units (repeatable).")] = None,
     tol: Annotated[float, typer.Option(help="Step and residual tolerance per position.")] = 1e-12,
+    batch: Annotated[Optional[bool], typer.Option("--batch/--no-batch", help="Use the numpy "
+                     "batch engine (default: above 20,000 positions; newton only).")] = None,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 10,
@@ -393,9 +396,18 @@ def sweep(
             raise InputError(f"--branch needs a mechanism with a closed form; {file} has none "
                              "(its branch follows the file's guess)")
     values = driver_values(a, b, step, points)
-    with _progress(len(values)) as advance:
-        result = run_sweep(mechanism, values, method=method, branch=branch, tol=tol,
-                           progress=advance)
+    use_batch = batch if batch is not None else (len(values) > 20_000 and method == "newton")
+    if use_batch:
+        if method != "newton":
+            raise InputError("--batch runs Newton-Raphson; drop --method or --batch")
+        from .analysis.batch import batch_sweep
+
+        result = batch_sweep(mechanism, values, branch=branch, tol=tol).to_sweep()
+        result = replace(result, method="newton (batch)")
+    else:
+        with _progress(len(values)) as advance:
+            result = run_sweep(mechanism, values, method=method, branch=branch, tol=tol,
+                               progress=advance)
     emit(out_fmt, output, blocks=sweep_blocks(result, digits), json_obj=sweep_dict(result),
          csv_table=(sweep_headers(result), sweep_rows(result)))
     if result.summary.get("failed"):

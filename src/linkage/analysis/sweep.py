@@ -7,9 +7,14 @@ fails, or lands on another branch, is retried from the last solved position in 2
 there; it is never given numbers. After a gap the sweep re-enters on the branch it
 started on (from the closed form where there is one). Branches: the closed form's
 open/crossed rule for four-bars and slider-cranks, the sign of det J otherwise.
-Limit positions (the feasible range ends) and toggles (det J changes sign between
-solved positions) are located by bisection to 1e-9 of the driver's unit, or taken from
-the closed form where it gives them exactly.
+A followed branch also ends at a fold, where det J goes to zero and the driver cannot
+advance on that assembly; there continuation would jump to another assembly with no
+warning, so each step is checked against the tangent predictor and such positions are
+``off_branch`` (another assembly exists, not connected) rather than silently solved.
+For a full turn, a backward pass from the start covers the end of the cycle.
+Limit positions (where the branch or the feasible range ends) and toggles (det J
+changes sign between solved positions) are located by bisection to 1e-9 of the
+driver's unit, or taken from the closed form where it gives them exactly.
 """
 
 from __future__ import annotations
@@ -37,7 +42,7 @@ LOCATE_TOL = 1e-9  # driver units (deg for angles)
 @dataclass(frozen=True)
 class Position:
     input: float
-    status: str  # "converged", "no_solution" or "failed"
+    status: str  # "converged", "no_solution", "off_branch" or "failed"
     solution: dict[str, float] | None
     branch: str | None
     iterations: int
@@ -136,28 +141,71 @@ def sweep(
     target = branch
     positions: list[Position] = []
     last_q: tuple[float, ...] | None = None
-    last_v: float | None = None
     anchor_q = guess0  # last solution on the target branch, for re-entry without a closed form
     if values and not have_closed:
         # The file's guess belongs to the file's driver value: solve there, then walk to
         # the first sweep value in short steps, so the sweep starts on that branch.
-        last_q, last_v = _walk_to(solver, m, values[0], guess0)
+        last_q, _last_v = _walk_to(solver, m, values[0], guess0)
         if last_q is not None:
             anchor_q = last_q
-            if target is None:
-                p0 = solver.problem(last_v, last_q)  # type: ignore[arg-type]
-                target = solver.branch(last_q, solver.det(p0, last_q))
-    for i, v in enumerate(values):
-        pos, q = _solve_position(solver, v, last_q, last_v, anchor_q, target, have_closed)
-        if pos.status == "converged":
-            if target is None:
-                target = pos.branch
-            last_q, last_v, anchor_q = q, v, q
+    done: dict[int, Position] = {}
+    history: list[tuple[float, tuple[float, ...]]] = []  # (v, q) of the followed branch
+    i = 0
+    # Forward: continuation along the branch until it ends (a gap, or a fold of a branch
+    # without a closed form, where continuing would silently jump to another assembly).
+    while i < len(values):
+        v = values[i]
+        if history:
+            pos, q = _continue(solver, v, history, target)
         else:
-            last_q, last_v = None, None
-        positions.append(pos)
+            pos, q = _solve_position(solver, v, None, None, anchor_q if last_q is None else last_q,
+                                     target, have_closed)
+        if pos.status != "converged":
+            break
+        if target is None:
+            target = pos.branch
+        done[i] = pos
+        history = [*history[-1:], (v, q)]  # type: ignore[list-item]
+        anchor_q = q
+        i += 1
         if progress is not None:
-            progress(i + 1)
+            progress(len(done))
+    first_gap = i
+    # Backward, for a sweep over a full turn: from the start, down through the end of
+    # the cycle (v - 360 is the same position), on the same branch.
+    full_turn = m.driver.kind == "angle" and values and values[-1] - values[0] >= 360.0 - 1e-9
+    if full_turn and first_gap < len(values) and done:
+        back = [(values[0], _q_of(solver, done[0]))]
+        for j in range(len(values) - 1, first_gap - 1, -1):
+            if j in done:
+                continue
+            v = values[j]
+            pos, q = _continue(solver, v - 360.0, back, target)
+            if pos.status != "converged":
+                break
+            from dataclasses import replace as _replace
+
+            done[j] = _replace(pos, input=v)
+            back = [*back[-1:], (v - 360.0, q)]  # type: ignore[list-item]
+            if progress is not None:
+                progress(len(done))
+    # The rest: re-entry on the same branch where a closed form names it; otherwise the
+    # position is no_solution (no assembly at all) or off_branch (one not connected).
+    for j, v in enumerate(values):
+        if j in done:
+            continue
+        prev = done.get(j - 1)
+        if have_closed:
+            last = (_q_of(solver, prev), values[j - 1]) if prev else (None, None)
+            pos, q = _solve_position(solver, v, last[0], last[1], anchor_q, target, True)
+        else:
+            pos = _classify_gap(solver, v, anchor_q, prev)
+        if target is None and pos.status == "converged":
+            target = pos.branch
+        done[j] = pos
+        if progress is not None:
+            progress(len(done))
+    positions = [done[j] for j in range(len(values))]
     positions = _continuous_angles(solver, positions)
     toggles = _toggles(solver, positions, arcs, lo, hi, have_closed)
     ranges = (tuple(arcs_within(arcs, lo, hi)) if have_closed else _solved_ranges(positions))
@@ -171,8 +219,8 @@ def sweep(
 
 
 def _solve_position(solver: _Solver, v: float, last_q: tuple[float, ...] | None, last_v: float | None,
-                    anchor_q: tuple[float, ...], target: str | None,
-                    have_closed: bool) -> tuple[Position, tuple[float, ...] | None]:
+                    anchor_q: tuple[float, ...], target: str | None, have_closed: bool,
+                    halvings: int = MAX_HALVINGS) -> tuple[Position, tuple[float, ...] | None]:
     def accept(p: Any, r: Any, substeps: int = 0, note: str = "") -> tuple[Position, tuple[float, ...]]:
         q = tuple(r.x)
         det = solver.det(p, q)
@@ -183,6 +231,10 @@ def _solve_position(solver: _Solver, v: float, last_q: tuple[float, ...] | None,
     def ok(p: Any, r: Any) -> bool:
         return r.converged and (target is None or solver.branch(r.x, solver.det(p, r.x)) == target)
 
+    ref = solver.problem(v, anchor_q).reference() if have_closed else None
+    if have_closed and ref == {}:
+        return Position(v, "no_solution", None, None, 0, None,
+                        note="the closed form has no real solution"), None
     # 1. continuation from the previous position
     if last_q is not None:
         p, r = solver.solve(v, last_q)
@@ -190,7 +242,7 @@ def _solve_position(solver: _Solver, v: float, last_q: tuple[float, ...] | None,
             return accept(p, r)
         # 2. the same path in ever smaller sub-steps
         assert last_v is not None
-        for h in range(1, MAX_HALVINGS + 1):
+        for h in range(1, halvings + 1):
             n = 2 ** h
             q = last_q
             good = True
@@ -205,10 +257,6 @@ def _solve_position(solver: _Solver, v: float, last_q: tuple[float, ...] | None,
                 return accept(p, r, n, f"step halved to 1/{n}")
     # 3. re-entry (or first position): the closed form on the target branch, else anchors
     if have_closed:
-        ref = solver.problem(v, anchor_q).reference()
-        if ref == {}:
-            return Position(v, "no_solution", None, None, 0, None,
-                            note="the closed form has no real solution"), None
         if ref:
             want = target if target is not None else solver.branch(anchor_q, 1.0)
             if target is None:
@@ -233,6 +281,102 @@ def _solve_position(solver: _Solver, v: float, last_q: tuple[float, ...] | None,
             return Position(v, "no_solution", None, None, r.iterations, None,
                             note="least squares: the loops cannot close here"), None
     return Position(v, "failed", None, None, 0, None, note="no convergence on the branch"), None
+
+
+def _q_of(solver: _Solver, pos: Position | None) -> tuple[float, ...] | None:
+    return solver_q(solver, pos) if pos is not None and pos.solution is not None else None
+
+
+def _continue(solver: _Solver, v: float, history: list[tuple[float, tuple[float, ...]]],
+              target: str | None) -> tuple[Position, tuple[float, ...] | None]:
+    """One continuation step to v from the branch's last solved position.
+
+    Predictor: the tangent dq/dv = -J^-1 dPhi/dv at the last solution. Corrector: Newton
+    from the prediction. The result is accepted only on the target branch and close to
+    the prediction: the correction may be at most half the predicted change plus a term
+    in dv^2 (the path's curvature) and rounding. Anything else, a jump to another
+    assembly included, halves the step, down to 1/64. A branch that cannot be followed
+    further ends here; the caller decides what the position is.
+    """
+    v_last, q_last = history[-1]
+    for h in range(0, MAX_HALVINGS + 1):
+        n = 2 ** h
+        vq = (v_last, q_last)
+        ok = True
+        r = p = None
+        for k in range(1, n + 1):
+            vk = v_last + (v - v_last) * k / n
+            pred = _predict(solver, vq[0], vq[1], vk)
+            if pred is None:
+                ok = False
+                break
+            p, r = solver.solve(vk, pred)
+            if not r.converged:
+                ok = False
+                break
+            q = tuple(r.x)
+            if target is not None and solver.branch(q, solver.det(p, q)) != target:
+                ok = False
+                break
+            dv = abs(vk - vq[0]) * solver.scale
+            size = 1.0 + max(abs(c) for c in q)
+            moved = max(abs(a - b) for a, b in zip(pred, vq[1]))
+            correction = max(abs(a - b) for a, b in zip(q, pred))
+            if correction > 0.5 * moved + (1e-7 + 10.0 * dv * dv) * size:
+                ok = False
+                break
+            vq = (vk, q)
+        if ok and r is not None:
+            q = tuple(r.x)
+            det = solver.det(p, q)
+            sol = solver.display(q)
+            note = f"step halved to 1/{n}" if n > 1 else ""
+            return Position(v, "converged", sol, solver.branch(q, det), r.iterations, det,
+                            _transmission(solver, sol), n if n > 1 else 0, note), q
+    return Position(v, "failed", None, None, 0, None, note="the branch could not be continued"), None
+
+
+def tangent(solver: _Solver, v0: float, q0: Sequence[float]) -> list[float] | None:
+    """dq/dv on the branch at (v0, q0), from J dq/dv = -dPhi/dv (dPhi/dv by a difference);
+    q in internal units, v in display units. None where J is singular."""
+    from ..methods._linalg import SingularMatrix, lu, lu_solve
+
+    p = solver.problem(v0, tuple(q0))
+    dv = 1e-7 * max(1.0, abs(v0))
+    f0 = p.F(list(q0))
+    f1 = solver.problem(v0 + dv, tuple(q0)).F(list(q0))
+    try:
+        return lu_solve(lu(p.J(list(q0))), [-(b - a) / dv for a, b in zip(f0, f1)])
+    except SingularMatrix:
+        return None
+
+
+def _predict(solver: _Solver, v0: float, q0: tuple[float, ...], v: float) -> tuple[float, ...] | None:
+    """q0 + (v - v0) dq/dv: the tangent predictor."""
+    t = tangent(solver, v0, q0)
+    if t is None:
+        return None
+    return tuple(q + (v - v0) * ti for q, ti in zip(q0, t))
+
+
+def _classify_gap(solver: _Solver, v: float, anchor_q: tuple[float, ...],
+                  prev: Position | None) -> Position:
+    """A position the followed branch does not reach, for a mechanism without a closed
+    form: no_solution if least squares cannot close the loops from the branch's last
+    solution or the file's guess, off_branch if it can (another assembly exists)."""
+    guesses = [anchor_q, tuple(u.value for u in solver.m.unknowns)]
+    for g in guesses:
+        _p, r = solver.solve(v, g)
+        if r.converged:
+            return Position(v, "off_branch", None, None, r.iterations, None,
+                            note="an assembly exists here, but the followed branch does not reach it")
+    for g in guesses:
+        _p, r = solver.solve(v, g, method="lm")
+        if r.converged:
+            return Position(v, "off_branch", None, None, r.iterations, None,
+                            note="an assembly exists here, but the followed branch does not reach it")
+    return Position(v, "no_solution", None, None, 0, None,
+                    note="least squares: the loops cannot close here")
 
 
 def _continuous_angles(solver: _Solver, positions: list[Position]) -> list[Position]:
@@ -314,8 +458,7 @@ def _toggles(solver: _Solver, positions: Sequence[Position], arcs: Any, lo: floa
         if a.status == "converged" and b.status == "converged" and a.det and b.det \
                 and (a.det > 0) != (b.det > 0):
             found.append(_bisect_det(solver, a, b))
-        elif not have_closed and (a.status == "converged") != (b.status == "converged") \
-                and "no_solution" in (a.status, b.status):
+        elif not have_closed and (a.status == "converged") != (b.status == "converged"):
             found.append(_bisect_limit(solver, a, b))
     return sorted(found)
 
@@ -338,18 +481,77 @@ def _bisect_det(solver: _Solver, a: Position, b: Position) -> float:
 
 
 def _bisect_limit(solver: _Solver, a: Position, b: Position) -> float:
-    """One side solves, the other has no solution: bisect on solvability."""
+    """One side is on the branch, the other is not (no solution, or another assembly):
+    bisect on "Newton from the branch's nearest solution stays on it" (see _reaches)."""
     good, bad = (a, b) if a.status == "converged" else (b, a)
     q = solver_q(solver, good)
     vg, vb = good.input, bad.input
-    while abs(vb - vg) > LOCATE_TOL:
+    while abs(vb - vg) > 1e-6:
         vm = 0.5 * (vg + vb)
-        _p, r = solver.solve(vm, q)
-        if r.converged:
-            vg, q = vm, tuple(r.x)
+        qm = _reaches(solver, vm, vg, q, good.branch)
+        if qm is not None:
+            vg, q = vm, qm
         else:
             vb = vm
+    refined = _refine_limit(solver, vg, q)
+    if refined is not None and min(good.input, bad.input) <= refined <= max(good.input, bad.input):
+        return refined
     return 0.5 * (vg + vb)
+
+
+def _refine_limit(solver: _Solver, v0: float, q0: tuple[float, ...]) -> float | None:
+    """The limit exactly: Newton on Phi(q, v) = 0, det J(q, v) = 0 for (q, v), from a
+    point near it (the fold or assembly limit is where det J vanishes on the branch)."""
+    from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve
+
+    def g(x: list[float]) -> list[float]:
+        *q, v = x
+        p = solver.problem(v, tuple(q))
+        try:
+            d = det_from_lu(lu(p.J(q)))
+        except SingularMatrix:
+            d = 0.0
+        return [*p.F(q), d]
+
+    x = [*q0, v0]
+    for _ in range(30):
+        gx = g(x)
+        cols = []
+        for j in range(len(x)):
+            h = 1e-7 * max(1.0, abs(x[j]))
+            xj = list(x)
+            xj[j] += h
+            cols.append([(a - b) / h for a, b in zip(g(xj), gx)])
+        jac = [[cols[j][i] for j in range(len(x))] for i in range(len(x))]
+        try:
+            dx = lu_solve(lu(jac), [-c for c in gx])
+        except SingularMatrix:
+            return None
+        x = [a + b for a, b in zip(x, dx)]
+        if not all(math.isfinite(c) for c in x):
+            return None
+        if abs(dx[-1]) <= 1e-12 * max(1.0, abs(x[-1])) and max(abs(c) for c in dx[:-1]) <= 1e-12:
+            return x[-1]
+    return None
+
+
+def _reaches(solver: _Solver, v: float, v_good: float, q_good: tuple[float, ...],
+             branch: str | None) -> tuple[float, ...] | None:
+    """The solution at v on the branch through (v_good, q_good), or None.
+
+    Near a limit or a fold the branch moves like sqrt(v* - v), so a solution within
+    2 sqrt(|v - v_good|) (radians, scaled by the size of q) counts as the same branch;
+    a jump to another assembly is larger once the interval is small.
+    """
+    p, r = solver.solve(v, q_good)
+    if not r.converged:
+        return None
+    q = tuple(r.x)
+    if branch is not None and solver.branch(q, solver.det(p, q)) != branch:
+        return None
+    dist = max(abs(x - y) for x, y in zip(q, q_good))
+    allow = 2.0 * math.sqrt(abs(v - v_good) * solver.scale) * (1.0 + max(abs(c) for c in q_good))
+    return q if dist <= allow + 1e-12 else None
 
 
 def solver_q(solver: _Solver, pos: Position) -> tuple[float, ...]:
