@@ -153,11 +153,18 @@ def test_links_give_the_seed_coefficients(cli):
     assert json.loads(a.out)["solution"] == json.loads(b.out)["solution"]
 
 
-@pytest.mark.parametrize("command", [[], ["solve"]])
+def all_commands() -> list[list[str]]:
+    from linkage.cli import app
+
+    return [[]] + [[c.name or c.callback.__name__] for c in app.registered_commands]
+
+
+@pytest.mark.parametrize("command", all_commands(), ids=lambda c: " ".join(c) or "linkage")
 def test_every_command_has_help_with_an_example(cli, command):
     run = cli(*command, "--help")
     assert run.code == 0
-    assert "Example" in run.out and "linkage solve" in run.out
+    assert "Example" in run.out and "linkage " in run.out
+    assert len(all_commands()) >= 4  # solve, sweep, draw, and the top level
 
 
 def test_help_lists_all_methods(cli):

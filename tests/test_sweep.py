@@ -86,10 +86,11 @@ def test_a_large_step_does_not_jump_branches():
 
 
 def test_offset_slider_fold_gap_and_limits_are_found_numerically():
-    """No closed form. The followed assembly ends at a fold near 28.62 deg (det J -> 0):
-    beyond it another assembly exists but is not connected (off_branch, no numbers,
-    never a silent jump); 132.4..185.75 has no assembly at all (no_solution); the
-    backward pass over the full turn brings the branch back from 360 down to 185.75."""
+    """No closed form. The sweep follows the assembly of the file's guess (at 60 deg):
+    it ends at a fold near 15.48 deg (det J -> 0) and at the assembly limit near
+    132.43 deg. Elsewhere another assembly exists but is not connected to it
+    (off_branch: no numbers, never a silent jump), and 132.43..185.75 has no assembly
+    at all (no_solution)."""
     import random
 
     from linkage import solve_system
@@ -99,10 +100,13 @@ def test_offset_slider_fold_gap_and_limits_are_found_numerically():
     s = sweep(m, driver_values(0, 360, 2, None))
     assert set(s.summary) == {"converged", "off_branch", "no_solution"}
     fold, limit = s.toggles
-    assert fold == pytest.approx(28.6228, abs=1e-3) and limit == pytest.approx(185.7509, abs=1e-3)
+    assert fold == pytest.approx(15.477, abs=1e-2) and limit == pytest.approx(132.4256, abs=1e-3)
+    at60 = next(p for p in s.positions if p.input == 60)
+    assert at60.solution["theta14"] == pytest.approx(86.135718, abs=1e-5)  # the file's assembly
     for p in s.positions:
-        expected = ("converged" if p.input < fold or p.input > limit else
-                    "off_branch" if p.input < 132.4 else "no_solution" if p.input > 132.5 else p.status)
+        expected = ("converged" if fold < p.input < limit else
+                    "no_solution" if limit < p.input < 185.7 else
+                    "off_branch" if p.input < fold or p.input > 185.8 else p.status)
         assert p.status == expected, (p.input, p.status)
     # both located limits are singular points of the branch: det J -> 0 there
     for t in (fold, limit):
@@ -129,7 +133,7 @@ def test_offset_slider_fold_gap_and_limits_are_found_numerically():
                 return True
         return False
 
-    assert some_assembly(80.0) and not some_assembly(160.0)
+    assert some_assembly(10.0) and some_assembly(250.0) and not some_assembly(160.0)
 
 
 def test_sweep_csv_has_units_and_one_row_per_position(cli):

@@ -6,6 +6,7 @@ Exit codes: 0 converged, 1 ran but did not converge (the rows are still shown),
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from dataclasses import replace
@@ -43,6 +44,14 @@ OutputOpt = Annotated[
     Optional[Path],
     typer.Option("--output", "-o", help="Write to this file instead of standard output; "
                  "the format follows the suffix (.csv, .json) unless --format is given."),
+]
+MechanismFile = Annotated[
+    Path, typer.Argument(help="A mechanism file (TOML, see sample_inputs/).", show_default=False)
+]
+SetOpt = Annotated[
+    Optional[list[str]],
+    typer.Option("--set", help="Override a parameter or the driver, name=value in the file's "
+                 "units (repeatable)."),
 ]
 DigitsOpt = Annotated[
     int, typer.Option("--digits", min=3, max=17, help="Significant digits printed in tables.")
@@ -133,8 +142,7 @@ def solve(
     ftol: Annotated[Optional[float], typer.Option(help="Residual tolerance epsilon_e "
                     "(off unless given).")] = None,
     max_iter: Annotated[int, typer.Option("--max-iter", help="Iteration cap.")] = 100,
-    set_: Annotated[Optional[list[str]], typer.Option("--set", help="With FILE: override a "
-                    "parameter or the driver, name=value in the file's units (repeatable).")] = None,
+    set_: SetOpt = None,
     guess: Annotated[Optional[list[str]], typer.Option(help="With FILE: initial guess "
                      "name=value in the file's units (repeatable).")] = None,
     show_jacobian: Annotated[bool, typer.Option("--show-jacobian", help="With FILE: add the "
@@ -144,6 +152,8 @@ def solve(
                        "sqrt(eps)*max(1,|q|)).")] = None,
     damped: Annotated[bool, typer.Option("--damped", help="With FILE: Newton with a "
                       "backtracking line search, for poor guesses.")] = False,
+    plot: Annotated[Optional[Path], typer.Option(help="Also plot log10 error against iteration "
+                    "for the method(s) run (.png, .svg or .pdf; needs matplotlib).")] = None,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 12,
@@ -174,7 +184,7 @@ def solve(
             raise InputError(f"{', '.join(given)} apply to a single equation, not to a mechanism file")
         _solve_file(file, method, set_ or [], guess or [], tol, rtol, ftol,
                     max_iter if max_iter != 100 else 50, fd_step, damped, show_jacobian,
-                    out_fmt, output, digits)
+                    out_fmt, output, digits, plot)
         return
     given = [k for k, v in system_only.items() if v is not None]
     if given:
@@ -227,8 +237,22 @@ def solve(
                                  "seconds_per_solve": s})
                     for r, c, s in runs]
     emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=csv_table)
+    if plot is not None:
+        _convergence_plot([r for r, _, _ in runs], plot, problem.title)
     if not all(r.converged for r, _, _ in runs):
         raise typer.Exit(1)
+
+
+def _convergence_plot(results: list[Any], path: Path, title: str) -> None:
+    from .render.plots import convergence_plot
+
+    series = []
+    for r in results:
+        errors = [abs(e) if isinstance(e, (int, float)) else None for e in r.history.errors()] \
+            if r.history is not None else []
+        series.append((f"{r.method} ({r.status.value})", errors))
+    convergence_plot(series, path, title)
+    typer.echo(f"wrote {path}", err=True)
 
 
 def parse_assignments(option: str, items: list[str]) -> dict[str, float]:
@@ -243,7 +267,8 @@ def parse_assignments(option: str, items: list[str]) -> dict[str, float]:
 
 def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: float, rtol: float,
                 ftol: float | None, max_iter: int, fd_step: float | None, damped: bool,
-                show_jacobian: bool, out_fmt: str, output: Path | None, digits: int) -> None:
+                show_jacobian: bool, out_fmt: str, output: Path | None, digits: int,
+                plot: Path | None = None) -> None:
     from .analysis.convergence import analyze
     from .problems.loops import load
     from .render.export import result_dict
@@ -266,6 +291,8 @@ def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol:
     h = result.history
     emit(out_fmt, output, blocks=blocks, json_obj=json_obj,
          csv_table=(h.columns, h.rows) if h is not None else ((), ()))
+    if plot is not None:
+        _convergence_plot([result], plot, problem.title)
     if not result.converged:
         raise typer.Exit(1)
 
@@ -336,8 +363,7 @@ def _time_solve(problem: Any, kwargs: dict[str, Any]) -> float:
     "linkage sweep sample_inputs/crank_rocker.toml --branch crossed --format csv -o cycle.csv",
 )
 def sweep(
-    file: Annotated[Path, typer.Argument(help="A mechanism file (TOML, see sample_inputs/).",
-                                         show_default=False)],
+    file: MechanismFile,
     *,
     start: Annotated[float, typer.Option("--from", help="First driver value (driver's unit).")] = 0.0,
     stop: Annotated[float, typer.Option("--to", help="Last driver value.")] = 360.0,
@@ -348,11 +374,12 @@ def sweep(
     branch: Annotated[Optional[str], typer.Option(help="Assembly branch to follow: open or "
                       "crossed (mechanisms with a closed form); default: the branch of the "
                       "file's guess.")] = None,
-    set_: Annotated[Optional[list[str]], typer.Option("--set", help="Override a parameter, "
-                    "name=value in the file's units (repeatable).")] = None,
+    set_: SetOpt = None,
     tol: Annotated[float, typer.Option(help="Step and residual tolerance per position.")] = 1e-12,
     batch: Annotated[Optional[bool], typer.Option("--batch/--no-batch", help="Use the numpy "
                      "batch engine (default: above 20,000 positions; newton only).")] = None,
+    plot: Annotated[Optional[Path], typer.Option(help="Also plot the outputs against the driver "
+                    "(.png, .svg or .pdf; needs matplotlib).")] = None,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 10,
@@ -410,8 +437,72 @@ def sweep(
                                progress=advance)
     emit(out_fmt, output, blocks=sweep_blocks(result, digits), json_obj=sweep_dict(result),
          csv_table=(sweep_headers(result), sweep_rows(result)))
+    if plot is not None:
+        from .render.plots import sweep_plot
+
+        sweep_plot(result, plot)
+        typer.echo(f"wrote {plot}", err=True)
     if result.summary.get("failed"):
         raise typer.Exit(1)
+
+
+@app.command(
+    epilog="Examples:  linkage draw sample_inputs/rapier_drive.toml -o rapier.svg  |  "
+    "linkage draw sample_inputs/crank_rocker.toml --animate crank.gif --step 10",
+)
+def draw(
+    file: MechanismFile,
+    *,
+    output: Annotated[Optional[Path], typer.Option("--output", "-o", help="The drawing at the "
+                      "file's driver value (.png, .svg or .pdf).")] = None,
+    animate: Annotated[Optional[Path], typer.Option(help="A GIF of the mechanism over a sweep of "
+                       "its driver (--from, --to, --step).")] = None,
+    set_: SetOpt = None,
+    start: Annotated[float, typer.Option("--from", help="Animation: first driver value.")] = 0.0,
+    stop: Annotated[float, typer.Option("--to", help="Animation: last driver value.")] = 360.0,
+    step: Annotated[float, typer.Option(help="Animation: driver increment per frame.")] = 5.0,
+) -> None:
+    """Draw a mechanism from its joint coordinates, links and joints labelled.
+
+    Example: linkage draw sample_inputs/fourbar_me581.toml --set theta2=80 -o fourbar.png
+    """
+    from .analysis.sweep import driver_values
+    from .analysis.sweep import sweep as run_sweep
+    from .problems.loops import load
+    from .solve import check_number, solve_system
+
+    if output is None and animate is None:
+        raise InputError("give -o PATH for a drawing, --animate PATH.gif for an animation, or both")
+    mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
+    if output is not None:
+        from .render.plots import draw_mechanism
+
+        problem = mechanism.problem()
+        result = solve_system(problem, tol=1e-12, record=False)
+        if not result.converged:
+            typer.echo(f"error: cannot draw {file} at {problem.title}: {result.message}", err=True)
+            raise typer.Exit(1)
+        draw_mechanism(mechanism, result.x, output, problem.title)
+        typer.echo(f"wrote {output}", err=True)
+    if animate is not None:
+        from .render.plots import animate_sweep
+
+        a, b = check_number("--from", start), check_number("--to", stop)
+        if not check_number("--step", step) > 0 or b < a:
+            raise InputError("--step must be > 0 and --to must not be below --from")
+        values = driver_values(a, b, step, None)
+        if len(values) > 2000:
+            raise InputError(f"{len(values)} frames is too many for a GIF; use a larger --step")
+        s = run_sweep(mechanism, values)
+        scale = math.pi / 180.0 if mechanism.driver.kind == "angle" else 1.0
+        frames = [(p.input * scale,
+                   [math.radians(p.solution[u.name]) if u.kind == "angle" else p.solution[u.name]
+                    for u in mechanism.unknowns]) for p in s.positions if p.solution]
+        if not frames:
+            typer.echo(f"error: no position of {file} between {a:g} and {b:g} could be solved", err=True)
+            raise typer.Exit(1)
+        animate_sweep(mechanism, frames, animate)
+        typer.echo(f"wrote {animate} ({len(frames)} frames)", err=True)
 
 
 class _progress:

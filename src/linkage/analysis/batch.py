@@ -270,8 +270,8 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
             if len(set(others)) > 1 and not have_closed:
                 # a boundary between two kinds of gap falls in this coarse interval
                 anchor = next((solver_q(solver, p) for p in rough.positions if p.solution), None)
-                status[i] = code[_classify_gap(solver, v, anchor or tuple(u.value for u in m.unknowns),
-                                               None).status]
+                tries = [g for g in (anchor, tuple(u.value for u in m.unknowns)) if g is not None]
+                status[i] = code[_classify_gap(solver, v, tries)[0].status]
             else:
                 status[i] = code[others[0]] if others else code["failed"]
             continue

@@ -138,59 +138,37 @@ def sweep(
     arcs = feasible_arcs(m) if m.closed_form and m.driver.kind == "angle" else None
     have_closed = m.closed_form is not None and m.driver.kind == "angle"
     guess0 = tuple(u.value for u in m.unknowns)
-    target = branch
-    positions: list[Position] = []
-    last_q: tuple[float, ...] | None = None
-    anchor_q = guess0  # last solution on the target branch, for re-entry without a closed form
-    if values and not have_closed:
-        # The file's guess belongs to the file's driver value: solve there, then walk to
-        # the first sweep value in short steps, so the sweep starts on that branch.
-        last_q, _last_v = _walk_to(solver, m, values[0], guess0)
-        if last_q is not None:
-            anchor_q = last_q
+    full_turn = m.driver.kind == "angle" and bool(values) and values[-1] - values[0] >= 360.0 - 1e-9
     done: dict[int, Position] = {}
-    history: list[tuple[float, tuple[float, ...]]] = []  # (v, q) of the followed branch
-    i = 0
-    # Forward: continuation along the branch until it ends (a gap, or a fold of a branch
-    # without a closed form, where continuing would silently jump to another assembly).
-    while i < len(values):
-        v = values[i]
-        if history:
-            pos, q = _continue(solver, v, history, target)
-        else:
-            pos, q = _solve_position(solver, v, None, None, anchor_q if last_q is None else last_q,
-                                     target, have_closed)
-        if pos.status != "converged":
-            break
-        if target is None:
-            target = pos.branch
-        done[i] = pos
-        history = [*history[-1:], (v, q)]  # type: ignore[list-item]
-        anchor_q = q
-        i += 1
-        if progress is not None:
-            progress(len(done))
-    first_gap = i
-    # Backward, for a sweep over a full turn: from the start, down through the end of
-    # the cycle (v - 360 is the same position), on the same branch.
-    full_turn = m.driver.kind == "angle" and values and values[-1] - values[0] >= 360.0 - 1e-9
-    if full_turn and first_gap < len(values) and done:
-        back = [(values[0], _q_of(solver, done[0]))]
-        for j in range(len(values) - 1, first_gap - 1, -1):
-            if j in done:
-                continue
-            v = values[j]
-            pos, q = _continue(solver, v - 360.0, back, target)
-            if pos.status != "converged":
+    target = branch
+    anchor_q = guess0
+    # The seed: where the branch to follow is known. With a closed form, the first
+    # position that can be assembled, on the requested branch (or the guess's);
+    # otherwise the file's own driver value, whose guess names the assembly.
+    seed: tuple[float, tuple[float, ...]] | None = None
+    if have_closed:
+        for i, v in enumerate(values):
+            pos, q = _solve_position(solver, v, None, None, guess0, target, True)
+            if pos.status == "converged" and q is not None:
+                seed, target = (v, q), pos.branch
+                done[i] = pos
                 break
-            from dataclasses import replace as _replace
-
-            done[j] = _replace(pos, input=v)
-            back = [*back[-1:], (v - 360.0, q)]  # type: ignore[list-item]
-            if progress is not None:
-                progress(len(done))
+            done[i] = pos
+    else:
+        v0 = m.driver.value / solver.scale
+        p0, r0 = solver.solve(v0, guess0)
+        if r0.converged:
+            q0 = tuple(r0.x)
+            seed = (v0, q0)
+            target = solver.branch(q0, solver.det(p0, q0))
+    if seed is not None:
+        anchor_q = seed[1]
+        for i, pos in _follow(solver, values, seed, target, full_turn, progress, done).items():
+            done[i] = pos
     # The rest: re-entry on the same branch where a closed form names it; otherwise the
-    # position is no_solution (no assembly at all) or off_branch (one not connected).
+    # position is no_solution (no assembly at all) or off_branch (one not connected),
+    # trying the last other assembly found first (continuation along it).
+    other: tuple[float, ...] | None = None
     for j, v in enumerate(values):
         if j in done:
             continue
@@ -199,7 +177,9 @@ def sweep(
             last = (_q_of(solver, prev), values[j - 1]) if prev else (None, None)
             pos, q = _solve_position(solver, v, last[0], last[1], anchor_q, target, True)
         else:
-            pos = _classify_gap(solver, v, anchor_q, prev)
+            tries = [g for g in (other, anchor_q, guess0) if g is not None]
+            pos, found = _classify_gap(solver, v, tries)
+            other = found or other
         if target is None and pos.status == "converged":
             target = pos.branch
         done[j] = pos
@@ -359,24 +339,21 @@ def _predict(solver: _Solver, v0: float, q0: tuple[float, ...], v: float) -> tup
     return tuple(q + (v - v0) * ti for q, ti in zip(q0, t))
 
 
-def _classify_gap(solver: _Solver, v: float, anchor_q: tuple[float, ...],
-                  prev: Position | None) -> Position:
+def _classify_gap(solver: _Solver, v: float, guesses: Sequence[tuple[float, ...]]
+                  ) -> tuple[Position, tuple[float, ...] | None]:
     """A position the followed branch does not reach, for a mechanism without a closed
-    form: no_solution if least squares cannot close the loops from the branch's last
-    solution or the file's guess, off_branch if it can (another assembly exists)."""
-    guesses = [anchor_q, tuple(u.value for u in solver.m.unknowns)]
-    for g in guesses:
-        _p, r = solver.solve(v, g)
-        if r.converged:
-            return Position(v, "off_branch", None, None, r.iterations, None,
-                            note="an assembly exists here, but the followed branch does not reach it")
-    for g in guesses:
-        _p, r = solver.solve(v, g, method="lm")
-        if r.converged:
-            return Position(v, "off_branch", None, None, r.iterations, None,
-                            note="an assembly exists here, but the followed branch does not reach it")
+    form: off_branch if Newton or least squares closes the loops from any guess (another
+    assembly exists; its solution is returned so the next position can start from it),
+    no_solution if neither does from any of them."""
+    for method in (None, "lm"):
+        for g in guesses:
+            _p, r = solver.solve(v, g, method=method)
+            if r.converged:
+                return Position(v, "off_branch", None, None, r.iterations, None,
+                                note="an assembly exists here, but the followed branch does not "
+                                     "reach it"), tuple(r.x)
     return Position(v, "no_solution", None, None, 0, None,
-                    note="least squares: the loops cannot close here")
+                    note="least squares: the loops cannot close here"), None
 
 
 def _continuous_angles(solver: _Solver, positions: list[Position]) -> list[Position]:
@@ -401,21 +378,52 @@ def _continuous_angles(solver: _Solver, positions: list[Position]) -> list[Posit
     return out
 
 
-def _walk_to(solver: _Solver, m: Mechanism, v: float,
-             guess: tuple[float, ...]) -> tuple[tuple[float, ...] | None, float | None]:
-    """Solve at the file's own driver value, then continue to v in steps of <= 2 units."""
-    v0 = m.driver.value / solver.scale
-    _p, r = solver.solve(v0, guess)
-    if not r.converged:
-        return None, None
-    q = tuple(r.x)
+def _follow(solver: _Solver, values: Sequence[float], seed: tuple[float, tuple[float, ...]],
+            target: str | None, full_turn: bool, progress: Callable[[int], None] | None,
+            done: dict[int, Position]) -> dict[int, Position]:
+    """Continuation from the seed, up through the values above it and down through those
+    below, each direction until the branch ends; over a full turn a direction that
+    reaches the end of the range carries on around (v + 360 is the same position)."""
+    from dataclasses import replace
+
+    found: dict[int, Position] = {}
+    v_seed = seed[0]
+    order = sorted(range(len(values)), key=lambda i: values[i])
+    up = [i for i in order if values[i] >= v_seed]
+    down = [i for i in reversed(order) if values[i] < v_seed]
+    for first, second, shift in ((up, down[::-1], 360.0), (down, up[::-1], -360.0)):
+        hist = [seed]
+        plan = [(i, values[i]) for i in first]
+        if full_turn:
+            plan += [(i, values[i] + shift) for i in second]
+        for i, v in plan:
+            if i in found or i in done:
+                if i in found:
+                    continue
+            pos, q = _continue(solver, v, hist, target) if abs(v - hist[-1][0]) <= 5.0 else \
+                _walk(solver, v, hist, target)
+            if pos.status != "converged" or q is None:
+                break
+            found[i] = replace(pos, input=values[i])
+            hist = [(v, q)]
+            if progress is not None:
+                progress(len(found) + len(done))
+    return found
+
+
+def _walk(solver: _Solver, v: float, hist: list[tuple[float, tuple[float, ...]]],
+          target: str | None) -> tuple[Position, tuple[float, ...] | None]:
+    """Continuation over a long interval in steps of at most 2 driver units."""
+    v0 = hist[-1][0]
     n = max(1, math.ceil(abs(v - v0) / 2.0))
+    pos, q = Position(v, "failed", None, None, 0, None), None
     for k in range(1, n + 1):
-        _p, r = solver.solve(v0 + (v - v0) * k / n, q)
-        if not r.converged:
-            return None, None
-        q = tuple(r.x)
-    return q, v
+        pos, q = _continue(solver, v0 + (v - v0) * k / n, hist, target)
+        if pos.status != "converged" or q is None:
+            return pos, None
+        hist = [(v0 + (v - v0) * k / n, q)]
+    return Position(v, pos.status, pos.solution, pos.branch, pos.iterations, pos.det,
+                    pos.transmission, pos.substeps, pos.note), q
 
 
 def _transmission(solver: _Solver, sol: dict[str, float]) -> float | None:

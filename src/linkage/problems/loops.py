@@ -62,6 +62,7 @@ class VectorTerm:
 class Loop:
     name: str
     vectors: tuple[VectorTerm, ...]
+    joints: tuple[str, ...] = ()  # the start point of each vector ("" unnamed), for drawings
 
 
 @dataclass(frozen=True)
@@ -223,6 +224,14 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         lkey = f"loops[{li}]"
         if not isinstance(loop, Mapping) or not isinstance(loop.get("vectors"), list):
             raise fail(lkey, "needs a list 'vectors'")
+        for k in loop:
+            if k not in ("name", "vectors", "joints"):
+                raise fail(f"{lkey}.{k}", "unknown key (expected name, vectors, joints)")
+        joints = loop.get("joints", [])
+        if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints) or (
+                joints and len(joints) != len(loop["vectors"])):
+            raise fail(f"{lkey}.joints", f"must list one name per vector ({len(loop['vectors'])}), "
+                                         "\"\" for an unnamed point")
         terms = []
         for vi, vec in enumerate(loop["vectors"]):
             vkey = f"{lkey}.vectors[{vi}]"
@@ -240,7 +249,7 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
             if isinstance(offset, bool) or not isinstance(offset, (int, float)):
                 raise fail(f"{vkey}.offset", "must be a number of degrees")
             terms.append(VectorTerm(float(sign), length, angle, math.radians(offset)))
-        loops.append(Loop(str(loop.get("name", f"loop {li + 1}")), tuple(terms)))
+        loops.append(Loop(str(loop.get("name", f"loop {li + 1}")), tuple(terms), tuple(joints)))
 
     n_eq = 2 * len(loops)
     if n_eq != len(unknowns):
