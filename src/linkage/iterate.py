@@ -7,7 +7,11 @@ Stopping tests run after every step, in this fixed order (first match wins):
 2. a non-finite error or residual                                   -> ``NON_FINITE``;
 3. an exact zero of the residual                                    -> ``CONVERGED_EXACT``;
 4. the residual test ``|f| <= ftol`` (only when ``ftol`` is given)  -> ``CONVERGED_RESIDUAL``;
-5. the step test ``err <= tol + rtol * |x|``                        -> ``CONVERGED_STEP``.
+5. the step test ``err <= tol + rtol * |x|``                        -> ``CONVERGED_STEP``;
+   for the open scalar methods (Newton, secant) not at a point whose |f| is worse than
+   one already seen and still above 1e-8 of the start's (a tiny step from a far-away
+   slope is not a root; differences at rounding level are), and only where the method
+   finds its own step plausible (the secant: a local chord, see ``Secant.plausible``).
    Methods with ``needs_residual`` (the systems) converge only when the step *and* the
    residual pass (P3: max|Phi| < eps and max|dq| < eps; ``ftol`` defaults to ``tol``);
    a small step with the residual above it continues, or, for methods that minimise
@@ -93,6 +97,11 @@ def run(
     gate = (ftol if ftol is not None else tol) if needs_residual else math.inf
     can_diverge = method.can_diverge
     prev_err = math.inf
+    check_best = can_diverge and not needs_residual  # the open scalar methods
+    plausible = getattr(method, "plausible", None)
+    seen = [abs(v) for v in (state.fx, getattr(state, "fxp", None)) if isinstance(v, float) and v == v]
+    best_fx = min(seen) if seen else math.inf
+    start_fx = max(seen) if seen else math.inf
     growth = 0
     stalls = 0
     rounding_steps = 0
@@ -114,7 +123,13 @@ def run(
             break
         err = state.err
         fx = state.fx
-        if not _isfinite(err) or (fx is not None and not _isfinite(fx)):
+        try:
+            finite = _isfinite(err) and (fx is None or _isfinite(fx))
+        except TypeError:
+            # e.g. (-8) ** (1/3) in a user's function is complex in Python
+            status, detail = Status.DOMAIN_ERROR, f"f returned a non-real value: {fx!r}"
+            break
+        if not finite:
             status, detail = Status.NON_FINITE, f"error = {err!r}, residual = {fx!r}"
             break
         if fx is not None:
@@ -126,6 +141,18 @@ def run(
                 break
         x = state.x
         limit = tol + rtol * magnitude(x) if rtol else tol
+        if err <= limit and plausible is not None and not plausible(state):
+            limit = -1.0  # the method's own evidence says the small step is not convergence
+        if check_best and fx is not None:
+            size = abs(fx)
+            if err <= limit and size > best_fx and size > 1e-8 * start_fx:
+                # A small step to a point worse than one already seen, with a residual
+                # still of the order of the start's, is not convergence: the slope came
+                # from far away (a secant chord through a huge f). Differences at rounding
+                # level are allowed. Iterate on; a stall ends as precision_limit.
+                limit = -1.0
+            elif size < best_fx:
+                best_fx = size
         if err <= limit:
             if needs_residual and (fx is None or abs(fx) > gate):
                 if minimizes:

@@ -25,6 +25,7 @@ class Status(Enum):
     PRECISION_LIMIT = "precision_limit"
     SINGULAR_JACOBIAN = "singular_jacobian"
     NO_SOLUTION = "no_solution"
+    DISCONTINUITY = "discontinuity"
 
     @property
     def converged(self) -> bool:
@@ -50,6 +51,8 @@ _MESSAGES = {
     Status.PRECISION_LIMIT: "stopped at the limit of double precision before reaching the tolerance",
     Status.SINGULAR_JACOBIAN: "stalled: the Jacobian is singular",
     Status.NO_SOLUTION: "no solution: the residual stays above the tolerance",
+    Status.DISCONTINUITY: "stopped: the bracket closed on a sign change where |f| does not shrink "
+                          "(a jump or a pole), not on a root",
 }
 
 

@@ -132,6 +132,12 @@ def solve_scalar(
             start = {"x0": x0}
     try:
         state = m.init(problem, *args)
+    except TypeError:
+        return Result(method=m.name, x=args[0], status=Status.DOMAIN_ERROR, iterations=0, nfev=0,
+                      error=math.inf, residual=None, detail="at the start: f returned a non-real value",
+                      history=History((), (), 0) if record else None,
+                      meta={"var": problem.var, "unit": problem.unit, "title": problem.title,
+                            "tol": crit.tol, "rtol": crit.rtol, **start})
     except (ArithmeticError, ValueError) as exc:
         status, detail = explain(exc)
         return Result(method=m.name, x=args[0], status=status, iterations=0, nfev=0,
@@ -140,6 +146,51 @@ def solve_scalar(
                       meta={"var": problem.var, "unit": problem.unit, "title": problem.title,
                             "tol": crit.tol, "rtol": crit.rtol, **start})
     return finish(m, problem, state, crit, record, start)
+
+
+def check_sign_change(problem: ScalarProblem, state: Any, bracket: tuple[float, float],
+                      detail: str) -> tuple[Status, str, int]:
+    """A bracket that closed on a root has a small residual; one that closed on a jump or
+    a pole does not. When |f| at the answer is not far below its size at the starting
+    bracket, bisect the final bracket 8 more times: at a root |f| falls below the
+    answer's with the width (about 256 times for a simple root), at a jump it stays, at a
+    pole it grows."""
+    x, fx = state.x, state.fx
+    if fx is None or fx == 0.0:
+        return Status.CONVERGED_STEP, detail, 0
+    try:
+        start_size = max(abs(problem.f(bracket[0])), abs(problem.f(bracket[1])))
+    except (ArithmeticError, ValueError, TypeError):
+        return Status.CONVERGED_STEP, detail, 0
+    if not math.isfinite(start_size) or abs(fx) <= 1e-3 * start_size:
+        return Status.CONVERGED_STEP, detail, 2
+    lo, hi = sorted(_final_bracket(state))
+    flo = problem.f(lo)
+    evals = 3
+    smallest = best_at_start = abs(fx)
+    for _ in range(8):
+        mid = 0.5 * lo + 0.5 * hi
+        if mid in (lo, hi):
+            break
+        fm = problem.f(mid)
+        evals += 1
+        if fm == 0.0:
+            return Status.CONVERGED_STEP, detail, evals
+        smallest = min(smallest, abs(fm))
+        if (fm < 0.0) == (flo < 0.0):
+            lo, flo = mid, fm
+        else:
+            hi = mid
+    if smallest <= best_at_start / 16.0:
+        return Status.CONVERGED_STEP, detail, evals
+    return (Status.DISCONTINUITY,
+            f"|f| is {abs(fx):.3g} at x = {x!r} and does not shrink with the bracket", evals)
+
+
+def _final_bracket(state: Any) -> tuple[float, float]:
+    if hasattr(state, "xblk"):
+        return state.x, state.xblk
+    return state.a, state.b
 
 
 def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: bool,
@@ -153,6 +204,9 @@ def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: b
     nfev = m.init_evals + iterations * m.step_evals
     x = outcome_state.x
     residual = outcome_state.fx
+    if m.bracketing and status is Status.CONVERGED_STEP and "bracket" in start:
+        status, detail, extra = check_sign_change(problem, outcome_state, start["bracket"], detail)
+        nfev += extra
     if residual is None and status is not Status.INVALID_BRACKET:
         try:
             residual = problem.f(x)

@@ -93,14 +93,18 @@ class Hybrid:
         sbis = 0.5 * (xblk - xcur)
         kind = "bisection"
         if abs(spre) > delta and abs(fcur) < abs(fpre):
-            if xpre == xblk:
-                stry = -fcur * (xcur - xpre) / (fcur - fpre)
-                trial = "secant"
-            else:
-                dpre = (fpre - fcur) / (xpre - xcur)
-                dblk = (fblk - fcur) / (xblk - xcur)
-                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
-                trial = "inverse quadratic"
+            try:
+                if xpre == xblk:
+                    stry = -fcur * (xcur - xpre) / (fcur - fpre)
+                    trial = "secant"
+                else:
+                    dpre = (fpre - fcur) / (xpre - xcur)
+                    dblk = (fblk - fcur) / (xblk - xcur)
+                    stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+                    trial = "inverse quadratic"
+            except ZeroDivisionError:
+                # Products of tiny f values underflow to 0 (x^9 near its root): bisect.
+                stry, trial = math.inf, "bisection"
             if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - delta):
                 spre, scur = scur, stry
                 kind = trial

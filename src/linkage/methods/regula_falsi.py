@@ -71,7 +71,9 @@ class RegulaFalsi:
         a, fa, b, fb, wa, wb, side = s.a, s.fa, s.b, s.fb, s.wa, s.wb, s.side
         big_fa = fa * wa
         big_fb = fb * wb
-        c = b - big_fb * (b - a) / (big_fb - big_fa)
+        denominator = big_fb - big_fa
+        # (weights halved many times can underflow: then the secant is undefined)
+        c = b - big_fb * (b - a) / denominator if denominator != 0.0 else a
         if not a < c < b:
             c = 0.5 * a + 0.5 * b
         fc = problem.f(c)

@@ -28,6 +28,7 @@ class SecantState(NamedTuple):
     xp: float
     fxp: float
     slope: float
+    slope_before: float
 
 
 @dataclass(frozen=True)
@@ -63,18 +64,32 @@ class Secant:
             stop = (Status.CONVERGED_EXACT, f"f is zero at the start {v} = {x0!r}")
         elif any(f != f or abs(f) == float("inf") for f in (f0, f1)):
             stop = (Status.NON_FINITE, f"f({v}={x0:g}) = {f0!r}, f({v}={x1:g}) = {f1!r}")
-        return SecantState(x, fx, float("inf"), stop, x0, f0, _NAN)
+        return SecantState(x, fx, float("inf"), stop, x0, f0, _NAN, _NAN)
 
     def step(self, problem: ScalarProblem, s: SecantState) -> SecantState:
         x, fx = s.x, s.fx
+        if x == s.xp:
+            return new_state(SecantState, (
+                x, fx, _NAN,
+                (Status.PRECISION_LIMIT, f"the last two points are equal in double precision "
+                                         f"({problem.var} = {x!r}): no chord to follow"),
+                x, fx, _NAN, s.slope))
         slope = (fx - s.fxp) / (x - s.xp)
         if slope == 0.0:
             return new_state(SecantState, (
                 x, fx, _NAN,
                 (Status.ZERO_DERIVATIVE, f"the secant slope is zero at {problem.var} = {x!r}"),
-                x, fx, slope))
+                x, fx, slope, s.slope))
         x1 = x - fx / slope
-        return new_state(SecantState, (x1, problem.f(x1), abs(x1 - x), None, x, fx, slope))
+        return new_state(SecantState, (x1, problem.f(x1), abs(x1 - x), None, x, fx, slope, s.slope))
+
+    @staticmethod
+    def plausible(s: SecantState) -> bool:
+        """A small step means convergence only once the chord is local: from the second
+        iteration on, with the last two slopes within a factor of 2 (far-apart points
+        give a chord unrelated to f' at the root, and a meaningless tiny step)."""
+        ratio = s.slope / s.slope_before if s.slope_before else _NAN
+        return 0.5 <= ratio <= 2.0
 
     def initial_row(self, problem: ScalarProblem, s: SecantState) -> tuple[Any, ...]:
         return (0, s.xp, s.fxp, None, None, None)

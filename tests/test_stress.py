@@ -1,0 +1,325 @@
+"""The stress battery, the regressions it caught, and a seeded fuzz test of the CLI."""
+
+from __future__ import annotations
+
+import json
+import math
+import random
+import sys
+from pathlib import Path
+
+import pytest
+
+from linkage import Status, fourbar_equation, solve_scalar
+from linkage.stress import run, summary_rows
+
+EPS = sys.float_info.epsilon
+SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
+
+
+def test_quick_battery_is_clean_and_deterministic(cli):
+    first = cli("stress", "--quick", "--format", "json")
+    assert first.code == 0, first.err
+    doc = json.loads(first.out)
+    assert doc["false_convergences"] == 0 and doc["crashes"] == 0
+    assert doc["seconds"] < 60
+    again = json.loads(cli("stress", "--quick", "--format", "json").out)
+    strip = [{k: v for k, v in row.items()} for row in doc["summary"]]
+    assert strip == again["summary"]  # same seed, same outcome, row by row
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_full_battery_is_clean(seed):
+    report = run(quick=False, seed=seed)
+    rows = summary_rows(report)
+    assert sum(r[6] for r in rows) == 0, [t.examples for t in report["tallies"].values() if t.examples]
+    assert sum(r[7] for r in rows) == 0
+    assert sum(r[2] for r in rows) > 5000
+
+
+def test_hybrid_reaches_4_eps_on_every_bracketed_classic_case():
+    """Done-when 2: every APS and Chandrupatla case whose bracket holds a sign change."""
+    h = run(quick=False, seed=0, methods=["hybrid", "bisection"])["hybrid"]
+    assert h["cases"] == 200 and h["within_4_eps"] == 200, h["failures"]
+    assert h["hybrid_iterations"] < h["bisection_iterations"] / 2
+
+
+# --- regressions, each named after what the battery caught -----------------------------------
+
+
+def test_regression_hybrid_interpolation_underflow_bisects():
+    """x^9 near its root: the inverse-quadratic denominator underflowed to 0 and the
+    hybrid stopped with a division by zero; now it bisects that step."""
+    for f, br in ((lambda x: x**9, (-1.0, 4.0)), (lambda x: x**19, (-2.0, 5.0))):
+        r = solve_scalar(f, method="hybrid", bracket=br, tol=1e-300, rtol=4 * EPS, max_iter=2000)
+        assert r.converged and (abs(r.x) <= 1e-30 or f(r.x) == 0.0), r.message
+
+
+def test_regression_complex_value_is_a_domain_error():
+    """x ** (1/n) at negative x is complex in Python; the check of the residual raised
+    TypeError out of the solver. It is now a named domain error."""
+    r = solve_scalar(lambda x: x ** (1.0 / 3.0) - 2.0, method="secant", x0=-1.0, x1=-2.0)
+    assert r.status is Status.DOMAIN_ERROR and "non-real" in r.message
+    r0 = solve_scalar(lambda x: x**0.5, method="bisection", bracket=(-1.0, 4.0))
+    assert r0.status is Status.DOMAIN_ERROR
+
+
+@pytest.mark.parametrize(
+    "f,bracket",
+    [
+        (lambda x: (-1.0 if x < 1 else 1.0) + 0.1 * x, (0.5, 1.7)),
+        (lambda x: 1.0 / (1.0 - x) if x != 1 else math.inf, (0.3, 1.9)),
+    ],
+    ids=["jump", "pole"],
+)
+@pytest.mark.parametrize("method", ["bisection", "regula-falsi", "hybrid"])
+def test_regression_bracket_on_a_jump_or_pole_is_not_a_root(f, bracket, method):
+    """Every bracketing method used to report converged_step on a sign change that is a
+    jump or a pole; the residual does not shrink there, and that is now a named stop."""
+    r = solve_scalar(f, method=method, bracket=bracket, tol=1e-10)
+    assert not r.converged and r.status in (Status.DISCONTINUITY, Status.NON_FINITE), r.message
+
+
+@pytest.mark.parametrize(
+    "f,bracket,root",
+    [
+        (
+            lambda x: (
+                math.exp(500.5 * 1000 * x) - 1.859
+                if 0 <= x <= 2e-3 / 1001
+                else (-0.859 if x < 0 else math.e - 1.859)
+            ),
+            (-1e4, 1e-4),
+            math.log(1.859) / 500500.0,
+        ),
+        (lambda x: x**3 - 1.6251234902833584e-207, (0.0, 1.0), 1.6251234902833584e-207 ** (1 / 3)),
+    ],
+    ids=["steep exponential (aps15)", "tiny constant term"],
+)
+def test_regression_steep_and_tiny_roots_are_still_roots(f, bracket, root):
+    """The discontinuity check must not flag a steep root, nor one whose bracket end has
+    a tiny |f| (hypothesis found the second one)."""
+    for method in ("bisection", "hybrid", "regula-falsi"):
+        r = solve_scalar(f, method=method, bracket=bracket, tol=1e-9, max_iter=500)
+        assert r.converged, (method, r.message)
+        assert abs(r.x - root) <= 1e-9 + 4 * EPS * abs(root) or f(r.x) == 0.0
+
+
+def test_regression_secant_far_chord_is_not_convergence():
+    """aps03 from -2 and 11: the chord through f(-2) = 1.6e5 gave a step below one ulp at
+    11, where f is an exponential tail, not a zero; the secant claimed a root at 11."""
+    f = lambda x: -200 * x * math.exp(-3 * x)  # noqa: E731
+    r = solve_scalar(f, method="secant", x0=-2.0, x1=11.0, tol=1e-300, rtol=4 * EPS, max_iter=500)
+    assert not r.converged or abs(r.x) < 1e-10
+
+
+def test_regression_tiny_step_from_a_far_slope():
+    """aps06 with n = 60: a chord through f = -1.6e32 made a tiny step at x = 0.5, where
+    f = 1; the secant claimed a root there."""
+    n = 60
+    f = lambda x: 2 * x * math.exp(-n) - 2 * math.exp(-n * x) + 1  # noqa: E731
+    r = solve_scalar(f, method="secant", x0=1 / 30, x1=0.5, tol=1e-300, rtol=4 * EPS, max_iter=500)
+    assert not r.converged or abs(r.x - 0.011552453009332421) < 1e-12
+
+
+def test_rounding_noise_does_not_block_convergence():
+    """The residual rules above must still let Newton finish where the last iterates
+    differ only by rounding noise (seed 002 at alpha = 10, tol 1e-12)."""
+    r = solve_scalar(fourbar_equation(10.0), method="newton", tol=1e-12)
+    assert r.converged and abs(r.x - 8.0693453136225160) < 1e-12
+
+
+def test_tolerance_below_epsilon_ends_with_a_named_stop():
+    for method in ("bisection", "hybrid", "newton", "secant", "regula-falsi"):
+        r = solve_scalar(fourbar_equation(70.0), method=method, tol=1e-20, max_iter=1000)
+        assert r.status in (Status.PRECISION_LIMIT, Status.CONVERGED_EXACT), (method, r.status)
+        assert r.iterations < 200
+
+
+# --- CLI fuzz -------------------------------------------------------------------------------------
+
+NUMBERS = [
+    "0",
+    "-1",
+    "1",
+    "0.5",
+    "70",
+    "5/3",
+    "1e308",
+    "-1e308",
+    "1e-320",
+    "nan",
+    "inf",
+    "-inf",
+    "abc",
+    "",
+    "--",
+    "1/0",
+    "3e",
+    "360",
+    "50",
+    "60",
+    "7",
+]
+OPTIONS = {
+    "solve": [
+        "--method",
+        "--alpha",
+        "--r1",
+        "--r2",
+        "--r3",
+        "--links",
+        "--equation",
+        "--g",
+        "--x0",
+        "--x1",
+        "--bracket",
+        "--tol",
+        "--rtol",
+        "--ftol",
+        "--max-iter",
+        "--format",
+        "--digits",
+        "--set",
+        "--guess",
+        "--fd-step",
+        "--damped",
+        "--show-jacobian",
+    ],
+    "sweep": [
+        "--from",
+        "--to",
+        "--step",
+        "--points",
+        "--method",
+        "--branch",
+        "--set",
+        "--tol",
+        "--format",
+        "--digits",
+        "--batch",
+        "--no-batch",
+    ],
+}
+WORDS = [
+    "newton",
+    "secant",
+    "bisection",
+    "hybrid",
+    "fixed-point",
+    "regula-falsi",
+    "lm",
+    "newton-fd",
+    "all",
+    "open",
+    "crossed",
+    "json",
+    "csv",
+    "plain",
+    "table",
+    "github",
+    "x**2-2",
+    "sin(x)",
+    "x^",
+    "theta2=80",
+    "r1=-3",
+    "theta3=0",
+    "junk",
+    "theta2",
+    "__import__('os')",
+    "cos(x)",
+]
+FILES = [
+    str(SAMPLES / "fourbar_me581.toml"),
+    str(SAMPLES / "rapier_drive.toml"),
+    str(SAMPLES / "crank_rocker.toml"),
+    "/nonexistent.toml",
+    str(SAMPLES),
+    str(Path(__file__)),
+]
+
+
+VALID = {
+    "solve": [
+        ["--max-iter", "2"],
+        ["--method", "newton"],
+        ["--method", "secant"],
+        ["--method", "fixed-point"],
+        ["--method", "all"],
+        ["--alpha", "130"],
+        ["--alpha", "10"],
+        ["--tol", "1e-12"],
+        ["--tol", "1e-20"],
+        ["--format", "json"],
+        ["--format", "csv"],
+        ["--digits", "5"],
+        ["--x0", "85"],
+    ],
+    "sweep": [
+        ["--step", "30"],
+        ["--points", "7"],
+        ["--from", "100"],
+        ["--to", "200"],
+        ["--branch", "crossed"],
+        ["--format", "json"],
+        ["--set", "theta2=10"],
+        ["--tol", "1e-9"],
+    ],
+    "solve FILE": [
+        ["--set", "theta2=180"],
+        ["--guess", "theta3=30", "--guess", "theta4=30"],
+        ["--method", "lm"],
+        ["--method", "newton-fd"],
+        ["--damped"],
+        ["--max-iter", "2"],
+        ["--show-jacobian"],
+        ["--format", "csv"],
+    ],
+}
+
+
+def valid_invocation(rng: random.Random) -> list[str]:
+    kind = rng.choice(list(VALID))
+    args = (
+        ["solve", rng.choice(FILES[:3])]
+        if kind == "solve FILE"
+        else (["sweep", rng.choice(FILES[:3])] if kind == "sweep" else ["solve"])
+    )
+    for pair in rng.sample(VALID[kind], rng.randint(1, 3)):
+        args += pair
+    return args
+
+
+def random_invocation(rng: random.Random) -> list[str]:
+    if rng.random() < 0.3:
+        return valid_invocation(rng)
+    command = rng.choice(["solve", "solve", "solve", "sweep", rng.choice(["draw", "stress", "bogus", ""])])
+    args = [command] if command else []
+    if command == "sweep" or (command == "solve" and rng.random() < 0.4):
+        args.append(rng.choice(FILES))
+    for _ in range(rng.randint(0, 5)):
+        opt = rng.choice(OPTIONS.get(command, ["--help", "--format", "--seed", "--quick", "-o"]))
+        args.append(opt)
+        for _ in range(rng.choice([0, 1, 1, 1, 2, 4])):
+            args.append(rng.choice(NUMBERS + WORDS))
+    if command == "stress":
+        args = ["stress", "--help"]  # the battery itself is tested above; here only parsing
+    if command == "draw":
+        args = [a for a in args if a not in ("-o", "--output", "--animate")]
+    return args
+
+
+def test_cli_fuzz_no_traceback_and_known_exit_codes(cli, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # anything an invocation writes lands here
+    rng = random.Random(20261122)
+    codes = {0: 0, 1: 0, 2: 0}
+    for _ in range(1200):
+        args = random_invocation(rng)
+        run = cli(*args)
+        assert run.code in (0, 1, 2), (args, run.code, run.err[-300:])
+        text = run.out + run.err
+        assert "Traceback" not in text and "internal error" not in text, (args, text[-500:])
+        if run.code == 2:
+            assert len(run.err.strip().splitlines()) == 1, (args, run.err)
+        codes[run.code] += 1
+    assert all(codes.values()), codes  # the fuzz reached every outcome
