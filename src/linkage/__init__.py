@@ -10,16 +10,37 @@ The public API, in the order a reader meets it:
 - :func:`analyze` estimates convergence order and rate from a recorded history.
 """
 
-from .analysis.convergence import Convergence, analyze
-from .errors import InputError, LinkageError, NotConvergedError, ParseError
-from .problems.expression import equation_problem
-from .problems.freudenstein import coefficients_from_links, fourbar_equation
-from .problems.loops import Mechanism
-from .problems.loops import load as load_mechanism
-from .problems.scalar import ScalarProblem
-from .problems.system import SystemProblem
-from .result import History, IterationRecord, Result, Status
-from .solve import solve_scalar, solve_system
+from importlib import import_module
+from typing import Any
+
+_EXPORTS = {
+    "Convergence": ".analysis.convergence", "analyze": ".analysis.convergence",
+    "InputError": ".errors", "LinkageError": ".errors", "NotConvergedError": ".errors",
+    "ParseError": ".errors",
+    "equation_problem": ".problems.expression",
+    "coefficients_from_links": ".problems.freudenstein", "fourbar_equation": ".problems.freudenstein",
+    "ScalarProblem": ".problems.scalar",
+    "History": ".result", "IterationRecord": ".result", "Result": ".result", "Status": ".result",
+    "Mechanism": ".problems.loops", "load_mechanism": ".problems.loops",
+    "SystemProblem": ".problems.system",
+    "solve_scalar": ".solve", "solve_system": ".solve",
+}
+
+
+def __getattr__(name: str) -> Any:
+    """Import on first use, so a command pays only for the modules it runs (PEP 562)."""
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'linkage' has no attribute {name!r}")
+    attr = "load" if name == "load_mechanism" else name
+    value = getattr(import_module(module, __name__), attr)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *_EXPORTS])
+
 
 __version__ = "0.1.0"
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import replace
@@ -27,6 +28,7 @@ def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: b
     return v
 
 
+@functools.lru_cache(maxsize=256)
 def check_criteria(tol: float, rtol: float, ftol: float | None, max_iter: int) -> Criteria:
     tol = check_number("tol", tol, positive=True, allow_zero=False)
     rtol = check_number("rtol", rtol, positive=True)
@@ -148,6 +150,15 @@ def solve_scalar(
     return finish(m, problem, state, crit, record, start)
 
 
+@functools.lru_cache(maxsize=128)
+def column_labels(m: Any, var: str, unit: str, has_u: bool, has_gprime: bool) -> tuple[str, ...]:
+    """A method's table headers for a problem's names and units (computed once)."""
+    from .problems.scalar import ScalarProblem as _P
+
+    shape = _P(f=abs, var=var, unit=unit, u=abs if has_u else None, gprime=abs if has_gprime else None)
+    return tuple(c.label(var, unit) for c in m.columns(shape))
+
+
 def check_sign_change(problem: ScalarProblem, state: Any, bracket: tuple[float, float],
                       detail: str) -> tuple[Status, str, int]:
     """A bracket that closed on a root has a small residual; one that closed on a jump or
@@ -215,9 +226,9 @@ def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: b
             residual = math.nan
     history = None
     if rows is not None:
-        cols = m.columns(problem)
-        labels = tuple(c.label(problem.var, problem.unit) for c in cols)
-        history = History(labels, tuple(rows), len(cols) - 1)
+        labels = column_labels(m, problem.var, problem.unit, problem.u is not None,
+                               problem.gprime is not None)
+        history = History(labels, tuple(rows), len(labels) - 1)
     err = outcome_state.err
     return Result(
         method=m.name,
@@ -314,7 +325,10 @@ def solve_system(
         status, detail = Status.NO_SOLUTION, f"max|Phi| = {residual:.3g} at the end, above {gate:.3g}"
     meta: dict[str, Any] = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names,
                             "kinds": problem.kinds, "title": problem.title, **problem.meta}
-    reference = problem.reference() if problem.reference is not None else None
+    # The closed form serves the table's true-error column and the verdict on a failed
+    # solve; a converged solve without history does not pay for it.
+    wanted = problem.reference is not None and (record or not status.converged)
+    reference = problem.reference() if wanted else None  # type: ignore[misc]
     if reference is not None:
         meta["reference"] = reference
         if not reference and not status.converged:

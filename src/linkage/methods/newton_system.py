@@ -112,6 +112,18 @@ class NewtonSystem:
             jac = problem.J(q)  # type: ignore[misc]
             njev += 1
         resid = max_abs(phi)
+        if len(q) == 2 and not self.damped:
+            # Two unknowns (every four-bar, the slider-crank): Cramer's rule, no LU.
+            (a, b), (c, d) = jac
+            det = a * d - b * c
+            scale = max(abs(a), abs(b), 1e-300) * max(abs(c), abs(d), 1e-300)
+            if abs(det) > SINGULAR_RATIO * scale:
+                dq = [(b * phi[1] - d * phi[0]) / det, (c * phi[0] - a * phi[1]) / det]
+                cond = cond1(jac) if self.diagnostics else math.nan
+                x = (q[0] + dq[0], q[1] + dq[1])
+                return new_state(NewtonSystemState, (
+                    x, resid, max_abs(dq), None, tuple(q), tuple(phi), tuple(map(tuple, jac)),
+                    tuple(dq), det, cond, 1.0, nfev, njev))
         try:
             f = lu(jac)
             ratio = pivot_ratio(f)

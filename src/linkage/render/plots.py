@@ -198,3 +198,28 @@ def convergence_plot(runs: Sequence[tuple[str, Sequence[float]]], path: Path, ti
     ax.legend(fontsize=8)
     ax.set_title(title, fontsize=10)
     _save(fig, path)
+
+
+def work_precision_plot(measurements: Sequence[Any], path: Path) -> None:
+    """log10 error against log10 time, one line per contender, one panel per problem."""
+    _check_suffix(path, SUFFIXES)
+    plt = _pyplot()
+    problems = list(dict.fromkeys(m.problem for m in measurements))
+    fig, axes = plt.subplots(1, len(problems), figsize=(6.5 * len(problems), 5.5), squeeze=False)
+    for ax, problem in zip(axes[0], problems):
+        series: dict[str, list[tuple[float, float]]] = {}
+        for m in measurements:
+            if m.problem == problem:
+                series.setdefault(m.contender, []).append(
+                    (math.log10(m.seconds), math.log10(max(m.error, 1e-17))))
+        for label, pts in sorted(series.items()):
+            pts.sort()
+            style = "-" if label.startswith("linkage") else ("--" if label.startswith("scipy") else ":")
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], style, marker="o", ms=3, lw=1.2, label=label)
+        ax.set_xlabel("log10 time per solve (s)")
+        ax.set_ylabel("log10 error (errors of 0 drawn at -17)")
+        ax.set_title(problem, fontsize=10)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=6, loc="best")
+    fig.suptitle("work-precision: lower left is better", fontsize=10)
+    _save(fig, path)
