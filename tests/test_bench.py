@@ -42,3 +42,12 @@ def test_bench_without_scipy_skips_its_rows_with_a_note(cli, monkeypatch):
 def test_bench_bad_input(cli):
     run = cli("bench", "--problem", "nope")
     assert run.code == 2 and "unknown problem" in run.err
+
+
+def test_sample_mechanisms_ship_with_the_package():
+    """Regression: an installed linkage looked for sample_inputs/ beside its source tree,
+    so `linkage bench` failed outside a checkout. They are package data now."""
+    from linkage.samples import sample_path
+
+    for name in ("fourbar_me581.toml", "rapier_drive.toml"):
+        assert sample_path(name).read_text().startswith("#")

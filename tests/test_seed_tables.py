@@ -152,3 +152,20 @@ def test_seed_002_solution_table_for_every_alpha(alpha, phi):
     result = solve_scalar(fourbar_equation(alpha), method="newton", tol=1e-12)
     assert result.converged
     assert matches(result.root, phi)
+
+
+@pytest.mark.parametrize("method,order,rate", [
+    ("newton", 2.0, None), ("secant", 1.6, None), ("bisection", 1.0, 0.5), ("fixed-point", 1.0, 0.1275),
+])
+def test_estimated_orders_printed_for_the_seed_runs(cli, method, order, rate):
+    """Newton about 2, secant about 1.6, bisection and fixed-point linear at rates about
+    0.5 and 0.1275 (seed 002's convergence analyses)."""
+    doc = json.loads(cli("solve", "--method", method, "--format", "json").out)
+    conv = doc["convergence"]
+    assert conv["order"] == pytest.approx(order, abs=0.06)
+    if rate is not None:
+        assert conv["rate"] == pytest.approx(rate, abs=0.002)
+    from linkage.render.report import fmt
+
+    table = cli("solve", "--method", method).out
+    assert f"estimated order {fmt(conv['order'], 4)} (theory" in table

@@ -83,18 +83,14 @@ def scalar_problem(name: str) -> dict[str, Any]:
 
 
 def system_problem(name: str) -> dict[str, Any]:
-    from pathlib import Path
 
     import mpmath as mp
 
     from .problems.loops import load
+    from .samples import sample_path
     from .stress import _mp_fourbar_positions
 
-    here = Path(__file__).resolve()
-    for base in (here.parents[2] / "sample_inputs", Path.cwd() / "sample_inputs"):
-        if base.exists():
-            break
-    m = load(base / ("fourbar_me581.toml" if name == "fourbar" else "rapier_drive.toml"))
+    m = load(sample_path("fourbar_me581.toml" if name == "fourbar" else "rapier_drive.toml"))
     p = m.problem()
     if name == "fourbar":
         exact = _mp_fourbar_positions(90, 30, 60, 45, 65.0)["open"]
@@ -280,6 +276,17 @@ def error_of(x: Any, root: Any) -> float:
     return abs(x - root)
 
 
+def count_measurements(problems: Sequence[str], tolerances: Sequence[float]) -> int:
+    """How many measurements ``measure`` will make (for a progress bar)."""
+    total = 0
+    for name in problems:
+        spec = scalar_problem(name) if name in ("seed002", "quadratic") else system_problem(name)
+        contenders = (scalar_contenders(spec, 1e-6) if name in ("seed002", "quadratic")
+                      else system_contenders(name, spec, 1e-6))
+        total += len(contenders) * len(tolerances)
+    return total
+
+
 def measure(
     problems: Sequence[str],
     tolerances: Sequence[float],
@@ -313,25 +320,16 @@ def measure(
 
 def cold_start(repeats: int = 5) -> dict[str, float]:
     """Median wall time of fresh interpreters running the CLI and the stack's floor."""
-    from pathlib import Path
+    from .samples import sample_path
 
-    base = Path(__file__).resolve().parents[2] / "sample_inputs"
-    sample = base / "fourbar_me581.toml" if base.exists() else None
+    sample = sample_path("fourbar_me581.toml")
     commands = {
         "import typer, rich.table (floor)": [sys.executable, "-c", "import typer, rich.table"],
         "linkage solve": [sys.executable, "-m", "linkage", "solve"],
     }
-    if sample is not None:
-        commands["linkage solve FILE"] = [sys.executable, "-m", "linkage", "solve", str(sample)]
-        commands["linkage sweep FILE --step 10"] = [
-            sys.executable,
-            "-m",
-            "linkage",
-            "sweep",
-            str(sample),
-            "--step",
-            "10",
-        ]
+    commands["linkage solve FILE"] = [sys.executable, "-m", "linkage", "solve", str(sample)]
+    commands["linkage sweep FILE --step 10"] = [sys.executable, "-m", "linkage", "sweep", str(sample),
+                                                "--step", "10"]
     out = {}
     for label, cmd in commands.items():
         times = []

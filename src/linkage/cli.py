@@ -562,7 +562,10 @@ def stress(
     json_obj = {"seed": seed, "quick": quick, "seconds": report["seconds"],
                 "summary": [dict(zip(SUMMARY_HEADERS, r)) for r in rows],
                 "false_convergences": false, "crashes": crashes,
-                "hybrid": {k: v for k, v in (h or {}).items() if k != "rows"} or None}
+                "hybrid": ({**{k: v for k, v in h.items() if k not in ("rows", "failures")},
+                            "cases_detail": [{"case": n, "within_4_eps": ok, "hybrid_iterations": hi,
+                                              "bisection_iterations": bi, "hybrid_status": st}
+                                             for n, ok, hi, bi, st in h["rows"]]} if h else None)}
     emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=(SUMMARY_HEADERS, rows))
     if false or crashes:
         raise typer.Exit(1)
@@ -609,9 +612,18 @@ def bench(
                          "pip install 'linkage[bench]'") from None
     tolerances = QUICK_TOLERANCES if quick else FULL_TOLERANCES
     budget = 0.01 if quick else 0.015
-    with _progress_text() as say:
-        results = measure(names, tolerances, n_repeats, budget, progress=say)
-        cold_times = cold_start(3 if quick else 5) if cold else {}
+    from .bench import count_measurements
+
+    with _progress(count_measurements(names, tolerances), minimum=1) as advance:
+        done = [0]
+
+        def step(_: str) -> None:
+            done[0] += 1
+            if advance is not None:
+                advance(done[0])
+
+        results = measure(names, tolerances, n_repeats, budget, progress=step)
+    cold_times = cold_start(3 if quick else 5) if cold else {}
     target_rows = targets(results, cold_times) if cold else targets(results, {"linkage solve": math.nan})
     headers = ("problem", "contender", "tol", "time per solve (us)", "spread (us)", "error", "iterations",
                "evaluations")
@@ -641,35 +653,16 @@ def bench(
         typer.echo(f"wrote {plot}", err=True)
 
 
-class _progress_text:
-    """A rich status line on a terminal while a long job runs; nothing when piped."""
-
-    def __init__(self) -> None:
-        self.status: Any = None
-
-    def __enter__(self) -> Any:
-        if not sys.stderr.isatty():
-            return None
-        from rich.console import Console
-
-        self.status = Console(stderr=True).status("benchmarking")
-        self.status.start()
-        return lambda text: self.status.update(f"benchmarking: {text}")
-
-    def __exit__(self, *exc: object) -> None:
-        if self.status is not None:
-            self.status.stop()
-
-
 class _progress:
     """A rich progress bar on a terminal for long runs; nothing when piped."""
 
-    def __init__(self, total: int) -> None:
+    def __init__(self, total: int, minimum: int = 2000) -> None:
         self.total = total
+        self.minimum = minimum
         self.bar: Any = None
 
     def __enter__(self) -> Any:
-        if self.total < 2000 or not sys.stderr.isatty():
+        if self.total < self.minimum or not sys.stderr.isatty():
             return None
         from rich.progress import Progress
 
