@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..result import Status
-
 new_state = tuple.__new__
 """Build a NamedTuple state without its Python-level ``__new__``.
 
@@ -23,13 +21,5 @@ def display(fn: Any, x: float) -> float | None:
     """A value computed only for the table: a failure there must not end the solve."""
     try:
         return fn(x)
-    except (ArithmeticError, ValueError):
+    except (ArithmeticError, ValueError, TypeError):
         return None
-
-
-def failure(status: Status, detail: str) -> tuple[Status, str]:
-    return (status, detail)
-
-
-def nan_to_none(v: Any) -> Any:
-    return None if isinstance(v, float) and v != v else v
