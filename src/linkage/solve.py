@@ -134,6 +134,9 @@ def solve_scalar(
             start = {"x0": x0}
     try:
         state = m.init(problem, *args)
+        if "bracket" in start:
+            # f at the bracket's ends, known from init: the discontinuity check reuses them
+            start["f_ends"] = (state.fa, state.fb) if hasattr(state, "fa") else (state.fpre, state.fx)
     except TypeError:
         return Result(method=m.name, x=args[0], status=Status.DOMAIN_ERROR, iterations=0, nfev=0,
                       error=math.inf, residual=None, detail="at the start: f returned a non-real value",
@@ -159,7 +162,7 @@ def column_labels(m: Any, var: str, unit: str, has_u: bool, has_gprime: bool) ->
     return tuple(c.label(var, unit) for c in m.columns(shape))
 
 
-def check_sign_change(problem: ScalarProblem, state: Any, bracket: tuple[float, float],
+def check_sign_change(problem: ScalarProblem, state: Any, f_ends: tuple[float, float],
                       detail: str) -> tuple[Status, str, int]:
     """A bracket that closed on a root has a small residual; one that closed on a jump or
     a pole does not. When |f| at the answer is not far below its size at the starting
@@ -169,15 +172,12 @@ def check_sign_change(problem: ScalarProblem, state: Any, bracket: tuple[float, 
     x, fx = state.x, state.fx
     if fx is None or fx == 0.0:
         return Status.CONVERGED_STEP, detail, 0
-    try:
-        start_size = max(abs(problem.f(bracket[0])), abs(problem.f(bracket[1])))
-    except (ArithmeticError, ValueError, TypeError):
-        return Status.CONVERGED_STEP, detail, 0
+    start_size = max(abs(f_ends[0]), abs(f_ends[1]))
     if not math.isfinite(start_size) or abs(fx) <= 1e-3 * start_size:
-        return Status.CONVERGED_STEP, detail, 2
+        return Status.CONVERGED_STEP, detail, 0
     lo, hi = sorted(_final_bracket(state))
     flo = problem.f(lo)
-    evals = 3
+    evals = 1
     smallest = best_at_start = abs(fx)
     for _ in range(8):
         mid = 0.5 * lo + 0.5 * hi
@@ -215,8 +215,8 @@ def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: b
     nfev = m.init_evals + iterations * m.step_evals
     x = outcome_state.x
     residual = outcome_state.fx
-    if m.bracketing and status is Status.CONVERGED_STEP and "bracket" in start:
-        status, detail, extra = check_sign_change(problem, outcome_state, start["bracket"], detail)
+    if m.bracketing and status is Status.CONVERGED_STEP and "f_ends" in start:
+        status, detail, extra = check_sign_change(problem, outcome_state, start["f_ends"], detail)
         nfev += extra
     if residual is None and status is not Status.INVALID_BRACKET:
         try:
