@@ -88,12 +88,12 @@ def system_problem(name: str) -> dict[str, Any]:
 
     from .problems.loops import load
     from .samples import sample_path
-    from .stress import _mp_fourbar_positions
+    from .stress import mp_fourbar_positions
 
     m = load(sample_path("fourbar_me581.toml" if name == "fourbar" else "rapier_drive.toml"))
     p = m.problem()
     if name == "fourbar":
-        exact = _mp_fourbar_positions(90, 30, 60, 45, 65.0)["open"]
+        exact = mp_fourbar_positions(90, 30, 60, 45, 65.0)["open"]
         root = (exact["theta3"], exact["theta4"])
     else:
         from .problems.loops import DRIVER, LoopModel

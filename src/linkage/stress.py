@@ -437,7 +437,7 @@ def fourbar_cases(rng: random.Random, count: int) -> list[dict[str, Any]]:
                 continue
         except Indeterminate:
             continue
-        sols = _mp_fourbar_positions(r1, r2, r3, r4, theta2)
+        sols = mp_fourbar_positions(r1, r2, r3, r4, theta2)
         if not sols:
             continue
         branch = rng.choice(sorted(sols))
@@ -754,7 +754,7 @@ def run_scalar(cases: Sequence[Case], methods: Sequence[str]) -> dict[tuple[str,
     return tallies
 
 
-def _mp_fourbar_positions(
+def mp_fourbar_positions(
     r1: float, r2: float, r3: float, r4: float, theta2_deg: float
 ) -> dict[str, dict[str, float]]:
     """Both branches (rad) at 40 digits: the double-precision circle intersection loses
@@ -831,7 +831,7 @@ def run_fourbars(items: Sequence[dict[str, Any]], methods: Sequence[str]) -> dic
                 t.failed += 1
                 continue
             t3, t4 = (math.degrees(v) for v in result.x)
-            reference = _mp_fourbar_positions(r1, r2, r3, r4, it["theta2"])
+            reference = mp_fourbar_positions(r1, r2, r3, r4, it["theta2"])
             errs = {
                 b: max(
                     abs(wrap_degrees(t3 - math.degrees(s["theta3"]))),

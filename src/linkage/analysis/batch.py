@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from ..problems.closed_form import wrap_degrees
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel, Mechanism
 from .sweep import (
     Position,
@@ -74,9 +75,7 @@ class BatchResult:
 def _transmission_of(c: SweepResult, sol: dict[str, float] | None) -> float | None:
     if not c.classification or sol is None or "theta3" not in sol or "theta4" not in sol:
         return None
-    w = math.fmod(sol["theta4"] - sol["theta3"], 360.0)
-    w = w - 360.0 if w > 180.0 else (w + 360.0 if w <= -180.0 else w)
-    return abs(w)
+    return abs(wrap_degrees(sol["theta4"] - sol["theta3"]))
 
 
 class VectorLoops:
@@ -260,7 +259,7 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
             if cp.status == "converged":
                 qc = solver_q(solver, cp)
                 if have_closed:
-                    pos, _ = _solve_position(solver, v, qc, cp.input, qc, target, True, halvings=3)
+                    pos, _ = _solve_position(solver, v, qc, cp.input, qc, target, True)
                 else:
                     pos, _ = _continue(solver, v, [(cp.input, qc)], target)
                 if pos.status == "converged":

@@ -199,8 +199,8 @@ def sweep(
 
 
 def _solve_position(solver: _Solver, v: float, last_q: tuple[float, ...] | None, last_v: float | None,
-                    anchor_q: tuple[float, ...], target: str | None, have_closed: bool,
-                    halvings: int = MAX_HALVINGS) -> tuple[Position, tuple[float, ...] | None]:
+                    anchor_q: tuple[float, ...], target: str | None,
+                    have_closed: bool) -> tuple[Position, tuple[float, ...] | None]:
     def accept(p: Any, r: Any, substeps: int = 0, note: str = "") -> tuple[Position, tuple[float, ...]]:
         q = tuple(r.x)
         det = solver.det(p, q)
@@ -215,26 +215,11 @@ def _solve_position(solver: _Solver, v: float, last_q: tuple[float, ...] | None,
     if have_closed and ref == {}:
         return Position(v, "no_solution", None, None, 0, None,
                         note="the closed form has no real solution"), None
-    # 1. continuation from the previous position
-    if last_q is not None:
-        p, r = solver.solve(v, last_q)
-        if ok(p, r):
-            return accept(p, r)
-        # 2. the same path in ever smaller sub-steps
-        assert last_v is not None
-        for h in range(1, halvings + 1):
-            n = 2 ** h
-            q = last_q
-            good = True
-            for k in range(1, n + 1):
-                vk = last_v + (v - last_v) * k / n
-                p, r = solver.solve(vk, q)
-                if not ok(p, r):
-                    good = False
-                    break
-                q = tuple(r.x)
-            if good:
-                return accept(p, r, n, f"step halved to 1/{n}")
+    # 1. continuation from the previous position (with its own step halving)
+    if last_q is not None and last_v is not None:
+        pos, q = _continue(solver, v, [(last_v, last_q)], target)
+        if pos.status == "converged":
+            return pos, q
     # 3. re-entry (or first position): the closed form on the target branch, else anchors
     if have_closed:
         if ref:

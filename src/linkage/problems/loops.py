@@ -400,8 +400,11 @@ class LoopModel:
         if m.closed_form is not None:
             from .closed_form import branch_rule, reference_for
 
-            mm = m.with_values({m.driver.name: shown}, {})
-            reference = reference_for(mm)
+            def reference() -> Any:
+                # built when read: sweeps create several problems per position and
+                # rarely ask for the closed form
+                return reference_for(m.with_values({m.driver.name: shown}, {}))()
+
             branch_of = branch_rule(m)
         return SystemProblem(
             F=F, J=J,
