@@ -83,27 +83,62 @@ def emit(fmt: str, output: Path | None, *, blocks: Any, json_obj: Any,
         text = to_csv(*csv_table)
     elif fmt == "table":
         if output is None:
-            print_rich(blocks)
+            with _stdout_errors():
+                print_rich(blocks)
             return
         text = render_text(blocks, "simple")
     else:
         text = render_text(blocks, fmt)
     if output is None:
-        sys.stdout.write(text)
+        with _stdout_errors():
+            sys.stdout.write(text)
+            sys.stdout.flush()
         return
-    try:
-        output.write_text(text, encoding="utf-8")
-    except OSError as exc:
-        raise InputError(f"cannot write {output}: {exc.strerror or exc}") from None
+    from .files import write_atomic
+
+    write_atomic(output, text)
     typer.echo(f"wrote {output}", err=True)
+
+
+class _stdout_errors:
+    """A failed write to standard output (full disk, closed pipe) becomes one error line."""
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, kind: Any, exc: Any, tb: Any) -> bool:
+        if isinstance(exc, OSError):
+            from .errors import OutputError
+
+            raise OutputError(f"cannot write to standard output: {exc.strerror or exc}") from None
+        return False
+
+
+PICTURES = (".png", ".svg", ".pdf")
+
+
+def check_paths(inputs: list[Path | None], outputs: list[tuple[str, Path | None]],
+                pictures: dict[str, tuple[Path | None, tuple[str, ...]]] | None = None) -> None:
+    """Every output path checked before any work: not an input, not shared, its folder
+    exists; pictures have a suffix the plotter can write."""
+    from .files import check_outputs
+
+    for opt, (path, suffixes) in (pictures or {}).items():
+        if path is not None and path.suffix.lower() not in suffixes:
+            raise InputError(f"{opt} {path}: use one of {', '.join(suffixes)} for the picture")
+    check_outputs(inputs, outputs)
 
 
 def parse_number(name: str, text: str) -> float:
     """A finite number; fractions such as 5/3 are accepted."""
+    shown = text if len(text) <= 40 else f"{text[:20]}...({len(text)} characters)"
     try:
+        if len(text) > 400:
+            raise ValueError(text)
         value = float(Fraction(text.strip()))
-    except (ValueError, ZeroDivisionError):
-        raise InputError(f"{name} must be a finite number or a fraction like 5/3, got {text!r}") from None
+    except (ValueError, ZeroDivisionError, OverflowError):
+        raise InputError(f"{name} must be a finite number (at most about 1e308) or a fraction "
+                         f"like 5/3, got {shown!r}") from None
     return value
 
 
@@ -173,6 +208,7 @@ def solve(
     from .solve import check_criteria, check_number, solve_scalar
 
     out_fmt = choose_format(fmt, output)
+    check_paths([file], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})
     check_criteria(tol, rtol, ftol, max_iter)
     scalar_only = {"--alpha": alpha, "--r1": r1, "--r2": r2, "--r3": r3, "--links": links,
                    "--equation": equation, "--g": g, "--x0": x0, "--x1": x1, "--bracket": bracket}
@@ -391,28 +427,26 @@ def sweep(
 
     Example: linkage sweep sample_inputs/rapier_drive.toml --step 5
     """
-    from .analysis.sweep import driver_values
+    from .analysis.sweep import check_driver_values, driver_values
     from .analysis.sweep import sweep as run_sweep
     from .problems.loops import load
     from .render.sweep import sweep_blocks, sweep_dict, sweep_headers, sweep_rows
     from .solve import SYSTEM_METHODS, check_criteria, check_number
 
     out_fmt = choose_format(fmt, output)
+    check_paths([file], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})
     check_criteria(tol, 0.0, None, 50)
     a = check_number("--from", start)
     b = check_number("--to", stop)
     if step is not None and points is not None:
         raise InputError("give --step or --points, not both")
-    if points is not None and points < 1:
-        raise InputError(f"--points must be >= 1, got {points}")
-    if step is not None and not check_number("--step", step) > 0:
-        raise InputError(f"--step must be > 0, got {step!r}")
+    if step is not None:
+        check_number("--step", step)
     if b < a:
         raise InputError(f"--to ({b:g}) must not be below --from ({a:g})")
     if points is None and step is None:
         step = 1.0
-    if points is None and (b - a) / step > 10_000_000:  # type: ignore[operator]
-        raise InputError("that is more than ten million positions; use a larger --step")
+    values = driver_values(a, b, step, points)
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SYSTEM_METHODS)}")
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
@@ -422,7 +456,7 @@ def sweep(
         if mechanism.closed_form is None:
             raise InputError(f"--branch needs a mechanism with a closed form; {file} has none "
                              "(its branch follows the file's guess)")
-    values = driver_values(a, b, step, points)
+    values = check_driver_values(mechanism, values)
     use_batch = batch if batch is not None else (len(values) > 20_000 and method == "newton")
     if use_batch:
         if method != "newton":
@@ -473,6 +507,8 @@ def draw(
 
     if output is None and animate is None:
         raise InputError("give -o PATH for a drawing, --animate PATH.gif for an animation, or both")
+    check_paths([file], [("--output", output), ("--animate", animate)],
+                {"--output": (output, PICTURES), "--animate": (animate, (".gif",))})
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
     if output is not None:
         from .render.plots import draw_mechanism
@@ -534,6 +570,7 @@ def stress(
         if m not in known:
             raise InputError(f"unknown method {m!r}; choose from {', '.join(sorted(known))}")
     out_fmt = choose_format(fmt, output)
+    check_paths([], [("--output", output)])
     try:
         import mpmath  # noqa: F401
     except ImportError:
@@ -598,6 +635,7 @@ def bench(
     from .render.report import Text, table
 
     out_fmt = choose_format(fmt, output)
+    check_paths([], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})
     names = problem or (["seed002", "fourbar"] if quick else list(PROBLEMS))
     for name in names:
         if name not in PROBLEMS:
@@ -692,9 +730,16 @@ def run_cli(argv: list[str] | None = None) -> int:
         return 2
     except KeyboardInterrupt:
         typer.echo("error: interrupted", err=True)
-        return 1
+        return 130
     except BrokenPipeError:
-        return 0
+        typer.echo("error: cannot write to standard output: the pipe was closed", err=True)
+        return 2
+    except RecursionError:
+        typer.echo("error: the input is nested too deeply to read", err=True)
+        return 2
+    except MemoryError:
+        typer.echo("error: out of memory: the input asks for more than this machine has", err=True)
+        return 2
     except Exception as exc:
         if hasattr(exc, "format_message") and hasattr(exc, "exit_code"):
             # A usage error from typer's (or click's) parser: bad option, bad value.
@@ -707,4 +752,15 @@ def run_cli(argv: list[str] | None = None) -> int:
 
 
 def main() -> None:
-    sys.exit(run_cli())
+    code = run_cli()
+    try:
+        sys.stdout.flush()
+    except OSError:
+        # stdout is gone (closed pipe, full disk): say nothing more when Python exits
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        if code == 0:
+            typer.echo("error: cannot write to standard output", err=True)
+            code = 2
+    sys.exit(code)

@@ -19,6 +19,10 @@ class ParseError(InputError):
     """An equation, a number or a mechanism file that cannot be read."""
 
 
+class OutputError(LinkageError):
+    """An output that cannot be written (full disk, closed pipe, missing folder)."""
+
+
 class NotConvergedError(LinkageError):
     """Raised by :meth:`linkage.result.Result.raise_for_status` when a solve failed."""
 

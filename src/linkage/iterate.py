@@ -11,39 +11,82 @@ Stopping tests run after every step, in this fixed order (first match wins):
    for the open scalar methods (Newton, secant) not at a point whose |f| is worse than
    one already seen and still above 1e-8 of the start's (a tiny step from a far-away
    slope is not a root; differences at rounding level are), and only where the method
-   finds its own step plausible (the secant: a local chord, see ``Secant.plausible``).
+   finds its own step plausible (the secant: a local chord, see ``Secant.plausible``),
+   and, when a ``certify`` test is given (the open scalar methods), only where it finds
+   evidence of a root within the tolerance; without it the run goes on (a linearly
+   converging iteration's step understates its error), and after ``UNCERTIFIED_LIMIT``
+   small steps without evidence it ends as ``STALLED`` (or as what the test names);
    Methods with ``needs_residual`` (the systems) converge only when the step *and* the
    residual pass (P3: max|Phi| < eps and max|dq| < eps; ``ftol`` defaults to ``tol``);
    a small step with the residual above it continues, or, for methods that minimise
-   the residual (``minimizes``), is ``NO_SOLUTION``;
+   the residual (``minimizes``), is ``LOCAL_MINIMUM`` (no root found from this start;
+   ``NO_SOLUTION`` is kept for proven non-assembly, by a closed form);
 6. growth of the error for ``DIVERGE_STREAK`` steps in a row        -> ``DIVERGED``
-   (open methods only: a bracket cannot diverge);
+   (open methods only: a bracket cannot diverge; for systems only with the iterate
+   running away past ``RUNAWAY`` times its starting size);
 7. an error at rounding level that stops shrinking (twice), or six
    rounding-level steps, while still above the tolerance            -> ``PRECISION_LIMIT``;
 8. the iteration cap                                                -> ``MAX_ITER``.
 
 The step test mirrors seed 001 section 3.9 (epsilon_s on the step, epsilon_e on the
 residual) and, with ``ftol=None``, reproduces the seed-002 tables row for row.
-Recording is off unless asked for: with ``record=False`` no row is built.
+Recording is off unless asked for: with ``record=False`` no row is built. A recorded
+history has a fixed ceiling: the first ``HISTORY_HEAD`` and the last ``HISTORY_TAIL`` rows
+are kept and the count of rows left out between them is reported.
 """
 
 from __future__ import annotations
 
 import math
 import sys
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 from .result import Status
 
+UNCERTIFIED_LIMIT = 4
+"""Small steps without evidence of a root after which an open scalar method stops."""
+
 DIVERGE_STREAK = 5
 """Consecutive growing steps after which an open method is declared diverged."""
+
+RUNAWAY = 1e8
+"""For systems, growing steps are divergence only once |q| exceeds this times 1 + |q0|."""
 
 ROUNDING = 4.0 * sys.float_info.epsilon
 """Relative size of a step that is indistinguishable from rounding noise."""
 
 _isfinite = math.isfinite
+
+MAX_ITER_LIMIT = 100_000
+"""The largest iteration cap accepted: a run that has not converged by then never will."""
+
+HISTORY_HEAD = 200
+HISTORY_TAIL = 300
+"""Rows kept from the start and from the end of a long recorded run."""
+
+
+class Rows(list):  # type: ignore[type-arg]
+    """Recorded rows with a fixed ceiling: the head in the list, the tail in a ring."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.tail: deque[tuple[Any, ...]] = deque(maxlen=HISTORY_TAIL)
+        self.elided = 0
+
+    def add(self, row: tuple[Any, ...]) -> None:
+        if len(self) < HISTORY_HEAD:
+            self.append(row)
+            return
+        if len(self.tail) == HISTORY_TAIL:
+            self.elided += 1
+        self.tail.append(row)
+
+    def finish(self) -> tuple[list[tuple[Any, ...]], int, int]:
+        """(rows, elided, index in rows where the gap is)."""
+        return [*self, *self.tail], self.elided, len(self)
 
 
 @dataclass(frozen=True)
@@ -56,7 +99,7 @@ class Criteria:
     max_iter: int = 100
 
 
-Outcome = tuple  # (final state, Status, detail, iterations, rows or None)
+Outcome = tuple  # (final state, Status, detail, iterations, Rows or None)
 
 
 def explain(exc: BaseException) -> tuple[Status, str]:
@@ -75,6 +118,7 @@ def run(
     *,
     record: bool,
     magnitude: Callable[[Any], float] = abs,
+    certify: Callable[[Any, float], tuple[Status, str]] | None = None,
 ) -> Outcome:
     """Iterate ``method.step`` from ``state`` until a stopping test fires.
 
@@ -82,12 +126,12 @@ def run(
     not evaluated), ``err`` (the method's error measure, >= 0) and ``stop`` (``None`` or
     a ``(Status, detail)`` pair set by the step).
     """
-    rows: list[tuple[Any, ...]] | None = None
+    rows: Rows | None = None
     if record:
-        rows = []
+        rows = Rows()
         first = method.initial_row(problem, state)
         if first is not None:
-            rows.append(first)
+            rows.add(first)
     step = method.step
     row = method.row
     index0 = method.first_index - 1
@@ -103,6 +147,8 @@ def run(
     best_fx = min(seen) if seen else math.inf
     start_fx = max(seen) if seen else math.inf
     growth = 0
+    runaway = RUNAWAY * (1.0 + magnitude(state.x))
+    uncertified = 0
     stalls = 0
     rounding_steps = 0
     status = Status.MAX_ITER
@@ -117,7 +163,7 @@ def run(
             break
         state = new
         if rows is not None:
-            rows.append(row(problem, state, k + index0))
+            rows.add(row(problem, state, k + index0))
         if state.stop is not None:
             status, detail = state.stop
             break
@@ -156,9 +202,18 @@ def run(
         if err <= limit:
             if needs_residual and (fx is None or abs(fx) > gate):
                 if minimizes:
-                    status = Status.NO_SOLUTION
+                    status = Status.LOCAL_MINIMUM
                     detail = (f"the least-squares residual stalls at {abs(fx or math.nan):.3g}, "
                               f"above the tolerance {gate:.3g}")
+                    break
+            elif certify is not None:
+                verdict, why = certify(state, limit)
+                if verdict is Status.CONVERGED_STEP:
+                    status = verdict
+                    break
+                uncertified += 1
+                if verdict is not Status.STALLED or uncertified >= UNCERTIFIED_LIMIT:
+                    status, detail = verdict, why
                     break
             else:
                 # The detail is formatted later from the result's fields: formatting here
@@ -167,7 +222,9 @@ def run(
                 break
         if can_diverge:
             growth = growth + 1 if err > prev_err else 0
-            if growth >= DIVERGE_STREAK:
+            # a system's Newton may wander and recover (MGH, a mechanism far from its
+            # assembly): only iterates running away are evidence of divergence
+            if growth >= DIVERGE_STREAK and (not needs_residual or magnitude(x) > runaway):
                 status, detail = Status.DIVERGED, f"{growth} growing steps, last {err:.3g}"
                 break
         if err <= ROUNDING * magnitude(x):

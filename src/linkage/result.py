@@ -26,6 +26,8 @@ class Status(Enum):
     SINGULAR_JACOBIAN = "singular_jacobian"
     NO_SOLUTION = "no_solution"
     DISCONTINUITY = "discontinuity"
+    STALLED = "stalled"
+    LOCAL_MINIMUM = "local_minimum"
 
     @property
     def converged(self) -> bool:
@@ -51,8 +53,11 @@ _MESSAGES = {
     Status.PRECISION_LIMIT: "stopped at the limit of double precision before reaching the tolerance",
     Status.SINGULAR_JACOBIAN: "stalled: the Jacobian is singular",
     Status.NO_SOLUTION: "no solution: the residual stays above the tolerance",
-    Status.DISCONTINUITY: "stopped: the bracket closed on a sign change where |f| does not shrink "
-                          "(a jump or a pole), not on a root",
+    Status.STALLED: "stalled: the steps fell below the tolerance, but nothing shows a root within it",
+    Status.LOCAL_MINIMUM: "no root found from this start: the residual stopped decreasing at a local "
+                          "minimum above the tolerance",
+    Status.DISCONTINUITY: "stopped: f changes sign here through a jump or a pole (|f| does not "
+                          "shrink toward the sign change), not through a root",
 }
 
 
@@ -95,6 +100,26 @@ class History:
     columns: tuple[str, ...]
     rows: tuple[tuple[Any, ...], ...]
     error_column: int
+    elided: int = 0
+    """Rows left out of a long run (the history keeps its first and last rows)."""
+    gap_at: int = 0
+    """With ``elided``: the index in ``rows`` of the first row after the gap."""
+
+    @classmethod
+    def of(cls, columns: tuple[str, ...], rows: Any, error_column: int) -> History:
+        """A History from the loop's rows (a list, or a ceiling-bounded ``Rows``)."""
+        if hasattr(rows, "finish"):
+            kept, elided, gap = rows.finish()
+            return cls(columns, tuple(kept), error_column, elided, gap if elided else 0)
+        return cls(columns, tuple(rows), error_column)
+
+    @property
+    def note(self) -> str:
+        if not self.elided:
+            return ""
+        return (f"({self.elided} rows between i = {self.rows[self.gap_at - 1][0]} and "
+                f"i = {self.rows[self.gap_at][0]} are left out: a history keeps its first "
+                f"{self.gap_at} and last {len(self.rows) - self.gap_at} rows)")
 
     def errors(self) -> list[float | None]:
         k = self.error_column

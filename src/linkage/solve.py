@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import functools
 import math
+import sys
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any
 
 from .errors import InputError
-from .iterate import Criteria, explain, run
+from .iterate import MAX_ITER_LIMIT, Criteria, explain, run
 from .methods import SCALAR_METHODS, Bisection, FixedPoint, Hybrid, Newton, RegulaFalsi, Secant
 from .problems.scalar import ScalarProblem
 from .result import History, Result, Status
@@ -28,6 +29,11 @@ def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: b
     return v
 
 
+def _short_int(v: int) -> str:
+    text = str(v) if v < 10**30 else f"about 1e{len(str(v)) - 1}"
+    return text
+
+
 @functools.lru_cache(maxsize=256)
 def check_criteria(tol: float, rtol: float, ftol: float | None, max_iter: int) -> Criteria:
     tol = check_number("tol", tol, positive=True, allow_zero=False)
@@ -36,6 +42,9 @@ def check_criteria(tol: float, rtol: float, ftol: float | None, max_iter: int) -
         ftol = check_number("ftol", ftol, positive=True, allow_zero=False)
     if isinstance(max_iter, bool) or not isinstance(max_iter, int) or max_iter < 1:
         raise InputError(f"max_iter must be an integer >= 1, got {max_iter!r}")
+    if max_iter > MAX_ITER_LIMIT:
+        raise InputError(f"max_iter must be at most {MAX_ITER_LIMIT:,}, got {_short_int(max_iter)}: "
+                         "a run that has not converged by then will not")
     return Criteria(tol, rtol, ftol, max_iter)
 
 
@@ -162,23 +171,26 @@ def column_labels(m: Any, var: str, unit: str, has_u: bool, has_gprime: bool) ->
     return tuple(c.label(var, unit) for c in m.columns(shape))
 
 
-def check_sign_change(problem: ScalarProblem, state: Any, f_ends: tuple[float, float],
-                      detail: str) -> tuple[Status, str, int]:
-    """A bracket that closed on a root has a small residual; one that closed on a jump or
-    a pole does not. When |f| at the answer is not far below its size at the starting
-    bracket, bisect the final bracket 8 more times: at a root |f| falls below the
-    answer's with the width (about 256 times for a simple root), at a jump it stays, at a
-    pole it grows."""
-    x, fx = state.x, state.fx
+def check_sign_change(problem: ScalarProblem, x: float, fx: float | None, lo: float, hi: float,
+                      f_ends: tuple[float, float], detail: str,
+                      shrink_from: float | None = None) -> tuple[Status, str, int]:
+    """A bracket [lo, hi] with a sign change that closed on a root has a small residual;
+    one that closed on a jump or a pole does not. When |f| at x is not far below its size
+    at ``f_ends``, bisect [lo, hi] 8 more times: at a root |f| falls below the answer's
+    with the width (about 256 times for a simple root), at a jump it stays, at a pole it
+    grows. ``shrink_from``: the size |f| must fall below by 16 (default |f(x)|; the
+    certification of an open method, whose x may already sit nearer the root than the
+    bisection resolves, passes the size at the interval's ends)."""
     if fx is None or fx == 0.0:
         return Status.CONVERGED_STEP, detail, 0
     start_size = max(abs(f_ends[0]), abs(f_ends[1]))
     if not math.isfinite(start_size) or abs(fx) <= 1e-3 * start_size:
         return Status.CONVERGED_STEP, detail, 0
-    lo, hi = sorted(_final_bracket(state))
+    lo, hi = sorted((lo, hi))
     flo = problem.f(lo)
     evals = 1
-    smallest = best_at_start = abs(fx)
+    smallest = abs(fx)
+    best_at_start = abs(fx) if shrink_from is None else shrink_from
     for _ in range(8):
         mid = 0.5 * lo + 0.5 * hi
         if mid in (lo, hi):
@@ -204,6 +216,47 @@ def _final_bracket(state: Any) -> tuple[float, float]:
     return state.a, state.b
 
 
+def _value(f: Callable[[float], float], x: float) -> float | None:
+    try:
+        v = f(x)
+    except (ArithmeticError, ValueError, TypeError):
+        return None
+    return v if isinstance(v, float) and math.isfinite(v) else None
+
+
+_BIG = sys.float_info.max
+
+
+def certify_root(problem: ScalarProblem, x: float, fx: float | None, width: float) -> tuple[Status, str, int]:
+    """Evidence that a root of f lies within ``width`` of x, for an open method's small step.
+
+    Accepted: |f(x)| within its own rounding bound (``problem.fbound``: f is zero to the
+    precision it can be computed with), or a sign change of f across [x - width, x + width]
+    that is not a jump or a pole (:func:`check_sign_change`). Otherwise ``STALLED``: a
+    small step is only a symptom (Newton near a pole, an overflowing power, a flat f).
+    Returns (status, detail, extra evaluations of f).
+    """
+    if not isinstance(fx, (int, float)) or not math.isfinite(fx):
+        return Status.STALLED, f"f = {fx!r} at the last iterate", 0
+    if fx == 0.0:
+        return Status.CONVERGED_STEP, "", 0
+    if problem.fbound is not None:
+        bound = _value(problem.fbound, x)
+        if bound is not None and abs(fx) <= bound:
+            return Status.CONVERGED_STEP, "", 0
+    lo, hi = max(x - width, -_BIG), min(x + width, _BIG)
+    flo, fhi = _value(problem.f, lo), _value(problem.f, hi)
+    if flo is not None and fhi is not None and (flo == 0.0 or fhi == 0.0 or (flo < 0.0) != (fhi < 0.0)):
+        ends = max(abs(flo), abs(fhi))
+        status, detail, extra = check_sign_change(problem, x, fx, lo, hi, (flo, fhi), "", ends)
+        return status, detail, 2 + extra
+    shown = ", ".join(f"f({v:.17g}) = {fv:.3g}" if fv is not None else f"f({v:.17g}) is undefined"
+                      for v, fv in ((lo, flo), (hi, fhi)))
+    return (Status.STALLED,
+            f"f = {fx:.3g} at {problem.var} = {x!r}; no sign change within +-{width:.3g} ({shown})"
+            + ("" if problem.fbound is None else " and |f| is above its rounding level"), 2)
+
+
 def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: bool,
            start: dict[str, Any]) -> Result:
     """Run the loop from an initial state and package the outcome as a Result."""
@@ -211,24 +264,37 @@ def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: b
         status, detail = state.stop
         outcome_state, iterations, rows = state, 0, ([] if record else None)
     else:
-        outcome_state, status, detail, iterations, rows = run(m, problem, state, crit, record=record)
-    nfev = m.init_evals + iterations * m.step_evals
+        certify = None
+        extra_evals = [0]
+        if not m.bracketing:
+            def certify(s: Any, width: float) -> tuple[Status, str]:
+                fx = s.fx if s.fx is not None else _value(problem.f, s.x)
+                verdict, why, n = certify_root(problem, s.x, fx, width)
+                extra_evals[0] += n + (s.fx is None)
+                return verdict, why
+        outcome_state, status, detail, iterations, rows = run(m, problem, state, crit, record=record,
+                                                              certify=certify)
+    nfev = m.init_evals + iterations * m.step_evals + (0 if state.stop is not None else extra_evals[0])
     x = outcome_state.x
     residual = outcome_state.fx
-    if m.bracketing and status is Status.CONVERGED_STEP and "f_ends" in start:
-        status, detail, extra = check_sign_change(problem, outcome_state, start["f_ends"], detail)
-        nfev += extra
     if residual is None and status is not Status.INVALID_BRACKET:
         try:
             residual = problem.f(x)
             nfev += 1
         except (ArithmeticError, ValueError):
             residual = math.nan
+    if status is Status.CONVERGED_STEP:
+        if m.bracketing:
+            if "f_ends" in start:
+                lo, hi = _final_bracket(outcome_state)
+                status, detail, extra = check_sign_change(problem, x, residual, lo, hi, start["f_ends"],
+                                                          detail)
+                nfev += extra
     history = None
     if rows is not None:
         labels = column_labels(m, problem.var, problem.unit, problem.u is not None,
                                problem.gprime is not None)
-        history = History(labels, tuple(rows), len(labels) - 1)
+        history = History.of(labels, rows, len(labels) - 1)
     err = outcome_state.err
     return Result(
         method=m.name,
@@ -249,6 +315,9 @@ def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: b
 
 SYSTEM_METHODS: tuple[str, ...] = ("newton", "newton-fd", "lm")
 
+MAX_RELATIVE_TOL = 1e-2
+"""The loosest tolerance a mechanism accepts: 1% of its size, or 0.01 rad (0.57 deg)."""
+
 
 def solve_system(
     F: Callable[..., list[float]] | Any,
@@ -262,7 +331,7 @@ def solve_system(
     max_iter: int = 50,
     record: bool = True,
     fd_step: float | None = None,
-    damped: bool = False,
+    damped: bool = True,
     show_jacobian: bool = False,
 ) -> Result:
     """Solve Phi(q) = 0 for n unknowns: ``newton`` (analytic Jacobian ``jac``),
@@ -273,7 +342,12 @@ def solve_system(
     (for instance ``linkage.load_mechanism(path).problem()``), which supplies the
     Jacobian, names, units and a default ``x0``. ``x0`` is in internal units (radians).
     Converges when max|dq| <= tol + rtol max|q| and max|Phi| <= ftol (ftol defaults to
-    tol), as in PROBLEMS.md P3; ``damped`` adds a line search to Newton.
+    tol), as in PROBLEMS.md P3. For a mechanism both are relative to its size
+    (``problem.length_scale``, its longest length): Phi and length steps are compared
+    with tol times that size, so units do not change the answer, and tolerances above
+    MAX_RELATIVE_TOL are refused. ``damped`` (default) globalises Newton (see
+    :class:`~linkage.methods.newton_system.NewtonSystem`); ``damped=False`` is the
+    textbook iteration.
     Returns a :class:`Result` with ``x`` (a tuple), ``nfev`` and ``njev``.
     """
     from .methods.least_squares import LevenbergMarquardt
@@ -299,6 +373,12 @@ def solve_system(
         raise InputError(f"x0 needs {problem.n} values ({', '.join(problem.names)}), "
                          f"got {0 if x0 is None else len(x0)}")
     q0 = tuple(check_number(f"x0[{n}]", v) for n, v in zip(problem.names, x0))
+    if problem.length_scale != 1.0 or "length" in problem.kinds or problem.length_unit:
+        for name, value in (("tol", crit.tol), ("ftol", crit.ftol)):
+            if value is not None and value > MAX_RELATIVE_TOL:
+                raise InputError(f"{name} = {value:g} is too loose to mean anything: for a mechanism "
+                                 f"it is relative to its size ({problem.length_scale:g} "
+                                 f"{problem.length_unit}); use at most {MAX_RELATIVE_TOL:g}")
     if method == "newton" and problem.J is None:
         raise InputError("newton needs the Jacobian jac; use method='newton-fd' to difference it")
     kind = "fd" if method == "newton-fd" or problem.J is None else "analytic"
@@ -311,7 +391,10 @@ def solve_system(
     if len(phi0) != problem.n:
         raise InputError(f"the system has {len(phi0)} equations for {problem.n} unknowns")
     state = m.init(problem, q0)
-    final, status, detail, iterations, rows = run(m, problem, state, crit, record=record,
+    scale = problem.length_scale
+    gate = (crit.ftol if crit.ftol is not None else crit.tol) * scale
+    run_crit = replace(crit, ftol=gate)
+    final, status, detail, iterations, rows = run(m, problem, state, run_crit, record=record,
                                                   magnitude=max_abs)
     x = tuple(final.x)
     nfev, njev = final.nfev, final.njev
@@ -320,9 +403,12 @@ def solve_system(
         nfev += 1
     except (ArithmeticError, ValueError):
         residual = math.nan
-    gate = crit.ftol if crit.ftol is not None else crit.tol
+    if status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN) and residual <= gate and final.stop:
+        # no step lowers |Phi| any more, and it is already within the residual tolerance:
+        # a root to that tolerance (ill-conditioned, so the step test could not pass)
+        status, detail = Status.CONVERGED_RESIDUAL, f"max|Phi| = {residual:.3g} <= {gate:.3g}; {detail}"
     if status.converged and not residual <= gate:
-        status, detail = Status.NO_SOLUTION, f"max|Phi| = {residual:.3g} at the end, above {gate:.3g}"
+        status, detail = Status.STALLED, f"max|Phi| = {residual:.3g} at the end, above {gate:.3g}"
     meta: dict[str, Any] = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names,
                             "kinds": problem.kinds, "title": problem.title, **problem.meta}
     # The closed form serves the table's true-error column and the verdict on a failed
@@ -350,8 +436,9 @@ def _system_history(m: Any, problem: Any, rows: list[tuple[Any, ...]], show_jaco
     from .problems.closed_form import wrap_degrees
 
     labels = [c.template for c in m.columns(problem, show_jacobian)]
+    kept, elided, gap = rows.finish() if hasattr(rows, "finish") else (rows, 0, 0)
     out = []
-    for r in rows:
+    for r in kept:
         *head, jac, err = r
         body = list(head)
         if show_jacobian:
@@ -369,7 +456,7 @@ def _system_history(m: Any, problem: Any, rows: list[tuple[Any, ...]], show_jaco
                     for v, n, k in zip(qd, problem.names, problem.kinds)]
             fixed.append((*r[:-1], max(errs), r[-1]))
         out = fixed
-    return History(tuple(labels), tuple(out), len(labels) - 1)
+    return History(tuple(labels), tuple(out), len(labels) - 1, elided, gap if elided else 0)
 
 
 def nearest_branch(problem: Any, reference: dict[str, dict[str, float]] | None,

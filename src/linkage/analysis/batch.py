@@ -23,15 +23,18 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import InputError
 from ..problems.closed_form import wrap_degrees
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel, Mechanism
 from .sweep import (
+    MAX_POSITIONS,
     Position,
     SweepResult,
     _classify_gap,
     _continue,
     _solve_position,
     _Solver,
+    check_driver_values,
     driver_values,
     solver_q,
     sweep,
@@ -155,6 +158,14 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
                 tol: float = 1e-12, max_iter: int = 30, coarse: int = 361) -> BatchResult:
     """Solve ``m`` at every driver value in ``values`` (display units, ascending)."""
     vals = np.asarray(values, dtype=float)
+    if vals.ndim != 1:
+        raise InputError("the driver values must be a one-dimensional sequence")
+    if len(vals) > MAX_POSITIONS:
+        raise InputError(f"{len(vals):,} driver values is more than {MAX_POSITIONS:,}; sweep in parts")
+    if len(vals):
+        if not np.isfinite(vals).all():
+            raise InputError("the driver values must be finite")
+        check_driver_values(m, [float(vals.min()), float(vals.max())])
     n_pos = len(vals)
     lo, hi = float(vals[0]), float(vals[-1])
     grid = driver_values(lo, hi, None, min(coarse, n_pos))

@@ -83,11 +83,13 @@ estimates use |x_k - x_final| from the column of best estimates instead."""
 def _errors(result: Result) -> list[tuple[Any, float]]:
     h = result.history
     assert h is not None
+    # after a gap in a long history, only the contiguous last rows give ratios
+    rows = h.rows[h.gap_at:] if h.elided else h.rows
     col = ESTIMATE_COLUMN.get(result.method)
     if col is not None:
-        xs = [(r[0], r[col]) for r in h.rows if isinstance(r[col], float)]
+        xs = [(r[0], r[col]) for r in rows if isinstance(r[col], float)]
         return [(i, abs(x - result.x)) for i, x in xs[:-1] if math.isfinite(x)]
-    return [(r[0], abs(e)) for r, e in zip(h.rows, h.errors())
+    return [(r[0], abs(e)) for r, e in zip(rows, (r[h.error_column] for r in rows))
             if isinstance(e, (int, float)) and math.isfinite(e)]
 
 

@@ -96,12 +96,15 @@ class _Solver:
     def problem(self, value: float, guess: Sequence[float]) -> Any:
         return self.model.problem_at(value * self.scale, tuple(guess))
 
-    def solve(self, value: float, guess: Sequence[float], method: str | None = None) -> tuple[Any, Any]:
+    def solve(self, value: float, guess: Sequence[float], method: str | None = None,
+              damped: bool = False) -> tuple[Any, Any]:
+        """Continuation takes the textbook step (``damped=False``): its own step halving
+        and continuity check decide which assembly a position belongs to."""
         from ..solve import solve_system
 
         p = self.problem(value, guess)
         r = solve_system(p, method=method or self.method, tol=self.tol, max_iter=self.max_iter,
-                         record=False)
+                         record=False, damped=damped)
         return p, r
 
     def display(self, q: Sequence[float]) -> dict[str, float]:
@@ -132,8 +135,8 @@ def sweep(
     progress: Callable[[int], None] | None = None,
 ) -> SweepResult:
     """Solve the mechanism at each driver value (display units), by continuation."""
+    values = check_driver_values(m, values)
     solver = _Solver(m, method, tol, max_iter)
-    values = list(values)
     lo, hi = (min(values), max(values)) if values else (0.0, 0.0)
     arcs = feasible_arcs(m) if m.closed_form and m.driver.kind == "angle" else None
     have_closed = m.closed_form is not None and m.driver.kind == "angle"
@@ -196,6 +199,27 @@ def sweep(
     return SweepResult(m.name, m.driver.name, m.driver.unit, solver.names,
                        tuple("deg" if k == "angle" else m.length_unit for k in solver.kinds),
                        tuple(positions), ranges, tuple(toggles), target, classification, method)
+
+
+def check_driver_values(m: Mechanism, values: Sequence[float]) -> list[float]:
+    """The values as floats, or InputError: too many, not finite, or beyond what the
+    driver's kind can represent (see :func:`~linkage.problems.loops.magnitude_problem`)."""
+    from ..errors import InputError
+    from ..problems.loops import magnitude_problem
+
+    if len(values) > MAX_POSITIONS:
+        raise InputError(f"{len(values):,} driver values is more than {MAX_POSITIONS:,}; sweep in parts")
+    out = [float(v) for v in values]
+    if not out:
+        return out
+    lo, hi = min(out), max(out)
+    scale = math.pi / 180.0 if m.driver.kind == "angle" else 1.0
+    for v in (lo, hi):
+        why = magnitude_problem(v * scale, m.driver.kind, m.length_unit) if math.isfinite(v) else \
+            "the driver values must be finite"
+        if why:
+            raise InputError(f"driver {m.driver.name}: {why}")
+    return out
 
 
 def _solve_position(solver: _Solver, v: float, last_q: tuple[float, ...] | None, last_v: float | None,
@@ -330,9 +354,9 @@ def _classify_gap(solver: _Solver, v: float, guesses: Sequence[tuple[float, ...]
     form: off_branch if Newton or least squares closes the loops from any guess (another
     assembly exists; its solution is returned so the next position can start from it),
     no_solution if neither does from any of them."""
-    for method in (None, "lm"):
+    for method, damped in ((None, False), (None, True), ("lm", True)):
         for g in guesses:
-            _p, r = solver.solve(v, g, method=method)
+            _p, r = solver.solve(v, g, method=method, damped=damped)
             if r.converged:
                 return Position(v, "off_branch", None, None, r.iterations, None,
                                 note="an assembly exists here, but the followed branch does not "
@@ -553,12 +577,43 @@ def solver_q(solver: _Solver, pos: Position) -> tuple[float, ...]:
                  for n, k in zip(solver.names, solver.kinds))
 
 
+MAX_POSITIONS = 2_000_000
+"""The most positions one sweep may ask for (the batch engine holds them all in memory)."""
+
+
 def driver_values(start: float, stop: float, step: float | None, points: int | None) -> list[float]:
-    """The driver values of a sweep: start, start + step, ... <= stop, or ``points`` evenly."""
+    """The driver values of a sweep: start, start + step, ... <= stop, or ``points`` evenly.
+
+    Refuses (InputError) more than MAX_POSITIONS values, and ranges whose values double
+    precision cannot tell apart at that spacing (``--from 1e26 --step 1``)."""
+    from ..errors import InputError
+
+    for name, v in (("--from", start), ("--to", stop)):
+        if not math.isfinite(v):
+            raise InputError(f"{name} must be finite, got {v!r}")
+    if points is not None:
+        if points < 1:
+            raise InputError(f"--points must be >= 1, got {points}")
+        if points > MAX_POSITIONS:
+            raise InputError(f"--points {points} is more than {MAX_POSITIONS:,} positions; "
+                             "sweep in parts or use fewer points")
+        spacing = (stop - start) / (points - 1) if points > 1 else math.inf
+    else:
+        assert step is not None
+        if not (math.isfinite(step) and step > 0.0):
+            raise InputError(f"--step must be > 0 and finite, got {step!r}")
+        count = (stop - start) / step
+        if count + 1 > MAX_POSITIONS:
+            raise InputError(f"--from {start:g} --to {stop:g} --step {step:g} is more than "
+                             f"{MAX_POSITIONS:,} positions; use a larger --step")
+        spacing = step
+    ulp = math.ulp(max(abs(start), abs(stop)))
+    if points != 1 and not spacing >= 1e6 * ulp:
+        raise InputError(f"--from {start:g} and --to {stop:g} are too large for a spacing of "
+                         f"{spacing:g}: double precision resolves only {ulp:.3g} there")
     if points is not None:
         if points == 1:
             return [start]
         return [start + (stop - start) * k / (points - 1) for k in range(points)]
-    assert step is not None
     n = math.floor((stop - start) / step + 1e-9)
     return [start + k * step for k in range(n + 1)]

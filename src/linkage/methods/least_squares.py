@@ -5,8 +5,9 @@ squares; mu shrinks by 3 after a success and doubles after a failure (Marquardt,
 SIAM J. Appl. Math. 11, 1963). Near a zero-residual solution it behaves like
 Gauss-Newton (fast, about quadratic); where the loops cannot close it settles on a
 least-squares point with residual above the tolerance, and the loop then reports
-``no_solution`` rather than success (seed 001: the spreadsheet's Solver stops at a
-minimum, which is a solution only if the minimum is zero).
+``local_minimum`` rather than success (seed 001: the spreadsheet's Solver stops at a
+minimum, which is a solution only if the minimum is zero). Where a closed form proves
+that no assembly exists, the solve reports ``no_solution`` instead.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from ..problems.system import SystemProblem
 from ..result import Column, Status
 from ._common import new_state
 from ._linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve
-from .newton_system import fd_jacobian, max_abs, system_columns, system_row
+from .newton_system import fd_jacobian, max_abs, step_measure, system_columns, system_row
 
 MU_MAX = 1e16
 
@@ -99,7 +100,8 @@ class LevenbergMarquardt:
                 cost_t = sum(v * v for v in phi_t)
                 if cost_t < s.cost:
                     return new_state(LMState, (
-                        tuple(trial), max_abs(phi_t), max_abs(dq), None, tuple(q), tuple(phi),
+                        tuple(trial), max_abs(phi_t), step_measure(dq, problem.step_scales), None,
+                        tuple(q), tuple(phi),
                         tuple(map(tuple, jac)), tuple(dq), det, cond, max(mu / 3.0, 1e-12), cost_t,
                         tuple(phi_t), nfev, njev))
             mu *= 2.0

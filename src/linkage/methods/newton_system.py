@@ -4,11 +4,12 @@ Quadratic convergence near a solution where J is nonsingular (seed 001 section 3
 eq. 7; PROBLEMS.md P3). One residual and one Jacobian evaluation per step; with the
 Jacobian by forward differences (``newton-fd``, seed 000's recipe: perturb one
 coordinate by h, take (Phi(q + h e_j) - Phi(q)) / h as column j, restore it), n + 1
-residual evaluations and order falling toward linear as h grows. ``damped`` adds a
-backtracking line search on |Phi|^2 (Armijo, halving down to 1/1024) for poor
-starting guesses. Fails where det J = 0 (toggle or dead-centre positions, a start
-such as theta3 = theta4): a named ``singular_jacobian`` stop with det and condition
-number. Rows follow P3: k, q_k, Phi(q_k), max|Phi|, dq (rad and deg), det J, cond J.
+residual evaluations and order falling toward linear as h grows. By default the step
+is globalised (``damped``, see :class:`NewtonSystem`): taken whole when it lowers
+|Phi|^2, else shortened, else replaced by a Levenberg-Marquardt step. The textbook
+iteration (``damped=False``) fails where det J = 0 (toggle or dead-centre positions, a
+start such as theta3 = theta4): a named ``singular_jacobian`` stop with det and
+condition number. Rows follow P3: k, q_k, Phi(q_k), max|Phi|, dq (rad and deg), det J, cond J.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ from ..problems.system import SystemProblem
 from ..result import Column, Status
 from ._common import new_state
 from ._linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve, pivot_ratio
+
+EPS = sys.float_info.epsilon
 
 SINGULAR_RATIO = 1e-12
 """Smallest |pivot| / largest |pivot| of J before a step is refused as singular."""
@@ -67,27 +70,106 @@ class NewtonSystemState(NamedTuple):
     alpha: float
     nfev: int
     njev: int
+    phi_x: tuple[float, ...]  # Phi at x (the next step's residual, computed by the trial)
 
 
 def singular_detail(det: float, cond: float) -> str:
     return f"det J = {det:.6g}, cond J = {cond:.3g}"
 
 
+def equilibrate(jac: list[list[float]]) -> tuple[list[list[float]], list[float], list[float]]:
+    """R J C with row scales R and column scales C making every row's and column's largest
+    entry 1: a singularity test on the result reacts to singularity, not to units or to
+    one equation being written 1e6 times larger than another."""
+    n = len(jac)
+    r = []
+    for row in jac:
+        big = max(abs(v) for v in row)
+        r.append(1.0 / big if big > 0.0 and math.isfinite(big) else 1.0)
+    c = []
+    for j in range(n):
+        big = max(abs(jac[i][j]) * r[i] for i in range(n))
+        c.append(1.0 / big if big > 0.0 and math.isfinite(big) else 1.0)
+    return [[jac[i][j] * r[i] * c[j] for j in range(n)] for i in range(n)], r, c
+
+
+def newton_direction(jac: list[list[float]], phi: list[float]) -> tuple[list[float] | None, float, float]:
+    """Solve J dq = -Phi on the equilibrated matrix: (dq or None when singular, det J,
+    smallest/largest pivot of the equilibrated LU)."""
+    n = len(phi)
+    if n == 2:
+        (a, b), (c, d) = jac
+        det = a * d - b * c
+        size = abs(a * d) + abs(b * c)  # invariant under row and column scaling
+        if size > 0.0 and abs(det) > SINGULAR_RATIO * size and math.isfinite(det):
+            return [(b * phi[1] - d * phi[0]) / det, (c * phi[0] - a * phi[1]) / det], det, abs(det) / size
+        return None, det, (abs(det) / size if size > 0.0 else 0.0)
+    scaled, _, _ = equilibrate(jac)
+    try:
+        ratio = pivot_ratio(lu(scaled))
+        f = lu(jac)
+    except SingularMatrix:
+        return None, 0.0, 0.0
+    det = det_from_lu(f)
+    if not ratio >= SINGULAR_RATIO:
+        return None, det, ratio
+    # the solve itself uses J as given: equilibration decides singularity only
+    return lu_solve(f, [-v for v in phi]), det, ratio
+
+
+def lm_direction(jac: list[list[float]], phi: list[float], mu: float) -> list[float] | None:
+    """(J^T J + mu diag(J^T J)) dq = -J^T Phi: a step between Newton's (mu -> 0) and a
+    scaled steepest descent (mu large), defined where J is singular."""
+    n = len(phi)
+    jtj = [[sum(jac[k][i] * jac[k][j] for k in range(n)) for j in range(n)] for i in range(n)]
+    g = [sum(jac[k][i] * phi[k] for k in range(n)) for i in range(n)]
+    top = max((jtj[i][i] for i in range(n)), default=0.0)
+    for i in range(n):
+        jtj[i][i] += mu * max(jtj[i][i], 1e-12 * top, 1e-300)
+    try:
+        return lu_solve(lu(jtj), [-v for v in g])
+    except (SingularMatrix, ArithmeticError):
+        return None
+
+
+def step_measure(step: Any, scales: tuple[float, ...] | None) -> float:
+    """max |dq_i| / scale_i: angles in rad, lengths relative to the mechanism's size."""
+    if scales is None:
+        return max_abs(step)
+    return max(abs(d) / sc for d, sc in zip(step, scales))
+
+
+def _sumsq(v: Any) -> float:
+    return sum(c * c for c in v)
+
+
 @dataclass(frozen=True)
 class NewtonSystem:
     """``jacobian``: "analytic" or "fd"; ``fd_step``: h for "fd" (None: sqrt(eps) max(1, |q|));
-    ``damped``: backtracking line search; ``diagnostics``: compute cond J every step."""
+    ``damped``: globalised (the default; False for the textbook iteration); ``diagnostics``:
+    compute cond J every step.
+
+    Globalised: the Newton step is taken whole when it lowers |Phi|^2 (so a good start
+    gives the textbook table, P3 row for row); otherwise it is halved down to 1/64; when
+    that fails, or J is singular after equilibration, a Levenberg-Marquardt step with a
+    growing damping looks for any decrease. When none exists the iterate sits at a
+    stationary point of |Phi|^2 that is not a root: ``local_minimum``.
+    """
 
     jacobian: str = "analytic"
     fd_step: float | None = None
-    damped: bool = False
+    damped: bool = True
     diagnostics: bool = True
 
     bracketing: ClassVar[bool] = False
-    can_diverge: ClassVar[bool] = True
     needs_residual: ClassVar[bool] = True
     minimizes: ClassVar[bool] = False
     first_index: ClassVar[int] = 1
+
+    @property
+    def can_diverge(self) -> bool:  # type: ignore[override]
+        # a globalised run lowers |Phi| every step: growing steps are no evidence
+        return not self.damped
 
     @property
     def name(self) -> str:
@@ -98,13 +180,14 @@ class NewtonSystem:
 
     def init(self, problem: SystemProblem, q0: tuple[float, ...]) -> NewtonSystemState:
         nan = math.nan
+        phi0 = tuple(problem.F(list(q0)))
         return NewtonSystemState(tuple(q0), None, math.inf, None, tuple(q0), (), (), (), nan, nan,
-                                 1.0, 0, 0)
+                                 1.0, 1, 0, phi0)
 
     def step(self, problem: SystemProblem, s: NewtonSystemState) -> NewtonSystemState:
         q = list(s.x)
-        phi = problem.F(q)
-        nfev, njev = s.nfev + 1, s.njev
+        phi = list(s.phi_x)
+        nfev, njev = s.nfev, s.njev
         if self.jacobian == "fd":
             jac = fd_jacobian(problem, q, phi, self.fd_step)
             nfev += len(q)
@@ -112,47 +195,62 @@ class NewtonSystem:
             jac = problem.J(q)  # type: ignore[misc]
             njev += 1
         resid = max_abs(phi)
-        if len(q) == 2 and not self.damped:
-            # Two unknowns (every four-bar, the slider-crank): Cramer's rule, no LU.
-            (a, b), (c, d) = jac
-            det = a * d - b * c
-            scale = max(abs(a), abs(b), 1e-300) * max(abs(c), abs(d), 1e-300)
-            if abs(det) > SINGULAR_RATIO * scale:
-                dq = [(b * phi[1] - d * phi[0]) / det, (c * phi[0] - a * phi[1]) / det]
-                cond = cond1(jac) if self.diagnostics else math.nan
-                x = (q[0] + dq[0], q[1] + dq[1])
-                return new_state(NewtonSystemState, (
-                    x, resid, max_abs(dq), None, tuple(q), tuple(phi), tuple(map(tuple, jac)),
-                    tuple(dq), det, cond, 1.0, nfev, njev))
-        try:
-            f = lu(jac)
-            ratio = pivot_ratio(f)
-        except SingularMatrix:
-            f, ratio = None, 0.0
-        if f is None or ratio < SINGULAR_RATIO:
-            det = det_from_lu(f) if f is not None else 0.0
-            cond = cond1(jac)
+        scales = problem.step_scales
+        dq, det, _ = newton_direction(jac, phi)
+        cond = (cond1(jac) if dq is None or self.diagnostics else math.nan)
+        tjac = tuple(map(tuple, jac))
+
+        def state(step: list[float], alpha: float, phi_new: Any, stop: Any = None) -> NewtonSystemState:
+            x = tuple(qi + di for qi, di in zip(q, step))
+            err = step_measure(step, scales)
             return new_state(NewtonSystemState, (
-                tuple(q), resid, math.nan,
-                (Status.SINGULAR_JACOBIAN, singular_detail(det, cond)),
-                tuple(q), tuple(phi), tuple(map(tuple, jac)), (), det, cond, 1.0, nfev, njev))
-        dq = lu_solve(f, [-v for v in phi])
-        det = det_from_lu(f)
-        cond = cond1(jac, f) if self.diagnostics else math.nan
-        alpha = 1.0
-        if self.damped:
-            base = sum(v * v for v in phi)
-            while alpha > 1.0 / 1024.0:
-                trial = problem.F([qi + alpha * di for qi, di in zip(q, dq)])
+                x, resid, err if stop is None else math.nan, stop, tuple(q), tuple(phi), tjac,
+                tuple(step), det, cond, alpha, nfev, njev, tuple(phi_new)))
+
+        if not self.damped:
+            if dq is None:
+                return state([0.0] * len(q), 1.0, phi,
+                             (Status.SINGULAR_JACOBIAN, singular_detail(det, cond)))
+            trial = [qi + di for qi, di in zip(q, dq)]
+            phi_t = problem.F(trial)
+            nfev += 1
+            return state(dq, 1.0, phi_t)
+
+        base = _sumsq(phi)
+        if dq is not None and max_abs(dq) <= 64.0 * EPS * (1.0 + max_abs(q)):
+            # a step at rounding level: |Phi| is noise there, no decrease can be asked of it
+            phi_t = problem.F([qi + di for qi, di in zip(q, dq)])
+            nfev += 1
+            return state(dq, 1.0, phi_t)
+        if dq is not None:
+            alpha = 1.0
+            while alpha >= 1.0 / 64.0:
+                step = dq if alpha == 1.0 else [alpha * d for d in dq]
+                phi_t = problem.F([qi + di for qi, di in zip(q, step)])
                 nfev += 1
-                if sum(v * v for v in trial) <= (1.0 - 1e-4 * alpha) * base:
-                    break
+                if _sumsq(phi_t) <= (1.0 - 1e-4 * alpha) * base:
+                    return state(step, alpha, phi_t)
                 alpha *= 0.5
-        step = [alpha * d for d in dq]
-        x = tuple(qi + di for qi, di in zip(q, step))
-        return new_state(NewtonSystemState, (
-            x, resid, max_abs(step), None, tuple(q), tuple(phi), tuple(map(tuple, jac)),
-            tuple(step), det, cond, alpha, nfev, njev))
+        # Newton's direction failed (or J is singular): damped steps toward lower |Phi|^2
+        mu = 1e-3
+        while mu <= 1e12:
+            d = lm_direction(jac, phi, mu)
+            if d is not None and all(map(math.isfinite, d)):
+                phi_t = problem.F([qi + di for qi, di in zip(q, d)])
+                nfev += 1
+                if _sumsq(phi_t) < base:
+                    return state(d, 0.0, phi_t)
+                if max(abs(di) for di in d) <= 1e-15 * (1.0 + max_abs(q)):
+                    break  # the steps no longer move q: nothing lower is reachable
+            mu *= 10.0
+        grad = max(abs(sum(jac[k][i] * phi[k] for k in range(len(phi)))) for i in range(len(q)))
+        if dq is None:
+            why = (Status.SINGULAR_JACOBIAN, f"{singular_detail(det, cond)}; no damped step lowers "
+                                             f"max|Phi| = {resid:.3g}")
+        else:
+            why = (Status.LOCAL_MINIMUM, f"max|Phi| = {resid:.3g} cannot be lowered from here "
+                                         f"(|J^T Phi| = {grad:.3g}); try another start")
+        return state([0.0] * len(q), 0.0, phi, why)
 
     def initial_row(self, problem: SystemProblem, s: NewtonSystemState) -> None:
         return None

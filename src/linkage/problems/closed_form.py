@@ -115,7 +115,9 @@ def reference_for(m: Any) -> Callable[[], Solutions | None]:
 
 
 def wrap_degrees(a: float) -> float:
-    """An angle in degrees brought to (-180, 180]."""
+    """An angle in degrees brought to (-180, 180]; NaN for a non-finite angle."""
+    if not math.isfinite(a):
+        return math.nan
     w = math.fmod(a, 360.0)
     if w <= -180.0:
         w += 360.0

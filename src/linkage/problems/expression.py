@@ -1,12 +1,29 @@
-"""Equations in x typed by users: parsed safely, differentiated exactly.
+"""Equations in x typed by users: parsed safely, compiled once to straight-line code.
 
-The text is parsed with :func:`ast.parse` (which only builds a tree, it runs
-nothing) and every node is checked against a whitelist: numbers, the name ``x``,
-the constants ``pi`` and ``e``, ``+ - * / **`` (``^`` is read as ``**``), unary
-signs, and calls of the functions in :data:`FUNCTIONS` with one argument. The tree
-is rebuilt as this module's own small expression nodes, differentiated symbolically
-(so f' is exact, not a finite difference) and turned into nested Python closures.
-No user text is ever passed to ``eval``.
+The text is parsed with :func:`ast.parse` (which only builds a tree, it runs nothing)
+and every node is checked against a whitelist: numbers, the name ``x``, the constants
+``pi`` and ``e``, ``+ - * / **`` (``^`` is read as ``**``), unary signs, and calls of the
+functions in :data:`FUNCTIONS` with one argument.
+
+The checked tree becomes a list of single operations on numbered temporaries (static
+single assignment), walked without recursion, so chains and nestings of any depth the
+parser accepts cost time and memory linear in their length. Identical subexpressions
+share one temporary (``sin(x)*sin(x)*...`` computes sin(x) once). From that list this
+module *generates* Python source, from its own tokens only (temporary names, operator
+symbols, ``repr`` of floats, whitelisted function names) and never from user text:
+
+- ``f(x)``: the value;
+- ``fprime(x)``, ``fsecond(x)``: exact first and second derivatives by forward-mode
+  differentiation (each operation carries its value and derivatives), so their size
+  grows linearly with the expression, never exponentially as repeated symbolic
+  differentiation of products does;
+- ``fbound(x)``: a first-order bound on the rounding error of the computed f(x)
+  (each operation adds one rounding of its result and propagates its arguments'
+  bounds by the local derivative), used to certify that a tiny |f| is a root.
+
+Only constant folding simplifies: an operation on two numbers is computed once when it
+is finite. No identity rule (0*a = 0, a/a = 1, a - a = 0) is ever applied, so a NaN or a
+domain restriction in the text (``0/0 + x``, ``0*log(x) + x``) is kept.
 """
 
 from __future__ import annotations
@@ -20,10 +37,13 @@ from ..errors import ParseError
 from .scalar import ScalarProblem
 
 MAX_LENGTH = 2000
+MAX_OPERATIONS = 2000
+"""Operations one equation may compile to (a 2000-character text stays well below)."""
 
 Fn = Callable[[float], float]
 
 DEG = math.pi / 180.0
+EPS = 2.0**-52
 
 
 def _sign(v: float) -> float:
@@ -43,344 +63,361 @@ FUNCTIONS: dict[str, Fn] = {
 }
 """Functions an equation may call. Angles in radians, except the ``*d`` ones (degrees)."""
 
-_INTERNAL: dict[str, Fn] = {"sign": _sign}
 CONSTANTS = {"pi": math.pi, "e": math.e}
 
+# d/du fn(u) and d2/du2 fn(u) as source templates in u (the argument) and v (fn(u));
+# g1 names the first derivative's temporary, usable in the second's template.
+_RULES: dict[str, tuple[str, str]] = {
+    "sin": ("_cos({u})", "-{v}"),
+    "cos": ("-_sin({u})", "-{v}"),
+    "tan": ("1.0 + {v} * {v}", "2.0 * {v} * {g1}"),
+    "asin": ("1.0 / _sqrt(1.0 - {u} * {u})", "{u} * {g1} * {g1} * {g1}"),
+    "acos": ("-1.0 / _sqrt(1.0 - {u} * {u})", "{u} * {g1} * {g1} * {g1}"),
+    "atan": ("1.0 / (1.0 + {u} * {u})", "-2.0 * {u} * {g1} * {g1}"),
+    "sinh": ("_cosh({u})", "{v}"),
+    "cosh": ("_sinh({u})", "{v}"),
+    "tanh": ("1.0 - {v} * {v}", "-2.0 * {v} * {g1}"),
+    "exp": ("{v}", "{v}"),
+    "log": ("1.0 / {u}", "-{g1} * {g1}"),
+    "log10": (f"1.0 / ({{u}} * {math.log(10.0)!r})", "-{g1} / {u}"),
+    "sqrt": ("0.5 / {v}", "-0.5 * {g1} / {u}"),
+    "abs": ("_sign({u})", "0.0"),
+    "sind": (f"{DEG!r} * _cos({{u}} * {DEG!r})", f"-{DEG * DEG!r} * {{v}}"),
+    "cosd": (f"-{DEG!r} * _sin({{u}} * {DEG!r})", f"-{DEG * DEG!r} * {{v}}"),
+    "tand": (f"{DEG!r} * (1.0 + _tan({{u}} * {DEG!r}) ** 2)",
+             f"2.0 * {DEG!r} * _tan({{u}} * {DEG!r}) * {{g1}}"),
+    "asind": (f"1.0 / ({DEG!r} * _sqrt(1.0 - {{u}} * {{u}}))", f"{DEG * DEG!r} * {{u}} * {{g1}} ** 3"),
+    "acosd": (f"-1.0 / ({DEG!r} * _sqrt(1.0 - {{u}} * {{u}}))", f"{DEG * DEG!r} * {{u}} * {{g1}} ** 3"),
+    "atand": (f"1.0 / ({DEG!r} * (1.0 + {{u}} * {{u}}))", f"-2.0 * {DEG!r} * {{u}} * {{g1}} * {{g1}}"),
+}
 
-# --- the expression tree -------------------------------------------------------------
-
-class Node:
-    """An expression node. Subclasses are frozen dataclasses."""
-
-    def __str__(self) -> str:  # pragma: no cover - overridden
-        raise NotImplementedError
-
-
-@dataclass(frozen=True)
-class Num(Node):
-    value: float
-
-    def __str__(self) -> str:
-        return repr(self.value) if self.value >= 0 else f"({self.value!r})"
-
-
-@dataclass(frozen=True)
-class Var(Node):
-    def __str__(self) -> str:
-        return "x"
-
-
-@dataclass(frozen=True)
-class Bin(Node):
-    op: str
-    left: Node
-    right: Node
-
-    def __str__(self) -> str:
-        return f"({self.left} {self.op} {self.right})"
-
-
-@dataclass(frozen=True)
-class Neg(Node):
-    arg: Node
-
-    def __str__(self) -> str:
-        return f"(-{self.arg})"
-
-
-@dataclass(frozen=True)
-class Call(Node):
-    name: str
-    arg: Node
-
-    def __str__(self) -> str:
-        return f"{self.name}({self.arg})"
-
-
-ZERO, ONE = Num(0.0), Num(1.0)
-
-
-def _pow(a: float, b: float) -> float:
-    # math.pow raises ValueError for (-8) ** (1/3) where ** would return a complex.
-    return math.pow(a, b)
-
-
-_OPS: dict[str, Callable[[float, float], float]] = {
-    "+": lambda a, b: a + b,
-    "-": lambda a, b: a - b,
-    "*": lambda a, b: a * b,
-    "/": lambda a, b: a / b,
-    "**": _pow,
+_NAMESPACE = {
+    **{f"_{k}": v for k, v in FUNCTIONS.items()},
+    "_cos": math.cos, "_sin": math.sin, "_tan": math.tan, "_sqrt": math.sqrt,
+    "_cosh": math.cosh, "_sinh": math.sinh, "_pow": math.pow, "_log": math.log,
+    "_sign": _sign, "_fabs": math.fabs, "__builtins__": {},
 }
 
 
-# --- construction with light simplification ---------------------------------------------
+# --- the operation list -----------------------------------------------------------------
 
-def add(a: Node, b: Node) -> Node:
-    if a == ZERO:
-        return b
-    if b == ZERO:
-        return a
-    return _fold(Bin("+", a, b))
+@dataclass(frozen=True)
+class Op:
+    """One operation: ``kind`` is ``num``, ``x``, ``neg``, ``+ - * / **`` or a function name;
+    ``args`` index earlier operations; ``value`` is the number of a ``num``."""
 
+    kind: str
+    args: tuple[int, ...] = ()
+    value: float = 0.0
 
-def sub(a: Node, b: Node) -> Node:
-    if b == ZERO:
-        return a
-    if a == ZERO:
-        return neg(b)
-    return _fold(Bin("-", a, b))
-
-
-def mul(a: Node, b: Node) -> Node:
-    if a == ZERO or b == ZERO:
-        return ZERO
-    if a == ONE:
-        return b
-    if b == ONE:
-        return a
-    return _fold(Bin("*", a, b))
-
-
-def div(a: Node, b: Node) -> Node:
-    if a == ZERO:
-        return ZERO
-    if b == ONE:
-        return a
-    return _fold(Bin("/", a, b))
-
-
-def power(a: Node, b: Node) -> Node:
-    if b == ZERO:
-        return ONE
-    if b == ONE:
-        return a
-    return _fold(Bin("**", a, b))
-
-
-def neg(a: Node) -> Node:
-    if isinstance(a, Num):
-        return Num(-a.value)
-    if isinstance(a, Neg):
-        return a.arg
-    return Neg(a)
-
-
-def call(name: str, a: Node) -> Node:
-    return _fold(Call(name, a))
-
-
-def _fold(n: Node) -> Node:
-    """Evaluate constant sub-trees once; leave them alone if that fails (e.g. 1/0)."""
-    if isinstance(n, Bin) and isinstance(n.left, Num) and isinstance(n.right, Num):
-        try:
-            v = _OPS[n.op](n.left.value, n.right.value)
-        except (ArithmeticError, ValueError):
-            return n
-        return Num(v) if math.isfinite(v) else n
-    if isinstance(n, Call) and isinstance(n.arg, Num):
-        try:
-            v = {**FUNCTIONS, **_INTERNAL}[n.name](n.arg.value)
-        except (ArithmeticError, ValueError):
-            return n
-        return Num(float(v)) if math.isfinite(v) else n
-    return n
-
-
-def has_var(n: Node) -> bool:
-    if isinstance(n, Var):
-        return True
-    if isinstance(n, Bin):
-        return has_var(n.left) or has_var(n.right)
-    if isinstance(n, (Neg, Call)):
-        return has_var(n.arg)
-    return False
-
-
-# --- differentiation -------------------------------------------------------------------
-
-def derivative(n: Node) -> Node:
-    """d n / dx, exactly, by the usual rules."""
-    if isinstance(n, Num):
-        return ZERO
-    if isinstance(n, Var):
-        return ONE
-    if isinstance(n, Neg):
-        return neg(derivative(n.arg))
-    if isinstance(n, Bin):
-        a, b = n.left, n.right
-        da, db = derivative(a), derivative(b)
-        if n.op == "+":
-            return add(da, db)
-        if n.op == "-":
-            return sub(da, db)
-        if n.op == "*":
-            return add(mul(da, b), mul(a, db))
-        if n.op == "/":
-            return div(sub(mul(da, b), mul(a, db)), power(b, Num(2.0)))
-        if not has_var(b):  # a ** c
-            return mul(mul(b, power(a, sub(b, ONE))), da)
-        # a ** b = exp(b log a): d = a**b (b' log a + b a' / a)
-        return mul(n, add(mul(db, call("log", a)), div(mul(b, da), a)))
-    if isinstance(n, Call):
-        a = n.arg
-        da = derivative(a)
-        if da == ZERO:
-            return ZERO
-        return mul(_outer_derivative(n.name, a), da)
-    raise TypeError(n)  # pragma: no cover
-
-
-def _outer_derivative(name: str, a: Node) -> Node:
-    one_minus_sq = sub(ONE, power(a, Num(2.0)))
-    deg = Num(DEG)
-    rules: dict[str, Callable[[], Node]] = {
-        "sin": lambda: call("cos", a),
-        "cos": lambda: neg(call("sin", a)),
-        "tan": lambda: div(ONE, power(call("cos", a), Num(2.0))),
-        "asin": lambda: div(ONE, call("sqrt", one_minus_sq)),
-        "acos": lambda: neg(div(ONE, call("sqrt", one_minus_sq))),
-        "atan": lambda: div(ONE, add(ONE, power(a, Num(2.0)))),
-        "sinh": lambda: call("cosh", a),
-        "cosh": lambda: call("sinh", a),
-        "tanh": lambda: sub(ONE, power(call("tanh", a), Num(2.0))),
-        "exp": lambda: call("exp", a),
-        "log": lambda: div(ONE, a),
-        "log10": lambda: div(ONE, mul(a, Num(math.log(10.0)))),
-        "sqrt": lambda: div(ONE, mul(Num(2.0), call("sqrt", a))),
-        "abs": lambda: call("sign", a),
-        "sign": lambda: ZERO,
-        "sind": lambda: mul(deg, call("cosd", a)),
-        "cosd": lambda: neg(mul(deg, call("sind", a))),
-        "tand": lambda: div(deg, power(call("cosd", a), Num(2.0))),
-        "asind": lambda: div(Num(1.0 / DEG), call("sqrt", one_minus_sq)),
-        "acosd": lambda: neg(div(Num(1.0 / DEG), call("sqrt", one_minus_sq))),
-        "atand": lambda: div(Num(1.0 / DEG), add(ONE, power(a, Num(2.0)))),
-    }
-    return rules[name]()
-
-
-# --- evaluation ---------------------------------------------------------------------------
-
-def compile_node(n: Node) -> Fn:
-    """Turn a tree into a Python function of x, as nested closures."""
-    if isinstance(n, Num):
-        v = n.value
-        return lambda x: v
-    if isinstance(n, Var):
-        return lambda x: x
-    if isinstance(n, Neg):
-        fa = compile_node(n.arg)
-        return lambda x: -fa(x)
-    if isinstance(n, Call):
-        fn = {**FUNCTIONS, **_INTERNAL}[n.name]
-        fa = compile_node(n.arg)
-        return lambda x: fn(fa(x))
-    assert isinstance(n, Bin)
-    fl, fr = compile_node(n.left), compile_node(n.right)
-    if n.op == "+":
-        return lambda x: fl(x) + fr(x)
-    if n.op == "-":
-        return lambda x: fl(x) - fr(x)
-    if n.op == "*":
-        return lambda x: fl(x) * fr(x)
-    if n.op == "/":
-        return lambda x: fl(x) / fr(x)
-    if isinstance(n.right, Num) and n.right.value == 2.0:
-        def square(x: float) -> float:
-            t = fl(x)
-            return t * t
-        return square
-    return lambda x: _pow(fl(x), fr(x))
-
-
-# --- parsing ---------------------------------------------------------------------------------
 
 _BINOPS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Pow: "**"}
+_FOLD: dict[str, Callable[..., float]] = {
+    "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
+    "/": lambda a, b: a / b, "**": math.pow, "neg": lambda a: -a,
+}
 
 
-def parse(text: str, *, what: str = "equation") -> Node:
-    """Parse user text into a checked expression tree, or raise ParseError (one line)."""
+class _Builder:
+    """Appends operations, sharing identical ones and folding finite constant ones."""
+
+    def __init__(self) -> None:
+        self.ops: list[Op] = []
+        self.index: dict[tuple[str, tuple[int, ...], float], int] = {}
+
+    def add(self, op: Op) -> int:
+        if op.args and all(self.ops[a].kind == "num" for a in op.args):
+            fn = _FOLD.get(op.kind) or FUNCTIONS.get(op.kind)
+            try:
+                v = float(fn(*(self.ops[a].value for a in op.args)))  # type: ignore[misc]
+            except (ArithmeticError, ValueError, TypeError):
+                v = math.nan
+            if math.isfinite(v):
+                op = Op("num", (), v)
+        key = (op.kind, op.args, op.value)
+        found = self.index.get(key)
+        if found is not None:
+            return found
+        if len(self.ops) >= MAX_OPERATIONS:
+            raise ParseError(f"the equation has more than {MAX_OPERATIONS} operations")
+        self.ops.append(op)
+        self.index[key] = len(self.ops) - 1
+        return len(self.ops) - 1
+
+
+def parse_ops(text: str, *, what: str = "equation") -> tuple[Op, ...]:
+    """Parse user text into a checked operation list (the last one is the result)."""
     if not isinstance(text, str) or not text.strip():
         raise ParseError(f"the {what} is empty")
     if len(text) > MAX_LENGTH:
         raise ParseError(f"the {what} is longer than {MAX_LENGTH} characters")
     src = text.replace("^", "**").strip()
+    shown = text if len(text) <= 60 else text[:57] + "..."
     try:
         tree = ast.parse(src, mode="eval")
     except SyntaxError as exc:
         col = f" at column {exc.offset}" if exc.offset else ""
-        raise ParseError(f"could not parse the {what} {text!r}: {exc.msg}{col}") from None
+        raise ParseError(f"could not parse the {what} {shown!r}: {exc.msg}{col}") from None
     except (RecursionError, MemoryError, ValueError):
-        raise ParseError(f"the {what} {text!r} is too deeply nested or malformed") from None
-    try:
-        return _convert(tree.body, text, what)
-    except RecursionError:
-        raise ParseError(f"the {what} {text!r} is too deeply nested") from None
+        raise ParseError(f"the {what} {shown!r} is too deeply nested or malformed") from None
+    b = _Builder()
+    # Iterative post-order walk: (node, visited) pairs on a stack, results on another.
+    stack: list[tuple[ast.AST, bool]] = [(tree.body, False)]
+    out: list[int] = []
+    while stack:
+        node, visited = stack.pop()
+        if not visited:
+            children = _check(node, shown, what)
+            stack.append((node, True))
+            stack.extend((c, False) for c in reversed(children))
+            continue
+        out.append(_emit(node, b, out))
+    return tuple(b.ops)
 
 
-def _convert(node: ast.AST, text: str, what: str) -> Node:
+def _check(node: ast.AST, shown: str, what: str) -> list[ast.AST]:
+    """Validate one node; return the children to visit first."""
     if isinstance(node, ast.Constant):
         if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
-            raise ParseError(f"the {what} {text!r} may contain only numbers, not {node.value!r}")
+            raise ParseError(f"the {what} {shown!r} may contain only numbers, not {node.value!r}")
         try:
             v = float(node.value)
         except OverflowError:
-            raise ParseError(f"the number {node.value} in the {what} is too large") from None
-        return Num(v)
+            raise ParseError(f"a number in the {what} is too large for a double") from None
+        if not math.isfinite(v):
+            raise ParseError(f"a number in the {what} is too large for a double")
+        return []
     if isinstance(node, ast.Name):
-        if node.id == "x":
-            return Var()
-        if node.id in CONSTANTS:
-            return Num(CONSTANTS[node.id])
-        raise ParseError(
-            f"unknown name {node.id!r} in the {what} {text!r}; use x, pi, e and "
-            f"{', '.join(sorted(FUNCTIONS))}")
+        if node.id == "x" or node.id in CONSTANTS:
+            return []
+        raise ParseError(f"unknown name {node.id!r} in the {what} {shown!r}; use x, pi, e and "
+                         f"{', '.join(sorted(FUNCTIONS))}")
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub)):
-        inner = _convert(node.operand, text, what)
-        return inner if isinstance(node.op, ast.UAdd) else neg(inner)
+        return [node.operand]
     if isinstance(node, ast.BinOp) and type(node.op) in _BINOPS:
-        left = _convert(node.left, text, what)
-        right = _convert(node.right, text, what)
-        op = _BINOPS[type(node.op)]
-        return {"+": add, "-": sub, "*": mul, "/": div, "**": power}[op](left, right)
+        return [node.left, node.right]
     if isinstance(node, ast.Call):
         if not isinstance(node.func, ast.Name) or node.func.id not in FUNCTIONS:
-            name = node.func.id if isinstance(node.func, ast.Name) else ast.unparse(node.func)
-            raise ParseError(
-                f"unknown function {name!r} in the {what} {text!r}; "
-                f"allowed: {', '.join(sorted(FUNCTIONS))}")
+            name = node.func.id if isinstance(node.func, ast.Name) else "that call"
+            raise ParseError(f"unknown function {name!r} in the {what} {shown!r}; "
+                             f"allowed: {', '.join(sorted(FUNCTIONS))}")
         if len(node.args) != 1 or node.keywords:
-            raise ParseError(f"{node.func.id}() takes exactly one argument in the {what} {text!r}")
-        return call(node.func.id, _convert(node.args[0], text, what))
-    shown = ast.unparse(node) if hasattr(ast, "unparse") else type(node).__name__
-    raise ParseError(f"{shown!r} is not allowed in the {what} {text!r}; "
+            raise ParseError(f"{node.func.id}() takes exactly one argument in the {what} {shown!r}")
+        return [node.args[0]]
+    raise ParseError(f"{type(node).__name__} is not allowed in the {what} {shown!r}; "
                      "use numbers, x, + - * / ** and functions")
+
+
+def _emit(node: ast.AST, b: _Builder, out: list[int]) -> int:
+    if isinstance(node, ast.Constant):
+        return b.add(Op("num", (), float(node.value)))
+    if isinstance(node, ast.Name):
+        return b.add(Op("x")) if node.id == "x" else b.add(Op("num", (), CONSTANTS[node.id]))
+    if isinstance(node, ast.UnaryOp):
+        a = out.pop()
+        return a if isinstance(node.op, ast.UAdd) else b.add(Op("neg", (a,)))
+    if isinstance(node, ast.BinOp):
+        right, left = out.pop(), out.pop()
+        return b.add(Op(_BINOPS[type(node.op)], (left, right)))
+    assert isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+    return b.add(Op(node.func.id, (out.pop(),)))
+
+
+# --- code generation --------------------------------------------------------------------
+
+def _num(v: float) -> str:
+    return repr(v) if v >= 0.0 else f"({v!r})"
+
+
+def generate(ops: tuple[Op, ...], order: int) -> str:
+    """Source of ``def fn(x)`` returning the value (order 0), f' (1) or f'' (2)."""
+    lines = ["def fn(x):"]
+    v: list[str] = []          # the value's expression per op (a name or a literal)
+    d: list[str | None] = []   # first derivative (None: identically zero)
+    dd: list[str | None] = []  # second derivative
+
+    def emit(name: str, expr: str) -> str:
+        lines.append(f"    {name} = {expr}")
+        return name
+
+    def push(value: str, first: str | None, second: str | None) -> None:
+        v.append(value)
+        d.append(first)
+        dd.append(second)
+
+    for i, op in enumerate(ops):
+        t = f"t{i}"
+        if op.kind == "num":
+            push(_num(op.value), None, None)
+            continue
+        if op.kind == "x":
+            push("x", "1.0" if order else None, None)
+            continue
+        a = op.args[0]
+        va, da, dda = v[a], d[a], dd[a]
+        if op.kind == "neg":
+            v.append(emit(t, f"-{va}"))
+            d.append(emit(f"d{i}", f"-{da}") if order and da else None)
+            dd.append(emit(f"e{i}", f"-{dda}") if order > 1 and dda else None)
+            continue
+        if op.kind in FUNCTIONS:
+            vt = emit(t, f"_{op.kind}({va})")
+            v.append(vt)
+            if order and da:
+                g1 = emit(f"g{i}", _RULES[op.kind][0].format(u=va, v=vt))
+                d.append(emit(f"d{i}", f"{g1} * {da}"))
+                if order > 1:
+                    g2 = _RULES[op.kind][1].format(u=va, v=vt, g1=g1)
+                    terms = [f"({g2}) * {da} * {da}"] + ([f"{g1} * {dda}"] if dda else [])
+                    dd.append(emit(f"e{i}", " + ".join(terms)))
+                else:
+                    dd.append(None)
+            else:
+                d.append(None)
+                dd.append(None)
+            continue
+        c = op.args[1]
+        vb, db, ddb = v[c], d[c], dd[c]
+        k = op.kind
+        if k == "**":
+            const_exp = ops[c].kind == "num"
+            vt = emit(t, f"{va} * {va}" if const_exp and ops[c].value == 2.0 else f"_pow({va}, {vb})")
+        else:
+            vt = emit(t, f"{va} {k} {vb}")
+        v.append(vt)
+        if not order or (da is None and db is None):
+            d.append(None)
+            dd.append(None)
+            continue
+        z = "0.0"
+        if k in "+-":
+            d.append(emit(f"d{i}", f"{da or z} {k} {db or z}"))
+            dd.append(emit(f"e{i}", f"{dda or z} {k} {ddb or z}") if order > 1 and (dda or ddb) else None)
+        elif k == "*":
+            d.append(emit(f"d{i}", f"{da or z} * {vb} + {va} * {db or z}"))
+            if order > 1:
+                dd.append(emit(f"e{i}", f"{dda or z} * {vb} + 2.0 * {da or z} * {db or z} + "
+                                        f"{va} * {ddb or z}"))
+            else:
+                dd.append(None)
+        elif k == "/":
+            di = emit(f"d{i}", f"({da or z} - {vt} * {db or z}) / {vb}")
+            d.append(di)
+            dd.append(emit(f"e{i}", f"({dda or z} - 2.0 * {di} * {db or z} - {vt} * {ddb or z}) / {vb}")
+                      if order > 1 else None)
+        elif db is None:  # a ** c, c constant
+            cv = ops[c].value
+            if cv == 2.0:
+                g1 = emit(f"g{i}", f"2.0 * {va}")
+                g2 = "2.0"
+            else:
+                g1 = emit(f"g{i}", f"{_num(cv)} * _pow({va}, {_num(cv - 1.0)})")
+                g2 = f"{_num(cv * (cv - 1.0))} * _pow({va}, {_num(cv - 2.0)})" if cv != 1.0 else "0.0"
+            d.append(emit(f"d{i}", f"{g1} * {da}"))
+            if order > 1:
+                terms = [f"({g2}) * {da} * {da}"] + ([f"{g1} * {dda}"] if dda else [])
+                dd.append(emit(f"e{i}", " + ".join(terms)))
+            else:
+                dd.append(None)
+        else:  # a ** b = exp(b log a): d = v w, w = b' log a + b a'/a
+            w = emit(f"w{i}", f"{db} * _log({va}) + {vb} * {da or z} / {va}")
+            di = emit(f"d{i}", f"{vt} * {w}")
+            d.append(di)
+            if order > 1:
+                wp = emit(f"q{i}", f"{ddb or z} * _log({va}) + 2.0 * {db} * {da or z} / {va} + "
+                                   f"{vb} * ({dda or z} * {va} - {da or z} * {da or z}) / ({va} * {va})")
+                dd.append(emit(f"e{i}", f"{di} * {w} + {vt} * {wp}"))
+            else:
+                dd.append(None)
+    result = [v, d, dd][order][-1]
+    lines.append(f"    return {result or '0.0'}")
+    return "\n".join(lines) + "\n"
+
+
+def generate_bound(ops: tuple[Op, ...]) -> str:
+    """Source of ``def fn(x)`` returning a first-order bound on the rounding error of f(x):
+    every operation contributes eps*|result| and passes on its arguments' bounds times the
+    local derivative's magnitude."""
+    lines = ["def fn(x):"]
+    v: list[str] = []
+    err: list[str | None] = []
+    u = repr(EPS)
+    for i, op in enumerate(ops):
+        t = f"t{i}"
+        if op.kind in ("num", "x"):
+            v.append(_num(op.value) if op.kind == "num" else "x")
+            err.append(None)
+            continue
+        a = op.args[0]
+        if op.kind == "neg":
+            lines.append(f"    {t} = -{v[a]}")
+            v.append(t)
+            err.append(err[a])
+            continue
+        if op.kind in FUNCTIONS:
+            lines.append(f"    {t} = _{op.kind}({v[a]})")
+            own = f"{u} * _fabs({t})"
+            if err[a]:
+                g1 = _RULES[op.kind][0].format(u=v[a], v=t)
+                own += f" + _fabs({g1}) * {err[a]}"
+            lines.append(f"    r{i} = {own}")
+            v.append(t)
+            err.append(f"r{i}")
+            continue
+        c = op.args[1]
+        va, vb, ea, eb = v[a], v[c], err[a], err[c]
+        k = op.kind
+        lines.append(f"    {t} = {'_pow(' + va + ', ' + vb + ')' if k == '**' else va + ' ' + k + ' ' + vb}")
+        terms = [f"{u} * _fabs({t})"]
+        if k in "+-":
+            terms += [e for e in (ea, eb) if e]
+        elif k == "*":
+            terms += ([f"_fabs({vb}) * {ea}"] if ea else []) + ([f"_fabs({va}) * {eb}"] if eb else [])
+        elif k == "/":
+            terms += ([f"{ea} / _fabs({vb})"] if ea else []) + ([f"_fabs({t} / {vb}) * {eb}"] if eb else [])
+        else:
+            terms += ([f"_fabs({vb} * {t} / {va}) * {ea}"] if ea else []) + \
+                     ([f"_fabs({t} * _log(_fabs({va}))) * {eb}"] if eb else [])
+        lines.append(f"    r{i} = {' + '.join(terms)}")
+        v.append(t)
+        err.append(f"r{i}")
+    lines.append(f"    return {err[-1] or '0.0'}")
+    return "\n".join(lines) + "\n"
+
+
+def build(source: str) -> Fn:
+    """Compile generated source (never user text) into a function."""
+    namespace = dict(_NAMESPACE)
+    exec(compile(source, "<linkage-equation>", "exec"), namespace)
+    return namespace["fn"]  # type: ignore[no-any-return]
 
 
 @dataclass(frozen=True)
 class Expression:
-    """A parsed function of x with its exact first and second derivatives."""
+    """A parsed function of x, compiled to straight-line code with exact derivatives."""
 
     text: str
-    tree: Node
-    d1: Node
-    d2: Node
+    ops: tuple[Op, ...]
 
     @classmethod
     def parse(cls, text: str, *, what: str = "equation") -> Expression:
-        tree = parse(text, what=what)
-        d1 = derivative(tree)
-        return cls(text, tree, d1, derivative(d1))
+        return cls(text, parse_ops(text, what=what))
+
+    def source(self, order: int = 0) -> str:
+        """The generated code for f (0), f' (1), f'' (2); ``order=-1``: the rounding bound."""
+        return generate_bound(self.ops) if order < 0 else generate(self.ops, order)
 
     def function(self) -> Fn:
-        return compile_node(self.tree)
+        return build(self.source(0))
 
     def derivative(self) -> Fn:
-        return compile_node(self.d1)
+        return build(self.source(1))
 
     def second_derivative(self) -> Fn:
-        return compile_node(self.d2)
+        return build(self.source(2))
+
+    def rounding_bound(self) -> Fn:
+        return build(self.source(-1))
 
 
 def equation_problem(equation: str, g: str | None = None) -> ScalarProblem:
@@ -393,5 +430,5 @@ def equation_problem(equation: str, g: str | None = None) -> ScalarProblem:
     return ScalarProblem(
         f=f.function(), fprime=f.derivative(), fsecond=f.second_derivative(),
         g=gx.function() if gx else None, gprime=gx.derivative() if gx else None,
-        var="x", unit="", title=f"f(x) = {equation}",
+        var="x", unit="", title=f"f(x) = {equation}", fbound=f.rounding_bound(),
     )

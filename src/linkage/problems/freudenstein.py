@@ -15,6 +15,7 @@ R1, R2, R3 = 5/3, 5/2, 11/6 are links (a, b, c, d) = (2, 4, 3, 5).
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -22,6 +23,7 @@ from ..errors import InputError
 from .scalar import ScalarProblem
 
 DEG = math.pi / 180.0
+EPS = sys.float_info.epsilon
 
 SEED_R = (5.0 / 3.0, 5.0 / 2.0, 11.0 / 6.0)
 SEED_ALPHA_DEG = 70.0
@@ -39,7 +41,18 @@ def coefficients_from_links(a: float, b: float, c: float, d: float) -> FourBarCo
     for name, v in zip("abcd", (a, b, c, d)):
         if not math.isfinite(v) or v <= 0.0:
             raise InputError(f"link length {name} must be a finite number > 0, got {v!r}")
-    return FourBarCoefficients(d / c, d / a, (a * a - b * b + c * c + d * d) / (2.0 * a * c))
+        if v < sys.float_info.min:
+            raise InputError(f"link length {name} = {v!r} is subnormal: it has too few significant "
+                             "digits; give the lengths in a smaller unit")
+    # Only ratios matter: scale by the longest link first, so squares neither overflow
+    # nor underflow (links 9e307 or 1e-300 give the same R as links 9 or 1).
+    big = max(a, b, c, d)
+    a, b, c, d = a / big, b / big, c / big, d / big
+    r = FourBarCoefficients(d / c, d / a, (a * a - b * b + c * c + d * d) / (2.0 * a * c))
+    if not all(math.isfinite(v) for v in (r.r1, r.r2, r.r3)):
+        raise InputError(f"the link ratios {a * big:g}, {b * big:g}, {c * big:g}, {d * big:g} are too "
+                         "extreme for double precision (R1, R2, R3 overflow)")
+    return r
 
 
 def fourbar_equation(
@@ -76,6 +89,14 @@ def fourbar_equation(
         p = phi * DEG
         return DEG * DEG * (r2 * cos(p) + cos(alpha - p))
 
+    def fbound(phi: float) -> float:
+        # one rounding per term and per operation, plus the rounding of phi*DEG and of
+        # alpha - p carried through the slopes r2 sin(p) and sin(alpha - p)
+        p = phi * DEG
+        terms = abs(k) + abs(r1 * math.cos(alpha)) + abs(r2 * cos(p)) + abs(cos(alpha - p))
+        slopes = (abs(r2 * sin(p)) + abs(sin(alpha - p))) * (abs(p) + abs(alpha))
+        return 4.0 * EPS * (terms + slopes)
+
     def u(phi: float) -> float:
         return (k - cos(alpha - phi * DEG)) / r2
 
@@ -90,7 +111,7 @@ def fourbar_equation(
         return sin(alpha - phi * DEG) / (r2 * sqrt(1.0 - uu * uu))
 
     return ScalarProblem(
-        f=f, fprime=fprime, fsecond=fsecond, g=g, gprime=gprime, u=u,
+        f=f, fprime=fprime, fsecond=fsecond, g=g, gprime=gprime, u=u, fbound=fbound,
         var="phi", unit="deg",
         title=(f"four-bar input-output equation, alpha = {alpha_deg:g} deg, "
                f"R1 = {r1:.10g}, R2 = {r2:.10g}, R3 = {r3:.10g}"),

@@ -28,6 +28,7 @@ File layout (see sample_inputs/ for complete, commented examples)::
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 from collections.abc import Mapping
@@ -39,6 +40,40 @@ from ..errors import ParseError
 from .system import SystemProblem
 
 ANGLE_UNITS = {"deg": math.pi / 180.0, "rad": 1.0}
+
+LENGTH_RANGE = (1e-100, 1e100)
+"""Magnitudes a nonzero length may have: squares and products of two stay normal doubles."""
+
+ANGLE_LIMIT_DEG = 1e6
+"""Largest |angle| in degrees: beyond it a degree has too few bits to follow a sweep."""
+
+
+def magnitude_problem(value: float, kind: str, unit: str, signed: bool = False) -> str | None:
+    """Why a finite value is out of the range this engine can represent faithfully, or None.
+    A signed length (an offset) may be as small as it likes: it only adds to others."""
+    if kind == "angle":
+        deg = value * 180.0 / math.pi
+        if abs(deg) > ANGLE_LIMIT_DEG:
+            return f"an angle must be within +-{ANGLE_LIMIT_DEG:g} deg, got {deg:g} deg"
+        return None
+    lo, hi = LENGTH_RANGE
+    if signed:
+        lo = 0.0
+    if value != 0.0 and not lo <= abs(value) <= hi:
+        return (f"a length must be 0 or between {lo:g} and {hi:g} {unit} in magnitude, got {value!r} "
+                "(change length_unit to rescale)")
+    return None
+
+
+def as_float(value: Any) -> float | None:
+    """A TOML or CLI number as a finite float; None for booleans, non-numbers, overflow, NaN."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    try:
+        v = float(value)
+    except OverflowError:
+        return None
+    return v if math.isfinite(v) else None
 
 
 @dataclass(frozen=True)
@@ -114,12 +149,28 @@ class Mechanism:
     def problem(self) -> SystemProblem:
         return build_problem(self)
 
+    @functools.cached_property
+    def length_scale(self) -> float:
+        """The longest length in the loops (parameters, numbers, a length driver): the
+        size that residual tolerances are relative to."""
+        sizes = [abs(q.value) for q in self.parameters.values() if q.kind == "length"]
+        if self.driver.kind == "length":
+            sizes.append(abs(self.driver.value))
+        sizes += [abs(t.length) for loop in self.loops for t in loop.vectors
+                  if isinstance(t.length, float)]
+        big = max(sizes, default=0.0)
+        return big if big > 0.0 else 1.0
+
 
 def _requantify(q: Quantity, value: float) -> Quantity:
     if not math.isfinite(value):
         raise ParseError(f"{q.name} must be finite, got {value!r}")
     scale = ANGLE_UNITS[q.unit] if q.kind == "angle" else 1.0
-    return Quantity(q.name, q.kind, value * scale, q.unit, q.signed)
+    internal = value * scale
+    why = magnitude_problem(internal, q.kind, q.unit, q.signed)
+    if why:
+        raise ParseError(f"{q.name}: {why}")
+    return Quantity(q.name, q.kind, internal, q.unit, q.signed)
 
 
 # --- loading ------------------------------------------------------------------------------
@@ -131,17 +182,17 @@ def load(path: str | Path) -> Mechanism:
         import tomllib
     else:  # pragma: no cover
         import tomli as tomllib
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ParseError(f"no such file: {p}") from None
-    except IsADirectoryError:
-        raise ParseError(f"{p} is a directory, not a mechanism file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ParseError(f"cannot read {p}: {exc}") from None
+    from ..files import read_input
+
+    text = read_input(p)
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
+        raise ParseError(f"{p}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ParseError(f"{p}: not valid TOML: nested too deeply") from None
+    except (ValueError, OverflowError, MemoryError) as exc:
+        # e.g. an integer of more digits than Python converts (ValueError)
         raise ParseError(f"{p}: not valid TOML: {exc}") from None
     return parse_mechanism(doc, str(p))
 
@@ -176,14 +227,17 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
             raise fail(f"{key}.signed", "must be true or false")
         if field_name not in spec:
             raise fail(key, f"missing {field_name!r}")
-        value = spec[field_name]
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise fail(f"{key}.{field_name}", f"must be a finite number, got {value!r}")
+        value = as_float(spec[field_name])
+        if value is None:
+            raise fail(f"{key}.{field_name}", f"must be a finite number, got {_short(spec[field_name])}")
         unit = spec.get("unit")
-        if unit in ANGLE_UNITS:
-            return Quantity(qname, "angle", float(value) * ANGLE_UNITS[unit], unit)
-        if unit == length_unit:
-            return Quantity(qname, "length", float(value), unit, signed)
+        if unit in ANGLE_UNITS or unit == length_unit:
+            kind = "angle" if unit in ANGLE_UNITS else "length"
+            internal = value * ANGLE_UNITS[unit] if kind == "angle" else value
+            why = magnitude_problem(internal, kind, str(unit), signed)
+            if why:
+                raise fail(f"{key}.{field_name}", why)
+            return Quantity(qname, kind, internal, unit, signed if kind == "length" else False)
         raise fail(f"{key}.unit", f"unit {unit!r} is neither an angle unit (deg, rad) nor the "
                                   f"file's length_unit {length_unit!r}")
 
@@ -245,9 +299,10 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
                 raise fail(f"{vkey}.sign", f"must be 1 or -1, got {sign!r}")
             length = _ref(vec.get("length"), f"{vkey}.length", "length", known, fail, used)
             angle = _ref(vec.get("angle"), f"{vkey}.angle", "angle", known, fail, used)
-            offset = vec.get("offset", 0.0)
-            if isinstance(offset, bool) or not isinstance(offset, (int, float)):
-                raise fail(f"{vkey}.offset", "must be a number of degrees")
+            offset = as_float(vec.get("offset", 0.0))
+            if offset is None or abs(offset) > ANGLE_LIMIT_DEG:
+                raise fail(f"{vkey}.offset", f"must be a finite number of degrees within "
+                                             f"+-{ANGLE_LIMIT_DEG:g}")
             terms.append(VectorTerm(float(sign), length, angle, math.radians(offset)))
         loops.append(Loop(str(loop.get("name", f"loop {li + 1}")), tuple(terms), tuple(joints)))
 
@@ -271,6 +326,11 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
                      {"notes": doc.get("notes", "")})
 
 
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else f"{text[:20]}...({len(text)} characters)"
+
+
 def _ref(value: Any, key: str, kind: str, known: Mapping[str, Quantity], fail: Any,
          used: set[str]) -> str | float:
     if value is None:
@@ -278,9 +338,14 @@ def _ref(value: Any, key: str, kind: str, known: Mapping[str, Quantity], fail: A
     if isinstance(value, bool):
         raise fail(key, f"must be a name or a number, got {value!r}")
     if isinstance(value, (int, float)):
-        if not math.isfinite(value):
-            raise fail(key, "must be finite")
-        return math.radians(value) if kind == "angle" else float(value)
+        v = as_float(value)
+        if v is None:
+            raise fail(key, f"must be a finite number, got {_short(value)}")
+        internal = math.radians(v) if kind == "angle" else v
+        why = magnitude_problem(internal, kind, "")
+        if why:
+            raise fail(key, why)
+        return internal
     if not isinstance(value, str):
         raise fail(key, f"must be a name or a number, got {value!r}")
     q = known.get(value)
@@ -418,6 +483,7 @@ class LoopModel:
             branch_of=branch_of,
             meta={"driver": m.driver.name, "driver_value": shown, "driver_unit": m.driver.unit,
                   "source": m.source},
+            length_scale=m.length_scale,
         )
 
 

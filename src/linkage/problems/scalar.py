@@ -28,3 +28,6 @@ class ScalarProblem:
     title: str = ""
     guess: tuple[float, float] | None = None
     """A default (x0, x1) that also brackets a root, when the problem knows one."""
+    fbound: Fn | None = None
+    """A bound on the rounding error of the computed f(x): |f(x)| below it is a root to
+    within rounding (certifies convergence where f does not change sign)."""

@@ -33,6 +33,17 @@ class SystemProblem:
     branch_of: Callable[[dict[str, float]], str] | None = None
     """Names the assembly branch of a solution (display units); None: use the sign of det J."""
     meta: dict[str, Any] = field(default_factory=dict)
+    length_scale: float = 1.0
+    """The mechanism's size (its longest length): residual tolerances are relative to it,
+    so a mechanism behaves the same in metres, millimetres or micrometres."""
+
+    @property
+    def step_scales(self) -> tuple[float, ...] | None:
+        """Per unknown, what a step is measured against: 1 for angles (rad), the length
+        scale for lengths; None when every unknown is measured as it is."""
+        if self.length_scale == 1.0 or "length" not in self.kinds:
+            return None
+        return tuple(self.length_scale if k == "length" else 1.0 for k in self.kinds)
 
     @property
     def n(self) -> int:

@@ -38,10 +38,11 @@ def _check_suffix(path: Path, allowed: Sequence[str]) -> None:
 
 
 def _save(fig: Any, path: Path) -> None:
+    from ..files import atomic_target
+
     try:
-        fig.savefig(path, dpi=120, bbox_inches="tight")
-    except OSError as exc:
-        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
+        with atomic_target(path) as tmp:
+            fig.savefig(tmp, dpi=120, bbox_inches="tight", format=path.suffix.lower()[1:])
     finally:
         import matplotlib.pyplot as plt
 
@@ -174,10 +175,11 @@ def animate_sweep(mechanism: Any, frames: Sequence[tuple[float, Sequence[float]]
         ax.set_ylim(min(ys) - pad, max(ys) + pad)
 
     anim = FuncAnimation(fig, update, frames=len(frames))
+    from ..files import atomic_target
+
     try:
-        anim.save(path, writer=PillowWriter(fps=fps))
-    except OSError as exc:
-        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
+        with atomic_target(path) as tmp:
+            anim.save(tmp, writer=PillowWriter(fps=fps))
     finally:
         plt.close(fig)
 

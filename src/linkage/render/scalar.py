@@ -39,6 +39,8 @@ def scalar_blocks(problem: ScalarProblem, result: Result, conv: Convergence | No
     h = result.history
     if h is not None and h.rows:
         blocks.append(table("", h.columns, h.rows, digits))
+        if h.elided:
+            blocks.append(Text(h.note))
     style = "green" if result.converged else "red"
     blocks.append(Text(result.message, style))
     blocks.append(Text(

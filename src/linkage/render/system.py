@@ -31,6 +31,8 @@ def system_blocks(problem: SystemProblem, result: Result, conv: Convergence | No
     h = result.history
     if h is not None and h.rows:
         blocks.append(table("", h.columns, h.rows, digits))
+        if h.elided:
+            blocks.append(Text(h.note))
     blocks.append(Text(result.message, "green" if result.converged else "red"))
     solution = system_solution(problem, result)
     ref = (meta.get("reference") or {}).get(branch) if branch else None

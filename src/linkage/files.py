@@ -1,0 +1,159 @@
+"""Reading inputs and writing outputs so that no file is ever lost or half written.
+
+Inputs: a mechanism file must be a regular file (not a FIFO, a device or a socket, which
+could block or never end) of at most :data:`MAX_INPUT_BYTES`; it is read with that bound.
+
+Outputs: every path is checked before any work is done (:func:`check_outputs`): it may not
+resolve to an input (through symlinks and hard links alike), two outputs may not share a
+path, and its folder must exist. Regular files are written to a temporary file in the same
+folder and renamed over the target (:func:`write_atomic`, :func:`atomic_target`), so a full
+disk or an interrupted run leaves the old file as it was. Special files (``/dev/null``, a
+terminal, a FIFO) are written in place, since renaming over them would replace the device.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import stat
+import tempfile
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+
+from .errors import InputError, OutputError, ParseError
+
+MAX_INPUT_BYTES = 1_000_000
+"""A mechanism file is a page of TOML; a megabyte is far beyond any real one."""
+
+
+def read_input(path: Path, what: str = "mechanism file") -> str:
+    """The text of a regular UTF-8 file of at most MAX_INPUT_BYTES, or a ParseError."""
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise ParseError(f"no such file: {path}") from None
+    except OSError as exc:
+        raise ParseError(f"cannot read {path}: {exc.strerror or exc}") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise ParseError(f"{path} is a directory, not a {what}")
+    if not stat.S_ISREG(st.st_mode):
+        raise ParseError(f"{path} is not a regular file (a FIFO, a device or a socket); "
+                         f"give the {what} itself")
+    if st.st_size > MAX_INPUT_BYTES:
+        raise ParseError(f"{path} has {st.st_size:,} bytes; a {what} may have at most "
+                         f"{MAX_INPUT_BYTES:,}")
+    try:
+        # O_NONBLOCK: if the path was swapped for a FIFO since the stat, do not wait on it
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        with os.fdopen(fd, "rb") as fh:
+            if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+                raise ParseError(f"{path} is not a regular file")
+            data = fh.read(MAX_INPUT_BYTES + 1)
+    except OSError as exc:
+        raise ParseError(f"cannot read {path}: {exc.strerror or exc}") from None
+    if len(data) > MAX_INPUT_BYTES:
+        raise ParseError(f"{path} is larger than {MAX_INPUT_BYTES:,} bytes")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ParseError(f"{path} is not UTF-8 text (byte {exc.start})") from None
+
+
+def _identity(path: Path) -> tuple[int, int] | None:
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino
+
+
+def check_outputs(inputs: Sequence[Path | None], outputs: Sequence[tuple[str, Path | None]]) -> None:
+    """Refuse, before any work, an output that is an input, two outputs on one path, an
+    output in a missing folder or on a directory. ``outputs`` pairs option names with paths."""
+    given = [(opt, p) for opt, p in outputs if p is not None and str(p) != "-"]
+    in_ids = {}
+    for p in inputs:
+        if p is not None and str(p) != "-":
+            ident = _identity(p)
+            if ident is not None:
+                in_ids[ident] = p
+            in_ids[os.path.realpath(p)] = p
+    seen: dict[object, str] = {}
+    for opt, p in given:
+        real = os.path.realpath(p)
+        ident = _identity(p)
+        for key in (real, ident):
+            if key is not None and key in in_ids:
+                raise InputError(f"{opt} {p} is the input file {in_ids[key]}; writing there would "
+                                 "replace it: choose another path")
+        for key in (real, ident):
+            if key is not None and key in seen:
+                raise InputError(f"{opt} {p} and {seen[key]} name the same file; give each output "
+                                 "its own path")
+        for key in (real, ident):
+            if key is not None:
+                seen[key] = f"{opt} {p}"
+        if os.path.isdir(real):
+            raise InputError(f"{opt} {p} is a directory; give a file name")
+        parent = os.path.dirname(real) or "."
+        if not os.path.isdir(parent):
+            raise InputError(f"cannot write {opt} {p}: the folder {os.path.dirname(str(p)) or '.'} "
+                             "does not exist")
+
+
+def _in_place(path: str) -> bool:
+    """True for an existing special file (device, FIFO): written directly, never renamed over."""
+    try:
+        return not stat.S_ISREG(os.stat(path).st_mode)
+    except OSError:
+        return False
+
+
+@contextlib.contextmanager
+def atomic_target(path: Path) -> Iterator[str]:
+    """Yield a temporary path beside ``path``; on success rename it over ``path``.
+
+    Writes through a symlink to its target. On any failure the temporary file is
+    removed, the old file is untouched and an OutputError names the path.
+    """
+    real = os.path.realpath(path)
+    if _in_place(real):
+        try:
+            yield real
+        except OSError as exc:
+            raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
+        return
+    folder = os.path.dirname(real) or "."
+    suffix = os.path.splitext(real)[1]
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(real)}.", suffix=f".part{suffix}",
+                                   dir=folder)
+        os.close(fd)
+    except OSError as exc:
+        raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
+    try:
+        yield tmp
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)
+        os.replace(tmp, real)
+    except OSError as exc:
+        _remove(tmp)
+        raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
+    except BaseException:
+        _remove(tmp)
+        raise
+
+
+def _remove(path: str) -> None:
+    with contextlib.suppress(OSError):
+        os.unlink(path)
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` completely or not at all."""
+    with atomic_target(path) as tmp, open(tmp, "w", encoding="utf-8") as fh:
+        fh.write(text)
+        fh.flush()
+        if stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+            os.fsync(fh.fileno())
