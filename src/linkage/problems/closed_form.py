@@ -126,6 +126,52 @@ def wrap_degrees(a: float) -> float:
     return w
 
 
+DRIVERS = {"fourbar": ("theta2", "theta4"), "slider_crank": ("theta2",)}
+"""The driver each closed form can be given."""
+
+
+def verify(m: Any) -> str | None:
+    """Why the mechanism's loops are not the closed form it names, or None when they are.
+
+    The closed form is a claim about the loops: its solutions must close them. It is
+    checked at the file's driver value and, where that cannot be assembled, at every
+    30 degrees (a length driver: at its value only), to 1e-9 of the mechanism's size.
+    """
+    name = m.closed_form
+    drivers = DRIVERS[name]
+    if m.driver.name not in drivers:
+        return (f"{name} takes {' or '.join(drivers)} as its driver, and the file drives "
+                f"{m.driver.name}")
+    unknowns = {u.name for u in m.unknowns}
+    expected = set(REQUIRED_NAMES[name]) - set(m.parameters) - {m.driver.name}
+    if unknowns != expected:
+        return (f"{name} solves for {', '.join(sorted(expected))}; the file's unknowns are "
+                f"{', '.join(sorted(unknowns))}")
+    from .loops import ANGLE_UNITS, LoopModel
+
+    model = LoopModel.compile(m)
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    shown0 = m.driver.value / scale
+    tries = [shown0] + ([shown0 + 30.0 * k for k in range(1, 12)] if m.driver.kind == "angle" else [])
+    limit = 1e-9 * m.length_scale
+    for shown in tries:
+        try:
+            sols = reference_for(m.with_values({m.driver.name: shown}, {}))()
+        except (ArithmeticError, ValueError, KeyError) as exc:
+            return f"the closed form cannot be evaluated: {exc}"
+        if not sols:
+            continue
+        F = model.functions(shown * scale)[0]
+        for branch, sol in sols.items():
+            q = [math.radians(sol[u.name]) if u.kind == "angle" else sol[u.name] for u in m.unknowns]
+            worst = max(abs(v) for v in F(q))
+            if not worst <= limit:
+                return (f"its {branch} solution at {m.driver.name} = {shown:g} leaves the loops open by "
+                        f"{worst:.3g} {m.length_unit}: the loops are not that mechanism")
+        return None
+    return None
+
+
 def branch_rule(m: Any) -> Callable[[dict[str, float]], str]:
     """The branch label of a solution given in display units (degrees)."""
     values = {k: q.value for k, q in m.parameters.items()}

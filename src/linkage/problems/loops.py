@@ -321,9 +321,16 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         raise fail(f"unknowns.{unused[0]}", "appears in no loop")
     if drv_name not in used:
         raise fail("driver.name", f"{drv_name!r} appears in no loop")
-    return Mechanism(name, source, length_unit, parameters, driver, unknowns, tuple(loops),
-                     closed_form, str(doc.get("description", "")),
-                     {"notes": doc.get("notes", "")})
+    mechanism = Mechanism(name, source, length_unit, parameters, driver, unknowns, tuple(loops),
+                          closed_form, str(doc.get("description", "")),
+                          {"notes": doc.get("notes", "")})
+    if closed_form is not None:
+        from .closed_form import verify
+
+        why = verify(mechanism)
+        if why:
+            raise fail("closed_form", f"{closed_form!r} does not describe this file: {why}")
+    return mechanism
 
 
 def _short(value: Any) -> str:
