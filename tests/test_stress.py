@@ -323,3 +323,119 @@ def test_cli_fuzz_no_traceback_and_known_exit_codes(cli, tmp_path, monkeypatch):
             assert len(run.err.strip().splitlines()) == 1, (args, run.err)
         codes[run.code] += 1
     assert all(codes.values()), codes  # the fuzz reached every outcome
+
+
+# --- mechanism-file mutations and numeric extremes ---------------------------------------------
+
+EXTREMES = [0, -1, 1e-320, 3e-320, 1e-300, 1e308, 1.7e308, 10**58, 10**400, -(10**30), 0.5, 1e6, 1e7,
+            float("nan"), float("inf"), "text", True, [1, 2], {"value": 1}, ""]
+
+
+def _toml_value(v: object) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float):
+        return "nan" if v != v else ("inf" if v == float("inf") else repr(v))
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
+    return json.dumps(v)
+
+
+def mutate(text: str, rng: random.Random) -> str:
+    """One to three random edits of a mechanism file: a number, a name, a key, a type,
+    a line dropped or doubled, nesting, truncation."""
+    import re
+
+    for _ in range(rng.randint(1, 3)):
+        kind = rng.randrange(8)
+        numbers = list(re.finditer(r"(?<![\w.])-?\d+(\.\d+)?(e-?\d+)?", text))
+        names = list(re.finditer(r'"(\w+)"', text))
+        lines = text.splitlines()
+        if kind == 0 and numbers:
+            m = rng.choice(numbers)
+            text = text[:m.start()] + _toml_value(rng.choice(EXTREMES)) + text[m.end():]
+        elif kind == 1 and names:
+            m = rng.choice(names)
+            new = rng.choice(['"nosuch"', '"theta2"', '"r1"', '""', '"' + "x" * 300 + '"', "7"])
+            text = text[:m.start()] + new + text[m.end():]
+        elif kind == 2 and lines:
+            i = rng.randrange(len(lines))
+            del lines[i]
+            text = "\n".join(lines)
+        elif kind == 3 and lines:
+            i = rng.randrange(len(lines))
+            lines.insert(i, lines[i])
+            text = "\n".join(lines)
+        elif kind == 4:
+            text = text[: rng.randrange(len(text) + 1)]
+        elif kind == 5 and lines:
+            i = rng.randrange(len(lines))
+            lines[i] = lines[i].replace("=", "= [", 1) + "]" if "=" in lines[i] else lines[i]
+            text = "\n".join(lines)
+        elif kind == 6:
+            depth = rng.choice([3, 50, 400])
+            text += "\nnotes = " + "[" * depth + "1" + "]" * depth + "\n"
+        else:
+            for key in ("unit", "sign", "offset", "closed_form", "length_unit", "guess", "value"):
+                if key in text and rng.random() < 0.3:
+                    junk = _toml_value(rng.choice(EXTREMES))
+                    text = text.replace(f"{key} = ", f"{key} = {junk}, x{key} = ", 1)
+    return text
+
+
+MUTATION_COMMANDS = [
+    ["solve"], ["solve", "--method", "lm"], ["solve", "--method", "newton-fd"], ["solve", "--format", "json"],
+    ["sweep", "--step", "45"], ["sweep", "--points", "5", "--format", "csv"],
+]
+
+
+def test_cli_fuzz_mechanism_mutations_and_extremes(cli, tmp_path, monkeypatch):
+    """At least 2,000 invocations on mutated sample files and extreme numbers: no traceback,
+    no internal error, exit codes 0, 1 or 2, and exit 2 is one line."""
+    monkeypatch.chdir(tmp_path)
+    rng = random.Random(9)
+    samples = sorted(SAMPLES.glob("*.toml"))
+    codes = {0: 0, 1: 0, 2: 0}
+    count = 0
+    for i in range(1400):
+        text = mutate(rng.choice(samples).read_text(), rng)
+        path = tmp_path / f"m{i % 7}.toml"
+        path.write_text(text)
+        args = [*rng.choice(MUTATION_COMMANDS)]
+        args.insert(1, str(path))
+        run = cli(*args)
+        count += 1
+        assert run.code in (0, 1, 2), (text[:2000], args, run.code, run.err[-300:])
+        out = run.out + run.err
+        assert "Traceback" not in out and "internal error" not in out, (text[:2000], args, out[-500:])
+        if run.code == 2:
+            assert len(run.err.strip().splitlines()) == 1, (args, run.err)
+        codes[run.code] += 1
+    for _ in range(700):
+        value = _toml_value(rng.choice(EXTREMES))
+        args = rng.choice([
+            ["solve", str(SAMPLES / "fourbar_me581.toml"), "--set", f"r{rng.randint(1, 4)}={value}"],
+            ["solve", str(SAMPLES / "fourbar_me581.toml"), "--guess", f"theta3={value}"],
+            ["solve", "--links", "2", "4", value, "5"],
+            ["solve", "--equation", "x**2-2", "--x0", value],
+            ["solve", "--method", "bisection", "--bracket", value, "2"],
+            ["solve", "--tol", value],
+            ["solve", "--max-iter", value],
+            ["sweep", str(SAMPLES / "crank_rocker.toml"), "--from", value, "--to", "1e9", "--step", "1"],
+            ["sweep", str(SAMPLES / "crank_rocker.toml"), "--points", value],
+            ["solve", str(SAMPLES / "slider_crank.toml"), "--fd-step", value, "--method", "newton-fd"],
+        ])
+        run = cli(*args)
+        count += 1
+        assert run.code in (0, 1, 2), (args, run.code, run.err[-300:])
+        out = run.out + run.err
+        assert "Traceback" not in out and "internal error" not in out, (args, out[-500:])
+        if run.code == 2:
+            assert len(run.err.strip().splitlines()) == 1, (args, run.err)
+        codes[run.code] += 1
+    assert count >= 2000
+    assert all(codes.values()), codes

@@ -122,7 +122,10 @@ def analyze(result: Result, problem: ScalarProblem | None = None) -> Convergence
             e0 = entries[k - 1][1]
             if e0 > 0.0:
                 ratio = e / e0
-                const = e / e0 ** p if e0 ** p > 0.0 else None
+                try:
+                    const = e / e0 ** p if e0 ** p > 0.0 else None
+                except OverflowError:  # a huge first error: no constant to show
+                    const = None
             if k >= 2 and e > 0.0 and e0 > 0.0:
                 em = entries[k - 2][1]
                 if em > 0.0 and e0 != em:
@@ -156,7 +159,7 @@ def _theory(result: Result, problem: ScalarProblem | None,
         theory["rate"] = 0.5
         a, b = (result.meta or {}).get("bracket", (None, None))
         tol = (result.meta or {}).get("tol")
-        if a is not None and tol:
+        if a is not None and tol and math.isfinite(abs(b - a) / tol):
             n = max(0, math.ceil(math.log2(abs(b - a) / tol) - 1.0))
             theory["a_priori_iterations"] = n + 1
             notes.append(f"a-priori bound: (b - a)/2^(n+1) <= tol needs n >= {n}, "

@@ -231,6 +231,9 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         if value is None:
             raise fail(f"{key}.{field_name}", f"must be a finite number, got {_short(spec[field_name])}")
         unit = spec.get("unit")
+        if not isinstance(unit, str):
+            raise fail(f"{key}.unit", f"must be a unit name such as \"deg\" or {length_unit!r}, "
+                                      f"got {_short(unit)}")
         if unit in ANGLE_UNITS or unit == length_unit:
             kind = "angle" if unit in ANGLE_UNITS else "length"
             internal = value * ANGLE_UNITS[unit] if kind == "angle" else value
