@@ -26,14 +26,21 @@ def test_quick_start_is_two_commands_and_ci_runs_them_verbatim():
         assert line in ci
 
 
-def readme_solve_examples() -> list[list[str]]:
-    found = re.findall(r"^\$ (linkage solve[^#\n]*)", README, flags=re.M)
-    return [shlex.split(c)[1:] for c in found]
+def readme_solve_examples() -> list[tuple[list[str], int]]:
+    """Every ``$ linkage solve ...`` line, with the exit code its ``# exit N`` comment
+    promises (0 without one)."""
+    found = re.findall(r"^\$ (linkage solve[^#\n]*)(#[^\n]*)?", README, flags=re.M)
+    out = []
+    for command, comment in found:
+        code = re.search(r"exit (\d)", comment or "")
+        out.append((shlex.split(command)[1:], int(code.group(1)) if code else 0))
+    return out
 
 
-@pytest.mark.parametrize("args", readme_solve_examples(), ids=" ".join)
-def test_every_readme_example_runs(cli, args, tmp_path, monkeypatch):
+@pytest.mark.parametrize("args,code", readme_solve_examples(), ids=lambda a: " ".join(a) if
+                         isinstance(a, list) else str(a))
+def test_every_readme_example_runs(cli, args, code, tmp_path, monkeypatch):
     (tmp_path / "sample_inputs").symlink_to(ROOT / "sample_inputs")
     monkeypatch.chdir(tmp_path)  # examples that write files write them here
     run = cli(*args)
-    assert run.code == 0, run.err
+    assert run.code == code, run.err

@@ -229,12 +229,20 @@ def test_non_assemblable_input_is_no_solution_with_rows(cli):
 
 
 def test_singular_start_is_a_named_stop(cli):
-    run = cli("solve", ME581, "--guess", "theta3=30", "--guess", "theta4=30", "--format", "json")
+    """The textbook iteration (--plain) stops at a singular start with det and cond; the
+    default, globalised, steps off it with a damped step and reaches an assembly."""
+    run = cli("solve", ME581, "--plain", "--guess", "theta3=30", "--guess", "theta4=30", "--format", "json")
     assert run.code == 1
     doc = json.loads(run.out)
     assert doc["status"] == "singular_jacobian"
     assert "det J = " in doc["message"] and "cond J = " in doc["message"]
     assert len(doc["iterations"]) == 1
+    recovered = json.loads(cli("solve", ME581, "--guess", "theta3=30", "--guess", "theta4=30",
+                               "--format", "json").out)
+    assert recovered["converged"]
+    branch = recovered["reference"][recovered["branch"]]
+    for name in ("theta3", "theta4"):
+        assert recovered["solution"][name] == pytest.approx(branch[name], abs=1e-9)
 
 
 MALFORMED = {

@@ -62,35 +62,35 @@ def time_per_call(fn: Callable[[], Any], repeats: int, budget: float) -> tuple[f
 
 
 def scalar_problem(name: str) -> dict[str, Any]:
+    """A bench problem from the registry, with its root at 40 digits (the reference)."""
     import mpmath as mp
 
-    from .problems.expression import equation_problem
-    from .problems.freudenstein import fourbar_equation
+    from .problems.catalog import BENCH_SCALAR, entry
 
-    if name == "seed002":
-        p = fourbar_equation(70.0)
+    e = entry(BENCH_SCALAR[name])
+    if e.equation is None:  # the seed-002 four-bar equation at alpha = 70 deg
         d = mp.pi / 180
         with mp.workdps(40):
             a = 70 * d
             big_a, big_b = mp.mpf(5) / 2 + mp.cos(a), mp.sin(a)
             k = mp.mpf(5) / 3 * mp.cos(a) + mp.mpf(11) / 6
             root = float(mp.degrees(mp.atan2(big_b, big_a) + mp.acos(k / mp.sqrt(big_a**2 + big_b**2))))
-        return {"problem": p, "bracket": (50.0, 60.0), "x0": 50.0, "x1": 60.0, "root": root}
-    p = equation_problem("x**2 - 4*x + 1")
-    with mp.workdps(40):
-        root = float(2 + mp.sqrt(3))
-    return {"problem": p, "bracket": (3.0, 5.0), "x0": 5.0, "x1": 4.5, "root": root}
+    else:
+        with mp.workdps(40):
+            root = float(mp.findroot(lambda x: x**2 - 4 * x + 1, e.x0))
+    return {"problem": e.problem(), "bracket": e.bracket, "x0": e.x0, "x1": e.x1, "root": root}
 
 
 def system_problem(name: str) -> dict[str, Any]:
 
     import mpmath as mp
 
+    from .problems.catalog import BENCH_SYSTEMS
     from .problems.loops import load
     from .samples import sample_path
     from .stress import mp_fourbar_positions
 
-    m = load(sample_path("fourbar_me581.toml" if name == "fourbar" else "rapier_drive.toml"))
+    m = load(sample_path(BENCH_SYSTEMS[name]))
     p = m.problem()
     if name == "fourbar":
         exact = mp_fourbar_positions(90, 30, 60, 45, 65.0)["open"]

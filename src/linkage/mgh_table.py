@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from .problems.mgh import mgh_cases
+from .problems.catalog import mgh_cases
 
 SOLVED_RESIDUAL = 1e-8
 TOL = 1e-10

@@ -187,6 +187,10 @@ def check_sign_change(problem: ScalarProblem, x: float, fx: float | None, lo: fl
     if not math.isfinite(start_size) or abs(fx) <= 1e-3 * start_size:
         return Status.CONVERGED_STEP, detail, 0
     lo, hi = sorted((lo, hi))
+    if hi - lo <= 64.0 * math.ulp(max(abs(lo), abs(hi))):
+        # a sign change within a few ulps: double precision cannot tell a root from a
+        # jump there, and |f| is rounding noise that no bisection can shrink
+        return Status.CONVERGED_STEP, detail, 0
     flo = problem.f(lo)
     evals = 1
     smallest = abs(fx)
@@ -246,15 +250,29 @@ def certify_root(problem: ScalarProblem, x: float, fx: float | None, width: floa
             return Status.CONVERGED_STEP, "", 0
     lo, hi = max(x - width, -_BIG), min(x + width, _BIG)
     flo, fhi = _value(problem.f, lo), _value(problem.f, hi)
+    evals = 2
     if flo is not None and fhi is not None and (flo == 0.0 or fhi == 0.0 or (flo < 0.0) != (fhi < 0.0)):
         ends = max(abs(flo), abs(fhi))
         status, detail, extra = check_sign_change(problem, x, fx, lo, hi, (flo, fhi), "", ends)
-        return status, detail, 2 + extra
+        return status, detail, evals + extra
+    # No sign change across the whole interval: look inside it, on both sides of x (a root
+    # pair, or a root where f is rounding noise and the ends happen to share a sign).
+    for a, fa in ((lo, flo), (hi, fhi)):
+        for frac in (0.5, 0.25, 0.125):
+            b = x + (a - x) * frac
+            fb = _value(problem.f, b)
+            evals += 1
+            if fb is not None and (fb == 0.0 or (fb < 0.0) != (fx < 0.0)):
+                inner = sorted((x, b))
+                status, detail, extra = check_sign_change(problem, x, fx, inner[0], inner[1], (fx, fb), "",
+                                                          max(abs(fx), abs(fb)))
+                return status, detail, evals + extra
+        del fa
     shown = ", ".join(f"f({v:.17g}) = {fv:.3g}" if fv is not None else f"f({v:.17g}) is undefined"
                       for v, fv in ((lo, flo), (hi, fhi)))
     return (Status.STALLED,
             f"f = {fx:.3g} at {problem.var} = {x!r}; no sign change within +-{width:.3g} ({shown})"
-            + ("" if problem.fbound is None else " and |f| is above its rounding level"), 2)
+            + ("" if problem.fbound is None else " and |f| is above its rounding level"), evals)
 
 
 def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: bool,

@@ -1,17 +1,29 @@
-"""One registry of scalar test problems, shared by the tests, the stress suite and benchmarks.
+"""The one registry of test problems, shared by the tests, ``linkage stress`` and
+``linkage bench`` (STYLE habit 9).
 
-Each entry is an equation (as text, so derivatives are exact), a bracket with a sign
-change, an open-method start, and optionally a fixed-point form. No answers are stored
-here: the tests compute reference roots independently (40-digit mpmath).
+- :data:`CATALOG`: named scalar problems. Each entry is an equation (as text, so
+  derivatives are exact), a bracket with a sign change, an open-method start, and
+  optionally a fixed-point form. No answers are stored: references are computed
+  independently (40-digit mpmath).
+- :func:`classic_cases`: the Alefeld-Potra-Shi and Chandrupatla collections
+  (:mod:`.classic`), with mpmath references.
+- :func:`mgh_cases`: the 66 Moré-Garbow-Hillstrom square systems (:mod:`.mgh`).
+- :data:`BENCH_SCALAR` and :data:`BENCH_SYSTEMS`: the problems ``linkage bench`` times,
+  named by catalogue entry and sample mechanism.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .classic import Case, classic_cases
 from .expression import equation_problem
 from .freudenstein import fourbar_equation
+from .mgh import SquareSystem, mgh_cases
 from .scalar import ScalarProblem
+
+__all__ = ["BENCH_SCALAR", "BENCH_SYSTEMS", "CATALOG", "Case", "CatalogEntry", "SquareSystem",
+           "classic_cases", "entry", "mgh_cases"]
 
 
 @dataclass(frozen=True)
@@ -52,3 +64,10 @@ def entry(name: str) -> CatalogEntry:
         if e.name == name:
             return e
     raise KeyError(name)
+
+
+BENCH_SCALAR = {"seed002": "fourbar-seed-002", "quadratic": "quadratic-high"}
+"""``linkage bench``'s scalar problems: its names -> catalogue entries."""
+
+BENCH_SYSTEMS = {"fourbar": "fourbar_me581.toml", "rapier": "rapier_drive.toml"}
+"""``linkage bench``'s systems: its names -> sample mechanisms."""
