@@ -334,3 +334,95 @@ def test_offset_nan_in_a_loop_is_one_line(cli, tmp_path):
 def test_deeply_nested_toml_is_one_line(cli, tmp_path):
     path = write(tmp_path, "deep.toml", 'name = "x"\nnotes = ' + "[" * 600 + "]" * 600 + "\n")
     one_line_exit_2(cli("solve", str(path)))
+
+
+def test_closed_pipe_on_stdout_is_one_line_and_nonzero(capsys, monkeypatch):
+    """A reader that goes away (``| head``): the write raises BrokenPipeError. (Pipes here
+    may buffer megabytes, so the failure is injected rather than provoked.)"""
+    from linkage.cli import run_cli
+
+    class ClosedPipe:
+        def write(self, text: str) -> int:
+            raise BrokenPipeError(errno.EPIPE, "Broken pipe")
+
+        def flush(self) -> None:
+            raise BrokenPipeError(errno.EPIPE, "Broken pipe")
+
+        def isatty(self) -> bool:
+            return False
+
+    monkeypatch.setattr(sys, "stdout", ClosedPipe())
+    code = run_cli(["sweep", str(SAMPLES / "crank_rocker.toml"), "--step", "10", "--format", "csv"])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.strip().startswith("error: cannot write to standard output")
+    assert len(err.strip().splitlines()) == 1
+
+
+# --- system solver robustness ---------------------------------------------------------------------
+
+WATT = SAMPLES / "watt_sixbar.toml"
+ROUGH = ("theta3=0", "theta4=90", "theta6=0", "theta7=90")
+
+
+def _watt_reference(theta2_deg: float) -> list[tuple[float, float, float, float]]:
+    """Both loops by circle intersections (no Newton): every assembly at theta2, in degrees."""
+    import cmath
+    import math
+
+    from linkage.problems.closed_form import fourbar_positions
+
+    d = math.radians
+    out = []
+    for sol in fourbar_positions(100, 40, 120, 80, 0.0, theta2=d(theta2_deg)).values():
+        t3, t4 = sol["theta3"], sol["theta4"]
+        o4 = 100 + 0j
+        c = o4 + 70 * cmath.exp(1j * (t4 + d(40)))
+        o6 = o4 + 120 * cmath.exp(1j * d(60))
+        from linkage.problems.closed_form import circle_points
+
+        for dpt in circle_points(o6, 80, c, 110):
+            out.append(tuple(math.degrees(v) for v in (t3, t4, cmath.phase(dpt - c), cmath.phase(dpt - o6))))
+    return out
+
+
+def test_watt_sixbar_from_a_rough_guess_converges_where_plain_newton_cycles(cli):
+    """The sample Watt six-bar from a rough guess: the textbook iteration cycles to the cap;
+    the default globalised Newton and lm reach an assembly that the circle-intersection
+    reference confirms."""
+    guesses = [a for g in ROUGH for a in ("--guess", g)]
+    plain = json.loads(cli("solve", str(WATT), "--plain", *guesses, "--format", "json").out)
+    assert plain["status"] == "max_iter" and plain["solution"] is not None
+    for method in ("newton", "lm"):
+        doc = json.loads(cli("solve", str(WATT), "--method", method, *guesses, "--format", "json").out)
+        assert doc["converged"], doc["message"]
+        got = [doc["solution"][k] for k in ("theta3", "theta4", "theta6", "theta7")]
+        refs = _watt_reference(30)
+        best = min(max(abs((g - r + 180) % 360 - 180) for g, r in zip(got, ref)) for ref in refs)
+        assert best <= 1e-9
+
+
+def test_brown_almost_linear_is_not_called_singular():
+    """Brown n = 10 from x10: the old row-scaled test stopped as 'singular' at cond 4e25
+    while Newton converges; the equilibrated test lets it run."""
+    from linkage.problems.mgh import brown_almost_linear
+
+    s = brown_almost_linear(10)
+    r = solve_system(s.F, s.start(10.0), jac=s.J, tol=1e-10, ftol=1e-10, max_iter=200, record=False)
+    assert r.converged and max(abs(v) for v in s.F(list(r.x))) <= 1e-8
+
+
+def test_lm_at_a_local_minimum_says_so():
+    """Powell badly scaled from x100: lm stops where |F| cannot be lowered; that is a
+    local_minimum (no root from this start), not a proof that no solution exists."""
+    from linkage.problems.mgh import mgh_cases
+
+    named = {label: (s, f) for label, s, f in mgh_cases()}
+    seen = set()
+    for label, (s, f) in named.items():
+        r = solve_system(s.F, s.start(f), jac=s.J, method="lm", tol=1e-10, ftol=1e-10, max_iter=200,
+                         record=False)
+        if not r.converged:
+            seen.add(r.status)
+            assert r.status is not Status.NO_SOLUTION, label
+    assert Status.LOCAL_MINIMUM in seen

@@ -38,7 +38,10 @@ def scalar_blocks(problem: ScalarProblem, result: Result, conv: Convergence | No
     ]
     h = result.history
     if h is not None and h.rows:
-        blocks.append(table("", h.columns, h.rows, digits))
+        rows = h.rows
+        if h.elided:  # a visible gap where the history left rows out
+            rows = (*rows[:h.gap_at], ("...",) * len(h.columns), *rows[h.gap_at:])
+        blocks.append(table("", h.columns, rows, digits))
         if h.elided:
             blocks.append(Text(h.note))
     style = "green" if result.converged else "red"

@@ -30,7 +30,10 @@ def system_blocks(problem: SystemProblem, result: Result, conv: Convergence | No
     ]
     h = result.history
     if h is not None and h.rows:
-        blocks.append(table("", h.columns, h.rows, digits))
+        rows = h.rows
+        if h.elided:  # a visible gap where the history left rows out
+            rows = (*rows[:h.gap_at], ("...",) * len(h.columns), *rows[h.gap_at:])
+        blocks.append(table("", h.columns, rows, digits))
         if h.elided:
             blocks.append(Text(h.note))
     blocks.append(Text(result.message, "green" if result.converged else "red"))
