@@ -399,6 +399,17 @@ MUTATION_COMMANDS = [
 ]
 
 
+def well_behaved(run, args: list[str], context: str = "") -> int:
+    """The CLI's contract for any input: exit 0, 1 or 2, no traceback or internal error,
+    and exit 2 is one line. Returns the exit code."""
+    assert run.code in (0, 1, 2), (context, args, run.code, run.err[-300:])
+    out = run.out + run.err
+    assert "Traceback" not in out and "internal error" not in out, (context, args, out[-500:])
+    if run.code == 2:
+        assert len(run.err.strip().splitlines()) == 1, (args, run.err)
+    return run.code
+
+
 def test_cli_fuzz_mechanism_mutations_and_extremes(cli, tmp_path, monkeypatch):
     """At least 2,000 invocations on mutated sample files and extreme numbers: no traceback,
     no internal error, exit codes 0, 1 or 2, and exit 2 is one line."""
@@ -413,14 +424,8 @@ def test_cli_fuzz_mechanism_mutations_and_extremes(cli, tmp_path, monkeypatch):
         path.write_text(text)
         args = [*rng.choice(MUTATION_COMMANDS)]
         args.insert(1, str(path))
-        run = cli(*args)
+        codes[well_behaved(cli(*args), args, text[:2000])] += 1
         count += 1
-        assert run.code in (0, 1, 2), (text[:2000], args, run.code, run.err[-300:])
-        out = run.out + run.err
-        assert "Traceback" not in out and "internal error" not in out, (text[:2000], args, out[-500:])
-        if run.code == 2:
-            assert len(run.err.strip().splitlines()) == 1, (args, run.err)
-        codes[run.code] += 1
     for _ in range(700):
         value = _toml_value(rng.choice(EXTREMES))
         args = rng.choice([
@@ -435,13 +440,7 @@ def test_cli_fuzz_mechanism_mutations_and_extremes(cli, tmp_path, monkeypatch):
             ["sweep", str(SAMPLES / "crank_rocker.toml"), "--points", value],
             ["solve", str(SAMPLES / "slider_crank.toml"), "--fd-step", value, "--method", "newton-fd"],
         ])
-        run = cli(*args)
+        codes[well_behaved(cli(*args), args)] += 1
         count += 1
-        assert run.code in (0, 1, 2), (args, run.code, run.err[-300:])
-        out = run.out + run.err
-        assert "Traceback" not in out and "internal error" not in out, (args, out[-500:])
-        if run.code == 2:
-            assert len(run.err.strip().splitlines()) == 1, (args, run.err)
-        codes[run.code] += 1
     assert count >= 2000
     assert all(codes.values()), codes

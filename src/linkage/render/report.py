@@ -57,6 +57,20 @@ def table(title: str, headers: Sequence[str], rows: Sequence[Sequence[Any]], dig
                  tuple(notes))
 
 
+def history_blocks(h: Any, digits: int) -> list[Block]:
+    """A recorded history as a table, with a visible gap and a note where a long run's
+    history left rows out; nothing for an empty one."""
+    if h is None or not h.rows:
+        return []
+    rows = h.rows
+    if h.elided:
+        rows = (*rows[:h.gap_at], ("...",) * len(h.columns), *rows[h.gap_at:])
+    blocks: list[Block] = [table("", h.columns, rows, digits)]
+    if h.elided:
+        blocks.append(Text(h.note))
+    return blocks
+
+
 def tabulate_formats() -> list[str]:
     from tabulate import tabulate_formats as names
 

@@ -8,7 +8,7 @@ from typing import Any
 from ..analysis.convergence import Convergence
 from ..problems.scalar import ScalarProblem
 from ..result import Result
-from .report import Block, Table, Text, fmt, table
+from .report import Block, Table, Text, fmt, history_blocks, table
 
 _CONSTANT_HEADER = {
     "newton": "e_k+1/e_k^2",
@@ -37,13 +37,7 @@ def scalar_blocks(problem: ScalarProblem, result: Result, conv: Convergence | No
         Text(""),
     ]
     h = result.history
-    if h is not None and h.rows:
-        rows = h.rows
-        if h.elided:  # a visible gap where the history left rows out
-            rows = (*rows[:h.gap_at], ("...",) * len(h.columns), *rows[h.gap_at:])
-        blocks.append(table("", h.columns, rows, digits))
-        if h.elided:
-            blocks.append(Text(h.note))
+    blocks.extend(history_blocks(h, digits))
     style = "green" if result.converged else "red"
     blocks.append(Text(result.message, style))
     blocks.append(Text(

@@ -7,7 +7,7 @@ from typing import Any
 from ..analysis.convergence import Convergence
 from ..problems.system import SystemProblem
 from ..result import Result
-from .report import Block, Text, fmt, table
+from .report import Block, Text, fmt, history_blocks
 from .scalar import convergence_blocks
 
 
@@ -29,13 +29,7 @@ def system_blocks(problem: SystemProblem, result: Result, conv: Convergence | No
         Text(""),
     ]
     h = result.history
-    if h is not None and h.rows:
-        rows = h.rows
-        if h.elided:  # a visible gap where the history left rows out
-            rows = (*rows[:h.gap_at], ("...",) * len(h.columns), *rows[h.gap_at:])
-        blocks.append(table("", h.columns, rows, digits))
-        if h.elided:
-            blocks.append(Text(h.note))
+    blocks.extend(history_blocks(h, digits))
     blocks.append(Text(result.message, "green" if result.converged else "red"))
     solution = system_solution(problem, result)
     ref = (meta.get("reference") or {}).get(branch) if branch else None
