@@ -12,7 +12,11 @@ from typing import Any
 from .errors import InputError
 from .iterate import MAX_ITER_LIMIT, Criteria, explain, run
 from .methods import SCALAR_METHODS, Bisection, FixedPoint, Hybrid, Newton, RegulaFalsi, Secant
+from .methods.least_squares import LevenbergMarquardt
+from .methods.newton import newton_lean
+from .methods.newton_system import NewtonSystem, max_abs, newton_system_lean
 from .problems.scalar import ScalarProblem
+from .problems.system import SystemProblem, generic_system
 from .result import History, Result, Status
 
 
@@ -91,6 +95,11 @@ def solve_scalar(
     >>> round(r.root, 12), r.status.value
     (1.414213562373, 'converged_step')
     """
+    if (method == "newton" and not record and type(f) is ScalarProblem and fprime is None
+            and type(x0) is float and x0 - x0 == 0.0 and f.fprime is not None):
+        # the common case, without the general front door: a problem with its
+        # derivative and a finite start
+        return _newton_lean(f, x0, check_criteria(tol, rtol, ftol, max_iter))
     if method not in SCALAR_METHODS:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")
     crit = check_criteria(tol, rtol, ftol, max_iter)
@@ -132,6 +141,8 @@ def solve_scalar(
         elif method == "newton":
             if problem.fprime is None:
                 raise InputError("newton needs the derivative fprime")
+            if not record:
+                return _newton_lean(problem, x0, crit)
             m = Newton()
             args = (x0,)
             start = {"x0": x0}
@@ -160,6 +171,35 @@ def solve_scalar(
                       meta={"var": problem.var, "unit": problem.unit, "title": problem.title,
                             "tol": crit.tol, "rtol": crit.rtol, **start})
     return finish(m, problem, state, crit, record, start)
+
+
+def _newton_lean(problem: ScalarProblem, x0: float, crit: Criteria) -> Result:
+    """Newton without a history: the tight loop of :func:`~linkage.methods.newton.newton_lean`,
+    packaged exactly as :func:`finish` packages the generic loop's outcome."""
+    extra = [0]
+
+    def certify(x: float, fx: float, width: float) -> tuple[Status, str]:
+        verdict, why, n = certify_root(problem, x, fx, width)
+        extra[0] += n
+        return verdict, why
+
+    try:
+        x, fx, err, status, detail, k = newton_lean(problem, x0, crit.tol, crit.rtol, crit.ftol,
+                                                    crit.max_iter, certify)
+    except TypeError:  # the generic path's answer to a non-real f at the start
+        return Result(method="newton", x=x0, status=Status.DOMAIN_ERROR, iterations=0, nfev=0,
+                      error=math.inf, residual=None, detail="at the start: f returned a non-real value",
+                      meta={"var": problem.var, "unit": problem.unit, "title": problem.title,
+                            "tol": crit.tol, "rtol": crit.rtol, "x0": x0})
+    except (ArithmeticError, ValueError) as exc:
+        status, detail = explain(exc)
+        return Result(method="newton", x=x0, status=status, iterations=0, nfev=0, error=math.inf,
+                      residual=None, detail=f"at the start: {detail}",
+                      meta={"var": problem.var, "unit": problem.unit, "title": problem.title,
+                            "tol": crit.tol, "rtol": crit.rtol, "x0": x0})
+    return Result.fast("newton", x, status, k, 1 + 2 * k + extra[0], err, fx, detail,
+                       {"var": problem.var, "unit": problem.unit, "title": problem.title,
+                        "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, "x0": x0})
 
 
 @functools.lru_cache(maxsize=128)
@@ -368,10 +408,6 @@ def solve_system(
     textbook iteration.
     Returns a :class:`Result` with ``x`` (a tuple), ``nfev`` and ``njev``.
     """
-    from .methods.least_squares import LevenbergMarquardt
-    from .methods.newton_system import NewtonSystem, max_abs
-    from .problems.system import SystemProblem, generic_system
-
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r} for a system; choose from {', '.join(SYSTEM_METHODS)}")
     crit = check_criteria(tol, rtol, ftol, max_iter)
@@ -408,20 +444,30 @@ def solve_system(
         raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
     if len(phi0) != problem.n:
         raise InputError(f"the system has {len(phi0)} equations for {problem.n} unknowns")
-    state = m.init(problem, q0)
     scale = problem.length_scale
     gate = (crit.ftol if crit.ftol is not None else crit.tol) * scale
-    run_crit = replace(crit, ftol=gate)
-    final, status, detail, iterations, rows = run(m, problem, state, run_crit, record=record,
-                                                  magnitude=max_abs)
-    x = tuple(final.x)
-    nfev, njev = final.nfev, final.njev
-    try:
-        residual = max_abs(problem.F(list(x)))
-        nfev += 1
-    except (ArithmeticError, ValueError):
-        residual = math.nan
-    if status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN) and residual <= gate and final.stop:
+    rows = None
+    if method == "newton" and kind == "analytic" and not record:
+        q, phi, err, status, detail, iterations, nfev, njev = newton_system_lean(
+            problem, q0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
+        x, stopped = tuple(q), status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN)
+        residual = max_abs(phi)
+    else:
+        state = m.init(problem, q0, phi0) if isinstance(m, NewtonSystem) else m.init(problem, q0)
+        run_crit = replace(crit, ftol=gate)
+        final, status, detail, iterations, rows = run(m, problem, state, run_crit, record=record,
+                                                      magnitude=max_abs)
+        x, stopped, err = tuple(final.x), final.stop is not None, final.err
+        nfev, njev = final.nfev, final.njev
+        if hasattr(final, "phi_x"):  # Newton's last trial evaluated Phi at x already
+            residual = max_abs(final.phi_x)
+        else:
+            try:
+                residual = max_abs(problem.F(list(x)))
+                nfev += 1
+            except (ArithmeticError, ValueError):
+                residual = math.nan
+    if status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN) and residual <= gate and stopped:
         # no step lowers |Phi| any more, and it is already within the residual tolerance:
         # a root to that tolerance (ill-conditioned, so the step test could not pass)
         status, detail = Status.CONVERGED_RESIDUAL, f"max|Phi| = {residual:.3g} <= {gate:.3g}; {detail}"
@@ -445,8 +491,10 @@ def solve_system(
     history = None
     if rows is not None:
         history = _system_history(m, problem, rows, show_jacobian, reference, x)
-    return Result(method=m.name, x=x, status=status, iterations=iterations, nfev=nfev, error=final.err,
-                  residual=residual, detail=detail, history=history, njev=njev, meta=meta)
+    result = Result.fast(m.name, x, status, iterations, nfev, err, residual, detail, meta)
+    if history is not None or njev:
+        result.__dict__.update(history=history, njev=njev)
+    return result
 
 
 def _system_history(m: Any, problem: Any, rows: list[tuple[Any, ...]], show_jacobian: bool,

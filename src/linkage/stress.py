@@ -431,44 +431,50 @@ def mp_fourbar_positions(
         return out
 
 
+def fourbar_mechanism(it: dict[str, Any]) -> Any:
+    """A random four-bar of :func:`fourbar_cases` as a mechanism (metres, closed form)."""
+    from .problems.loops import parse_mechanism
+
+    r1, r2, r3, r4 = it["links"]
+    unit = {"unit": "m"}
+    doc = {
+        "name": "random four-bar",
+        "length_unit": "m",
+        "closed_form": "fourbar",
+        "parameters": {
+            "r1": {"value": r1, **unit},
+            "r2": {"value": r2, **unit},
+            "r3": {"value": r3, **unit},
+            "r4": {"value": r4, **unit},
+            "theta1": {"value": 0.0, "unit": "deg"},
+        },
+        "driver": {"name": "theta2", "value": it["theta2"], "unit": "deg"},
+        "unknowns": {
+            "theta3": {"guess": it["guess"][0], "unit": "deg"},
+            "theta4": {"guess": it["guess"][1], "unit": "deg"},
+        },
+        "loops": [
+            {
+                "name": "L",
+                "vectors": [
+                    {"length": "r2", "angle": "theta2"},
+                    {"length": "r3", "angle": "theta3"},
+                    {"length": "r4", "angle": "theta4", "sign": -1},
+                    {"length": "r1", "angle": "theta1", "sign": -1},
+                ],
+            }
+        ],
+    }
+    return parse_mechanism(doc)
+
+
 def run_fourbars(items: Sequence[dict[str, Any]], methods: Sequence[str]) -> dict[tuple[str, str], Tally]:
     from .problems.closed_form import wrap_degrees
-    from .problems.loops import parse_mechanism
     from .solve import solve_system
 
     tallies: dict[tuple[str, str], Tally] = {}
     for it in items:
-        r1, r2, r3, r4 = it["links"]
-        unit = {"unit": "m"}
-        doc = {
-            "name": "random four-bar",
-            "length_unit": "m",
-            "closed_form": "fourbar",
-            "parameters": {
-                "r1": {"value": r1, **unit},
-                "r2": {"value": r2, **unit},
-                "r3": {"value": r3, **unit},
-                "r4": {"value": r4, **unit},
-                "theta1": {"value": 0.0, "unit": "deg"},
-            },
-            "driver": {"name": "theta2", "value": it["theta2"], "unit": "deg"},
-            "unknowns": {
-                "theta3": {"guess": it["guess"][0], "unit": "deg"},
-                "theta4": {"guess": it["guess"][1], "unit": "deg"},
-            },
-            "loops": [
-                {
-                    "name": "L",
-                    "vectors": [
-                        {"length": "r2", "angle": "theta2"},
-                        {"length": "r3", "angle": "theta3"},
-                        {"length": "r4", "angle": "theta4", "sign": -1},
-                        {"length": "r1", "angle": "theta1", "sign": -1},
-                    ],
-                }
-            ],
-        }
-        problem = parse_mechanism(doc).problem()
+        problem = fourbar_mechanism(it).problem()
         for method in methods:
             t = tallies.setdefault(("fourbar", method), Tally())
             t.cases += 1
@@ -483,7 +489,7 @@ def run_fourbars(items: Sequence[dict[str, Any]], methods: Sequence[str]) -> dic
                 t.failed += 1
                 continue
             t3, t4 = (math.degrees(v) for v in result.x)
-            reference = mp_fourbar_positions(r1, r2, r3, r4, it["theta2"])
+            reference = mp_fourbar_positions(*it["links"], it["theta2"])
             errs = {
                 b: max(
                     abs(wrap_degrees(t3 - math.degrees(s["theta3"]))),

@@ -11,9 +11,11 @@ Rows follow seed 002: i, x_i, f(x_i), f'(x_i), x_{i+1}, |x_{i+1} - x_i|.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
+from ..iterate import DIVERGE_STREAK, ROUNDING, UNCERTIFIED_LIMIT, explain
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
 from ._common import new_state
@@ -77,3 +79,85 @@ class Newton:
         if s.stop is not None:
             return (i, s.xp, s.fxp, s.dfxp, None, None)
         return (i, s.xp, s.fxp, s.dfxp, s.x, s.err)
+
+
+def newton_lean(problem: ScalarProblem, x0: float, tol: float, rtol: float, ftol: float | None,
+                max_iter: int, certify: Any) -> tuple[float, float, float, Status, str, int]:
+    """Newton with recording off, as one tight loop: the generic loop's stopping rules for
+    this method (:mod:`linkage.iterate`, tests 1-8, in order) written out without states,
+    method dispatch or rows. Gives the generic loop's status, root and iteration count
+    (tests/test_compile.py checks that on the stress battery).
+
+    Returns (x, f(x), last error, status, detail, iterations); ``certify(x, fx, width)``
+    decides a small step as in the generic loop.
+    """
+    f, fp = problem.f, problem.fprime
+    isfinite = math.isfinite
+    x = x0
+    fx = f(x)
+    if fx == 0.0:
+        return x, fx, math.inf, Status.CONVERGED_EXACT, f"f is zero at the start {problem.var} = {x0!r}", 0
+    if fx != fx or abs(fx) == math.inf:
+        return x, fx, math.inf, Status.NON_FINITE, f"f({problem.var}={x0:g}) = {fx!r}", 0
+    best = start = abs(fx) if isinstance(fx, float) else math.inf
+    prev_err = math.inf
+    err = math.inf
+    growth = uncertified = stalls = rounding_steps = 0
+    k = 0
+    for k in range(1, max_iter + 1):
+        try:
+            d = fp(x)  # type: ignore[misc]
+            if d == 0.0:
+                return (x, fx, math.nan, Status.ZERO_DERIVATIVE,
+                        f"f'({problem.var}) = 0 at {problem.var} = {x!r}, f = {fx:.6g}", k)
+            x1 = x - fx / d
+            fx1 = f(x1)
+        except (ArithmeticError, ValueError) as exc:
+            status, detail = explain(exc)
+            return x, fx, err, status, detail, k - 1
+        err = x1 - x
+        if err < 0.0:
+            err = -err
+        x, fx = x1, fx1
+        # inline finiteness: v - v is 0.0 for a finite float, NaN for inf and NaN
+        if type(fx) is not float or type(err) is not float:
+            try:
+                finite = isfinite(err) and isfinite(fx)
+            except TypeError:
+                return x, fx, err, Status.DOMAIN_ERROR, f"f returned a non-real value: {fx!r}", k
+        else:
+            finite = err - err == 0.0 and fx - fx == 0.0
+        if not finite:
+            return x, fx, err, Status.NON_FINITE, f"error = {err!r}, residual = {fx!r}", k
+        if fx == 0.0:
+            return x, fx, err, Status.CONVERGED_EXACT, "", k
+        size = fx if fx > 0.0 else -fx
+        if ftol is not None and size <= ftol:
+            return x, fx, err, Status.CONVERGED_RESIDUAL, "", k
+        ax = x if x >= 0.0 else -x
+        limit = tol + rtol * ax if rtol else tol
+        if err <= limit:
+            if size > best and size > 1e-8 * start:
+                limit = -1.0
+            else:
+                if size < best:
+                    best = size
+                verdict, why = certify(x, fx, limit)
+                if verdict is Status.CONVERGED_STEP:
+                    return x, fx, err, verdict, "", k
+                uncertified += 1
+                if verdict is not Status.STALLED or uncertified >= UNCERTIFIED_LIMIT:
+                    return x, fx, err, verdict, why, k
+        elif size < best:
+            best = size
+        growth = growth + 1 if err > prev_err else 0
+        if growth >= DIVERGE_STREAK:
+            return x, fx, err, Status.DIVERGED, f"{growth} growing steps, last {err:.3g}", k
+        if err <= ROUNDING * ax:
+            rounding_steps += 1
+            stalls += err >= prev_err
+            if stalls >= 2 or rounding_steps >= 6:
+                return (x, fx, err, Status.PRECISION_LIMIT,
+                        f"error {err:.3g} is rounding noise; tolerance {limit:.3g} is out of reach", k)
+        prev_err = err
+    return x, fx, err, Status.MAX_ITER, "", k

@@ -140,7 +140,10 @@ def step_measure(step: Any, scales: tuple[float, ...] | None) -> float:
 
 
 def _sumsq(v: Any) -> float:
-    return sum(c * c for c in v)
+    total = 0.0
+    for c in v:
+        total += c * c
+    return total
 
 
 @dataclass(frozen=True)
@@ -178,9 +181,10 @@ class NewtonSystem:
     def columns(self, problem: SystemProblem, show_jacobian: bool = False) -> tuple[Column, ...]:
         return system_columns(problem, show_jacobian, step_label="dq")
 
-    def init(self, problem: SystemProblem, q0: tuple[float, ...]) -> NewtonSystemState:
+    def init(self, problem: SystemProblem, q0: tuple[float, ...],
+             phi0: Any = None) -> NewtonSystemState:
         nan = math.nan
-        phi0 = tuple(problem.F(list(q0)))
+        phi0 = tuple(problem.F(list(q0)) if phi0 is None else phi0)
         return NewtonSystemState(tuple(q0), None, math.inf, None, tuple(q0), (), (), (), nan, nan,
                                  1.0, 1, 0, phi0)
 
@@ -315,3 +319,100 @@ def system_row(problem: SystemProblem, k: int, q: Any, phi: Any, dq: Any, det: f
     row.append(jac)  # expanded (or dropped) by the solve function: see solve_system
     row.append(err)
     return tuple(row)
+
+
+def newton_system_lean(problem: SystemProblem, q0: tuple[float, ...], phi0: list[float], tol: float,
+                       rtol: float, gate: float, max_iter: int, damped: bool) -> tuple[Any, ...]:
+    """Newton-Raphson with recording off, as one tight loop: the generic loop's stopping
+    rules for systems (:mod:`linkage.iterate`) written out, the whole-step path inline
+    (Cramer's rule for two unknowns). An iteration whose whole step is refused (a line
+    search, a damped or singular step) is handed to :meth:`NewtonSystem.step`, so there is
+    one implementation of globalisation; the outcome equals the generic loop's (status,
+    root, iterations; tests/test_compile.py).
+
+    Returns (x, Phi(x), last error, status, detail, iterations, nfev, njev).
+    """
+    from ..iterate import DIVERGE_STREAK, ROUNDING, RUNAWAY, explain
+
+    F, Jf = problem.F, problem.J
+    scales = problem.step_scales
+    method = NewtonSystem("analytic", None, damped, diagnostics=False)
+    isfinite = math.isfinite
+    q = list(q0)
+    phi = list(phi0)
+    n = len(q)
+    nfev, njev = 1, 0
+    prev_err = err = math.inf
+    growth = stalls = rounding_steps = 0
+    runaway = RUNAWAY * (1.0 + max_abs(q))
+    k = 0
+    for k in range(1, max_iter + 1):
+        try:
+            jac = Jf(q)  # type: ignore[misc]
+            njev += 1
+            dq = None
+            if n == 2:
+                p0, p1 = phi
+                a0, a1 = abs(p0), abs(p1)
+                resid = (a0 if a0 >= a1 else a1) if a0 == a0 and a1 == a1 else math.nan
+                (a, b), (c, d) = jac
+                det = a * d - b * c
+                size = abs(a * d) + abs(b * c)
+                if size > 0.0 and abs(det) > SINGULAR_RATIO * size and isfinite(det):
+                    dq = [(b * p1 - d * p0) / det, (c * p0 - a * p1) / det]
+            else:
+                resid = max_abs(phi)
+                dq = newton_direction(jac, phi)[0]
+            phi_t = None
+            if dq is not None:
+                trial = [qi + di for qi, di in zip(q, dq)]
+                phi_t = F(trial)
+                nfev += 1
+                if damped and not _sumsq(phi_t) <= (1.0 - 1e-4) * _sumsq(phi) and \
+                        not max_abs(dq) <= 64.0 * EPS * (1.0 + max_abs(q)):
+                    phi_t = None  # the whole step does not lower |Phi|: the method decides
+                    nfev -= 1
+            if phi_t is None:
+                njev -= 1
+                s = method.step(problem, NewtonSystemState(tuple(q), None, err, None, (), (), (), (),
+                                                           math.nan, math.nan, 1.0, nfev, njev, tuple(phi)))
+                nfev, njev = s.nfev, s.njev
+                if s.stop is not None:
+                    return (list(s.x), list(s.phi_x), s.err, s.stop[0], s.stop[1], k, nfev, njev)
+                step, trial, phi_t = list(s.dq), list(s.x), list(s.phi_x)
+            else:
+                step = dq
+        except (ArithmeticError, ValueError) as exc:
+            status, detail = explain(exc)
+            return q, phi, err, status, detail, k - 1, nfev, njev
+        if scales is None and n == 2:
+            e0, e1 = abs(step[0]), abs(step[1])
+            err = (e0 if e0 >= e1 else e1) if e0 == e0 and e1 == e1 else math.nan
+        else:
+            err = step_measure(step, scales)
+        q, phi = trial, phi_t
+        try:
+            finite = isfinite(err) and isfinite(resid)
+        except TypeError:
+            return q, phi, err, Status.DOMAIN_ERROR, f"f returned a non-real value: {resid!r}", k, nfev, njev
+        if not finite:
+            return q, phi, err, Status.NON_FINITE, f"error = {err!r}, residual = {resid!r}", k, nfev, njev
+        if resid == 0.0:
+            return q, phi, err, Status.CONVERGED_EXACT, "", k, nfev, njev
+        size_q = max_abs(q)
+        if err <= (tol + rtol * size_q if rtol else tol) and resid <= gate:
+            return q, phi, err, Status.CONVERGED_STEP, "", k, nfev, njev
+        limit = tol + rtol * size_q if rtol else tol
+        if not damped:
+            growth = growth + 1 if err > prev_err else 0
+            if growth >= DIVERGE_STREAK and size_q > runaway:
+                return q, phi, err, Status.DIVERGED, f"{growth} growing steps, last {err:.3g}", k, nfev, njev
+        if err <= ROUNDING * size_q:
+            rounding_steps += 1
+            stalls += err >= prev_err
+            if stalls >= 2 or rounding_steps >= 6:
+                return (q, phi, err, Status.PRECISION_LIMIT,
+                        f"error {err:.3g} is rounding noise; tolerance {limit:.3g} is out of reach", k, nfev,
+                        njev)
+        prev_err = err
+    return q, phi, err, Status.MAX_ITER, "", k, nfev, njev

@@ -91,11 +91,26 @@ _RULES: dict[str, tuple[str, str]] = {
     "atand": (f"1.0 / ({DEG!r} * (1.0 + {{u}} * {{u}}))", f"-2.0 * {DEG!r} * {{u}} * {{g1}} * {{g1}}"),
 }
 
+def _small(e: float, u: float) -> float:
+    """An argument's error bound where a first-order bound through a nonlinear operation
+    holds (at most 1e-6 of the argument); infinite otherwise (log(sin(pi)): the argument
+    may be zero, and no bound holds)."""
+    return e if e <= 1e-6 * abs(u) else math.inf
+
+
+def _quotient_err(q: float, b: float, eb: float) -> float:
+    """How far a / b moves when b moves by up to eb: |q| eb / (|b| - eb), infinite once eb
+    reaches |b| (the divisor may be zero: no first-order bound holds)."""
+    room = abs(b) - eb
+    return abs(q) * eb / room if room > 0.0 else math.inf
+
+
 _NAMESPACE = {
     **{f"_{k}": v for k, v in FUNCTIONS.items()},
     "_cos": math.cos, "_sin": math.sin, "_tan": math.tan, "_sqrt": math.sqrt,
     "_cosh": math.cosh, "_sinh": math.sinh, "_pow": math.pow, "_log": math.log,
-    "_sign": _sign, "_fabs": math.fabs, "__builtins__": {},
+    "_sign": _sign, "_fabs": math.fabs, "_quotient_err": _quotient_err, "_small": _small,
+    "__builtins__": {},
 }
 
 
@@ -109,6 +124,9 @@ class Op:
     kind: str
     args: tuple[int, ...] = ()
     value: float = 0.0
+    err: float = 0.0
+    """For a ``num``: a bound on how far it is from the exact value it stands for (the
+    rounding of a literal such as 0.1 or pi, and of every operation folded into it)."""
 
 
 _BINOPS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Pow: "**"}
@@ -128,13 +146,15 @@ class _Builder:
     def add(self, op: Op) -> int:
         if op.args and all(self.ops[a].kind == "num" for a in op.args):
             fn = _FOLD.get(op.kind) or FUNCTIONS.get(op.kind)
+            vals = [self.ops[a].value for a in op.args]
             try:
-                v = float(fn(*(self.ops[a].value for a in op.args)))  # type: ignore[misc]
+                v = float(fn(*vals))  # type: ignore[misc]
+                err = _folded_error(op.kind, vals, [self.ops[a].err for a in op.args], v)
             except (ArithmeticError, ValueError, TypeError):
-                v = math.nan
-            if math.isfinite(v):
-                op = Op("num", (), v)
-        key = (op.kind, op.args, op.value)
+                v = err = math.nan
+            if math.isfinite(v) and math.isfinite(err):
+                op = Op("num", (), v, err)
+        key = (op.kind, op.args, op.value, op.err)
         found = self.index.get(key)
         if found is not None:
             return found
@@ -143,6 +163,44 @@ class _Builder:
         self.ops.append(op)
         self.index[key] = len(self.ops) - 1
         return len(self.ops) - 1
+
+
+def _literal(v: float, exact: bool) -> Op:
+    """A number as written: integers are exact, anything else carries half an ulp."""
+    return Op("num", (), v, 0.0 if exact else 0.5 * EPS * abs(v))
+
+
+_SLOPES: dict[str, Callable[[float, float], float]] = {}
+
+
+def _slope(name: str, u: float, v: float) -> float:
+    """The derivative of a whitelisted function at u (v = fn(u)), from the same rules the
+    generated code uses."""
+    fn = _SLOPES.get(name)
+    if fn is None:
+        src = f"lambda u, v: {_RULES[name][0].format(u='u', v='v')}"
+        fn = eval(compile(src, "<linkage-rule>", "eval"), dict(_NAMESPACE))  # our own template
+        _SLOPES[name] = fn
+    return fn(u, v)  # type: ignore[no-any-return]
+
+
+def _folded_error(kind: str, vals: list[float], errs: list[float], v: float) -> float:
+    """First-order bound on a folded constant's error: the arguments' errors carried by
+    the local slope, plus one rounding of the result (as :func:`generate_bound`)."""
+    own = EPS * abs(v)
+    if kind == "neg":
+        return errs[0]
+    if kind in FUNCTIONS:
+        return own + (abs(_slope(kind, vals[0], v)) * _small(errs[0], vals[0]) if errs[0] else 0.0)
+    (a, b), (ea, eb) = vals, errs
+    if kind in "+-":
+        return own + ea + eb
+    ea, eb = (_small(ea, a) if ea else 0.0), (_small(eb, b) if eb else 0.0)
+    if kind == "*":
+        return own + abs(b) * ea + abs(a) * eb
+    if kind == "/":
+        return own + ea / abs(b) + (_quotient_err(v, b, eb) if eb else 0.0)
+    return own + (abs(b * v / a) * ea if ea else 0.0) + (abs(v * math.log(abs(a))) * eb if eb else 0.0)
 
 
 def parse_ops(text: str, *, what: str = "equation") -> tuple[Op, ...]:
@@ -172,7 +230,9 @@ def parse_ops(text: str, *, what: str = "equation") -> tuple[Op, ...]:
             stack.extend((c, False) for c in reversed(children))
             continue
         out.append(_emit(node, b, out))
-    return tuple(b.ops)
+    # The result is the root's operation, which folding or sharing may have placed
+    # before later (now unused) ones: keep the list up to it.
+    return tuple(b.ops[: out[-1] + 1])
 
 
 def _check(node: ast.AST, shown: str, what: str) -> list[ast.AST]:
@@ -210,9 +270,10 @@ def _check(node: ast.AST, shown: str, what: str) -> list[ast.AST]:
 
 def _emit(node: ast.AST, b: _Builder, out: list[int]) -> int:
     if isinstance(node, ast.Constant):
-        return b.add(Op("num", (), float(node.value)))
+        v = float(node.value)
+        return b.add(_literal(v, v.is_integer() and abs(v) <= 2.0**53))
     if isinstance(node, ast.Name):
-        return b.add(Op("x")) if node.id == "x" else b.add(Op("num", (), CONSTANTS[node.id]))
+        return b.add(Op("x")) if node.id == "x" else b.add(_literal(CONSTANTS[node.id], False))
     if isinstance(node, ast.UnaryOp):
         a = out.pop()
         return a if isinstance(node.op, ast.UAdd) else b.add(Op("neg", (a,)))
@@ -346,7 +407,7 @@ def generate_bound(ops: tuple[Op, ...]) -> str:
         t = f"t{i}"
         if op.kind in ("num", "x"):
             v.append(_num(op.value) if op.kind == "num" else "x")
-            err.append(None)
+            err.append(repr(op.err) if op.kind == "num" and op.err else None)
             continue
         a = op.args[0]
         if op.kind == "neg":
@@ -359,7 +420,7 @@ def generate_bound(ops: tuple[Op, ...]) -> str:
             own = f"{u} * _fabs({t})"
             if err[a]:
                 g1 = _RULES[op.kind][0].format(u=v[a], v=t)
-                own += f" + _fabs({g1}) * {err[a]}"
+                own += f" + _fabs({g1}) * _small({err[a]}, {v[a]})"
             lines.append(f"    r{i} = {own}")
             v.append(t)
             err.append(f"r{i}")
@@ -372,12 +433,14 @@ def generate_bound(ops: tuple[Op, ...]) -> str:
         if k in "+-":
             terms += [e for e in (ea, eb) if e]
         elif k == "*":
-            terms += ([f"_fabs({vb}) * {ea}"] if ea else []) + ([f"_fabs({va}) * {eb}"] if eb else [])
+            terms += ([f"_fabs({vb}) * _small({ea}, {va})"] if ea else []) + \
+                     ([f"_fabs({va}) * _small({eb}, {vb})"] if eb else [])
         elif k == "/":
-            terms += ([f"{ea} / _fabs({vb})"] if ea else []) + ([f"_fabs({t} / {vb}) * {eb}"] if eb else [])
+            terms += ([f"{ea} / _fabs({vb})"] if ea else []) + \
+                     ([f"_quotient_err({t}, {vb}, {eb})"] if eb else [])
         else:
-            terms += ([f"_fabs({vb} * {t} / {va}) * {ea}"] if ea else []) + \
-                     ([f"_fabs({t} * _log(_fabs({va}))) * {eb}"] if eb else [])
+            terms += ([f"_fabs({vb} * {t} / {va}) * _small({ea}, {va})"] if ea else []) + \
+                     ([f"_fabs({t} * _log(_fabs({va}))) * _small({eb}, {vb})"] if eb else [])
         lines.append(f"    r{i} = {' + '.join(terms)}")
         v.append(t)
         err.append(f"r{i}")

@@ -407,8 +407,32 @@ class LoopModel:
             loops.append(tuple(terms))
         return cls(m, tuple(loops), len(m.unknowns))
 
+    @functools.cached_property
+    def factory(self) -> Any:
+        """The compiled model: ``factory(driver) -> (F, J, V)`` (see :mod:`linkage.codegen`)."""
+        from ..codegen import build
+
+        return build(self.terms, self.n)
+
+    @property
+    def source(self) -> str:
+        """The generated code of the compiled model, for inspection."""
+        from ..codegen import source
+
+        return source(self.terms, self.n)
+
     def functions(self, driver: float) -> tuple[Any, Any]:
-        """Phi(q) and J(q) at one driver value (internal units)."""
+        """Phi(q) and J(q) at one driver value (internal units), compiled."""
+        F, J, _ = self.factory(driver)
+        return F, J
+
+    def driver_derivative(self, driver: float) -> Any:
+        """dPhi/d(driver)(q) at one driver value, compiled."""
+        return self.factory(driver)[2]
+
+    def interpreted_functions(self, driver: float) -> tuple[Any, Any]:
+        """Phi(q) and J(q) by walking the terms: the definition the compiled code is
+        tested against."""
         n = self.n
         # Resolve the driver into constants once, so the closures see only fixed terms.
         loops = [[(s, driver if li == DRIVER else lc, -1 if li == DRIVER else li,

@@ -1,0 +1,196 @@
+"""Compiled code equals its definitions: loop models (F, J, dPhi/dv) against the term
+walk and finite differences, equations (f, f', f'') against mpmath on random expressions."""
+
+from __future__ import annotations
+
+import math
+import random
+from pathlib import Path
+
+import mpmath as mp
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from linkage import load_mechanism
+from linkage.problems.expression import Expression
+from linkage.problems.loops import LoopModel
+
+SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
+
+
+def _random_state(m, rng: random.Random) -> tuple[float, list[float]]:
+    scale = m.length_scale
+    d = rng.uniform(-7, 7) if m.driver.kind == "angle" else rng.uniform(-2, 2) * scale
+    q = [rng.uniform(-7, 7) if u.kind == "angle" else rng.uniform(-2, 2) * scale for u in m.unknowns]
+    return d, q
+
+
+@pytest.mark.parametrize("path", sorted(SAMPLES.glob("*.toml")), ids=lambda p: p.name)
+def test_compiled_model_equals_the_term_walk(path):
+    m = load_mechanism(path)
+    model = LoopModel.compile(m)
+    rng = random.Random(path.name)
+    tol = 1e-12 * m.length_scale * len(m.loops[0].vectors)
+    for _ in range(300):
+        d, q = _random_state(m, rng)
+        F, J = model.functions(d)
+        Fi, Ji = model.interpreted_functions(d)
+        assert max(abs(a - b) for a, b in zip(F(q), Fi(q))) <= tol
+        assert max(abs(a - b) for ra, rb in zip(J(q), Ji(q)) for a, b in zip(ra, rb)) <= tol
+
+
+@pytest.mark.parametrize("path", sorted(SAMPLES.glob("*.toml")), ids=lambda p: p.name)
+def test_compiled_jacobian_and_driver_derivative_match_finite_differences(path):
+    m = load_mechanism(path)
+    model = LoopModel.compile(m)
+    rng = random.Random(path.name + "fd")
+    for _ in range(50):
+        d, q = _random_state(m, rng)
+        F, J = model.functions(d)
+        V = model.driver_derivative(d)
+        jac, v = J(q), V(q)
+        for c in range(len(q)):
+            h = 1e-6 * max(1.0, abs(q[c]))
+            qp, qm = list(q), list(q)
+            qp[c] += h
+            qm[c] -= h
+            for r, (a, b) in enumerate(zip(F(qp), F(qm))):
+                assert (a - b) / (2 * h) == pytest.approx(jac[r][c], rel=1e-6, abs=1e-6 * m.length_scale)
+        h = 1e-6 * max(1.0, abs(d))
+        Fp, _ = model.functions(d + h)
+        Fm, _ = model.functions(d - h)
+        for r, (a, b) in enumerate(zip(Fp(q), Fm(q))):
+            assert (a - b) / (2 * h) == pytest.approx(v[r], rel=1e-6, abs=1e-6 * m.length_scale)
+
+
+# --- equations ------------------------------------------------------------------------------
+
+LEAVES = ["x", "2", "0.5", "pi", "3.25"]
+UNARY = ["sin", "cos", "exp", "atan", "sqrt", "log", "tanh", "cosd", "sind"]
+
+
+def expressions(depth: int) -> st.SearchStrategy[str]:
+    leaf = st.sampled_from(LEAVES)
+    if depth == 0:
+        return leaf
+    sub = expressions(depth - 1)
+    return st.one_of(
+        leaf,
+        st.builds(lambda a, op, b: f"({a} {op} {b})", sub, st.sampled_from(["+", "-", "*", "/"]), sub),
+        st.builds(lambda f, a: f"{f}({a})", st.sampled_from(UNARY), sub),
+        st.builds(lambda a, k: f"({a})**{k}", sub, st.sampled_from(["2", "3", "0.5", "x"])),
+        st.builds(lambda a: f"-({a})", sub),
+    )
+
+
+MP = {"sin": mp.sin, "cos": mp.cos, "exp": mp.exp, "atan": mp.atan, "sqrt": mp.sqrt, "log": mp.log,
+      "tanh": mp.tanh, "pi": mp.pi, "cosd": lambda v: mp.cos(v * mp.pi / 180),
+      "sind": lambda v: mp.sin(v * mp.pi / 180)}
+
+
+def _mp(text: str):
+    code = compile(text.replace("^", "**"), "<test>", "eval")  # the test's own grammar, not user text
+    return lambda x: eval(code, {"__builtins__": {}}, {**MP, "x": x})
+
+
+@settings(max_examples=300, deadline=None)
+@given(expressions(4), st.floats(0.2, 2.5))
+def test_compiled_equation_and_derivatives_match_mpmath(text, x):
+    e = Expression.parse(text)
+    g = _mp(text)
+    mp.mp.dps = 40
+    try:
+        exact = [g(mp.mpf(x)), mp.diff(g, mp.mpf(x)), mp.diff(g, mp.mpf(x), 2)]
+    except (ZeroDivisionError, ValueError, OverflowError):
+        return
+    if any(not isinstance(v, mp.mpf) or not mp.isfinite(v) or abs(v) > 1e12 for v in exact):
+        return
+    try:
+        bound = e.rounding_bound()(x)
+    except (ArithmeticError, ValueError):
+        return
+    if not bound <= 1e-9 * (1.0 + abs(float(exact[0]))):
+        return  # ill-conditioned in double precision (sin of 5e23): no digits to compare
+    for fn, want in zip((e.function(), e.derivative(), e.second_derivative()), exact):
+        try:
+            got = fn(x)
+        except (ArithmeticError, ValueError):
+            return  # double precision may fail where 40 digits do not (a near-zero sqrt argument)
+        if not isinstance(got, float) or not math.isfinite(got):
+            return
+        scale = 1.0 + abs(float(want))
+        assert abs(got - float(want)) <= 1e-6 * scale, (text, x, got, float(want))
+
+
+@settings(max_examples=200, deadline=None)
+@given(expressions(4), st.floats(0.2, 2.5))
+def test_rounding_bound_covers_the_actual_rounding_error(text, x):
+    """The compiled bound on |computed f - exact f| holds (with a small factor, since it is
+    a first-order bound)."""
+    e = Expression.parse(text)
+    mp.mp.dps = 40
+    try:
+        exact = _mp(text)(mp.mpf(x))
+        got, bound = e.function()(x), e.rounding_bound()(x)
+    except (ArithmeticError, ValueError):
+        return
+    if not (isinstance(exact, mp.mpf) and mp.isfinite(exact) and math.isfinite(got) and math.isfinite(bound)):
+        return
+    assert abs(got - float(exact)) <= 4 * bound + 1e-300, (text, x, got, float(exact), bound)
+
+
+# --- lean loops against the generic loop -----------------------------------------------------
+
+def _same(a, b, label):
+    assert a.status is b.status, (label, a.status, b.status, a.detail, b.detail)
+    assert a.iterations == b.iterations, (label, a.iterations, b.iterations)
+    xa, xb = (a.x, b.x) if isinstance(a.x, tuple) else ((a.x,), (b.x,))
+    assert all(u == v or (u != u and v != v) for u, v in zip(xa, xb)), (label, a.x, b.x)
+
+
+def test_lean_scalar_newton_equals_the_generic_loop_on_the_stress_battery():
+    from linkage import solve_scalar
+    from linkage.stress import (
+        _start,
+        bad_start_cases,
+        classic_cases,
+        fourbar_equation_cases,
+        non_finite_cases,
+        tiny_tol_cases,
+    )
+
+    cases = [*classic_cases(), *fourbar_equation_cases(random.Random(0), 600), *bad_start_cases(),
+             *tiny_tol_cases(), *non_finite_cases()]
+    compared = 0
+    for case in cases:
+        start = _start(case, "newton")
+        if start is None:
+            continue
+        kw = dict(method="newton", fprime=case.fprime, tol=case.tol, rtol=case.rtol, max_iter=500, **start)
+        try:
+            lean = solve_scalar(case.f, record=False, **kw)
+        except Exception as exc:  # the generic path must raise the same
+            with pytest.raises(type(exc)):
+                solve_scalar(case.f, record=True, **kw)
+            continue
+        _same(lean, solve_scalar(case.f, record=True, **kw), case.name)
+        compared += 1
+    assert compared > 600
+
+
+def test_lean_system_newton_equals_the_generic_loop_on_the_stress_battery():
+    from linkage import solve_system
+    from linkage.problems.catalog import mgh_cases
+    from linkage.stress import fourbar_cases, fourbar_mechanism
+
+    for it in fourbar_cases(random.Random(0), 400):
+        p = fourbar_mechanism(it).problem()
+        for damped in (True, False):
+            kw = dict(tol=1e-10, max_iter=100, damped=damped)
+            _same(solve_system(p, record=False, **kw), solve_system(p, record=True, **kw), it["links"])
+    for label, s, factor in mgh_cases():
+        for damped in (True, False):
+            kw = dict(jac=s.J, tol=1e-10, ftol=1e-10, max_iter=200, damped=damped)
+            _same(solve_system(s.F, s.start(factor), record=False, **kw),
+                  solve_system(s.F, s.start(factor), record=True, **kw), label)
