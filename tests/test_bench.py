@@ -23,7 +23,7 @@ def test_bench_quick_on_one_problem(cli, tmp_path):
         if m["contender"].startswith("linkage newton") and m["tol"] <= 1e-8:
             assert m["error"] < 1e-8  # the benchmark measures errors against mpmath, not against itself
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert any(t["target"].startswith("scalar Newton") for t in doc["targets"])
+    assert any(t["target"].startswith("1. scalar Newton") for t in doc["targets"])
 
 
 def test_bench_without_scipy_skips_its_rows_with_a_note(cli, monkeypatch):

@@ -193,3 +193,31 @@ def test_a_scalar_solve_does_not_import_numpy():
     proc = run_process(code=code)
     assert proc.returncode == 0, proc.stderr
     assert "HEAVY []" in proc.stdout
+
+
+def test_plain_tables_are_tabulates_simple_format_without_tabulate():
+    """The plain renderer draws tabulate's ``simple`` format itself (tabulate costs ~20 ms
+    of a piped command's start); random tables must come out identical."""
+    import random
+
+    from tabulate import tabulate
+
+    from linkage.render.report import simple_table
+
+    rng = random.Random(7)
+    cells = ["—", "converged", "", "no_solution", "-0.5", "1e+300"]
+    for _ in range(500):
+        nc, nr = rng.randint(1, 7), rng.randint(0, 9)
+        headers = ["h" * rng.randint(0, 14) for _ in range(nc)]
+        rows = [[f"{rng.uniform(-1e5, 1e5):.{rng.randint(1, 12)}g}" if rng.random() < 0.7
+                 else rng.choice(cells) for _ in range(nc)] for _ in range(nr)]
+        want = tabulate(rows, headers=headers, tablefmt="simple", disable_numparse=True, stralign="right")
+        assert simple_table(headers, rows) == want
+
+
+def test_a_piped_solve_does_not_import_tabulate():
+    from conftest import run_process
+
+    p = run_process(code="import sys; from linkage.cli import run_cli; run_cli(['solve']); "
+                         "print('tabulate' in sys.modules, file=sys.stderr)")
+    assert p.stderr.strip().endswith("False")

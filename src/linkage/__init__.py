@@ -7,6 +7,7 @@ The public API, in the order a reader meets it:
 - :func:`fourbar_equation` and :func:`equation_problem` build the problems it solves.
 - :func:`solve_system` solves loop-closure systems; :func:`load_mechanism` reads a
   mechanism file whose ``.problem()`` it takes.
+- :func:`sweep` solves a mechanism over a range of its driver (a :class:`SweepResult`).
 - :func:`analyze` estimates convergence order and rate from a recorded history.
 """
 
@@ -24,7 +25,9 @@ _EXPORTS = {
     "Mechanism": ".problems.loops", "load_mechanism": ".problems.loops",
     "SystemProblem": ".problems.system",
     "solve_scalar": ".solve", "solve_system": ".solve",
+    "sweep": ".analysis.sweep", "SweepResult": ".analysis.sweep", "Position": ".analysis.sweep",
 }
+_RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism"}
 
 
 def __getattr__(name: str) -> Any:
@@ -32,7 +35,7 @@ def __getattr__(name: str) -> Any:
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'linkage' has no attribute {name!r}")
-    attr = "load" if name == "load_mechanism" else name
+    attr = _RENAMED.get(name, name)
     value = getattr(import_module(module, __name__), attr)
     globals()[name] = value
     return value
@@ -53,9 +56,11 @@ __all__ = [
     "Mechanism",
     "NotConvergedError",
     "ParseError",
+    "Position",
     "Result",
     "ScalarProblem",
     "Status",
+    "SweepResult",
     "SystemProblem",
     "analyze",
     "coefficients_from_links",
@@ -64,4 +69,5 @@ __all__ = [
     "load_mechanism",
     "solve_scalar",
     "solve_system",
+    "sweep",
 ]

@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 import sys
 import time
-from dataclasses import replace
 from fractions import Fraction
 from pathlib import Path
 from typing import Annotated, Any, Optional
@@ -428,8 +427,7 @@ def sweep(
 
     Example: linkage sweep sample_inputs/rapier_drive.toml --step 5
     """
-    from .analysis.sweep import check_driver_values, driver_values
-    from .analysis.sweep import sweep as run_sweep
+    from .analysis.sweep import driver_values, sweep_mechanism
     from .problems.loops import load
     from .render.sweep import sweep_blocks, sweep_dict, sweep_headers, sweep_rows
     from .solve import SYSTEM_METHODS, check_criteria, check_number
@@ -451,25 +449,9 @@ def sweep(
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SYSTEM_METHODS)}")
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
-    if branch is not None:
-        if branch not in ("open", "crossed"):
-            raise InputError(f"--branch must be open or crossed, got {branch!r}")
-        if mechanism.closed_form is None:
-            raise InputError(f"--branch needs a mechanism with a closed form; {file} has none "
-                             "(its branch follows the file's guess)")
-    values = check_driver_values(mechanism, values)
-    use_batch = batch if batch is not None else (len(values) > 20_000 and method == "newton")
-    if use_batch:
-        if method != "newton":
-            raise InputError("--batch runs Newton-Raphson; drop --method or --batch")
-        from .analysis.batch import batch_sweep
-
-        result = batch_sweep(mechanism, values, branch=branch, tol=tol).to_sweep()
-        result = replace(result, method="newton (batch)")
-    else:
-        with _progress(len(values)) as advance:
-            result = run_sweep(mechanism, values, method=method, branch=branch, tol=tol,
-                               progress=advance)
+    with _progress(len(values)) as advance:
+        result = sweep_mechanism(mechanism, values, method=method, branch=branch, tol=tol, batch=batch,
+                                 progress=advance)
     emit(out_fmt, output, blocks=sweep_blocks(result, digits), json_obj=sweep_dict(result),
          csv_table=(sweep_headers(result), sweep_rows(result)))
     if plot is not None:
@@ -634,7 +616,17 @@ def bench(
 
     Example: linkage bench --quick --plot wp.png
     """
-    from .bench import FULL_TOLERANCES, PROBLEMS, QUICK_TOLERANCES, cold_start, has_scipy, measure, targets
+    from .bench import (
+        FULL_TOLERANCES,
+        PROBLEMS,
+        QUICK_TOLERANCES,
+        cold_start,
+        has_pylinkage,
+        has_scipy,
+        measure,
+        sweep_times,
+        targets,
+    )
     from .render.report import Text, table
 
     out_fmt = choose_format(fmt, output)
@@ -665,7 +657,8 @@ def bench(
 
         results = measure(names, tolerances, n_repeats, budget, progress=step)
     cold_times = cold_start(3 if quick else 5) if cold else {}
-    target_rows = targets(results, cold_times) if cold else targets(results, {"linkage solve": math.nan})
+    sweeps = sweep_times(n_repeats, 100_000 if quick else 1_000_000)
+    target_rows = targets(results, cold_times, sweeps)
     headers = ("problem", "contender", "tol", "time per solve (us)", "spread (us)", "error", "iterations",
                "evaluations")
     rows = [(m.problem, m.contender, m.tol, m.seconds * 1e6,
@@ -675,7 +668,11 @@ def bench(
                               "batches each (median; spread = fastest-slowest batch)", "bold")]
     if not has_scipy():
         blocks.append(Text("scipy is not installed: its rows are skipped (pip install 'linkage[bench]')"))
+    if not has_pylinkage():
+        blocks.append(Text("pylinkage is not installed: the sweep comparison is skipped "
+                           "(pip install 'pylinkage==1.3.0')"))
     blocks += [Text(""), table("", headers, rows, 4)]
+    blocks.append(table("Sweeps (median seconds)", ("sweep", "seconds"), list(sweeps.items()), 4))
     if cold_times:
         blocks.append(table("Cold start (fresh interpreter, median wall time)", ("command", "seconds"),
                             list(cold_times.items()), 4))
@@ -683,6 +680,7 @@ def bench(
                         [(t, c, r, "n/a" if r is None or r != r else ("yes" if ok else "no"))
                          for t, c, r, ok in target_rows], 3))
     json_obj = {"measurements": [dict(zip(headers, r)) for r in rows], "cold_start": cold_times,
+                "sweeps": sweeps,
                 "targets": [{"target": t, "ratio": c, "measured": r, "met": ok}
                             for t, c, r, ok in target_rows],
                 "scipy": has_scipy()}

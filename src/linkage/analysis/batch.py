@@ -42,6 +42,7 @@ from .sweep import (
 )
 
 STATUS_CODES = {"converged": 0, "no_solution": 1, "failed": 2, "off_branch": 3}
+CODE_STATUS = {v: k for k, v in STATUS_CODES.items()}
 
 
 @dataclass(frozen=True)
@@ -59,20 +60,47 @@ class BatchResult:
     fallback: int
 
     def to_sweep(self) -> SweepResult:
-        """The same result as a SweepResult (one Position per entry; slow for millions)."""
+        """The same result as a SweepResult whose positions are built only when read
+        (a million positions cost nothing until a caller asks for one)."""
         c = self.coarse
-        names = c.names
-        code_to_status = {v: k for k, v in STATUS_CODES.items()}
-        positions = []
-        for i in range(len(self.values)):
-            st = code_to_status[int(self.status[i])]
-            sol = {n: float(self.solution[i, j]) for j, n in enumerate(names)} if st == "converged" else None
-            positions.append(Position(float(self.values[i]), st, sol,
-                                      self.branch if sol else None,
-                                      int(self.iterations[i]), float(self.det[i]) if sol else None,
-                                      _transmission_of(c, sol)))
-        return SweepResult(c.mechanism, c.driver, c.driver_unit, c.names, c.units, tuple(positions),
+        return SweepResult(c.mechanism, c.driver, c.driver_unit, c.names, c.units, BatchPositions(self),
                            c.feasible_ranges, c.toggles, c.branch, c.classification, c.method)
+
+
+class BatchPositions(Sequence):  # type: ignore[type-arg]
+    """The positions of a batch sweep as a sequence: columns (arrays) inside, a
+    :class:`Position` built for each entry that is read."""
+
+    def __init__(self, batch: BatchResult) -> None:
+        self.batch = batch
+
+    def __len__(self) -> int:
+        return len(self.batch.values)
+
+    def __getitem__(self, i: Any) -> Any:
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        b = self.batch
+        if i < 0:
+            i += len(self)
+        if not 0 <= i < len(self):
+            raise IndexError(i)
+        st = CODE_STATUS[int(b.status[i])]
+        sol = ({n: float(b.solution[i, j]) for j, n in enumerate(b.coarse.names)}
+               if st == "converged" else None)
+        return Position(float(b.values[i]), st, sol, b.branch if sol else None, int(b.iterations[i]),
+                        float(b.det[i]) if sol else None, _transmission_of(b.coarse, sol))
+
+    def summary(self) -> dict[str, int]:
+        codes, counts = np.unique(self.batch.status, return_counts=True)
+        return {CODE_STATUS[int(c)]: int(k) for c, k in zip(codes, counts)}
+
+    def column(self, name: str) -> np.ndarray:
+        """One unknown over every position (NaN where not converged), without objects."""
+        j = self.batch.coarse.names.index(name)
+        out = self.batch.solution[:, j].copy()
+        out[self.batch.status != STATUS_CODES["converged"]] = np.nan
+        return out
 
 
 def _transmission_of(c: SweepResult, sol: dict[str, float] | None) -> float | None:

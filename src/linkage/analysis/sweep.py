@@ -59,7 +59,8 @@ class SweepResult:
     driver_unit: str
     names: tuple[str, ...]
     units: tuple[str, ...]
-    positions: tuple[Position, ...]
+    positions: Sequence[Position]
+    """Every position in driver order (a tuple, or built lazily for a batch sweep)."""
     feasible_ranges: tuple[tuple[float, float], ...]
     toggles: tuple[float, ...]
     branch: str | None
@@ -68,12 +69,17 @@ class SweepResult:
 
     @property
     def summary(self) -> dict[str, int]:
+        if hasattr(self.positions, "summary"):
+            return self.positions.summary()  # type: ignore[no-any-return]
         out: dict[str, int] = {}
         for p in self.positions:
             out[p.status] = out.get(p.status, 0) + 1
         return out
 
-    def column(self, name: str) -> list[float | None]:
+    def column(self, name: str) -> Any:
+        """One unknown over every position (display units; None or NaN where unsolved)."""
+        if hasattr(self.positions, "column"):
+            return self.positions.column(name)
         return [p.solution[name] if p.solution else None for p in self.positions]
 
 
@@ -92,9 +98,17 @@ class _Solver:
         from ..problems.closed_form import branch_rule
 
         self.rule = branch_rule(m) if m.closed_form else None
+        self._problems: dict[float, Any] = {}
 
-    def problem(self, value: float, guess: Sequence[float]) -> Any:
-        return self.model.problem_at(value * self.scale, tuple(guess))
+    def problem(self, value: float, guess: Sequence[float] | None = None) -> Any:
+        """The compiled problem at a driver value, built once per value (a position asks
+        for it several times: tangent, solve, det); its x0 is the file's guess."""
+        p = self._problems.get(value)
+        if p is None:
+            if len(self._problems) > 64:
+                self._problems.clear()
+            p = self._problems[value] = self.model.problem_at(value * self.scale)
+        return p
 
     def solve(self, value: float, guess: Sequence[float], method: str | None = None,
               damped: bool = False) -> tuple[Any, Any]:
@@ -102,9 +116,9 @@ class _Solver:
         and continuity check decide which assembly a position belongs to."""
         from ..solve import solve_system
 
-        p = self.problem(value, guess)
-        r = solve_system(p, method=method or self.method, tol=self.tol, max_iter=self.max_iter,
-                         record=False, damped=damped)
+        p = self.problem(value)
+        r = solve_system(p, tuple(guess), method=method or self.method, tol=self.tol,
+                         max_iter=self.max_iter, record=False, damped=damped)
         return p, r
 
     def display(self, q: Sequence[float]) -> dict[str, float]:
@@ -199,6 +213,60 @@ def sweep(
     return SweepResult(m.name, m.driver.name, m.driver.unit, solver.names,
                        tuple("deg" if k == "angle" else m.length_unit for k in solver.kinds),
                        tuple(positions), ranges, tuple(toggles), target, classification, method)
+
+
+BATCH_ABOVE = 20_000
+"""Sweeps of more positions than this run on the batch engine (numpy) by default."""
+
+
+def sweep_mechanism(
+    mechanism: Mechanism | str | Any,
+    values: Sequence[float] | Any,
+    *,
+    branch: str | None = None,
+    method: str = "newton",
+    tol: float = 1e-12,
+    max_iter: int = 50,
+    batch: bool | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> SweepResult:
+    """Solve a mechanism over driver values (display units: degrees for an angle), each
+    position from the previous one; the public ``linkage.sweep``.
+
+    ``mechanism``: a :class:`~linkage.problems.loops.Mechanism` or a path to a file.
+    ``values``: a list or a numpy array. ``branch``: "open" or "crossed" for a mechanism
+    with a closed form, else the branch of the file's guess. More than ``BATCH_ABOVE``
+    values with Newton go through the numpy batch engine (``batch`` forces the choice);
+    its result keeps columns and builds a position only when one is read.
+
+    Each position has ``.input``, ``.status`` ("converged", "no_solution", "off_branch",
+    "failed"), ``.solution`` (unknown name -> value, display units), ``.branch``,
+    ``.iterations`` and ``.det``; ``result.column(name)`` gives one unknown throughout.
+    """
+    from ..errors import InputError
+    from ..problems.loops import load
+
+    m = mechanism if isinstance(mechanism, Mechanism) else load(mechanism)
+    if method not in ("newton", "newton-fd", "lm"):
+        raise InputError(f"unknown method {method!r}; choose from newton, newton-fd, lm")
+    if branch is not None:
+        if branch not in ("open", "crossed"):
+            raise InputError(f"--branch must be open or crossed, got {branch!r}")
+        if m.closed_form is None:
+            raise InputError(f"--branch needs a mechanism with a closed form; {m.source} has none "
+                             "(its branch follows the file's guess)")
+    n = len(values)
+    use_batch = batch if batch is not None else (n > BATCH_ABOVE and method == "newton")
+    if use_batch:
+        if method != "newton":
+            raise InputError("--batch runs Newton-Raphson; drop --method or --batch")
+        from dataclasses import replace
+
+        from .batch import batch_sweep
+
+        return replace(batch_sweep(m, values, branch=branch, tol=tol).to_sweep(), method="newton (batch)")
+    return sweep(m, check_driver_values(m, values), method=method, branch=branch, tol=tol,
+                 max_iter=max_iter, progress=progress)
 
 
 def check_driver_values(m: Mechanism, values: Sequence[float]) -> list[float]:
@@ -304,7 +372,8 @@ def _continue(solver: _Solver, v: float, history: list[tuple[float, tuple[float,
                 ok = False
                 break
             q = tuple(r.x)
-            if target is not None and solver.branch(q, solver.det(p, q)) != target:
+            det = solver.det(p, q)
+            if target is not None and solver.branch(q, det) != target:
                 ok = False
                 break
             dv = abs(vk - vq[0]) * solver.scale
@@ -317,7 +386,6 @@ def _continue(solver: _Solver, v: float, history: list[tuple[float, tuple[float,
             vq = (vk, q)
         if ok and r is not None:
             q = tuple(r.x)
-            det = solver.det(p, q)
             sol = solver.display(q)
             note = f"step halved to 1/{n}" if n > 1 else ""
             return Position(v, "converged", sol, solver.branch(q, det), r.iterations, det,
@@ -326,16 +394,14 @@ def _continue(solver: _Solver, v: float, history: list[tuple[float, tuple[float,
 
 
 def tangent(solver: _Solver, v0: float, q0: Sequence[float]) -> list[float] | None:
-    """dq/dv on the branch at (v0, q0), from J dq/dv = -dPhi/dv (dPhi/dv by a difference);
-    q in internal units, v in display units. None where J is singular."""
+    """dq/dv on the branch at (v0, q0), from J dq/dv = -dPhi/dv with the compiled, exact
+    dPhi/dv; q in internal units, v in display units. None where J is singular."""
     from ..methods._linalg import SingularMatrix, lu, lu_solve
 
-    p = solver.problem(v0, tuple(q0))
-    dv = 1e-7 * max(1.0, abs(v0))
-    f0 = p.F(list(q0))
-    f1 = solver.problem(v0 + dv, tuple(q0)).F(list(q0))
+    d = v0 * solver.scale
+    _, J, V = solver.model.factory(d)
     try:
-        return lu_solve(lu(p.J(list(q0))), [-(b - a) / dv for a, b in zip(f0, f1)])
+        return lu_solve(lu(J(list(q0))), [-solver.scale * c for c in V(list(q0))])
     except SingularMatrix:
         return None
 
