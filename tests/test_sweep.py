@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from linkage import load_mechanism
-from linkage.analysis.sweep import driver_values, sweep
+from linkage.kinematics.sweep import driver_values, sweep
 from linkage.problems.closed_form import fourbar_positions, wrap_degrees
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
@@ -178,7 +178,7 @@ BATCH_CASES = [("crank_rocker", 0, 360), ("fourbar_me581", 0, 359), ("rapier_dri
 def test_batch_engine_matches_the_one_at_a_time_path(name, lo, hi):
     import numpy as np
 
-    from linkage.analysis.batch import STATUS_CODES, batch_sweep
+    from linkage.kinematics.batch import STATUS_CODES, batch_sweep
 
     m = load_mechanism(SAMPLES / f"{name}.toml")
     values = driver_values(lo, hi, None, 1201)

@@ -7,7 +7,8 @@ The public API, in the order a reader meets it:
 - :func:`fourbar_equation` and :func:`equation_problem` build the problems it solves.
 - :func:`solve_system` solves loop-closure systems; :func:`load_mechanism` reads a
   mechanism file whose ``.problem()`` it takes.
-- :func:`sweep` solves a mechanism over a range of its driver (a :class:`SweepResult`).
+- :func:`sweep` solves a mechanism over a range of its driver (a :class:`SweepResult`);
+  :func:`position_rates` gives joints, velocities and accelerations at one solution.
 - :func:`analyze` estimates convergence order and rate from a recorded history.
 """
 
@@ -25,9 +26,10 @@ _EXPORTS = {
     "Mechanism": ".problems.loops", "load_mechanism": ".problems.loops",
     "SystemProblem": ".problems.system",
     "solve_scalar": ".solve", "solve_system": ".solve",
-    "sweep": ".analysis.sweep", "SweepResult": ".analysis.sweep", "Position": ".analysis.sweep",
+    "sweep": ".kinematics.sweep", "SweepResult": ".kinematics.sweep", "Position": ".kinematics.sweep",
+    "position_rates": ".kinematics.rates", "Rates": ".kinematics.rates",
 }
-_RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism"}
+_RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at"}
 
 
 def __getattr__(name: str) -> Any:
@@ -57,6 +59,7 @@ __all__ = [
     "NotConvergedError",
     "ParseError",
     "Position",
+    "Rates",
     "Result",
     "ScalarProblem",
     "Status",
@@ -67,6 +70,7 @@ __all__ = [
     "equation_problem",
     "fourbar_equation",
     "load_mechanism",
+    "position_rates",
     "solve_scalar",
     "solve_system",
     "sweep",

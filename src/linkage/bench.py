@@ -387,7 +387,7 @@ def sweep_times(repeats: int = 5, batch_positions: int = 1_000_000) -> dict[str,
     sweep of ``batch_positions`` beside the numpy closed form."""
     import numpy as np
 
-    from .analysis.sweep import sweep_mechanism
+    from .kinematics.sweep import sweep_mechanism
     from .problems.loops import load
     from .samples import sample_path
 

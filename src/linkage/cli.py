@@ -57,6 +57,18 @@ DigitsOpt = Annotated[
 ]
 
 
+SpeedOpt = Annotated[
+    Optional[str],
+    typer.Option("--speed", help="Driver speed, for velocities and accelerations of every unknown, "
+                 "joint and point: a number in rad/s (or the file's length unit per second for a "
+                 "sliding driver), or with a unit: 600rpm, 10rad/s, 90deg/s, 250mm/s."),
+]
+AccelOpt = Annotated[
+    Optional[str],
+    typer.Option("--accel", help="Driver acceleration (with --speed; default 0): rad/s^2, or "
+                 "5rad/s^2, 90deg/s^2, 100rpm/s, 20mm/s^2."),
+]
+
 def choose_format(fmt: str | None, output: Path | None) -> str:
     from .render.report import FORMATS_OWN, tabulate_formats
 
@@ -189,6 +201,8 @@ def solve(
                       "damped one) or the textbook iteration (--plain).")] = True,
     plot: Annotated[Optional[Path], typer.Option(help="Also plot log10 error against iteration "
                     "for the method(s) run (.png, .svg or .pdf; needs matplotlib).")] = None,
+    speed: SpeedOpt = None,
+    accel: AccelOpt = None,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 12,
@@ -212,7 +226,7 @@ def solve(
     check_criteria(tol, rtol, ftol, max_iter)
     scalar_only = {"--alpha": alpha, "--r1": r1, "--r2": r2, "--r3": r3, "--links": links,
                    "--equation": equation, "--g": g, "--x0": x0, "--x1": x1, "--bracket": bracket}
-    system_only = {"--set": set_, "--guess": guess, "--fd-step": fd_step,
+    system_only = {"--set": set_, "--guess": guess, "--fd-step": fd_step, "--speed": speed, "--accel": accel,
                    "--show-jacobian": show_jacobian or None, "--plain": (not damped) or None}
     if file is not None:
         given = [k for k, v in scalar_only.items() if v is not None]
@@ -220,7 +234,7 @@ def solve(
             raise InputError(f"{', '.join(given)} apply to a single equation, not to a mechanism file")
         _solve_file(file, method, set_ or [], guess or [], tol, rtol, ftol,
                     max_iter if max_iter != 100 else 50, fd_step, damped, show_jacobian,
-                    out_fmt, output, digits, plot)
+                    out_fmt, output, digits, plot, (speed, accel))
         return
     given = [k for k, v in system_only.items() if v is not None]
     if given:
@@ -291,6 +305,35 @@ def _convergence_plot(results: list[Any], path: Path, title: str) -> None:
     typer.echo(f"wrote {path}", err=True)
 
 
+def parse_motion(speed: str | None, accel: str | None, mechanism: Any) -> tuple[float | None, float]:
+    """--speed and --accel in internal units (rad/s, rad/s^2, or length/s, length/s^2)."""
+    import re
+
+    if speed is None:
+        if accel is not None:
+            raise InputError("--accel needs --speed (the driver's velocity)")
+        return None, 0.0
+    angle = mechanism.driver.kind == "angle"
+    unit = mechanism.length_unit
+    tables = (
+        {"": 1.0, "rad/s": 1.0, "deg/s": math.pi / 180.0, "rpm": math.pi / 30.0} if angle
+        else {"": 1.0, f"{unit}/s": 1.0},
+        {"": 1.0, "rad/s^2": 1.0, "rad/s2": 1.0, "deg/s^2": math.pi / 180.0, "deg/s2": math.pi / 180.0,
+         "rpm/s": math.pi / 30.0} if angle else {"": 1.0, f"{unit}/s^2": 1.0, f"{unit}/s2": 1.0},
+    )
+    out = []
+    for option, text, units in (("--speed", speed, tables[0]), ("--accel", accel or "0", tables[1])):
+        m = re.fullmatch(r"\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*", text)
+        if m is None or m.group(2) not in units:
+            known = ", ".join(u for u in units if u) or "none"
+            raise InputError(f"{option} {text!r}: give a number, optionally with one of these units: {known}")
+        value = parse_number(option, m.group(1)) * units[m.group(2)]
+        if not math.isfinite(value) or abs(value) > 1e12:
+            raise InputError(f"{option} {text!r} is out of range (at most 1e12)")
+        out.append(value)
+    return out[0], out[1]
+
+
 def parse_assignments(option: str, items: list[str]) -> dict[str, float]:
     out = {}
     for item in items:
@@ -304,7 +347,7 @@ def parse_assignments(option: str, items: list[str]) -> dict[str, float]:
 def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: float, rtol: float,
                 ftol: float | None, max_iter: int, fd_step: float | None, damped: bool,
                 show_jacobian: bool, out_fmt: str, output: Path | None, digits: int,
-                plot: Path | None = None) -> None:
+                plot: Path | None = None, motion: tuple[str | None, str | None] = (None, None)) -> None:
     from .analysis.convergence import analyze
     from .problems.loops import load
     from .render.export import result_dict
@@ -316,14 +359,31 @@ def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol:
                          f"{', '.join(SYSTEM_METHODS)}")
     mechanism = load(file).with_values(parse_assignments("--set", set_),
                                        parse_assignments("--guess", guess))
+    speed, accel = parse_motion(*motion, mechanism)
     problem = mechanism.problem()
     result = solve_system(problem, method=method, tol=tol, rtol=rtol, ftol=ftol, max_iter=max_iter,
                           fd_step=fd_step, damped=damped, show_jacobian=show_jacobian)
     conv = analyze(result)
     branch = branch_label(problem, result) if result.converged else None
     blocks = system_blocks(problem, result, conv, digits, branch)
+    extra = system_extra(problem, result, branch)
+    if result.converged:
+        from .kinematics.rates import position_rates
+        from .problems.loops import LoopModel
+        from .render.rates import rates_blocks, rates_dict
+
+        rates = position_rates(LoopModel.compile(mechanism), result.x, mechanism.driver.value, speed, accel)
+        extra.update(rates_dict(rates))
+        if speed is not None:
+            extra["driver"].update(speed=speed, accel=accel)
+        blocks += rates_blocks(rates, problem.names, problem.kinds, mechanism.length_unit, digits)
+        if rates.status != "ok":
+            from .render.report import Text
+
+            blocks.append(Text("velocities and accelerations are undefined here: the Jacobian is "
+                               "singular (a toggle or dead-centre position)", "red"))
     json_obj = result_dict(result, system_solution(problem, result), conv.as_dict() if conv else None,
-                           system_extra(problem, result, branch))
+                           extra)
     h = result.history
     emit(out_fmt, output, blocks=blocks, json_obj=json_obj,
          csv_table=(h.columns, h.rows) if h is not None else ((), ()))
@@ -416,6 +476,11 @@ def sweep(
                      "batch engine (default: above 20,000 positions; newton only).")] = None,
     plot: Annotated[Optional[Path], typer.Option(help="Also plot the outputs against the driver "
                     "(.png, .svg or .pdf; needs matplotlib).")] = None,
+    path: Annotated[Optional[list[str]], typer.Option(
+        "--path", help="With --plot: draw the path of this joint or named point over the sweep "
+        "instead (a coupler curve; repeatable).")] = None,
+    speed: SpeedOpt = None,
+    accel: AccelOpt = None,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 10,
@@ -427,7 +492,7 @@ def sweep(
 
     Example: linkage sweep sample_inputs/rapier_drive.toml --step 5
     """
-    from .analysis.sweep import driver_values, sweep_mechanism
+    from .kinematics.sweep import driver_values, sweep_mechanism
     from .problems.loops import load
     from .render.sweep import sweep_blocks, sweep_dict, sweep_headers, sweep_rows
     from .solve import SYSTEM_METHODS, check_criteria, check_number
@@ -449,15 +514,27 @@ def sweep(
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SYSTEM_METHODS)}")
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
+    w, a_ = parse_motion(speed, accel, mechanism)
+    if path:
+        if plot is None:
+            raise InputError("--path draws into the --plot file: give --plot PATH.png as well")
+        named = [j for loop in mechanism.loops for j in loop.joints if j] + list(mechanism.points)
+        for name in path:
+            if name not in named:
+                raise InputError(f"--path {name}: no joint or point of that name in {file} "
+                                 f"(named: {', '.join(dict.fromkeys(named)) or 'none'})")
     with _progress(len(values)) as advance:
         result = sweep_mechanism(mechanism, values, method=method, branch=branch, tol=tol, batch=batch,
-                                 progress=advance)
+                                 progress=advance, speed=w, accel=a_)
     emit(out_fmt, output, blocks=sweep_blocks(result, digits), json_obj=sweep_dict(result),
          csv_table=(sweep_headers(result), sweep_rows(result)))
     if plot is not None:
-        from .render.plots import sweep_plot
+        from .render.plots import path_plot, sweep_plot
 
-        sweep_plot(result, plot)
+        if path:
+            path_plot(result, mechanism, path, plot)
+        else:
+            sweep_plot(result, plot)
         typer.echo(f"wrote {plot}", err=True)
     if result.summary.get("failed"):
         raise typer.Exit(1)
@@ -483,8 +560,8 @@ def draw(
 
     Example: linkage draw sample_inputs/fourbar_me581.toml --set theta2=80 -o fourbar.png
     """
-    from .analysis.sweep import driver_values
-    from .analysis.sweep import sweep as run_sweep
+    from .kinematics.sweep import driver_values
+    from .kinematics.sweep import sweep as run_sweep
     from .problems.loops import load
     from .solve import check_number, solve_system
 

@@ -114,6 +114,8 @@ class Mechanism:
     closed_form: str | None = None
     description: str = ""
     extra: dict[str, Any] = field(default_factory=dict)
+    points: dict[str, tuple[str, tuple[VectorTerm, ...]]] = field(default_factory=dict)
+    """Named points on links: name -> (the joint it starts from, its vectors)."""
 
     def value_of(self, name: str) -> Quantity:
         if name == self.driver.name:
@@ -144,7 +146,7 @@ class Mechanism:
                                  f"(unknowns: {', '.join(u.name for u in unknowns)})")
             unknowns[idx] = _requantify(unknowns[idx], v)
         return Mechanism(self.name, self.source, self.length_unit, params, driver, tuple(unknowns),
-                         self.loops, self.closed_form, self.description, self.extra)
+                         self.loops, self.closed_form, self.description, self.extra, self.points)
 
     def problem(self) -> SystemProblem:
         return build_problem(self)
@@ -202,7 +204,7 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         return ParseError(f"{source}: {key}: {msg}")
 
     allowed = {"name", "description", "length_unit", "closed_form", "parameters", "driver",
-               "unknowns", "loops", "notes"}
+               "unknowns", "loops", "notes", "points"}
     for key in doc:
         if key not in allowed:
             raise fail(key, f"unknown key (expected one of {', '.join(sorted(allowed))})")
@@ -272,6 +274,24 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         raise fail(f"unknowns.{clash[0]}", "is also a parameter or the driver")
 
     known = {**parameters, drv_name: driver, **{u.name: u for u in unknowns}}
+
+    def vector(vec: Any, vkey: str, used: set[str]) -> VectorTerm:
+        if not isinstance(vec, Mapping):
+            raise fail(vkey, "must be a table like { length = \"r2\", angle = \"theta2\" }")
+        for k in vec:
+            if k not in ("length", "angle", "offset", "sign"):
+                raise fail(f"{vkey}.{k}", "unknown key (expected length, angle, offset, sign)")
+        sign = vec.get("sign", 1)
+        if sign not in (1, -1) or isinstance(sign, bool):
+            raise fail(f"{vkey}.sign", f"must be 1 or -1, got {_short(sign)}")
+        length = _ref(vec.get("length"), f"{vkey}.length", "length", known, fail, used)
+        angle = _ref(vec.get("angle"), f"{vkey}.angle", "angle", known, fail, used)
+        offset = as_float(vec.get("offset", 0.0))
+        if offset is None or abs(offset) > ANGLE_LIMIT_DEG:
+            raise fail(f"{vkey}.offset", f"must be a finite number of degrees within "
+                                         f"+-{ANGLE_LIMIT_DEG:g}")
+        return VectorTerm(float(sign), length, angle, math.radians(offset))
+
     loops_doc = doc.get("loops")
     if not isinstance(loops_doc, list) or not loops_doc:
         raise fail("loops", "missing: give at least one [[loops]] with its vectors")
@@ -291,22 +311,7 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
                                          "\"\" for an unnamed point")
         terms = []
         for vi, vec in enumerate(loop["vectors"]):
-            vkey = f"{lkey}.vectors[{vi}]"
-            if not isinstance(vec, Mapping):
-                raise fail(vkey, "must be a table like { length = \"r2\", angle = \"theta2\" }")
-            for k in vec:
-                if k not in ("length", "angle", "offset", "sign"):
-                    raise fail(f"{vkey}.{k}", "unknown key (expected length, angle, offset, sign)")
-            sign = vec.get("sign", 1)
-            if sign not in (1, -1):
-                raise fail(f"{vkey}.sign", f"must be 1 or -1, got {sign!r}")
-            length = _ref(vec.get("length"), f"{vkey}.length", "length", known, fail, used)
-            angle = _ref(vec.get("angle"), f"{vkey}.angle", "angle", known, fail, used)
-            offset = as_float(vec.get("offset", 0.0))
-            if offset is None or abs(offset) > ANGLE_LIMIT_DEG:
-                raise fail(f"{vkey}.offset", f"must be a finite number of degrees within "
-                                             f"+-{ANGLE_LIMIT_DEG:g}")
-            terms.append(VectorTerm(float(sign), length, angle, math.radians(offset)))
+            terms.append(vector(vec, f"{lkey}.vectors[{vi}]", used))
         loops.append(Loop(str(loop.get("name", f"loop {li + 1}")), tuple(terms), tuple(joints)))
 
     n_eq = 2 * len(loops)
@@ -324,9 +329,10 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         raise fail(f"unknowns.{unused[0]}", "appears in no loop")
     if drv_name not in used:
         raise fail("driver.name", f"{drv_name!r} appears in no loop")
+    points = _points(doc.get("points", {}), loops, vector, fail)
     mechanism = Mechanism(name, source, length_unit, parameters, driver, unknowns, tuple(loops),
                           closed_form, str(doc.get("description", "")),
-                          {"notes": doc.get("notes", "")})
+                          {"notes": doc.get("notes", "")}, points)
     if closed_form is not None:
         from .closed_form import verify
 
@@ -334,6 +340,34 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         if why:
             raise fail("closed_form", f"{closed_form!r} does not describe this file: {why}")
     return mechanism
+
+
+def _points(spec: Any, loops: list[Loop], vector: Any,
+            fail: Any) -> dict[str, tuple[str, tuple[VectorTerm, ...]]]:
+    """``[points.NAME]`` tables: a named joint to start from and vectors to add."""
+    if not isinstance(spec, Mapping):
+        raise fail("points", "must be a table of points, like [points.P]")
+    joints = {j for loop in loops for j in loop.joints if j}
+    out = {}
+    for pname, p in spec.items():
+        key = f"points.{pname}"
+        if not isinstance(p, Mapping):
+            raise fail(key, "must be a table with 'from' and 'vectors'")
+        for k in p:
+            if k not in ("from", "vectors", "note"):
+                raise fail(f"{key}.{k}", "unknown key (expected from, vectors)")
+        origin = p.get("from")
+        if not isinstance(origin, str) or origin not in joints:
+            named = ", ".join(sorted(joints)) if joints else "none: give the loops joints = [...]"
+            raise fail(f"{key}.from", f"must name a joint of the loops ({named}), got {_short(origin)}")
+        if pname in joints:
+            raise fail(key, f"{pname!r} is already a joint")
+        vecs = p.get("vectors")
+        if not isinstance(vecs, list) or not vecs:
+            raise fail(f"{key}.vectors", "must list at least one vector")
+        out[str(pname)] = (origin, tuple(vector(v, f"{key}.vectors[{i}]", set())
+                                         for i, v in enumerate(vecs)))
+    return out
 
 
 def _short(value: Any) -> str:
@@ -382,6 +416,8 @@ class LoopModel:
     mechanism: Mechanism
     terms: tuple[tuple[tuple[float, float, int, float, int, float], ...], ...]
     n: int
+    point_terms: dict[str, tuple[str, tuple[tuple[float, float, int, float, int, float], ...]]] = field(
+        default_factory=dict)
 
     @classmethod
     def compile(cls, m: Mechanism) -> LoopModel:
@@ -405,7 +441,10 @@ class LoopModel:
                 ac, ai = resolve(t.angle)
                 terms.append((t.sign, lc, li, ac, ai, t.offset))
             loops.append(tuple(terms))
-        return cls(m, tuple(loops), len(m.unknowns))
+        points = {name: (origin, tuple((t.sign, *resolve(t.length), *resolve(t.angle), t.offset)
+                                       for t in vecs))
+                  for name, (origin, vecs) in m.points.items()}
+        return cls(m, tuple(loops), len(m.unknowns), points)
 
     @functools.cached_property
     def factory(self) -> Any:
@@ -475,16 +514,23 @@ class LoopModel:
         return F, J
 
     def points(self, q: Any, driver: float) -> list[list[complex]]:
-        """Cumulative vector sums along each loop from the origin: the joints to draw."""
+        """Cumulative vector sums along each loop, the joints to draw: the first loop from
+        the origin, a later loop from its first joint where an earlier loop placed it (a
+        six-bar's second loop at the rocker pivot), else from the origin too."""
         out = []
-        for terms in self.terms:
-            p = 0j
+        placed: dict[str, complex] = {}
+        for loop, terms in zip(self.mechanism.loops, self.terms):
+            names = loop.joints
+            p = placed.get(names[0], 0j) if names and names[0] else 0j
             pts = [p]
             for sign, lc, li, ac, ai, off in terms:
                 r = q[li] if li >= 0 else (driver if li == DRIVER else lc)
                 th = (q[ai] if ai >= 0 else (driver if ai == DRIVER else ac)) + off
                 p += sign * r * complex(math.cos(th), math.sin(th))
                 pts.append(p)
+            for name, point in zip(names, pts):
+                if name:
+                    placed.setdefault(name, point)
             out.append(pts)
         return out
 

@@ -49,17 +49,34 @@ def _save(fig: Any, path: Path) -> None:
         plt.close(fig)
 
 
+def _series(result: Any) -> list[tuple[str, list[float]]]:
+    """(axis label, values) of every curve: each unknown, and with a driver speed its
+    velocity and acceleration (rad/s for angles)."""
+    out = []
+    for name, unit in zip(result.names, result.units):
+        out.append((f"{name} ({unit})", [p.solution[name] if p.solution else math.nan
+                                         for p in result.positions]))
+        if result.motion is not None:
+            base = "rad" if unit == "deg" else unit
+            for key, label, u in (("velocities", f"d{name}/dt", f"{base}/s"),
+                                  ("accelerations", f"d2{name}/dt2", f"{base}/s^2")):
+                out.append((f"{label}\n({u})", [getattr(p.rates, key).get(name, math.nan)
+                                                if p.rates is not None and p.rates.velocities else math.nan
+                                                for p in result.positions]))
+    return out
+
+
 def sweep_plot(result: Any, path: Path) -> None:
     _check_suffix(path, SUFFIXES)
     plt = _pyplot()
-    names, units = result.names, result.units
-    fig, axes = plt.subplots(len(names), 1, sharex=True, figsize=(8, 1.9 * len(names) + 1.2), squeeze=False)
+    series = _series(result)
+    fig, axes = plt.subplots(len(series), 1, sharex=True, figsize=(8, 1.9 * len(series) + 1.2),
+                             squeeze=False)
     xs = [p.input for p in result.positions]
     gaps = _runs([p.status for p in result.positions], xs)
-    for ax, name, unit in zip(axes[:, 0], names, units):
-        ys = [p.solution[name] if p.solution else math.nan for p in result.positions]
+    for ax, (label, ys) in zip(axes[:, 0], series):
         ax.plot(xs, ys, color="tab:blue", lw=1.6)
-        ax.set_ylabel(f"{name} ({unit})")
+        ax.set_ylabel(label, fontsize=9)
         ax.grid(True, alpha=0.3)
         for a, b, status in gaps:
             ax.axvspan(a, b, color="tab:red" if status == "no_solution" else "tab:orange", alpha=0.15, lw=0)
@@ -74,8 +91,35 @@ def sweep_plot(result: Any, path: Path) -> None:
         legend.append("orange band: another assembly, not connected")
     if result.toggles:
         legend.append("dashed: limit/toggle positions")
-    title = f"{result.mechanism}: {result.branch or ''} branch"
+    title = f"{result.mechanism}: " + (f"{result.branch} branch" if result.branch in ("open", "crossed")
+                                       else "the branch of the file's guess")
+    if result.motion is not None:
+        per = "rad" if result.driver_unit == "deg" else result.driver_unit
+        title += f"; driver at {result.motion[0]:g} {per}/s, {result.motion[1]:g} {per}/s^2"
     fig.suptitle(title + ("\n" + "; ".join(legend) if legend else ""), fontsize=10)
+    _save(fig, path)
+
+
+def path_plot(result: Any, mechanism: Any, names: Sequence[str], path: Path) -> None:
+    """The paths of named joints or points over a sweep (a coupler curve), with the
+    mechanism drawn faintly at the first solved position."""
+    _check_suffix(path, SUFFIXES)
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 5.5))
+    first = next((p for p in result.positions if p.rates is not None), None)
+    if first is not None:
+        scale = math.pi / 180.0 if mechanism.driver.kind == "angle" else 1.0
+        q = [math.radians(first.solution[u.name]) if u.kind == "angle" else first.solution[u.name]
+             for u in mechanism.unknowns]
+        _draw(ax, mechanism, q, first.input * scale,
+              f"{result.mechanism}: path of {', '.join(names)} over {result.driver} "
+              f"{result.positions[0].input:g} to {result.positions[-1].input:g} {result.driver_unit}")
+    for k, name in enumerate(names):
+        pts = [p.rates.joints[name] if p.rates is not None else (math.nan, math.nan)
+               for p in result.positions]
+        ax.plot([x for x, _ in pts], [y for _, y in pts], lw=1.8, color=("tab:green", "tab:purple",
+                                                                        "tab:brown")[k % 3], label=name)
+    ax.legend(fontsize=9)
     _save(fig, path)
 
 
@@ -139,10 +183,27 @@ def _draw(ax: Any, mechanism: Any, q: Sequence[float], driver: float, title: str
             drawn_joints[key] = label
             ax.plot([p.real], [p.imag], "o", ms=6, mfc="white", mec="black", zorder=5)
             ax.annotate(label, (p.real, p.imag), textcoords="offset points", xytext=(5, -11), fontsize=9)
+    for name, (origin, pos) in _named_points(mechanism, q, driver).items():
+        ax.plot([origin.real, pos.real], [origin.imag, pos.imag], color="tab:blue", lw=1.2, alpha=0.6)
+        ax.plot([pos.real], [pos.imag], "D", ms=6, color="tab:green", zorder=6)
+        ax.annotate(name, (pos.real, pos.imag), textcoords="offset points", xytext=(6, 4), fontsize=9,
+                    color="tab:green")
     ax.set_aspect("equal", adjustable=adjustable)
     ax.grid(True, alpha=0.25)
-    ax.set_xlabel(mechanism.length_unit)
+    ax.set_xlabel(f"x ({mechanism.length_unit})")
+    ax.set_ylabel(f"y ({mechanism.length_unit})")
     ax.set_title(title, fontsize=10)
+
+
+def _named_points(mechanism: Any, q: Sequence[float], driver: float) -> dict[str, tuple[complex, complex]]:
+    """Each named point with the joint it hangs from: name -> (joint, point)."""
+    if not mechanism.points:
+        return {}
+    from ..kinematics.rates import place
+    from ..problems.loops import LoopModel
+
+    placed = place(LoopModel.compile(mechanism), q, driver)
+    return {name: (placed[origin][0], placed[name][0]) for name, (origin, _) in mechanism.points.items()}
 
 
 def draw_mechanism(mechanism: Any, q: Sequence[float], path: Path, title: str) -> None:
@@ -166,9 +227,19 @@ def animate_sweep(mechanism: Any, frames: Sequence[tuple[float, Sequence[float]]
     pad = 0.08 * max(max(xs) - min(xs), max(ys) - min(ys), 1e-9)
     scale = 180.0 / math.pi if mechanism.driver.kind == "angle" else 1.0
 
+    traces = [_named_points(mechanism, q, d) for d, q in frames]
+    for t in traces:
+        for _, pos in t.values():
+            xs.append(pos.real)
+            ys.append(pos.imag)
+
     def update(i: int) -> None:
         ax.clear()
         d, q = frames[i]
+        for name in mechanism.points:  # the path each named point has traced so far
+            path_pts = [t[name][1] for t in traces[: i + 1]]
+            ax.plot([p.real for p in path_pts], [p.imag for p in path_pts], color="tab:green", lw=1.0,
+                    alpha=0.7)
         _draw(ax, mechanism, q, d, f"{mechanism.name}: {mechanism.driver.name} = {d * scale:.1f} "
                                    f"{mechanism.driver.unit}", adjustable="box")
         ax.set_xlim(min(xs) - pad, max(xs) + pad)

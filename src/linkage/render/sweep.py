@@ -4,27 +4,48 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..analysis.sweep import SweepResult
+from ..kinematics.sweep import SweepResult
+from .rates import rate_cells, rate_headers, rates_dict
 from .report import Block, Text, fmt, table
 
 
-def sweep_headers(s: SweepResult) -> list[str]:
+def _kinds(s: SweepResult) -> list[str]:
+    return ["angle" if u == "deg" else "length" for u in s.units]
+
+
+def joint_names(s: SweepResult) -> list[str]:
+    """Every joint and point named at any solved position, in the order first met."""
+    seen: dict[str, None] = {}
+    for p in s.positions:
+        if p.rates is not None:
+            seen.update(dict.fromkeys(p.rates.joints))
+            break
+    return list(seen)
+
+
+def sweep_headers(s: SweepResult, kinematics: bool = True) -> list[str]:
     u = s.driver_unit
     headers = [f"{s.driver} ({u})", "status"]
     headers += [f"{n} ({unit})" for n, unit in zip(s.names, s.units)]
     headers += ["branch", "iterations", "det J"]
     if s.classification:
         headers.append("transmission angle (deg)")
+    if kinematics:
+        headers += rate_headers(s.names, _kinds(s), s.length_unit, joint_names(s), s.motion is not None)
     return headers
 
 
-def sweep_rows(s: SweepResult) -> list[tuple[Any, ...]]:
+def sweep_rows(s: SweepResult, kinematics: bool = True) -> list[tuple[Any, ...]]:
     rows = []
+    joints = joint_names(s) if kinematics else []
+    motion = s.motion is not None
     for p in s.positions:
         sol = p.solution or {}
         row: list[Any] = [p.input, p.status, *[sol.get(n) for n in s.names], p.branch, p.iterations, p.det]
         if s.classification:
             row.append(p.transmission)
+        if kinematics:
+            row += rate_cells(p.rates, s.names, joints, motion)
         rows.append(tuple(row))
     return rows
 
@@ -49,10 +70,12 @@ def sweep_dict(s: SweepResult) -> dict[str, Any]:
         "branch": s.branch,
         "classification": s.classification or None,
         "units": dict(zip(s.names, s.units)),
+        "length_unit": s.length_unit,
+        "driver_motion": ({"speed": s.motion[0], "accel": s.motion[1]} if s.motion else None),
         "positions": [
             {"input": p.input, "status": p.status, "solution": p.solution, "branch": p.branch,
              "iterations": p.iterations, "det": p.det, "transmission": p.transmission,
-             **({"note": p.note} if p.note else {})}
+             **({"note": p.note} if p.note else {}), **rates_dict(p.rates)}
             for p in s.positions
         ],
         "feasible_ranges": [list(r) for r in s.feasible_ranges],
@@ -70,12 +93,16 @@ def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400) -> list[Block
         c = s.classification
         blocks.append(Text(f"four-bar: {c['type']} (s + l = {fmt(c['s_plus_l'], 6)}, "
                            f"p + q = {fmt(c['p_plus_q'], 6)})"))
-    rows = sweep_rows(s)
+    rows = sweep_rows(s, kinematics=False)
+    headers = sweep_headers(s, kinematics=False)
+    if s.motion is not None:  # the unknowns' rates beside their values (joints: csv, json)
+        headers += rate_headers(s.names, _kinds(s), s.length_unit, [], True)
+        rows = [(*r, *rate_cells(p.rates, s.names, [], True)) for r, p in zip(rows, s.positions)]
     shown = rows if len(rows) <= max_rows else rows[:: max(1, len(rows) // max_rows)]
     note = [] if shown is rows else [f"(every {len(rows) // len(shown)}th of {len(rows)} rows shown; "
                                      "--format csv or json gives all)"]
     blocks.append(Text(""))
-    blocks.append(table("", sweep_headers(s), shown, digits, notes=note))
+    blocks.append(table("", headers, shown, digits, notes=note))
     counts = ", ".join(f"{k}: {v}" for k, v in sorted(s.summary.items()))
     blocks.append(Text(f"positions: {counts}; branch: {s.branch}", "bold"))
     blocks.append(Text("feasible ranges: " + (", ".join(f"[{fmt(a, 12)}, {fmt(b, 12)}] {u}"

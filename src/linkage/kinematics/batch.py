@@ -64,7 +64,8 @@ class BatchResult:
         (a million positions cost nothing until a caller asks for one)."""
         c = self.coarse
         return SweepResult(c.mechanism, c.driver, c.driver_unit, c.names, c.units, BatchPositions(self),
-                           c.feasible_ranges, c.toggles, c.branch, c.classification, c.method)
+                           c.feasible_ranges, c.toggles, c.branch, c.classification, c.method,
+                           length_unit=c.length_unit)
 
 
 class BatchPositions(Sequence):  # type: ignore[type-arg]

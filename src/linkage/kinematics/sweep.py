@@ -50,6 +50,9 @@ class Position:
     transmission: float | None = None
     substeps: int = 0
     note: str = ""
+    rates: Any = None
+    """The joints (and with a driver speed, the velocities and accelerations) here: a
+    :class:`~linkage.kinematics.rates.Rates`, or None where unsolved."""
 
 
 @dataclass(frozen=True)
@@ -66,6 +69,9 @@ class SweepResult:
     branch: str | None
     classification: dict[str, Any] = field(default_factory=dict)
     method: str = "newton"
+    motion: tuple[float, float] | None = None
+    """The driver's (speed, acceleration) in internal units when rates were asked for."""
+    length_unit: str = ""
 
     @property
     def summary(self) -> dict[str, int]:
@@ -212,7 +218,8 @@ def sweep(
         classification = fourbar_class(v["r1"], v["r2"], v["r3"], v["r4"])
     return SweepResult(m.name, m.driver.name, m.driver.unit, solver.names,
                        tuple("deg" if k == "angle" else m.length_unit for k in solver.kinds),
-                       tuple(positions), ranges, tuple(toggles), target, classification, method)
+                       tuple(positions), ranges, tuple(toggles), target, classification, method,
+                       length_unit=m.length_unit)
 
 
 BATCH_ABOVE = 20_000
@@ -229,6 +236,8 @@ def sweep_mechanism(
     max_iter: int = 50,
     batch: bool | None = None,
     progress: Callable[[int], None] | None = None,
+    speed: float | None = None,
+    accel: float = 0.0,
 ) -> SweepResult:
     """Solve a mechanism over driver values (display units: degrees for an angle), each
     position from the previous one; the public ``linkage.sweep``.
@@ -242,6 +251,10 @@ def sweep_mechanism(
     Each position has ``.input``, ``.status`` ("converged", "no_solution", "off_branch",
     "failed"), ``.solution`` (unknown name -> value, display units), ``.branch``,
     ``.iterations`` and ``.det``; ``result.column(name)`` gives one unknown throughout.
+    Every solved position also has ``.rates``: its joints and named points and, with a
+    driver ``speed`` (rad/s, or length unit/s for a linear driver) and ``accel``, the
+    velocity and acceleration of every unknown, joint and point
+    (:class:`~linkage.kinematics.rates.Rates`; batch sweeps leave it None).
     """
     from ..errors import InputError
     from ..problems.loops import load
@@ -265,8 +278,30 @@ def sweep_mechanism(
         from .batch import batch_sweep
 
         return replace(batch_sweep(m, values, branch=branch, tol=tol).to_sweep(), method="newton (batch)")
-    return sweep(m, check_driver_values(m, values), method=method, branch=branch, tol=tol,
-                 max_iter=max_iter, progress=progress)
+    result = sweep(m, check_driver_values(m, values), method=method, branch=branch, tol=tol,
+                   max_iter=max_iter, progress=progress)
+    return with_rates(m, result, speed, accel)
+
+
+def with_rates(m: Mechanism, result: SweepResult, speed: float | None, accel: float) -> SweepResult:
+    """Joints, and with a driver speed velocities and accelerations, at every solved position."""
+    from dataclasses import replace
+
+    from .rates import position_rates
+
+    model = LoopModel.compile(m)
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    kinds = [u.kind for u in m.unknowns]
+    positions = []
+    for p in result.positions:
+        if p.solution is None:
+            positions.append(p)
+            continue
+        q = [math.radians(p.solution[u.name]) if k == "angle" else p.solution[u.name]
+             for u, k in zip(m.unknowns, kinds)]
+        positions.append(replace(p, rates=position_rates(model, q, p.input * scale, speed, accel)))
+    motion = (speed, accel) if speed is not None else None
+    return replace(result, positions=tuple(positions), motion=motion)
 
 
 def check_driver_values(m: Mechanism, values: Sequence[float]) -> list[float]:
