@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+from pathlib import Path
 
 import pytest
 
@@ -221,3 +222,28 @@ def test_a_piped_solve_does_not_import_tabulate():
     p = run_process(code="import sys; from linkage.cli import run_cli; run_cli(['solve']); "
                          "print('tabulate' in sys.modules, file=sys.stderr)")
     assert p.stderr.strip().endswith("False")
+
+
+@pytest.mark.parametrize("args", [
+    ("solve", "--equation", "x**2 + 1", "--x0", "1"),
+    ("solve", str(Path(__file__).resolve().parents[1] / "sample_inputs" / "fourbar_me581.toml"),
+     "--set", "theta2=150"),
+])
+def test_a_failed_run_has_no_solution_only_a_last_iterate(cli, args):
+    run = cli(*args, "--format", "json")
+    doc = json.loads(run.out)
+    assert run.code == 1 and doc["converged"] is False
+    assert doc["solution"] is None and doc["last_iterate"]
+    text = cli(*args, "--format", "plain").out
+    assert "last iterate" in text
+
+
+def test_method_all_leaves_the_root_blank_for_a_failed_method(cli):
+    doc = cli("solve", "--method", "all", "--equation", "x**2 - 2", "--x0", "1", "--x1", "2",
+              "--bracket", "3", "4", "--format", "csv")
+    rows = [r.split(",") for r in doc.out.splitlines()[1:]]
+    for r in rows:
+        if r[1] in ("converged_step", "converged_exact", "converged_residual"):
+            assert r[4]
+        else:
+            assert r[4] == "", r

@@ -459,10 +459,18 @@ def _time_solve(problem: Any, kwargs: dict[str, Any]) -> float:
     "linkage sweep sample_inputs/crank_rocker.toml --branch crossed --format csv -o cycle.csv",
 )
 def sweep(
-    file: MechanismFile,
+    file: Annotated[Optional[Path], typer.Argument(
+        help="A mechanism file (TOML, see sample_inputs/); without it, the four-bar "
+        "input-output equation over alpha.", show_default=False)] = None,
     *,
-    start: Annotated[float, typer.Option("--from", help="First driver value (driver's unit).")] = 0.0,
-    stop: Annotated[float, typer.Option("--to", help="Last driver value.")] = 360.0,
+    start: Annotated[Optional[float], typer.Option("--from", help="First driver value (driver's "
+                     "unit; default 0).")] = None,
+    stop: Annotated[Optional[float], typer.Option("--to", help="Last driver value (default 360).")] = None,
+    r1: Annotated[Optional[str], typer.Option("--r1", help="Without FILE: R1 (default 5/3).")] = None,
+    r2: Annotated[Optional[str], typer.Option("--r2", help="Without FILE: R2 (default 5/2).")] = None,
+    r3: Annotated[Optional[str], typer.Option("--r3", help="Without FILE: R3 (default 11/6).")] = None,
+    links: Annotated[Optional[tuple[str, str, str, str]], typer.Option(
+        help="Without FILE: link lengths input, coupler, output, ground.")] = None,
     step: Annotated[Optional[float], typer.Option(help="Driver increment (default 1).")] = None,
     points: Annotated[Optional[int], typer.Option(help="Number of evenly spaced positions "
                       "instead of --step.")] = None,
@@ -488,9 +496,13 @@ def sweep(
     """Solve a mechanism over a range of its driver, each position from the previous one.
 
     Reports every position (solved, or no_solution where the linkage cannot be assembled),
-    the branch, det J, the feasible ranges and the limit/toggle positions.
+    the branch, det J, the feasible ranges and the limit/toggle positions. Without FILE:
+    the four-bar input-output equation (solve's --r1/--r2/--r3/--links and --method) at
+    each alpha from --from to --to, each from the previous root.
 
     Example: linkage sweep sample_inputs/rapier_drive.toml --step 5
+
+    Example: linkage sweep --from 10 --to 160 --step 30
     """
     from .kinematics.sweep import driver_values, sweep_mechanism
     from .problems.loops import load
@@ -500,8 +512,19 @@ def sweep(
     out_fmt = choose_format(fmt, output)
     check_paths([file], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})
     check_criteria(tol, 0.0, None, 50)
-    a = check_number("--from", start)
-    b = check_number("--to", stop)
+    a = check_number("--from", 0.0 if start is None else start)
+    b = check_number("--to", 360.0 if stop is None else stop)
+    equation_only = {"--r1": r1, "--r2": r2, "--r3": r3, "--links": links}
+    if file is None:
+        given = [k for k, v in {"--branch": branch, "--set": set_, "--batch": batch, "--path": path,
+                                "--speed": speed, "--accel": accel}.items() if v]
+        if given:
+            raise InputError(f"{', '.join(given)} apply to a mechanism FILE")
+        _sweep_equation(a, b, step, points, method, r1, r2, r3, links, tol, out_fmt, output, digits, plot)
+        return
+    given = [k for k, v in equation_only.items() if v is not None]
+    if given:
+        raise InputError(f"{', '.join(given)} belong to the four-bar equation (sweep without FILE)")
     if step is not None and points is not None:
         raise InputError("give --step or --points, not both")
     if step is not None:
@@ -537,6 +560,102 @@ def sweep(
             sweep_plot(result, plot)
         typer.echo(f"wrote {plot}", err=True)
     if result.summary.get("failed"):
+        raise typer.Exit(1)
+
+
+def _sweep_equation(a: float, b: float, step: float | None, points: int | None, method: str,
+                    r1: str | None, r2: str | None, r3: str | None, links: Any, tol: float, out_fmt: str,
+                    output: Path | None, digits: int, plot: Path | None) -> None:
+    """The four-bar input-output equation over alpha: seed 002's table, each alpha solved
+    from the previous alpha's root (the first from the equation's own default start)."""
+    from .kinematics.sweep import driver_values
+    from .methods import BRACKETING, SCALAR_METHODS
+    from .render.report import Text, table
+    from .solve import solve_scalar
+
+    if method not in SCALAR_METHODS:
+        raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")
+    if plot is not None:
+        raise InputError("--plot draws mechanism sweeps; without FILE use --format csv")
+    if step is not None and points is not None:
+        raise InputError("give --step or --points, not both")
+    if b < a:
+        raise InputError(f"--to ({b:g}) must not be below --from ({a:g})")
+    values = driver_values(a, b, step if step is not None or points is not None else 1.0, points)
+    if len(values) > 100_000:
+        raise InputError(f"{len(values):,} values of alpha is more than 100,000; use a larger --step")
+    first = _scalar_problem(None, None, values[0], r1, r2, r3, links)
+    coeffs = first.title  # "..., R1 = ..., R2 = ..., R3 = ..." for the table's heading
+    rows: list[tuple[Any, ...]] = []
+    previous: tuple[float, float] | None = None  # (alpha, phi) of the last root on the branch
+
+    def solve_at(alpha: float, guess: float | None) -> Any:
+        problem = _scalar_problem(None, None, alpha, r1, r2, r3, links)
+        kw: dict[str, Any] = dict(method=method, tol=tol, max_iter=200, record=False)
+        if guess is None:
+            if problem.guess is None:
+                return None
+            if method in BRACKETING:
+                return solve_scalar(problem, bracket=problem.guess, **kw)
+            # an open method starts inside the first bracket with a sign change, so every
+            # method anchors on the same root (the seed's branch)
+            guess = 0.5 * (problem.guess[0] + problem.guess[1])
+        if method in BRACKETING:
+            width = 0.5
+            while width < 90.0:  # the nearest bracket around the prediction
+                lo, hi = guess - width, guess + width
+                if (problem.f(lo) < 0.0) != (problem.f(hi) < 0.0):
+                    return solve_scalar(problem, bracket=(lo, hi), **kw)
+                width *= 2.0
+            return None
+        kw["x0"] = guess
+        if method == "secant":
+            kw["x1"] = guess + 1e-3
+        return solve_scalar(problem, **kw)
+
+    def slope(alpha: float, phi: float) -> float:
+        """dphi/dalpha on the branch: -(df/dalpha) / (df/dphi), both per degree."""
+        p = _scalar_problem(None, None, alpha, r1, r2, r3, links)
+        d = math.pi / 180.0
+        h = 1e-6
+        dfa = (_scalar_problem(None, None, alpha + h, r1, r2, r3, links).f(phi) - p.f(phi)) / h
+        dfp = p.fprime(phi) if p.fprime is not None else d
+        return -dfa / dfp if dfp else 0.0
+
+    for alpha in values:
+        r = None
+        if previous is None:
+            r = solve_at(alpha, None)
+        else:
+            # walk from the last root in steps of at most 2 degrees, predicting along the
+            # tangent: the other root of the equation is never reached by a jump
+            a0, phi = previous
+            n = max(1, math.ceil(abs(alpha - a0) / 2.0))
+            for k in range(1, n + 1):
+                ak = a0 + (alpha - a0) * k / n
+                ap = a0 + (alpha - a0) * (k - 1) / n
+                r = solve_at(ak, phi + slope(ap, phi) * (ak - ap))
+                if r is None or not r.converged:
+                    break
+                phi = r.x
+        if r is None:
+            rows.append((alpha, "no_solution", None, 0, None))
+            previous = None
+            continue
+        if r.converged:
+            previous = (alpha, r.x)
+        rows.append((alpha, r.status.value, r.x if r.converged else None, r.iterations, r.residual))
+    headers = ("alpha (deg)", "status", "phi (deg)", "iterations", "f(phi)")
+    blocks: list[Any] = [
+        Text(f"four-bar input-output equation over alpha ({method}, each from the previous root): "
+             f"{coeffs.split(', ', 2)[2] if coeffs.count(', ') >= 2 else coeffs}", "bold"),
+        Text(""), table("", headers, rows, max(digits, 12))]
+    json_obj = {"equation": "f(phi) = R1 cos(alpha) - R2 cos(phi) + R3 - cos(alpha - phi)",
+                "method": method, "tol": tol,
+                "positions": [dict(zip(("alpha", "status", "phi", "iterations", "residual"), r))
+                              for r in rows]}
+    emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=(headers, rows))
+    if any(r[2] is None for r in rows):
         raise typer.Exit(1)
 
 

@@ -113,8 +113,32 @@ def render_text(blocks: Sequence[Block], tablefmt: str) -> str:
     return "\n".join(out).rstrip("\n") + "\n"
 
 
+def column_groups(headers: Sequence[str], rows: Sequence[Sequence[str]], width: int) -> list[list[int]]:
+    """Split columns into groups that fit ``width`` with every cell whole: a column needs
+    its widest cell (a number or a status is never broken) and its header's longest
+    word (headers may wrap between words). Groups after the first repeat column 0 (the
+    iteration or the driver value), so each stacked table reads on its own."""
+    need = []
+    for j, h in enumerate(headers):
+        cells = max((len(r[j]) for r in rows), default=0)
+        need.append(max(cells, max((len(w) for w in h.split()), default=0)) + 2)  # padding
+    groups: list[list[int]] = []
+    current: list[int] = [0]
+    used = 4 + need[0]  # the table's edges
+    for j in range(1, len(headers)):
+        if used + need[j] > width and len(current) > 1:
+            groups.append(current)
+            current, used = [0], 4 + need[0]
+        current.append(j)
+        used += need[j]
+    groups.append(current)
+    return groups
+
+
 def print_rich(blocks: Sequence[Block], file: Any = None) -> None:
-    """Render to a terminal with rich (imported only here)."""
+    """Render to a terminal with rich (imported only here). A table wider than the
+    terminal is split into stacked tables (:func:`column_groups`): numbers and status
+    words are never wrapped or cut."""
     import sys
 
     from rich import box
@@ -128,13 +152,18 @@ def print_rich(blocks: Sequence[Block], file: Any = None) -> None:
     for b in blocks:
         if isinstance(b, Text):
             console.print(b.text, style=b.style or None, markup=False)
-        else:
-            t = RichTable(title=b.title or None, box=box.SIMPLE_HEAVY, title_justify="left",
-                          title_style="bold")
-            for h in b.headers:
-                t.add_column(h, justify="right", overflow="fold")
+            continue
+        groups = column_groups(b.headers, b.rows, console.width) if b.headers else [[]]
+        for k, cols in enumerate(groups):
+            title = b.title or None
+            if len(groups) > 1:
+                title = f"{b.title + ' ' if b.title else ''}(columns part {k + 1} of {len(groups)})"
+            t = RichTable(title=title, box=box.SIMPLE_HEAVY, title_justify="left", title_style="bold")
+            for j in cols:
+                cells = max((len(r[j]) for r in b.rows), default=1)
+                t.add_column(b.headers[j], justify="right", overflow="fold", min_width=cells)
             for r in b.rows:
-                t.add_row(*r)
+                t.add_row(*(r[j] for j in cols))
             console.print(t)
-            for n in b.notes:
-                console.print(n, markup=False)
+        for n in b.notes:
+            console.print(n, markup=False)

@@ -40,8 +40,9 @@ def scalar_blocks(problem: ScalarProblem, result: Result, conv: Convergence | No
     blocks.extend(history_blocks(h, digits))
     style = "green" if result.converged else "red"
     blocks.append(Text(result.message, style))
+    answer = var if result.converged else f"last iterate (not a root): {var}"
     blocks.append(Text(
-        f"{var} = {_with_unit(result.x, unit, max(digits, 15))}   ({result.iterations} iterations, "
+        f"{answer} = {_with_unit(result.x, unit, max(digits, 15))}   ({result.iterations} iterations, "
         f"{result.nfev} evaluations, f({var}) = {fmt(result.residual, 3)})", "bold"))
     if conv is not None and len(conv.rows) >= 2:
         blocks.append(Text(""))
@@ -93,7 +94,8 @@ def summary_blocks(problem: ScalarProblem, runs: Sequence[tuple[Result, Converge
         headers[5] = f"final error ({unit})"
     rows = []
     for r, c, s in runs:
-        rows.append((r.method, r.status.value, r.iterations, r.nfev, r.x, r.error,
+        # a failed method has no root to show: its last iterate is in the JSON
+        rows.append((r.method, r.status.value, r.iterations, r.nfev, r.x if r.converged else None, r.error,
                      r.residual, c.order if c else None, s * 1e6 if s is not None else None))
     blocks: list[Block] = [
         Text(problem.title, "bold"),

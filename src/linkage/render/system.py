@@ -33,13 +33,18 @@ def system_blocks(problem: SystemProblem, result: Result, conv: Convergence | No
     blocks.append(Text(result.message, "green" if result.converged else "red"))
     solution = system_solution(problem, result)
     ref = (meta.get("reference") or {}).get(branch) if branch else None
+    if not result.converged:
+        blocks.append(Text("last iterate (not a solution):"))
     for i, (name, value) in enumerate(solution.items()):
         line = f"{name} = {fmt(value, max(digits, 15))} {problem.unit(i)}".rstrip()
+        if not result.converged:
+            line = "  " + line
         if ref is not None:
             line += f"   (closed form, {branch} branch: {fmt(ref[name], max(digits, 15))})"
         blocks.append(Text(line, "bold"))
     blocks.append(Text(f"{result.iterations} iterations, {result.nfev} residual evaluations, "
-                       f"{result.njev} Jacobian evaluations, max|Phi| at the solution = "
+                       f"{result.njev} Jacobian evaluations, max|Phi| at the "
+                       f"{'solution' if result.converged else 'last iterate'} = "
                        f"{fmt(result.residual, 3)} {problem.length_unit}".rstrip()))
     if conv is not None and len(conv.rows) >= 2:
         blocks.append(Text(""))

@@ -1,0 +1,70 @@
+"""What a person sees: tables at 80 and 200 columns in a real pseudo-terminal, and the
+seed's own table from one command."""
+
+from __future__ import annotations
+
+import json
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+from pty_run import run
+
+SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
+LINKAGE = [sys.executable, "-m", "linkage"]
+NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e[-+]\d+)?")
+STATUSES = ("converged_step", "converged_exact", "converged", "no_solution", "off_branch", "max_iter",
+            "precision_limit", "invalid_bracket", "discontinuity", "stalled")
+
+COMMANDS = [
+    ["solve"],
+    ["solve", str(SAMPLES / "fourbar_me581.toml")],
+    ["solve", "--method", "all"],
+    ["sweep", str(SAMPLES / "fourbar_me581.toml"), "--step", "30"],
+]
+
+
+def _cells(text: str, timed: bool) -> list[str]:
+    """Every number and status word in the table rows of a plain rendering (without the
+    timing column of --method all, which differs from run to run)."""
+    out = []
+    for line in text.splitlines():
+        if not line.strip() or set(line.strip()) <= set("-━ "):
+            continue
+        words = line.split()
+        if timed and words and words[0] in ("bisection", "regula-falsi", "hybrid", "secant", "newton",
+                                             "fixed-point"):
+            words = words[:-1]
+        out += [t for t in words if NUMBER.fullmatch(t) or t in STATUSES]
+    return out
+
+
+@pytest.mark.parametrize("cols", [80, 200])
+@pytest.mark.parametrize("args", COMMANDS, ids=" ".join)
+def test_every_number_and_status_is_printed_whole(args, cols):
+    """The plain output (no width) lists the table cells; at 80 and 200 columns in a
+    pseudo-terminal each one must appear as a whole token: no number or status is
+    wrapped, folded or cut."""
+    import subprocess
+
+    plain = subprocess.run([*LINKAGE, *args, "--format", "plain"], capture_output=True, text=True).stdout
+    seen = run([*LINKAGE, *args], cols)
+    tokens = set(seen.split())
+    missing = [c for c in _cells(plain, "all" in args) if c not in tokens]
+    assert not missing, (cols, missing[:10], seen[:3000])
+    assert max(len(line) for line in seen.splitlines()) <= cols
+
+
+def test_seed_002s_table_from_one_command(cli):
+    """`linkage sweep --from 10 --to 160 --step 30`: seed 002's phi for each alpha."""
+    printed = {10: "8.06934531362", 40: "32.01518035933", 70: "54.88776318878",
+               100: "75.27087338607", 130: "90.12408036526", 160: "92.73496285135"}
+    run_ = cli("sweep", "--from", "10", "--to", "160", "--step", "30", "--format", "json")
+    assert run_.code == 0, run_.err
+    rows = json.loads(run_.out)["positions"]
+    assert [r["alpha"] for r in rows] == [10, 40, 70, 100, 130, 160]
+    for r in rows:
+        want = printed[int(r["alpha"])]
+        assert f"{r['phi']:.11f}" == want, (r, want)
