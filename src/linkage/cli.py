@@ -18,15 +18,28 @@ import typer
 from .errors import InputError, LinkageError
 
 app = typer.Typer(
-    add_completion=False,
     no_args_is_help=True,
     pretty_exceptions_enable=False,
+    context_settings={"help_option_names": ["-h", "--help"]},
     epilog="Example: linkage solve --method all",
 )
 
+
+def _version(value: bool) -> None:
+    if value:
+        from . import __version__
+
+        typer.echo(f"linkage {__version__}")
+        raise typer.Exit(0)
+
+
 @app.callback()
-def _root() -> None:
-    """Position analysis of planar mechanisms by numerical root finding.
+def _root(
+    version: Annotated[bool, typer.Option("--version", callback=_version, is_eager=True,
+                                          help="Print the version and exit.")] = False,
+) -> None:
+    """Kinematics of planar mechanisms by numerical root finding: solve one equation or a
+    mechanism's loop equations, sweep a whole cycle, with every iteration shown.
 
     Example: linkage solve --method all
     """
@@ -72,6 +85,8 @@ AccelOpt = Annotated[
 def choose_format(fmt: str | None, output: Path | None) -> str:
     from .render.report import FORMATS_OWN, tabulate_formats
 
+    if output is not None and str(output) == "-":
+        output = None  # -o - is standard output
     if fmt is None:
         if output is not None:
             return {".csv": "csv", ".json": "json"}.get(output.suffix.lower(), "plain")
@@ -93,14 +108,14 @@ def emit(fmt: str, output: Path | None, *, blocks: Any, json_obj: Any,
     elif fmt == "csv":
         text = to_csv(*csv_table)
     elif fmt == "table":
-        if output is None:
+        if output is None or str(output) == "-":
             with _stdout_errors():
                 print_rich(blocks)
             return
         text = render_text(blocks, "simple")
     else:
         text = render_text(blocks, fmt)
-    if output is None:
+    if output is None or str(output) == "-":
         with _stdout_errors():
             sys.stdout.write(text)
             sys.stdout.flush()
@@ -207,10 +222,11 @@ def solve(
     output: OutputOpt = None,
     digits: DigitsOpt = 12,
 ) -> None:
-    """Solve one equation in one unknown and print every iteration.
+    """Solve an equation, or a mechanism's loop equations, and print every iteration.
 
-    Without options: Newton's method on the seed-002 four-bar equation at alpha = 70 deg
-    from phi = 50 deg. With FILE: Newton-Raphson on the mechanism's loop equations.
+    Without options: Newton's method on the four-bar input-output equation (the course
+    notes' example, alpha = 70 deg) from phi = 50 deg. With FILE (or - for standard
+    input): Newton-Raphson on the mechanism's loop equations.
 
     Example: linkage solve --method secant --x0 50 --x1 60
 
@@ -734,8 +750,10 @@ def stress(
     fmt: FormatOpt = None,
     output: OutputOpt = None,
 ) -> None:
-    """Try to break every method: classic test functions, random four-bars, bad starts,
-    tiny tolerances, non-finite values. False convergence must be 0.
+    """Try to break every method (test functions, random four-bars, bad starts, tiny tolerances).
+
+    Runs classic test functions, random four-bars, the MGH systems, bad starts, tiny
+    tolerances and non-finite values; a claimed root that is not one fails the run.
 
     Example: linkage stress --quick
     """
@@ -938,6 +956,8 @@ def run_cli(argv: list[str] | None = None) -> int:
         typer.echo("error: out of memory: the input asks for more than this machine has", err=True)
         return 2
     except Exception as exc:
+        if type(exc).__name__ == "NoArgsIsHelpError":
+            return 0  # bare `linkage`: the help was the answer
         if hasattr(exc, "format_message") and hasattr(exc, "exit_code"):
             # A usage error from typer's (or click's) parser: bad option, bad value.
             message = " ".join(exc.format_message().split())
@@ -945,6 +965,9 @@ def run_cli(argv: list[str] | None = None) -> int:
             return 2
         typer.echo(f"internal error: {type(exc).__name__}: {exc} (please report this)", err=True)
         return 1
+    if rv == 130:
+        # typer turns Ctrl-C into a silent return of 130 (no command returns a number)
+        typer.echo("error: interrupted", err=True)
     return rv if isinstance(rv, int) else 0
 
 

@@ -27,7 +27,19 @@ MAX_INPUT_BYTES = 1_000_000
 
 
 def read_input(path: Path, what: str = "mechanism file") -> str:
-    """The text of a regular UTF-8 file of at most MAX_INPUT_BYTES, or a ParseError."""
+    """The text of a regular UTF-8 file of at most MAX_INPUT_BYTES, or a ParseError;
+    ``-`` reads standard input (with the same bound)."""
+    if str(path) == "-":
+        import sys
+
+        data = sys.stdin.buffer.read(MAX_INPUT_BYTES + 1) if hasattr(sys.stdin, "buffer") else \
+            sys.stdin.read(MAX_INPUT_BYTES + 1).encode()
+        if len(data) > MAX_INPUT_BYTES:
+            raise ParseError(f"standard input has more than {MAX_INPUT_BYTES:,} bytes")
+        try:
+            return data.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise ParseError(f"standard input is not UTF-8 text (byte {exc.start})") from None
     try:
         st = os.stat(path)
     except FileNotFoundError:
