@@ -70,3 +70,24 @@ def test_paths_are_checked_before_any_work(cli, tmp_path, monkeypatch):
     for option, name in (("--plot", "x.txt"), ("-o", "no/such/dir/out.csv")):
         run = cli("sweep", str(SAMPLES / "crank_rocker.toml"), option, str(tmp_path / name))
         assert run.code == 2 and option in run.err
+
+
+def test_samples_lists_prints_and_copies_without_replacing(cli, tmp_path):
+    listing = cli("samples")
+    assert listing.code == 0 and "crank_rocker.toml" in listing.out and "watt_sixbar.toml" in listing.out
+    printed = cli("samples", "crank_rocker")
+    assert printed.out == (SAMPLES / "crank_rocker.toml").read_text()
+    out = tmp_path / "mine.toml"
+    assert cli("samples", "crank_rocker.toml", "-o", str(out)).code == 0
+    assert out.read_text() == printed.out
+    out.write_text("mine")
+    again = cli("samples", "crank_rocker", "-o", str(out))
+    assert again.code == 2 and out.read_text() == "mine"
+    assert cli("samples", "nope").code == 2
+
+
+def test_help_has_no_type_markers(cli):
+    for command in ("solve", "sweep", "draw", "samples"):
+        text = cli(command, "--help").out
+        for marker in ("<bool>", "<list[str]>", "<str,str", "<str str str str>"):
+            assert marker not in text, (command, marker)

@@ -68,3 +68,14 @@ def test_seed_002s_table_from_one_command(cli):
     for r in rows:
         want = printed[int(r["alpha"])]
         assert f"{r['phi']:.11f}" == want, (r, want)
+
+
+def test_columns_picks_what_a_table_and_the_csv_show(cli):
+    run = cli("sweep", str(SAMPLES / "fourbar_me581.toml"), "--step", "90", "--columns", "theta4,det",
+              "--format", "csv")
+    header = run.out.splitlines()[0].split(",")
+    assert header[0].startswith("theta2") and header[1].startswith("theta4") and header[2].startswith("det J")
+    assert len(header) == 3
+    text = cli("solve", str(SAMPLES / "fourbar_me581.toml"), "--columns", "theta3", "--format", "plain").out
+    assert "left out" in text and "max|Phi|" in text.split("left out")[1]
+    assert cli("solve", "--columns", "nothing-like-this").code == 2

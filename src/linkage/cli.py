@@ -58,12 +58,19 @@ OutputOpt = Annotated[
                  "the format follows the suffix (.csv, .json) unless --format is given."),
 ]
 MechanismFile = Annotated[
-    Path, typer.Argument(help="A mechanism file (TOML, see sample_inputs/).", show_default=False)
+    Path, typer.Argument(metavar="FILE", help="A mechanism file (TOML, see `linkage samples`).",
+                         show_default=False)
 ]
 SetOpt = Annotated[
     Optional[list[str]],
-    typer.Option("--set", help="Override a parameter or the driver, name=value in the file's "
-                 "units (repeatable)."),
+    typer.Option("--set", metavar="NAME=VALUE", help="Override a parameter or the driver, in "
+                 "the file's units (repeatable)."),
+]
+ColumnsOpt = Annotated[
+    Optional[str],
+    typer.Option("--columns", metavar="NAMES", help="Show only these columns of the tables and "
+                 "the CSV: comma-separated names or their beginnings, e.g. theta3,theta4,det "
+                 "(the first column always stays)."),
 ]
 DigitsOpt = Annotated[
     int, typer.Option("--digits", min=3, max=17, help="Significant digits printed in tables.")
@@ -72,14 +79,15 @@ DigitsOpt = Annotated[
 
 SpeedOpt = Annotated[
     Optional[str],
-    typer.Option("--speed", help="Driver speed, for velocities and accelerations of every unknown, "
-                 "joint and point: a number in rad/s (or the file's length unit per second for a "
-                 "sliding driver), or with a unit: 600rpm, 10rad/s, 90deg/s, 250mm/s."),
+    typer.Option("--speed", metavar="SPEED", help="Driver speed, for velocities and "
+                 "accelerations of every unknown, joint and point: a number in rad/s (or the "
+                 "file's length unit per second for a sliding driver), or with a unit: 600rpm, "
+                 "10rad/s, 90deg/s, 250mm/s."),
 ]
 AccelOpt = Annotated[
     Optional[str],
-    typer.Option("--accel", help="Driver acceleration (with --speed; default 0): rad/s^2, or "
-                 "5rad/s^2, 90deg/s^2, 100rpm/s, 20mm/s^2."),
+    typer.Option("--accel", metavar="ACCEL", help="Driver acceleration (with --speed; "
+                 "default 0): rad/s^2, or 5rad/s^2, 90deg/s^2, 100rpm/s, 20mm/s^2."),
 ]
 
 def choose_format(fmt: str | None, output: Path | None) -> str:
@@ -98,10 +106,14 @@ def choose_format(fmt: str | None, output: Path | None) -> str:
 
 
 def emit(fmt: str, output: Path | None, *, blocks: Any, json_obj: Any,
-         csv_table: tuple[Any, Any]) -> None:
-    """Write one command's output in the chosen format, to stdout or ``output``."""
+         csv_table: tuple[Any, Any], columns: str | None = None) -> None:
+    """Write one command's output in the chosen format, to stdout or ``output``;
+    ``columns`` (comma-separated name prefixes) keeps only those table and CSV columns."""
     from .render.export import to_csv, to_json
-    from .render.report import print_rich, render_text
+    from .render.report import pick_columns, print_rich, render_text
+
+    if columns:
+        blocks, csv_table = pick_columns(blocks, csv_table, columns)
 
     if fmt == "json":
         text = to_json(json_obj)
@@ -177,8 +189,8 @@ def parse_number(name: str, text: str) -> float:
 )
 def solve(
     file: Annotated[Optional[Path], typer.Argument(
-        help="A mechanism file (TOML, see sample_inputs/): solve its loop-closure equations.",
-        show_default=False)] = None,
+        metavar="[FILE]", help="A mechanism file (TOML, see sample_inputs/; - reads standard input): "
+        "solve its loop-closure equations.", show_default=False)] = None,
     *,
     method: Annotated[str, typer.Option("--method", "-m", help="bisection, regula-falsi, "
                       "hybrid, secant, newton, fixed-point, or all; with FILE: newton, "
@@ -189,7 +201,7 @@ def solve(
     r2: Annotated[Optional[str], typer.Option("--r2", help="R2 (default 5/2).")] = None,
     r3: Annotated[Optional[str], typer.Option("--r3", help="R3 (default 11/6).")] = None,
     links: Annotated[Optional[tuple[str, str, str, str]], typer.Option(
-        help="Link lengths: input, coupler, output, ground (sets R1, R2, R3).")] = None,
+        metavar="A B C D", help="Link lengths: input, coupler, output, ground (sets R1, R2, R3).")] = None,
     equation: Annotated[Optional[str], typer.Option("--equation", "-e", help="Solve this "
                         "equation in x instead, e.g. 'x**2 - 4*x + 1'.")] = None,
     g: Annotated[Optional[str], typer.Option("--g", help="Iteration function for "
@@ -197,14 +209,14 @@ def solve(
     x0: Annotated[Optional[float], typer.Option(help="Starting point (deg for the four-bar).")] = None,
     x1: Annotated[Optional[float], typer.Option(help="Second starting point (secant).")] = None,
     bracket: Annotated[Optional[tuple[float, float]], typer.Option(
-        help="Bracket A B with a sign change (bisection, regula-falsi, hybrid).")] = None,
+        metavar="A B", help="Bracket A B with a sign change (bisection, regula-falsi, hybrid).")] = None,
     tol: Annotated[float, typer.Option(help="Step tolerance epsilon_s (absolute).")] = 1e-6,
     rtol: Annotated[float, typer.Option(help="Relative step tolerance.")] = 0.0,
     ftol: Annotated[Optional[float], typer.Option(help="Residual tolerance epsilon_e "
                     "(off unless given).")] = None,
     max_iter: Annotated[int, typer.Option("--max-iter", help="Iteration cap.")] = 100,
     set_: SetOpt = None,
-    guess: Annotated[Optional[list[str]], typer.Option(help="With FILE: initial guess "
+    guess: Annotated[Optional[list[str]], typer.Option(metavar="NAME=VALUE", help="With FILE: initial guess "
                      "name=value in the file's units (repeatable).")] = None,
     show_jacobian: Annotated[bool, typer.Option("--show-jacobian", help="With FILE: add the "
                              "Jacobian entries (with units) to the table.")] = False,
@@ -216,11 +228,14 @@ def solve(
                       "damped one) or the textbook iteration (--plain).")] = True,
     plot: Annotated[Optional[Path], typer.Option(help="Also plot log10 error against iteration "
                     "for the method(s) run (.png, .svg or .pdf; needs matplotlib).")] = None,
+    branch: Annotated[Optional[str], typer.Option(help="With FILE (one with a closed form): the "
+                      "assembly to solve for, open or crossed (its closed form is the start).")] = None,
     speed: SpeedOpt = None,
     accel: AccelOpt = None,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 12,
+    columns: ColumnsOpt = None,
 ) -> None:
     """Solve an equation, or a mechanism's loop equations, and print every iteration.
 
@@ -243,6 +258,7 @@ def solve(
     scalar_only = {"--alpha": alpha, "--r1": r1, "--r2": r2, "--r3": r3, "--links": links,
                    "--equation": equation, "--g": g, "--x0": x0, "--x1": x1, "--bracket": bracket}
     system_only = {"--set": set_, "--guess": guess, "--fd-step": fd_step, "--speed": speed, "--accel": accel,
+                   "--branch": branch,
                    "--show-jacobian": show_jacobian or None, "--plain": (not damped) or None}
     if file is not None:
         given = [k for k, v in scalar_only.items() if v is not None]
@@ -250,7 +266,7 @@ def solve(
             raise InputError(f"{', '.join(given)} apply to a single equation, not to a mechanism file")
         _solve_file(file, method, set_ or [], guess or [], tol, rtol, ftol,
                     max_iter if max_iter != 100 else 50, fd_step, damped, show_jacobian,
-                    out_fmt, output, digits, plot, (speed, accel))
+                    out_fmt, output, digits, plot, (speed, accel), branch, columns)
         return
     given = [k for k, v in system_only.items() if v is not None]
     if given:
@@ -292,8 +308,12 @@ def solve(
     if method != "all":
         result, conv, _ = runs[0]
         blocks = scalar_blocks(problem, result, conv, digits)
-        json_obj: Any = result_dict(result, {var: result.x}, conv.as_dict() if conv else None,
-                                    {"problem": problem.title, "units": {var: problem.unit}})
+        extra: dict[str, Any] = {"problem": problem.title, "units": {var: problem.unit}}
+        if equation is None:
+            info = _fourbar_info(alpha, r1, r2, r3, links, result)
+            extra["fourbar"] = info
+            blocks += _fourbar_blocks(info, digits)
+        json_obj: Any = result_dict(result, {var: result.x}, conv.as_dict() if conv else None, extra)
         h = result.history
         csv_table = (h.columns, h.rows) if h is not None else ((), ())
     else:
@@ -302,14 +322,14 @@ def solve(
                                 {"problem": problem.title, "units": {var: problem.unit},
                                  "seconds_per_solve": s})
                     for r, c, s in runs]
-    emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=csv_table)
+    emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=csv_table, columns=columns)
     if plot is not None:
-        _convergence_plot([r for r, _, _ in runs], plot, problem.title)
+        _convergence_plot([r for r, _, _ in runs], plot, problem.title, problem.unit)
     if not all(r.converged for r, _, _ in runs):
         raise typer.Exit(1)
 
 
-def _convergence_plot(results: list[Any], path: Path, title: str) -> None:
+def _convergence_plot(results: list[Any], path: Path, title: str, unit: str = "") -> None:
     from .render.plots import convergence_plot
 
     series = []
@@ -317,7 +337,7 @@ def _convergence_plot(results: list[Any], path: Path, title: str) -> None:
         errors = [abs(e) if isinstance(e, (int, float)) else None for e in r.history.errors()] \
             if r.history is not None else []
         series.append((f"{r.method} ({r.status.value})", errors))
-    convergence_plot(series, path, title)
+    convergence_plot(series, path, title, unit)
     typer.echo(f"wrote {path}", err=True)
 
 
@@ -363,7 +383,8 @@ def parse_assignments(option: str, items: list[str]) -> dict[str, float]:
 def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: float, rtol: float,
                 ftol: float | None, max_iter: int, fd_step: float | None, damped: bool,
                 show_jacobian: bool, out_fmt: str, output: Path | None, digits: int,
-                plot: Path | None = None, motion: tuple[str | None, str | None] = (None, None)) -> None:
+                plot: Path | None = None, motion: tuple[str | None, str | None] = (None, None),
+                branch_wanted: str | None = None, columns: str | None = None) -> None:
     from .analysis.convergence import analyze
     from .problems.loops import load
     from .render.export import result_dict
@@ -375,6 +396,8 @@ def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol:
                          f"{', '.join(SYSTEM_METHODS)}")
     mechanism = load(file).with_values(parse_assignments("--set", set_),
                                        parse_assignments("--guess", guess))
+    if branch_wanted is not None:
+        mechanism = _start_on_branch(mechanism, branch_wanted, bool(guess))
     speed, accel = parse_motion(*motion, mechanism)
     problem = mechanism.problem()
     result = solve_system(problem, method=method, tol=tol, rtol=rtol, ftol=ftol, max_iter=max_iter,
@@ -402,11 +425,84 @@ def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol:
                            extra)
     h = result.history
     emit(out_fmt, output, blocks=blocks, json_obj=json_obj,
-         csv_table=(h.columns, h.rows) if h is not None else ((), ()))
+         csv_table=(h.columns, h.rows) if h is not None else ((), ()), columns=columns)
     if plot is not None:
-        _convergence_plot([result], plot, problem.title)
+        _convergence_plot([result], plot, problem.title,
+                          ", ".join(sorted({problem.step_unit(i) for i in range(problem.n)} - {""})))
     if not result.converged:
         raise typer.Exit(1)
+
+
+def _start_on_branch(mechanism: Any, branch: str, guessed: bool) -> Any:
+    """The mechanism with its guess replaced by the closed form's solution on ``branch``."""
+    if branch not in ("open", "crossed"):
+        raise InputError(f"--branch must be open or crossed, got {branch!r}")
+    if guessed:
+        raise InputError("give --branch or --guess, not both")
+    if mechanism.closed_form is None:
+        raise InputError(f"--branch needs a mechanism with a closed form; {mechanism.source} has none "
+                         "(its assembly follows the file's guess)")
+    reference = mechanism.problem().reference() or {}
+    if branch not in reference:
+        found = ", ".join(reference) or "none: it cannot be assembled there"
+        raise InputError(f"no {branch} assembly at {mechanism.driver.name} = "
+                         f"{mechanism.problem().meta['driver_value']:g} {mechanism.driver.unit} "
+                         f"(assemblies: {found})")
+    return mechanism.with_values({}, reference[branch])
+
+
+def _fourbar_coefficients(r1: str | None, r2: str | None, r3: str | None,
+                          links: tuple[str, ...] | None) -> tuple[tuple[float, float, float], Any]:
+    """(R1, R2, R3) and the link lengths (given, or derived for a unit ground)."""
+    from .problems.freudenstein import SEED_R, coefficients_from_links, links_of
+
+    if links is not None:
+        if any(v is not None for v in (r1, r2, r3)):
+            raise InputError("give either --links or --r1/--r2/--r3, not both")
+        lengths = tuple(parse_number(f"link {n}", t) for n, t in zip("abcd", links))
+        c = coefficients_from_links(*lengths)
+        return (c.r1, c.r2, c.r3), lengths
+    rs = tuple(parse_number(n, t) if t is not None else d
+               for n, t, d in (("R1", r1, SEED_R[0]), ("R2", r2, SEED_R[1]), ("R3", r3, SEED_R[2])))
+    return rs, links_of(*rs)  # type: ignore[arg-type]
+
+
+def _fourbar_info(alpha: float | None, r1: str | None, r2: str | None, r3: str | None,
+                  links: tuple[str, ...] | None, result: Any) -> dict[str, Any]:
+    """Both roots in closed form, and the answer in the mechanism-file convention."""
+    from .problems.freudenstein import equation_roots, file_convention
+
+    a = 70.0 if alpha is None else alpha
+    rs, lengths = _fourbar_coefficients(r1, r2, r3, links)
+    roots = equation_roots(a, *rs)
+    info: dict[str, Any] = {"alpha": a, "R": list(rs), "roots": roots,
+                            "links": list(lengths) if lengths else None, "file_convention": None}
+    if lengths and result.converged:
+        info["file_convention"] = file_convention(a, result.x, lengths)
+        others = [r for r in roots if abs(((r - result.x) + 180.0) % 360.0 - 180.0) > 1e-6]
+        info["other_assembly"] = file_convention(a, others[0], lengths) if others else None
+    return info
+
+
+def _fourbar_blocks(info: dict[str, Any], digits: int) -> list[Any]:
+    from .render.report import Text, fmt
+
+    d = max(digits, 12)
+    out: list[Any] = [Text("")]
+    roots = info["roots"]
+    out.append(Text("both roots (closed form): " + (", ".join(f"phi = {fmt(r, d)} deg" for r in roots)
+                                                     or "none: the linkage cannot be assembled here")))
+    fc = info.get("file_convention")
+    if fc:
+        other = info.get("other_assembly")
+        out.append(Text(f"in the mechanism-file convention (ground O2 -> O4 along +x, angles from +x): "
+                        f"theta2 = {fmt(fc['theta2'], d)}, theta3 = {fmt(fc['theta3'], d)}, "
+                        f"theta4 = {fmt(fc['theta4'], d)} deg ({fc['branch']} branch)"
+                        + (f"; other assembly theta3 = {fmt(other['theta3'], d)}, theta4 = "
+                           f"{fmt(other['theta4'], d)} deg ({other['branch']})" if other else "")))
+        out.append(Text("(alpha and phi are measured from the line O4 -> O2, so theta2 = alpha + 180 "
+                        "and theta4 = phi + 180: see the README's angle conventions)"))
+    return out
 
 
 def _scalar_problem(equation: str | None, g: str | None, alpha: float | None, r1: str | None,
@@ -422,17 +518,9 @@ def _scalar_problem(equation: str | None, g: str | None, alpha: float | None, r1
         return equation_problem(equation, g)
     if g is not None:
         raise InputError("--g applies to --equation; the four-bar has its own g = acos(u)")
-    from .problems.freudenstein import SEED_R, coefficients_from_links, fourbar_equation
+    from .problems.freudenstein import fourbar_equation
 
-    if links is not None:
-        if any(v is not None for v in (r1, r2, r3)):
-            raise InputError("give either --links or --r1/--r2/--r3, not both")
-        lengths = [parse_number(f"link {n}", t) for n, t in zip("abcd", links)]
-        c = coefficients_from_links(*lengths)
-        rs = (c.r1, c.r2, c.r3)
-    else:
-        rs = tuple(parse_number(n, t) if t is not None else d
-                   for n, t, d in (("R1", r1, SEED_R[0]), ("R2", r2, SEED_R[1]), ("R3", r3, SEED_R[2])))
+    rs, _ = _fourbar_coefficients(r1, r2, r3, links)
     return fourbar_equation(70.0 if alpha is None else alpha, *rs)
 
 
@@ -476,8 +564,8 @@ def _time_solve(problem: Any, kwargs: dict[str, Any]) -> float:
 )
 def sweep(
     file: Annotated[Optional[Path], typer.Argument(
-        help="A mechanism file (TOML, see sample_inputs/); without it, the four-bar "
-        "input-output equation over alpha.", show_default=False)] = None,
+        metavar="[FILE]", help="A mechanism file (TOML, see sample_inputs/; - reads standard input); "
+        "without it, the four-bar input-output equation over alpha.", show_default=False)] = None,
     *,
     start: Annotated[Optional[float], typer.Option("--from", help="First driver value (driver's "
                      "unit; default 0).")] = None,
@@ -486,7 +574,7 @@ def sweep(
     r2: Annotated[Optional[str], typer.Option("--r2", help="Without FILE: R2 (default 5/2).")] = None,
     r3: Annotated[Optional[str], typer.Option("--r3", help="Without FILE: R3 (default 11/6).")] = None,
     links: Annotated[Optional[tuple[str, str, str, str]], typer.Option(
-        help="Without FILE: link lengths input, coupler, output, ground.")] = None,
+        metavar="A B C D", help="Without FILE: link lengths input, coupler, output, ground.")] = None,
     step: Annotated[Optional[float], typer.Option(help="Driver increment (default 1).")] = None,
     points: Annotated[Optional[int], typer.Option(help="Number of evenly spaced positions "
                       "instead of --step.")] = None,
@@ -501,13 +589,14 @@ def sweep(
     plot: Annotated[Optional[Path], typer.Option(help="Also plot the outputs against the driver "
                     "(.png, .svg or .pdf; needs matplotlib).")] = None,
     path: Annotated[Optional[list[str]], typer.Option(
-        "--path", help="With --plot: draw the path of this joint or named point over the sweep "
-        "instead (a coupler curve; repeatable).")] = None,
+        "--path", metavar="JOINT", help="With --plot: draw the path of this joint or named "
+        "point over the sweep instead (a coupler curve; repeatable).")] = None,
     speed: SpeedOpt = None,
     accel: AccelOpt = None,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 10,
+    columns: ColumnsOpt = None,
 ) -> None:
     """Solve a mechanism over a range of its driver, each position from the previous one.
 
@@ -566,6 +655,7 @@ def sweep(
         result = sweep_mechanism(mechanism, values, method=method, branch=branch, tol=tol, batch=batch,
                                  progress=advance, speed=w, accel=a_)
     emit(out_fmt, output, blocks=sweep_blocks(result, digits), json_obj=sweep_dict(result),
+         columns=columns,
          csv_table=(sweep_headers(result), sweep_rows(result)))
     if plot is not None:
         from .render.plots import path_plot, sweep_plot
@@ -732,8 +822,55 @@ def draw(
         if not frames:
             typer.echo(f"error: no position of {file} between {a:g} and {b:g} could be solved", err=True)
             raise typer.Exit(1)
-        animate_sweep(mechanism, frames, animate)
+        with _progress(len(frames), minimum=1) as advance:
+            animate_sweep(mechanism, frames, animate, progress=advance)
         typer.echo(f"wrote {animate} ({len(frames)} frames)", err=True)
+
+
+@app.command(
+    epilog="Examples:  linkage samples  |  linkage samples crank_rocker -o my_linkage.toml  |  "
+    "linkage samples watt_sixbar | linkage solve -",
+)
+def samples(
+    name: Annotated[Optional[str], typer.Argument(metavar="[NAME]", help="A sample to print (or write "
+                    "with -o), e.g. crank_rocker.", show_default=False)] = None,
+    *,
+    output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Write the sample to this "
+                      "new file (an existing file is never replaced).")] = None,
+) -> None:
+    """List the mechanism files shipped with linkage, or copy one out to start your own.
+
+    Example: linkage samples crank_rocker -o my_linkage.toml
+    """
+    from .samples import find_sample
+    from .samples import samples as shipped
+
+    if name is None:
+        if output is not None:
+            raise InputError("give the NAME of the sample to write with -o")
+        from .render.report import Text
+
+        listing = shipped()
+        width = max((len(k) for k in listing), default=0)
+        emit("table" if sys.stdout.isatty() else "plain", None,
+             blocks=[*(Text(f"{k.ljust(width)}  {v}") for k, v in listing.items()), Text(""),
+                     Text("print one with `linkage samples NAME`, or copy it with "
+                          "`linkage samples NAME -o FILE`")],
+             json_obj=listing, csv_table=(("sample", "what it is"), list(listing.items())))
+        return
+    text = find_sample(name).read_text(encoding="utf-8")
+    if output is None or str(output) == "-":
+        with _stdout_errors():
+            sys.stdout.write(text)
+            sys.stdout.flush()
+        return
+    if output.exists() or output.is_symlink():
+        raise InputError(f"{output} exists; choose a new file name (samples never replace a file)")
+    check_paths([], [("--output", output)])
+    from .files import write_atomic
+
+    write_atomic(output, text)
+    typer.echo(f"wrote {output}", err=True)
 
 
 @app.command(
@@ -772,7 +909,7 @@ def stress(
         import mpmath  # noqa: F401
     except ImportError:
         raise InputError("the stress suite needs mpmath for its references: "
-                         "pip install 'linkage[stress]'") from None
+                         "pip install 'linkage-kinematics[stress]'") from None
     report = run(quick=quick, seed=seed, methods=method or None)
     rows = summary_rows(report)
     false, crashes = totals(rows)
@@ -856,7 +993,7 @@ def bench(
         import mpmath  # noqa: F401
     except ImportError:
         raise InputError("the benchmark needs mpmath for its references: "
-                         "pip install 'linkage[bench]'") from None
+                         "pip install 'linkage-kinematics[bench]'") from None
     tolerances = QUICK_TOLERANCES if quick else FULL_TOLERANCES
     budget = 0.01 if quick else 0.015
     from .bench import count_measurements
@@ -873,15 +1010,17 @@ def bench(
     cold_times = cold_start(3 if quick else 5) if cold else {}
     sweeps = sweep_times(n_repeats, 100_000 if quick else 1_000_000)
     target_rows = targets(results, cold_times, sweeps)
-    headers = ("problem", "contender", "tol", "time per solve (us)", "spread (us)", "error", "iterations",
+    headers = ("problem", "contender", "tol", "time per solve (us)", "fastest batch (us)",
+               "slowest batch (us)", "error", "iterations",
                "evaluations")
     rows = [(m.problem, m.contender, m.tol, m.seconds * 1e6,
-             f"{m.spread[0] * 1e6:.3g}-{m.spread[1] * 1e6:.3g}", m.error, m.iterations, m.nfev)
+             m.spread[0] * 1e6, m.spread[1] * 1e6, m.error, m.iterations, m.nfev)
             for m in results]
     blocks: list[Any] = [Text(f"work-precision benchmark: {len(results)} measurements, {n_repeats} timed "
                               "batches each (median; spread = fastest-slowest batch)", "bold")]
     if not has_scipy():
-        blocks.append(Text("scipy is not installed: its rows are skipped (pip install 'linkage[bench]')"))
+        blocks.append(Text("scipy is not installed: its rows are skipped "
+                           "(pip install 'linkage-kinematics[bench]')"))
     if not has_pylinkage():
         blocks.append(Text("pylinkage is not installed: the sweep comparison is skipped "
                            "(pip install 'pylinkage==1.3.0')"))

@@ -485,7 +485,33 @@ def _continuous_angles(solver: _Solver, positions: list[Position]) -> list[Posit
             sol[n] = wrap_degrees(v) if ref is None else ref + wrap_degrees(v - ref)
             prev[n] = sol[n]
         out.append(replace(p, solution=sol))
-    return out
+    return _anchor(solver, out, angles)
+
+
+def _anchor(solver: _Solver, positions: list[Position], angles: list[str]) -> list[Position]:
+    """Shift each angle's whole curve by a multiple of 360 so that at the position nearest
+    the file's own driver value it reads as `solve FILE` reports it there (Newton from the
+    file's guess): a sweep and a solve never disagree by a turn."""
+    from dataclasses import replace
+
+    solved = [p for p in positions if p.solution is not None]
+    if not angles or not solved:
+        return positions
+    m = solver.m
+    v0 = m.driver.value / solver.scale
+    from ..solve import solve_system
+
+    r = solve_system(solver.problem(v0), tuple(u.value for u in m.unknowns), tol=solver.tol, record=False)
+    if not r.converged:
+        return positions
+    anchor = solver.display(r.x)
+    near = min(solved, key=lambda p: abs(p.input - v0))
+    shift = {n: 360.0 * round((anchor[n] - near.solution[n]) / 360.0) for n in angles}  # type: ignore[index]
+    if not any(shift.values()):
+        return positions
+    return [p if p.solution is None else
+            replace(p, solution={k: v + shift.get(k, 0.0) for k, v in p.solution.items()})
+            for p in positions]
 
 
 def _follow(solver: _Solver, values: Sequence[float], seed: tuple[float, tuple[float, ...]],

@@ -137,3 +137,53 @@ def default_start(f: Callable[[float], float],
             return (prev, x) if step_inside else (x, prev)
         prev, fprev = x, fx
     return None
+
+
+def equation_roots(alpha_deg: float, r1: float, r2: float, r3: float) -> list[float]:
+    """Both roots phi (deg, in (-180, 180]) of the input-output equation, in closed form:
+    (R2 + cos a) cos phi + sin a sin phi = R1 cos a + R3, so
+    phi = atan2(sin a, R2 + cos a) +- acos(K / |(R2 + cos a, sin a)|). [] when the
+    linkage cannot be assembled at alpha; one root at a limit position."""
+    a = alpha_deg * DEG
+    p, q = r2 + math.cos(a), math.sin(a)
+    k = r1 * math.cos(a) + r3
+    size = math.hypot(p, q)
+    if size == 0.0 or abs(k) > size:
+        return []
+    base, spread = math.atan2(q, p), math.acos(max(-1.0, min(1.0, k / size)))
+    roots = {(math.degrees(base + s * spread) + 180.0) % 360.0 - 180.0 for s in (1.0, -1.0)}
+    return sorted(roots)
+
+
+def links_of(r1: float, r2: float, r3: float,
+             ground: float = 1.0) -> tuple[float, float, float, float] | None:
+    """Link lengths (input a, coupler b, output c, ground d) with R1 = d/c, R2 = d/a,
+    R3 = (a^2 - b^2 + c^2 + d^2) / (2ac), for a ground of ``ground``; None if no real
+    coupler length fits."""
+    if r1 <= 0.0 or r2 <= 0.0:
+        return None
+    d = ground
+    a, c = d / r2, d / r1
+    b2 = a * a + c * c + d * d - 2.0 * a * c * r3
+    return (a, math.sqrt(b2), c, d) if b2 > 0.0 else None
+
+
+def file_convention(alpha_deg: float, phi_deg: float,
+                    links: tuple[float, float, float, float]) -> dict[str, float | str]:
+    """The same position in the mechanism-file convention (sample_inputs/crank_rocker.toml:
+    ground O2 -> O4 along +x, every angle from +x). The equation measures alpha and phi
+    from the line of centres pointing from the output pivot O4 to the input pivot O2, the
+    opposite direction, so theta2 = alpha + 180 and theta4 = phi + 180; theta3 is the
+    coupler's direction from A to B. Angles in (-180, 180]."""
+    a, _, c, d = links
+    t2, t4 = math.radians(alpha_deg + 180.0), math.radians(phi_deg + 180.0)
+    A = a * complex(math.cos(t2), math.sin(t2))
+    B = d + c * complex(math.cos(t4), math.sin(t4))
+    t3 = math.atan2((B - A).imag, (B - A).real)
+
+    def wrap(v: float) -> float:
+        return (v + 180.0) % 360.0 - 180.0 if (v + 180.0) % 360.0 != 0.0 else 180.0
+
+    branch = "open" if math.sin(t4 - t3) > 0.0 else "crossed"
+    return {"theta2": wrap(alpha_deg + 180.0), "theta3": wrap(math.degrees(t3)),
+            "theta4": wrap(phi_deg + 180.0), "branch": branch}

@@ -541,6 +541,8 @@ class LoopModel:
         for loop in m.loops:
             eq_names += [f"{loop.name}.x", f"{loop.name}.y"]
         shown = driver / ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else driver
+        # the value as typed: degrees -> radians -> degrees leaves 59.99999999999999 for 60
+        shown = float(f"{shown:.12g}")
         reference = branch_of = None
         if m.closed_form is not None:
             from .closed_form import branch_rule, reference_for

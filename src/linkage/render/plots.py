@@ -25,7 +25,7 @@ def _pyplot() -> Any:
     try:
         import matplotlib
     except ImportError:
-        raise InputError("plots need matplotlib: pip install 'linkage[plot]'") from None
+        raise InputError("plots need matplotlib: pip install 'linkage-kinematics[plot]'") from None
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
@@ -168,9 +168,11 @@ def _draw(ax: Any, mechanism: Any, q: Sequence[float], driver: float, title: str
                 dict(color="tab:orange", ls=":", lw=2.0) if slider else
                 dict(color="tab:red" if driven else "tab:blue", lw=3.0 if driven else 2.4))
             ax.plot([a.real, b.real], [a.imag, b.imag], solid_capstyle="round", **style)
-            if not fixed and isinstance(term.length, str):
+            if not fixed and isinstance(term.length, str) and b != a:
                 mid = (a + b) / 2
-                ax.annotate(term.length, (mid.real, mid.imag), textcoords="offset points", xytext=(4, 4),
+                normal = 1j * (b - a) / abs(b - a)  # label beside the link, never on it
+                ax.annotate(term.length, (mid.real, mid.imag), textcoords="offset points",
+                            xytext=(9 * normal.real, 9 * normal.imag), ha="center", va="center",
                             fontsize=8, color=style["color"])
         labels = loop.joints or ("",) * len(loop.vectors)
         for k, label in enumerate(labels):
@@ -215,7 +217,7 @@ def draw_mechanism(mechanism: Any, q: Sequence[float], path: Path, title: str) -
 
 
 def animate_sweep(mechanism: Any, frames: Sequence[tuple[float, Sequence[float]]], path: Path,
-                  fps: int = 12) -> None:
+                  fps: int = 12, progress: Any = None) -> None:
     """frames: (driver value in internal units, q) per frame."""
     _check_suffix(path, (".gif",))
     plt = _pyplot()
@@ -250,13 +252,15 @@ def animate_sweep(mechanism: Any, frames: Sequence[tuple[float, Sequence[float]]
 
     try:
         with atomic_target(path) as tmp:
-            anim.save(tmp, writer=PillowWriter(fps=fps))
+            anim.save(tmp, writer=PillowWriter(fps=fps),
+                      progress_callback=(lambda i, n: progress(i + 1)) if progress else None)
     finally:
         plt.close(fig)
 
 
-def convergence_plot(runs: Sequence[tuple[str, Sequence[float]]], path: Path, title: str) -> None:
-    """runs: (label, errors per iteration)."""
+def convergence_plot(runs: Sequence[tuple[str, Sequence[float]]], path: Path, title: str,
+                     unit: str = "") -> None:
+    """runs: (label, errors per iteration); ``unit``: the errors' unit."""
     _check_suffix(path, SUFFIXES)
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.5))
@@ -266,7 +270,7 @@ def convergence_plot(runs: Sequence[tuple[str, Sequence[float]]], path: Path, ti
         if pts:
             ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=4, label=label)
     ax.set_xlabel("iteration")
-    ax.set_ylabel("log10 error")
+    ax.set_ylabel(f"log10 of the error ({unit})" if unit else "log10 of the error")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title, fontsize=10)
@@ -285,14 +289,19 @@ def work_precision_plot(measurements: Sequence[Any], path: Path) -> None:
             if m.problem == problem:
                 series.setdefault(m.contender, []).append(
                     (math.log10(m.seconds), math.log10(max(m.error, 1e-17))))
-        for label, pts in sorted(series.items()):
+        colours = plt.get_cmap("tab20").colors
+        markers = "osD^v<>pX*"
+        for k, (label, pts) in enumerate(sorted(series.items())):
             pts.sort()
             style = "-" if label.startswith("linkage") else ("--" if label.startswith("scipy") else ":")
-            ax.plot([p[0] for p in pts], [p[1] for p in pts], style, marker="o", ms=3, lw=1.2, label=label)
+            # 20 colours and 10 markers: no two of up to 20 contenders look alike
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], style, marker=markers[k % len(markers)], ms=4,
+                    lw=1.3, color=colours[k % len(colours)], label=label)
         ax.set_xlabel("log10 time per solve (s)")
         ax.set_ylabel("log10 error (errors of 0 drawn at -17)")
         ax.set_title(problem, fontsize=10)
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=6, loc="best")
-    fig.suptitle("work-precision: lower left is better", fontsize=10)
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, frameon=False)
+    fig.suptitle("work-precision: lower left is better (solid: linkage, dashed: scipy, dotted: hand loops)",
+                 fontsize=11)
     _save(fig, path)

@@ -57,6 +57,39 @@ def table(title: str, headers: Sequence[str], rows: Sequence[Sequence[Any]], dig
                  tuple(notes))
 
 
+def pick_columns(blocks: Sequence[Block], csv_table: tuple[Any, Any],
+                 names: str) -> tuple[list[Block], tuple[Any, Any]]:
+    """Keep the first column and the columns whose names begin with one of ``names``
+    (comma-separated, case-insensitive) in every table that has any, and in the CSV; a
+    table says which columns it left out."""
+    from ..errors import InputError
+
+    wanted = [w.strip().lower() for w in names.split(",") if w.strip()]
+
+    def keep(headers: Sequence[str]) -> list[int]:
+        return [0] + [j for j, h in enumerate(headers) if j and any(h.lower().startswith(w) for w in wanted)]
+
+    out: list[Block] = []
+    matched = False
+    for b in blocks:
+        if isinstance(b, Table) and len(keep(b.headers)) > 1:
+            cols = keep(b.headers)
+            matched = True
+            left = [h for j, h in enumerate(b.headers) if j not in cols]
+            notes = (*b.notes, f"(--columns: left out {', '.join(left)})") if left else b.notes
+            b = Table(b.title, tuple(b.headers[j] for j in cols),
+                      tuple(tuple(r[j] for j in cols) for r in b.rows), notes)
+        out.append(b)
+    headers, rows = csv_table
+    if headers and len(keep(headers)) > 1:
+        cols = keep(headers)
+        matched = True
+        csv_table = (tuple(headers[j] for j in cols), [tuple(r[j] for j in cols) for r in rows])
+    if not matched:
+        raise InputError(f"--columns {names!r} matches no column")
+    return out, csv_table
+
+
 def history_blocks(h: Any, digits: int) -> list[Block]:
     """A recorded history as a table, with a visible gap and a note where a long run's
     history left rows out; nothing for an empty one."""

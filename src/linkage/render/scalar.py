@@ -61,7 +61,7 @@ def convergence_blocks(conv: Convergence, unit: str, digits: int, converged: boo
         if c_head:
             row.append(r.constant)
         rows.append(tuple(fmt(v, 6) for v in row) + (("rounding",) if r.rounding else ("",)))
-    headers.append("")
+    headers.append("note")
     t = Table("Convergence", tuple(headers), tuple(rows))
     lines = [t, Text(_summary_line(conv))]
     if not converged:

@@ -13,6 +13,16 @@ def _kinds(s: SweepResult) -> list[str]:
     return ["angle" if u == "deg" else "length" for u in s.units]
 
 
+def det_unit_of(s: SweepResult) -> str:
+    """det J's unit: a length per radian for each angle unknown (a length unknown's column
+    is dimensionless)."""
+    n_angle = sum(u == "deg" for u in s.units)
+    if not n_angle:
+        return "1"
+    top = s.length_unit if n_angle == 1 else f"{s.length_unit}^{n_angle}"
+    return f"{top}/rad" if n_angle == 1 else f"{top}/rad^{n_angle}"
+
+
 def joint_names(s: SweepResult) -> list[str]:
     """Every joint and point named at any solved position, in the order first met."""
     seen: dict[str, None] = {}
@@ -27,7 +37,7 @@ def sweep_headers(s: SweepResult, kinematics: bool = True) -> list[str]:
     u = s.driver_unit
     headers = [f"{s.driver} ({u})", "status"]
     headers += [f"{n} ({unit})" for n, unit in zip(s.names, s.units)]
-    headers += ["branch", "iterations", "det J"]
+    headers += ["branch", "iterations", f"det J ({det_unit_of(s)})"]
     if s.classification:
         headers.append("transmission angle (deg)")
     if kinematics:
@@ -98,8 +108,9 @@ def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400) -> list[Block
     if s.motion is not None:  # the unknowns' rates beside their values (joints: csv, json)
         headers += rate_headers(s.names, _kinds(s), s.length_unit, [], True)
         rows = [(*r, *rate_cells(p.rates, s.names, [], True)) for r, p in zip(rows, s.positions)]
-    shown = rows if len(rows) <= max_rows else rows[:: max(1, len(rows) // max_rows)]
-    note = [] if shown is rows else [f"(every {len(rows) // len(shown)}th of {len(rows)} rows shown; "
+    every = -(-len(rows) // max_rows)  # ceil: the fewest rows skipped that fit max_rows
+    shown = rows if every <= 1 else rows[::every]
+    note = [] if shown is rows else [f"(one row in {every} of {len(rows)} shown; "
                                      "--format csv or json gives all)"]
     blocks.append(Text(""))
     blocks.append(table("", headers, shown, digits, notes=note))
