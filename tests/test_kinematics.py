@@ -94,7 +94,7 @@ def test_coupler_point_path_matches_the_closed_form():
     """Point P of crank_rocker.toml: A + 60 e^(i (theta3 + 30 deg)), theta3 from the circle
     intersection (open branch), over a whole crank turn."""
     m = load_mechanism(SAMPLES / "crank_rocker.toml")
-    r = linkage.sweep(m, [float(k) for k in range(0, 361, 3)])
+    r = linkage.sweep(m, [float(k) for k in range(0, 361, 3)], joints=True)
     for p in r.positions:
         t2 = math.radians(p.input)
         t3 = fourbar_positions(100, 40, 120, 80, 0.0, theta2=t2)["open"]["theta3"]

@@ -653,7 +653,8 @@ def sweep(
                                  f"(named: {', '.join(dict.fromkeys(named)) or 'none'})")
     with _progress(len(values)) as advance:
         result = sweep_mechanism(mechanism, values, method=method, branch=branch, tol=tol, batch=batch,
-                                 progress=advance, speed=w, accel=a_)
+                                 progress=advance, speed=w, accel=a_,
+                                 joints=out_fmt in ("csv", "json") or bool(path))
     emit(out_fmt, output, blocks=sweep_blocks(result, digits), json_obj=sweep_dict(result),
          columns=columns,
          csv_table=(sweep_headers(result), sweep_rows(result)))

@@ -238,6 +238,7 @@ def sweep_mechanism(
     progress: Callable[[int], None] | None = None,
     speed: float | None = None,
     accel: float = 0.0,
+    joints: bool = False,
 ) -> SweepResult:
     """Solve a mechanism over driver values (display units: degrees for an angle), each
     position from the previous one; the public ``linkage.sweep``.
@@ -251,10 +252,11 @@ def sweep_mechanism(
     Each position has ``.input``, ``.status`` ("converged", "no_solution", "off_branch",
     "failed"), ``.solution`` (unknown name -> value, display units), ``.branch``,
     ``.iterations`` and ``.det``; ``result.column(name)`` gives one unknown throughout.
-    Every solved position also has ``.rates``: its joints and named points and, with a
-    driver ``speed`` (rad/s, or length unit/s for a linear driver) and ``accel``, the
-    velocity and acceleration of every unknown, joint and point
-    (:class:`~linkage.kinematics.rates.Rates`; batch sweeps leave it None).
+    With a driver ``speed`` (rad/s, or length unit/s for a linear driver) and ``accel``, or
+    with ``joints=True``, every solved position also has ``.rates``: its joints and named
+    points and, with a speed, the velocity and acceleration of every unknown, joint and
+    point (:class:`~linkage.kinematics.rates.Rates`; batch sweeps leave it None). Without
+    them the sweep does not pay for it.
     """
     from ..errors import InputError
     from ..problems.loops import load
@@ -280,7 +282,7 @@ def sweep_mechanism(
         return replace(batch_sweep(m, values, branch=branch, tol=tol).to_sweep(), method="newton (batch)")
     result = sweep(m, check_driver_values(m, values), method=method, branch=branch, tol=tol,
                    max_iter=max_iter, progress=progress)
-    return with_rates(m, result, speed, accel)
+    return with_rates(m, result, speed, accel) if speed is not None or joints else result
 
 
 def with_rates(m: Mechanism, result: SweepResult, speed: float | None, accel: float) -> SweepResult:
