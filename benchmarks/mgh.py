@@ -14,7 +14,8 @@ from linkage.mgh_table import SOLVED_RESIDUAL, run_table, summary
 
 def main() -> None:
     table = run_table()
-    print(f"solved: success claimed and max|F| <= {SOLVED_RESIDUAL:g}; false success: claimed, but above it\n")
+    print(f"solved: success claimed and max|F| <= {SOLVED_RESIDUAL:g}; "
+          "false success: claimed, but above it\n")
     print("| solver | cases | solved | false successes |")
     print("|---|---|---|---|")
     for name, cases, solved, false in summary(table):

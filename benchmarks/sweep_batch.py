@@ -20,29 +20,16 @@ from pathlib import Path
 import numpy as np
 
 from linkage import load_mechanism
+from linkage.bench import numpy_fourbar
 from linkage.kinematics.batch import batch_sweep
 
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_inputs" / "crank_rocker.toml"
 
 
 def closed_form(theta2_deg: np.ndarray, r1: float, r2: float, r3: float, r4: float) -> np.ndarray:
-    """Open-branch theta3, theta4 (deg) of a four-bar for every theta2, in numpy."""
-    t2 = np.radians(theta2_deg)
-    ax, ay = r2 * np.cos(t2), r2 * np.sin(t2)  # crank tip A; O4 = (r1, 0)
-    dx, dy = ax - r1, ay
-    d = np.hypot(dx, dy)
-    a = (r4 * r4 - r3 * r3 + d * d) / (2.0 * d)  # along O4 -> A
-    h = np.sqrt(r4 * r4 - a * a)
-    ux, uy = dx / d, dy / d
-    bx = r1 + a * ux - h * uy  # the open branch: sin(theta4 - theta3) > 0
-    by = a * uy + h * ux
-    t3 = np.degrees(np.arctan2(by - ay, bx - ax))
-    t4 = np.degrees(np.arctan2(by, bx - r1))
-    open_side = np.sin(np.radians(t4 - t3)) > 0
-    bx2, by2 = r1 + a * ux + h * uy, a * uy - h * ux
-    t3 = np.where(open_side, t3, np.degrees(np.arctan2(by2 - ay, bx2 - ax)))
-    t4 = np.where(open_side, t4, np.degrees(np.arctan2(by2, bx2 - r1)))
-    return np.stack((t3, t4), axis=1)
+    """Open-branch theta3, theta4 (deg) of a four-bar for every theta2, in numpy (the same
+    baseline `linkage bench` uses)."""
+    return numpy_fourbar(theta2_deg, r1, r2, r3, r4)
 
 
 def timed(fn, repeats: int) -> tuple[float, list[float], object]:

@@ -36,10 +36,7 @@ def read_input(path: Path, what: str = "mechanism file") -> str:
             sys.stdin.read(MAX_INPUT_BYTES + 1).encode()
         if len(data) > MAX_INPUT_BYTES:
             raise ParseError(f"standard input has more than {MAX_INPUT_BYTES:,} bytes")
-        try:
-            return data.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            raise ParseError(f"standard input is not UTF-8 text (byte {exc.start})") from None
+        return _text(data, "standard input")
     try:
         st = os.stat(path)
     except FileNotFoundError:
@@ -65,10 +62,14 @@ def read_input(path: Path, what: str = "mechanism file") -> str:
         raise ParseError(f"cannot read {path}: {exc.strerror or exc}") from None
     if len(data) > MAX_INPUT_BYTES:
         raise ParseError(f"{path} is larger than {MAX_INPUT_BYTES:,} bytes")
+    return _text(data, str(path))
+
+
+def _text(data: bytes, where: str) -> str:
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise ParseError(f"{path} is not UTF-8 text (byte {exc.start})") from None
+        raise ParseError(f"{where} is not UTF-8 text (byte {exc.start})") from None
 
 
 def _identity(path: Path) -> tuple[int, int] | None:
