@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import errno
 import json
+import math
 import os
 import resource
 import shutil
@@ -426,3 +427,20 @@ def test_lm_at_a_local_minimum_says_so():
             seen.add(r.status)
             assert r.status is not Status.NO_SOLUTION, label
     assert Status.LOCAL_MINIMUM in seen
+
+
+def test_noise_around_an_ill_conditioned_root_is_not_a_jump():
+    """x^3 - 3x^2 + 3x - 1 (an expanded (x - 1)^3): near x = 1 its values are rounding
+    noise, so |f| does not shrink under bisection. That was reported as a jump or a pole
+    (`discontinuity`); f's own noise next to the sign change now identifies a root."""
+    f = lambda x: x * x * x - 3.0 * x * x + 3.0 * x - 1.0  # noqa: E731
+    fp = lambda x: 3.0 * x * x - 6.0 * x + 3.0  # noqa: E731
+    for tol in (1e-4, 1e-5):
+        r = solve_scalar(f, method="newton", fprime=fp, x0=1.5, tol=tol, record=False)
+        assert r.converged, r.message
+        assert abs(r.x - 1.0) <= tol + 2e-5  # within the tolerance and f's band of noise (eps^(1/3))
+    # jumps and poles are still named as such
+    jump = lambda x: (-1.0 if x < 1 else 1.0) + 0.1 * x  # noqa: E731
+    pole = lambda x: 1.0 / (1.0 - x) if x != 1 else math.inf  # noqa: E731
+    for g, br in ((jump, (0.5, 1.7)), (pole, (0.3, 1.9))):
+        assert solve_scalar(g, method="bisection", bracket=br, tol=1e-12).status is Status.DISCONTINUITY

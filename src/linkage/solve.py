@@ -227,6 +227,8 @@ def check_sign_change(problem: ScalarProblem, x: float, fx: float | None, lo: fl
     if not math.isfinite(start_size) or abs(fx) <= 1e-3 * start_size:
         return Status.CONVERGED_STEP, detail, 0
     lo, hi = sorted((lo, hi))
+    if 0.0 in f_ends:
+        return Status.CONVERGED_STEP, detail, 0  # f is exactly zero at an end: a root there
     if hi - lo <= 64.0 * math.ulp(max(abs(lo), abs(hi))):
         # a sign change within a few ulps: double precision cannot tell a root from a
         # jump there, and |f| is rounding noise that no bisection can shrink
@@ -234,6 +236,7 @@ def check_sign_change(problem: ScalarProblem, x: float, fx: float | None, lo: fl
     flo = problem.f(lo)
     evals = 1
     smallest = abs(fx)
+    x_small, f_small = x, fx
     best_at_start = abs(fx) if shrink_from is None else shrink_from
     for _ in range(8):
         mid = 0.5 * lo + 0.5 * hi
@@ -243,15 +246,48 @@ def check_sign_change(problem: ScalarProblem, x: float, fx: float | None, lo: fl
         evals += 1
         if fm == 0.0:
             return Status.CONVERGED_STEP, detail, evals
-        smallest = min(smallest, abs(fm))
+        if abs(fm) < smallest:
+            smallest, x_small, f_small = abs(fm), mid, fm
         if (fm < 0.0) == (flo < 0.0):
             lo, flo = mid, fm
         else:
             hi = mid
     if smallest <= best_at_start / 16.0:
         return Status.CONVERGED_STEP, detail, evals
+    # |f| that does not shrink may be rounding noise around a root (an ill-conditioned
+    # root such as an expanded (x - 1)^3), not a jump: f's own noise next to x tells
+    if abs(flo) < smallest:
+        x_small, f_small = lo, flo
+    noise, n = at_noise_level(problem, x_small, f_small, abs(hi - lo) + 1.0)
+    evals += n
+    if noise:
+        return Status.CONVERGED_STEP, detail, evals
     return (Status.DISCONTINUITY,
             f"|f| is {abs(fx):.3g} at x = {x!r} and does not shrink with the bracket", evals)
+
+
+def at_noise_level(problem: ScalarProblem, x: float, fx: float, width: float) -> tuple[bool, int]:
+    """Whether f(x) is indistinguishable from zero by f's own evaluation noise: f at the
+    floats next to x (up to 4 each side, within ``width``) changes sign, or |f(x)| is
+    within the spread of those values. (A jump or a pole has values that are steady, or
+    smooth, next to x; a root's are rounding noise.) Returns (verdict, evaluations)."""
+    near = []
+    evals = 0
+    for direction in (math.inf, -math.inf):
+        t = x
+        for _ in range(4):
+            t = math.nextafter(t, direction)
+            if abs(t - x) > width:
+                break
+            v = _value(problem.f, t)
+            evals += 1
+            if v is not None:
+                near.append(v)
+    if not near:
+        return False, evals
+    if any(v == 0.0 or (v < 0.0) != (fx < 0.0) for v in near):
+        return True, evals
+    return abs(fx) <= max(*near, fx) - min(*near, fx), evals
 
 
 def _final_bracket(state: Any) -> tuple[float, float]:
@@ -308,6 +344,12 @@ def certify_root(problem: ScalarProblem, x: float, fx: float | None, width: floa
                                                           max(abs(fx), abs(fb)))
                 return status, detail, evals + extra
         del fa
+    if problem.fbound is None:
+        # no rounding bound for a plain callable: read f's own noise next to x
+        noise, n = at_noise_level(problem, x, fx, width)
+        evals += n
+        if noise:
+            return Status.CONVERGED_STEP, "", evals
     shown = ", ".join(f"f({v:.17g}) = {fv:.3g}" if fv is not None else f"f({v:.17g}) is undefined"
                       for v, fv in ((lo, flo), (hi, fhi)))
     return (Status.STALLED,
