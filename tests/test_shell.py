@@ -25,9 +25,12 @@ def test_dash_h_is_help(cli):
         assert run.code == 0 and "Usage:" in run.out
 
 
-def test_completion_is_offered(cli):
-    run = cli("--help")
-    assert "--install-completion" in run.out and "--show-completion" in run.out
+def test_completion_is_offered_and_works():
+    help_text = subprocess.run([*LINKAGE, "--help"], capture_output=True, text=True, timeout=60).stdout
+    assert "--install-completion" in help_text and "--show-completion" in help_text
+    p = subprocess.run([*LINKAGE, "--show-completion", "bash"], capture_output=True, text=True, timeout=60,
+                       env={"PATH": "/usr/bin:/bin", "HOME": "/tmp"})
+    assert p.returncode == 0 and "complete" in p.stdout and "_linkage_completion" in p.stdout
 
 
 def test_bare_linkage_shows_help_without_an_error_line():
