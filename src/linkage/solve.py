@@ -372,8 +372,13 @@ def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: b
                 verdict, why, n = certify_root(problem, s.x, fx, width)
                 extra_evals[0] += n + (s.fx is None)
                 return verdict, why
-        outcome_state, status, detail, iterations, rows = run(m, problem, state, crit, record=record,
-                                                              certify=certify)
+        if not record and hasattr(m, "run_lean"):
+            # the method's own tight loop: the generic loop's outcome, without a state per step
+            outcome_state, status, detail, iterations = m.run_lean(problem, state, crit, certify)
+            rows = None
+        else:
+            outcome_state, status, detail, iterations, rows = run(m, problem, state, crit, record=record,
+                                                                  certify=certify)
     nfev = m.init_evals + iterations * m.step_evals + (0 if state.stop is not None else extra_evals[0])
     x = outcome_state.x
     residual = outcome_state.fx
@@ -395,20 +400,12 @@ def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: b
         labels = column_labels(m, problem.var, problem.unit, problem.u is not None,
                                problem.gprime is not None)
         history = History.of(labels, rows, len(labels) - 1)
-    err = outcome_state.err
-    return Result(
-        method=m.name,
-        x=x,
-        status=status,
-        iterations=iterations,
-        nfev=nfev,
-        error=err,
-        residual=residual,
-        detail=detail,
-        history=history,
-        meta={"var": problem.var, "unit": problem.unit, "title": problem.title,
-              "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, **start},
-    )
+    result = Result.fast(m.name, x, status, iterations, nfev, outcome_state.err, residual, detail,
+                         {"var": problem.var, "unit": problem.unit, "title": problem.title,
+                          "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, **start})
+    if history is not None:
+        result.__dict__["history"] = history
+    return result
 
 
 # --- systems ------------------------------------------------------------------------------

@@ -11,9 +11,11 @@ Rows follow seed 002: the interval being bisected, its midpoint c, e = (b - a) /
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
+from ..iterate import ROUNDING, explain
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
 from ._common import new_state, same_sign
@@ -97,3 +99,56 @@ class Bisection:
 
     def row(self, problem: ScalarProblem, s: BisectionState, i: int) -> tuple[Any, ...]:
         return (i, s.row_a, s.row_fa, s.row_b, s.row_fb, s.x, s.err)
+
+    def run_lean(self, problem: ScalarProblem, s: BisectionState, crit: Any,
+                 certify: Any = None) -> tuple[BisectionState, Status, str, int]:
+        """Bisection with recording off, as one tight loop with the generic loop's stopping
+        rules for a bracketing method (:mod:`linkage.iterate`): the same outcome, without
+        a state per step (tests/test_compile.py checks it on the stress battery)."""
+        f = problem.f
+        a, fa, b, fb = s.a, s.fa, s.b, s.fb
+        x, fx, err = s.x, s.fx, s.err
+        tol, rtol, ftol = crit.tol, crit.rtol, crit.ftol
+        prev_err = math.inf
+        stalls = rounding_steps = k = 0
+        status, detail = Status.MAX_ITER, ""
+        for k in range(1, crit.max_iter + 1):
+            c = 0.5 * a + 0.5 * b
+            try:
+                fc = f(c)
+            except (ArithmeticError, ValueError) as exc:
+                status, detail = explain(exc)
+                k -= 1
+                break
+            x, fx, err = c, fc, 0.5 * (b - a)
+            if same_sign(fc, fa):
+                a, fa = c, fc
+            else:
+                b, fb = c, fc
+            try:
+                finite = math.isfinite(err) and math.isfinite(fx)
+            except TypeError:
+                status, detail = Status.DOMAIN_ERROR, f"f returned a non-real value: {fx!r}"
+                break
+            if not finite:
+                status, detail = Status.NON_FINITE, f"error = {err!r}, residual = {fx!r}"
+                break
+            if fx == 0.0:
+                status = Status.CONVERGED_EXACT
+                break
+            if ftol is not None and abs(fx) <= ftol:
+                status = Status.CONVERGED_RESIDUAL
+                break
+            limit = tol + rtol * abs(x) if rtol else tol
+            if err <= limit:
+                status = Status.CONVERGED_STEP
+                break
+            if err <= ROUNDING * abs(x):
+                rounding_steps += 1
+                stalls += err >= prev_err
+                if stalls >= 2 or rounding_steps >= 6:
+                    status = Status.PRECISION_LIMIT
+                    detail = f"error {err:.3g} is rounding noise; tolerance {limit:.3g} is out of reach"
+                    break
+            prev_err = err
+        return (BisectionState(x, fx, err, None, a, fa, b, fb, a, fa, b, fb), status, detail, k)

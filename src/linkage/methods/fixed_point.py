@@ -13,9 +13,11 @@ g'(x_i), error = x_i - x_{i+1} (signed).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
+from ..iterate import DIVERGE_STREAK, ROUNDING, UNCERTIFIED_LIMIT, explain
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
 from ._common import display, new_state
@@ -64,6 +66,73 @@ class FixedPoint:
         x1 = problem.g(x)  # type: ignore[misc]
         fx1 = problem.f(x1) if self.evaluate_f else None
         return new_state(FixedPointState, (x1, fx1, abs(x - x1), None, x))
+
+    def run_lean(self, problem: ScalarProblem, s: FixedPointState, crit: Any,
+                 certify: Any) -> tuple[FixedPointState, Status, str, int]:
+        """Fixed-point iteration with recording off, as one tight loop with the generic
+        loop's stopping rules for an open method and the certification: the same outcome
+        (tests/test_compile.py)."""
+        f, g = problem.f, problem.g
+        evaluate_f = self.evaluate_f
+        x, fx, err, xp = s.x, s.fx, s.err, s.xp
+        tol, rtol, ftol = crit.tol, crit.rtol, crit.ftol
+        best = start = abs(fx) if isinstance(fx, float) and fx == fx else math.inf
+        prev_err = math.inf
+        growth = uncertified = stalls = rounding_steps = k = 0
+        status, detail = Status.MAX_ITER, ""
+        for k in range(1, crit.max_iter + 1):
+            try:
+                x1 = g(x)  # type: ignore[misc]
+                fx1 = f(x1) if evaluate_f else None
+            except (ArithmeticError, ValueError) as exc:
+                status, detail = explain(exc)
+                k -= 1
+                break
+            xp, x, fx, err = x, x1, fx1, abs(x - x1)
+            try:
+                finite = math.isfinite(err) and (fx is None or math.isfinite(fx))
+            except TypeError:
+                status, detail = Status.DOMAIN_ERROR, f"f returned a non-real value: {fx!r}"
+                break
+            if not finite:
+                status, detail = Status.NON_FINITE, f"error = {err!r}, residual = {fx!r}"
+                break
+            if fx is not None:
+                if fx == 0.0:
+                    status = Status.CONVERGED_EXACT
+                    break
+                if ftol is not None and abs(fx) <= ftol:
+                    status = Status.CONVERGED_RESIDUAL
+                    break
+            limit = tol + rtol * abs(x) if rtol else tol
+            if fx is not None:
+                size = abs(fx)
+                if err <= limit and size > best and size > 1e-8 * start:
+                    limit = -1.0
+                elif size < best:
+                    best = size
+            if err <= limit:
+                verdict, why = certify(FixedPointState(x, fx, err, None, xp), limit)
+                if verdict is Status.CONVERGED_STEP:
+                    status = verdict
+                    break
+                uncertified += 1
+                if verdict is not Status.STALLED or uncertified >= UNCERTIFIED_LIMIT:
+                    status, detail = verdict, why
+                    break
+            growth = growth + 1 if err > prev_err else 0
+            if growth >= DIVERGE_STREAK:
+                status, detail = Status.DIVERGED, f"{growth} growing steps, last {err:.3g}"
+                break
+            if err <= ROUNDING * abs(x):
+                rounding_steps += 1
+                stalls += err >= prev_err
+                if stalls >= 2 or rounding_steps >= 6:
+                    status = Status.PRECISION_LIMIT
+                    detail = f"error {err:.3g} is rounding noise; tolerance {limit:.3g} is out of reach"
+                    break
+            prev_err = err
+        return FixedPointState(x, fx, err, None, xp), status, detail, k
 
     def initial_row(self, problem: ScalarProblem, s: FixedPointState) -> None:
         return None

@@ -10,9 +10,11 @@ x_{i+1}, |x_{i+1} - x_i|.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
+from ..iterate import DIVERGE_STREAK, ROUNDING, UNCERTIFIED_LIMIT, explain
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
 from ._common import new_state
@@ -90,6 +92,89 @@ class Secant:
         give a chord unrelated to f' at the root, and a meaningless tiny step)."""
         ratio = s.slope / s.slope_before if s.slope_before else _NAN
         return 0.5 <= ratio <= 2.0
+
+    def run_lean(self, problem: ScalarProblem, s: SecantState, crit: Any,
+                 certify: Any) -> tuple[SecantState, Status, str, int]:
+        """The secant method with recording off, as one tight loop with the generic loop's
+        stopping rules for an open method (:mod:`linkage.iterate`), its plausibility test
+        and the certification included: the same outcome (tests/test_compile.py)."""
+        f = problem.f
+        v = problem.var
+        x, fx, xp, fxp = s.x, s.fx, s.xp, s.fxp
+        slope, slope_before, err = s.slope, s.slope_before, s.err
+        tol, rtol, ftol = crit.tol, crit.rtol, crit.ftol
+        seen = [abs(t) for t in (fx, fxp) if isinstance(t, float) and t == t]
+        best = min(seen) if seen else math.inf
+        start = max(seen) if seen else math.inf
+        prev_err = math.inf
+        growth = uncertified = stalls = rounding_steps = k = 0
+        status, detail = Status.MAX_ITER, ""
+        for k in range(1, crit.max_iter + 1):
+            if x == xp:
+                detail = (f"the last two points are equal in double precision ({v} = {x!r}): "
+                          "no chord to follow")
+                return (SecantState(x, fx, _NAN, None, x, fx, _NAN, slope), Status.PRECISION_LIMIT,
+                        detail, k)
+            try:
+                new_slope = (fx - fxp) / (x - xp)
+                if new_slope == 0.0:
+                    return (SecantState(x, fx, _NAN, None, x, fx, new_slope, slope), Status.ZERO_DERIVATIVE,
+                            f"the secant slope is zero at {v} = {x!r}", k)
+                x1 = x - fx / new_slope
+                fx1 = f(x1)
+            except (ArithmeticError, ValueError) as exc:
+                status, detail = explain(exc)
+                k -= 1
+                break
+            err = abs(x1 - x)
+            xp, fxp, x, fx = x, fx, x1, fx1
+            slope_before, slope = slope, new_slope
+            try:
+                finite = math.isfinite(err) and math.isfinite(fx)
+            except TypeError:
+                status, detail = Status.DOMAIN_ERROR, f"f returned a non-real value: {fx!r}"
+                break
+            if not finite:
+                status, detail = Status.NON_FINITE, f"error = {err!r}, residual = {fx!r}"
+                break
+            if fx == 0.0:
+                status = Status.CONVERGED_EXACT
+                break
+            size = abs(fx)
+            if ftol is not None and size <= ftol:
+                status = Status.CONVERGED_RESIDUAL
+                break
+            limit = tol + rtol * abs(x) if rtol else tol
+            if err <= limit:
+                ratio = slope / slope_before if slope_before else _NAN
+                if not 0.5 <= ratio <= 2.0:
+                    limit = -1.0
+            if err <= limit and size > best and size > 1e-8 * start:
+                limit = -1.0
+            elif size < best:
+                best = size
+            if err <= limit:
+                verdict, why = certify(SecantState(x, fx, err, None, xp, fxp, slope, slope_before), limit)
+                if verdict is Status.CONVERGED_STEP:
+                    status = verdict
+                    break
+                uncertified += 1
+                if verdict is not Status.STALLED or uncertified >= UNCERTIFIED_LIMIT:
+                    status, detail = verdict, why
+                    break
+            growth = growth + 1 if err > prev_err else 0
+            if growth >= DIVERGE_STREAK:
+                status, detail = Status.DIVERGED, f"{growth} growing steps, last {err:.3g}"
+                break
+            if err <= ROUNDING * abs(x):
+                rounding_steps += 1
+                stalls += err >= prev_err
+                if stalls >= 2 or rounding_steps >= 6:
+                    status = Status.PRECISION_LIMIT
+                    detail = f"error {err:.3g} is rounding noise; tolerance {limit:.3g} is out of reach"
+                    break
+            prev_err = err
+        return SecantState(x, fx, err, None, xp, fxp, slope, slope_before), status, detail, k
 
     def initial_row(self, problem: ScalarProblem, s: SecantState) -> tuple[Any, ...]:
         return (0, s.xp, s.fxp, None, None, None)
