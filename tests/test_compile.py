@@ -164,6 +164,20 @@ def _same(a, b, label):
     assert all(u == v or (u != u and v != v) for u, v in zip(xa, xb)), (label, a.x, b.x)
 
 
+def _generic_newton(f, fprime, x0, tol, rtol, max_iter):
+    """Newton through the generic loop (`run`), bypassing the lean one."""
+    from linkage.methods import Newton
+    from linkage.solve import _problem, check_criteria, finish
+
+    problem = _problem(f, fprime, None)
+    m = Newton()
+    try:
+        state = m.init(problem, x0)
+    except (ArithmeticError, ValueError, TypeError):
+        return None
+    return finish(m, problem, state, check_criteria(tol, rtol, None, max_iter), True, {"x0": x0})
+
+
 @pytest.mark.parametrize("method", ["newton", "secant", "bisection", "fixed-point"])
 def test_lean_scalar_loops_equal_the_generic_loop_on_the_stress_battery(method):
     """With history off each of these methods runs its own tight loop; with history on,
@@ -194,6 +208,12 @@ def test_lean_scalar_loops_equal_the_generic_loop_on_the_stress_battery(method):
                 solve_scalar(case.f, record=True, **kw)
             continue
         full = solve_scalar(case.f, record=True, **kw)
+        if method == "newton":  # Newton records in its lean loop too: compare with the generic one
+            generic = _generic_newton(case.f, case.fprime, start["x0"], case.tol, case.rtol, 500)
+            if generic is not None:
+                _same(full, generic, case.name)
+                assert repr(full.history.rows) == repr(generic.history.rows), case.name
+                full = generic
         _same(lean, full, case.name)
         assert lean.nfev == full.nfev, (case.name, lean.nfev, full.nfev)
         compared += 1

@@ -10,7 +10,7 @@ from dataclasses import replace
 from typing import Any
 
 from .errors import InputError
-from .iterate import MAX_ITER_LIMIT, Criteria, explain, run
+from .iterate import MAX_ITER_LIMIT, Criteria, Rows, explain, run
 from .methods import SCALAR_METHODS, Bisection, FixedPoint, Hybrid, Newton, RegulaFalsi, Secant
 from .methods.least_squares import LevenbergMarquardt
 from .methods.newton import newton_lean
@@ -141,8 +141,7 @@ def solve_scalar(
         elif method == "newton":
             if problem.fprime is None:
                 raise InputError("newton needs the derivative fprime")
-            if not record:
-                return _newton_lean(problem, x0, crit)
+            return _newton_lean(problem, x0, crit, record)
             m = Newton()
             args = (x0,)
             start = {"x0": x0}
@@ -173,9 +172,10 @@ def solve_scalar(
     return finish(m, problem, state, crit, record, start)
 
 
-def _newton_lean(problem: ScalarProblem, x0: float, crit: Criteria) -> Result:
-    """Newton without a history: the tight loop of :func:`~linkage.methods.newton.newton_lean`,
-    packaged exactly as :func:`finish` packages the generic loop's outcome."""
+def _newton_lean(problem: ScalarProblem, x0: float, crit: Criteria, record: bool = False) -> Result:
+    """Newton by the tight loop of :func:`~linkage.methods.newton.newton_lean`, packaged
+    exactly as :func:`finish` packages the generic loop's outcome (history included when
+    ``record``)."""
     extra = [0]
 
     def certify(x: float, fx: float, width: float) -> tuple[Status, str]:
@@ -183,23 +183,31 @@ def _newton_lean(problem: ScalarProblem, x0: float, crit: Criteria) -> Result:
         extra[0] += n
         return verdict, why
 
+    rows = Rows() if record else None
     try:
         x, fx, err, status, detail, k = newton_lean(problem, x0, crit.tol, crit.rtol, crit.ftol,
-                                                    crit.max_iter, certify)
+                                                    crit.max_iter, certify, rows)
     except TypeError:  # the generic path's answer to a non-real f at the start
         return Result(method="newton", x=x0, status=Status.DOMAIN_ERROR, iterations=0, nfev=0,
                       error=math.inf, residual=None, detail="at the start: f returned a non-real value",
+                      history=History((), (), 0) if record else None,
                       meta={"var": problem.var, "unit": problem.unit, "title": problem.title,
                             "tol": crit.tol, "rtol": crit.rtol, "x0": x0})
     except (ArithmeticError, ValueError) as exc:
         status, detail = explain(exc)
         return Result(method="newton", x=x0, status=status, iterations=0, nfev=0, error=math.inf,
                       residual=None, detail=f"at the start: {detail}",
+                      history=History((), (), 0) if record else None,
                       meta={"var": problem.var, "unit": problem.unit, "title": problem.title,
                             "tol": crit.tol, "rtol": crit.rtol, "x0": x0})
-    return Result.fast("newton", x, status, k, 1 + 2 * k + extra[0], err, fx, detail,
-                       {"var": problem.var, "unit": problem.unit, "title": problem.title,
-                        "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, "x0": x0})
+    result = Result.fast("newton", x, status, k, 1 + 2 * k + extra[0], err, fx, detail,
+                         {"var": problem.var, "unit": problem.unit, "title": problem.title,
+                          "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, "x0": x0})
+    if rows is not None:
+        labels = column_labels(Newton(), problem.var, problem.unit, problem.u is not None,
+                               problem.gprime is not None)
+        result.__dict__["history"] = History.of(labels, rows, len(labels) - 1)
+    return result
 
 
 @functools.lru_cache(maxsize=128)

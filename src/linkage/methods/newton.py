@@ -82,15 +82,18 @@ class Newton:
 
 
 def newton_lean(problem: ScalarProblem, x0: float, tol: float, rtol: float, ftol: float | None,
-                max_iter: int, certify: Any) -> tuple[float, float, float, Status, str, int]:
-    """Newton with recording off, as one tight loop: the generic loop's stopping rules for
-    this method (:mod:`linkage.iterate`, tests 1-8, in order) written out without states,
-    method dispatch or rows. Gives the generic loop's status, root and iteration count
-    (tests/test_compile.py checks that on the stress battery).
+                max_iter: int, certify: Any,
+                rows: Any = None) -> tuple[float, float, float, Status, str, int]:
+    """Newton as one tight loop: the generic loop's stopping rules for this method
+    (:mod:`linkage.iterate`, tests 1-8, in order) written out without states or method
+    dispatch. Gives the generic loop's status, root, iteration count and, when ``rows``
+    (an :class:`~linkage.iterate.Rows`) is given, its table row for row
+    (tests/test_compile.py checks both on the stress battery; the seed tables use it).
 
     Returns (x, f(x), last error, status, detail, iterations); ``certify(x, fx, width)``
     decides a small step as in the generic loop.
     """
+    add = rows.add if rows is not None else None
     f, fp = problem.f, problem.fprime
     isfinite = math.isfinite
     x = x0
@@ -108,6 +111,8 @@ def newton_lean(problem: ScalarProblem, x0: float, tol: float, rtol: float, ftol
         try:
             d = fp(x)  # type: ignore[misc]
             if d == 0.0:
+                if add is not None:
+                    add((k, x, fx, d, None, None))
                 return (x, fx, math.nan, Status.ZERO_DERIVATIVE,
                         f"f'({problem.var}) = 0 at {problem.var} = {x!r}, f = {fx:.6g}", k)
             x1 = x - fx / d
@@ -118,6 +123,8 @@ def newton_lean(problem: ScalarProblem, x0: float, tol: float, rtol: float, ftol
         err = x1 - x
         if err < 0.0:
             err = -err
+        if add is not None:
+            add((k, x, fx, d, x1, err))
         x, fx = x1, fx1
         # inline finiteness: v - v is 0.0 for a finite float, NaN for inf and NaN
         if type(fx) is not float or type(err) is not float:
