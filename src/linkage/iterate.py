@@ -102,6 +102,30 @@ class Criteria:
 Outcome = tuple  # (final state, Status, detail, iterations, Rows or None)
 
 
+def judge_certificate(verdict: Status, why: str, uncertified: int) -> tuple[Status | None, str, int]:
+    """Test 5's certification, shared by the generic and the lean loops: after a step
+    within the tolerance, (the status to stop with, or None to go on; its detail; the
+    updated count of small steps without evidence)."""
+    if verdict is Status.CONVERGED_STEP:
+        return verdict, "", uncertified
+    uncertified += 1
+    if verdict is not Status.STALLED or uncertified >= UNCERTIFIED_LIMIT:
+        return verdict, why, uncertified
+    return None, "", uncertified
+
+
+def rounding_stall(err: float, prev_err: float, limit: float, rounding_steps: int,
+                   stalls: int) -> tuple[str | None, int, int]:
+    """Test 7, shared by the generic and the lean loops, for a step at rounding level:
+    (the PRECISION_LIMIT detail when the error stopped shrinking, else None; the counts)."""
+    rounding_steps += 1
+    stalls += err >= prev_err
+    if stalls >= 2 or rounding_steps >= 6:
+        return (f"error {err:.3g} is rounding noise; tolerance {limit:.3g} is out of reach",
+                rounding_steps, stalls)
+    return None, rounding_steps, stalls
+
+
 def explain(exc: BaseException) -> tuple[Status, str]:
     if isinstance(exc, OverflowError):
         return Status.NON_FINITE, f"overflow: {exc}"
@@ -207,13 +231,9 @@ def run(
                               f"above the tolerance {gate:.3g}")
                     break
             elif certify is not None:
-                verdict, why = certify(state, limit)
-                if verdict is Status.CONVERGED_STEP:
-                    status = verdict
-                    break
-                uncertified += 1
-                if verdict is not Status.STALLED or uncertified >= UNCERTIFIED_LIMIT:
-                    status, detail = verdict, why
+                stop, why, uncertified = judge_certificate(*certify(state, limit), uncertified)
+                if stop is not None:
+                    status, detail = stop, why
                     break
             else:
                 # The detail is formatted later from the result's fields: formatting here
@@ -229,11 +249,9 @@ def run(
                 break
         if err <= ROUNDING * magnitude(x):
             # Rounding noise: the error can no longer shrink in double precision.
-            rounding_steps += 1
-            stalls += err >= prev_err
-            if stalls >= 2 or rounding_steps >= 6:
-                status = Status.PRECISION_LIMIT
-                detail = f"error {err:.3g} is rounding noise; tolerance {limit:.3g} is out of reach"
+            why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
+            if why is not None:
+                status, detail = Status.PRECISION_LIMIT, why
                 break
         prev_err = err
     return state, status, detail, k, rows

@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import ROUNDING, explain
+from ..iterate import ROUNDING, explain, rounding_stall
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
 from ._common import new_state, same_sign
@@ -144,11 +144,9 @@ class Bisection:
                 status = Status.CONVERGED_STEP
                 break
             if err <= ROUNDING * abs(x):
-                rounding_steps += 1
-                stalls += err >= prev_err
-                if stalls >= 2 or rounding_steps >= 6:
-                    status = Status.PRECISION_LIMIT
-                    detail = f"error {err:.3g} is rounding noise; tolerance {limit:.3g} is out of reach"
+                why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
+                if why is not None:
+                    status, detail = Status.PRECISION_LIMIT, why
                     break
             prev_err = err
         return (BisectionState(x, fx, err, None, a, fa, b, fb, a, fa, b, fb), status, detail, k)

@@ -17,7 +17,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import DIVERGE_STREAK, ROUNDING, UNCERTIFIED_LIMIT, explain
+from ..iterate import DIVERGE_STREAK, ROUNDING, explain, judge_certificate, rounding_stall
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
 from ._common import display, new_state
@@ -113,23 +113,18 @@ class FixedPoint:
                     best = size
             if err <= limit:
                 verdict, why = certify(FixedPointState(x, fx, err, None, xp), limit)
-                if verdict is Status.CONVERGED_STEP:
-                    status = verdict
-                    break
-                uncertified += 1
-                if verdict is not Status.STALLED or uncertified >= UNCERTIFIED_LIMIT:
-                    status, detail = verdict, why
+                stop, why, uncertified = judge_certificate(verdict, why, uncertified)
+                if stop is not None:
+                    status, detail = stop, why
                     break
             growth = growth + 1 if err > prev_err else 0
             if growth >= DIVERGE_STREAK:
                 status, detail = Status.DIVERGED, f"{growth} growing steps, last {err:.3g}"
                 break
             if err <= ROUNDING * abs(x):
-                rounding_steps += 1
-                stalls += err >= prev_err
-                if stalls >= 2 or rounding_steps >= 6:
-                    status = Status.PRECISION_LIMIT
-                    detail = f"error {err:.3g} is rounding noise; tolerance {limit:.3g} is out of reach"
+                why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
+                if why is not None:
+                    status, detail = Status.PRECISION_LIMIT, why
                     break
             prev_err = err
         return FixedPointState(x, fx, err, None, xp), status, detail, k

@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import DIVERGE_STREAK, ROUNDING, UNCERTIFIED_LIMIT, explain
+from ..iterate import DIVERGE_STREAK, ROUNDING, explain, judge_certificate, rounding_stall
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
 from ._common import new_state
@@ -149,22 +149,17 @@ def newton_lean(problem: ScalarProblem, x0: float, tol: float, rtol: float, ftol
             else:
                 if size < best:
                     best = size
-                verdict, why = certify(x, fx, limit)
-                if verdict is Status.CONVERGED_STEP:
-                    return x, fx, err, verdict, "", k
-                uncertified += 1
-                if verdict is not Status.STALLED or uncertified >= UNCERTIFIED_LIMIT:
-                    return x, fx, err, verdict, why, k
+                stop, why, uncertified = judge_certificate(*certify(x, fx, limit), uncertified)
+                if stop is not None:
+                    return x, fx, err, stop, why, k
         elif size < best:
             best = size
         growth = growth + 1 if err > prev_err else 0
         if growth >= DIVERGE_STREAK:
             return x, fx, err, Status.DIVERGED, f"{growth} growing steps, last {err:.3g}", k
         if err <= ROUNDING * ax:
-            rounding_steps += 1
-            stalls += err >= prev_err
-            if stalls >= 2 or rounding_steps >= 6:
-                return (x, fx, err, Status.PRECISION_LIMIT,
-                        f"error {err:.3g} is rounding noise; tolerance {limit:.3g} is out of reach", k)
+            why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
+            if why is not None:
+                return x, fx, err, Status.PRECISION_LIMIT, why, k
         prev_err = err
     return x, fx, err, Status.MAX_ITER, "", k

@@ -332,7 +332,7 @@ def newton_system_lean(problem: SystemProblem, q0: tuple[float, ...], phi0: list
 
     Returns (x, Phi(x), last error, status, detail, iterations, nfev, njev).
     """
-    from ..iterate import DIVERGE_STREAK, ROUNDING, RUNAWAY, explain
+    from ..iterate import DIVERGE_STREAK, ROUNDING, RUNAWAY, explain, rounding_stall
 
     F, Jf = problem.F, problem.J
     scales = problem.step_scales
@@ -408,11 +408,8 @@ def newton_system_lean(problem: SystemProblem, q0: tuple[float, ...], phi0: list
             if growth >= DIVERGE_STREAK and size_q > runaway:
                 return q, phi, err, Status.DIVERGED, f"{growth} growing steps, last {err:.3g}", k, nfev, njev
         if err <= ROUNDING * size_q:
-            rounding_steps += 1
-            stalls += err >= prev_err
-            if stalls >= 2 or rounding_steps >= 6:
-                return (q, phi, err, Status.PRECISION_LIMIT,
-                        f"error {err:.3g} is rounding noise; tolerance {limit:.3g} is out of reach", k, nfev,
-                        njev)
+            why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
+            if why is not None:
+                return q, phi, err, Status.PRECISION_LIMIT, why, k, nfev, njev
         prev_err = err
     return q, phi, err, Status.MAX_ITER, "", k, nfev, njev
