@@ -23,6 +23,9 @@ COMMANDS = [
     ["solve", str(SAMPLES / "fourbar_me581.toml")],
     ["solve", "--method", "all"],
     ["sweep", str(SAMPLES / "fourbar_me581.toml"), "--step", "30"],
+    ["sweep", "--from", "10", "--to", "160", "--step", "30"],
+    ["solve", str(SAMPLES / "slider_crank.toml"), "--speed", "600rpm"],
+    ["sweep", str(SAMPLES / "crank_rocker.toml"), "--step", "90", "--speed", "10", "--accel", "5"],
 ]
 
 

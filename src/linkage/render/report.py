@@ -146,22 +146,26 @@ def render_text(blocks: Sequence[Block], tablefmt: str) -> str:
     return "\n".join(out).rstrip("\n") + "\n"
 
 
+def column_widths(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> list[int]:
+    """Each column's width: its widest cell (a number or a status is never broken) or its
+    header's longest word (headers wrap between words), whichever is wider."""
+    return [max(max((len(r[j]) for r in rows), default=0), max((len(w) for w in h.split()), default=1))
+            for j, h in enumerate(headers)]
+
+
 def column_groups(headers: Sequence[str], rows: Sequence[Sequence[str]], width: int) -> list[list[int]]:
-    """Split columns into groups that fit ``width`` with every cell whole: a column needs
-    its widest cell (a number or a status is never broken) and its header's longest
-    word (headers may wrap between words). Groups after the first repeat column 0 (the
-    iteration or the driver value), so each stacked table reads on its own."""
-    need = []
-    for j, h in enumerate(headers):
-        cells = max((len(r[j]) for r in rows), default=0)
-        need.append(max(cells, max((len(w) for w in h.split()), default=0)) + 2)  # padding
+    """Split columns into groups that fit ``width`` with every cell whole (see
+    :func:`column_widths`; a column also takes 3 characters of padding and separator,
+    the table 1 more). Groups after the first repeat column 0 (the iteration or the
+    driver value), so each stacked table reads on its own."""
+    need = [w + 3 for w in column_widths(headers, rows)]
     groups: list[list[int]] = []
     current: list[int] = [0]
-    used = 4 + need[0]  # the table's edges
+    used = 1 + need[0]
     for j in range(1, len(headers)):
         if used + need[j] > width and len(current) > 1:
             groups.append(current)
-            current, used = [0], 4 + need[0]
+            current, used = [0], 1 + need[0]
         current.append(j)
         used += need[j]
     groups.append(current)
@@ -192,9 +196,10 @@ def print_rich(blocks: Sequence[Block], file: Any = None) -> None:
             if len(groups) > 1:
                 title = f"{b.title + ' ' if b.title else ''}(columns part {k + 1} of {len(groups)})"
             t = RichTable(title=title, box=box.SIMPLE_HEAVY, title_justify="left", title_style="bold")
+            widths = column_widths(b.headers, b.rows)
             for j in cols:
-                cells = max((len(r[j]) for r in b.rows), default=1)
-                t.add_column(b.headers[j], justify="right", overflow="fold", min_width=cells)
+                # a fixed width: rich wraps the header in it and never shrinks a number
+                t.add_column(b.headers[j], justify="right", overflow="fold", width=widths[j])
             for r in b.rows:
                 t.add_row(*(r[j] for j in cols))
             console.print(t)
