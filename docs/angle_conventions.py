@@ -12,10 +12,10 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.patches import Arc  # noqa: E402
+import matplotlib.pyplot as plt
+from matplotlib.patches import Arc
 
-from linkage.problems.closed_form import fourbar_positions  # noqa: E402
+from linkage.problems.closed_form import fourbar_positions
 
 # the course notes' linkage (links 2, 4, 3, 5, scaled by 20) at alpha = 70 deg, where the
 # notes find phi = 54.8878 deg: theta2 = 250 deg, theta4 = 234.8878 deg
@@ -44,8 +44,8 @@ def angle(center: complex, start: float, end: float, radius: float, color: str, 
     ax.add_patch(Arc((center.real, center.imag), 2 * radius, 2 * radius, theta1=lo, theta2=hi,
                      color=color, lw=1.5, ls=ls))
     mid = math.radians((lo + hi) / 2)
-    ax.annotate(label, (center.real + 1.15 * radius * math.cos(mid), center.imag + 1.15 * radius * math.sin(mid)),
-                color=color, fontsize=11, ha="center", va="center")
+    at = center + 1.15 * radius * cmath.exp(1j * mid)
+    ax.annotate(label, (at.real, at.imag), color=color, fontsize=11, ha="center", va="center")
 
 
 # mechanism files: every angle from +x (ground O2 -> O4)

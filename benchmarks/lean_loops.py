@@ -1,0 +1,56 @@
+"""Per-solve times of the lean loops, a 361-position sweep and a four-bar Newton with user
+callables (best of 7, timeit). The README's "before -> after" figures are this script run
+on the code before a change and after it, in one session:
+
+    python benchmarks/lean_loops.py                      # this checkout
+    git worktree add /tmp/before <commit>
+    PYTHONPATH=/tmp/before/src python benchmarks/lean_loops.py
+"""
+
+from __future__ import annotations
+
+import math
+import timeit
+
+from linkage import fourbar_equation, load_mechanism, solve_scalar, solve_system
+from linkage.samples import sample_path
+
+
+def best(fn, number: int) -> float:
+    return min(timeit.repeat(fn, number=number, repeat=7)) / number
+
+
+def main() -> None:
+    p = fourbar_equation(70.0)
+    for method, kw in (("newton", {"x0": 50.0}), ("secant", {"x0": 50.0, "x1": 60.0}),
+                       ("bisection", {"bracket": (50.0, 60.0)}), ("fixed-point", {"x0": 50.0}),
+                       ("hybrid", {"bracket": (50.0, 60.0)}), ("regula-falsi", {"bracket": (50.0, 60.0)})):
+        t = best(lambda method=method, kw=kw: solve_scalar(p, method=method, tol=1e-12, record=False,
+                                                           **kw), 2000)
+        print(f"{method:13s} {t * 1e6:7.2f} us")
+    r1, r2, r3, r4, t2 = 90.0, 30.0, 60.0, 45.0, math.radians(65)
+    c2, s2 = r2 * math.cos(t2), r2 * math.sin(t2)
+
+    def F(q):
+        a, b = q
+        return [c2 + r3 * math.cos(a) - r4 * math.cos(b) - r1, s2 + r3 * math.sin(a) - r4 * math.sin(b)]
+
+    def J(q):
+        a, b = q
+        return [[-r3 * math.sin(a), r4 * math.sin(b)], [r3 * math.cos(a), -r4 * math.cos(b)]]
+
+    t = best(lambda: solve_system(F, (0.0, math.pi / 2), jac=J, tol=1e-12, record=False), 1000)
+    print(f"{'four-bar F,J':13s} {t * 1e6:7.2f} us")
+    m = load_mechanism(sample_path("crank_rocker.toml"))  # the measured code's own sample
+    values = [float(k) for k in range(361)]
+    try:
+        from linkage import sweep
+    except ImportError:  # before the public API: the continuation sweep itself
+        from linkage.analysis.sweep import sweep
+    sweep(m, values)
+    t = best(lambda: sweep(m, values), 3)
+    print(f"{'sweep 361':13s} {t * 1e3:7.2f} ms")
+
+
+if __name__ == "__main__":
+    main()
