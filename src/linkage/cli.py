@@ -6,16 +6,17 @@ Exit codes: 0 converged, 1 ran but did not converge (the rows are still shown),
 
 from __future__ import annotations
 
+import contextlib
 import math
 import sys
 import time
-from fractions import Fraction
 from pathlib import Path
 from typing import Annotated, Any, Optional
 
 import typer
 
 from .errors import InputError, LinkageError
+from .numbers import parse_number
 
 app = typer.Typer(
     no_args_is_help=True,
@@ -165,19 +166,6 @@ def check_paths(inputs: list[Path | None], outputs: list[tuple[str, Path | None]
         if path is not None and path.suffix.lower() not in suffixes:
             raise InputError(f"{opt} {path}: use one of {', '.join(suffixes)} for the picture")
     check_outputs(inputs, outputs)
-
-
-def parse_number(name: str, text: str) -> float:
-    """A finite number; fractions such as 5/3 are accepted."""
-    shown = text if len(text) <= 40 else f"{text[:20]}...({len(text)} characters)"
-    try:
-        if len(text) > 400:
-            raise ValueError(text)
-        value = float(Fraction(text.strip()))
-    except (ValueError, ZeroDivisionError, OverflowError):
-        raise InputError(f"{name} must be a finite number (at most about 1e308) or a fraction "
-                         f"like 5/3, got {shown!r}") from None
-    return value
 
 
 # --- solve ----------------------------------------------------------------------------------
@@ -764,6 +752,184 @@ def _sweep_equation(a: float, b: float, step: float | None, points: int | None, 
     emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=(headers, rows))
     if any(r[2] is None for r in rows):
         raise typer.Exit(1)
+
+
+@app.command(
+    epilog="Examples:  linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60:9 --vary r3=80:160:9 "
+    "--where 'full_cycle and min_transmission_deg >= 40' --sort theta4_range --desc --top 10  |  "
+    "linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60 --vary r4=50:120 --samples 100000 "
+    "-o designs.parquet",
+)
+def scan(
+    file: MechanismFile,
+    *,
+    vary: Annotated[Optional[list[str]], typer.Option(
+        "--vary", metavar="NAME=LO:HI[:N]", help="A parameter to vary, in the file's units "
+        "(repeatable): N points from LO to HI (a grid of every combination), or LO:HI with "
+        "--samples.")] = None,
+    samples: Annotated[Optional[int], typer.Option(help="Draw this many random designs in the "
+                       "--vary ranges instead of a grid.")] = None,
+    sampling: Annotated[str, typer.Option(help="With --samples: lhs (Latin hypercube, default) "
+                        "or random.")] = "lhs",
+    seed: Annotated[int, typer.Option(help="With --samples: the random seed (same seed, same "
+                    "designs).")] = 0,
+    start: Annotated[Optional[float], typer.Option("--from", help="First driver value (default 0).")] = None,
+    stop: Annotated[Optional[float], typer.Option("--to", help="Last driver value (default 359).")] = None,
+    step: Annotated[float, typer.Option(help="Driver increment (default 1).")] = 1.0,
+    branch: Annotated[Optional[str], typer.Option(help="Assembly branch every design follows: "
+                      "open or crossed (mechanisms with a closed form); default: the branch of "
+                      "the file's guess.")] = None,
+    set_: SetOpt = None,
+    tol: Annotated[float, typer.Option(help="Step and residual tolerance per position.")] = 1e-12,
+    where: Annotated[Optional[str], typer.Option(metavar="TEST", help="Keep designs passing this "
+                     "test of their columns, e.g. \"full_cycle and min_transmission_deg >= 40\" "
+                     "(numbers, + - * / **, functions, comparisons, and, or, not).")] = None,
+    sort: Annotated[Optional[str], typer.Option(metavar="COLUMN", help="Order the kept designs "
+                    "by this column (ascending; NaN last).")] = None,
+    desc: Annotated[bool, typer.Option("--desc", help="With --sort: largest first.")] = False,
+    top: Annotated[Optional[int], typer.Option(help="Keep only the first K designs (after "
+                   "--where and --sort). A table shows 20 unless given.")] = None,
+    scheduler: Annotated[Optional[str], typer.Option(help="Where the chunks run: threads "
+                         "(default), processes, synchronous, or tcp://HOST:PORT (a "
+                         "dask.distributed scheduler).")] = None,
+    workers: Annotated[Optional[int], typer.Option(help="Local workers (default: one per "
+                       "core).")] = None,
+    chunk: Annotated[Optional[int], typer.Option(help="Designs per task (default: about "
+                     "200,000 positions per task).")] = None,
+    fmt: Annotated[Optional[str], typer.Option("--format", "-f", help="table (default on a "
+                   "terminal), plain, csv, json or parquet; -o FILE picks by suffix.")] = None,
+    output: OutputOpt = None,
+    digits: DigitsOpt = 6,
+    columns: ColumnsOpt = None,
+) -> None:
+    """Scan a range of designs: each over its whole cycle, one record per design.
+
+    Each record: the varied parameters, feasible_fraction (positions where an assembly
+    exists), solved_fraction (positions solved on the followed branch), full_cycle, every
+    unknown's _min, _max and _range, for four-bars grashof and min/max_transmission_deg
+    (folded into 0..90), and the x/y extents of each [points] path.
+
+    Example: linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60:5 --vary r4=60:100:5
+    """
+    from .files import read_input
+    from .kinematics.sweep import driver_values
+    from .problems.loops import load
+    from .problems.where import parse_where
+    from .render.scan import RecordSink, scan_blocks
+    from .scan import (
+        MAX_SCAN_POSITIONS,
+        DesignPlan,
+        Keeper,
+        ScanJob,
+        check_varies,
+        chunk_size,
+        columns_of,
+        default_branch,
+        parse_vary,
+        run_chunks,
+    )
+    from .solve import check_criteria
+
+    if output is not None and str(output) == "-":
+        output = None
+    if fmt is None:
+        suffix = output.suffix.lower() if output is not None else ""
+        fmt = {".csv": "csv", ".json": "json", ".parquet": "parquet"}.get(suffix) or (
+            "table" if output is None and sys.stdout.isatty() else "plain")
+    if fmt not in ("table", "plain", "csv", "json", "parquet"):
+        raise InputError(f"unknown format {fmt!r} for scan; use table, plain, csv, json or parquet")
+    check_paths([file], [("--output", output)])
+    check_criteria(tol, 0.0, None, 50)
+    for name, v in (("--top", top), ("--workers", workers), ("--chunk", chunk)):
+        if v is not None and v < 1:
+            raise InputError(f"{name} must be at least 1, got {v}")
+    if not vary:
+        raise InputError("give at least one --vary NAME=LO:HI[:N]")
+    varies = [parse_vary(v) for v in vary]
+    text = read_input(file)
+    mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
+    check_varies(mechanism, varies)
+    plan = DesignPlan(varies, samples, seed, sampling)
+    angle = mechanism.driver.kind == "angle"
+    if not angle and (start is None or stop is None):
+        raise InputError(f"{mechanism.driver.name} is a length: give --from and --to")
+    a = 0.0 if start is None else start
+    b = 359.0 if stop is None else stop
+    if b < a:
+        raise InputError(f"--to ({b:g}) must not be below --from ({a:g})")
+    values = driver_values(a, b, step, None)
+    if len(values) > MAX_SCAN_POSITIONS:
+        raise InputError(f"{len(values):,} driver positions per design is more than "
+                         f"{MAX_SCAN_POSITIONS:,}; use a larger --step")
+    from .kinematics.sweep import check_driver_values
+
+    check_driver_values(mechanism, values)
+    spec = columns_of(mechanism, plan.names)
+    known = {c[0]: ("number" if c[1] in ("int", "number") else c[1]) for c in spec}
+    if columns:
+        wanted = [w.strip().lower() for w in columns.split(",") if w.strip()]
+        picked = [c for c in spec[1:] if any(c[0].lower().startswith(w) for w in wanted)]
+        if not picked:
+            raise InputError(f"--columns {columns!r} matches no column; the columns are {', '.join(known)}")
+        spec = [spec[0], *picked]
+    test = parse_where(where, known) if where is not None else None
+    if sort is not None and sort not in known:
+        raise InputError(f"--sort {sort}: no such column; the columns are {', '.join(known)}")
+    if desc and sort is None:
+        raise InputError("--desc orders by --sort: give --sort COLUMN")
+    chosen = default_branch(mechanism, branch, tol)
+    overrides = tuple((k, float(v)) for k, v in parse_assignments("--set", set_ or []).items())
+    job = ScanJob(text, str(file), overrides, plan.names, tuple(values), chosen, tol)
+    size = chunk or chunk_size(mechanism, len(values))
+    as_table = fmt in ("table", "plain")
+    meta = {"mechanism": mechanism.name, "source": str(file), "branch": chosen,
+            "driver": {"name": mechanism.driver.name, "unit": mechanism.driver.unit, "from": a,
+                       "to": b, "step": step, "positions": len(values)},
+            "where": where, "sort": sort, "descending": desc, "designs": plan.total}
+    scanned = 0
+    sink = None if as_table else RecordSink(fmt, output, spec, meta)
+    started = time.perf_counter()
+    with contextlib.ExitStack() as stack:
+        if sink is not None:
+            stack.enter_context(sink)
+        keeper = Keeper(sort, desc, top, sink if (sink is not None and sort is None) else None,
+                        show=20 if as_table else None)
+        advance = stack.enter_context(_progress(plan.total, minimum=2 * size))
+        for cols in run_chunks(job, plan, size, scheduler=scheduler, workers=workers):
+            scanned += len(cols["design"])
+            if test is not None:
+                cols = {k: v[test(cols, len(cols["design"]))] for k, v in cols.items()}
+            keeper.add(cols)
+            if advance is not None:
+                advance(scanned)
+            if keeper.full:
+                break
+        held = keeper.result()
+        if sink is not None and sort is not None:
+            sink(held)
+    elapsed = time.perf_counter() - started
+    from .kinematics.designs import closed_form_applies
+
+    engine = ("closed form + vectorised Newton" if closed_form_applies(mechanism)
+              else "continuation, design by design")
+    where_note = f"; {keeper.kept:,} pass --where" if test is not None else ""
+    stopped = f" (stopped early: the first {top} are final)" if scanned < plan.total else ""
+    summary = [f"{mechanism.name}: {scanned:,} of {plan.total:,} designs scanned{stopped}"
+               f"{where_note}; {elapsed:.2f} s",
+               f"{len(values)} positions each ({mechanism.driver.name} {a:g}..{b:g} "
+               f"{mechanism.driver.unit}, step {step:g}); branch: {chosen or 'of the file guess'}; "
+               f"engine: {engine}"]
+    if as_table:
+        n_held = len(held["design"]) if held else 0
+        if n_held < keeper.kept:
+            summary.append(f"showing {n_held} of {keeper.kept:,}"
+                           + (f" by {sort}{' (largest first)' if desc else ''}" if sort else "")
+                           + "; --top K or --format csv/json/parquet for more")
+        emit(fmt, output, blocks=scan_blocks(held, spec, summary, digits), json_obj=None,
+             csv_table=([], []))
+    else:
+        typer.echo(f"{summary[0]}; wrote {sink.count:,} records" +  # type: ignore[union-attr]
+                   (f" to {output}" if output is not None else ""), err=True)
 
 
 @app.command(

@@ -118,16 +118,31 @@ class VectorLoops:
     """
 
     def __init__(self, model: LoopModel, drv: np.ndarray) -> None:
-        self.n = model.n
-        self.m = 2 * len(model.terms)
+        terms = [[(sign, drv if lidx == DRIVER else lc, lidx if lidx >= 0 else -1,
+                   drv if aidx == DRIVER else ac, aidx if aidx >= 0 else -1, off)
+                  for sign, lc, lidx, ac, aidx, off in loop] for loop in model.terms]
+        self.setup(terms, model.n, len(drv))
+
+    @classmethod
+    def of_terms(cls, terms: Sequence[Sequence[tuple[float, Any, int, Any, int, float]]], n: int,
+                 size: int) -> VectorLoops:
+        """Loops whose fixed lengths and angles may be arrays (one value per position):
+        each term is (sign, length, length index, angle, angle index, offset), an index
+        >= 0 naming an unknown, -1 a fixed value (a float or an array of ``size``)."""
+        self = cls.__new__(cls)
+        self.setup(terms, n, size)
+        return self
+
+    def setup(self, terms: Sequence[Sequence[tuple[float, Any, int, Any, int, float]]], n: int,
+              size: int) -> None:
+        self.n = n
+        self.m = 2 * len(terms)
         # Terms whose length and angle are both known do not change while iterating:
         # sum them once per position.
-        self.fixed = [np.zeros(len(drv)) for _ in range(self.m)]
+        self.fixed = [np.zeros(size) for _ in range(self.m)]
         self.moving: list[tuple[int, float, Any, int, Any, int, float]] = []
-        for li, terms in enumerate(model.terms):
-            for sign, lc, lidx, ac, aidx, off in terms:
-                r = drv if lidx == DRIVER else lc
-                th = drv if aidx == DRIVER else ac
+        for li, loop in enumerate(terms):
+            for sign, r, lidx, th, aidx, off in loop:
                 if lidx < 0 and aidx < 0:
                     self.fixed[2 * li] += sign * r * np.cos(th + off)
                     self.fixed[2 * li + 1] += sign * r * np.sin(th + off)

@@ -203,21 +203,40 @@ def _folded_error(kind: str, vals: list[float], errs: list[float], v: float) -> 
     return own + (abs(b * v / a) * ea if ea else 0.0) + (abs(v * math.log(abs(a))) * eb if eb else 0.0)
 
 
-def parse_ops(text: str, *, what: str = "equation") -> tuple[Op, ...]:
-    """Parse user text into a checked operation list (the last one is the result)."""
+def parse_tree(text: str, what: str) -> tuple[ast.Expression, str]:
+    """The syntax tree of user text (``^`` read as ``**``) after the checks every parser
+    here shares: not empty, at most MAX_LENGTH characters, a single expression. Returns
+    the tree and the text as error messages show it; ``what`` names it in them."""
     if not isinstance(text, str) or not text.strip():
-        raise ParseError(f"the {what} is empty")
+        raise ParseError(f"{what} is empty")
     if len(text) > MAX_LENGTH:
-        raise ParseError(f"the {what} is longer than {MAX_LENGTH} characters")
+        raise ParseError(f"{what} is longer than {MAX_LENGTH} characters")
     src = text.replace("^", "**").strip()
     shown = text if len(text) <= 60 else text[:57] + "..."
     try:
-        tree = ast.parse(src, mode="eval")
+        return ast.parse(src, mode="eval"), shown
     except SyntaxError as exc:
         col = f" at column {exc.offset}" if exc.offset else ""
-        raise ParseError(f"could not parse the {what} {shown!r}: {exc.msg}{col}") from None
+        raise ParseError(f"could not parse {what} {shown!r}: {exc.msg}{col}") from None
     except (RecursionError, MemoryError, ValueError):
-        raise ParseError(f"the {what} {shown!r} is too deeply nested or malformed") from None
+        raise ParseError(f"{what} {shown!r} is too deeply nested or malformed") from None
+
+
+def call_argument(node: ast.Call, where: str) -> ast.AST:
+    """The one argument of a call of a whitelisted function, or a ParseError; ``where``
+    ends the message ("in the equation 'x'")."""
+    if not isinstance(node.func, ast.Name) or node.func.id not in FUNCTIONS:
+        name = node.func.id if isinstance(node.func, ast.Name) else "that call"
+        raise ParseError(f"unknown function {name!r} {where}; allowed: {', '.join(sorted(FUNCTIONS))}")
+    if len(node.args) != 1 or node.keywords:
+        raise ParseError(f"{node.func.id}() takes exactly one argument {where}")
+    return node.args[0]
+
+
+def parse_ops(text: str, *, what: str = "equation") -> tuple[Op, ...]:
+    """Parse user text into a checked operation list (the last one is the result)."""
+    tree, _ = parse_tree(text, f"the {what}")
+    shown = text if len(text) <= 60 else text[:57] + "..."
     b = _Builder()
     # Iterative post-order walk: (node, visited) pairs on a stack, results on another.
     stack: list[tuple[ast.AST, bool]] = [(tree.body, False)]
@@ -257,13 +276,7 @@ def _check(node: ast.AST, shown: str, what: str) -> list[ast.AST]:
     if isinstance(node, ast.BinOp) and type(node.op) in _BINOPS:
         return [node.left, node.right]
     if isinstance(node, ast.Call):
-        if not isinstance(node.func, ast.Name) or node.func.id not in FUNCTIONS:
-            name = node.func.id if isinstance(node.func, ast.Name) else "that call"
-            raise ParseError(f"unknown function {name!r} in the {what} {shown!r}; "
-                             f"allowed: {', '.join(sorted(FUNCTIONS))}")
-        if len(node.args) != 1 or node.keywords:
-            raise ParseError(f"{node.func.id}() takes exactly one argument in the {what} {shown!r}")
-        return [node.args[0]]
+        return [call_argument(node, f"in the {what} {shown!r}")]
     raise ParseError(f"{type(node).__name__} is not allowed in the {what} {shown!r}; "
                      "use numbers, x, + - * / ** and functions")
 

@@ -1,0 +1,360 @@
+"""Many designs at once: a mechanism whose parameters are arrays, solved at every driver
+value for every design, vectorised over designs x positions (the engine of ``scan``).
+
+Mechanisms with a closed form (four-bars driven by theta2 or theta4, slider-cranks):
+
+1. The closed form gives every position of every design at once, on the branch asked
+   for, or shows that the linkage cannot be assembled there (``no_solution``).
+2. Newton-Raphson on the loop equations polishes every assembled position, vectorised,
+   with the single solve's stopping rule: max|dq| <= tol (a length step relative to the
+   design's size) and max|Phi| <= tol x size. A position counts as solved only when
+   Newton converges there, stays within 1e-6 (rad, or of the size) of the closed form
+   and lies on the branch; otherwise it is ``failed`` (never given numbers).
+
+Other mechanisms go design by design through the continuation sweep
+(:func:`~linkage.kinematics.sweep.sweep`): the same statuses, far slower.
+
+Either way angles are reported continuously along the driver (each the representative
+nearest the previous solved value, across gaps too), and each curve is shifted by whole
+turns so that at the position nearest the file's driver value it lies within half a turn
+of the file's guess: both engines report the same numbers for the same design.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..methods.newton_system import SINGULAR_RATIO
+from ..problems.closed_form import DRIVERS, REQUIRED_NAMES
+from ..problems.loops import ANGLE_UNITS, Mechanism, VectorTerm
+from .batch import STATUS_CODES, VectorLoops, _on_branch, _solve_linear
+
+CONVERGED, NO_SOLUTION, FAILED, OFF_BRANCH = (STATUS_CODES[k] for k in
+                                              ("converged", "no_solution", "failed", "off_branch"))
+SEED_DISTANCE = 1e-6
+"""How far Newton may move a closed-form position (rad, or relative to the size) and
+still be that position: further means it went to another assembly."""
+
+
+@dataclass(frozen=True)
+class DesignSolutions:
+    """Every design at every driver value. ``status`` and ``feasible`` are (designs,
+    positions); ``solution`` is (designs, positions, unknowns) in display units (deg for
+    angles), NaN where not solved; ``paths`` maps each joint and named point to its
+    complex position (designs, positions), NaN where not solved (only when asked for)."""
+
+    names: tuple[str, ...]
+    kinds: tuple[str, ...]
+    values: np.ndarray
+    status: np.ndarray
+    feasible: np.ndarray
+    solution: np.ndarray
+    branch: str | None
+    engine: str
+    paths: dict[str, np.ndarray]
+
+
+def closed_form_applies(m: Mechanism) -> bool:
+    """True when the vectorised closed-form engine can run this mechanism."""
+    if m.closed_form is None or m.driver.kind != "angle" or m.driver.name not in DRIVERS[m.closed_form]:
+        return False
+    expected = set(REQUIRED_NAMES[m.closed_form]) - set(m.parameters) - {m.driver.name}
+    return {u.name for u in m.unknowns} == expected
+
+
+def solve_designs(m: Mechanism, params: Mapping[str, np.ndarray], values: Sequence[float] | np.ndarray,
+                  *, branch: str | None, tol: float = 1e-12, max_iter: int = 30,
+                  paths: bool = False) -> DesignSolutions:
+    """Solve ``m`` with each named parameter taking the values of its array (file units,
+    one entry per design) at every driver value in ``values`` (display units).
+    ``branch``: open or crossed (mechanisms with a closed form), else None (the branch of
+    the file's guess, by continuation)."""
+    vals = np.asarray(values, dtype=float)
+    sizes = {len(np.atleast_1d(a)) for a in params.values()}
+    if len(sizes) > 1:
+        raise ValueError("every parameter array needs one value per design")
+    n_designs = sizes.pop() if sizes else 1
+    if closed_form_applies(m) and branch is not None:
+        q, status, feasible, engine = _closed_form_engine(m, params, vals, branch, tol, max_iter,
+                                                          n_designs)
+    else:
+        q, status, feasible, engine = _sweep_engine(m, params, vals, branch, tol, n_designs)
+    found_paths = _paths(m, params, vals, q, status == CONVERGED) if paths else {}
+    kinds = tuple(u.kind for u in m.unknowns)
+    shown = np.stack([np.degrees(c) if k == "angle" else c for c, k in zip(q, kinds)], axis=-1)
+    shown[status != CONVERGED] = np.nan
+    shown = shown.reshape(n_designs, len(vals), len(kinds))
+    _continuous(m, shown, vals)
+    return DesignSolutions(tuple(u.name for u in m.unknowns), kinds, vals,
+                           status.reshape(n_designs, len(vals)), feasible.reshape(n_designs, len(vals)),
+                           shown, branch, engine,
+                           {k: v.reshape(n_designs, len(vals)) for k, v in found_paths.items()})
+
+
+# --- the closed-form engine ----------------------------------------------------------------
+
+def _grid(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray,
+          n_designs: int) -> tuple[dict[str, Any], np.ndarray]:
+    """Every parameter (internal units) as a float or a flat array over designs x positions,
+    and the driver (internal units) flat the same way."""
+    k = len(vals)
+    out: dict[str, Any] = {}
+    for name, q in m.parameters.items():
+        if name in params:
+            a = np.asarray(params[name], dtype=float)
+            a = a * ANGLE_UNITS[q.unit] if q.kind == "angle" else a
+            out[name] = np.repeat(a, k)
+        else:
+            out[name] = q.value
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    return out, np.tile(vals * scale, n_designs)
+
+
+def _size(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray) -> Any:
+    """The longest length in the loops, per position (as Mechanism.length_scale)."""
+    size: Any = 0.0
+    for name, q in m.parameters.items():
+        if q.kind == "length":
+            size = np.maximum(size, np.abs(grid[name]))
+    if m.driver.kind == "length":
+        size = np.maximum(size, np.abs(drv))
+    for loop in m.loops:
+        for t in loop.vectors:
+            if isinstance(t.length, float):
+                size = np.maximum(size, abs(t.length))
+    size = np.broadcast_to(np.asarray(size, dtype=float), drv.shape)
+    return np.where(size > 0.0, size, 1.0)
+
+
+def _circle(center: Any, radius: Any, other: Any, distance: Any) -> tuple[Any, Any, Any]:
+    """Both points X with |X - center| = radius and |X - other| = distance, and where they
+    exist (as closed_form.circle_points, over arrays)."""
+    w = other - center
+    d = np.abs(w)
+    ok = (d > 0.0) & (d <= radius + distance) & (d >= np.abs(radius - distance))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = (radius * radius - distance * distance + d * d) / (2.0 * d)
+        h = np.sqrt(np.maximum(radius * radius - a * a, 0.0))
+        u = w / d
+    base = center + a * u
+    return base + h * 1j * u, base - h * 1j * u, ok
+
+
+def _closed_form_seeds(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray,
+                       branch: str) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
+    """Each unknown (internal units) on ``branch`` at every position, where the linkage
+    can be assembled at all, and where the two branches meet (a limit position: the
+    branch label of a solution there is a matter of rounding)."""
+    want_open = branch == "open"
+    if m.closed_form == "slider_crank":
+        r2, r3, e = grid["r2"], grid["r3"], grid["e"]
+        v = (e - r2 * np.sin(drv)) / r3
+        ok = np.abs(v) <= 1.0
+        t3 = np.arcsin(np.clip(v, -1.0, 1.0))
+        fold = np.abs(math.pi - 2.0 * t3) <= SEED_DISTANCE
+        if not want_open:
+            t3 = math.pi - t3
+        return {"theta3": t3, "s": r2 * np.cos(drv) + r3 * np.cos(t3)}, ok, fold
+    r1, r2, r3, r4, t1 = (grid[k] for k in ("r1", "r2", "r3", "r4", "theta1"))
+    o4 = r1 * np.exp(1j * t1)
+    if m.driver.name == "theta2":
+        a = r2 * np.exp(1j * drv)
+        b1, b2, ok = _circle(o4, r4, a, r3)
+        t3s = (np.angle(b1 - a), np.angle(b2 - a))
+        t4s = (np.angle(b1 - o4), np.angle(b2 - o4))
+        first_open = np.sin(t4s[0] - t3s[0]) > 0.0
+        pick = first_open == want_open
+        return ({"theta3": np.where(pick, t3s[0], t3s[1]), "theta4": np.where(pick, t4s[0], t4s[1])}, ok,
+                _apart(t3s) <= SEED_DISTANCE)
+    b = o4 + r4 * np.exp(1j * drv)
+    a1, a2, ok = _circle(0j, r2, b, r3)
+    t3s = (np.angle(b - a1), np.angle(b - a2))
+    first_open = np.sin(drv - t3s[0]) > 0.0
+    pick = first_open == want_open
+    return ({"theta2": np.where(pick, np.angle(a1), np.angle(a2)),
+             "theta3": np.where(pick, t3s[0], t3s[1])}, ok, _apart(t3s) <= SEED_DISTANCE)
+
+
+def _apart(angles: tuple[Any, Any]) -> Any:
+    """How far apart two angles are (rad, the short way round)."""
+    return np.abs(np.angle(np.exp(1j * (angles[0] - angles[1]))))
+
+
+def _closed_form_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, branch: str,
+                        tol: float, max_iter: int, n_designs: int) -> tuple[list[np.ndarray], np.ndarray,
+                                                                            np.ndarray, str]:
+    grid, drv = _grid(m, params, vals, n_designs)
+    seeds, feasible, fold = _closed_form_seeds(m, grid, drv, branch)
+    seed = [np.where(feasible, seeds[u.name], 0.0) for u in m.unknowns]
+    size = _size(m, grid, drv)
+    loops = VectorLoops.of_terms(_terms(m, grid, drv), len(m.unknowns), len(drv))
+    q = [c.copy() for c in seed]
+    done, det = _newton(loops, q, np.flatnonzero(feasible), tol, size,
+                        [k == "length" for k in (u.kind for u in m.unknowns)], max_iter)
+    moved = np.zeros(len(drv))
+    for c, s, u in zip(q, seed, m.unknowns):
+        np.maximum(moved, np.abs(c - s) / (size if u.kind == "length" else 1.0), out=moved)
+    names = [u.name for u in m.unknowns]
+    shown = np.stack([np.degrees(c) if u.kind == "angle" else c for c, u in zip(q, m.unknowns)], axis=1)
+    on_branch = _on_branch(m, shown, names, det, branch)
+    status = np.where(feasible, FAILED, NO_SOLUTION).astype(np.int8)
+    status[done & (moved <= SEED_DISTANCE) & (on_branch | fold) & feasible] = CONVERGED
+    return q, status, feasible, "closed form + vectorised Newton"
+
+
+def _terms(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray) -> list[list[tuple[Any, ...]]]:
+    """The loops' vectors with parameters and driver resolved to floats or flat arrays."""
+    index = {u.name: i for i, u in enumerate(m.unknowns)}
+
+    def ref(r: str | float) -> tuple[Any, int]:
+        if isinstance(r, str):
+            if r in index:
+                return 0.0, index[r]
+            return (drv, -1) if r == m.driver.name else (grid[r], -1)
+        return r, -1
+
+    return [[(t.sign, *ref(t.length), *ref(t.angle), t.offset) for t in loop.vectors] for loop in m.loops]
+
+
+def _newton(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol: float, size: np.ndarray,
+            is_length: list[bool], max_iter: int) -> tuple[np.ndarray, np.ndarray]:
+    """Newton-Raphson at every ``active`` position at once, updating ``q_all`` in place;
+    only unconverged positions keep iterating. Returns (converged, det J)."""
+    n_pos = len(size)
+    done = np.zeros(n_pos, dtype=bool)
+    det_out = np.full(n_pos, np.nan)
+    gate_all = tol * size
+    q = [c[active] for c in q_all]
+    for _ in range(max_iter):
+        if active.size == 0:
+            break
+        phi, jac = loops.evaluate(q, active)
+        dq, det = _solve_linear(jac, phi, active.size)
+        scale = size[active]
+        resid = np.abs(phi[0])
+        for f in phi[1:]:
+            np.maximum(resid, np.abs(f), out=resid)
+        singular = ~np.isfinite(det) | (det == 0.0)
+        if len(jac) == 2 and len(jac[0]) == 2:
+            (a, b), (c, d) = jac
+            with np.errstate(invalid="ignore"):
+                singular |= ~(np.abs(det) > SINGULAR_RATIO * (np.abs(a * d) + np.abs(b * c)))
+        step = np.zeros(active.size)
+        for j, d_j in enumerate(dq):
+            d_j = np.where(singular, 0.0, d_j)
+            np.maximum(step, np.abs(d_j) / scale if is_length[j] else np.abs(d_j), out=step)
+            q[j] += d_j
+        with np.errstate(invalid="ignore"):
+            within = resid <= gate_all[active]
+            # as a single solve: a singular J with max|Phi| already within tolerance is a
+            # root to that tolerance (a limit position); otherwise the step test decides
+            finished = np.where(singular, within, (step <= tol) & within)
+            keep = ~finished & ~singular & np.isfinite(step)
+        for j in range(len(q)):
+            q_all[j][active] = q[j]
+        det_out[active] = det
+        done[active[finished]] = True
+        active = active[keep]
+        q = [c[keep] for c in q]
+    return done, det_out
+
+
+# --- the continuation engine ----------------------------------------------------------------
+
+def _sweep_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, branch: str | None,
+                  tol: float, n_designs: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray, str]:
+    from .sweep import sweep
+
+    n, k = len(m.unknowns), len(vals)
+    q = [np.full(n_designs * k, np.nan) for _ in range(n)]
+    status = np.empty(n_designs * k, dtype=np.int8)
+    listed = [float(v) for v in vals]
+    for d in range(n_designs):
+        design = m.with_values({name: float(np.atleast_1d(a)[d]) for name, a in params.items()}, {})
+        result = sweep(design, listed, branch=branch, tol=tol)
+        for i, p in enumerate(result.positions):
+            status[d * k + i] = STATUS_CODES[p.status]
+            if p.solution is not None:
+                for j, u in enumerate(m.unknowns):
+                    v = p.solution[u.name]
+                    q[j][d * k + i] = math.radians(v) if u.kind == "angle" else v
+    feasible = (status == CONVERGED) | (status == OFF_BRANCH)
+    return q, status, feasible, "continuation, design by design"
+
+
+# --- shared: joints and points, continuous angles ------------------------------------------------
+
+def _paths(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, q: list[np.ndarray],
+           solved: np.ndarray) -> dict[str, np.ndarray]:
+    """Every named joint and point at every solved position (complex, NaN elsewhere), as
+    LoopModel.points places them."""
+    n_designs = len(solved) // max(len(vals), 1)
+    grid, drv = _grid(m, params, vals, n_designs)
+    index = {u.name: i for i, u in enumerate(m.unknowns)}
+
+    def value(r: str | float) -> Any:
+        if isinstance(r, str):
+            if r in index:
+                return q[index[r]]
+            return drv if r == m.driver.name else grid[r]
+        return r
+
+    def vec(t: VectorTerm) -> Any:
+        return t.sign * value(t.length) * np.exp(1j * (value(t.angle) + t.offset))
+
+    placed: dict[str, Any] = {}
+    for loop in m.loops:
+        names = loop.joints
+        p: Any = placed.get(names[0], 0j) if names and names[0] else 0j
+        for name, t in zip(names or [""] * len(loop.vectors), loop.vectors):
+            if name:
+                placed.setdefault(name, p)
+            p = p + vec(t)
+    for pname, (origin, vectors) in m.points.items():
+        p = placed[origin]
+        for t in vectors:
+            p = p + vec(t)
+        placed[pname] = p
+    out = {}
+    for name, p in placed.items():
+        full = np.broadcast_to(np.asarray(p, dtype=complex), solved.shape).copy()
+        full[~solved] = np.nan
+        out[name] = full
+    return out
+
+
+def _continuous(m: Mechanism, shown: np.ndarray, vals: np.ndarray) -> None:
+    """In place: each angle the representative nearest its previous solved value, the
+    first in (-180, 180]; then each design's curve shifted by whole turns to lie within
+    half a turn of the file's guess at the solved position nearest the file's driver value."""
+    if shown.size == 0:
+        return
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    v0 = m.driver.value / scale
+    distance = np.abs(vals - v0)
+    for j, u in enumerate(m.unknowns):
+        if u.kind != "angle":
+            continue
+        a = shown[:, :, j]
+        solved = np.isfinite(a)
+        if not solved.any():
+            continue
+        wrapped = np.where(solved, a - 360.0 * np.ceil((a - 180.0) / 360.0), np.nan)
+        # carry the last solved value over gaps, so each value is unwrapped against it
+        idx = np.where(solved, np.arange(a.shape[1]), 0)
+        np.maximum.accumulate(idx, axis=1, out=idx)
+        first = np.argmax(solved, axis=1)
+        filled = np.take_along_axis(wrapped, idx, axis=1)
+        lead = np.arange(a.shape[1])[None, :] < first[:, None]
+        filled[lead] = np.take_along_axis(wrapped, first[:, None], axis=1).repeat(a.shape[1], 1)[lead]
+        smooth = np.unwrap(filled, period=360.0, axis=1)
+        near = np.argmin(np.where(solved, distance[None, :], np.inf), axis=1)
+        at = np.take_along_axis(smooth, near[:, None], axis=1)[:, 0]
+        guess = math.degrees(u.value)
+        shift = 360.0 * np.round((guess - at) / 360.0)
+        shown[:, :, j] = np.where(solved, smooth + shift[:, None], np.nan)

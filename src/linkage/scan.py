@@ -1,0 +1,454 @@
+"""Design-space scans: many variants of one mechanism, each over its whole cycle, reduced to
+one flat record per design, filtered, ranked and streamed out chunk by chunk.
+
+Designs come from a grid (``NAME=LO:HI:N`` per parameter, the last varying fastest) or
+from ``samples`` random or Latin-hypercube draws (reproducible from ``seed``; design i is
+the same whatever the chunk size or the scheduler). They are cut into chunks; each chunk
+is one task, :func:`run_chunk`, which runs the design batch engine
+(:mod:`linkage.kinematics.designs`) and returns columns. A scan of one chunk runs in
+this process; more chunks run on dask: its local threaded scheduler by default
+(measured faster here than processes: ``benchmarks/scan.py``), or a dask.distributed
+cluster given by address. A task carries the mechanism file's text, never a path, so
+workers need only this package installed. Results do not depend on who ran them: every
+computation in a chunk is per design.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import sys
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .errors import InputError, ParseError
+from .kinematics.designs import CONVERGED, DesignSolutions, closed_form_applies, solve_designs
+from .problems.loops import ANGLE_UNITS, Mechanism
+
+MAX_DESIGNS = 10_000_000
+MAX_SCAN_POSITIONS = 100_000
+CHUNK_POSITIONS = 200_000
+"""Designs x positions per task on the closed-form engine: a few tens of MB of arrays."""
+CHUNK_DESIGNS_MAX = 20_000
+"""At most this many designs per task, whatever the positions: records stay small."""
+CHUNK_DESIGNS_SWEEP = 16
+"""Designs per task on the continuation engine (tens of ms per design)."""
+
+
+@dataclass(frozen=True)
+class Vary:
+    """One ``--vary NAME=LO:HI[:N]``: file units, N points (None: sampled)."""
+
+    name: str
+    lo: float
+    hi: float
+    n: int | None
+
+
+def parse_vary(text: str) -> Vary:
+    name, eq, spec = text.partition("=")
+    name = name.strip()
+    parts = spec.split(":")
+    if not eq or not name or len(parts) not in (2, 3):
+        raise InputError(f"--vary {text!r}: write NAME=LO:HI (sampled) or NAME=LO:HI:N (a grid of N)")
+    from .numbers import parse_number
+
+    lo, hi = (parse_number(f"--vary {name} bound", p) for p in parts[:2])
+    n = None
+    if len(parts) == 3:
+        try:
+            n = int(parts[2])
+        except ValueError:
+            raise InputError(f"--vary {name}: N must be a whole number of points, got {parts[2]!r}") from None
+        if not 1 <= n <= MAX_DESIGNS:
+            raise InputError(f"--vary {name}: N must be between 1 and {MAX_DESIGNS:,}, got {n}")
+        if n == 1 and lo != hi:
+            raise InputError(f"--vary {name}: one point needs LO = HI (or use --set)")
+    if hi < lo:
+        raise InputError(f"--vary {name}: HI ({hi:g}) is below LO ({lo:g})")
+    return Vary(name, lo, hi, n)
+
+
+def check_varies(m: Mechanism, varies: Sequence[Vary]) -> None:
+    """Each name a parameter of ``m``, once; both bounds valid values for it."""
+    seen: set[str] = set()
+    for v in varies:
+        if v.name in seen:
+            raise InputError(f"--vary {v.name} is given twice")
+        seen.add(v.name)
+        if v.name not in m.parameters:
+            what = ("the driver (use --from/--to)" if v.name == m.driver.name else
+                    "an unknown" if v.name in {u.name for u in m.unknowns} else "not a parameter")
+            raise InputError(f"--vary {v.name}: {what}; the parameters of {m.source} are "
+                             f"{', '.join(m.parameters)}")
+        for bound in (v.lo, v.hi):
+            try:
+                m.with_values({v.name: bound}, {})
+            except ParseError as exc:
+                raise InputError(f"--vary {v.name}: {str(exc).removeprefix('--set ')}") from None
+
+
+class DesignPlan:
+    """Which designs a scan visits: ``chunk(start, stop)`` gives their parameter values
+    (file units) as an array of shape (stop - start, parameters)."""
+
+    def __init__(self, varies: Sequence[Vary], samples: int | None, seed: int, method: str) -> None:
+        self.names = tuple(v.name for v in varies)
+        self.varies = tuple(varies)
+        gridded = [v.n is not None for v in varies]
+        if samples is None:
+            if not all(gridded):
+                missing = next(v.name for v in varies if v.n is None)
+                raise InputError(f"--vary {missing}: give :N points for a grid, or --samples N "
+                                 "for random designs")
+            total = math.prod(v.n for v in varies if v.n is not None) if varies else 1
+            self.axes = [np.linspace(v.lo, v.hi, v.n) if v.n and v.n > 1 else np.array([v.lo])
+                         for v in varies]
+            self.samples = None
+        else:
+            if any(gridded):
+                raise InputError("--samples draws random designs: give --vary NAME=LO:HI without :N")
+            if not 1 <= samples <= MAX_DESIGNS:
+                raise InputError(f"--samples must be between 1 and {MAX_DESIGNS:,}, got {samples}")
+            if method not in ("lhs", "random"):
+                raise InputError(f"--sampling must be lhs or random, got {method!r}")
+            total = samples
+            self.samples = _draw(varies, samples, seed, method)
+        if total > MAX_DESIGNS:
+            raise InputError(f"the grid has {total:,} designs, more than {MAX_DESIGNS:,}; use fewer "
+                             "points or --samples")
+        self.total = total
+
+    def chunk(self, start: int, stop: int) -> np.ndarray:
+        if self.samples is not None:
+            return self.samples[start:stop]
+        if not self.axes:
+            return np.empty((stop - start, 0))
+        idx = np.unravel_index(np.arange(start, stop), [len(a) for a in self.axes])
+        return np.stack([a[i] for a, i in zip(self.axes, idx)], axis=1)
+
+
+def _draw(varies: Sequence[Vary], n: int, seed: int, method: str) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    p = len(varies)
+    u = rng.random((n, p))
+    if method == "lhs":
+        # one draw in each of n equal strata per parameter, strata shuffled independently
+        for j in range(p):
+            u[:, j] = (rng.permutation(n) + u[:, j]) / n
+    lo = np.array([v.lo for v in varies])
+    hi = np.array([v.hi for v in varies])
+    return lo + u * (hi - lo)
+
+
+# --- one task ---------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class ScanJob:
+    """What every task needs, small and picklable: the mechanism as text (workers need no
+    file), the --set overrides, the varied names, the driver values and the options."""
+
+    text: str
+    source: str
+    overrides: tuple[tuple[str, float], ...]
+    names: tuple[str, ...]
+    values: tuple[float, ...]
+    branch: str | None
+    tol: float
+
+
+@functools.lru_cache(maxsize=8)
+def job_mechanism(text: str, source: str, overrides: tuple[tuple[str, float], ...]) -> Mechanism:
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover
+        import tomli as tomllib
+
+    from .problems.loops import parse_mechanism
+
+    return parse_mechanism(tomllib.loads(text), source).with_values(dict(overrides), {})
+
+
+def run_chunk(job: ScanJob, start: int, designs: np.ndarray) -> dict[str, np.ndarray]:
+    """One task: the records of designs ``start, start + 1, ...`` as columns."""
+    m = job_mechanism(job.text, job.source, job.overrides)
+    params = {name: designs[:, j] for j, name in enumerate(job.names)}
+    if not params:
+        params = {}
+    sol = solve_designs(m, params, np.array(job.values), branch=job.branch, tol=job.tol,
+                        paths=bool(m.points))
+    return design_metrics(m, job.names, designs, sol, start)
+
+
+def chunk_size(m: Mechanism, positions: int) -> int:
+    if closed_form_applies(m):
+        return max(1, min(CHUNK_DESIGNS_MAX, CHUNK_POSITIONS // max(positions, 1)))
+    return CHUNK_DESIGNS_SWEEP
+
+
+# --- metrics ---------------------------------------------------------------------------------
+
+def columns_of(m: Mechanism, names: Sequence[str]) -> list[tuple[str, str, str]]:
+    """Every record column: (name, type: number, bool, int or text, unit or "")."""
+    unit = {k: (q.unit if q.kind == "angle" else m.length_unit) for k, q in m.parameters.items()}
+    cols = [("design", "int", "")] + [(n, "number", unit[n]) for n in names]
+    cols += [("feasible_fraction", "number", ""), ("solved_fraction", "number", ""),
+             ("full_cycle", "bool", "")]
+    for u in m.unknowns:
+        uu = "deg" if u.kind == "angle" else m.length_unit
+        cols += [(f"{u.name}_min", "number", uu), (f"{u.name}_max", "number", uu),
+                 (f"{u.name}_range", "number", uu)]
+    if m.closed_form == "fourbar":
+        cols += [("grashof", "text", ""), ("min_transmission_deg", "number", "deg"),
+                 ("max_transmission_deg", "number", "deg")]
+    for p in m.points:
+        cols += [(f"{p}_{axis}_{end}", "number", m.length_unit) for axis in "xy" for end in ("min", "max")]
+    return cols
+
+
+def design_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray, sol: DesignSolutions,
+                   start: int) -> dict[str, np.ndarray]:
+    n_designs, n_pos = sol.status.shape
+    solved = sol.status == CONVERGED
+    out: dict[str, np.ndarray] = {"design": np.arange(start, start + n_designs, dtype=np.int64)}
+    for j, n in enumerate(names):
+        out[n] = np.array(designs[:, j], dtype=float)
+    out["feasible_fraction"] = sol.feasible.mean(axis=1) if n_pos else np.zeros(n_designs)
+    out["solved_fraction"] = solved.mean(axis=1) if n_pos else np.zeros(n_designs)
+    out["full_cycle"] = solved.all(axis=1) & (n_pos > 0)
+    with np.errstate(invalid="ignore"):
+        for j, u in enumerate(m.unknowns):
+            lo, hi = _extent(sol.solution[:, :, j], solved)
+            out[f"{u.name}_min"], out[f"{u.name}_max"], out[f"{u.name}_range"] = lo, hi, hi - lo
+        if m.closed_form == "fourbar":
+            out["grashof"] = grashof_class(*(_param(m, names, designs, k) for k in ("r1", "r2", "r3", "r4")))
+            t3, t4 = (_angle_deg(m, sol, names, designs, k) for k in ("theta3", "theta4"))
+            mu = np.abs((t4 - t3 + 180.0) % 360.0 - 180.0)
+            folded = np.where(mu > 90.0, 180.0 - mu, mu)
+            out["min_transmission_deg"], out["max_transmission_deg"] = _extent(folded, solved)
+        for p in m.points:
+            z = sol.paths[p]
+            for axis, part in (("x", z.real), ("y", z.imag)):
+                out[f"{p}_{axis}_min"], out[f"{p}_{axis}_max"] = _extent(part, solved)
+    return out
+
+
+def _extent(values: np.ndarray, solved: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per design (row): min and max over solved positions; NaN where none is solved."""
+    any_solved = solved.any(axis=1)
+    lo = np.where(solved, values, np.inf).min(axis=1, initial=np.inf)
+    hi = np.where(solved, values, -np.inf).max(axis=1, initial=-np.inf)
+    return np.where(any_solved, lo, np.nan), np.where(any_solved, hi, np.nan)
+
+
+def _param(m: Mechanism, names: Sequence[str], designs: np.ndarray, key: str) -> np.ndarray:
+    if key in names:
+        return np.asarray(designs[:, list(names).index(key)], dtype=float)
+    return np.full(len(designs), m.parameters[key].value)
+
+
+def _angle_deg(m: Mechanism, sol: DesignSolutions, names: Sequence[str], designs: np.ndarray,
+               key: str) -> np.ndarray:
+    """A four-bar angle at every position (deg): solved, the driver, or a parameter."""
+    if key in sol.names:
+        return sol.solution[:, :, sol.names.index(key)]
+    if key == m.driver.name:
+        return np.broadcast_to(sol.values[None, :] if m.driver.unit == "deg"
+                               else np.degrees(sol.values)[None, :], sol.status.shape)
+    q = m.parameters[key]
+    v = _param(m, names, designs, key)
+    v = v / ANGLE_UNITS[q.unit] * ANGLE_UNITS["deg"] if key in names else np.degrees(v)
+    return np.broadcast_to(v[:, None], sol.status.shape)
+
+
+GRASHOF_CLASSES = ("double crank", "crank-rocker", "double rocker", "rocker-crank")
+
+
+def grashof_class(r1: np.ndarray, r2: np.ndarray, r3: np.ndarray, r4: np.ndarray) -> np.ndarray:
+    """The Grashof class of each four-bar (r1 ground, r2 input, r3 coupler, r4 output), as
+    :func:`~linkage.problems.closed_form.fourbar_class` names it, without its "Grashof"."""
+    links = np.stack([r1, r2, r3, r4], axis=1)
+    s, longest = links.min(axis=1), links.max(axis=1)
+    p_q = links.sum(axis=1) - s - longest
+    total = s + longest
+    # math.isclose(total, p_q, rel_tol=1e-12)
+    change = np.abs(total - p_q) <= 1e-12 * np.maximum(np.abs(total), np.abs(p_q))
+    kinds = np.array(GRASHOF_CLASSES, dtype=object)[np.argmin(links, axis=1)]
+    out = np.where(change, "change point", np.where(total > p_q, "triple rocker", kinds))
+    return out.astype(object)
+
+
+# --- running the chunks -------------------------------------------------------------------------
+
+def chunk_bounds(total: int, size: int) -> list[tuple[int, int]]:
+    return [(a, min(a + size, total)) for a in range(0, total, size)]
+
+
+def run_chunks(job: ScanJob, plan: DesignPlan, size: int, *, scheduler: str | None = None,
+               workers: int | None = None) -> Iterator[dict[str, np.ndarray]]:
+    """Every chunk's records, in design order. ``scheduler``: None or "threads" (dask's
+    local threads), "processes", "synchronous", or the address of a dask.distributed
+    scheduler (tcp://host:port). A scan of one chunk, not sent to a cluster, runs here
+    without importing dask."""
+    bounds = chunk_bounds(plan.total, size)
+    remote = scheduler is not None and "://" in scheduler
+    if not remote and (len(bounds) == 1 or scheduler == "synchronous" or workers == 1):
+        for a, b in bounds:
+            yield run_chunk(job, a, plan.chunk(a, b))
+        return
+    if remote:
+        yield from _distributed(job, plan, bounds, scheduler)  # type: ignore[arg-type]
+        return
+    yield from _local(job, plan, bounds, scheduler or "threads", workers)
+
+
+def _local(job: ScanJob, plan: DesignPlan, bounds: list[tuple[int, int]], kind: str,
+           workers: int | None) -> Iterator[dict[str, np.ndarray]]:
+    import os
+
+    if kind not in ("threads", "processes"):
+        raise InputError(f"--scheduler must be threads, processes, synchronous or tcp://HOST:PORT, "
+                         f"got {kind!r}")
+    try:
+        if kind == "threads":
+            from dask.threaded import get
+        else:
+            from dask.multiprocessing import get
+    except ImportError:
+        print("note: dask is not installed, so the chunks run one after another here "
+              "(pip install 'linkage-kinematics[scan]' to run them in parallel)", file=sys.stderr)
+        for a, b in bounds:
+            yield run_chunk(job, a, plan.chunk(a, b))
+        return
+    n = workers or os.cpu_count() or 1
+    window = 2 * n  # chunks in flight: memory stays bounded however many designs there are
+    for w in range(0, len(bounds), window):
+        part = bounds[w:w + window]
+        graph = {("chunk", i): (run_chunk, job, a, plan.chunk(a, b)) for i, (a, b) in enumerate(part)}
+        yield from get(graph, [("chunk", i) for i in range(len(part))], num_workers=n)
+
+
+def _distributed(job: ScanJob, plan: DesignPlan, bounds: list[tuple[int, int]],
+                 address: str) -> Iterator[dict[str, np.ndarray]]:
+    from collections import deque
+
+    try:
+        from distributed import Client
+    except ImportError:
+        raise InputError("--scheduler tcp://... needs dask.distributed: pip install "
+                         "'linkage-kinematics[scan]'") from None
+    try:
+        client = Client(address, timeout="10s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise InputError(f"cannot reach the dask scheduler at {address}: {exc}") from None
+    try:
+        n = max(1, sum(client.nthreads().values()))
+        window = 2 * n
+        pending: deque[Any] = deque()
+        queue = iter(bounds)
+        for a, b in queue:
+            pending.append(client.submit(run_chunk, job, a, plan.chunk(a, b), pure=False))
+            if len(pending) >= window:
+                break
+        while pending:
+            result = pending.popleft().result()
+            nxt = next(queue, None)
+            if nxt is not None:
+                pending.append(client.submit(run_chunk, job, nxt[0], plan.chunk(*nxt), pure=False))
+            yield result
+    finally:
+        client.close()
+
+
+# --- filter, rank, keep ------------------------------------------------------------------------
+
+def take(cols: Mapping[str, np.ndarray], rows: np.ndarray) -> dict[str, np.ndarray]:
+    return {k: v[rows] for k, v in cols.items()}
+
+
+def concat(parts: Sequence[Mapping[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    if not parts:
+        return {}
+    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+
+
+def rank(cols: Mapping[str, np.ndarray], key: str, descending: bool) -> np.ndarray:
+    """Row order by ``key``: stable, ties in design order, NaN (and, for text, nothing
+    else) last whichever the direction."""
+    v = cols[key]
+    if v.dtype == object:
+        order = np.argsort(v.astype(str), kind="stable")
+        return order[::-1] if descending else order
+    v = v.astype(float)
+    missing = np.isnan(v)
+    keyed = np.where(missing, np.inf, -v if descending else v)
+    return np.lexsort((cols["design"], missing, keyed))
+
+
+class Keeper:
+    """The records a scan keeps: all of them (streamed on to ``sink`` as they come when
+    unsorted), or the first ``top`` (by ``sort``), merged chunk by chunk so memory stays
+    bounded. ``show`` caps what is held for a table without changing what is counted."""
+
+    def __init__(self, sort: str | None, descending: bool, top: int | None,
+                 sink: Callable[[Mapping[str, np.ndarray]], None] | None, show: int | None = None) -> None:
+        self.sort, self.descending, self.top, self.sink = sort, descending, top, sink
+        self.limit = top if top is not None else show
+        self.kept = 0
+        self.held: dict[str, np.ndarray] = {}
+        self.parts: list[dict[str, np.ndarray]] = []
+
+    @property
+    def full(self) -> bool:
+        """True once no later design can change the output (unsorted, top reached)."""
+        return self.sort is None and self.top is not None and self.kept >= self.top
+
+    def add(self, cols: dict[str, np.ndarray]) -> None:
+        if self.sort is None and self.top is not None:
+            cols = take(cols, np.arange(min(self.top - self.kept, len(cols["design"]))))
+        self.kept += len(cols["design"])
+        if self.sink is not None:
+            self.sink(cols)
+            return
+        if self.limit is None:
+            self.parts.append(cols)
+            return
+        merged = concat([self.held, cols]) if self.held else cols
+        order = (rank(merged, self.sort, self.descending) if self.sort is not None
+                 else np.arange(len(merged["design"])))
+        self.held = take(merged, order[: self.limit])
+
+    def result(self) -> dict[str, np.ndarray]:
+        """What is held at the end, in order: the rows a table shows, or every row of a
+        sorted file."""
+        if self.limit is not None:
+            return self.held
+        rows = concat(self.parts)
+        if self.sort is None or not rows:
+            return rows
+        return take(rows, rank(rows, self.sort, self.descending))
+
+
+def default_branch(m: Mechanism, branch: str | None, tol: float) -> str | None:
+    """The branch every design follows: the one asked for, else (with a closed form) the
+    branch the file's own guess solves to at its driver value, else None (continuation
+    from the file's guess, design by design)."""
+    if branch is not None:
+        if branch not in ("open", "crossed"):
+            raise InputError(f"--branch must be open or crossed, got {branch!r}")
+        if m.closed_form is None:
+            raise InputError(f"--branch needs a mechanism with a closed form; {m.source} has none")
+        return branch
+    if m.closed_form is None:
+        return None
+    from .problems.closed_form import branch_rule
+    from .solve import solve_system
+
+    r = solve_system(m.problem(), tol=max(tol, 1e-12), record=False)
+    if not r.converged:
+        return "open"
+    shown = {u.name: (math.degrees(x) if u.kind == "angle" else x) for u, x in zip(m.unknowns, r.x)}
+    return branch_rule(m)(shown)
