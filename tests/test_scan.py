@@ -438,3 +438,21 @@ def test_the_readme_scan_example_prints_what_the_readme_shows(cli):
         return re.sub(r"; [0-9.]+ s\n", "\n", s).strip()
 
     assert strip_time(r.out) == strip_time("Grashof" + shown)
+
+
+def test_the_python_api_returns_the_command_records(cli):
+    import linkage
+
+    cols = linkage.scan_designs(str(CRANK), {"r2": (20, 60, 5), "r4": (60, 100, 5)},
+                        where="full_cycle and min_transmission_deg >= 30", sort="theta4_range",
+                        descending=True, top=4)
+    rows = records(cli("scan", str(CRANK), "--vary", "r2=20:60:5", "--vary", "r4=60:100:5", "--where",
+                       "full_cycle and min_transmission_deg >= 30", "--sort", "theta4_range", "--desc",
+                       "--top", "4", "-f", "json").out)
+    assert list(cols["design"]) == [r["design"] for r in rows]
+    assert list(cols["theta4_range"]) == [r["theta4_range"] for r in rows]
+    m = linkage.load_mechanism(str(CRANK))
+    sampled = linkage.scan_designs(m, {"r3": (100, 140)}, samples=7, seed=2, values=[0.0, 90.0, 180.0])
+    assert len(sampled["design"]) == 7 and ((100 <= sampled["r3"]) & (sampled["r3"] <= 140)).all()
+    with pytest.raises(linkage.InputError):
+        linkage.scan_designs(m, {"r3": (100,)})

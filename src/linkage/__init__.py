@@ -9,6 +9,7 @@ The public API, in the order a reader meets it:
   mechanism file whose ``.problem()`` it takes.
 - :func:`sweep` solves a mechanism over a range of its driver (a :class:`SweepResult`);
   :func:`position_rates` gives joints, velocities and accelerations at one solution.
+- :func:`scan_designs` runs many designs of a mechanism over their cycles: one record each.
 - :func:`analyze` estimates convergence order and rate from a recorded history.
 """
 
@@ -28,8 +29,10 @@ _EXPORTS = {
     "solve_scalar": ".solve", "solve_system": ".solve",
     "sweep": ".kinematics.sweep", "SweepResult": ".kinematics.sweep", "Position": ".kinematics.sweep",
     "position_rates": ".kinematics.rates", "Rates": ".kinematics.rates",
+    "scan_designs": ".scan",
 }
-_RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at"}
+_RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",
+            "scan_designs": "scan"}
 
 
 def __getattr__(name: str) -> Any:
@@ -71,6 +74,7 @@ __all__ = [
     "fourbar_equation",
     "load_mechanism",
     "position_rates",
+    "scan_designs",
     "solve_scalar",
     "solve_system",
     "sweep",

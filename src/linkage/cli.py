@@ -814,20 +814,8 @@ def scan(
     from .files import read_input
     from .kinematics.sweep import driver_values
     from .problems.loops import load
-    from .problems.where import parse_where
     from .render.scan import RecordSink, scan_blocks
-    from .scan import (
-        MAX_SCAN_POSITIONS,
-        DesignPlan,
-        Keeper,
-        ScanJob,
-        check_varies,
-        chunk_size,
-        columns_of,
-        default_branch,
-        parse_vary,
-        run_chunks,
-    )
+    from .scan import Keeper, ScanJob, chunk_size, parse_vary, prepare, run_chunks
     from .solve import check_criteria
 
     if output is not None and str(output) == "-":
@@ -848,8 +836,6 @@ def scan(
     varies = [parse_vary(v) for v in vary]
     text = read_input(file)
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
-    check_varies(mechanism, varies)
-    plan = DesignPlan(varies, samples, seed, sampling)
     angle = mechanism.driver.kind == "angle"
     if not angle and (start is None or stop is None):
         raise InputError(f"{mechanism.driver.name} is a length: give --from and --to")
@@ -857,27 +843,18 @@ def scan(
     b = 359.0 if stop is None else stop
     if b < a:
         raise InputError(f"--to ({b:g}) must not be below --from ({a:g})")
-    values = driver_values(a, b, step, None)
-    if len(values) > MAX_SCAN_POSITIONS:
-        raise InputError(f"{len(values):,} driver positions per design is more than "
-                         f"{MAX_SCAN_POSITIONS:,}; use a larger --step")
-    from .kinematics.sweep import check_driver_values
-
-    check_driver_values(mechanism, values)
-    spec = columns_of(mechanism, plan.names)
-    known = {c[0]: ("number" if c[1] in ("int", "number") else c[1]) for c in spec}
+    setup = prepare(mechanism, varies, samples=samples, seed=seed, sampling=sampling,
+                    values=driver_values(a, b, step, None), branch=branch, tol=tol, where=where, sort=sort)
+    plan, spec, test, chosen, values = setup.plan, setup.spec, setup.where, setup.branch, setup.values
     if columns:
         wanted = [w.strip().lower() for w in columns.split(",") if w.strip()]
         picked = [c for c in spec[1:] if any(c[0].lower().startswith(w) for w in wanted)]
         if not picked:
-            raise InputError(f"--columns {columns!r} matches no column; the columns are {', '.join(known)}")
+            raise InputError(f"--columns {columns!r} matches no column; the columns are "
+                             f"{', '.join(c[0] for c in spec)}")
         spec = [spec[0], *picked]
-    test = parse_where(where, known) if where is not None else None
-    if sort is not None and sort not in known:
-        raise InputError(f"--sort {sort}: no such column; the columns are {', '.join(known)}")
     if desc and sort is None:
         raise InputError("--desc orders by --sort: give --sort COLUMN")
-    chosen = default_branch(mechanism, branch, tol)
     overrides = tuple((k, float(v)) for k, v in parse_assignments("--set", set_ or []).items())
     job = ScanJob(text, str(file), overrides, plan.names, tuple(values), chosen, tol)
     size = chunk or chunk_size(mechanism, len(values))

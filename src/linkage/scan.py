@@ -158,6 +158,8 @@ class ScanJob:
     values: tuple[float, ...]
     branch: str | None
     tol: float
+    mechanism: Mechanism | None = None
+    """A mechanism object given directly (the Python API); it travels pickled."""
 
 
 @functools.lru_cache(maxsize=8)
@@ -174,10 +176,8 @@ def job_mechanism(text: str, source: str, overrides: tuple[tuple[str, float], ..
 
 def run_chunk(job: ScanJob, start: int, designs: np.ndarray) -> dict[str, np.ndarray]:
     """One task: the records of designs ``start, start + 1, ...`` as columns."""
-    m = job_mechanism(job.text, job.source, job.overrides)
+    m = job.mechanism or job_mechanism(job.text, job.source, job.overrides)
     params = {name: designs[:, j] for j, name in enumerate(job.names)}
-    if not params:
-        params = {}
     sol = solve_designs(m, params, np.array(job.values), branch=job.branch, tol=job.tol,
                         paths=bool(m.points))
     return design_metrics(m, job.names, designs, sol, start)
@@ -452,3 +452,76 @@ def default_branch(m: Mechanism, branch: str | None, tol: float) -> str | None:
         return "open"
     shown = {u.name: (math.degrees(x) if u.kind == "angle" else x) for u, x in zip(m.unknowns, r.x)}
     return branch_rule(m)(shown)
+
+
+@dataclass(frozen=True)
+class ScanSetup:
+    """A checked scan: the designs, the record columns, the filter and the branch."""
+
+    plan: DesignPlan
+    spec: list[tuple[str, str, str]]
+    where: Any
+    branch: str | None
+    values: list[float]
+
+
+def prepare(m: Mechanism, varies: Sequence[Vary], *, samples: int | None, seed: int, sampling: str,
+            values: Sequence[float], branch: str | None, tol: float, where: str | None,
+            sort: str | None) -> ScanSetup:
+    """Everything checked before any design is solved (one InputError or ParseError)."""
+    from .kinematics.sweep import check_driver_values
+    from .problems.where import parse_where
+
+    check_varies(m, varies)
+    plan = DesignPlan(varies, samples, seed, sampling)
+    if len(values) > MAX_SCAN_POSITIONS:
+        raise InputError(f"{len(values):,} driver positions per design is more than "
+                         f"{MAX_SCAN_POSITIONS:,}; use a larger --step")
+    listed = check_driver_values(m, values)
+    spec = columns_of(m, plan.names)
+    known = {c[0]: ("number" if c[1] in ("int", "number") else c[1]) for c in spec}
+    test = parse_where(where, known) if where is not None else None
+    if sort is not None and sort not in known:
+        raise InputError(f"--sort {sort}: no such column; the columns are {', '.join(known)}")
+    return ScanSetup(plan, spec, test, default_branch(m, branch, tol), listed)
+
+
+def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, samples: int | None = None,
+         seed: int = 0, sampling: str = "lhs", values: Sequence[float] | None = None,
+         branch: str | None = None, tol: float = 1e-12, where: str | None = None,
+         sort: str | None = None, descending: bool = False, top: int | None = None,
+         scheduler: str | None = None, workers: int | None = None,
+         chunk: int | None = None) -> dict[str, np.ndarray]:
+    """Scan designs of ``mechanism`` (a Mechanism or a file path); the public
+    ``linkage.scan_designs`` (``linkage.scan`` is this module).
+
+    ``vary`` maps parameter names to ``(lo, hi, n)`` (a grid) or ``(lo, hi)`` (with
+    ``samples``), in the file's units; ``values`` are the driver values (default 0..359
+    deg). Returns the kept records as columns (name -> numpy array), in design order or
+    sorted by ``sort``: the columns ``linkage scan`` writes, with the same ``where``,
+    ``sort``, ``top``, ``scheduler`` and ``workers``.
+    """
+    from .problems.loops import load
+
+    m = mechanism if isinstance(mechanism, Mechanism) else load(mechanism)
+    varies = []
+    for name, spec in vary.items():
+        if len(spec) not in (2, 3):
+            raise InputError(f"vary[{name!r}] must be (lo, hi) or (lo, hi, n)")
+        lo, hi = float(spec[0]), float(spec[1])
+        n = int(spec[2]) if len(spec) == 3 else None
+        varies.append(parse_vary(f"{name}={lo!r}:{hi!r}" + (f":{n}" if n is not None else "")))
+    if values is None:
+        values = [float(k) for k in range(360)]
+    setup = prepare(m, varies, samples=samples, seed=seed, sampling=sampling, values=list(values),
+                    branch=branch, tol=tol, where=where, sort=sort)
+    job = ScanJob("", m.source, (), setup.plan.names, tuple(setup.values), setup.branch, tol, m)
+    keeper = Keeper(sort, descending, top, None)
+    for cols in run_chunks(job, setup.plan, chunk or chunk_size(m, len(setup.values)),
+                           scheduler=scheduler, workers=workers):
+        if setup.where is not None:
+            cols = take(cols, setup.where(cols, len(cols["design"])))
+        keeper.add(cols)
+        if keeper.full:
+            break
+    return keeper.result() or {c[0]: np.array([]) for c in setup.spec}
