@@ -216,3 +216,31 @@ def test_benchmark_script_runs_on_a_few_positions():
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert "ratio batch / closed form" in proc.stdout and "all converged: True" in proc.stdout
+
+
+@pytest.mark.parametrize("name", ["crank_rocker.toml", "fourbar_me581.toml", "fourbar_me581_theta4.toml",
+                                  "slider_crank.toml", "offset_slider.toml", "rapier_drive.toml",
+                                  "watt_sixbar.toml"])
+def test_the_lean_continuation_step_changes_no_position(name, monkeypatch):
+    """The lean step (compiled functions, no problem or Result objects) must accept exactly
+    what the full step accepts, with the same numbers: sweeps with it and without it are
+    identical, position by position, on every sample and on random four-bars."""
+    import numpy as np
+
+    from linkage.kinematics import sweep as sweep_module
+    from linkage.problems.loops import load
+
+    m = load(SAMPLES / name)
+    designs = [m]
+    if m.closed_form == "fourbar":
+        rng = np.random.default_rng(5)
+        designs += [m.with_values({k: float(rng.uniform(0.4, 1.6) * m.parameters[k].value)
+                                   for k in ("r2", "r3", "r4")}, {}) for _ in range(6)]
+    values = [float(v) for v in np.arange(0.0, 360.0, 2.5)]
+    branches = ["open", "crossed"] if m.closed_form else [None]
+    fast = [sweep_module.sweep(d, values, branch=b) for d in designs for b in branches]
+    monkeypatch.setattr(sweep_module, "_lean_step", lambda *args: None)
+    slow = [sweep_module.sweep(d, values, branch=b) for d in designs for b in branches]
+    for a, b in zip(fast, slow):
+        assert a.positions == b.positions
+        assert (a.toggles, a.feasible_ranges, a.branch) == (b.toggles, b.feasible_ranges, b.branch)

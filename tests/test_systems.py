@@ -316,3 +316,26 @@ def test_loop_closure_holds_at_every_converged_position(path, driver):
         if result.converged:
             scale = max(q.value for q in m.parameters.values() if q.kind == "length")
             assert max(abs(v) for v in problem.F(list(result.x))) <= 1e-9 * max(1.0, scale)
+
+
+def test_rocker_driven_fourbar_keeps_both_assemblies_and_labels_each_position():
+    """Driven by theta4, the two assemblies are mirror images of A across O2-B, and
+    sin(theta4 - theta3) can have the same sign on both (theta4 = 189 deg here): the
+    closed form once labelled both "crossed" and lost one, and the sweep labelled every
+    position with the file's own theta4."""
+    import math
+
+    from linkage.kinematics.sweep import sweep
+    from linkage.problems.closed_form import fourbar_positions
+
+    sols = fourbar_positions(90.0, 20.0, 60.0, 45.0, 0.0, theta4=math.radians(189.0))
+    assert set(sols) == {"open", "crossed"}
+    assert all(math.sin(s["theta3"] - s["theta2"]) < 0 for b, s in sols.items() if b == "open")
+    m = load_mechanism(SAMPLES / "fourbar_me581_theta4.toml").with_values({"r2": 20.0}, {})
+    for branch in ("open", "crossed"):
+        result = sweep(m, [float(v) for v in range(0, 360, 3)], branch=branch)
+        solved = [p for p in result.positions if p.solution]
+        assert solved and all(p.branch == branch for p in solved)
+        for p in solved:
+            side = math.sin(math.radians(p.solution["theta3"] - p.solution["theta2"]))
+            assert (side < 0) == (branch == "open"), p

@@ -894,7 +894,7 @@ def scan(
     summary = [f"{mechanism.name}: {scanned:,} of {plan.total:,} designs scanned{stopped}"
                f"{where_note}; {elapsed:.2f} s",
                f"{len(values)} positions each ({mechanism.driver.name} {a:g}..{b:g} "
-               f"{mechanism.driver.unit}, step {step:g}); branch: {chosen or 'of the file guess'}; "
+               f"{mechanism.driver.unit}, step {step:g}); branch: {chosen or 'that of the file guess'}; "
                f"engine: {engine}"]
     if as_table:
         n_held = len(held["design"]) if held else 0

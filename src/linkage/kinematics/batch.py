@@ -346,16 +346,18 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
 
 def _on_branch(m: Mechanism, shown: np.ndarray, names: Sequence[str], det: np.ndarray,
                target: str | None) -> np.ndarray:
-    """True where a solution lies on the target branch (vectorised branch rules)."""
+    """True where a solution lies on the target branch: the closed form's rule
+    (closed_form.branch_rule) over arrays, else the sign of det J."""
     if target is None:
         return np.ones(len(shown), dtype=bool)
     idx = {n: j for j, n in enumerate(names)}
     if m.closed_form == "fourbar" and "theta3" in idx and "theta4" in idx:
         is_open = np.sin(np.radians(shown[:, idx["theta4"]] - shown[:, idx["theta3"]])) > 0
+    elif m.closed_form == "fourbar" and "theta2" in idx and "theta3" in idx:
+        # driven by theta4: the mirror images of A across O2-B (closed_form.branch_rule)
+        is_open = np.sin(np.radians(shown[:, idx["theta3"]] - shown[:, idx["theta2"]])) < 0
     elif m.closed_form == "slider_crank" and "theta3" in idx:
         is_open = np.cos(np.radians(shown[:, idx["theta3"]])) > 0
-    elif m.closed_form == "fourbar":
-        is_open = det < 0  # theta4 driven: det = r2 r3 sin(theta3 - theta2) < 0 on the open branch
     else:
         return (det > 0) == (target == "det+")
     return is_open == (target == "open")

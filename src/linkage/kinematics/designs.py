@@ -174,7 +174,7 @@ def _closed_form_seeds(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray,
     b = o4 + r4 * np.exp(1j * drv)
     a1, a2, ok = _circle(0j, r2, b, r3)
     t3s = (np.angle(b - a1), np.angle(b - a2))
-    first_open = np.sin(drv - t3s[0]) > 0.0
+    first_open = np.sin(t3s[0] - np.angle(a1)) < 0.0  # closed_form.branch_rule, theta4 driving
     pick = first_open == want_open
     return ({"theta2": np.where(pick, np.angle(a1), np.angle(a2)),
              "theta3": np.where(pick, t3s[0], t3s[1])}, ok, _apart(t3s) <= SEED_DISTANCE)

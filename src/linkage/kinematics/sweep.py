@@ -25,6 +25,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve
+from ..methods.newton_system import max_abs, newton_system_lean
 from ..problems.closed_form import (
     arc_limits,
     arcs_within,
@@ -105,6 +107,40 @@ class _Solver:
 
         self.rule = branch_rule(m) if m.closed_form else None
         self._problems: dict[float, Any] = {}
+        self._compiled: tuple[float, Any] = (math.nan, None)
+        size = m.length_scale
+        self.gate = tol * size
+        self.step_scales = (None if size == 1.0 or "length" not in self.kinds else
+                            tuple(size if k == "length" else 1.0 for k in self.kinds))
+
+    def compiled(self, value: float) -> Any:
+        """(F, J, dPhi/dv) at a driver value (display units), the last one kept: a
+        continuation step's tangent is taken where the previous step solved."""
+        d, fns = self._compiled
+        if d != value:
+            fns = self.model.factory(value * self.scale)
+            self._compiled = (value, fns)
+        return fns
+
+    def solve_lean(self, value: float, guess: Sequence[float]) -> tuple[Any, list[float], int] | None:
+        """What :meth:`solve` does for textbook Newton, without building a problem or a
+        Result: (J, x, iterations) when it converges, None otherwise (the caller then
+        takes the full path, which computes the same and says why)."""
+        F, J, _ = self.compiled(value)
+        try:
+            phi0 = F(list(guess))
+        except (ArithmeticError, ValueError):
+            return None
+        light = _LightProblem(F, J, self.step_scales, self, value)
+        q, phi, _err, status, _detail, iterations, _nfev, _njev = newton_system_lean(
+            light, tuple(guess), phi0, self.tol, 0.0, self.gate, self.max_iter, False)
+        # solve_system's verdicts on the lean loop's outcome
+        residual = max_abs(phi)
+        if status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN) and residual <= self.gate:
+            return J, q, iterations
+        if not status.converged or not residual <= self.gate:
+            return None
+        return J, q, iterations
 
     def problem(self, value: float, guess: Sequence[float] | None = None) -> Any:
         """The compiled problem at a driver value, built once per value (a position asks
@@ -142,6 +178,20 @@ class _Solver:
         if self.rule is not None:
             return self.rule(self.display(q))
         return "det+" if det > 0 else "det-"
+
+
+class _LightProblem:
+    """The parts of a compiled problem Newton's lean loop reads on its common path; any
+    other attribute (a singular step hands over to the method) builds the full problem."""
+
+    __slots__ = ("F", "J", "_solver", "_value", "step_scales")
+
+    def __init__(self, F: Any, J: Any, step_scales: Any, solver: _Solver, value: float) -> None:
+        self.F, self.J, self.step_scales = F, J, step_scales
+        self._solver, self._value = solver, value
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._solver.problem(self._value), name)
 
 
 def sweep(
@@ -393,6 +443,10 @@ def _continue(solver: _Solver, v: float, history: list[tuple[float, tuple[float,
     further ends here; the caller decides what the position is.
     """
     v_last, q_last = history[-1]
+    if solver.method == "newton":
+        fast = _lean_step(solver, v, v_last, q_last, target)
+        if fast is not None:
+            return fast
     for h in range(0, MAX_HALVINGS + 1):
         n = 2 ** h
         vq = (v_last, q_last)
@@ -430,13 +484,40 @@ def _continue(solver: _Solver, v: float, history: list[tuple[float, tuple[float,
     return Position(v, "failed", None, None, 0, None, note="the branch could not be continued"), None
 
 
+def _lean_step(solver: _Solver, v: float, v_last: float, q_last: tuple[float, ...],
+               target: str | None) -> tuple[Position, tuple[float, ...]] | None:
+    """The whole step of :func:`_continue` (no halving) with the same predictor, Newton
+    run, det, branch and continuity tests, on compiled functions only; None wherever
+    that step would not be accepted, so the full loop decides (and computes the same)."""
+    pred = _predict(solver, v_last, q_last, v)
+    if pred is None:
+        return None
+    got = solver.solve_lean(v, pred)
+    if got is None:
+        return None
+    J, x, iterations = got
+    q = tuple(x)
+    try:
+        det = det_from_lu(lu(J(list(q))))
+    except SingularMatrix:
+        det = 0.0
+    branch = solver.branch(q, det)
+    if target is not None and branch != target:
+        return None
+    dv = abs(v - v_last) * solver.scale
+    size = 1.0 + max(abs(c) for c in q)
+    moved = max(abs(a - b) for a, b in zip(pred, q_last))
+    correction = max(abs(a - b) for a, b in zip(q, pred))
+    if correction > 0.5 * moved + (1e-7 + 10.0 * dv * dv) * size:
+        return None
+    sol = solver.display(q)
+    return Position(v, "converged", sol, branch, iterations, det, _transmission(solver, sol)), q
+
+
 def tangent(solver: _Solver, v0: float, q0: Sequence[float]) -> list[float] | None:
     """dq/dv on the branch at (v0, q0), from J dq/dv = -dPhi/dv with the compiled, exact
     dPhi/dv; q in internal units, v in display units. None where J is singular."""
-    from ..methods._linalg import SingularMatrix, lu, lu_solve
-
-    d = v0 * solver.scale
-    _, J, V = solver.model.factory(d)
+    _, J, V = solver.compiled(v0)
     try:
         return lu_solve(lu(J(list(q0))), [-solver.scale * c for c in V(list(q0))])
     except SingularMatrix:
@@ -471,7 +552,6 @@ def _classify_gap(solver: _Solver, v: float, guesses: Sequence[tuple[float, ...]
 def _continuous_angles(solver: _Solver, positions: list[Position]) -> list[Position]:
     """Report each angle as the representative (mod 360) nearest its previous solved value,
     starting in (-180, 180]: curves stay continuous, across gaps too."""
-    from dataclasses import replace
 
     angles = [n for n, k in zip(solver.names, solver.kinds) if k == "angle"]
     prev: dict[str, float] = {}
@@ -486,7 +566,9 @@ def _continuous_angles(solver: _Solver, positions: list[Position]) -> list[Posit
             ref = prev.get(n)
             sol[n] = wrap_degrees(v) if ref is None else ref + wrap_degrees(v - ref)
             prev[n] = sol[n]
-        out.append(replace(p, solution=sol))
+        # the constructor: dataclasses.replace costs several times more per position
+        out.append(Position(p.input, p.status, sol, p.branch, p.iterations, p.det, p.transmission,
+                            p.substeps, p.note, p.rates))
     return _anchor(solver, out, angles)
 
 
@@ -542,7 +624,7 @@ def _follow(solver: _Solver, values: Sequence[float], seed: tuple[float, tuple[f
                 _walk(solver, v, hist, target)
             if pos.status != "converged" or q is None:
                 break
-            found[i] = replace(pos, input=values[i])
+            found[i] = pos if pos.input == values[i] else replace(pos, input=values[i])
             hist = [(v, q)]
             if progress is not None:
                 progress(len(found) + len(done))

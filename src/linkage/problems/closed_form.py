@@ -4,8 +4,11 @@ Four-bar (names r1..r4, theta1..theta4; loop r2 e^(i t2) + r3 e^(i t3) = r1 e^(i
 r4 e^(i t4)): with theta2 or theta4 given, the free joint lies on one circle at a
 fixed distance from a known point, so it is a circle-circle intersection with two
 solutions, labelled by assembly branch: open where sin(theta4 - theta3) > 0 (as in
-PROBLEMS.md P3), crossed where it is < 0. No real intersection: the linkage cannot be
-assembled at that input.
+PROBLEMS.md P3), crossed where it is < 0. With theta4 driving, the two solutions are the
+mirror images of A across the line O2-B, which that sign need not tell apart; there open
+is where sin(theta3 - theta2) < 0 (det J < 0, PROBLEMS.md P3's alternative driver: the
+same label at P3's open position). No real intersection: the linkage cannot be assembled
+at that input.
 
 Slider-crank (names r2, r3, e, theta2, theta3, s; loop r2 e^(i t2) + r3 e^(i t3) =
 s + i e): sin(theta3) = (e - r2 sin(theta2)) / r3, s = r2 cos(theta2) + r3 cos(theta3);
@@ -67,7 +70,7 @@ def fourbar_positions(r1: float, r2: float, r3: float, r4: float, theta1: float,
         for a in circle_points(0j, r2, b, r3):
             t2 = cmath.phase(a)
             t3 = cmath.phase(b - a)
-            out[_fourbar_branch(t3, theta4)] = {"theta2": t2, "theta3": t3, "theta4": theta4}
+            out[_rocker_driven_branch(t2, t3)] = {"theta2": t2, "theta3": t3, "theta4": theta4}
     else:
         raise ValueError("give theta2 or theta4")
     return out
@@ -75,6 +78,10 @@ def fourbar_positions(r1: float, r2: float, r3: float, r4: float, theta1: float,
 
 def _fourbar_branch(t3: float, t4: float) -> str:
     return "open" if math.sin(t4 - t3) > 0.0 else "crossed"
+
+
+def _rocker_driven_branch(t2: float, t3: float) -> str:
+    return "open" if math.sin(t3 - t2) < 0.0 else "crossed"
 
 
 def slider_crank_positions(r2: float, r3: float, e: float, theta2: float) -> Solutions:
@@ -175,6 +182,11 @@ def verify(m: Any) -> str | None:
 def branch_rule(m: Any) -> Callable[[dict[str, float]], str]:
     """The branch label of a solution given in display units (degrees)."""
     values = {k: q.value for k, q in m.parameters.items()}
+
+    if m.closed_form == "fourbar" and m.driver.name == "theta4":
+        def rocker_driven(sol: dict[str, float]) -> str:
+            return _rocker_driven_branch(math.radians(sol["theta2"]), math.radians(sol["theta3"]))
+        return rocker_driven
 
     if m.closed_form == "fourbar":
         def fourbar(sol: dict[str, float]) -> str:
