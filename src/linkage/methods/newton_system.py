@@ -19,6 +19,7 @@ import sys
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
+from ..iterate import DIVERGE_STREAK, ROUNDING, RUNAWAY, explain, rounding_stall
 from ..problems.system import SystemProblem
 from ..result import Column, Status
 from ._common import new_state
@@ -332,10 +333,10 @@ def newton_system_lean(problem: SystemProblem, q0: tuple[float, ...], phi0: list
 
     Returns (x, Phi(x), last error, status, detail, iterations, nfev, njev).
     """
-    from ..iterate import DIVERGE_STREAK, ROUNDING, RUNAWAY, explain, rounding_stall
-
     F, Jf = problem.F, problem.J
     scales = problem.step_scales
+    if scales is None and len(q0) == 2 and len(phi0) == 2:
+        return _newton_2x2(problem, q0, phi0, tol, rtol, gate, max_iter, damped)
     method = NewtonSystem("analytic", None, damped, diagnostics=False)
     isfinite = math.isfinite
     q = list(q0)
@@ -413,3 +414,94 @@ def newton_system_lean(problem: SystemProblem, q0: tuple[float, ...], phi0: list
                 return q, phi, err, Status.PRECISION_LIMIT, why, k, nfev, njev
         prev_err = err
     return q, phi, err, Status.MAX_ITER, "", k, nfev, njev
+
+
+def _newton_2x2(problem: SystemProblem, q0: tuple[float, ...], phi0: list[float], tol: float, rtol: float,
+                gate: float, max_iter: int, damped: bool) -> tuple[Any, ...]:
+    """:func:`newton_system_lean` for two unknowns measured as they are (every four-bar),
+    on scalars: the same operations in the same order, so the same iterates, status and
+    counts (tests/test_compile.py), without the per-iteration lists and helper calls. A
+    refused or singular step goes to :meth:`NewtonSystem.step` exactly as there."""
+    F, Jf = problem.F, problem.J
+    isfinite = math.isfinite
+    nan = math.nan
+    x0, x1 = q0
+    p0, p1 = phi0
+    ss = p0 * p0 + p1 * p1  # _sumsq(phi), carried from the step that produced phi
+    nfev, njev = 1, 0
+    prev_err = err = math.inf
+    growth = stalls = rounding_steps = 0
+    a0, a1 = abs(x0), abs(x1)
+    runaway = RUNAWAY * (1.0 + (nan if a0 != a0 or a1 != a1 else (a0 if a0 >= a1 else a1)))
+    shrink = 1.0 - 1e-4
+    tiny = 64.0 * EPS
+    k = 0
+    for k in range(1, max_iter + 1):
+        try:
+            (a, b), (c, d) = Jf([x0, x1])
+            njev += 1
+            a0, a1 = abs(p0), abs(p1)
+            resid = (a0 if a0 >= a1 else a1) if a0 == a0 and a1 == a1 else nan
+            det = a * d - b * c
+            size = abs(a * d) + abs(b * c)
+            refused = True
+            if size > 0.0 and abs(det) > SINGULAR_RATIO * size and isfinite(det):
+                d0, d1 = (b * p1 - d * p0) / det, (c * p0 - a * p1) / det
+                t0, t1 = x0 + d0, x1 + d1
+                f0, f1 = F([t0, t1])
+                nfev += 1
+                refused = False
+                if damped:
+                    st = f0 * f0 + f1 * f1
+                    if not st <= shrink * ss:
+                        e0, e1 = abs(d0), abs(d1)
+                        step_size = nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
+                        e0, e1 = abs(x0), abs(x1)
+                        q_size = nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
+                        if not step_size <= tiny * (1.0 + q_size):
+                            refused = True  # the whole step does not lower |Phi|: the method decides
+                            nfev -= 1
+            if refused:
+                njev -= 1  # the method evaluates J again
+                method = NewtonSystem("analytic", None, damped, diagnostics=False)
+                s = method.step(problem, NewtonSystemState((x0, x1), None, err, None, (), (), (), (),
+                                                           nan, nan, 1.0, nfev, njev, (p0, p1)))
+                nfev, njev = s.nfev, s.njev
+                if s.stop is not None:
+                    return (list(s.x), list(s.phi_x), s.err, s.stop[0], s.stop[1], k, nfev, njev)
+                d0, d1 = s.dq
+                t0, t1 = s.x
+                f0, f1 = s.phi_x
+        except (ArithmeticError, ValueError) as exc:
+            status, detail = explain(exc)
+            return [x0, x1], [p0, p1], err, status, detail, k - 1, nfev, njev
+        e0, e1 = abs(d0), abs(d1)
+        err = (e0 if e0 >= e1 else e1) if e0 == e0 and e1 == e1 else nan
+        x0, x1, p0, p1 = t0, t1, f0, f1
+        ss = p0 * p0 + p1 * p1
+        try:
+            finite = isfinite(err) and isfinite(resid)
+        except TypeError:
+            return ([x0, x1], [p0, p1], err, Status.DOMAIN_ERROR, f"f returned a non-real value: {resid!r}",
+                    k, nfev, njev)
+        if not finite:
+            return [x0, x1], [p0, p1], err, Status.NON_FINITE, f"error = {err!r}, residual = {resid!r}", k, \
+                nfev, njev
+        if resid == 0.0:
+            return [x0, x1], [p0, p1], err, Status.CONVERGED_EXACT, "", k, nfev, njev
+        e0, e1 = abs(x0), abs(x1)
+        size_q = nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
+        limit = tol + rtol * size_q if rtol else tol
+        if err <= limit and resid <= gate:
+            return [x0, x1], [p0, p1], err, Status.CONVERGED_STEP, "", k, nfev, njev
+        if not damped:
+            growth = growth + 1 if err > prev_err else 0
+            if growth >= DIVERGE_STREAK and size_q > runaway:
+                return ([x0, x1], [p0, p1], err, Status.DIVERGED, f"{growth} growing steps, last {err:.3g}",
+                        k, nfev, njev)
+        if err <= ROUNDING * size_q:
+            why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
+            if why is not None:
+                return [x0, x1], [p0, p1], err, Status.PRECISION_LIMIT, why, k, nfev, njev
+        prev_err = err
+    return [x0, x1], [p0, p1], err, Status.MAX_ITER, "", k, nfev, njev

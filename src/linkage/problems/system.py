@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -65,6 +66,10 @@ class SystemProblem:
 
 def generic_system(F: Residual, n: int, J: Jacobian | None = None) -> SystemProblem:
     """Wrap a bare residual function of n unknowns (no units, names x1..xn)."""
-    names = tuple(f"x{i + 1}" for i in range(n))
-    return SystemProblem(F=F, J=J, names=names, kinds=("",) * n,
-                         equation_names=tuple(f"F{i + 1}" for i in range(n)))
+    names, kinds, equations = _generic_labels(n)
+    return SystemProblem(F=F, J=J, names=names, kinds=kinds, equation_names=equations)
+
+
+@functools.lru_cache(maxsize=64)
+def _generic_labels(n: int) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
+    return tuple(f"x{i + 1}" for i in range(n)), ("",) * n, tuple(f"F{i + 1}" for i in range(n))
