@@ -11,13 +11,13 @@ from typing import Any
 
 from .errors import InputError
 from .iterate import MAX_ITER_LIMIT, Criteria, Rows, explain, run
-from .methods import SCALAR_METHODS, Bisection, FixedPoint, Hybrid, Newton, RegulaFalsi, Secant
-from .methods.least_squares import LevenbergMarquardt
-from .methods.newton import newton_lean
-from .methods.newton_system import NewtonSystem, max_abs, newton_system_lean
+from .methods import SCALAR_METHODS
+from .methods.newton import Newton, newton_lean
 from .problems.scalar import ScalarProblem
-from .problems.system import SystemProblem, generic_system
 from .result import History, Result, Status
+
+# A scalar solve imports only its own method; the system solvers load with the first
+# system solve (python -X importtime: about 20 ms of every `linkage solve` otherwise).
 
 
 def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: bool = True) -> float:
@@ -117,8 +117,18 @@ def solve_scalar(
         b = check_number("bracket end", bracket[1])
         if a == b:
             raise InputError(f"the bracket ends are equal ({a!r}); give an interval")
-        m = {"bisection": Bisection(), "regula-falsi": RegulaFalsi(),
-             "hybrid": Hybrid(crit.tol, crit.rtol)}[method]
+        if method == "bisection":
+            from .methods.bisection import Bisection
+
+            m = Bisection()
+        elif method == "regula-falsi":
+            from .methods.regula_falsi import RegulaFalsi
+
+            m = RegulaFalsi()
+        else:
+            from .methods.hybrid import Hybrid
+
+            m = Hybrid(crit.tol, crit.rtol)
         args: tuple[float, ...] = (a, b)
         start: dict[str, Any] = {"bracket": (a, b)}
     else:
@@ -135,6 +145,8 @@ def solve_scalar(
             x1 = check_number("x1", x1)
             if x1 == x0:
                 raise InputError(f"secant needs two different starting points, got x0 = x1 = {x0!r}")
+            from .methods.secant import Secant
+
             m = Secant()
             args = (x0, x1)
             start = {"x0": x0, "x1": x1}
@@ -148,6 +160,8 @@ def solve_scalar(
         else:
             if problem.g is None:
                 raise InputError("fixed-point needs the iteration function g (x = g(x))")
+            from .methods.fixed_point import FixedPoint
+
             m = FixedPoint(evaluate_f=crit.ftol is not None)
             args = (x0,)
             start = {"x0": x0}
@@ -455,6 +469,10 @@ def solve_system(
     textbook iteration.
     Returns a :class:`Result` with ``x`` (a tuple), ``nfev`` and ``njev``.
     """
+    from .methods.least_squares import LevenbergMarquardt
+    from .methods.newton_system import NewtonSystem, max_abs, newton_system_lean
+    from .problems.system import SystemProblem, generic_system
+
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r} for a system; choose from {', '.join(SYSTEM_METHODS)}")
     crit = check_criteria(tol, rtol, ftol, max_iter)
