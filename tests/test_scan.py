@@ -458,3 +458,14 @@ def test_the_python_api_returns_the_command_records(cli):
     assert len(sampled["design"]) == 7 and ((100 <= sampled["r3"]) & (sampled["r3"] <= 140)).all()
     with pytest.raises(linkage.InputError):
         linkage.scan_designs(m, {"r3": (100,)})
+
+
+def test_an_angle_in_radians_scans_like_the_same_angle_in_degrees(cli, tmp_path):
+    rad = tmp_path / "rad.toml"
+    rad.write_text(CRANK.read_text().replace('theta1 = { value = 0, unit = "deg" }',
+                                             'theta1 = { value = 0, unit = "rad" }'))
+    a = records(cli("scan", str(rad), "--vary", "theta1=0:0.2:3", "-f", "json").out)
+    b = records(cli("scan", str(CRANK), "--vary", f"theta1=0:{math.degrees(0.2)!r}:3", "-f", "json").out)
+    for x, y in zip(a, b):
+        for key in ("theta4_min", "theta4_range", "min_transmission_deg", "max_transmission_deg", "P_x_max"):
+            assert abs(x[key] - y[key]) < 1e-9, key

@@ -259,8 +259,8 @@ def _angle_deg(m: Mechanism, sol: DesignSolutions, names: Sequence[str], designs
         return np.broadcast_to(sol.values[None, :] if m.driver.unit == "deg"
                                else np.degrees(sol.values)[None, :], sol.status.shape)
     q = m.parameters[key]
-    v = _param(m, names, designs, key)
-    v = v / ANGLE_UNITS[q.unit] * ANGLE_UNITS["deg"] if key in names else np.degrees(v)
+    v = _param(m, names, designs, key)  # file units when varied, else internal (rad)
+    v = v * ANGLE_UNITS[q.unit] / ANGLE_UNITS["deg"] if key in names else np.degrees(v)
     return np.broadcast_to(v[:, None], sol.status.shape)
 
 
