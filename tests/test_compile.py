@@ -250,3 +250,27 @@ def test_lean_system_newton_equals_the_generic_loop_on_the_stress_battery():
             kw = dict(jac=s.J, tol=1e-10, ftol=1e-10, max_iter=200, damped=damped)
             _same(solve_system(s.F, s.start(factor), record=False, **kw),
                   solve_system(s.F, s.start(factor), record=True, **kw), label)
+
+
+def test_the_two_unknown_front_door_equals_the_general_path():
+    """solve_system on user callables of two unknowns with a tuple start takes a short
+    front door; a list start takes the general path. Everything in the Result agrees."""
+    from linkage import solve_system
+    from linkage.problems.catalog import mgh_cases
+    from linkage.stress import fourbar_cases, fourbar_mechanism
+
+    pairs = []
+    for it in fourbar_cases(random.Random(1), 200):
+        p = fourbar_mechanism(it).problem()
+        pairs.append((it["links"], p.F, p.J, tuple(float(v) for v in p.x0)))
+    for label, s, factor in mgh_cases():
+        start = s.start(factor)
+        if len(start) == 2:
+            pairs.append((label, s.F, s.J, tuple(float(v) for v in start)))
+    assert len(pairs) > 200
+    for label, F, J, x0 in pairs:
+        for damped in (True, False):
+            for kw in (dict(tol=1e-10), dict(tol=1e-12, ftol=1e-9, max_iter=7), dict(tol=1e-8, rtol=1e-6)):
+                fast = solve_system(F, x0, jac=J, record=False, damped=damped, **kw)
+                full = solve_system(F, list(x0), jac=J, record=False, damped=damped, **kw)
+                assert vars(fast) == vars(full) or repr(vars(fast)) == repr(vars(full)), (label, kw)

@@ -444,3 +444,35 @@ def test_noise_around_an_ill_conditioned_root_is_not_a_jump():
     pole = lambda x: 1.0 / (1.0 - x) if x != 1 else math.inf  # noqa: E731
     for g, br in ((jump, (0.5, 1.7)), (pole, (0.3, 1.9))):
         assert solve_scalar(g, method="bisection", bracket=br, tol=1e-12).status is Status.DISCONTINUITY
+
+
+def test_a_bracketing_answer_near_the_root_is_not_called_a_jump():
+    """Regula falsi's answer can sit 100 times nearer the root than its bracket is wide;
+    eight halvings of that bracket did not bring |f| below the answer's, and a smooth
+    cubic was reported as a discontinuity (found by hypothesis)."""
+    c = (0.015625, -3.0, 1.0)
+    r = solve_scalar(lambda x: ((x + c[2]) * x + c[1]) * x + c[0], method="regula-falsi",
+                     bracket=(0.0, 0.03125), tol=0.0078125)
+    assert r.converged, r.message
+
+
+@pytest.mark.parametrize("method", ["bisection", "regula-falsi", "hybrid"])
+@pytest.mark.parametrize("tol", [1e-2, 1e-8, 1e-14])
+def test_a_pole_is_never_a_root(method, tol):
+    """tan has no root in [1, 2], only a pole at pi/2: at tight tolerances the bracket
+    closed to a few ulps and was accepted; 1/(x - 0.3) raised ZeroDivisionError from the
+    check itself."""
+    import math
+
+    for f, bracket in ((math.tan, (1.0, 2.0)), (lambda x: 1.0 / (x - 0.3), (0.0, 1.0))):
+        r = solve_scalar(f, method=method, bracket=bracket, tol=tol)
+        assert r.status is Status.DISCONTINUITY, (method, tol, r.message)
+
+
+@pytest.mark.parametrize("method", ["bisection", "regula-falsi"])
+def test_a_jump_is_not_a_root(method):
+    import math
+
+    r = solve_scalar(lambda x: x - 0.5 + 0.001 * math.copysign(1.0, x - 0.5), method=method,
+                     bracket=(0.0, 1.0), tol=1e-2)
+    assert r.status is Status.DISCONTINUITY, r.message

@@ -238,11 +238,13 @@ def check_sign_change(problem: ScalarProblem, x: float, fx: float | None, lo: fl
                       shrink_from: float | None = None) -> tuple[Status, str, int]:
     """A bracket [lo, hi] with a sign change that closed on a root has a small residual;
     one that closed on a jump or a pole does not. When |f| at x is not far below its size
-    at ``f_ends``, bisect [lo, hi] 8 more times: at a root |f| falls below the answer's
-    with the width (about 256 times for a simple root), at a jump it stays, at a pole it
-    grows. ``shrink_from``: the size |f| must fall below by 16 (default |f(x)|; the
-    certification of an open method, whose x may already sit nearer the root than the
-    bisection resolves, passes the size at the interval's ends)."""
+    at ``f_ends``, bisect [lo, hi] further, keeping the sign change, until |f| falls to
+    1e-3 of that size (the same shortcut as above: at a root it does, after a few
+    halvings whatever point x the method ended on), at most down to the rounding level;
+    at a jump |f| stays, at a pole it grows or f cannot be evaluated.
+    ``shrink_from``: for the certification of an open method's small step, the size |f|
+    must instead fall 16 times below (|f| at the ends of [x - w, x + w], which lie next
+    to x)."""
     if fx is None or fx == 0.0:
         return Status.CONVERGED_STEP, detail, 0
     start_size = max(abs(f_ends[0]), abs(f_ends[1]))
@@ -253,33 +255,45 @@ def check_sign_change(problem: ScalarProblem, x: float, fx: float | None, lo: fl
         return Status.CONVERGED_STEP, detail, 0  # f is exactly zero at an end: a root there
     if hi - lo <= 64.0 * math.ulp(max(abs(lo), abs(hi))):
         # a sign change within a few ulps: double precision cannot tell a root from a
-        # jump there, and |f| is rounding noise that no bisection can shrink
+        # jump there, and |f| is rounding noise that no bisection can shrink; but |f|
+        # above its size at the bracket's ends is no root's: it grows into a pole
+        if abs(fx) > start_size:
+            return (Status.DISCONTINUITY, f"|f| is {abs(fx):.3g} at x = {x!r}, above its size at the "
+                    f"bracket's ends ({start_size:.3g}): f changes sign through a pole", 0)
         return Status.CONVERGED_STEP, detail, 0
-    flo = problem.f(lo)
-    evals = 1
-    smallest = abs(fx)
-    x_small, f_small = x, fx
-    best_at_start = abs(fx) if shrink_from is None else shrink_from
-    for _ in range(8):
-        mid = 0.5 * lo + 0.5 * hi
-        if mid in (lo, hi):
-            break
-        fm = problem.f(mid)
-        evals += 1
-        if fm == 0.0:
-            return Status.CONVERGED_STEP, detail, evals
-        if abs(fm) < smallest:
-            smallest, x_small, f_small = abs(fm), mid, fm
-        if (fm < 0.0) == (flo < 0.0):
-            lo, flo = mid, fm
-        else:
-            hi = mid
-    if smallest <= best_at_start / 16.0:
-        return Status.CONVERGED_STEP, detail, evals
+    target = 1e-3 * start_size if shrink_from is None else shrink_from / 16.0
+    evals = 0
+    ulp = math.ulp(max(abs(lo), abs(hi)))
+    try:
+        flo = problem.f(lo)
+        evals = 1
+        smallest = abs(fx)
+        # the noise test below reads f at the floats next to its point: a point found
+        # within a million ulps of the sign change could read f across a jump
+        x_small, f_small = x, fx
+        for _ in range(64):
+            mid = 0.5 * lo + 0.5 * hi
+            if hi - lo <= 64.0 * ulp or mid in (lo, hi):
+                break
+            fm = problem.f(mid)
+            evals += 1
+            if fm == 0.0:
+                return Status.CONVERGED_STEP, detail, evals
+            if abs(fm) < smallest:
+                smallest = abs(fm)
+                if smallest <= target:
+                    return Status.CONVERGED_STEP, detail, evals
+                if hi - lo > 1e6 * ulp:
+                    x_small, f_small = mid, fm
+            if (fm < 0.0) == (flo < 0.0):
+                lo, flo = mid, fm
+            else:
+                hi = mid
+    except (ArithmeticError, ValueError) as exc:
+        return (Status.DISCONTINUITY, f"f cannot be evaluated inside the final bracket ({exc}): a pole or "
+                f"a gap, not a root", evals)
     # |f| that does not shrink may be rounding noise around a root (an ill-conditioned
     # root such as an expanded (x - 1)^3), not a jump: f's own noise next to x tells
-    if abs(flo) < smallest:
-        x_small, f_small = lo, flo
     noise, n = at_noise_level(problem, x_small, f_small, abs(hi - lo) + 1.0)
     evals += n
     if noise:
@@ -469,6 +483,12 @@ def solve_system(
     textbook iteration.
     Returns a :class:`Result` with ``x`` (a tuple), ``nfev`` and ``njev``.
     """
+    if (method == "newton" and not record and jac is not None and fd_step is None and type(x0) is tuple
+            and len(x0) == 2 and type(x0[0]) is float and type(x0[1]) is float
+            and x0[0] - x0[0] == 0.0 and x0[1] - x0[1] == 0.0 and callable(F)):
+        # the common case without the general front door: user callables, two unknowns,
+        # a finite start (the same outcome: tests/test_compile.py)
+        return _newton_two(F, jac, x0, _criteria(tol, rtol, ftol, max_iter), damped)
     from .methods.least_squares import LevenbergMarquardt
     from .methods.newton_system import NewtonSystem, max_abs, newton_system_lean
     from .problems.system import SystemProblem, generic_system
@@ -559,6 +579,50 @@ def solve_system(
     result = Result.fast(m.name, x, status, iterations, nfev, err, residual, detail, meta)
     if history is not None or njev:
         result.__dict__.update(history=history, njev=njev)
+    return result
+
+
+@functools.lru_cache(maxsize=64, typed=True)
+def _criteria(tol: float, rtol: float, ftol: float | None, max_iter: int) -> Criteria:
+    """check_criteria, remembered (a refusal raises, and is not remembered)."""
+    return check_criteria(tol, rtol, ftol, max_iter)
+
+
+@functools.lru_cache(maxsize=1)
+def _two_unknowns() -> tuple[Any, ...]:
+    """What :func:`_newton_two` needs, imported once (a scalar solve never pays for it)."""
+    from .methods.newton_system import _newton_2x2, max_abs
+    from .problems.system import LeanProblem, _generic_labels, generic_system
+
+    return _newton_2x2, max_abs, LeanProblem, _generic_labels(2), generic_system
+
+
+def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float, float], crit: Criteria,
+                damped: bool) -> Result:
+    """:func:`solve_system` for ``newton`` on user callables of two unknowns, with the
+    general path's checks and packaging, but no problem object unless a step is refused."""
+    _newton_2x2, max_abs, LeanProblem, labels, generic_system = _two_unknowns()
+    try:
+        phi0 = F(list(x0))
+    except (ArithmeticError, ValueError) as exc:
+        raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
+    if len(phi0) != 2:
+        raise InputError(f"the system has {len(phi0)} equations for 2 unknowns")
+    gate = crit.ftol if crit.ftol is not None else crit.tol
+    problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
+    q, phi, err, status, detail, iterations, nfev, njev = _newton_2x2(
+        problem, x0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
+    stopped = status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN)
+    residual = max_abs(phi)
+    if stopped and residual <= gate:
+        status, detail = Status.CONVERGED_RESIDUAL, f"max|Phi| = {residual:.3g} <= {gate:.3g}; {detail}"
+    if status.converged and not residual <= gate:
+        status, detail = Status.STALLED, f"max|Phi| = {residual:.3g} at the end, above {gate:.3g}"
+    names, kinds, _ = labels
+    meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": names, "kinds": kinds, "title": ""}
+    result = Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, meta)
+    if njev:
+        result.__dict__["njev"] = njev
     return result
 
 

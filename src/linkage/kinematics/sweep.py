@@ -35,6 +35,7 @@ from ..problems.closed_form import (
     wrap_degrees,
 )
 from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism
+from ..problems.system import LeanProblem
 from ..result import Status
 
 MAX_HALVINGS = 6
@@ -131,7 +132,7 @@ class _Solver:
             phi0 = F(list(guess))
         except (ArithmeticError, ValueError):
             return None
-        light = _LightProblem(F, J, self.step_scales, self, value)
+        light = LeanProblem(F, J, self.step_scales, lambda: self.problem(value))
         q, phi, _err, status, _detail, iterations, _nfev, _njev = newton_system_lean(
             light, tuple(guess), phi0, self.tol, 0.0, self.gate, self.max_iter, False)
         # solve_system's verdicts on the lean loop's outcome
@@ -178,20 +179,6 @@ class _Solver:
         if self.rule is not None:
             return self.rule(self.display(q))
         return "det+" if det > 0 else "det-"
-
-
-class _LightProblem:
-    """The parts of a compiled problem Newton's lean loop reads on its common path; any
-    other attribute (a singular step hands over to the method) builds the full problem."""
-
-    __slots__ = ("F", "J", "_solver", "_value", "step_scales")
-
-    def __init__(self, F: Any, J: Any, step_scales: Any, solver: _Solver, value: float) -> None:
-        self.F, self.J, self.step_scales = F, J, step_scales
-        self._solver, self._value = solver, value
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self._solver.problem(self._value), name)
 
 
 def sweep(

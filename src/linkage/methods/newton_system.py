@@ -423,7 +423,6 @@ def _newton_2x2(problem: SystemProblem, q0: tuple[float, ...], phi0: list[float]
     counts (tests/test_compile.py), without the per-iteration lists and helper calls. A
     refused or singular step goes to :meth:`NewtonSystem.step` exactly as there."""
     F, Jf = problem.F, problem.J
-    isfinite = math.isfinite
     nan = math.nan
     x0, x1 = q0
     p0, p1 = phi0
@@ -445,7 +444,7 @@ def _newton_2x2(problem: SystemProblem, q0: tuple[float, ...], phi0: list[float]
             det = a * d - b * c
             size = abs(a * d) + abs(b * c)
             refused = True
-            if size > 0.0 and abs(det) > SINGULAR_RATIO * size and isfinite(det):
+            if size > 0.0 and abs(det) > SINGULAR_RATIO * size and det - det == 0.0:
                 d0, d1 = (b * p1 - d * p0) / det, (c * p0 - a * p1) / det
                 t0, t1 = x0 + d0, x1 + d1
                 f0, f1 = F([t0, t1])
@@ -480,7 +479,8 @@ def _newton_2x2(problem: SystemProblem, q0: tuple[float, ...], phi0: list[float]
         x0, x1, p0, p1 = t0, t1, f0, f1
         ss = p0 * p0 + p1 * p1
         try:
-            finite = isfinite(err) and isfinite(resid)
+            # v - v is 0.0 for a finite number, NaN for inf and NaN (isfinite, without calls)
+            finite = err - err == 0.0 and resid - resid == 0.0
         except TypeError:
             return ([x0, x1], [p0, p1], err, Status.DOMAIN_ERROR, f"f returned a non-real value: {resid!r}",
                     k, nfev, njev)

@@ -73,3 +73,23 @@ def generic_system(F: Residual, n: int, J: Jacobian | None = None) -> SystemProb
 @functools.lru_cache(maxsize=64)
 def _generic_labels(n: int) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
     return tuple(f"x{i + 1}" for i in range(n)), ("",) * n, tuple(f"F{i + 1}" for i in range(n))
+
+
+class LeanProblem:
+    """What Newton's lean loop reads on its common path (F, J, step_scales), with the full
+    problem built by ``build()`` only if anything else is asked for (a refused or
+    singular step hands over to the method, which reads more)."""
+
+    __slots__ = ("F", "J", "_build", "_full", "step_scales")
+
+    def __init__(self, F: Residual, J: Jacobian | None, step_scales: tuple[float, ...] | None,
+                 build: Callable[[], SystemProblem]) -> None:
+        self.F, self.J, self.step_scales, self._build, self._full = F, J, step_scales, build, None
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_"):
+            raise AttributeError(name)
+        full = self._full
+        if full is None:
+            full = self._full = self._build()
+        return getattr(full, name)
