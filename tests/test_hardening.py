@@ -476,3 +476,19 @@ def test_a_jump_is_not_a_root(method):
     r = solve_scalar(lambda x: x - 0.5 + 0.001 * math.copysign(1.0, x - 0.5), method=method,
                      bracket=(0.0, 1.0), tol=1e-2)
     assert r.status is Status.DISCONTINUITY, r.message
+
+
+def test_criteria_of_any_type_are_refused_with_input_error():
+    """The checked criteria are remembered: a list could not be (TypeError from the cache)
+    and True shared 1's entry, so max_iter=True passed after a run with max_iter=1."""
+    from linkage import InputError, solve_system
+
+    f = lambda x: x * x - 2  # noqa: E731
+    assert solve_scalar(f, method="bisection", bracket=(0.0, 2.0), max_iter=1).iterations == 1
+    with pytest.raises(InputError):
+        solve_scalar(f, method="bisection", bracket=(0.0, 2.0), max_iter=True)
+    for bad in ([1e-3], {"a": 1}):
+        with pytest.raises(InputError):
+            solve_scalar(f, method="bisection", bracket=(0.0, 2.0), tol=bad)
+        with pytest.raises(InputError):
+            solve_system(lambda q: [q[0] - 1, q[1] - 2], (0.0, 0.0), jac=lambda q: [[1, 0], [0, 1]], tol=bad)

@@ -38,8 +38,22 @@ def _short_int(v: int) -> str:
     return text
 
 
-@functools.lru_cache(maxsize=256)
 def check_criteria(tol: float, rtol: float, ftol: float | None, max_iter: int) -> Criteria:
+    """The stopping criteria, checked (InputError naming the bad one). Remembered per
+    value and type (True is not 1 here); values that cannot be remembered, such as a list,
+    are checked afresh and refused with their message."""
+    try:
+        return _checked_criteria(tol, rtol, ftol, max_iter)
+    except TypeError:
+        return _check_criteria(tol, rtol, ftol, max_iter)
+
+
+@functools.lru_cache(maxsize=256, typed=True)
+def _checked_criteria(tol: float, rtol: float, ftol: float | None, max_iter: int) -> Criteria:
+    return _check_criteria(tol, rtol, ftol, max_iter)
+
+
+def _check_criteria(tol: float, rtol: float, ftol: float | None, max_iter: int) -> Criteria:
     tol = check_number("tol", tol, positive=True, allow_zero=False)
     rtol = check_number("rtol", rtol, positive=True)
     if ftol is not None:
@@ -488,11 +502,9 @@ def solve_system(
             and x0[0] - x0[0] == 0.0 and x0[1] - x0[1] == 0.0 and callable(F)):
         # the common case without the general front door: user callables, two unknowns,
         # a finite start (the same outcome: tests/test_compile.py)
-        return _newton_two(F, jac, x0, _criteria(tol, rtol, ftol, max_iter), damped)
-    from .methods.least_squares import LevenbergMarquardt
-    from .methods.newton_system import NewtonSystem, max_abs, newton_system_lean
-    from .problems.system import SystemProblem, generic_system
-
+        return _newton_two(F, jac, x0, check_criteria(tol, rtol, ftol, max_iter), damped)
+    LevenbergMarquardt, NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system = \
+        _system_solvers()
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r} for a system; choose from {', '.join(SYSTEM_METHODS)}")
     crit = check_criteria(tol, rtol, ftol, max_iter)
@@ -511,7 +523,10 @@ def solve_system(
     if x0 is None or len(x0) != problem.n:
         raise InputError(f"x0 needs {problem.n} values ({', '.join(problem.names)}), "
                          f"got {0 if x0 is None else len(x0)}")
-    q0 = tuple(check_number(f"x0[{n}]", v) for n, v in zip(problem.names, x0))
+    if all(type(v) is float and v - v == 0.0 for v in x0):
+        q0 = tuple(x0)  # finite floats already: what check_number would return
+    else:
+        q0 = tuple(check_number(f"x0[{n}]", v) for n, v in zip(problem.names, x0))
     if problem.length_scale != 1.0 or "length" in problem.kinds or problem.length_unit:
         for name, value in (("tol", crit.tol), ("ftol", crit.ftol)):
             if value is not None and value > MAX_RELATIVE_TOL:
@@ -582,10 +597,14 @@ def solve_system(
     return result
 
 
-@functools.lru_cache(maxsize=64, typed=True)
-def _criteria(tol: float, rtol: float, ftol: float | None, max_iter: int) -> Criteria:
-    """check_criteria, remembered (a refusal raises, and is not remembered)."""
-    return check_criteria(tol, rtol, ftol, max_iter)
+@functools.lru_cache(maxsize=1)
+def _system_solvers() -> tuple[Any, ...]:
+    """The system solvers, imported on the first system solve (never by a scalar one)."""
+    from .methods.least_squares import LevenbergMarquardt
+    from .methods.newton_system import NewtonSystem, max_abs, newton_system_lean
+    from .problems.system import SystemProblem, generic_system
+
+    return LevenbergMarquardt, NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system
 
 
 @functools.lru_cache(maxsize=1)
