@@ -131,18 +131,8 @@ def solve_scalar(
         b = check_number("bracket end", bracket[1])
         if a == b:
             raise InputError(f"the bracket ends are equal ({a!r}); give an interval")
-        if method == "bisection":
-            from .methods.bisection import Bisection
-
-            m = Bisection()
-        elif method == "regula-falsi":
-            from .methods.regula_falsi import RegulaFalsi
-
-            m = RegulaFalsi()
-        else:
-            from .methods.hybrid import Hybrid
-
-            m = Hybrid(crit.tol, crit.rtol)
+        cls = _method_class(method)
+        m = cls(crit.tol, crit.rtol) if method == "hybrid" else cls()
         args: tuple[float, ...] = (a, b)
         start: dict[str, Any] = {"bracket": (a, b)}
     else:
@@ -159,9 +149,7 @@ def solve_scalar(
             x1 = check_number("x1", x1)
             if x1 == x0:
                 raise InputError(f"secant needs two different starting points, got x0 = x1 = {x0!r}")
-            from .methods.secant import Secant
-
-            m = Secant()
+            m = _method_class("secant")()
             args = (x0, x1)
             start = {"x0": x0, "x1": x1}
         elif method == "newton":
@@ -174,9 +162,7 @@ def solve_scalar(
         else:
             if problem.g is None:
                 raise InputError("fixed-point needs the iteration function g (x = g(x))")
-            from .methods.fixed_point import FixedPoint
-
-            m = FixedPoint(evaluate_f=crit.ftol is not None)
+            m = _method_class("fixed-point")(evaluate_f=crit.ftol is not None)
             args = (x0,)
             start = {"x0": x0}
     try:
@@ -198,6 +184,25 @@ def solve_scalar(
                       meta={"var": problem.var, "unit": problem.unit, "title": problem.title,
                             "tol": crit.tol, "rtol": crit.rtol, **start})
     return finish(m, problem, state, crit, record, start)
+
+
+_METHOD_MODULES = {"bisection": (".methods.bisection", "Bisection"),
+                   "regula-falsi": (".methods.regula_falsi", "RegulaFalsi"),
+                   "hybrid": (".methods.hybrid", "Hybrid"), "secant": (".methods.secant", "Secant"),
+                   "fixed-point": (".methods.fixed_point", "FixedPoint")}
+_METHOD_CLASSES: dict[str, Any] = {}
+
+
+def _method_class(name: str) -> Any:
+    """A scalar method's class, imported on its first use (an import statement inside a
+    function costs almost a microsecond on every call; a dictionary lookup does not)."""
+    cls = _METHOD_CLASSES.get(name)
+    if cls is None:
+        from importlib import import_module
+
+        module, attr = _METHOD_MODULES[name]
+        cls = _METHOD_CLASSES[name] = getattr(import_module(module, __package__), attr)
+    return cls
 
 
 def _newton_lean(problem: ScalarProblem, x0: float, crit: Criteria, record: bool = False) -> Result:
