@@ -809,7 +809,7 @@ def scan(
     unknown's _min, _max and _range, for four-bars grashof and min/max_transmission_deg
     (folded into 0..90), and the x/y extents of each [points] path.
 
-    Example: linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60:5 --vary r4=60:100:5
+    Example: linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60:5 --vary r4=60:120:7
     """
     from .files import read_input
     from .kinematics.sweep import driver_values
@@ -1213,6 +1213,22 @@ class _progress:
 
 
 # --- entry point ----------------------------------------------------------------------------
+
+def _reflow(doc: str) -> str:
+    """A docstring as help text: each paragraph one line (rich keeps single line breaks,
+    so hard-wrapped source lines would break mid-sentence at any width), and square
+    brackets escaped (rich would read "[points]" as a style)."""
+    import inspect
+
+    paragraphs = inspect.cleandoc(doc).split("\n\n")
+    return "\n\n".join(" ".join(line.strip() for line in p.splitlines()).replace("[", "\\[")
+                       for p in paragraphs)
+
+
+for _command in app.registered_commands:
+    if _command.help is None and _command.callback is not None and _command.callback.__doc__:
+        _command.help = _reflow(_command.callback.__doc__)
+
 
 def run_cli(argv: list[str] | None = None) -> int:
     """Run the app and turn every error into one stderr line and an exit code."""
