@@ -469,3 +469,10 @@ def test_an_angle_in_radians_scans_like_the_same_angle_in_degrees(cli, tmp_path)
     for x, y in zip(a, b):
         for key in ("theta4_min", "theta4_range", "min_transmission_deg", "max_transmission_deg", "P_x_max"):
             assert abs(x[key] - y[key]) < 1e-9, key
+
+
+def test_help_reads_as_written(cli):
+    r = cli("scan", "--help")
+    text = " ".join(r.out.split())
+    assert "extents of each [points] path" in text and "\U0001f4af" not in r.out
+    assert "assembly exists), solved_fraction" in text  # a paragraph, not its source lines
