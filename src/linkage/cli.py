@@ -888,6 +888,8 @@ def scan(
     from .kinematics.designs import closed_form_applies
 
     engine = ("closed form + vectorised Newton" if closed_form_applies(mechanism)
+              else "vectorised continuation (a design that needs more is swept on its own)"
+              if mechanism.closed_form is None and mechanism.driver.kind == "angle"
               else "continuation, design by design")
     where_note = f"; {keeper.kept:,} pass --where" if test is not None else ""
     stopped = f" (stopped early: the first {top} are final)" if scanned < plan.total else ""

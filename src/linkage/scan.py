@@ -35,7 +35,7 @@ CHUNK_POSITIONS = 200_000
 CHUNK_DESIGNS_MAX = 20_000
 """At most this many designs per task, whatever the positions: records stay small."""
 CHUNK_DESIGNS_SWEEP = 16
-"""Designs per task on the continuation engine (tens of ms per design)."""
+"""Designs per task where every design is swept on its own (tens of ms per design)."""
 
 
 @dataclass(frozen=True)
@@ -184,7 +184,7 @@ def run_chunk(job: ScanJob, start: int, designs: np.ndarray) -> dict[str, np.nda
 
 
 def chunk_size(m: Mechanism, positions: int) -> int:
-    if closed_form_applies(m):
+    if closed_form_applies(m) or (m.closed_form is None and m.driver.kind == "angle"):
         return max(1, min(CHUNK_DESIGNS_MAX, CHUNK_POSITIONS // max(positions, 1)))
     return CHUNK_DESIGNS_SWEEP
 

@@ -11,8 +11,11 @@ Mechanisms with a closed form (four-bars driven by theta2 or theta4, slider-cran
    Newton converges there, stays within 1e-6 (rad, or of the size) of the closed form
    and lies on the branch; otherwise it is ``failed`` (never given numbers).
 
-Other mechanisms go design by design through the continuation sweep
-(:func:`~linkage.kinematics.sweep.sweep`): the same statuses, far slower.
+Mechanisms without a closed form (six-bars, the rapier drive) follow the sweep's
+continuation for every design at once (:func:`_continuation_engine`); a design that
+would need more than a plain step anywhere (a halved step, a gap, a fold) is swept on
+its own by :func:`~linkage.kinematics.sweep.sweep`. Either way every design gets the
+sweep's statuses (tests/test_scan.py compares them).
 
 Either way angles are reported continuously along the driver (each the representative
 nearest the previous solved value, across gaps too), and each curve is shifted by whole
@@ -82,6 +85,8 @@ def solve_designs(m: Mechanism, params: Mapping[str, np.ndarray], values: Sequen
     if closed_form_applies(m) and branch is not None:
         q, status, feasible, engine = _closed_form_engine(m, params, vals, branch, tol, max_iter,
                                                           n_designs)
+    elif branch is None and m.closed_form is None and m.driver.kind == "angle":
+        q, status, feasible, engine = _continuation_engine(m, params, vals, tol, n_designs)
     else:
         q, status, feasible, engine = _sweep_engine(m, params, vals, branch, tol, n_designs)
     found_paths = _paths(m, params, vals, q, status == CONVERGED) if paths else {}
@@ -222,12 +227,14 @@ def _terms(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray) -> list[list[
 
 
 def _newton(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol: float, size: np.ndarray,
-            is_length: list[bool], max_iter: int) -> tuple[np.ndarray, np.ndarray]:
+            is_length: list[bool], max_iter: int, count: bool = False) -> Any:
     """Newton-Raphson at every ``active`` position at once, updating ``q_all`` in place;
-    only unconverged positions keep iterating. Returns (converged, det J)."""
+    only unconverged positions keep iterating. Returns (converged, det J), and with
+    ``count`` the iterations each took as well."""
     n_pos = len(size)
     done = np.zeros(n_pos, dtype=bool)
     det_out = np.full(n_pos, np.nan)
+    iterations = np.zeros(n_pos, dtype=np.int32)
     gate_all = tol * size
     q = [c[active] for c in q_all]
     for _ in range(max_iter):
@@ -258,13 +265,162 @@ def _newton(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol
         for j in range(len(q)):
             q_all[j][active] = q[j]
         det_out[active] = det
+        iterations[active] += 1
         done[active[finished]] = True
         active = active[keep]
         q = [c[keep] for c in q]
-    return done, det_out
+    return (done, det_out, iterations) if count else (done, det_out)
 
 
-# --- the continuation engine ----------------------------------------------------------------
+# --- the continuation engines -----------------------------------------------------------------
+
+SEED_ITERATIONS = 12
+"""A design whose seed takes Newton longer than this goes through the one-at-a-time sweep
+(whose loop may stop such a run earlier, as diverged or at rounding level)."""
+
+
+def _continuation_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, tol: float,
+                         n_designs: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray, str]:
+    """The sweep's continuation for every design at once, where it is plain sailing.
+
+    The seed is Newton from the file's guess at the file's driver value (the branch: the
+    sign of det J there); the positions follow in the sweep's order, each from the last
+    by the tangent predictor and Newton, with the sweep's tests: converged, det J of the
+    same sign, and the correction within the continuity bound. A design that fails any
+    test anywhere (it would need a halved step, or reaches a gap or a fold) leaves the
+    batch and goes through :func:`~linkage.kinematics.sweep.sweep` on its own, so every
+    design gets the sweep's statuses; a design that passes them all is the sweep's
+    continuation step for step, vectorised.
+    """
+    scale = ANGLE_UNITS[m.driver.unit]
+    v0 = m.driver.value / scale
+    n, k = len(m.unknowns), len(vals)
+    is_length = [u.kind == "length" for u in m.unknowns]
+    grid, _ = _grid(m, params, np.array([v0]), n_designs)  # one entry per design
+    size = _size(m, grid, np.full(n_designs, v0 * scale))
+    clean = np.ones(n_designs, dtype=bool)
+    q_out = [np.full((n_designs, k), np.nan) for _ in range(n)]
+
+    def at(v: float, rows: np.ndarray) -> tuple[VectorLoops, dict[str, Any]]:
+        sub = {key: (val[rows] if isinstance(val, np.ndarray) else val) for key, val in grid.items()}
+        drv = np.full(rows.size, v * scale)
+        return VectorLoops.of_terms(_terms(m, sub, drv), n, rows.size), sub
+
+    # the seed
+    rows = np.arange(n_designs)
+    loops, _ = at(v0, rows)
+    seed = [np.full(n_designs, u.value) for u in m.unknowns]
+    done, _, iters = _newton(loops, seed, rows, tol, size, is_length, SEED_ITERATIONS, count=True)
+    clean &= done & (iters <= SEED_ITERATIONS)
+    det0 = _det_at(loops, seed, n_designs)
+    clean &= np.isfinite(det0) & (det0 != 0.0)
+    positive = det0 > 0.0
+    order = np.argsort(vals, kind="stable")
+    up = [int(i) for i in order if vals[i] >= v0]
+    down = [int(i) for i in order[::-1] if vals[i] < v0]
+    full_turn = k > 0 and vals[order[-1]] - vals[order[0]] >= 360.0 - 1e-9
+    passes = [[(i, float(vals[i])) for i in up], [(i, float(vals[i])) for i in down]]
+    if full_turn:  # as the sweep: each direction carries on around the turn
+        passes[0] += [(i, float(vals[i]) + 360.0) for i in down[::-1]]
+        passes[1] += [(i, float(vals[i]) - 360.0) for i in up[::-1]]
+    reached = np.zeros((n_designs, k), dtype=bool)
+    for plan in passes:
+        live = np.flatnonzero(clean)
+        q_last = [c[live] for c in seed]
+        v_last = v0
+        for i, v in plan:
+            if live.size == 0:
+                break
+            if reached[live, i].all():
+                continue  # found by the other pass: the sweep skips it too
+            if abs(v - v_last) > 5.0:  # the sweep walks long intervals in smaller steps
+                clean[live] = False
+                break
+            fresh = ~reached[live, i]
+            loops_last, _ = at(v_last, live)
+            t = _tangent(m, loops_last, grid, live, v_last * scale, q_last, scale)
+            pred = [ql + (v - v_last) * tj for ql, tj in zip(q_last, t)]
+            loops_v, _ = at(v, live)
+            q = [c.copy() for c in pred]
+            ok, _, _ = _newton(loops_v, q, np.arange(live.size), tol, size[live], is_length, 50, count=True)
+            det = _det_at(loops_v, q, live.size)
+            ok &= np.isfinite(det) & ((det > 0.0) == positive[live]) & (det != 0.0)
+            dv = abs(v - v_last) * scale
+            mag = 1.0 + np.max(np.abs(np.stack(q)), axis=0)
+            moved = np.max(np.abs(np.stack(pred) - np.stack(q_last)), axis=0)
+            correction = np.max(np.abs(np.stack(q) - np.stack(pred)), axis=0)
+            with np.errstate(invalid="ignore"):
+                ok &= correction <= 0.5 * moved + (1e-7 + 10.0 * dv * dv) * mag
+            clean[live[~ok]] = False
+            keep = ok
+            live = live[keep]
+            q = [c[keep] for c in q]
+            store = fresh[keep]
+            for j in range(n):
+                q_out[j][live[store], i] = q[j][store]
+            reached[live[store], i] = True
+            q_last, v_last = q, v
+    clean &= reached.all(axis=1)
+    status = np.full((n_designs, k), CONVERGED, dtype=np.int8)
+    q_flat = [c.reshape(-1) for c in q_out]
+    status_flat = status.reshape(-1)
+    rest = np.flatnonzero(~clean)
+    if rest.size:
+        sub = {name: np.atleast_1d(a)[rest] for name, a in params.items()}
+        q_rest, st_rest, _, _ = _sweep_engine(m, sub, vals, None, tol, rest.size)
+        idx = (rest[:, None] * k + np.arange(k)[None, :]).reshape(-1)
+        for j in range(n):
+            q_flat[j][idx] = q_rest[j]
+        status_flat[idx] = st_rest
+    feasible = (status_flat == CONVERGED) | (status_flat == OFF_BRANCH)
+    engine = "vectorised continuation" + (f" ({rest.size} designs one at a time)" if rest.size else "")
+    return q_flat, status_flat, feasible, engine
+
+
+def _det_at(loops: VectorLoops, q: list[np.ndarray], count: int) -> np.ndarray:
+    """det J at q (every entry)."""
+    _, jac = loops.evaluate(q, None)
+    zeros = [np.zeros(count) for _ in q]
+    _, det = _solve_linear(jac, zeros, count)
+    return np.broadcast_to(det, (count,)).astype(float)
+
+
+def _tangent(m: Mechanism, loops: VectorLoops, grid: Mapping[str, Any], rows: np.ndarray, drv: float,
+             q: list[np.ndarray], scale: float) -> list[np.ndarray]:
+    """dq/dv (per display unit of the driver) from J dq/dv = -scale dPhi/dv, as
+    :func:`~linkage.kinematics.sweep.tangent`; NaN where J is singular."""
+    index = {u.name: i for i, u in enumerate(m.unknowns)}
+    count = rows.size
+
+    def value(ref: str | float) -> Any:
+        if isinstance(ref, str):
+            if ref in index:
+                return q[index[ref]]
+            if ref == m.driver.name:
+                return drv
+            val = grid[ref]
+            return val[rows] if isinstance(val, np.ndarray) else val
+        return ref
+
+    rhs = []
+    for loop in m.loops:
+        dx: Any = np.zeros(count)
+        dy: Any = np.zeros(count)
+        for t in loop.vectors:
+            th = value(t.angle) + t.offset
+            if t.angle == m.driver.name:
+                r = value(t.length)
+                dx = dx - t.sign * r * np.sin(th)
+                dy = dy + t.sign * r * np.cos(th)
+            if t.length == m.driver.name:
+                dx = dx + t.sign * np.cos(th)
+                dy = dy + t.sign * np.sin(th)
+        rhs += [-scale * np.broadcast_to(dx, (count,)), -scale * np.broadcast_to(dy, (count,))]
+    _, jac = loops.evaluate(q, None)
+    # J t = rhs, i.e. J t + (-rhs) = 0: _solve_linear solves J dq = -phi
+    dq, _ = _solve_linear(jac, [-c for c in rhs], count)
+    return [np.asarray(c, dtype=float) for c in dq]
+
 
 def _sweep_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, branch: str | None,
                   tol: float, n_designs: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray, str]:
