@@ -273,23 +273,26 @@ def check_sign_change(problem: ScalarProblem, x: float, fx: float | None, lo: fl
     if 0.0 in f_ends:
         return Status.CONVERGED_STEP, detail, 0  # f is exactly zero at an end: a root there
     if hi - lo <= 64.0 * math.ulp(max(abs(lo), abs(hi))):
-        # a sign change within a few ulps: double precision cannot tell a root from a
-        # jump there, and |f| is rounding noise that no bisection can shrink; but |f|
-        # above its size at the bracket's ends is no root's: it grows into a pole
-        if abs(fx) > start_size:
-            return (Status.DISCONTINUITY, f"|f| is {abs(fx):.3g} at x = {x!r}, above its size at the "
-                    f"bracket's ends ({start_size:.3g}): f changes sign through a pole", 0)
-        return Status.CONVERGED_STEP, detail, 0
+        # A sign change within a few ulps with |f| still above 1e-3 of its size at the
+        # ends (the shortcut above did not take it): a root's |f| at the floats next to
+        # it is its slope times an ulp, far below that unless the user's bracket was
+        # itself a few thousand ulps wide. So this is a jump, or a pole when |f| grew.
+        # (An open method's certificate interval is only its tolerance wide, a few ulps
+        # at tight tolerances: there only |f| above the ends, a pole, is held against it.)
+        if shrink_from is not None and abs(fx) <= start_size:
+            return Status.CONVERGED_STEP, detail, 0
+        kind = "a pole" if abs(fx) > start_size else "a jump"
+        return (Status.DISCONTINUITY, f"|f| is {abs(fx):.3g} at x = {x!r} across a sign change a few ulps "
+                f"wide ({start_size:.3g} at the bracket's ends): f changes sign through {kind}", 0)
     target = 1e-3 * start_size if shrink_from is None else shrink_from / 16.0
     evals = 0
     ulp = math.ulp(max(abs(lo), abs(hi)))
+    seen = [(x, fx)]
     try:
         flo = problem.f(lo)
         evals = 1
+        seen.append((lo, flo))
         smallest = abs(fx)
-        # the noise test below reads f at the floats next to its point: a point found
-        # within a million ulps of the sign change could read f across a jump
-        x_small, f_small = x, fx
         for _ in range(64):
             mid = 0.5 * lo + 0.5 * hi
             if hi - lo <= 64.0 * ulp or mid in (lo, hi):
@@ -298,12 +301,11 @@ def check_sign_change(problem: ScalarProblem, x: float, fx: float | None, lo: fl
             evals += 1
             if fm == 0.0:
                 return Status.CONVERGED_STEP, detail, evals
+            seen.append((mid, fm))
             if abs(fm) < smallest:
                 smallest = abs(fm)
                 if smallest <= target:
                     return Status.CONVERGED_STEP, detail, evals
-                if hi - lo > 1e6 * ulp:
-                    x_small, f_small = mid, fm
             if (fm < 0.0) == (flo < 0.0):
                 lo, flo = mid, fm
             else:
@@ -312,11 +314,19 @@ def check_sign_change(problem: ScalarProblem, x: float, fx: float | None, lo: fl
         return (Status.DISCONTINUITY, f"f cannot be evaluated inside the final bracket ({exc}): a pole or "
                 f"a gap, not a root", evals)
     # |f| that does not shrink may be rounding noise around a root (an ill-conditioned
-    # root such as an expanded (x - 1)^3), not a jump: f's own noise next to x tells
-    noise, n = at_noise_level(problem, x_small, f_small, abs(hi - lo) + 1.0)
-    evals += n
-    if noise:
-        return Status.CONVERGED_STEP, detail, evals
+    # root such as an expanded (x - 1)^3), not a jump: f's own noise next to a point
+    # tells. After a bracketing method the point must lie a million ulps clear of the
+    # sign change, or its neighbours would read f across a jump (the noise band of such
+    # a root is far wider); an open method's interval is only its tolerance wide, and
+    # its own best point is read.
+    clear = seen if shrink_from is not None else [
+        (v, fv) for v, fv in seen if min(abs(v - lo), abs(v - hi)) > 1e6 * ulp]
+    if clear:
+        x_small, f_small = min(clear, key=lambda p: abs(p[1]))
+        noise, n = at_noise_level(problem, x_small, f_small, abs(hi - lo) + 1.0)
+        evals += n
+        if noise:
+            return Status.CONVERGED_STEP, detail, evals
     return (Status.DISCONTINUITY,
             f"|f| is {abs(fx):.3g} at x = {x!r} and does not shrink with the bracket", evals)
 
