@@ -274,3 +274,26 @@ def test_the_two_unknown_front_door_equals_the_general_path():
                 fast = solve_system(F, x0, jac=J, record=False, damped=damped, **kw)
                 full = solve_system(F, list(x0), jac=J, record=False, damped=damped, **kw)
                 assert vars(fast) == vars(full) or repr(vars(fast)) == repr(vars(full)), (label, kw)
+
+
+
+def test_the_two_unknown_mechanism_front_door_equals_the_general_path():
+    """A compiled problem of two angles with a tuple start (its own x0 included) takes a
+    short front door when Newton converges; a list start takes the general path."""
+    from linkage import solve_system
+    from linkage.stress import fourbar_cases, fourbar_mechanism
+
+    problems = [fourbar_mechanism(it).problem() for it in fourbar_cases(random.Random(2), 200)]
+    assert len(problems) == 200
+    converged = 0
+    for p in problems:
+        x0 = tuple(float(v) for v in p.x0)
+        for damped in (True, False):
+            for kw in (dict(tol=1e-10), dict(tol=1e-12, ftol=1e-9, max_iter=7), dict(tol=1e-8, rtol=1e-6)):
+                fast = solve_system(p, x0, record=False, damped=damped, **kw)
+                full = solve_system(p, list(x0), record=False, damped=damped, **kw)
+                assert repr(vars(fast)) == repr(vars(full)), kw
+                fast = solve_system(p, record=False, damped=damped, **kw)  # its own x0
+                assert repr(vars(fast)) == repr(vars(full)), kw
+                converged += fast.converged
+    assert converged > 300

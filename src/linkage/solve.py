@@ -520,6 +520,11 @@ def solve_system(
         return _newton_two(F, jac, x0, check_criteria(tol, rtol, ftol, max_iter), damped)
     LevenbergMarquardt, NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system = \
         _system_solvers()
+    if (method == "newton" and not record and jac is None and fd_step is None and type(F) is SystemProblem
+            and len(F.names) == 2 and F.J is not None and F.step_scales is None):
+        fast = _mechanism_two(F, x0, check_criteria(tol, rtol, ftol, max_iter), damped)
+        if fast is not None:
+            return fast
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r} for a system; choose from {', '.join(SYSTEM_METHODS)}")
     crit = check_criteria(tol, rtol, ftol, max_iter)
@@ -654,6 +659,41 @@ def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float,
         status, detail = Status.STALLED, f"max|Phi| = {residual:.3g} at the end, above {gate:.3g}"
     names, kinds, _ = labels
     meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": names, "kinds": kinds, "title": ""}
+    result = Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, meta)
+    if njev:
+        result.__dict__["njev"] = njev
+    return result
+
+
+def _mechanism_two(problem: Any, x0: Any, crit: Criteria, damped: bool) -> Result | None:
+    """:func:`solve_system` for ``newton`` on a compiled problem of two unknowns measured
+    as they are (a four-bar), when it converges: the general path's checks and packaging
+    without its generality. None for anything else (a start to check, a failure for the
+    closed form to explain): the general path then runs and says what happened."""
+    _newton_2x2, max_abs, _, _, _ = _two_unknowns()
+    q0 = problem.x0 if x0 is None else x0
+    if type(q0) is not tuple or len(q0) != 2 or not all(type(v) is float and v - v == 0.0 for v in q0):
+        return None
+    scale = problem.length_scale
+    if scale != 1.0 or "length" in problem.kinds or problem.length_unit:
+        if crit.tol > MAX_RELATIVE_TOL or (crit.ftol is not None and crit.ftol > MAX_RELATIVE_TOL):
+            return None
+    try:
+        phi0 = problem.F(list(q0))
+    except (ArithmeticError, ValueError):
+        return None
+    if len(phi0) != 2:
+        return None
+    gate = (crit.ftol if crit.ftol is not None else crit.tol) * scale
+    q, phi, err, status, detail, iterations, nfev, njev = _newton_2x2(
+        problem, q0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
+    residual = max_abs(phi)
+    if status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN) and residual <= gate:
+        status, detail = Status.CONVERGED_RESIDUAL, f"max|Phi| = {residual:.3g} <= {gate:.3g}; {detail}"
+    if not status.converged or not residual <= gate:
+        return None
+    meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names, "kinds": problem.kinds,
+            "title": problem.title, **problem.meta}
     result = Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, meta)
     if njev:
         result.__dict__["njev"] = njev
