@@ -815,7 +815,7 @@ def scan(
     from .kinematics.sweep import driver_values
     from .problems.loops import load
     from .render.scan import RecordSink, scan_blocks
-    from .scan import Keeper, ScanJob, chunk_size, parse_vary, prepare, run_chunks
+    from .scan import Keeper, ScanJob, chunk_size, feed, parse_vary, prepare
     from .solve import check_criteria
 
     if output is not None and str(output) == "-":
@@ -857,13 +857,12 @@ def scan(
         raise InputError("--desc orders by --sort: give --sort COLUMN")
     overrides = tuple((k, float(v)) for k, v in parse_assignments("--set", set_ or []).items())
     job = ScanJob(text, str(file), overrides, plan.names, tuple(values), chosen, tol)
-    size = chunk or chunk_size(mechanism, len(values))
+    size = chunk or chunk_size(mechanism, len(values), chosen)
     as_table = fmt in ("table", "plain")
     meta = {"mechanism": mechanism.name, "source": str(file), "branch": chosen,
             "driver": {"name": mechanism.driver.name, "unit": mechanism.driver.unit, "from": a,
                        "to": b, "step": step, "positions": len(values)},
             "where": where, "sort": sort, "descending": desc, "designs": plan.total}
-    scanned = 0
     sink = None if as_table else RecordSink(fmt, output, spec, meta)
     started = time.perf_counter()
     with contextlib.ExitStack() as stack:
@@ -872,25 +871,14 @@ def scan(
         keeper = Keeper(sort, desc, top, sink if (sink is not None and sort is None) else None,
                         show=20 if as_table else None)
         advance = stack.enter_context(_progress(plan.total, minimum=2 * size))
-        for cols in run_chunks(job, plan, size, scheduler=scheduler, workers=workers):
-            scanned += len(cols["design"])
-            if test is not None:
-                cols = {k: v[test(cols, len(cols["design"]))] for k, v in cols.items()}
-            keeper.add(cols)
-            if advance is not None:
-                advance(scanned)
-            if keeper.full:
-                break
+        scanned = feed(keeper, job, setup, size, scheduler=scheduler, workers=workers, progress=advance)
         held = keeper.result()
         if sink is not None and sort is not None:
             sink(held)
     elapsed = time.perf_counter() - started
-    from .kinematics.designs import closed_form_applies
+    from .kinematics.designs import ENGINES, engine_for
 
-    engine = ("closed form + vectorised Newton" if closed_form_applies(mechanism)
-              else "vectorised continuation (a design that needs more is swept on its own)"
-              if mechanism.closed_form is None and mechanism.driver.kind == "angle"
-              else "continuation, design by design")
+    engine = ENGINES[engine_for(mechanism, chosen)]
     where_note = f"; {keeper.kept:,} pass --where" if test is not None else ""
     stopped = f" (stopped early: the first {top} are final)" if scanned < plan.total else ""
     summary = [f"{mechanism.name}: {scanned:,} of {plan.total:,} designs scanned{stopped}"

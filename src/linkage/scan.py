@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError, ParseError
-from .kinematics.designs import CONVERGED, DesignSolutions, closed_form_applies, solve_designs
+from .kinematics.designs import CONVERGED, DesignSolutions, engine_for, solve_designs
 from .problems.loops import ANGLE_UNITS, Mechanism
 
 MAX_DESIGNS = 10_000_000
@@ -183,8 +183,8 @@ def run_chunk(job: ScanJob, start: int, designs: np.ndarray) -> dict[str, np.nda
     return design_metrics(m, job.names, designs, sol, start)
 
 
-def chunk_size(m: Mechanism, positions: int) -> int:
-    if closed_form_applies(m) or (m.closed_form is None and m.driver.kind == "angle"):
+def chunk_size(m: Mechanism, positions: int, branch: str | None) -> int:
+    if engine_for(m, branch) != "sweep":
         return max(1, min(CHUNK_DESIGNS_MAX, CHUNK_POSITIONS // max(positions, 1)))
     return CHUNK_DESIGNS_SWEEP
 
@@ -225,7 +225,7 @@ def design_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray, sol:
             out[f"{u.name}_min"], out[f"{u.name}_max"], out[f"{u.name}_range"] = lo, hi, hi - lo
         if m.closed_form == "fourbar":
             out["grashof"] = grashof_class(*(_param(m, names, designs, k) for k in ("r1", "r2", "r3", "r4")))
-            t3, t4 = (_angle_deg(m, sol, names, designs, k) for k in ("theta3", "theta4"))
+            t3, t4 = (_angle_deg(m, sol, k) for k in ("theta3", "theta4"))
             mu = np.abs((t4 - t3 + 180.0) % 360.0 - 180.0)
             folded = np.where(mu > 90.0, 180.0 - mu, mu)
             out["min_transmission_deg"], out["max_transmission_deg"] = _extent(folded, solved)
@@ -250,18 +250,13 @@ def _param(m: Mechanism, names: Sequence[str], designs: np.ndarray, key: str) ->
     return np.full(len(designs), m.parameters[key].value)
 
 
-def _angle_deg(m: Mechanism, sol: DesignSolutions, names: Sequence[str], designs: np.ndarray,
-               key: str) -> np.ndarray:
-    """A four-bar angle at every position (deg): solved, the driver, or a parameter."""
+def _angle_deg(m: Mechanism, sol: DesignSolutions, key: str) -> np.ndarray:
+    """theta3 or theta4 at every position (deg): solved, or the driver (a four-bar file's
+    closed form is checked on reading: both are unknowns or the driver)."""
     if key in sol.names:
         return sol.solution[:, :, sol.names.index(key)]
-    if key == m.driver.name:
-        return np.broadcast_to(sol.values[None, :] if m.driver.unit == "deg"
-                               else np.degrees(sol.values)[None, :], sol.status.shape)
-    q = m.parameters[key]
-    v = _param(m, names, designs, key)  # file units when varied, else internal (rad)
-    v = v * ANGLE_UNITS[q.unit] / ANGLE_UNITS["deg"] if key in names else np.degrees(v)
-    return np.broadcast_to(v[:, None], sol.status.shape)
+    shown = sol.values * (ANGLE_UNITS[m.driver.unit] / ANGLE_UNITS["deg"])
+    return np.broadcast_to(shown[None, :], sol.status.shape)
 
 
 GRASHOF_CLASSES = ("double crank", "crank-rocker", "double rocker", "rocker-crank")
@@ -517,11 +512,23 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
                     branch=branch, tol=tol, where=where, sort=sort)
     job = ScanJob("", m.source, (), setup.plan.names, tuple(setup.values), setup.branch, tol, m)
     keeper = Keeper(sort, descending, top, None)
-    for cols in run_chunks(job, setup.plan, chunk or chunk_size(m, len(setup.values)),
-                           scheduler=scheduler, workers=workers):
+    feed(keeper, job, setup, chunk or chunk_size(m, len(setup.values), setup.branch),
+         scheduler=scheduler, workers=workers)
+    return keeper.result() or {c[0]: np.array([]) for c in setup.spec}
+
+
+def feed(keeper: Keeper, job: ScanJob, setup: ScanSetup, size: int, *, scheduler: str | None,
+         workers: int | None, progress: Callable[[int], None] | None = None) -> int:
+    """Run the scan's chunks into ``keeper``, each filtered by the setup's test, until
+    every design is done or the keeper is full. Returns the designs scanned."""
+    scanned = 0
+    for cols in run_chunks(job, setup.plan, size, scheduler=scheduler, workers=workers):
+        scanned += len(cols["design"])
         if setup.where is not None:
             cols = take(cols, setup.where(cols, len(cols["design"])))
         keeper.add(cols)
+        if progress is not None:
+            progress(scanned)
         if keeper.full:
             break
-    return keeper.result() or {c[0]: np.array([]) for c in setup.spec}
+    return scanned

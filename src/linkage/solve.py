@@ -587,12 +587,7 @@ def solve_system(
                 nfev += 1
             except (ArithmeticError, ValueError):
                 residual = math.nan
-    if status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN) and residual <= gate and stopped:
-        # no step lowers |Phi| any more, and it is already within the residual tolerance:
-        # a root to that tolerance (ill-conditioned, so the step test could not pass)
-        status, detail = Status.CONVERGED_RESIDUAL, f"max|Phi| = {residual:.3g} <= {gate:.3g}; {detail}"
-    if status.converged and not residual <= gate:
-        status, detail = Status.STALLED, f"max|Phi| = {residual:.3g} at the end, above {gate:.3g}"
+    status, detail = system_verdict(status, detail, residual, gate, stopped)
     meta: dict[str, Any] = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names,
                             "kinds": problem.kinds, "title": problem.title, **problem.meta}
     # The closed form serves the table's true-error column and the verdict on a failed
@@ -636,11 +631,39 @@ def _two_unknowns() -> tuple[Any, ...]:
     return _newton_2x2, max_abs, LeanProblem, _generic_labels(2), generic_system
 
 
+def system_verdict(status: Status, detail: str, residual: float, gate: float,
+                   stopped: bool = True) -> tuple[Status, str]:
+    """The verdict on a system solve from its loop's outcome and its final max|Phi|: a run
+    the method stopped (no step lowers |Phi|, or J is singular) with |Phi| already within
+    tolerance is a root to that tolerance (ill-conditioned, so the step test could not
+    pass); a converged status with |Phi| above it is not."""
+    if stopped and status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN) and residual <= gate:
+        return Status.CONVERGED_RESIDUAL, f"max|Phi| = {residual:.3g} <= {gate:.3g}; {detail}"
+    if status.converged and not residual <= gate:
+        return Status.STALLED, f"max|Phi| = {residual:.3g} at the end, above {gate:.3g}"
+    return status, detail
+
+
+def _two_unknown_result(problem: Any, q0: tuple[float, ...], phi0: Any, crit: Criteria, gate: float,
+                        damped: bool, meta: dict[str, Any]) -> Result:
+    """Newton on two unknowns by :func:`~linkage.methods.newton_system._newton_2x2`,
+    judged and packaged as :func:`solve_system` does."""
+    _newton_2x2, max_abs, _, _, _ = _two_unknowns()
+    q, phi, err, status, detail, iterations, nfev, njev = _newton_2x2(
+        problem, q0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
+    residual = max_abs(phi)
+    status, detail = system_verdict(status, detail, residual, gate)
+    result = Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, meta)
+    if njev:
+        result.__dict__["njev"] = njev
+    return result
+
+
 def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float, float], crit: Criteria,
                 damped: bool) -> Result:
     """:func:`solve_system` for ``newton`` on user callables of two unknowns, with the
     general path's checks and packaging, but no problem object unless a step is refused."""
-    _newton_2x2, max_abs, LeanProblem, labels, generic_system = _two_unknowns()
+    _, _, LeanProblem, (names, kinds, _), generic_system = _two_unknowns()
     try:
         phi0 = F(list(x0))
     except (ArithmeticError, ValueError) as exc:
@@ -649,20 +672,8 @@ def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float,
         raise InputError(f"the system has {len(phi0)} equations for 2 unknowns")
     gate = crit.ftol if crit.ftol is not None else crit.tol
     problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
-    q, phi, err, status, detail, iterations, nfev, njev = _newton_2x2(
-        problem, x0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
-    stopped = status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN)
-    residual = max_abs(phi)
-    if stopped and residual <= gate:
-        status, detail = Status.CONVERGED_RESIDUAL, f"max|Phi| = {residual:.3g} <= {gate:.3g}; {detail}"
-    if status.converged and not residual <= gate:
-        status, detail = Status.STALLED, f"max|Phi| = {residual:.3g} at the end, above {gate:.3g}"
-    names, kinds, _ = labels
     meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": names, "kinds": kinds, "title": ""}
-    result = Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, meta)
-    if njev:
-        result.__dict__["njev"] = njev
-    return result
+    return _two_unknown_result(problem, x0, phi0, crit, gate, damped, meta)
 
 
 def _mechanism_two(problem: Any, x0: Any, crit: Criteria, damped: bool) -> Result | None:
@@ -670,7 +681,6 @@ def _mechanism_two(problem: Any, x0: Any, crit: Criteria, damped: bool) -> Resul
     as they are (a four-bar), when it converges: the general path's checks and packaging
     without its generality. None for anything else (a start to check, a failure for the
     closed form to explain): the general path then runs and says what happened."""
-    _newton_2x2, max_abs, _, _, _ = _two_unknowns()
     q0 = problem.x0 if x0 is None else x0
     if type(q0) is not tuple or len(q0) != 2 or not all(type(v) is float and v - v == 0.0 for v in q0):
         return None
@@ -685,19 +695,10 @@ def _mechanism_two(problem: Any, x0: Any, crit: Criteria, damped: bool) -> Resul
     if len(phi0) != 2:
         return None
     gate = (crit.ftol if crit.ftol is not None else crit.tol) * scale
-    q, phi, err, status, detail, iterations, nfev, njev = _newton_2x2(
-        problem, q0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
-    residual = max_abs(phi)
-    if status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN) and residual <= gate:
-        status, detail = Status.CONVERGED_RESIDUAL, f"max|Phi| = {residual:.3g} <= {gate:.3g}; {detail}"
-    if not status.converged or not residual <= gate:
-        return None
     meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names, "kinds": problem.kinds,
             "title": problem.title, **problem.meta}
-    result = Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, meta)
-    if njev:
-        result.__dict__["njev"] = njev
-    return result
+    result = _two_unknown_result(problem, q0, phi0, crit, gate, damped, meta)
+    return result if result.converged else None
 
 
 def _system_history(m: Any, problem: Any, rows: list[tuple[Any, ...]], show_jacobian: bool,

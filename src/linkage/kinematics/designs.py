@@ -70,6 +70,23 @@ def closed_form_applies(m: Mechanism) -> bool:
     return {u.name for u in m.unknowns} == expected
 
 
+ENGINES = {
+    "closed form": "closed form + vectorised Newton",
+    "continuation": "vectorised continuation (a design that needs more is swept on its own)",
+    "sweep": "continuation, design by design",
+}
+"""What each engine is called where a person reads it."""
+
+
+def engine_for(m: Mechanism, branch: str | None) -> str:
+    """The engine :func:`solve_designs` runs for ``m``: a key of :data:`ENGINES`."""
+    if closed_form_applies(m) and branch is not None:
+        return "closed form"
+    if branch is None and m.closed_form is None and m.driver.kind == "angle":
+        return "continuation"
+    return "sweep"
+
+
 def solve_designs(m: Mechanism, params: Mapping[str, np.ndarray], values: Sequence[float] | np.ndarray,
                   *, branch: str | None, tol: float = 1e-12, max_iter: int = 30,
                   paths: bool = False) -> DesignSolutions:
@@ -82,10 +99,12 @@ def solve_designs(m: Mechanism, params: Mapping[str, np.ndarray], values: Sequen
     if len(sizes) > 1:
         raise ValueError("every parameter array needs one value per design")
     n_designs = sizes.pop() if sizes else 1
-    if closed_form_applies(m) and branch is not None:
+    which = engine_for(m, branch)
+    if which == "closed form":
+        assert branch is not None
         q, status, feasible, engine = _closed_form_engine(m, params, vals, branch, tol, max_iter,
                                                           n_designs)
-    elif branch is None and m.closed_form is None and m.driver.kind == "angle":
+    elif which == "continuation":
         q, status, feasible, engine = _continuation_engine(m, params, vals, tol, n_designs)
     else:
         q, status, feasible, engine = _sweep_engine(m, params, vals, branch, tol, n_designs)
@@ -212,16 +231,28 @@ def _closed_form_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np
     return q, status, feasible, "closed form + vectorised Newton"
 
 
-def _terms(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray) -> list[list[tuple[Any, ...]]]:
-    """The loops' vectors with parameters and driver resolved to floats or flat arrays."""
+def _resolver(m: Mechanism, grid: Mapping[str, Any], drv: Any,
+              q: Sequence[np.ndarray] = ()) -> tuple[dict[str, int], Any]:
+    """(each unknown's index, the value of a length or angle reference): an unknown from
+    ``q``, the driver, a parameter from ``grid`` (a float or an array), or a number."""
     index = {u.name: i for i, u in enumerate(m.unknowns)}
 
+    def value(ref: str | float) -> Any:
+        if isinstance(ref, str):
+            if ref in index:
+                return q[index[ref]]
+            return drv if ref == m.driver.name else grid[ref]
+        return ref
+
+    return index, value
+
+
+def _terms(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray) -> list[list[tuple[Any, ...]]]:
+    """The loops' vectors with parameters and driver resolved to floats or flat arrays."""
+    index, value = _resolver(m, grid, drv)
+
     def ref(r: str | float) -> tuple[Any, int]:
-        if isinstance(r, str):
-            if r in index:
-                return 0.0, index[r]
-            return (drv, -1) if r == m.driver.name else (grid[r], -1)
-        return r, -1
+        return (0.0, index[r]) if isinstance(r, str) and r in index else (value(r), -1)
 
     return [[(t.sign, *ref(t.length), *ref(t.angle), t.offset) for t in loop.vectors] for loop in m.loops]
 
@@ -328,6 +359,7 @@ def _continuation_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: n
         live = np.flatnonzero(clean)
         q_last = [c[live] for c in seed]
         v_last = v0
+        here: tuple[VectorLoops, dict[str, Any]] | None = None  # the loops at v_last, while live is unchanged
         for i, v in plan:
             if live.size == 0:
                 break
@@ -337,10 +369,10 @@ def _continuation_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: n
                 clean[live] = False
                 break
             fresh = ~reached[live, i]
-            loops_last, _ = at(v_last, live)
-            t = _tangent(m, loops_last, grid, live, v_last * scale, q_last, scale)
+            loops_last, sub = here if here is not None else at(v_last, live)
+            t = _tangent(m, loops_last, sub, v_last * scale, q_last, scale)
             pred = [ql + (v - v_last) * tj for ql, tj in zip(q_last, t)]
-            loops_v, _ = at(v, live)
+            loops_v, sub_v = at(v, live)
             q = [c.copy() for c in pred]
             ok, _, _ = _newton(loops_v, q, np.arange(live.size), tol, size[live], is_length, 50, count=True)
             det = _det_at(loops_v, q, live.size)
@@ -353,6 +385,7 @@ def _continuation_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: n
                 ok &= correction <= 0.5 * moved + (1e-7 + 10.0 * dv * dv) * mag
             clean[live[~ok]] = False
             keep = ok
+            here = (loops_v, sub_v) if keep.all() else None
             live = live[keep]
             q = [c[keep] for c in q]
             store = fresh[keep]
@@ -385,22 +418,13 @@ def _det_at(loops: VectorLoops, q: list[np.ndarray], count: int) -> np.ndarray:
     return np.broadcast_to(det, (count,)).astype(float)
 
 
-def _tangent(m: Mechanism, loops: VectorLoops, grid: Mapping[str, Any], rows: np.ndarray, drv: float,
+def _tangent(m: Mechanism, loops: VectorLoops, grid: Mapping[str, Any], drv: float,
              q: list[np.ndarray], scale: float) -> list[np.ndarray]:
     """dq/dv (per display unit of the driver) from J dq/dv = -scale dPhi/dv, as
-    :func:`~linkage.kinematics.sweep.tangent`; NaN where J is singular."""
-    index = {u.name: i for i, u in enumerate(m.unknowns)}
-    count = rows.size
-
-    def value(ref: str | float) -> Any:
-        if isinstance(ref, str):
-            if ref in index:
-                return q[index[ref]]
-            if ref == m.driver.name:
-                return drv
-            val = grid[ref]
-            return val[rows] if isinstance(val, np.ndarray) else val
-        return ref
+    :func:`~linkage.kinematics.sweep.tangent`; NaN where J is singular. ``grid``: the
+    parameters of these designs."""
+    count = len(q[0])
+    _, value = _resolver(m, grid, drv, q)
 
     rhs = []
     for loop in m.loops:
@@ -451,14 +475,7 @@ def _paths(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, q: 
     LoopModel.points places them."""
     n_designs = len(solved) // max(len(vals), 1)
     grid, drv = _grid(m, params, vals, n_designs)
-    index = {u.name: i for i, u in enumerate(m.unknowns)}
-
-    def value(r: str | float) -> Any:
-        if isinstance(r, str):
-            if r in index:
-                return q[index[r]]
-            return drv if r == m.driver.name else grid[r]
-        return r
+    _, value = _resolver(m, grid, drv, q)
 
     def vec(t: VectorTerm) -> Any:
         return t.sign * value(t.length) * np.exp(1j * (value(t.angle) + t.offset))

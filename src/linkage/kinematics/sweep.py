@@ -37,6 +37,7 @@ from ..problems.closed_form import (
 from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism
 from ..problems.system import LeanProblem
 from ..result import Status
+from ..solve import system_verdict
 
 MAX_HALVINGS = 6
 LOCATE_TOL = 1e-9  # driver units (deg for angles)
@@ -135,13 +136,8 @@ class _Solver:
         light = LeanProblem(F, J, self.step_scales, lambda: self.problem(value))
         q, phi, _err, status, _detail, iterations, _nfev, _njev = newton_system_lean(
             light, tuple(guess), phi0, self.tol, 0.0, self.gate, self.max_iter, False)
-        # solve_system's verdicts on the lean loop's outcome
-        residual = max_abs(phi)
-        if status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN) and residual <= self.gate:
-            return J, q, iterations
-        if not status.converged or not residual <= self.gate:
-            return None
-        return J, q, iterations
+        status, _ = system_verdict(status, "", max_abs(phi), self.gate)
+        return (J, q, iterations) if status.converged else None
 
     def problem(self, value: float, guess: Sequence[float] | None = None) -> Any:
         """The compiled problem at a driver value, built once per value (a position asks

@@ -233,22 +233,29 @@ def call_argument(node: ast.Call, where: str) -> ast.AST:
     return node.args[0]
 
 
+def walk_postorder(root: ast.AST, children: Callable[[ast.AST], list[ast.AST]],
+                   emit: Callable[[ast.AST], object]) -> None:
+    """Visit a checked tree bottom-up without recursion, so nestings of any depth the
+    parser accepts cost time and memory linear in their length: ``children(node)``
+    checks a node and names those to visit first; ``emit(node)`` runs after them."""
+    stack: list[tuple[ast.AST, bool]] = [(root, False)]
+    while stack:
+        node, visited = stack.pop()
+        if visited:
+            emit(node)
+            continue
+        stack.append((node, True))
+        stack.extend((c, False) for c in reversed(children(node)))
+
+
 def parse_ops(text: str, *, what: str = "equation") -> tuple[Op, ...]:
     """Parse user text into a checked operation list (the last one is the result)."""
     tree, _ = parse_tree(text, f"the {what}")
     shown = text if len(text) <= 60 else text[:57] + "..."
     b = _Builder()
-    # Iterative post-order walk: (node, visited) pairs on a stack, results on another.
-    stack: list[tuple[ast.AST, bool]] = [(tree.body, False)]
     out: list[int] = []
-    while stack:
-        node, visited = stack.pop()
-        if not visited:
-            children = _check(node, shown, what)
-            stack.append((node, True))
-            stack.extend((c, False) for c in reversed(children))
-            continue
-        out.append(_emit(node, b, out))
+    walk_postorder(tree.body, lambda node: _check(node, shown, what),
+                   lambda node: out.append(_emit(node, b, out)))
     # The result is the root's operation, which folding or sharing may have placed
     # before later (now unused) ones: keep the list up to it.
     return tuple(b.ops[: out[-1] + 1])

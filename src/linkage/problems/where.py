@@ -23,7 +23,15 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParseError
-from .expression import _BINOPS, CONSTANTS, FUNCTIONS, MAX_OPERATIONS, call_argument, parse_tree
+from .expression import (
+    _BINOPS,
+    CONSTANTS,
+    FUNCTIONS,
+    MAX_OPERATIONS,
+    call_argument,
+    parse_tree,
+    walk_postorder,
+)
 
 _DEG = math.pi / 180.0
 NUMPY_FUNCTIONS: dict[str, Callable[[Any], Any]] = {
@@ -95,18 +103,14 @@ def parse_where(text: str, columns: Mapping[str, str]) -> Where:
     (number, bool or text). Raises ParseError with one line saying what is wrong."""
     tree, shown = parse_tree(text, "--where")
     ops: list[_Op] = []
-    stack: list[tuple[ast.AST, bool]] = [(tree.body, False)]
     out: list[int] = []
-    while stack:
-        node, visited = stack.pop()
-        if not visited:
-            children = _children(node, shown, columns)
-            stack.append((node, True))
-            stack.extend((c, False) for c in reversed(children))
-            continue
+
+    def emit(node: ast.AST) -> None:
         _emit(node, ops, out, shown, columns)
         if len(ops) > MAX_OPERATIONS:
             raise ParseError(f"--where has more than {MAX_OPERATIONS} operations")
+
+    walk_postorder(tree.body, lambda node: _children(node, shown, columns), emit)
     if ops[out[-1]].type != "bool":
         raise ParseError(f"--where {shown!r} must be a test (a comparison, true/false, "
                          "and/or/not), not a number")
