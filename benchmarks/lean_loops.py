@@ -41,6 +41,17 @@ def main() -> None:
 
     t = best(lambda: solve_system(F, (0.0, math.pi / 2), jac=J, tol=1e-12, record=False), 1000)
     print(f"{'four-bar F,J':13s} {t * 1e6:7.2f} us")
+    try:  # the same F and J by hand and by scipy, when this checkout has them
+        from linkage.bench import hand_newton_2x2
+
+        hand = best(lambda: hand_newton_2x2(F, J, (0.0, math.pi / 2), 1e-12), 1000)
+        print(f"{'  hand 2x2':13s} {hand * 1e6:7.2f} us  (linkage / hand {t / hand:.2f}x)")
+        from scipy.optimize import root
+
+        hybr = best(lambda: root(F, (0.0, math.pi / 2), jac=J, method="hybr", options={"xtol": 1e-12}), 200)
+        print(f"{'  scipy hybr':13s} {hybr * 1e6:7.2f} us  (hybr / linkage {hybr / t:.2f}x)")
+    except ImportError:
+        pass
     m = load_mechanism(sample_path("crank_rocker.toml"))  # the measured code's own sample
     values = [float(k) for k in range(361)]
     try:

@@ -2,7 +2,9 @@
 four-bar metrics, and the local scheduler against a two-worker dask LocalCluster.
 
     python benchmarks/scan.py                 # 2,000 designs x 360 positions
-    python benchmarks/scan.py --designs 20000 --repeats 3
+    python benchmarks/scan.py --designs 20000 --repeats 1 --no-cluster
+    python benchmarks/scan.py --continuation  # six-bar designs: batch against one at a time
+    python benchmarks/scan.py --writers       # 10^6 three-position designs to Parquet and CSV
 
 Every figure is a median of repeats measured in this run (the machines are shared and
 noisy): the CLI's wall time includes Python's start-up, as a user sees it, and the
@@ -98,12 +100,59 @@ def time_cluster(n: int, repeats: int) -> tuple[float, float] | None:
     return local, remote
 
 
+def continuation(designs: int = 200, one_at_a_time: int = 20) -> None:
+    """Six-bar designs (r5, r6 varied) over 0..359 deg: the vectorised continuation per
+    design against the one-at-a-time sweep on the first few, and their agreement."""
+    from linkage.kinematics.designs import _continuation_engine, _sweep_engine
+    from linkage.problems.loops import load
+
+    m = load(ROOT / "sample_inputs" / "watt_sixbar.toml")
+    arrays = {"r5": np.linspace(60, 80, designs), "r6": np.linspace(100, 120, designs)}
+    vals = np.arange(0.0, 360.0)
+    t = time.perf_counter()
+    q, status, _, engine = _continuation_engine(m, arrays, vals, 1e-12, designs)
+    batch = (time.perf_counter() - t) / designs
+    sub = {k: v[:one_at_a_time] for k, v in arrays.items()}
+    t = time.perf_counter()
+    q1, status1, _, _ = _sweep_engine(m, sub, vals, None, 1e-12, one_at_a_time)
+    single = (time.perf_counter() - t) / one_at_a_time
+    k = one_at_a_time * len(vals)
+    worst = max(float(np.nanmax(np.abs(a[:k] - b))) for a, b in zip(q, q1))
+    print(f"watt_sixbar.toml, {designs} designs x 360 positions ({engine})")
+    print(f"  vectorised continuation   {batch * 1e3:7.2f} ms per design")
+    print(f"  one at a time (first {one_at_a_time})  {single * 1e3:7.2f} ms per design")
+    print(f"  same statuses: {bool((status[:k] == status1).all())}; largest difference {worst:.2g}")
+
+
+def writers(n_r2: int = 1000, n_r4: int = 1000) -> None:
+    """A grid of n_r2 x n_r4 designs at 3 positions each to Parquet and to CSV: the
+    time is mostly writing."""
+    with tempfile.TemporaryDirectory() as tmp:
+        for suffix in ("parquet", "csv"):
+            cmd = [sys.executable, "-m", "linkage", "scan", str(SAMPLE), "--vary", f"r2=20:60:{n_r2}",
+                   "--vary", f"r4=50:120:{n_r4}", "--from", "0", "--to", "240", "--step", "120",
+                   "-o", str(Path(tmp) / f"scan.{suffix}")]
+            t = time.perf_counter()
+            subprocess.run(cmd, check=True, capture_output=True)
+            took = time.perf_counter() - t
+            print(f"  {n_r2 * n_r4:,} designs to {suffix:8s} {took:6.1f} s  "
+                  f"({n_r2 * n_r4 / took:,.0f} records/s)")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--designs", type=int, default=2000)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--no-cluster", action="store_true")
+    ap.add_argument("--continuation", action="store_true", help="only the six-bar comparison")
+    ap.add_argument("--writers", action="store_true", help="only the Parquet and CSV writing rates")
     args = ap.parse_args()
+    if args.continuation:
+        continuation()
+        return
+    if args.writers:
+        writers()
+        return
     n = args.designs
     base = time_closed_form(n, args.repeats)
     threads = time_cli(n, args.repeats, [])

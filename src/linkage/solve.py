@@ -637,18 +637,23 @@ def system_verdict(status: Status, detail: str, residual: float, gate: float,
     the method stopped (no step lowers |Phi|, or J is singular) with |Phi| already within
     tolerance is a root to that tolerance (ill-conditioned, so the step test could not
     pass); a converged status with |Phi| above it is not."""
-    if stopped and status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN) and residual <= gate:
-        return Status.CONVERGED_RESIDUAL, f"max|Phi| = {residual:.3g} <= {gate:.3g}; {detail}"
-    if status.converged and not residual <= gate:
+    if residual <= gate:
+        if stopped and status in _STOPPED:
+            return Status.CONVERGED_RESIDUAL, f"max|Phi| = {residual:.3g} <= {gate:.3g}; {detail}"
+        return status, detail
+    if status.converged:
         return Status.STALLED, f"max|Phi| = {residual:.3g} at the end, above {gate:.3g}"
     return status, detail
 
 
+_STOPPED = frozenset({Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN})
+
+
 def _two_unknown_result(problem: Any, q0: tuple[float, ...], phi0: Any, crit: Criteria, gate: float,
-                        damped: bool, meta: dict[str, Any]) -> Result:
+                        damped: bool, meta: dict[str, Any], loaded: tuple[Any, ...]) -> Result:
     """Newton on two unknowns by :func:`~linkage.methods.newton_system._newton_2x2`,
-    judged and packaged as :func:`solve_system` does."""
-    _newton_2x2, max_abs, _, _, _ = _two_unknowns()
+    judged and packaged as :func:`solve_system` does (``loaded``: :func:`_two_unknowns`)."""
+    _newton_2x2, max_abs = loaded[0], loaded[1]
     q, phi, err, status, detail, iterations, nfev, njev = _newton_2x2(
         problem, q0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
     residual = max_abs(phi)
@@ -663,7 +668,8 @@ def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float,
                 damped: bool) -> Result:
     """:func:`solve_system` for ``newton`` on user callables of two unknowns, with the
     general path's checks and packaging, but no problem object unless a step is refused."""
-    _, _, LeanProblem, (names, kinds, _), generic_system = _two_unknowns()
+    loaded = _two_unknowns()
+    _, _, LeanProblem, (names, kinds, _), generic_system = loaded
     try:
         phi0 = F(list(x0))
     except (ArithmeticError, ValueError) as exc:
@@ -673,7 +679,7 @@ def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float,
     gate = crit.ftol if crit.ftol is not None else crit.tol
     problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
     meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": names, "kinds": kinds, "title": ""}
-    return _two_unknown_result(problem, x0, phi0, crit, gate, damped, meta)
+    return _two_unknown_result(problem, x0, phi0, crit, gate, damped, meta, loaded)
 
 
 def _mechanism_two(problem: Any, x0: Any, crit: Criteria, damped: bool) -> Result | None:
@@ -697,7 +703,7 @@ def _mechanism_two(problem: Any, x0: Any, crit: Criteria, damped: bool) -> Resul
     gate = (crit.ftol if crit.ftol is not None else crit.tol) * scale
     meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names, "kinds": problem.kinds,
             "title": problem.title, **problem.meta}
-    result = _two_unknown_result(problem, q0, phi0, crit, gate, damped, meta)
+    result = _two_unknown_result(problem, q0, phi0, crit, gate, damped, meta, _two_unknowns())
     return result if result.converged else None
 
 
