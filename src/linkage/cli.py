@@ -880,11 +880,12 @@ def scan(
 
     engine = ENGINES[engine_for(mechanism, chosen)]
     where_note = f"; {keeper.kept:,} pass --where" if test is not None else ""
+    branch_shown = chosen or "the one the file's guess is on"
     stopped = f" (stopped early: the first {top} are final)" if scanned < plan.total else ""
     summary = [f"{mechanism.name}: {scanned:,} of {plan.total:,} designs scanned{stopped}"
                f"{where_note}; {elapsed:.2f} s",
                f"{len(values)} positions each ({mechanism.driver.name} {a:g}..{b:g} "
-               f"{mechanism.driver.unit}, step {step:g}); branch: {chosen or 'that of the file guess'}; "
+               f"{mechanism.driver.unit}, step {step:g}); branch: {branch_shown}; "
                f"engine: {engine}"]
     if as_table:
         n_held = len(held["design"]) if held else 0
