@@ -297,3 +297,119 @@ def test_the_two_unknown_mechanism_front_door_equals_the_general_path():
                 assert repr(vars(fast)) == repr(vars(full)), kw
                 converged += fast.converged
     assert converged > 300
+
+
+def _two_unknown_mechanisms():
+    from linkage.stress import fourbar_cases, fourbar_mechanism
+
+    sample = [load_mechanism(p) for p in sorted(SAMPLES.glob("*.toml"))]
+    return [m for m in sample if len(m.unknowns) == 2] + \
+        [fourbar_mechanism(it) for it in fourbar_cases(random.Random(5), 60)]
+
+
+def test_compiled_newton_two_equals_the_lean_loop():
+    """The model's generated Newton (one function, Phi and J written in) gives the same
+    iterations and root, bit for bit, as _newton_2x2 with the verdict, wherever it returns
+    a result; it hands back (None) only runs that did not converge by whole steps."""
+    from linkage.methods.newton_system import _newton_2x2, max_abs
+    from linkage.problems.system import LeanProblem
+    from linkage.solve import system_verdict
+
+    agreed = handed_back = 0
+    rng = random.Random(7)
+    for m in _two_unknown_mechanisms():
+        model = m.model
+        size = m.length_scale
+        for _ in range(60):
+            d, q = _random_state(m, rng)
+            if rng.random() < 0.5:  # near the file's own assembly as well as anywhere
+                d = m.driver.value + rng.uniform(-0.3, 0.3)
+                q = [u.value + rng.uniform(-0.2, 0.2) for u in m.unknowns]
+            tol, gate = 1e-12, 1e-12 * size
+            F, J = model.functions(d)
+            try:
+                phi0 = F(list(q))
+            except (ArithmeticError, ValueError):
+                continue
+            light = LeanProblem(F, J, None, lambda m=m, d=d: m.model.problem_at(d))
+            x, phi, _e, status, detail, k, _nf, _nj = _newton_2x2(light, tuple(q), phi0, tol, 0.0, gate,
+                                                                  50, False)
+            status, _ = system_verdict(status, detail, max_abs(phi), gate)
+            got = model.newton_two(d, q[0], q[1], tol, gate, 50)
+            if got is None:
+                handed_back += status.converged
+                continue
+            assert status.converged, (m.name, d, q)
+            assert (got[0], got[1], got[2]) == (k, x[0], x[1])
+            (a, b), (c, e) = J([got[1], got[2]])
+            assert got[3:7] == (a, b, c, e)
+            assert list(got[7:]) == model.driver_derivative(d)([got[1], got[2]])
+            agreed += 1
+    assert agreed > 2000
+    assert handed_back <= 0.01 * agreed  # singular or refused steps only
+
+
+def _sweep_both_ways(m, values, **kw):
+    from linkage.kinematics import sweep as S
+
+    init = S._Solver.__init__
+
+    def general(self, *a, **k):
+        init(self, *a, **k)
+        self.two = False
+
+    out = [S.sweep(m, values, **kw)]
+    S._Solver.__init__ = general
+    try:
+        out.append(S.sweep(m, values, **kw))
+    finally:
+        S._Solver.__init__ = init
+    return out
+
+
+def test_the_two_unknown_sweep_step_equals_the_general_step():
+    """A continuation step on two unknowns runs on scalars with the generated Newton;
+    every position of every sweep equals the general step's, bit for bit (gaps, re-entry,
+    halved steps and both branches included)."""
+    from linkage.kinematics.sweep import _Solver
+
+    checked = fast = 0
+    for m in _two_unknown_mechanisms()[:40]:
+        values = ([float(v) for v in range(0, 361, 3)] if m.driver.kind == "angle"
+                  else [m.driver.value * (0.5 + k / 100) for k in range(100)])
+        assert _Solver(m, "newton", 1e-12, 50).two == (m.length_scale == 1.0 or
+                                                       all(u.kind == "angle" for u in m.unknowns))
+        for branch in (None, "crossed"):
+            a, b = _sweep_both_ways(m, values, branch=branch)
+            assert repr(a) == repr(b), (m.name, branch)
+            checked += 1
+            fast += _Solver(m, "newton", 1e-12, 50).two
+    assert checked >= 80 and fast >= 70
+
+
+def test_a_converged_position_built_fast_equals_the_constructor():
+    from dataclasses import fields
+
+    from linkage.kinematics.sweep import Position, _converged
+
+    assert [f.name for f in fields(Position)] == ["input", "status", "solution", "branch", "iterations",
+                                                 "det", "transmission", "substeps", "note", "rates"]
+    sol = {"theta3": 12.5, "theta4": 80.0}
+    fast, slow = _converged(3.0, sol, "open", 3, -1.5, 67.5), Position(3.0, "converged", sol, "open", 3, -1.5,
+                                                                       67.5)
+    assert fast == slow and repr(fast) == repr(slow)
+
+
+def test_a_mechanism_with_its_compiled_model_still_pickles():
+    """Scans send mechanisms to worker processes; the compiled model (generated
+    functions) stays behind and the worker compiles its own."""
+    import pickle
+
+    import linkage
+
+    m = load_mechanism(SAMPLES / "crank_rocker.toml")
+    before = linkage.sweep(m, [0.0, 10.0, 20.0])
+    assert "model" in vars(m)
+    copy = pickle.loads(pickle.dumps(m))
+    assert "model" not in vars(copy) and copy == m
+    assert repr(linkage.sweep(copy, [0.0, 10.0, 20.0])) == repr(before)

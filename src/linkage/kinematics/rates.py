@@ -168,6 +168,6 @@ def rates_at(mechanism: Any, q: Any, *, speed: float | None = None, accel: float
     solution ``q`` (radians and length units, as ``solve_system`` returns it), at its
     driver value (or ``driver``, internal units), with the rates of everything when a
     driver ``speed`` (rad/s or length/s) and ``accel`` are given."""
-    model = LoopModel.compile(mechanism)
+    model = mechanism.model
     d = mechanism.driver.value if driver is None else driver
     return position_rates(model, list(q), d, speed, accel)

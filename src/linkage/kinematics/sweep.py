@@ -34,12 +34,13 @@ from ..problems.closed_form import (
     fourbar_class,
     wrap_degrees,
 )
-from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism
+from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..problems.system import LeanProblem
 from ..result import Status
 from ..solve import system_verdict
 
 MAX_HALVINGS = 6
+_DEG = 180.0 / math.pi  # math.degrees(x) is x * (180 / pi), bit for bit (CPython's mathmodule)
 LOCATE_TOL = 1e-9  # driver units (deg for angles)
 
 
@@ -98,7 +99,7 @@ class _Solver:
 
     def __init__(self, m: Mechanism, method: str, tol: float, max_iter: int) -> None:
         self.m = m
-        self.model = LoopModel.compile(m)
+        self.model = m.model
         self.method = method
         self.tol = tol
         self.max_iter = max_iter
@@ -114,6 +115,14 @@ class _Solver:
         self.gate = tol * size
         self.step_scales = (None if size == 1.0 or "length" not in self.kinds else
                             tuple(size if k == "length" else 1.0 for k in self.kinds))
+        # two unknowns measured as they are: the continuation step on scalars (_step_two)
+        self.two_angles = self.kinds == ("angle", "angle")
+        self.two = len(self.names) == 2 and self.step_scales is None and len(m.loops) == 1
+        # (v, q0, q1, LU of J, dPhi/dv) where _step_two last solved: the next tangent
+        self.solved_at: tuple[float, float, float, Any, float, float] | None = None
+        self.newton_two = self.model.newton_two if self.two else None
+        self._fixed_deg: dict[str, float] | None = None
+        self.coupler_and_output = "theta3" in self.names and "theta4" in self.names
 
     def compiled(self, value: float) -> Any:
         """(F, J, dPhi/dv) at a driver value (display units), the last one kept: a
@@ -123,6 +132,30 @@ class _Solver:
             fns = self.model.factory(value * self.scale)
             self._compiled = (value, fns)
         return fns
+
+    def transmission(self, sol: dict[str, float]) -> float | None:
+        """Four-bars: the transmission angle between coupler and output link, in [0, 180]."""
+        if self.m.closed_form != "fourbar":
+            return None
+        if self.coupler_and_output:
+            x = sol["theta4"] - sol["theta3"]
+            if x - x == 0.0:  # abs(wrap_degrees(x)) inline: once per position
+                x = math.fmod(x, 360.0)
+                if x <= -180.0:
+                    x += 360.0
+                elif x > 180.0:
+                    x -= 360.0
+                return abs(x)
+            return math.nan
+        fixed = self._fixed_deg
+        if fixed is None:
+            fixed = self._fixed_deg = {k: math.degrees(q.value) for k, q in self.m.parameters.items()
+                                       if q.kind == "angle" and k != self.m.driver.name}
+        t3 = sol.get("theta3", fixed.get("theta3"))
+        t4 = sol.get("theta4", fixed.get("theta4"))
+        if t3 is None or t4 is None:
+            return None
+        return abs(wrap_degrees(t4 - t3))
 
     def solve_lean(self, value: float, guess: Sequence[float]) -> tuple[Any, list[float], int] | None:
         """What :meth:`solve` does for textbook Newton, without building a problem or a
@@ -161,6 +194,10 @@ class _Solver:
         return p, r
 
     def display(self, q: Sequence[float]) -> dict[str, float]:
+        if self.two_angles:
+            n0, n1 = self.names
+            x0, x1 = q
+            return {n0: x0 * _DEG, n1: x1 * _DEG}
         return {n: (math.degrees(v) if k == "angle" else v) for n, v, k in zip(self.names, q, self.kinds)}
 
     def det(self, p: Any, q: Sequence[float]) -> float:
@@ -324,7 +361,7 @@ def with_rates(m: Mechanism, result: SweepResult, speed: float | None, accel: fl
 
     from .rates import position_rates
 
-    model = LoopModel.compile(m)
+    model = m.model
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     kinds = [u.kind for u in m.unknowns]
     positions = []
@@ -427,7 +464,8 @@ def _continue(solver: _Solver, v: float, history: list[tuple[float, tuple[float,
     """
     v_last, q_last = history[-1]
     if solver.method == "newton":
-        fast = _lean_step(solver, v, v_last, q_last, target)
+        fast = (_step_two(solver, v, v_last, q_last, target) if solver.two else
+                _lean_step(solver, v, v_last, q_last, target))
         if fast is not None:
             return fast
     for h in range(0, MAX_HALVINGS + 1):
@@ -497,6 +535,93 @@ def _lean_step(solver: _Solver, v: float, v_last: float, q_last: tuple[float, ..
     return Position(v, "converged", sol, branch, iterations, det, _transmission(solver, sol)), q
 
 
+def _lu_two(a: float, b: float, c: float, d: float) -> tuple[float, float, float, float, bool] | None:
+    """:func:`~linkage.methods._linalg.lu` of [[a, b], [c, d]] on scalars, the same operations
+    in the same order: (m00, m01, m10, m11, swapped), None for a zero pivot."""
+    swapped = abs(c) > abs(a)  # max() keeps the first of equal candidates
+    if swapped:
+        a, b, c, d = c, d, a, b
+    if a == 0.0:
+        return None
+    factor = c / a
+    if factor != 0.0:
+        d -= factor * b
+    else:
+        factor = 0.0
+    if d == 0.0:
+        return None
+    return a, b, factor, d, swapped
+
+
+def _step_two(solver: _Solver, v: float, v_last: float, q_last: tuple[float, ...],
+              target: str | None) -> tuple[Position, tuple[float, ...]] | None:
+    """:func:`_lean_step` for two unknowns measured as they are (every four-bar), on
+    scalars: the tangent's LU and det J written out, and Newton run by the model's compiled
+    ``newton_two`` (:mod:`linkage.codegen`), the same operations in the same order as the
+    general path, so the same predictor, iterates, counts, det and branch
+    (tests/test_compile.py). J and dPhi/dv at a solved position serve its det and the
+    next step's tangent. None wherever that step would not be accepted, so the full loop
+    decides (and computes the same)."""
+    x0, x1 = q_last
+    cached = solver.solved_at
+    if cached is not None and cached[0] == v_last and cached[1] == x0 and cached[2] == x1:
+        factors, w0, w1 = cached[3], cached[4], cached[5]
+    else:
+        _, J, V = solver.compiled(v_last)
+        (a, b), (c, d) = J([x0, x1])
+        w0, w1 = V([x0, x1])
+        factors = _lu_two(a, b, c, d)
+    if factors is None:
+        return None
+    m00, m01, m10, m11, swapped = factors
+    neg = -solver.scale
+    y0, y1 = (neg * w1, neg * w0) if swapped else (neg * w0, neg * w1)
+    y1 = (y1 - m10 * y0) / m11
+    y0 = (y0 - m01 * y1) / m00
+    dv = v - v_last
+    pred0, pred1 = x0 + dv * y0, x1 + dv * y1
+    try:
+        got = solver.newton_two(v * solver.scale, pred0, pred1, solver.tol, solver.gate, solver.max_iter)
+    except (ArithmeticError, ValueError):
+        return None
+    if got is None:
+        return None
+    k, x0, x1, a, b, c, d, w0, w1 = got
+    factors = _lu_two(a, b, c, d)
+    det = 0.0 if factors is None else (-1.0 if factors[4] else 1.0) * factors[0] * factors[3]
+    solver.solved_at = (v, x0, x1, factors, w0, w1)
+    q = (x0, x1)
+    sol = solver.display(q)
+    branch = solver.rule(sol) if solver.rule is not None else ("det+" if det > 0 else "det-")
+    if target is not None and branch != target:
+        return None
+    dv = abs(dv) * solver.scale
+    e0, e1 = abs(x0), abs(x1)
+    size = 1.0 + (e0 if e0 >= e1 else e1)
+    e0, e1 = abs(pred0 - q_last[0]), abs(pred1 - q_last[1])
+    moved = e0 if e0 >= e1 else e1
+    e0, e1 = abs(x0 - pred0), abs(x1 - pred1)
+    correction = e0 if e0 >= e1 else e1
+    if correction > 0.5 * moved + (1e-7 + 10.0 * dv * dv) * size:
+        return None
+    return _converged(v, sol, branch, k, det, solver.transmission(sol)), q
+
+
+_new = object.__new__
+
+
+def _converged(v: float, sol: dict[str, float], branch: str, iterations: int, det: float,
+               transmission: float | None) -> Position:
+    """``Position(v, "converged", ...)`` for the hot loop, without the frozen dataclass's
+    ``__init__``, which sets each of its ten fields through ``object.__setattr__`` (1.5 us
+    against 0.6 us; a sweep makes one per position). tests/test_compile.py checks that
+    both give equal positions and that the fields are still these."""
+    p = _new(Position)
+    p.__dict__.update(input=v, status="converged", solution=sol, branch=branch, iterations=iterations,
+                      det=det, transmission=transmission, substeps=0, note="", rates=None)
+    return p
+
+
 def tangent(solver: _Solver, v0: float, q0: Sequence[float]) -> list[float] | None:
     """dq/dv on the branch at (v0, q0), from J dq/dv = -dPhi/dv with the compiled, exact
     dPhi/dv; q in internal units, v in display units. None where J is singular."""
@@ -538,21 +663,27 @@ def _continuous_angles(solver: _Solver, positions: list[Position]) -> list[Posit
 
     angles = [n for n, k in zip(solver.names, solver.kinds) if k == "angle"]
     prev: dict[str, float] = {}
-    out = []
+    fmod = math.fmod
     for p in positions:
-        if p.solution is None:
-            out.append(p)
+        sol = p.solution
+        if sol is None:
             continue
-        sol = dict(p.solution)
+        # in place: each position and its solution dict were made by this sweep and are
+        # not yet anybody else's (a new Position per position cost 1.5 us each)
         for n in angles:
             v = sol[n]
             ref = prev.get(n)
-            sol[n] = wrap_degrees(v) if ref is None else ref + wrap_degrees(v - ref)
-            prev[n] = sol[n]
-        # the constructor: dataclasses.replace costs several times more per position
-        out.append(Position(p.input, p.status, sol, p.branch, p.iterations, p.det, p.transmission,
-                            p.substeps, p.note, p.rates))
-    return _anchor(solver, out, angles)
+            x = v if ref is None else v - ref
+            if x - x == 0.0:  # wrap_degrees(x), inline: two per position
+                x = fmod(x, 360.0)
+                if x <= -180.0:
+                    x += 360.0
+                elif x > 180.0:
+                    x -= 360.0
+            else:
+                x = math.nan
+            prev[n] = sol[n] = x if ref is None else ref + x
+    return _anchor(solver, positions, angles)
 
 
 def _anchor(solver: _Solver, positions: list[Position], angles: list[str]) -> list[Position]:
@@ -590,6 +721,7 @@ def _follow(solver: _Solver, values: Sequence[float], seed: tuple[float, tuple[f
     from dataclasses import replace
 
     found: dict[int, Position] = {}
+    two = solver.two and solver.method == "newton"
     v_seed = seed[0]
     order = sorted(range(len(values)), key=lambda i: values[i])
     up = [i for i in order if values[i] >= v_seed]
@@ -603,7 +735,17 @@ def _follow(solver: _Solver, values: Sequence[float], seed: tuple[float, tuple[f
             if i in found or i in done:
                 if i in found:
                     continue
-            pos, q = _continue(solver, v, hist, target) if abs(v - hist[-1][0]) <= 5.0 else \
+            v_last, q_last = hist[-1]
+            step = _step_two(solver, v, v_last, q_last, target) if two and abs(v - v_last) <= 5.0 \
+                else None
+            if step is not None:
+                # the common case, first: what _continue would return (it tries this first)
+                found[i] = step[0] if step[0].input == values[i] else replace(step[0], input=values[i])
+                hist = [(v, step[1])]
+                if progress is not None:
+                    progress(len(found) + len(done))
+                continue
+            pos, q = _continue(solver, v, hist, target) if abs(v - v_last) <= 5.0 else \
                 _walk(solver, v, hist, target)
             if pos.status != "converged" or q is None:
                 break
@@ -630,16 +772,7 @@ def _walk(solver: _Solver, v: float, hist: list[tuple[float, tuple[float, ...]]]
 
 
 def _transmission(solver: _Solver, sol: dict[str, float]) -> float | None:
-    """Four-bars: the transmission angle between coupler and output link, in [0, 180]."""
-    if solver.m.closed_form != "fourbar":
-        return None
-    values = {k: math.degrees(q.value) for k, q in solver.m.parameters.items() if q.kind == "angle"}
-    values[solver.m.driver.name] = None  # type: ignore[assignment]
-    t3 = sol.get("theta3", values.get("theta3"))
-    t4 = sol.get("theta4", values.get("theta4"))
-    if t3 is None or t4 is None:
-        return None
-    return abs(wrap_degrees(t4 - t3))
+    return solver.transmission(sol)
 
 
 def _solved_ranges(positions: Sequence[Position]) -> tuple[tuple[float, float], ...]:

@@ -154,9 +154,9 @@ def verify(m: Any) -> str | None:
     if unknowns != expected:
         return (f"{name} solves for {', '.join(sorted(expected))}; the file's unknowns are "
                 f"{', '.join(sorted(unknowns))}")
-    from .loops import ANGLE_UNITS, LoopModel
+    from .loops import ANGLE_UNITS
 
-    model = LoopModel.compile(m)
+    model = m.model
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     shown0 = m.driver.value / scale
     tries = [shown0] + ([shown0 + 30.0 * k for k in range(1, 12)] if m.driver.kind == "angle" else [])

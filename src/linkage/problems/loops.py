@@ -152,6 +152,18 @@ class Mechanism:
         return build_problem(self)
 
     @functools.cached_property
+    def model(self) -> LoopModel:
+        """The loop model, compiled once per mechanism (its generated functions with it)."""
+        return LoopModel.compile(self)
+
+    def __getstate__(self) -> dict[str, Any]:
+        # the compiled model holds generated functions, which do not pickle (scans send
+        # mechanisms to worker processes): a worker compiles its own
+        state = dict(self.__dict__)
+        state.pop("model", None)
+        return state
+
+    @functools.cached_property
     def length_scale(self) -> float:
         """The longest length in the loops (parameters, numbers, a length driver): the
         size that residual tolerances are relative to."""
@@ -453,6 +465,14 @@ class LoopModel:
 
         return build(self.terms, self.n)
 
+    @functools.cached_property
+    def newton_two(self) -> Any:
+        """For two unknowns: ``newton_two(d, x0, x1, tol, gate, max_iter)``, Newton-Raphson
+        at driver value d with the model written in (see :mod:`linkage.codegen`)."""
+        from ..codegen import build
+
+        return build(self.terms, self.n, newton=True)
+
     @property
     def source(self) -> str:
         """The generated code of the compiled model, for inspection."""
@@ -571,7 +591,7 @@ class LoopModel:
 
 def build_problem(m: Mechanism) -> SystemProblem:
     """Phi(q) and its exact Jacobian at the mechanism's own driver value."""
-    return LoopModel.compile(m).problem_at(m.driver.value)
+    return m.model.problem_at(m.driver.value)
 
 
 def _display(q: Quantity) -> float:

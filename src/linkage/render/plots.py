@@ -143,9 +143,8 @@ def _runs(statuses: Sequence[str], xs: Sequence[float]) -> list[tuple[float, flo
 
 
 def _geometry(mechanism: Any, q: Sequence[float], driver: float) -> list[tuple[list[complex], Any]]:
-    from ..problems.loops import LoopModel
 
-    model = LoopModel.compile(mechanism)
+    model = mechanism.model
     return list(zip(model.points(q, driver), mechanism.loops))
 
 
@@ -202,9 +201,8 @@ def _named_points(mechanism: Any, q: Sequence[float], driver: float) -> dict[str
     if not mechanism.points:
         return {}
     from ..kinematics.rates import place
-    from ..problems.loops import LoopModel
 
-    placed = place(LoopModel.compile(mechanism), q, driver)
+    placed = place(mechanism.model, q, driver)
     return {name: (placed[origin][0], placed[name][0]) for name, (origin, _) in mechanism.points.items()}
 
 
