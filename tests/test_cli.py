@@ -247,3 +247,39 @@ def test_method_all_leaves_the_root_blank_for_a_failed_method(cli):
             assert r[4]
         else:
             assert r[4] == "", r
+
+
+def test_a_run_builds_only_the_command_it_names(cli):
+    """typer builds a parser for every registered command before it dispatches; a run
+    that names a command gets an app with only that one. Its help and errors read as
+    before, and anything that is not a command name gets the whole app."""
+    from linkage.cli import _app_for, app
+
+    assert [c.callback.__name__ for c in _app_for(["sweep", "x.toml"]).registered_commands] == ["sweep"]
+    for args in ([], ["--help"], ["--version"], ["sovle"]):
+        assert _app_for(args) is app
+    assert cli("sweep", "--help").out.count("Usage: linkage sweep") == 1
+    bad = cli("sovle")
+    assert bad.code == 2 and "No such command 'sovle'" in bad.err and "solve" in bad.err
+    top = cli("--help").out
+    assert all(name in top for name in ("solve", "sweep", "scan", "draw", "samples", "stress", "bench"))
+
+
+def test_plain_numbers_parse_as_fractions_do():
+    """parse_number reads plain decimals with float() (fractions costs a cold start ~2 ms):
+    the same double as Fraction, and the same refusals."""
+    import random
+    from fractions import Fraction
+
+    from linkage.errors import InputError
+    from linkage.numbers import parse_number
+
+    rng = random.Random(3)
+    for _ in range(5000):
+        text = f"{rng.choice(['', '-', '+'])}{rng.randrange(10 ** rng.randrange(1, 20))}." \
+               f"{rng.randrange(10 ** rng.randrange(1, 20))}e{rng.randrange(-320, 280)}"
+        assert parse_number("x", text) == float(Fraction(text)), text
+    assert parse_number("x", " 2.5 ") == 2.5 and parse_number("x", "5/3") == float(Fraction(5, 3))
+    for text in ("1e400", "-1e999", "nan", "inf", "-inf", "1e", ".", "", "1 5", "+-1", "0x10", "1/0"):
+        with pytest.raises(InputError):
+            parse_number("x", text)

@@ -4,9 +4,9 @@ Exit codes: 0 converged, 1 ran but did not converge (the rows are still shown),
 2 bad input (one line on stderr, never a traceback).
 """
 
-from __future__ import annotations
 
 import contextlib
+import copy
 import math
 import sys
 import time
@@ -396,10 +396,9 @@ def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol:
     extra = system_extra(problem, result, branch)
     if result.converged:
         from .kinematics.rates import position_rates
-        from .problems.loops import LoopModel
         from .render.rates import rates_blocks, rates_dict
 
-        rates = position_rates(LoopModel.compile(mechanism), result.x, mechanism.driver.value, speed, accel)
+        rates = position_rates(mechanism.model, result.x, mechanism.driver.value, speed, accel)
         extra.update(rates_dict(rates))
         if speed is not None:
             extra["driver"].update(speed=speed, accel=accel)
@@ -1221,10 +1220,27 @@ for _command in app.registered_commands:
         _command.help = _reflow(_command.callback.__doc__)
 
 
+def _app_for(args: list[str]) -> typer.Typer:
+    """The app with only the command this run names: typer builds the parser of every
+    registered command (signature, type hints, options) before it dispatches, and a run
+    uses one. Anything else (no command, an option first, a misspelt name) gets the
+    whole app, whose help and "No such command" list them all."""
+    if not args or args[0].startswith("-"):
+        return app
+    chosen = [c for c in app.registered_commands if c.callback is not None and
+              (c.name or c.callback.__name__) == args[0]]
+    if not chosen:
+        return app
+    lean = copy.copy(app)
+    lean.registered_commands = chosen
+    return lean
+
+
 def run_cli(argv: list[str] | None = None) -> int:
     """Run the app and turn every error into one stderr line and an exit code."""
+    args = list(sys.argv[1:] if argv is None else argv)
     try:
-        rv = app(args=argv, prog_name="linkage", standalone_mode=False)
+        rv = _app_for(args)(args=args, prog_name="linkage", standalone_mode=False)
     except typer.Exit as exc:
         return exc.exit_code
     except typer.Abort:

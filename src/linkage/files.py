@@ -16,7 +16,6 @@ from __future__ import annotations
 import contextlib
 import os
 import stat
-import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
@@ -139,6 +138,8 @@ def atomic_target(path: Path) -> Iterator[str]:
     folder = os.path.dirname(real) or "."
     suffix = os.path.splitext(real)[1]
     try:
+        import tempfile
+
         fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(real)}.", suffix=f".part{suffix}",
                                    dir=folder)
         os.close(fd)

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import csv
 import io
-import json
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -47,11 +45,15 @@ def result_dict(result: Result, solution: dict[str, Any], convergence: dict[str,
 
 
 def to_json(obj: Any) -> str:
+    import json
+
     return json.dumps(clean(obj), indent=2, allow_nan=False) + "\n"
 
 
 def to_csv(headers: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:
     """A header row, then one row per record; empty cells for missing or non-finite values."""
+    import csv
+
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(headers)
