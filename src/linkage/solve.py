@@ -12,7 +12,6 @@ from typing import Any
 from .errors import InputError
 from .iterate import MAX_ITER_LIMIT, Criteria, Rows, explain, run
 from .methods import SCALAR_METHODS
-from .methods.newton import Newton, newton_lean
 from .problems.scalar import ScalarProblem
 from .result import History, Result, Status
 
@@ -156,9 +155,6 @@ def solve_scalar(
             if problem.fprime is None:
                 raise InputError("newton needs the derivative fprime")
             return _newton_lean(problem, x0, crit, record)
-            m = Newton()
-            args = (x0,)
-            start = {"x0": x0}
         else:
             if problem.g is None:
                 raise InputError("fixed-point needs the iteration function g (x = g(x))")
@@ -205,6 +201,19 @@ def _method_class(name: str) -> Any:
     return cls
 
 
+_newton_loop: Any = None
+"""linkage.methods.newton.newton_lean once a scalar Newton solve has loaded it (a sweep or
+a system solve never does)."""
+
+
+def _load_newton_loop() -> Any:
+    global _newton_loop
+    from .methods.newton import newton_lean
+
+    _newton_loop = newton_lean
+    return newton_lean
+
+
 def _newton_lean(problem: ScalarProblem, x0: float, crit: Criteria, record: bool = False) -> Result:
     """Newton by the tight loop of :func:`~linkage.methods.newton.newton_lean`, packaged
     exactly as :func:`finish` packages the generic loop's outcome (history included when
@@ -218,8 +227,9 @@ def _newton_lean(problem: ScalarProblem, x0: float, crit: Criteria, record: bool
 
     rows = Rows() if record else None
     try:
-        x, fx, err, status, detail, k = newton_lean(problem, x0, crit.tol, crit.rtol, crit.ftol,
-                                                    crit.max_iter, certify, rows)
+        loop = _newton_loop or _load_newton_loop()
+        x, fx, err, status, detail, k = loop(problem, x0, crit.tol, crit.rtol, crit.ftol, crit.max_iter,
+                                             certify, rows)
     except TypeError:  # the generic path's answer to a non-real f at the start
         return Result(method="newton", x=x0, status=Status.DOMAIN_ERROR, iterations=0, nfev=0,
                       error=math.inf, residual=None, detail="at the start: f returned a non-real value",
@@ -237,6 +247,8 @@ def _newton_lean(problem: ScalarProblem, x0: float, crit: Criteria, record: bool
                          {"var": problem.var, "unit": problem.unit, "title": problem.title,
                           "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, "x0": x0})
     if rows is not None:
+        from .methods.newton import Newton
+
         labels = column_labels(Newton(), problem.var, problem.unit, problem.u is not None,
                                problem.gprime is not None)
         result.__dict__["history"] = History.of(labels, rows, len(labels) - 1)
@@ -518,8 +530,7 @@ def solve_system(
         # the common case without the general front door: user callables, two unknowns,
         # a finite start (the same outcome: tests/test_compile.py)
         return _newton_two(F, jac, x0, check_criteria(tol, rtol, ftol, max_iter), damped)
-    LevenbergMarquardt, NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system = \
-        _system_solvers()
+    NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system = _system_solvers()
     if (method == "newton" and not record and jac is None and fd_step is None and type(F) is SystemProblem
             and len(F.names) == 2 and F.J is not None and F.step_scales is None):
         fast = _mechanism_two(F, x0, check_criteria(tol, rtol, ftol, max_iter), damped)
@@ -556,8 +567,12 @@ def solve_system(
     if method == "newton" and problem.J is None:
         raise InputError("newton needs the Jacobian jac; use method='newton-fd' to difference it")
     kind = "fd" if method == "newton-fd" or problem.J is None else "analytic"
-    m: Any = (LevenbergMarquardt(kind, fd_step, diagnostics=record) if method == "lm"
-              else NewtonSystem(kind, fd_step, damped, diagnostics=record))
+    if method == "lm":
+        from .methods.least_squares import LevenbergMarquardt
+
+        m: Any = LevenbergMarquardt(kind, fd_step, diagnostics=record)
+    else:
+        m = NewtonSystem(kind, fd_step, damped, diagnostics=record)
     try:
         phi0 = problem.F(list(q0))
     except (ArithmeticError, ValueError) as exc:
@@ -574,7 +589,7 @@ def solve_system(
         residual = max_abs(phi)
     else:
         state = m.init(problem, q0, phi0) if isinstance(m, NewtonSystem) else m.init(problem, q0)
-        run_crit = replace(crit, ftol=gate)
+        run_crit = crit._replace(ftol=gate)
         final, status, detail, iterations, rows = run(m, problem, state, run_crit, record=record,
                                                       magnitude=max_abs)
         x, stopped, err = tuple(final.x), final.stop is not None, final.err
@@ -614,12 +629,12 @@ def solve_system(
 
 @functools.lru_cache(maxsize=1)
 def _system_solvers() -> tuple[Any, ...]:
-    """The system solvers, imported on the first system solve (never by a scalar one)."""
-    from .methods.least_squares import LevenbergMarquardt
+    """The system solvers, imported on the first system solve (never by a scalar one;
+    Levenberg-Marquardt only when asked for)."""
     from .methods.newton_system import NewtonSystem, max_abs, newton_system_lean
     from .problems.system import SystemProblem, generic_system
 
-    return LevenbergMarquardt, NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system
+    return NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system
 
 
 @functools.lru_cache(maxsize=1)
