@@ -215,7 +215,7 @@ def test_benchmark_script_runs_on_a_few_positions():
     proc = subprocess.run([sys.executable, str(script), "-n", "2000", "--repeats", "1"],
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
-    assert "ratio batch / closed form" in proc.stdout and "all converged: True" in proc.stdout
+    assert "ratio sweep / closed form" in proc.stdout and "all converged: True" in proc.stdout
 
 
 @pytest.mark.parametrize("name", ["crank_rocker.toml", "fourbar_me581.toml", "fourbar_me581_theta4.toml",
@@ -244,3 +244,78 @@ def test_the_lean_continuation_step_changes_no_position(name, monkeypatch):
     for a, b in zip(fast, slow):
         assert a.positions == b.positions
         assert (a.toggles, a.feasible_ranges, a.branch) == (b.toggles, b.feasible_ranges, b.branch)
+
+
+@pytest.mark.parametrize("name,lo,hi", BATCH_CASES, ids=[c[0] for c in BATCH_CASES])
+def test_batch_blocks_give_the_answer_of_one_block(name, lo, hi, monkeypatch):
+    """The batch engine settles positions a block at a time (cache-sized arrays); blocks
+    of 97 positions, boundaries inside gaps and fallbacks included, give exactly what
+    one block does."""
+    import numpy as np
+
+    import linkage.kinematics.batch as batch
+
+    m = load_mechanism(SAMPLES / f"{name}.toml")
+    values = np.array(driver_values(lo, hi, None, 1201))
+    whole = batch.batch_sweep(m, values)
+    monkeypatch.setattr(batch, "BLOCK", 97)
+    parts = batch.batch_sweep(m, values)
+    for f in ("status", "solution", "det", "iterations"):
+        assert np.array_equal(getattr(whole, f), getattr(parts, f), equal_nan=True), f
+    assert whole.fallback == parts.fallback
+
+
+def test_batch_grid_index_equals_searchsorted():
+    import numpy as np
+
+    from linkage.kinematics.batch import _grid_index
+
+    rng = np.random.default_rng(4)
+    grid = np.linspace(-30.0, 400.0, 361)
+    for vals in (np.sort(rng.uniform(-50, 420, 5000)), rng.uniform(-50, 420, 5000), grid.copy(),
+                 np.repeat(grid[::7], 3), np.array([grid[5]]), np.array([-100.0, 1000.0])):
+        assert np.array_equal(_grid_index(grid, vals), np.searchsorted(grid, vals, side="right"))
+
+
+def test_batch_of_no_position_and_of_one():
+    import numpy as np
+
+    from linkage.kinematics.batch import batch_sweep
+
+    m = load_mechanism(SAMPLES / "crank_rocker.toml")
+    assert batch_sweep(m, np.zeros(0)).to_sweep().summary == {}
+    one = batch_sweep(m, np.array([10.0]))
+    assert list(one.status) == [0]
+    want = sweep(m, [10.0]).positions[0].solution
+    assert np.allclose(one.solution[0], [want["theta3"], want["theta4"]], rtol=0, atol=1e-10)
+
+
+def test_batch_trigonometry_after_a_small_step_is_within_a_few_ulps():
+    """The batch's second Newton evaluation takes cos and sin of each angle from the
+    first by the angle-addition formula where the step is at most 1e-6 rad; elsewhere
+    (a larger step, NaN) directly. Either way within 4 units in the last place of
+    np.cos/np.sin, and never twice in a row."""
+    import numpy as np
+
+    from linkage.kinematics.batch import VectorLoops
+
+    m = load_mechanism(SAMPLES / "crank_rocker.toml")
+    rng = np.random.default_rng(11)
+    size = 200_000
+    loops = VectorLoops(m.model, rng.uniform(-7, 7, size))
+    q = [rng.uniform(-40, 40, size), rng.uniform(-7, 7, size)]
+    loops.evaluate(q, None)
+    step = rng.choice([1e-6, 1e-9, 1e-12, 3e-5, 0.1], size) * rng.choice([-1.0, 1.0], size)
+    step[::1000] = np.nan
+    q1 = [q[0] + step, q[1] - step]
+    loops.evaluate(q1, None, near=True)
+    assert not any(t[3] for t in loops.last_trig.values())  # the formula was used
+    for (aidx, _off), (_, c, s, _direct) in loops.last_trig.items():
+        want_c, want_s = np.cos(q1[aidx]), np.sin(q1[aidx])
+        ok = np.isfinite(want_c)
+        assert np.array_equal(np.isnan(c), ~ok)
+        ulp = np.spacing(1.0)
+        assert np.max(np.abs(c[ok] - want_c[ok])) <= 4 * ulp
+        assert np.max(np.abs(s[ok] - want_s[ok])) <= 4 * ulp
+    loops.evaluate([q1[0] + 1e-9, q1[1]], None, near=True)  # never twice in a row
+    assert all(t[3] for t in loops.last_trig.values())

@@ -374,15 +374,6 @@ def numpy_fourbar(theta2_deg: Any, r1: float, r2: float, r3: float, r4: float) -
     return np.stack((t3, t4), axis=1)
 
 
-def _median_time(fn: Callable[[], Any], repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
-
-
 def has_pylinkage() -> bool:
     try:
         import pylinkage  # noqa: F401
@@ -404,8 +395,7 @@ def sweep_times(repeats: int = 5, batch_positions: int = 1_000_000) -> dict[str,
     m = load(sample_path("crank_rocker.toml"))
     v = {k: q.value for k, q in m.parameters.items()}
     values = [float(k) for k in range(361)]
-    sweep_mechanism(m, values)  # compile the model once, as a session would
-    out = {"linkage.sweep 361 positions": _median_time(lambda: sweep_mechanism(m, values), repeats)}
+    pair: dict[str, Callable[[], Any]] = {"linkage.sweep 361 positions": lambda: sweep_mechanism(m, values)}
     if has_pylinkage():
         import pylinkage as pl
 
@@ -413,16 +403,32 @@ def sweep_times(repeats: int = 5, batch_positions: int = 1_000_000) -> dict[str,
         crank = pl.Crank(o2, radius=v["r2"], angular_velocity=math.radians(1.0), initial_angle=0.0)
         b = pl.RRRDyad(crank, o4, distance1=v["r3"], distance2=v["r4"], x=v["r1"] + 37.0, y=71.0)
         lk = pl.Linkage([o2, o4, crank, b])
-        lk.step_fast(iterations=361)
-        out["pylinkage step_fast 361 positions"] = _median_time(lambda: lk.step_fast(iterations=361),
-                                                                repeats)
+        pair["pylinkage step_fast 361 positions"] = lambda: lk.step_fast(iterations=361)
+    out = {k: t for k, (t, _, _) in interleaved(pair, max(repeats, 5)).items()}
     grid = np.linspace(0.0, 360.0, batch_positions)
-    reps = max(1, min(3, repeats))
-    out[f"numpy closed form {batch_positions:,} positions"] = _median_time(
-        lambda: numpy_fourbar(grid, v["r1"], v["r2"], v["r3"], v["r4"]), reps)
-    out[f"linkage.sweep {batch_positions:,} positions (batch)"] = _median_time(
-        lambda: sweep_mechanism(m, grid), reps)
+    big = interleaved({
+        f"numpy closed form {batch_positions:,} positions":
+            lambda: numpy_fourbar(grid, v["r1"], v["r2"], v["r3"], v["r4"]),
+        f"linkage.sweep {batch_positions:,} positions (batch)": lambda: sweep_mechanism(m, grid, batch=True),
+    }, max(3, min(5, repeats)))
+    out.update({k: t for k, (t, _, _) in big.items()})
     return out
+
+
+def interleaved(fns: dict[str, Callable[[], Any]], repeats: int) -> dict[str, tuple[float, list[float], Any]]:
+    """(median seconds, the timings, the last result) of each function: one untimed run of
+    each first (a model compiles once, as in a session; numpy's first runs also pay for
+    fresh pages), then the repeats taken in turn, so that the machine's noise hits all
+    alike."""
+    times: dict[str, list[float]] = {k: [] for k in fns}
+    last: dict[str, Any] = {}
+    for rep in range(repeats + 1):
+        for k, fn in fns.items():
+            t0 = time.perf_counter()
+            last[k] = fn()
+            if rep:
+                times[k].append(time.perf_counter() - t0)
+    return {k: (statistics.median(ts), ts, last[k]) for k, ts in times.items()}
 
 
 TARGETS = (

@@ -149,20 +149,25 @@ class VectorLoops:
                 else:
                     self.moving.append((li, sign, r, lidx, th, aidx, off))
 
-    def evaluate(self, q: list[np.ndarray],
-                 rows: np.ndarray | None) -> tuple[list[np.ndarray], list[list[Any]]]:
-        """Phi (m arrays) and J (m x n arrays or zeros) at ``rows`` (None: all positions)."""
+    def evaluate(self, q: list[np.ndarray], rows: np.ndarray | None,
+                 near: bool = False) -> tuple[list[np.ndarray], list[list[Any]]]:
+        """Phi (m arrays) and J (m x n arrays or zeros) at ``rows`` (None: all positions).
+        ``near``: q is the last evaluation's q plus a Newton step (see :meth:`_trig`)."""
         def sub(a: Any) -> Any:
             return a if rows is None or not isinstance(a, np.ndarray) else a[rows]
 
         phi: list[Any] = [sub(f) for f in self.fixed]  # replaced, never modified in place
         jac: list[list[Any]] = [[0.0] * self.n for _ in range(self.m)]
+        trig: dict[tuple[int, float], tuple[Any, Any, Any, bool]] = {}
         for li, sign, r, lidx, th, aidx, off in self.moving:
             rr = q[lidx] if lidx >= 0 else sub(r)
-            tt = q[aidx] if aidx >= 0 else sub(th)
-            if off:
-                tt = tt + off
-            c, s = np.cos(tt), np.sin(tt)
+            if aidx >= 0 and rows is None:
+                c, s = self._trig(trig, aidx, off, q[aidx], near)
+            else:
+                tt = q[aidx] if aidx >= 0 else sub(th)
+                if off:
+                    tt = tt + off
+                c, s = np.cos(tt), np.sin(tt)
             rc, rs = sign * rr * c, sign * rr * s
             phi[2 * li] = phi[2 * li] + rc
             phi[2 * li + 1] = phi[2 * li + 1] + rs
@@ -172,7 +177,40 @@ class VectorLoops:
             if lidx >= 0:
                 jac[2 * li][lidx] = jac[2 * li][lidx] + sign * c
                 jac[2 * li + 1][lidx] = jac[2 * li + 1][lidx] + sign * s
+        self.last_trig = trig
         return phi, jac
+
+    SMALL_STEP = 1e-6
+    """rad: below this, cos d = 1 - d^2/2 and sin d = d to within 1.7e-19 (d^3/6)."""
+
+    def _trig(self, trig: dict[tuple[int, float], tuple[Any, Any, Any, bool]], aidx: int, off: float,
+              qa: np.ndarray, near: bool) -> tuple[Any, Any]:
+        """cos and sin of an unknown angle (plus its offset) at every position. Just after
+        a Newton step, where it moved at most SMALL_STEP, from the values computed
+        directly at the previous iterate by the angle-addition formula, within a few units in the
+        last place of np.cos and np.sin (tests/test_sweep.py) for a fraction of the time:
+        the batch's second Newton evaluation, which certifies every position, costs two
+        trigonometric calls less per angle. Never twice in a row: a value so obtained is
+        not the base of another."""
+        key = (aidx, off)
+        if key in trig:
+            return trig[key][1], trig[key][2]
+        last = getattr(self, "last_trig", {}).get(key) if near else None
+        if last is not None and last[3]:
+            d = qa - last[0]  # exact: the two iterates are within a factor of 2 of each other
+            c0, s0 = last[1], last[2]
+            cd = 1.0 - 0.5 * (d * d)
+            c, s = c0 * cd - s0 * d, s0 * cd + c0 * d
+            far = ~(np.abs(d) <= self.SMALL_STEP)  # (NaN included): those directly
+            if far.any():
+                tt = qa[far] + off if off else qa[far]
+                c[far], s[far] = np.cos(tt), np.sin(tt)
+            trig[key] = (None, c, s, False)
+            return c, s
+        tt = qa + off if off else qa
+        c, s = np.cos(tt), np.sin(tt)
+        trig[key] = (qa.copy(), c, s, True)
+        return c, s
 
 
 def _solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[list[np.ndarray], np.ndarray]:
@@ -189,7 +227,8 @@ def _solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[
     for i, row in enumerate(jac):
         for j, v in enumerate(row):
             full[:, i, j] = v
-    det = np.linalg.det(full)
+    with np.errstate(invalid="ignore"):  # positions not iterating hold NaN
+        det = np.linalg.det(full)
     ok = np.isfinite(det) & (det != 0.0)
     dq = np.full((k, n), np.nan)
     if ok.any():
@@ -211,6 +250,11 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
             raise InputError("the driver values must be finite")
         check_driver_values(m, [float(vals.min()), float(vals.max())])
     n_pos = len(vals)
+    if n_pos == 0:
+        rough = sweep(m, [], branch=branch, tol=tol)
+        empty = np.zeros(0)
+        return BatchResult(vals, np.zeros(0, dtype=np.int8), np.zeros((0, len(m.unknowns))), empty,
+                           np.zeros(0, dtype=np.int32), rough.branch, rough, 0)
     lo, hi = float(vals[0]), float(vals[-1])
     grid = driver_values(lo, hi, None, min(coarse, n_pos))
     rough = sweep(m, grid, branch=branch, tol=tol)
@@ -222,87 +266,39 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
     coarse_sol = np.array([[p.solution[nm] if p.solution else np.nan for nm in names]
                            for p in rough.positions])
 
-    # 2. warm starts: cubic Hermite interpolation between coarse neighbours that both
-    # solved, with the exact tangents dq/dv there (error ~ h^4: two Newton steps do)
-    right = np.clip(np.searchsorted(grid_arr, vals, side="right"), 1, len(grid_arr) - 1)
-    left = right - 1
-    usable = ok_coarse[left] & ok_coarse[right]
     scale = [math.pi / 180.0 if k == "angle" else 1.0 for k in kinds]
     slopes = np.zeros_like(coarse_sol)
+    no_tangent = np.zeros(len(grid_arr), dtype=bool)
     for c, p in enumerate(rough.positions):
         if p.solution is not None:
             t = tangent(solver, p.input, solver_q(solver, p))
             if t is None:
-                usable &= (left != c) & (right != c)
+                no_tangent[c] = True
             else:
                 slopes[c] = [ti / sc for ti, sc in zip(t, scale)]
-    width = grid_arr[right] - grid_arr[left]
-    u = np.where(width > 0, (vals - grid_arr[left]) / np.where(width > 0, width, 1.0), 0.0)
-    h00, h10 = (1 + 2 * u) * (1 - u) ** 2, u * (1 - u) ** 2
-    h01, h11 = u * u * (3 - 2 * u), u * u * (u - 1)
-    guess = []
-    for j in range(n):
-        y0, y1 = coarse_sol[left, j], coarse_sol[right, j]
-        if kinds[j] == "angle":
-            y1 = y0 + (y1 - y0 + 180.0) % 360.0 - 180.0
-        guess.append(h00 * y0 + h10 * width * slopes[left, j] + h01 * y1 + h11 * width * slopes[right, j])
-    drv = vals * (ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0)
-
-    # 3. vectorised Newton on the usable positions, only the unconverged ones iterating
-    loops = VectorLoops(solver.model, drv)
+    drv_scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     code = STATUS_CODES
     status = np.full(n_pos, code["failed"], dtype=np.int8)
     iters = np.zeros(n_pos, dtype=np.int32)
     det_out = np.full(n_pos, np.nan)
-    q_all = [g * sc for g, sc in zip(guess, scale)]
-    active = np.flatnonzero(usable)
-    everyone = active.size == n_pos
-    q = [c[active] for c in q_all] if not everyone else [c.copy() for c in q_all]
-    done = np.zeros(n_pos, dtype=bool)
-    for it in range(1, max_iter + 1):
-        if active.size == 0:
-            break
-        phi, jac = loops.evaluate(q, None if everyone else active)
-        dq, det = _solve_linear(jac, phi, active.size)
-        step = np.abs(dq[0])
-        resid = np.abs(phi[0])
-        for j in range(1, n):
-            np.maximum(step, np.abs(dq[j]), out=step)
-        for f in phi[1:]:
-            np.maximum(resid, np.abs(f), out=resid)
-        for j in range(n):
-            q[j] += dq[j]
-        finished = (step <= tol) & (resid <= tol)
-        keep = ~finished & np.isfinite(step)
-        if everyone and keep.all():
-            iters[:] = it
-            det_out[:] = det
-            continue
-        # scatter back and shrink the active set
-        for j in range(n):
-            q_all[j][active] = q[j]
-        iters[active] = it
-        det_out[active] = det
-        done[active[finished]] = True
-        active = active[keep]
-        q = [c[active] for c in q_all]
-        everyone = False
-    status[done] = code["converged"]
-    shown = np.stack([c / sc for c, sc in zip(q_all, scale)], axis=1)
-    ref = np.stack(guess, axis=1)
-    # Continuity: a position must stay near its interpolated guess. Near a nearly
-    # singular configuration Newton can jump to another assembly with the same det J
-    # sign; such positions go to the one-at-a-time path below.
-    spread = np.nanmax(np.abs(coarse_sol[right] - coarse_sol[left]), axis=1, initial=0.0)
-    allowed = 2.0 * np.where(np.isfinite(spread), spread, 0.0) + 1e-6
-    jumped = done & (np.max(np.abs(shown - ref), axis=1) > allowed)
-    status[jumped] = code["failed"]
-    on_target = _on_branch(m, shown, names, det_out, rough.branch)
-    status[done & ~on_target] = code["failed"]
+    shown = np.empty((n_pos, n))
+    ref = np.empty((n_pos, n))
+    coarse = _coarse(grid_arr, ok_coarse & ~no_tangent, coarse_sol, slopes, kinds)
+    # Steps 2 and 3 a block of positions at a time: every temporary array then stays in
+    # the processor's cache (1,000,000 positions at once made each one 8 MB, and the
+    # engine waited on memory).
+    for lo_i in range(0, n_pos, BLOCK):
+        hi_i = min(n_pos, lo_i + BLOCK)
+        _settle(m, solver.model, coarse, names, kinds, scale, vals[lo_i:hi_i], drv_scale, tol, max_iter,
+                rough.branch, status[lo_i:hi_i], iters[lo_i:hi_i], det_out[lo_i:hi_i],
+                shown[lo_i:hi_i], ref[lo_i:hi_i])
 
     # 4. everything else, one at a time: continuation from the nearer solved coarse
     # neighbour; failing that, the status of the coarse neighbour that did not solve.
     todo = np.flatnonzero(status != code["converged"])
+    right = np.full(n_pos, -1)
+    right[todo] = np.clip(np.searchsorted(grid_arr, vals[todo], side="right"), 1, len(grid_arr) - 1)
+    left = right - 1
     have_closed = m.closed_form is not None and m.driver.kind == "angle"
     target = rough.branch
     for i in todo:
@@ -333,31 +329,182 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
         iters[i] = pos.iterations
         shown[i] = [pos.solution[nm] for nm in names]
         det_out[i] = pos.det if pos.det is not None else np.nan
-    # report angles continuously, as the one-at-a-time sweep does
-    for j, k in enumerate(kinds):
-        if k == "angle":
-            # (positions settled one at a time have no guess, and are continuous already)
-            has_ref = np.isfinite(ref[:, j])
-            r = ref[has_ref, j]
-            shown[has_ref, j] = r + (shown[has_ref, j] - r + 180.0) % 360.0 - 180.0
+    # report angles continuously, as the one-at-a-time sweep does (where a position has
+    # a guess; the blocks did the others)
+    for i in todo:
+        for j, k in enumerate(kinds):
+            if k == "angle" and math.isfinite(ref[i, j]):
+                r = ref[i, j]
+                shown[i, j] = r + (shown[i, j] - r + 180.0) % 360.0 - 180.0
     shown[status != code["converged"]] = np.nan
     return BatchResult(vals, status, shown, det_out, iters, rough.branch, rough, len(todo))
+
+
+def _grid_index(grid: np.ndarray, vals: np.ndarray) -> np.ndarray:
+    """np.searchsorted(grid, vals, side="right"): for ascending vals (a sweep's) by one
+    merge, a quarter of the binary searches' time."""
+    if len(vals) > 1 and not (vals[1:] >= vals[:-1]).all():
+        return np.searchsorted(grid, vals, side="right")
+    # grid[c] <= vals[i] exactly when i >= first[c]: count the grid points passed
+    first = np.searchsorted(vals, grid, side="left")
+    return np.cumsum(np.bincount(first, minlength=len(vals) + 1)[:len(vals)])
+
+
+BLOCK = 16_384
+"""Positions per block of the batch engine's vectorised steps (temporaries of 128 kB)."""
+
+
+@dataclass(frozen=True)
+class _Coarse:
+    """The coarse pass as the blocks read it, arranged per interval [grid[c], grid[c + 1]]
+    where a block would otherwise recompute it per position."""
+
+    grid: np.ndarray
+    pair_usable: np.ndarray  # both ends solved, with a tangent
+    width: np.ndarray
+    solution: np.ndarray    # one row per unknown, per grid point (1-D rows gather faster)
+    next_value: np.ndarray  # the right end's value; for an angle, the one nearest the left's
+    slopes: np.ndarray      # dq/dv, one row per unknown, per grid point (display units)
+    allowed: np.ndarray     # how far a position may move from its guess (continuity)
+
+
+def _coarse(grid: np.ndarray, usable: np.ndarray, sol: np.ndarray, slopes: np.ndarray,
+            kinds: Sequence[str]) -> _Coarse:
+    rows = np.ascontiguousarray(sol.T)
+    one = len(grid) == 1  # a one-point grid is one interval, from the point to itself
+    nxt = rows.copy() if one else np.concatenate((rows[:, 1:], rows[:, -1:]), axis=1)
+    for j, k in enumerate(kinds):
+        if k == "angle":
+            nxt[j] = rows[j] + (nxt[j] - rows[j] + 180.0) % 360.0 - 180.0
+    with np.errstate(invalid="ignore"):
+        spread = np.zeros(1) if one else np.nanmax(np.abs(sol[1:] - sol[:-1]), axis=1, initial=0.0)
+    allowed = 2.0 * np.where(np.isfinite(spread), spread, 0.0) + 1e-6
+    pair = usable.copy() if one else np.append(usable[:-1] & usable[1:], False)
+    width = np.zeros(1) if one else np.append(grid[1:] - grid[:-1], 0.0)
+    return _Coarse(grid, pair, width, rows, nxt, np.ascontiguousarray(slopes.T), allowed)
+
+
+def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str], kinds: Sequence[str],
+            scale: Sequence[float], vals: np.ndarray, drv_scale: float, tol: float, max_iter: int,
+            branch: str | None, status: np.ndarray, iters: np.ndarray, det_out: np.ndarray,
+            shown: np.ndarray, ref: np.ndarray) -> None:
+    """Steps 2 and 3 for one block of positions, written into the output slices: the warm
+    start, vectorised Newton, the continuity and branch checks and continuous angles.
+    A position left "failed" goes to the one-at-a-time path. Columns are contiguous 1-D
+    arrays, written into the (N, n) outputs once (reading a strided column costs
+    several times more)."""
+    n, n_pos, code, take = len(kinds), len(vals), STATUS_CODES, np.take
+    # 2. warm starts: cubic Hermite interpolation between coarse neighbours that both
+    # solved, with the exact tangents dq/dv there (error ~ h^4: two Newton steps do)
+    right = np.clip(_grid_index(coarse.grid, vals), 1, len(coarse.grid) - 1)
+    left = right - 1
+    usable = take(coarse.pair_usable, left)
+    width = take(coarse.width, left)
+    g_left = take(coarse.grid, left)
+    if width.min() > 0.0:
+        u = (vals - g_left) / width
+    else:  # a one-point grid
+        u = np.where(width > 0, (vals - g_left) / np.where(width > 0, width, 1.0), 0.0)
+    one_minus_u_sq, u_sq = (1 - u) ** 2, u * u
+    h00, h10 = (1 + 2 * u) * one_minus_u_sq, u * one_minus_u_sq
+    h01, h11 = u_sq * (3 - 2 * u), u_sq * (u - 1)
+    refs = []
+    for j in range(n):
+        y0, y1 = take(coarse.solution[j], left), take(coarse.next_value[j], left)
+        refs.append(h00 * y0 + h10 * width * take(coarse.slopes[j], left) + h01 * y1
+                    + h11 * width * take(coarse.slopes[j], right))
+
+    # 3. vectorised Newton on the usable positions. The first two iterations (all most
+    # positions need) evaluate every position and move only the live ones (no gathers);
+    # later ones gather the few left. Position by position the iterates do not depend on
+    # the block they are in.
+    loops = VectorLoops(model, vals * drv_scale)
+    q_all = [r * sc for r, sc in zip(refs, scale)]
+    live = usable.copy()
+    done = np.zeros(n_pos, dtype=bool)
+    it = 0
+    while it < min(2, max_iter) and live.any():
+        it += 1
+        phi, jac = loops.evaluate(q_all, None, near=it > 1)
+        dq, det = _solve_linear(jac, phi, n_pos)
+        step, resid = _largest(dq), _largest(phi)
+        finite = np.isfinite(step)
+        for j in range(n):
+            np.add(q_all[j], dq[j], out=q_all[j], where=live & finite)
+        iters[live] = it
+        det_out[live] = det[live]
+        finished = live & (step <= tol) & (resid <= tol)
+        done |= finished
+        live &= ~finished & finite
+    active = np.flatnonzero(live)
+    q = [c[active] for c in q_all]
+    while it < max_iter and active.size:
+        it += 1
+        phi, jac = loops.evaluate(q, active)
+        dq, det = _solve_linear(jac, phi, active.size)
+        step, resid = _largest(dq), _largest(phi)
+        for j in range(n):
+            q[j] += dq[j]
+        finished = (step <= tol) & (resid <= tol)
+        keep = ~finished & np.isfinite(step)
+        for j in range(n):
+            q_all[j][active] = q[j]
+        iters[active] = it
+        det_out[active] = det
+        done[active[finished]] = True
+        active = active[keep]
+        q = [c[keep] for c in q]
+    status[done] = code["converged"]
+    cols = [c / sc for c, sc in zip(q_all, scale)]
+    # Continuity: a position must stay near its interpolated guess. Near a nearly
+    # singular configuration Newton can jump to another assembly with the same det J
+    # sign; such positions go to the one-at-a-time path.
+    moved = np.abs(cols[0] - refs[0])
+    for j in range(1, n):
+        np.maximum(moved, np.abs(cols[j] - refs[j]), out=moved)
+    status[done & (moved > take(coarse.allowed, left))] = code["failed"]
+    status[done & ~_on_branch_columns(m, cols, names, det_out, branch)] = code["failed"]
+    # angles reported continuously with the guess (the one-at-a-time sweep's convention):
+    # a solution within half a turn of its guess is already the representative nearest it
+    for j, k in enumerate(kinds):
+        if k == "angle":
+            far = ~(np.abs(cols[j] - refs[j]) < 180.0)  # (NaN included)
+            if far.any():
+                r, c = refs[j][far], cols[j][far]
+                cols[j][far] = r + (c - r + 180.0) % 360.0 - 180.0
+    for j in range(n):
+        shown[:, j] = cols[j]
+        ref[:, j] = refs[j]
+
+
+def _largest(parts: Sequence[np.ndarray]) -> np.ndarray:
+    """max |part| over the parts, position by position (NaN if any part is NaN)."""
+    out = np.abs(parts[0])
+    for p in parts[1:]:
+        np.maximum(out, np.abs(p), out=out)
+    return out
 
 
 def _on_branch(m: Mechanism, shown: np.ndarray, names: Sequence[str], det: np.ndarray,
                target: str | None) -> np.ndarray:
     """True where a solution lies on the target branch: the closed form's rule
     (closed_form.branch_rule) over arrays, else the sign of det J."""
+    return _on_branch_columns(m, [shown[:, j] for j in range(len(names))], names, det, target)
+
+
+def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence[str], det: np.ndarray,
+                       target: str | None) -> np.ndarray:
+    """:func:`_on_branch` with the solution given as one array per unknown."""
     if target is None:
-        return np.ones(len(shown), dtype=bool)
+        return np.ones(len(det), dtype=bool)
     idx = {n: j for j, n in enumerate(names)}
     if m.closed_form == "fourbar" and "theta3" in idx and "theta4" in idx:
-        is_open = np.sin(np.radians(shown[:, idx["theta4"]] - shown[:, idx["theta3"]])) > 0
+        is_open = np.sin(np.radians(cols[idx["theta4"]] - cols[idx["theta3"]])) > 0
     elif m.closed_form == "fourbar" and "theta2" in idx and "theta3" in idx:
         # driven by theta4: the mirror images of A across O2-B (closed_form.branch_rule)
-        is_open = np.sin(np.radians(shown[:, idx["theta3"]] - shown[:, idx["theta2"]])) < 0
+        is_open = np.sin(np.radians(cols[idx["theta3"]] - cols[idx["theta2"]])) < 0
     elif m.closed_form == "slider_crank" and "theta3" in idx:
-        is_open = np.cos(np.radians(shown[:, idx["theta3"]])) > 0
+        is_open = np.cos(np.radians(cols[idx["theta3"]])) > 0
     else:
         return (det > 0) == (target == "det+")
     return is_open == (target == "open")
