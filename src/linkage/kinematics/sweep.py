@@ -405,7 +405,7 @@ def _solve_position(solver: _Solver, v: float, last_q: tuple[float, ...] | None,
         det = solver.det(p, q)
         sol = solver.display(q)
         return Position(v, "converged", sol, solver.branch(q, det), r.iterations, det,
-                        _transmission(solver, sol), substeps, note), q
+                        solver.transmission(sol), substeps, note), q
 
     def ok(p: Any, r: Any) -> bool:
         return r.converged and (target is None or solver.branch(r.x, solver.det(p, r.x)) == target)
@@ -501,7 +501,7 @@ def _continue(solver: _Solver, v: float, history: list[tuple[float, tuple[float,
             sol = solver.display(q)
             note = f"step halved to 1/{n}" if n > 1 else ""
             return Position(v, "converged", sol, solver.branch(q, det), r.iterations, det,
-                            _transmission(solver, sol), n if n > 1 else 0, note), q
+                            solver.transmission(sol), n if n > 1 else 0, note), q
     return Position(v, "failed", None, None, 0, None, note="the branch could not be continued"), None
 
 
@@ -532,7 +532,7 @@ def _lean_step(solver: _Solver, v: float, v_last: float, q_last: tuple[float, ..
     if correction > 0.5 * moved + (1e-7 + 10.0 * dv * dv) * size:
         return None
     sol = solver.display(q)
-    return Position(v, "converged", sol, branch, iterations, det, _transmission(solver, sol)), q
+    return Position(v, "converged", sol, branch, iterations, det, solver.transmission(sol)), q
 
 
 def _lu_two(a: float, b: float, c: float, d: float) -> tuple[float, float, float, float, bool] | None:
@@ -769,10 +769,6 @@ def _walk(solver: _Solver, v: float, hist: list[tuple[float, tuple[float, ...]]]
         hist = [(v0 + (v - v0) * k / n, q)]
     return Position(v, pos.status, pos.solution, pos.branch, pos.iterations, pos.det,
                     pos.transmission, pos.substeps, pos.note), q
-
-
-def _transmission(solver: _Solver, sol: dict[str, float]) -> float | None:
-    return solver.transmission(sol)
 
 
 def _solved_ranges(positions: Sequence[Position]) -> tuple[tuple[float, float], ...]:
