@@ -51,3 +51,19 @@ def test_sample_mechanisms_ship_with_the_package():
 
     for name in ("fourbar_me581.toml", "rapier_drive.toml"):
         assert sample_path(name).read_text().startswith("#")
+
+
+def test_targets_judge_the_batch_only_at_a_million_positions():
+    """--quick sweeps 100,000 positions; target 4 is stated at 1,000,000, so a quick run
+    shows its ratio under its own size and does not call it met or not."""
+    from linkage.bench import targets
+
+    def row4(sweeps):
+        return next(r for r in targets([], {}, sweeps) if r[0].startswith("4."))
+
+    full = row4({"numpy closed form 1,000,000 positions": 0.1,
+                 "linkage.sweep 1,000,000 positions (batch)": 0.18})
+    assert full[2] == pytest.approx(1.8) and full[3] is True
+    quick = row4({"numpy closed form 100,000 positions": 0.01,
+                  "linkage.sweep 100,000 positions (batch)": 0.025})
+    assert "100,000 positions" in quick[0] and quick[2] == pytest.approx(2.5) and quick[3] is None

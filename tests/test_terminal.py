@@ -82,3 +82,17 @@ def test_columns_picks_what_a_table_and_the_csv_show(cli):
     text = cli("solve", str(SAMPLES / "fourbar_me581.toml"), "--columns", "theta3", "--format", "plain").out
     assert "left out" in text and "max|Phi|" in text.split("left out")[1]
     assert cli("solve", "--columns", "nothing-like-this").code == 2
+
+
+def test_sentences_wrap_only_when_a_table_is_too_wide():
+    """A cell of words (a benchmark target) wraps between words, read from the left,
+    when the table would not fit the terminal; numbers never wrap."""
+    from linkage.render.report import PROSE_WIDTH, column_widths, is_prose
+
+    headers = ("target", "ratio", "met")
+    rows = [("1. scalar Newton, history off, within 2x of the hand loop", "3.66", "no")]
+    wide = column_widths(headers, rows, 200)
+    assert wide[0] == len(rows[0][0]) and not is_prose(rows, 0, wide[0])
+    narrow = column_widths(headers, rows, 60)
+    assert narrow == [PROSE_WIDTH, 5, 3] and is_prose(rows, 0, narrow[0])
+    assert not is_prose(rows, 1, narrow[1])

@@ -459,9 +459,10 @@ TARGETS = (
 
 
 def targets(ms: Sequence[Measurement], cold: dict[str, float],
-            sweeps: dict[str, float] | None = None) -> list[tuple[str, str, float | None, bool]]:
-    """(target, comparison, measured ratio, met) for issue 10's targets, from this run;
-    solve times are compared at the tolerance nearest 1e-12."""
+            sweeps: dict[str, float] | None = None) -> list[tuple[str, str, float | None, bool | None]]:
+    """(target, comparison, measured ratio, met; None where this run cannot judge it) for
+    issue 10's targets, from this run; solve times are compared at the tolerance nearest
+    1e-12."""
 
     def at(problem: str, contender: str) -> Measurement | None:
         cands = [m for m in ms if m.problem == problem and m.contender == contender]
@@ -470,7 +471,7 @@ def targets(ms: Sequence[Measurement], cold: dict[str, float],
     def ratio(a: float | None, b: float | None) -> float | None:
         return a / b if a and b and a == a and b == b else None
 
-    rows: list[tuple[str, str, float | None, bool]] = []
+    rows: list[tuple[str, str, float | None, bool | None]] = []
     for label, comparison, num, den, bound in TARGETS:
         a, b = at(*num), at(*den)
         r = ratio(a.seconds if a else None, b.seconds if b else None)
@@ -480,11 +481,18 @@ def targets(ms: Sequence[Measurement], cold: dict[str, float],
     r = ratio(sw.get("linkage.sweep 361 positions"), py)
     rows.append(("3. linkage.sweep 0..360 step 1 no slower than pylinkage step_fast", "linkage / pylinkage",
                  r, r is not None and r <= 1.0))
-    big = next((v for k, v in sw.items() if k.endswith("(batch)")), None)
+    big_key = next((k for k in sw if k.endswith("(batch)")), "")
     ref = next((v for k, v in sw.items() if k.startswith("numpy closed form")), None)
-    r = ratio(big, ref)
-    rows.append(("4. linkage.sweep of 1,000,000 positions within 2x of numpy closed form", "linkage / numpy",
-                 r, r is not None and r <= 2.0))
+    r = ratio(sw.get(big_key), ref)
+    if big_key and "1,000,000 positions" not in big_key:
+        # --quick sweeps fewer positions; the target is stated at a million (and a smaller
+        # sweep pays its coarse pass over fewer positions), so it is not judged here
+        size = big_key.removeprefix("linkage.sweep ").removesuffix(" (batch)")
+        rows.append((f"4. linkage.sweep of {size} (the target: 1,000,000) against numpy closed form",
+                     "linkage / numpy", r, None))
+    else:
+        rows.append(("4. linkage.sweep of 1,000,000 positions within 2x of numpy closed form",
+                     "linkage / numpy", r, r is not None and r <= 2.0))
     floor = cold.get("python -c 'import rich.table' (floor)")
     for label, key, bound in (
             ("5. linkage solve cold start within 1.6x of import rich.table", "linkage solve", 1.6),

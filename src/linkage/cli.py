@@ -1164,7 +1164,7 @@ def bench(
         blocks.append(table("Cold start (fresh interpreter, median wall time)", ("command", "seconds"),
                             list(cold_times.items()), 4))
     blocks.append(table("Targets (ratios measured in this run)", ("target", "ratio", "measured", "met"),
-                        [(t, c, r, "n/a" if r is None or r != r else ("yes" if ok else "no"))
+                        [(t, c, r, "n/a" if r is None or r != r or ok is None else ("yes" if ok else "no"))
                          for t, c, r, ok in target_rows], 3))
     json_obj = {"measurements": [dict(zip(headers, r)) for r in rows], "cold_start": cold_times,
                 "sweeps": sweeps,

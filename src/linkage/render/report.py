@@ -145,11 +145,34 @@ def render_text(blocks: Sequence[Block], tablefmt: str) -> str:
     return "\n".join(out).rstrip("\n") + "\n"
 
 
-def column_widths(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> list[int]:
+PROSE_WIDTH = 30
+"""A cell of words longer than this (a benchmark target, a note) wraps between them."""
+
+
+def _cell_width(cell: str) -> int:
+    if len(cell) <= PROSE_WIDTH or " " not in cell:
+        return len(cell)
+    return max(PROSE_WIDTH, *(len(w) for w in cell.split()))
+
+
+def column_widths(headers: Sequence[str], rows: Sequence[Sequence[str]],
+                  width: int | None = None) -> list[int]:
     """Each column's width: its widest cell (a number or a status is never broken) or its
-    header's longest word (headers wrap between words), whichever is wider."""
-    return [max(max((len(r[j]) for r in rows), default=0), max((len(w) for w in h.split()), default=1))
-            for j, h in enumerate(headers)]
+    header's longest word (headers wrap between words), whichever is wider. If that
+    table is wider than ``width``, sentences wrap between words at PROSE_WIDTH first."""
+    def widths(cell: Any) -> list[int]:
+        return [max(max((cell(r[j]) for r in rows), default=0),
+                    max((len(w) for w in h.split()), default=1)) for j, h in enumerate(headers)]
+
+    natural = widths(len)
+    if width is None or 1 + sum(w + 3 for w in natural) <= width:
+        return natural
+    return widths(_cell_width)
+
+
+def is_prose(rows: Sequence[Sequence[str]], j: int, width: int) -> bool:
+    """Column j holds sentences wrapped to ``width`` (read from the left)."""
+    return any(len(r[j]) > width and " " in r[j] for r in rows)
 
 
 def column_groups(headers: Sequence[str], rows: Sequence[Sequence[str]], width: int) -> list[list[int]]:
@@ -157,7 +180,7 @@ def column_groups(headers: Sequence[str], rows: Sequence[Sequence[str]], width: 
     :func:`column_widths`; a column also takes 3 characters of padding and separator,
     the table 1 more). Groups after the first repeat column 0 (the iteration or the
     driver value), so each stacked table reads on its own."""
-    need = [w + 3 for w in column_widths(headers, rows)]
+    need = [w + 3 for w in column_widths(headers, rows, width)]
     groups: list[list[int]] = []
     current: list[int] = [0]
     used = 1 + need[0]
@@ -195,10 +218,11 @@ def print_rich(blocks: Sequence[Block], file: Any = None) -> None:
             if len(groups) > 1:
                 title = f"{b.title + ' ' if b.title else ''}(columns part {k + 1} of {len(groups)})"
             t = RichTable(title=title, box=box.SIMPLE_HEAVY, title_justify="left", title_style="bold")
-            widths = column_widths(b.headers, b.rows)
+            widths = column_widths(b.headers, b.rows, console.width)
             for j in cols:
                 # a fixed width: rich wraps the header in it and never shrinks a number
-                t.add_column(b.headers[j], justify="right", overflow="fold", width=widths[j])
+                t.add_column(b.headers[j], justify="left" if is_prose(b.rows, j, widths[j]) else "right",
+                             overflow="fold", width=widths[j])
             for r in b.rows:
                 t.add_row(*(r[j] for j in cols))
             console.print(t)
