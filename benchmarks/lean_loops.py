@@ -5,6 +5,8 @@ on the code before a change and after it, in one session:
     python benchmarks/lean_loops.py                      # this checkout
     git worktree add /tmp/before <commit>
     PYTHONPATH=/tmp/before/src python benchmarks/lean_loops.py
+
+    python benchmarks/lean_loops.py --parts              # where a Newton solve's time goes
 """
 
 from __future__ import annotations
@@ -63,5 +65,42 @@ def main() -> None:
     print(f"{'sweep 361':13s} {t * 1e3:7.2f} ms")
 
 
+def parts() -> None:
+    """A Newton solve split into its loop and what surrounds it (front door, checks of the
+    input, the Result), beside the hand loops; for the README's account of targets 1-2."""
+    from linkage.bench import hand_newton, hand_newton_2x2, scalar_problem, system_problem
+    from linkage.methods.newton import newton_lean
+    from linkage.methods.newton_system import _newton_2x2
+    from linkage.problems.system import LeanProblem
+    from linkage.solve import certify_root
+
+    spec = scalar_problem("seed002")
+    p, x0 = spec["problem"], spec["x0"]
+    r = solve_scalar(p, method="newton", x0=x0, tol=1e-12, record=False)
+
+    def certify(x, fx, width):
+        return certify_root(p, x, fx, width)[:2]
+
+    whole = best(lambda: solve_scalar(p, method="newton", x0=x0, tol=1e-12, record=False), 20000)
+    loop = best(lambda: newton_lean(p, x0, 1e-12, 0.0, None, 100, certify, None), 20000)
+    hand = best(lambda: hand_newton(p.f, p.fprime, x0, 1e-12), 20000)
+    print(f"seed-002 Newton ({r.iterations} iterations): solve {whole * 1e6:.2f} us = loop "
+          f"{loop * 1e6:.2f} us + front door and Result {(whole - loop) * 1e6:.2f} us; hand loop "
+          f"{hand * 1e6:.2f} us; the loop's checks {(loop - hand) / r.iterations * 1e6:.2f} us an iteration")
+    q = system_problem("fourbar")["problem"]
+    q0 = tuple(float(v) for v in q.x0)
+    r = solve_system(q.F, q0, jac=q.J, tol=1e-12, record=False)
+    light = LeanProblem(q.F, q.J, None, lambda: q)
+    phi0 = q.F(list(q0))
+    whole = best(lambda: solve_system(q.F, q0, jac=q.J, tol=1e-12, record=False), 5000)
+    loop = best(lambda: _newton_2x2(light, q0, phi0, 1e-12, 0.0, 1e-12, 50, True), 5000)
+    hand = best(lambda: hand_newton_2x2(q.F, q.J, q0, 1e-12), 5000)
+    print(f"four-bar Newton, F and J as callables ({r.iterations} iterations): solve {whole * 1e6:.2f} us = "
+          f"_newton_2x2 {loop * 1e6:.2f} us + front door and Result {(whole - loop) * 1e6:.2f} us; "
+          f"hand loop {hand * 1e6:.2f} us")
+
+
 if __name__ == "__main__":
-    main()
+    import sys
+
+    parts() if "--parts" in sys.argv[1:] else main()

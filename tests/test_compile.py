@@ -413,3 +413,21 @@ def test_a_mechanism_with_its_compiled_model_still_pickles():
     copy = pickle.loads(pickle.dumps(m))
     assert "model" not in vars(copy) and copy == m
     assert repr(linkage.sweep(copy, [0.0, 10.0, 20.0])) == repr(before)
+
+
+def test_lu_of_two_by_two_on_scalars_equals_lu():
+    from linkage.methods._linalg import SingularMatrix, det_from_lu, lu, lu_two
+
+    rng = random.Random(9)
+    cases = [(1.0, 2.0, 1.0, 3.0), (-2.0, 1.0, 2.0, 5.0), (0.0, 1.0, 0.0, 2.0), (1.0, 2.0, 2.0, 4.0),
+             (0.0, 0.0, 3.0, 1.0)]
+    cases += [tuple(rng.choice([0.0, rng.uniform(-5, 5)]) for _ in range(4)) for _ in range(2000)]
+    for a, b, c, d in cases:
+        got = lu_two(a, b, c, d)
+        try:
+            m, perm, sign = lu([[a, b], [c, d]])
+        except SingularMatrix:
+            assert got is None
+            continue
+        assert got == (m[0][0], m[0][1], m[1][0], m[1][1], perm == [1, 0])
+        assert (-1.0 if got[4] else 1.0) * got[0] * got[3] == det_from_lu((m, perm, sign))

@@ -328,7 +328,7 @@ def measure(
     return out
 
 
-def cold_start(repeats: int = 5) -> dict[str, float]:
+def cold_start(repeats: int = 5, extra: dict[str, list[str]] | None = None) -> dict[str, float]:
     """Median wall time of fresh interpreters running the CLI, and the floor it is
     compared with (``python -c "import rich.table"``), interleaved so that the machine's
     noise hits every command alike.
@@ -351,6 +351,7 @@ def cold_start(repeats: int = 5) -> dict[str, float]:
         "linkage sweep crank_rocker.toml": [sys.executable, "-m", "linkage", "sweep",
                                             str(sample_path("crank_rocker.toml"))],
     }
+    commands.update(extra or {})
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     times: dict[str, list[float]] = {label: [] for label in commands}
     for rep in range(repeats + 1):

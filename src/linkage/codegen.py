@@ -139,13 +139,14 @@ def source(terms: tuple[tuple[tuple[float, float, int, float, int, float], ...],
 
 def build(terms: Any, n: int, newton: bool = False) -> Callable[..., Any]:
     """Compile the factory for a model's terms, or its Newton function (see :func:`source`)."""
-    from .iterate import DIVERGE_STREAK, ROUNDING, RUNAWAY, rounding_stall
-    from .methods.newton_system import SINGULAR_RATIO
+    namespace: dict[str, Any] = {"_cos": math.cos, "_sin": math.sin, "__builtins__": {}}
+    if newton:  # the stopping rules' constants, from where the other loops read them
+        from .iterate import DIVERGE_STREAK, ROUNDING, RUNAWAY, rounding_stall
+        from .methods.newton_system import SINGULAR_RATIO
 
-    namespace: dict[str, Any] = {"_cos": math.cos, "_sin": math.sin, "__builtins__": {"range": range},
-                                 "_nan": math.nan, "_inf": math.inf, "_stall": rounding_stall,
-                                 "_RUNAWAY": RUNAWAY, "_SINGULAR": SINGULAR_RATIO,
-                                 "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING}
+        namespace.update(__builtins__={"range": range}, _nan=math.nan, _inf=math.inf, _stall=rounding_stall,
+                         _RUNAWAY=RUNAWAY, _SINGULAR=SINGULAR_RATIO, _DIVERGE=DIVERGE_STREAK,
+                         _ROUNDING=ROUNDING)
     exec(compile(source(terms, n, newton), "<linkage-model>", "exec"), namespace)
     return namespace["newton2" if newton else "make"]  # type: ignore[no-any-return]
 

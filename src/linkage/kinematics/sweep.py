@@ -25,7 +25,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve
+from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve, lu_two
 from ..methods.newton_system import max_abs, newton_system_lean
 from ..problems.closed_form import (
     arc_limits,
@@ -138,15 +138,7 @@ class _Solver:
         if self.m.closed_form != "fourbar":
             return None
         if self.coupler_and_output:
-            x = sol["theta4"] - sol["theta3"]
-            if x - x == 0.0:  # abs(wrap_degrees(x)) inline: once per position
-                x = math.fmod(x, 360.0)
-                if x <= -180.0:
-                    x += 360.0
-                elif x > 180.0:
-                    x -= 360.0
-                return abs(x)
-            return math.nan
+            return abs(wrap_degrees(sol["theta4"] - sol["theta3"]))
         fixed = self._fixed_deg
         if fixed is None:
             fixed = self._fixed_deg = {k: math.degrees(q.value) for k, q in self.m.parameters.items()
@@ -535,24 +527,6 @@ def _lean_step(solver: _Solver, v: float, v_last: float, q_last: tuple[float, ..
     return Position(v, "converged", sol, branch, iterations, det, solver.transmission(sol)), q
 
 
-def _lu_two(a: float, b: float, c: float, d: float) -> tuple[float, float, float, float, bool] | None:
-    """:func:`~linkage.methods._linalg.lu` of [[a, b], [c, d]] on scalars, the same operations
-    in the same order: (m00, m01, m10, m11, swapped), None for a zero pivot."""
-    swapped = abs(c) > abs(a)  # max() keeps the first of equal candidates
-    if swapped:
-        a, b, c, d = c, d, a, b
-    if a == 0.0:
-        return None
-    factor = c / a
-    if factor != 0.0:
-        d -= factor * b
-    else:
-        factor = 0.0
-    if d == 0.0:
-        return None
-    return a, b, factor, d, swapped
-
-
 def _step_two(solver: _Solver, v: float, v_last: float, q_last: tuple[float, ...],
               target: str | None) -> tuple[Position, tuple[float, ...]] | None:
     """:func:`_lean_step` for two unknowns measured as they are (every four-bar), on
@@ -570,7 +544,7 @@ def _step_two(solver: _Solver, v: float, v_last: float, q_last: tuple[float, ...
         _, J, V = solver.compiled(v_last)
         (a, b), (c, d) = J([x0, x1])
         w0, w1 = V([x0, x1])
-        factors = _lu_two(a, b, c, d)
+        factors = lu_two(a, b, c, d)
     if factors is None:
         return None
     m00, m01, m10, m11, swapped = factors
@@ -587,7 +561,7 @@ def _step_two(solver: _Solver, v: float, v_last: float, q_last: tuple[float, ...
     if got is None:
         return None
     k, x0, x1, a, b, c, d, w0, w1 = got
-    factors = _lu_two(a, b, c, d)
+    factors = lu_two(a, b, c, d)
     det = 0.0 if factors is None else (-1.0 if factors[4] else 1.0) * factors[0] * factors[3]
     solver.solved_at = (v, x0, x1, factors, w0, w1)
     q = (x0, x1)
@@ -663,7 +637,7 @@ def _continuous_angles(solver: _Solver, positions: list[Position]) -> list[Posit
 
     angles = [n for n, k in zip(solver.names, solver.kinds) if k == "angle"]
     prev: dict[str, float] = {}
-    fmod = math.fmod
+    wrap = wrap_degrees
     for p in positions:
         sol = p.solution
         if sol is None:
@@ -673,15 +647,7 @@ def _continuous_angles(solver: _Solver, positions: list[Position]) -> list[Posit
         for n in angles:
             v = sol[n]
             ref = prev.get(n)
-            x = v if ref is None else v - ref
-            if x - x == 0.0:  # wrap_degrees(x), inline: two per position
-                x = fmod(x, 360.0)
-                if x <= -180.0:
-                    x += 360.0
-                elif x > 180.0:
-                    x -= 360.0
-            else:
-                x = math.nan
+            x = wrap(v if ref is None else v - ref)
             prev[n] = sol[n] = x if ref is None else ref + x
     return _anchor(solver, positions, angles)
 

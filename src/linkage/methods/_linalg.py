@@ -43,6 +43,24 @@ def lu(a: Sequence[Sequence[float]]) -> tuple[Matrix, list[int], int]:
     return m, perm, sign
 
 
+def lu_two(a: float, b: float, c: float, d: float) -> tuple[float, float, float, float, bool] | None:
+    """:func:`lu` of [[a, b], [c, d]] on scalars, the same operations
+    in the same order: (m00, m01, m10, m11, swapped), None for a zero pivot."""
+    swapped = abs(c) > abs(a)  # max() keeps the first of equal candidates
+    if swapped:
+        a, b, c, d = c, d, a, b
+    if a == 0.0:
+        return None
+    factor = c / a
+    if factor != 0.0:
+        d -= factor * b
+    else:
+        factor = 0.0
+    if d == 0.0:
+        return None
+    return a, b, factor, d, swapped
+
+
 def lu_solve(factors: tuple[Matrix, list[int], int], b: Sequence[float]) -> list[float]:
     m, perm, _ = factors
     n = len(m)
