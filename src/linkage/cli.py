@@ -406,8 +406,11 @@ def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol:
         if rates.status != "ok":
             from .render.report import Text
 
-            blocks.append(Text("velocities and accelerations are undefined here: the Jacobian is "
-                               "singular (a toggle or dead-centre position)", "red"))
+            why = ("velocities and accelerations are undefined here: the Jacobian is singular "
+                   "(a toggle or dead-centre position)" if rates.status == "undefined" else
+                   f"ill-conditioned here (near a toggle or limit): {', '.join(rates.ill_conditioned)} "
+                   "shown with the digits their error bounds leave")
+            blocks.append(Text(why, "red"))
     json_obj = result_dict(result, system_solution(problem, result), conv.as_dict() if conv else None,
                            extra)
     h = result.history

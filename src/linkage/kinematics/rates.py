@@ -27,15 +27,29 @@ from __future__ import annotations
 
 import cmath
 import math
+import sys
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..methods.newton_system import newton_direction
+from ..methods._linalg import SingularMatrix, lu, lu_solve
+from ..methods.newton_system import max_abs, newton_direction
 from ..problems.loops import DRIVER, LoopModel
 
 FIXED = -1
 
 XY = tuple[float, float]
+
+EPS = sys.float_info.epsilon
+
+RATE_RTOL = 1e-6
+"""A rate whose error bound exceeds this, relative to the rate (or to the driver's own
+speed or acceleration where the rate is smaller), is ``ill_conditioned``."""
+
+POLISH_STEPS = 60
+"""Most Newton steps taken to polish a position before its rates (each must shrink)."""
+
+SAFETY = 2.0
+"""Every bound is the first-order analysis below, doubled."""
 
 
 @dataclass(frozen=True)
@@ -43,7 +57,17 @@ class Rates:
     """One position's kinematics. ``velocities``/``accelerations``: unknown name -> rad/s
     and rad/s^2 (angles) or length unit/s and /s^2 (lengths); the joint and point maps:
     name -> (x, y) in the length unit (/s, /s^2). Empty rate maps when ``status`` is
-    ``singular`` (J cannot be inverted there) or when no driver motion was given."""
+    ``undefined`` (J is singular there, within its own uncertainty) or when no driver
+    motion was given.
+
+    Each rate carries an error bound (``*_bounds``: absolute, in the rate's unit; for a
+    joint or point, on each of its x and y): the rates are computed at the position
+    polished to full precision, and the bound covers rounding in J and the right-hand
+    side, the position's remaining error and the inputs' representation, propagated
+    through J^-1 (see :func:`rate_bounds`). A rate whose bound exceeds ``RATE_RTOL`` of
+    itself (or of the driver's motion, where the rate is smaller) is listed by label in
+    ``ill_conditioned`` (``dtheta3/dt``, ``d2theta3/dt2``, ``B.v``, ``B.a``), and the
+    status is then ``ill_conditioned``."""
 
     joints: dict[str, XY]
     velocities: dict[str, float] = field(default_factory=dict)
@@ -51,6 +75,22 @@ class Rates:
     joint_velocities: dict[str, XY] = field(default_factory=dict)
     joint_accelerations: dict[str, XY] = field(default_factory=dict)
     status: str = "ok"
+    velocity_bounds: dict[str, float] = field(default_factory=dict)
+    acceleration_bounds: dict[str, float] = field(default_factory=dict)
+    joint_velocity_bounds: dict[str, float] = field(default_factory=dict)
+    joint_acceleration_bounds: dict[str, float] = field(default_factory=dict)
+    ill_conditioned: tuple[str, ...] = ()
+
+    def flagged(self, label: str) -> bool:
+        """Whether the rate labelled ``label`` (see :func:`rate_label`) is ill-conditioned."""
+        return label in self.ill_conditioned
+
+
+def rate_label(name: str, order: int, joint: bool = False) -> str:
+    """The label of a rate: ``dtheta3/dt``, ``d2theta3/dt2``, ``B.v``, ``B.a``."""
+    if joint:
+        return f"{name}.v" if order == 1 else f"{name}.a"
+    return f"d{name}/dt" if order == 1 else f"d2{name}/dt2"
 
 
 def _value(idx: int, const: float, q: Any, d: float) -> float:
@@ -75,12 +115,205 @@ def _term(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any,
     return pos, vel, acc
 
 
-def solve_rates(model: LoopModel, q: Any, d: float, speed: float,
-                accel: float) -> tuple[list[float], list[float]] | None:
-    """(q', q'') at (q, d) for driver rate ``speed`` and ``accel`` (internal units), or
-    None where J is singular."""
-    _, J, V = model.factory(d)
-    jac, dv = J(list(q)), V(list(q))
+@dataclass(frozen=True)
+class _Uncertainty:
+    """How far each input of the rate equations may be from its exact value: the
+    unknowns' position, velocity and acceleration (``eq``, ``ev``, ``ea``, absolute) and
+    the driver's value, speed and acceleration (``ed``, ``evd``, ``evdd``). Constants
+    (lengths, angles, offsets) are taken within one rounding of their decimal values."""
+
+    eq: Any
+    ev: Any
+    ea: Any
+    ed: float
+    evd: float
+    evdd: float
+
+
+def _unc(idx: int, const: float, vec: Any, drv: float) -> float:
+    return vec[idx] if idx >= 0 else (drv if idx == DRIVER else EPS * abs(const))
+
+
+def _dunc(idx: int, vec: Any, drv: float) -> float:
+    return vec[idx] if idx >= 0 else (drv if idx == DRIVER else 0.0)
+
+
+def _parts_bounds(c: complex, dc: float, rc: float, th: float, dth: float) -> tuple[float, float]:
+    """Bounds on the x and y error of z = c e^(i theta) computed in floating point: c within
+    dc of exact (and rounded within rc), theta within dth. The change of angle moves x by at
+    most |Im z| dth + |z| dth^2 / 2 (and y by |Re z| dth + ...), a change of c by dc."""
+    co, si = math.cos(th), math.sin(th)
+    cr, ci = abs(c.real), abs(c.imag)
+    x = cr * abs(co) + ci * abs(si)  # |Re z| <= x, |Im z| <= y (the rounding scales too)
+    y = cr * abs(si) + ci * abs(co)
+    big = abs(c)
+    common = dc + rc + (big + dc) * dth * dth / 2.0
+    return common + 3.0 * EPS * x + (y + dc) * dth, common + 3.0 * EPS * y + (x + dc) * dth
+
+
+def _term_bounds(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float,
+                 u: _Uncertainty) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float]]:
+    """Bounds on how far one vector's computed position, velocity and acceleration
+    (:func:`_term`), each as (x, y), may be from their exact values at the exact inputs:
+    rounding in evaluating them, plus the inputs' uncertainties propagated exactly (the
+    products by |x y - x' y'| <= |x| |dy| + |y| |dx| + |dx| |dy|, the angle by
+    :func:`_parts_bounds`)."""
+    _sign, lc, li, ac, ai, off = t
+    r, th = _value(li, lc, q, d), _value(ai, ac, q, d) + off
+    r1, w = _rate(li, qd, vd), _rate(ai, qd, vd)
+    r2, al = _rate(li, qdd, vdd), _rate(ai, qdd, vdd)
+    ar, aw, ar1 = abs(r), abs(w), abs(r1)
+    dr = _unc(li, lc, u.eq, u.ed)
+    # the angle: its uncertainty, the offset's decimal value, and the sum's rounding
+    dth = _unc(ai, ac, u.eq, u.ed) + EPS * (abs(off) + abs(th))
+    dr1, dw = _dunc(li, u.ev, u.evd), _dunc(ai, u.ev, u.evd)
+    dr2, dal = _dunc(li, u.ea, u.evdd), _dunc(ai, u.ea, u.evdd)
+    dn = dr1 + dr * aw + ar * dw + dr * dw
+    dm = (dr2 + dr * abs(al) + ar * dal + dr * dal + 2.0 * (ar1 * dw + aw * dr1 + dr1 * dw)
+          + dr * (aw + dw) ** 2 + ar * (2.0 * aw * dw + dw * dw))
+    n = complex(r1, r * w)
+    m = complex(r2 - r * w * w, r * al + 2.0 * r1 * w)
+    # the coefficients' own rounding: each product and sum within an ulp
+    rn = EPS * ar * aw
+    rm = 2.0 * EPS * (abs(r2) + ar * w * w + ar * abs(al) + 2.0 * ar1 * aw)
+    return (_parts_bounds(complex(r), dr, 0.0, th, dth), _parts_bounds(n, dn, rn, th, dth),
+            _parts_bounds(m, dm, rm, th, dth))
+
+
+def _loop_residuals(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float,
+                    u: _Uncertainty, order: int) -> list[float]:
+    """Per equation row (x then y of each loop): a bound on the exact residual of the
+    loop's position (``order`` 0), velocity (1) or acceleration (2) equation at the
+    exact inputs, for the computed values: |computed residual| plus its bound."""
+    out: list[float] = []
+    for terms in model.terms:
+        total = 0j
+        bx = by = 0.0
+        sx = sy = 0.0
+        for t in terms:
+            z = _term(t, q, d, qd, vd, qdd, vdd)[order]
+            ex, ey = _term_bounds(t, q, d, qd, vd, qdd, vdd, u)[order]
+            total += z
+            bx, by = bx + ex, by + ey
+            sx, sy = sx + abs(z.real), sy + abs(z.imag)
+        # the sum's own rounding: each addition within an ulp of the partial sums
+        k = len(terms) * EPS
+        out += [abs(total.real) + bx + k * sx, abs(total.imag) + by + k * sy]
+    return out
+
+
+def _jacobian_spread(model: LoopModel, q: Any, d: float, u: _Uncertainty) -> list[list[float]]:
+    """|J(exact) - J(computed)| entry by entry, from the position's uncertainty: column j
+    of an angle is sum sign i r e^(i theta), of a length sum sign e^(i theta)."""
+    n = model.n
+    rows: list[list[float]] = []
+    for terms in model.terms:
+        row_x, row_y = [0.0] * n, [0.0] * n
+        for _sign, lc, li, ac, ai, off in terms:
+            r, th = _value(li, lc, q, d), _value(ai, ac, q, d) + off
+            dr = _unc(li, lc, u.eq, u.ed)
+            dth = _unc(ai, ac, u.eq, u.ed) + EPS * (abs(off) + abs(th))
+            if ai >= 0:
+                ex, ey = _parts_bounds(complex(0.0, r), dr, EPS * abs(r), th, dth)
+                row_x[ai] += ex
+                row_y[ai] += ey
+            if li >= 0:
+                ex, ey = _parts_bounds(complex(1.0), 0.0, 0.0, th, dth)
+                row_x[li] += ex
+                row_y[li] += ey
+        rows += [row_x, row_y]
+    return rows
+
+
+def _abs_inverse(jac: list[list[float]]) -> list[list[float]] | None:
+    """|J^-1| entry by entry, enlarged by the inverse's own rounding; None where J is
+    singular to working precision (the rounding would be of the order of J^-1 itself)."""
+    n = len(jac)
+    if n == 2:
+        (a, b), (c, d) = jac
+        det = a * d - b * c
+        size = abs(a * d) + abs(b * c)
+        if det == 0.0 or not math.isfinite(det) or EPS * size > 1e-3 * abs(det):
+            return None
+        grow = (1.0 + 4.0 * EPS * size / abs(det)) / abs(det)
+        return [[abs(d) * grow, abs(b) * grow], [abs(c) * grow, abs(a) * grow]]
+    try:
+        f = lu(jac)
+    except SingularMatrix:
+        return None
+    cols = [lu_solve(f, [1.0 if i == j else 0.0 for i in range(n)]) for j in range(n)]
+    inv = [[abs(cols[j][i]) for j in range(n)] for i in range(n)]
+    if not all(math.isfinite(v) for row in inv for v in row):
+        return None
+    # Skeel's condition number || |J^-1| |J| || (infinity norm) bounds the inverse's error
+    jrow = [sum(abs(v) for v in row) for row in jac]
+    kappa = max(sum(inv[i][k] * jrow[k] for k in range(n)) for i in range(n))
+    if EPS * kappa * n > 1e-3:
+        return None
+    grow = 1.0 + 8.0 * n * EPS * kappa
+    return [[v * grow for v in row] for row in inv]
+
+
+def _matvec(a: list[list[float]], x: list[float]) -> list[float]:
+    return [sum(ai * xi for ai, xi in zip(row, x)) for row in a]
+
+
+def _through_inverse(inv: list[list[float]], spread: list[list[float]], g: list[float]) -> list[float] | None:
+    """A bound on |x| where J(exact) x = y, |y| <= g, |J(exact) - J| <= spread: the
+    Neumann series |J^-1| g + B |J^-1| g + ..., B = |J^-1| spread, summed until a term w
+    has B w <= rho w with rho <= 1/2 (then the rest is at most rho / (1 - rho) w, as B is
+    nonnegative). None when it does not contract: J may be singular within its spread."""
+    w = _matvec(inv, g)
+    total = list(w)
+    top = max(w, default=0.0)
+    if top == 0.0:
+        return total
+    floor = 1e-30 * top
+    for _ in range(60):
+        bw = _matvec(inv, _matvec(spread, w))
+        rho = max(b / max(x, floor) for b, x in zip(bw, w))
+        if not math.isfinite(rho):
+            return None
+        if rho <= 0.5:
+            return [t + x * rho / (1.0 - rho) for t, x in zip(total, w)]
+        total = [t + b for t, b in zip(total, bw)]
+        w = bw
+    return None
+
+
+def polish(model: LoopModel, q: Any, d: float) -> list[float]:
+    """The position q made as exact as double precision allows: Newton steps (quadratic
+    there, so usually one or two) while each step is smaller than the last and max|Phi|
+    does not grow; q as given if the first step is refused. A solve stopped at its
+    tolerance can be 1e-7 rad from the root near a limit, where the rates' sensitivity
+    turns that into percent."""
+    F, J, _ = model.factory(d)
+    q = [float(x) for x in q]
+    phi = F(q)
+    res = max_abs(phi)
+    last = math.inf
+    for _ in range(POLISH_STEPS):
+        if not res > 0.0:
+            break
+        dq = newton_direction(J(q), phi)[0]
+        if dq is None or not all(map(math.isfinite, dq)):
+            break
+        size = max_abs(dq)
+        if not size < last:
+            break
+        trial = [a + b for a, b in zip(q, dq)]
+        phi_t = F(trial)
+        res_t = max_abs(phi_t)
+        if not res_t <= res:
+            break
+        q, phi, res, last = trial, phi_t, res_t, size
+        if all(abs(s) <= 4.0 * EPS * abs(x) for s, x in zip(dq, q)):
+            break  # a step at rounding level: nothing more to gain
+    return q
+
+
+def _solve(jac: list[list[float]], dv: list[float], model: LoopModel, q: Any, d: float, speed: float,
+           accel: float) -> tuple[list[float], list[float]] | None:
     # newton_direction solves J x = -rhs with the engine's equilibrated singularity test
     qd = newton_direction(jac, [speed * c for c in dv])[0]
     if qd is None or not all(map(math.isfinite, qd)):
@@ -96,24 +329,118 @@ def solve_rates(model: LoopModel, q: Any, d: float, speed: float,
             total += sign * (2j * r1 * w - r * w * w) * cmath.exp(1j * th)
         bias += [total.real, total.imag]
     qdd = newton_direction(jac, [accel * c + b for c, b in zip(dv, bias)])[0]
-    if qdd is None:
+    if qdd is None or not all(map(math.isfinite, qdd)):
         return None
     return qd, qdd
+
+
+def solve_rates(model: LoopModel, q: Any, d: float, speed: float,
+                accel: float) -> tuple[list[float], list[float]] | None:
+    """(q', q'') at (q, d) for driver rate ``speed`` and ``accel`` (internal units), or
+    None where J is singular. No polishing and no bound: see :func:`position_rates`."""
+    _, J, V = model.factory(d)
+    q = list(q)
+    return _solve(J(q), V(q), model, q, d, speed, accel)
+
+
+@dataclass(frozen=True)
+class RateBounds:
+    """Absolute error bounds of one position's rates: per unknown (``velocity``,
+    ``acceleration``, and ``position`` for the polished q) in internal units."""
+
+    position: list[float]
+    velocity: list[float]
+    acceleration: list[float]
+    uncertainty: _Uncertainty
+
+
+def rate_bounds(model: LoopModel, q: Any, d: float, speed: float, accel: float, qd: Any, qdd: Any,
+                jac: list[list[float]]) -> RateBounds | None:
+    """Error bounds for (q, q', q'') at driver (d, speed, accel), or None where J is
+    singular within its own uncertainty (the rates are then undefined).
+
+    The exact position q* solves Phi*(q*) = 0 with the exact parameters; J(q*) (q - q*) =
+    Phi*(q) to within the spread of J over the segment, so |q - q*| is bounded by
+    |J^-1| (|Phi(q)| + rounding + the inputs' representation), amplified by the Neumann
+    series of |J^-1| |dJ| (:func:`_through_inverse`), with dJ the spread of J for that
+    |q - q*| (checked self-consistent). The velocity equation J(q*) q'* = -V(q*) v' is
+    linear: J(q*) (q' - q'*) is the velocity residual at (q*, q'), bounded by the
+    computed residual at (q, q') plus its rounding plus its change from q to q*; the same
+    for the acceleration, whose right-hand side holds the velocities, with their bound.
+    First order in nothing: each change is bounded exactly (chords, products)."""
+    n = model.n
+    inv = _abs_inverse(jac)
+    if inv is None:
+        return None
+    ed = 2.0 * EPS * abs(d)  # the driver: a decimal value, then degrees to radians
+    zero = [0.0] * n
+    u0 = _Uncertainty(zero, zero, zero, ed, EPS * abs(speed), EPS * abs(accel))
+    g = _loop_residuals(model, q, d, qd, speed, qdd, accel, u0, 0)
+    guess = _through_inverse(inv, _jacobian_spread(model, q, d, u0), g)
+    if guess is None:
+        return None
+    eq: list[float] | None = None
+    for _ in range(6):
+        trial = [1.25 * x + EPS * abs(v) for x, v in zip(guess, q)]
+        spread = _jacobian_spread(model, q, d, _Uncertainty(trial, zero, zero, ed, 0.0, 0.0))
+        got = _through_inverse(inv, spread, g)
+        if got is None:
+            return None
+        if all(a <= b for a, b in zip(got, trial)):
+            eq = trial  # the spread assumed holds for the bound it gives
+            break
+        guess = got
+    if eq is None:
+        return None
+    uq = _Uncertainty(eq, zero, zero, ed, u0.evd, u0.evdd)
+    ev = _through_inverse(inv, spread, _loop_residuals(model, q, d, qd, speed, qdd, accel, uq, 1))
+    if ev is None:
+        return None
+    uv = _Uncertainty(eq, ev, zero, ed, u0.evd, u0.evdd)
+    ea = _through_inverse(inv, spread, _loop_residuals(model, q, d, qd, speed, qdd, accel, uv, 2))
+    if ea is None:
+        return None
+    return RateBounds(eq, ev, ea, _Uncertainty(eq, ev, ea, ed, u0.evd, u0.evdd))
 
 
 def place(model: LoopModel, q: Any, d: float, qd: Any = None, vd: float = 0.0, qdd: Any = None,
           vdd: float = 0.0) -> dict[str, tuple[complex, complex, complex]]:
     """Every named joint and point: name -> (position, velocity, acceleration), complex."""
+    return {k: v[:3] for k, v in _place(model, q, d, qd, vd, qdd, vdd, None).items()}
+
+
+def _place(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float,
+           unc: _Uncertainty | None) -> dict[str, tuple[complex, complex, complex, float, float]]:
+    """:func:`place`, each joint and point with bounds on its velocity and acceleration
+    (each of x and y) when ``unc`` gives the inputs' uncertainties (else 0)."""
     m = model.mechanism
     n = model.n
     qd = qd if qd is not None else [0.0] * n
     qdd = qdd if qdd is not None else [0.0] * n
-    placed: dict[str, tuple[complex, complex, complex]] = {}
+    placed: dict[str, tuple[complex, complex, complex, float, float]] = {}
+
+    def bounds(t: Any) -> tuple[float, float]:
+        if unc is None:
+            return 0.0, 0.0
+        _, bv, ba = _term_bounds(t, q, d, qd, vd, qdd, vdd, unc)
+        return max(bv), max(ba)
+
+    def add(start: tuple[complex, complex, complex, float, float], parts: Any, sign: float
+            ) -> tuple[complex, complex, complex, float, float]:
+        p, v, a, bv, ba = start
+        for (dp, dv, da), (cv, ca) in parts:
+            p, v, a = p + sign * dp, v + sign * dv, a + sign * da
+            # each addition rounds by at most an ulp of the running sum
+            bv += cv + EPS * abs(v) if unc is not None else 0.0
+            ba += ca + EPS * abs(a) if unc is not None else 0.0
+        return p, v, a, bv, ba
+
+    origin0 = (0j, 0j, 0j, 0.0, 0.0)
     for loop, terms in zip(m.loops, model.terms):
         names = loop.joints
         start = placed.get(names[0]) if names and names[0] else None
-        origin = start if start is not None else (0j, 0j, 0j)
-        parts = [_term(t, q, d, qd, vd, qdd, vdd) for t in terms]
+        origin = start if start is not None else origin0
+        parts = [(_term(t, q, d, qd, vd, qdd, vdd), bounds(t)) for t in terms]
         moving = [t[2] != FIXED or t[4] != FIXED for t in terms]
         for k in range(len(terms)):
             if not names or not names[k] or names[k] in placed:
@@ -123,17 +450,11 @@ def place(model: LoopModel, q: Any, d: float, qd: Any = None, vd: float = 0.0, q
             forward = range(k)
             backward = range(k, len(terms))
             ahead = sum(moving[j] for j in forward) <= sum(moving[j] for j in backward)
-            sign = 1.0 if ahead else -1.0
-            p, v, a = origin
-            for j in (forward if ahead else backward):
-                p, v, a = p + sign * parts[j][0], v + sign * parts[j][1], a + sign * parts[j][2]
-            placed[names[k]] = (p, v, a)
-    for name, (origin, terms) in model.point_terms.items():
-        p, v, a = placed.get(origin, (0j, 0j, 0j))
-        for t in terms:
-            dp, dv, da = _term(t, q, d, qd, vd, qdd, vdd)
-            p, v, a = p + dp, v + dv, a + da
-        placed[name] = (p, v, a)
+            placed[names[k]] = add(origin, [parts[j] for j in (forward if ahead else backward)],
+                                   1.0 if ahead else -1.0)
+    for name, (origin_name, terms) in model.point_terms.items():
+        start = placed.get(origin_name, origin0)
+        placed[name] = add(start, [(_term(t, q, d, qd, vd, qdd, vdd), bounds(t)) for t in terms], 1.0)
     return placed
 
 
@@ -144,21 +465,56 @@ def _xy(c: complex) -> XY:
 def position_rates(model: LoopModel, q: Any, d: float, speed: float | None = None,
                    accel: float = 0.0) -> Rates:
     """The joints and points at (q, d) (internal units), and with a driver ``speed`` the
-    rates of every unknown, joint and point (internal units: rad/s for angles)."""
+    rates of every unknown, joint and point (internal units: rad/s for angles), each with
+    its error bound: computed at q polished to full precision (:func:`polish`), bounded by
+    :func:`rate_bounds`, flagged ``ill_conditioned`` beyond ``RATE_RTOL``, and absent
+    (status ``undefined``) where J is singular within its own uncertainty."""
     names = [u.name for u in model.mechanism.unknowns]
     if speed is None:
         return Rates({k: _xy(p) for k, (p, _, _) in place(model, q, d).items()})
-    solved = solve_rates(model, q, d, speed, accel)
-    if solved is None:
-        return Rates({k: _xy(p) for k, (p, _, _) in place(model, q, d).items()}, status="singular")
+    q = polish(model, q, d)
+    _, J, V = model.factory(d)
+    jac = J(q)
+    solved = _solve(jac, V(q), model, q, d, speed, accel)
+    bounds = rate_bounds(model, q, d, speed, accel, solved[0], solved[1], jac) if solved else None
+    if solved is None or bounds is None:
+        return Rates({k: _xy(p) for k, (p, _, _) in place(model, q, d).items()}, status="undefined")
     qd, qdd = solved
-    pts = place(model, q, d, qd, speed, qdd, accel)
+    pts = _place(model, q, d, qd, speed, qdd, accel, bounds.uncertainty)
+    # the scale below which a rate is judged against the driver's own motion instead
+    size = model.mechanism.length_scale
+    omega = abs(speed) / (1.0 if model.mechanism.driver.kind == "angle" else size)
+    alpha = abs(accel) / (1.0 if model.mechanism.driver.kind == "angle" else size) + omega * omega
+    kinds = [u.kind for u in model.mechanism.unknowns]
+    flags: list[str] = []
+
+    def judge(label: str, value: float, bound: float, floor: float) -> None:
+        if not bound <= RATE_RTOL * max(abs(value), floor):
+            flags.append(label)
+
+    vb = [SAFETY * b for b in bounds.velocity]
+    ab = [SAFETY * b for b in bounds.acceleration]
+    for name, kind, v, a, bv, ba in zip(names, kinds, qd, qdd, vb, ab):
+        unit = 1.0 if kind == "angle" else size
+        judge(rate_label(name, 1), v, bv, omega * unit)
+        judge(rate_label(name, 2), a, ba, alpha * unit)
+    jvb = {k: SAFETY * bv for k, (_, _, _, bv, _) in pts.items()}
+    jab = {k: SAFETY * ba for k, (_, _, _, _, ba) in pts.items()}
+    for k, (_, v, a, _, _) in pts.items():
+        judge(rate_label(k, 1, joint=True), abs(v), jvb[k], omega * size)
+        judge(rate_label(k, 2, joint=True), abs(a), jab[k], alpha * size)
     return Rates(
-        joints={k: _xy(p) for k, (p, _, _) in pts.items()},
+        joints={k: _xy(p[0]) for k, p in pts.items()},
         velocities=dict(zip(names, qd)),
         accelerations=dict(zip(names, qdd)),
-        joint_velocities={k: _xy(v) for k, (_, v, _) in pts.items()},
-        joint_accelerations={k: _xy(a) for k, (_, _, a) in pts.items()},
+        joint_velocities={k: _xy(p[1]) for k, p in pts.items()},
+        joint_accelerations={k: _xy(p[2]) for k, p in pts.items()},
+        status="ill_conditioned" if flags else "ok",
+        velocity_bounds=dict(zip(names, vb)),
+        acceleration_bounds=dict(zip(names, ab)),
+        joint_velocity_bounds=jvb,
+        joint_acceleration_bounds=jab,
+        ill_conditioned=tuple(flags),
     )
 
 

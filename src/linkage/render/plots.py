@@ -52,6 +52,8 @@ def _save(fig: Any, path: Path) -> None:
 def _series(result: Any) -> list[tuple[str, list[float]]]:
     """(axis label, values) of every curve: each unknown, and with a driver speed its
     velocity and acceleration (rad/s for angles)."""
+    from ..kinematics.rates import rate_label
+
     out = []
     for name, unit in zip(result.names, result.units):
         out.append((f"{name} ({unit})", [p.solution[name] if p.solution else math.nan
@@ -60,8 +62,11 @@ def _series(result: Any) -> list[tuple[str, list[float]]]:
             base = "rad" if unit == "deg" else unit
             for key, label, u in (("velocities", f"d{name}/dt", f"{base}/s"),
                                   ("accelerations", f"d2{name}/dt2", f"{base}/s^2")):
+                order = 1 if key == "velocities" else 2
+                # undefined and ill-conditioned rates are NaN: the line breaks there
                 out.append((f"{label}\n({u})", [getattr(p.rates, key).get(name, math.nan)
-                                                if p.rates is not None and p.rates.velocities else math.nan
+                                                if p.rates is not None and p.rates.velocities
+                                                and not p.rates.flagged(rate_label(name, order)) else math.nan
                                                 for p in result.positions]))
     return out
 

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
+from ..kinematics.rates import rate_label
 from .report import Block, table
 
 
@@ -13,8 +15,17 @@ def rate_units(kind: str, length_unit: str) -> tuple[str, str]:
     return f"{base}/s", f"{base}/s^2"
 
 
+def uncertain(value: float, bound: float) -> str:
+    """An ill-conditioned rate as text: the digits its bound leaves, then the bound."""
+    if not (math.isfinite(value) and math.isfinite(bound)) or bound <= 0.0:
+        return f"{value:.6g} ±{bound:.2g}"
+    digits = 1 if bound >= abs(value) else min(6, max(1, math.floor(math.log10(abs(value) / bound)) + 1))
+    return f"{value:.{digits}g} ±{bound:.2g}"
+
+
 def rates_dict(rates: Any) -> dict[str, Any]:
-    """The JSON fields of one position's kinematics (rate fields only with a driver speed)."""
+    """The JSON fields of one position's kinematics (rate fields only with a driver speed):
+    each rate's absolute error bound beside it, and the labels of the ill-conditioned ones."""
     if rates is None:
         return {}
     out: dict[str, Any] = {"joints": {k: list(v) for k, v in rates.joints.items()}}
@@ -25,43 +36,72 @@ def rates_dict(rates: Any) -> dict[str, Any]:
         out["accelerations"] = rates.accelerations
         out["joint_velocities"] = {k: list(v) for k, v in rates.joint_velocities.items()}
         out["joint_accelerations"] = {k: list(v) for k, v in rates.joint_accelerations.items()}
+        out["rate_bounds"] = {"velocities": rates.velocity_bounds, "accelerations": rates.acceleration_bounds,
+                              "joint_velocities": rates.joint_velocity_bounds,
+                              "joint_accelerations": rates.joint_acceleration_bounds}
+        if rates.ill_conditioned:
+            out["ill_conditioned"] = list(rates.ill_conditioned)
     return out
 
 
-def rate_headers(names: Any, kinds: Any, length_unit: str, joints: Any, motion: bool) -> list[str]:
-    """CSV columns for the kinematics: unknown rates (with a driver speed), then joints."""
-    out = []
+def rate_headers(names: Any, kinds: Any, length_unit: str, joints: Any, motion: bool,
+                 bounds: bool = True) -> list[str]:
+    """CSV columns for the kinematics: with a driver speed the rates' status, the unknowns'
+    rates (each followed by its error bound), then the joints (with the bounds of their
+    velocity and acceleration, on each of x and y). ``bounds=False``: the unknowns' rates
+    only, for a table whose cells carry their bounds as text (:func:`rate_cells`)."""
+    out = ["rates status"] if motion and bounds else []
     if motion:
         for n, k in zip(names, kinds):
             v, a = rate_units(k, length_unit)
-            out += [f"d{n}/dt ({v})", f"d2{n}/dt2 ({a})"]
+            out += [f"d{n}/dt ({v})", f"d{n}/dt bound ({v})", f"d2{n}/dt2 ({a})", f"d2{n}/dt2 bound ({a})"] \
+                if bounds else [f"d{n}/dt ({v})", f"d2{n}/dt2 ({a})"]
     for j in joints:
         out += [f"{j}.x ({length_unit})", f"{j}.y ({length_unit})"]
         if motion:
             out += [f"{j}.vx ({length_unit}/s)", f"{j}.vy ({length_unit}/s)",
-                    f"{j}.ax ({length_unit}/s^2)", f"{j}.ay ({length_unit}/s^2)"]
+                    f"{j}.ax ({length_unit}/s^2)", f"{j}.ay ({length_unit}/s^2)",
+                    f"{j}.v bound ({length_unit}/s)", f"{j}.a bound ({length_unit}/s^2)"]
     return out
 
 
-def rate_cells(rates: Any, names: Any, joints: Any, motion: bool) -> list[Any]:
-    """One row of :func:`rate_headers` (empty cells where unsolved or singular)."""
+def rate_cells(rates: Any, names: Any, joints: Any, motion: bool, bounds: bool = True) -> list[Any]:
+    """One row of :func:`rate_headers` (empty cells where unsolved or undefined). With
+    ``bounds=False`` (a table's cells): an ill-conditioned rate as text with its bound
+    (:func:`uncertain`), an undefined one as "undefined"."""
     cells: list[Any] = []
     if motion:
+        ok = rates is not None and bool(rates.velocities)
+        if bounds:
+            cells.append(rates.status if rates is not None else None)
         for n in names:
-            ok = rates is not None and rates.velocities
-            cells += [rates.velocities[n], rates.accelerations[n]] if ok else [None, None]
+            if not ok:
+                undefined = "undefined" if rates is not None and not bounds else None
+                cells += [undefined] * (4 if bounds else 2)
+                continue
+            for order, value, bound in ((1, rates.velocities[n], rates.velocity_bounds.get(n)),
+                                        (2, rates.accelerations[n], rates.acceleration_bounds.get(n))):
+                if bounds:
+                    cells += [value, bound]
+                elif bound is not None and rates.flagged(rate_label(n, order)):
+                    cells.append(uncertain(value, bound))
+                else:
+                    cells.append(value)
     for j in joints:
         xy = rates.joints.get(j) if rates is not None else None
         cells += list(xy) if xy else [None, None]
         if motion:
             v = rates.joint_velocities.get(j) if rates is not None else None
             a = rates.joint_accelerations.get(j) if rates is not None else None
-            cells += [*(v or (None, None)), *(a or (None, None))]
+            bv = rates.joint_velocity_bounds.get(j) if rates is not None else None
+            ba = rates.joint_acceleration_bounds.get(j) if rates is not None else None
+            cells += [*(v or (None, None)), *(a or (None, None)), bv, ba]
     return cells
 
 
 def rates_blocks(rates: Any, names: Any, kinds: Any, length_unit: str, digits: int) -> list[Block]:
-    """Tables of one position's kinematics: the unknowns' rates, then the joints."""
+    """Tables of one position's kinematics: the unknowns' rates with their error bounds,
+    then the joints; an ill-conditioned rate shows only the digits its bound leaves."""
     blocks: list[Block] = []
     if rates is None:
         return blocks
@@ -69,14 +109,17 @@ def rates_blocks(rates: Any, names: Any, kinds: Any, length_unit: str, digits: i
         rows = []
         for n, k in zip(names, kinds):
             v, a = rate_units(k, length_unit)
-            rows.append((n, rates.velocities[n], v, rates.accelerations[n], a))
-        blocks.append(table("Velocities and accelerations", ("unknown", "velocity", "unit", "acceleration",
-                                                             "unit"), rows, digits))
+            vel, acc = rate_cells(rates, [n], [], True, bounds=False)
+            rows.append((n, vel, _bound(rates.velocity_bounds.get(n)), v, acc,
+                         _bound(rates.acceleration_bounds.get(n)), a))
+        headers = ("unknown", "velocity", "± bound", "unit", "acceleration", "± bound", "unit")
+        blocks.append(table("Velocities and accelerations", headers, rows, digits))
     L = length_unit
     if rates.velocities:
-        headers = ("joint", f"x ({L})", f"y ({L})", f"vx ({L}/s)", f"vy ({L}/s)", f"ax ({L}/s^2)",
-                   f"ay ({L}/s^2)")
-        rows = [(j, *xy, *rates.joint_velocities[j], *rates.joint_accelerations[j])
+        headers = ("joint", f"x ({L})", f"y ({L})", f"vx ({L}/s)", f"vy ({L}/s)", f"± v ({L}/s)",
+                   f"ax ({L}/s^2)", f"ay ({L}/s^2)", f"± a ({L}/s^2)")
+        rows = [(j, *xy, *_joint_cells(rates, j, 1), _bound(rates.joint_velocity_bounds.get(j)),
+                 *_joint_cells(rates, j, 2), _bound(rates.joint_acceleration_bounds.get(j)))
                 for j, xy in rates.joints.items()]
     else:
         headers = ("joint", f"x ({L})", f"y ({L})")
@@ -85,3 +128,15 @@ def rates_blocks(rates: Any, names: Any, kinds: Any, length_unit: str, digits: i
         blocks.append(table("Joints (the first loop's first joint at the origin, x along 0 deg)", headers,
                             rows, digits))
     return blocks
+
+
+def _bound(b: float | None) -> str | None:
+    return None if b is None else f"{b:.2g}"
+
+
+def _joint_cells(rates: Any, j: str, order: int) -> tuple[Any, Any]:
+    xy = rates.joint_velocities[j] if order == 1 else rates.joint_accelerations[j]
+    bound = rates.joint_velocity_bounds.get(j) if order == 1 else rates.joint_acceleration_bounds.get(j)
+    if bound is not None and rates.flagged(rate_label(j, order, joint=True)):
+        return uncertain(xy[0], bound), uncertain(xy[1], bound)
+    return xy[0], xy[1]

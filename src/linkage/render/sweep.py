@@ -106,8 +106,9 @@ def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400) -> list[Block
     rows = sweep_rows(s, kinematics=False)
     headers = sweep_headers(s, kinematics=False)
     if s.motion is not None:  # the unknowns' rates beside their values (joints: csv, json)
-        headers += rate_headers(s.names, _kinds(s), s.length_unit, [], True)
-        rows = [(*r, *rate_cells(p.rates, s.names, [], True)) for r, p in zip(rows, s.positions)]
+        headers += rate_headers(s.names, _kinds(s), s.length_unit, [], True, bounds=False)
+        rows = [(*r, *rate_cells(p.rates, s.names, [], True, bounds=False))
+                for r, p in zip(rows, s.positions)]
     every = -(-len(rows) // max_rows)  # ceil: the fewest rows skipped that fit max_rows
     shown = rows if every <= 1 else rows[::every]
     note = [] if shown is rows else [f"(one row in {every} of {len(rows)} shown; "
