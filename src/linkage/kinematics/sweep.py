@@ -766,7 +766,54 @@ def _toggles(solver: _Solver, positions: Sequence[Position], arcs: Any, lo: floa
             found.append(_bisect_det(solver, a, b))
         elif not have_closed and (a.status == "converged") != (b.status == "converged"):
             found.append(_bisect_limit(solver, a, b))
+    # det J can also touch zero without changing sign (two assemblies crossing, as an
+    # in-line slider-crank with r3 = r2 at 90 deg): a local minimum of |det J| over the
+    # solved positions is refined, and is a toggle where J is singular there
+    for a, b, c in zip(positions, positions[1:], positions[2:]):
+        if a.det is not None and b.det is not None and c.det is not None \
+                and a.status == b.status == c.status == "converged" \
+                and (a.det > 0) == (b.det > 0) == (c.det > 0) \
+                and abs(b.det) <= abs(a.det) and abs(b.det) <= abs(c.det):
+            touch = _touch_det(solver, a, b, c)
+            if touch is not None and not any(abs(touch - t) <= 2 * LOCATE_TOL for t in found):
+                found.append(touch)
     return sorted(found)
+
+
+TOUCH_RATIO = 1e-5
+"""A minimum of |det J| / (its columns' lengths) at most this is a toggle (see hadamard_ratio)."""
+
+
+def _touch_det(solver: _Solver, a: Position, b: Position, c: Position) -> float | None:
+    """The driver value in [a, c] where the branch's J is nearest singular (golden-section
+    search on hadamard_ratio, to LOCATE_TOL), if J is singular there; else None."""
+    from ..methods._linalg import hadamard_ratio
+
+    ends = ((a.input, solver_q(solver, a)), (c.input, solver_q(solver, c)))
+    cache: dict[float, float] = {}
+
+    def ratio(v: float) -> float:
+        if v not in cache:
+            # from the nearer end, where J is regular (not from b: J may be singular there)
+            v0, q0 = min(ends, key=lambda e: abs(e[0] - v))
+            p, r = solver.solve(v, _predict(solver, v0, q0, v) or q0)
+            cache[v] = hadamard_ratio(p.J(list(r.x))) if r.converged else math.inf
+        return cache[v]
+
+    lo, hi = a.input, c.input
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+    while abs(hi - lo) > LOCATE_TOL:
+        if ratio(x1) <= ratio(x2):
+            hi, x2 = x2, x1
+            x1 = hi - g * (hi - lo)
+        else:
+            lo, x1 = x1, x2
+            x2 = lo + g * (hi - lo)
+    best = min(cache, key=cache.__getitem__, default=None)
+    if best is None or not cache[best] <= TOUCH_RATIO:
+        return None
+    return best
 
 
 def _bisect_det(solver: _Solver, a: Position, b: Position) -> float:

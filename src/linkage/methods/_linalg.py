@@ -111,3 +111,21 @@ def pivot_ratio(factors: tuple[Matrix, list[int], int]) -> float:
     diag = [abs(m[i][i]) for i in range(len(m))]
     top = max(diag)
     return min(diag) / top if top > 0.0 else 0.0
+
+
+def hadamard_ratio(a: Sequence[Sequence[float]]) -> float:
+    """|det A| / (product of its columns' Euclidean lengths), in [0, 1]: 0 where A is
+    singular, 1 where its columns are orthogonal. Unlike |det| it does not depend on the
+    columns' units, and unlike the pivot ratio of an equilibrated LU it is not fooled by a
+    row that is small only because the matrix is near singular (a slider-crank's
+    [[-r3 sin t3, -1], [r3 cos t3, 0]] at cos t3 -> 0)."""
+    n = len(a)
+    norms = 1.0
+    for j in range(n):
+        norms *= sum(a[i][j] * a[i][j] for i in range(n)) ** 0.5
+    if not norms > 0.0:
+        return 0.0
+    try:
+        return abs(det_from_lu(lu(a))) / norms
+    except SingularMatrix:
+        return 0.0
