@@ -138,21 +138,21 @@ def _dunc(idx: int, vec: Any, drv: float) -> float:
     return vec[idx] if idx >= 0 else (drv if idx == DRIVER else 0.0)
 
 
-def _parts_bounds(c: complex, dc: float, rc: float, th: float, dth: float) -> tuple[float, float]:
+def _parts_bounds(c: complex, dc: float, rc: float, co: float, si: float, dth: float) -> tuple[float, float]:
     """Bounds on the x and y error of z = c e^(i theta) computed in floating point: c within
-    dc of exact (and rounded within rc), theta within dth. The change of angle moves x by at
-    most |Im z| dth + |z| dth^2 / 2 (and y by |Re z| dth + ...), a change of c by dc."""
-    co, si = math.cos(th), math.sin(th)
+    dc of exact (and rounded within rc), theta within dth (|cos theta| = co, |sin theta| =
+    si). The change of angle moves x by at most |Im z| dth + |z| dth^2 / 2 (and y by
+    |Re z| dth + ...), a change of c by dc."""
     cr, ci = abs(c.real), abs(c.imag)
-    x = cr * abs(co) + ci * abs(si)  # |Re z| <= x, |Im z| <= y (the rounding scales too)
-    y = cr * abs(si) + ci * abs(co)
+    x = cr * co + ci * si  # |Re z| <= x, |Im z| <= y (the rounding scales too)
+    y = cr * si + ci * co
     big = abs(c)
     common = dc + rc + (big + dc) * dth * dth / 2.0
     return common + 3.0 * EPS * x + (y + dc) * dth, common + 3.0 * EPS * y + (x + dc) * dth
 
 
 def _term_bounds(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float,
-                 u: _Uncertainty) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float]]:
+                 u: _Uncertainty, orders: tuple[int, ...] = (0, 1, 2)) -> list[tuple[float, float]]:
     """Bounds on how far one vector's computed position, velocity and acceleration
     (:func:`_term`), each as (x, y), may be from their exact values at the exact inputs:
     rounding in evaluating them, plus the inputs' uncertainties propagated exactly (the
@@ -167,17 +167,22 @@ def _term_bounds(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: fl
     # the angle: its uncertainty, the offset's decimal value, and the sum's rounding
     dth = _unc(ai, ac, u.eq, u.ed) + EPS * (abs(off) + abs(th))
     dr1, dw = _dunc(li, u.ev, u.evd), _dunc(ai, u.ev, u.evd)
-    dr2, dal = _dunc(li, u.ea, u.evdd), _dunc(ai, u.ea, u.evdd)
-    dn = dr1 + dr * aw + ar * dw + dr * dw
-    dm = (dr2 + dr * abs(al) + ar * dal + dr * dal + 2.0 * (ar1 * dw + aw * dr1 + dr1 * dw)
-          + dr * (aw + dw) ** 2 + ar * (2.0 * aw * dw + dw * dw))
-    n = complex(r1, r * w)
-    m = complex(r2 - r * w * w, r * al + 2.0 * r1 * w)
-    # the coefficients' own rounding: each product and sum within an ulp
-    rn = EPS * ar * aw
-    rm = 2.0 * EPS * (abs(r2) + ar * w * w + ar * abs(al) + 2.0 * ar1 * aw)
-    return (_parts_bounds(complex(r), dr, 0.0, th, dth), _parts_bounds(n, dn, rn, th, dth),
-            _parts_bounds(m, dm, rm, th, dth))
+    co, si = abs(math.cos(th)), abs(math.sin(th))
+    out = []
+    for order in orders:
+        if order == 0:
+            out.append(_parts_bounds(complex(r), dr, 0.0, co, si, dth))
+        elif order == 1:
+            dn = dr1 + dr * aw + ar * dw + dr * dw
+            # the coefficient's own rounding: each product and sum within an ulp
+            out.append(_parts_bounds(complex(r1, r * w), dn, EPS * ar * aw, co, si, dth))
+        else:
+            dr2, dal = _dunc(li, u.ea, u.evdd), _dunc(ai, u.ea, u.evdd)
+            dm = (dr2 + dr * abs(al) + ar * dal + dr * dal + 2.0 * (ar1 * dw + aw * dr1 + dr1 * dw)
+                  + dr * (aw + dw) ** 2 + ar * (2.0 * aw * dw + dw * dw))
+            rm = 2.0 * EPS * (abs(r2) + ar * w * w + ar * abs(al) + 2.0 * ar1 * aw)
+            out.append(_parts_bounds(complex(r2 - r * w * w, r * al + 2.0 * r1 * w), dm, rm, co, si, dth))
+    return out
 
 
 def _loop_residuals(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float,
@@ -192,7 +197,7 @@ def _loop_residuals(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd:
         sx = sy = 0.0
         for t in terms:
             z = _term(t, q, d, qd, vd, qdd, vdd)[order]
-            ex, ey = _term_bounds(t, q, d, qd, vd, qdd, vdd, u)[order]
+            ex, ey = _term_bounds(t, q, d, qd, vd, qdd, vdd, u, (order,))[0]
             total += z
             bx, by = bx + ex, by + ey
             sx, sy = sx + abs(z.real), sy + abs(z.imag)
@@ -213,12 +218,13 @@ def _jacobian_spread(model: LoopModel, q: Any, d: float, u: _Uncertainty) -> lis
             r, th = _value(li, lc, q, d), _value(ai, ac, q, d) + off
             dr = _unc(li, lc, u.eq, u.ed)
             dth = _unc(ai, ac, u.eq, u.ed) + EPS * (abs(off) + abs(th))
+            co, si = abs(math.cos(th)), abs(math.sin(th))
             if ai >= 0:
-                ex, ey = _parts_bounds(complex(0.0, r), dr, EPS * abs(r), th, dth)
+                ex, ey = _parts_bounds(complex(0.0, r), dr, EPS * abs(r), co, si, dth)
                 row_x[ai] += ex
                 row_y[ai] += ey
             if li >= 0:
-                ex, ey = _parts_bounds(complex(1.0), 0.0, 0.0, th, dth)
+                ex, ey = _parts_bounds(complex(1.0), 0.0, 0.0, co, si, dth)
                 row_x[li] += ex
                 row_y[li] += ey
         rows += [row_x, row_y]
@@ -422,7 +428,7 @@ def _place(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd
     def bounds(t: Any) -> tuple[float, float]:
         if unc is None:
             return 0.0, 0.0
-        _, bv, ba = _term_bounds(t, q, d, qd, vd, qdd, vdd, unc)
+        bv, ba = _term_bounds(t, q, d, qd, vd, qdd, vdd, unc, (1, 2))
         return max(bv), max(ba)
 
     def add(start: tuple[complex, complex, complex, float, float], parts: Any, sign: float

@@ -783,12 +783,21 @@ def _toggles(solver: _Solver, positions: Sequence[Position], arcs: Any, lo: floa
 TOUCH_RATIO = 1e-5
 """A minimum of |det J| / (its columns' lengths) at most this is a toggle (see hadamard_ratio)."""
 
+TOUCH_CANDIDATE = 0.1
+"""A local minimum of |det J| over the solved positions is searched only where
+hadamard_ratio is below this there (a transmission angle under 5.7 deg): near a touch it
+falls like the distance to it (0.017 a degree on the in-line slider-crank), while an
+ordinary mechanism's smallest transmission angle is far above, and costs nothing."""
+
 
 def _touch_det(solver: _Solver, a: Position, b: Position, c: Position) -> float | None:
     """The driver value in [a, c] where the branch's J is nearest singular (golden-section
     search on hadamard_ratio, to LOCATE_TOL), if J is singular there; else None."""
     from ..methods._linalg import hadamard_ratio
 
+    q_b = solver_q(solver, b)
+    if not hadamard_ratio(solver.problem(b.input).J(list(q_b))) <= TOUCH_CANDIDATE:
+        return None
     ends = ((a.input, solver_q(solver, a)), (c.input, solver_q(solver, c)))
     cache: dict[float, float] = {}
 

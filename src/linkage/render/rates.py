@@ -15,12 +15,14 @@ def rate_units(kind: str, length_unit: str) -> tuple[str, str]:
     return f"{base}/s", f"{base}/s^2"
 
 
-def uncertain(value: float, bound: float) -> str:
-    """An ill-conditioned rate as text: the digits its bound leaves, then the bound."""
+def uncertain(value: float, bound: float, with_bound: bool = True) -> str:
+    """An ill-conditioned rate as text: the digits its bound leaves, then the bound (unless
+    a column beside it shows the bound)."""
     if not (math.isfinite(value) and math.isfinite(bound)) or bound <= 0.0:
-        return f"{value:.6g} ±{bound:.2g}"
-    digits = 1 if bound >= abs(value) else min(6, max(1, math.floor(math.log10(abs(value) / bound)) + 1))
-    return f"{value:.{digits}g} ±{bound:.2g}"
+        digits = 6
+    else:
+        digits = 1 if bound >= abs(value) else min(6, max(1, math.floor(math.log10(abs(value) / bound)) + 1))
+    return f"{value:.{digits}g} ±{bound:.2g}" if with_bound else f"{value:.{digits}g}"
 
 
 def rates_dict(rates: Any) -> dict[str, Any]:
@@ -109,7 +111,9 @@ def rates_blocks(rates: Any, names: Any, kinds: Any, length_unit: str, digits: i
         rows = []
         for n, k in zip(names, kinds):
             v, a = rate_units(k, length_unit)
-            vel, acc = rate_cells(rates, [n], [], True, bounds=False)
+            vel, acc = (_shown(rates, rate_label(n, order), value, bound) for order, value, bound in (
+                (1, rates.velocities[n], rates.velocity_bounds.get(n)),
+                (2, rates.accelerations[n], rates.acceleration_bounds.get(n))))
             rows.append((n, vel, _bound(rates.velocity_bounds.get(n)), v, acc,
                          _bound(rates.acceleration_bounds.get(n)), a))
         headers = ("unknown", "velocity", "± bound", "unit", "acceleration", "± bound", "unit")
@@ -134,9 +138,13 @@ def _bound(b: float | None) -> str | None:
     return None if b is None else f"{b:.2g}"
 
 
+def _shown(rates: Any, label: str, value: float, bound: float | None) -> Any:
+    """A table cell beside its bound's column: a flagged rate to the digits its bound leaves."""
+    return uncertain(value, bound, with_bound=False) if bound is not None and rates.flagged(label) else value
+
+
 def _joint_cells(rates: Any, j: str, order: int) -> tuple[Any, Any]:
     xy = rates.joint_velocities[j] if order == 1 else rates.joint_accelerations[j]
     bound = rates.joint_velocity_bounds.get(j) if order == 1 else rates.joint_acceleration_bounds.get(j)
-    if bound is not None and rates.flagged(rate_label(j, order, joint=True)):
-        return uncertain(xy[0], bound), uncertain(xy[1], bound)
-    return xy[0], xy[1]
+    label = rate_label(j, order, joint=True)
+    return _shown(rates, label, xy[0], bound), _shown(rates, label, xy[1], bound)
