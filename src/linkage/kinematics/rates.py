@@ -151,23 +151,36 @@ def _parts_bounds(c: complex, dc: float, rc: float, co: float, si: float, dth: f
     return common + 3.0 * EPS * x + (y + dc) * dth, common + 3.0 * EPS * y + (x + dc) * dth
 
 
-def _term_bounds(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float,
-                 u: _Uncertainty, orders: tuple[int, ...] = (0, 1, 2)) -> list[tuple[float, float]]:
-    """Bounds on how far one vector's computed position, velocity and acceleration
-    (:func:`_term`), each as (x, y), may be from their exact values at the exact inputs:
-    rounding in evaluating them, plus the inputs' uncertainties propagated exactly (the
-    products by |x y - x' y'| <= |x| |dy| + |y| |dx| + |dx| |dy|, the angle by
-    :func:`_parts_bounds`)."""
+def _static(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float) -> tuple[Any, ...]:
+    """One vector's values at a position, computed once for all its bounds: (length
+    index and constant, angle index and constant, offset, r, theta, r', w, r'', w',
+    |cos theta|, |sin theta|, position, velocity, acceleration)."""
     _sign, lc, li, ac, ai, off = t
     r, th = _value(li, lc, q, d), _value(ai, ac, q, d) + off
     r1, w = _rate(li, qd, vd), _rate(ai, qd, vd)
     r2, al = _rate(li, qdd, vdd), _rate(ai, qdd, vdd)
+    return (li, lc, ai, ac, off, r, th, r1, w, r2, al, abs(math.cos(th)), abs(math.sin(th)),
+            *_term(t, q, d, qd, vd, qdd, vdd))
+
+
+def _term_bounds(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float,
+                 u: _Uncertainty, orders: tuple[int, ...] = (0, 1, 2)) -> list[tuple[float, float]]:
+    """Bounds on how far one vector's computed position, velocity and acceleration
+    (:func:`_term`), each as (x, y), may be from their exact values at the exact inputs:
+    see :func:`_bounds_of`."""
+    return _bounds_of(_static(t, q, d, qd, vd, qdd, vdd), u, orders)
+
+
+def _bounds_of(s: tuple[Any, ...], u: _Uncertainty, orders: tuple[int, ...]) -> list[tuple[float, float]]:
+    """:func:`_term_bounds` from the vector's :func:`_static` values: rounding in evaluating
+    it, plus the inputs' uncertainties propagated exactly (the products by |x y - x' y'| <=
+    |x| |dy| + |y| |dx| + |dx| |dy|, the angle by :func:`_parts_bounds`)."""
+    li, lc, ai, ac, off, r, th, r1, w, r2, al, co, si = s[:13]
     ar, aw, ar1 = abs(r), abs(w), abs(r1)
     dr = _unc(li, lc, u.eq, u.ed)
     # the angle: its uncertainty, the offset's decimal value, and the sum's rounding
     dth = _unc(ai, ac, u.eq, u.ed) + EPS * (abs(off) + abs(th))
     dr1, dw = _dunc(li, u.ev, u.evd), _dunc(ai, u.ev, u.evd)
-    co, si = abs(math.cos(th)), abs(math.sin(th))
     out = []
     for order in orders:
         if order == 0:
@@ -185,19 +198,19 @@ def _term_bounds(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: fl
     return out
 
 
-def _loop_residuals(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float,
-                    u: _Uncertainty, order: int) -> list[float]:
+def _loop_residuals(data: list[list[tuple[Any, ...]]], u: _Uncertainty, order: int) -> list[float]:
     """Per equation row (x then y of each loop): a bound on the exact residual of the
     loop's position (``order`` 0), velocity (1) or acceleration (2) equation at the
-    exact inputs, for the computed values: |computed residual| plus its bound."""
+    exact inputs, for the computed values: |computed residual| plus its bound. ``data``:
+    each loop's vectors' :func:`_static` values."""
     out: list[float] = []
-    for terms in model.terms:
+    for terms in data:
         total = 0j
         bx = by = 0.0
         sx = sy = 0.0
-        for t in terms:
-            z = _term(t, q, d, qd, vd, qdd, vdd)[order]
-            ex, ey = _term_bounds(t, q, d, qd, vd, qdd, vdd, u, (order,))[0]
+        for s in terms:
+            z = s[13 + order]
+            ex, ey = _bounds_of(s, u, (order,))[0]
             total += z
             bx, by = bx + ex, by + ey
             sx, sy = sx + abs(z.real), sy + abs(z.imag)
@@ -207,18 +220,15 @@ def _loop_residuals(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd:
     return out
 
 
-def _jacobian_spread(model: LoopModel, q: Any, d: float, u: _Uncertainty) -> list[list[float]]:
+def _jacobian_spread(data: list[list[tuple[Any, ...]]], n: int, u: _Uncertainty) -> list[list[float]]:
     """|J(exact) - J(computed)| entry by entry, from the position's uncertainty: column j
     of an angle is sum sign i r e^(i theta), of a length sum sign e^(i theta)."""
-    n = model.n
     rows: list[list[float]] = []
-    for terms in model.terms:
+    for terms in data:
         row_x, row_y = [0.0] * n, [0.0] * n
-        for _sign, lc, li, ac, ai, off in terms:
-            r, th = _value(li, lc, q, d), _value(ai, ac, q, d) + off
+        for li, lc, ai, ac, off, r, th, _r1, _w, _r2, _al, co, si, *_ in terms:
             dr = _unc(li, lc, u.eq, u.ed)
             dth = _unc(ai, ac, u.eq, u.ed) + EPS * (abs(off) + abs(th))
-            co, si = abs(math.cos(th)), abs(math.sin(th))
             if ai >= 0:
                 ex, ey = _parts_bounds(complex(0.0, r), dr, EPS * abs(r), co, si, dth)
                 row_x[ai] += ex
@@ -381,14 +391,15 @@ def rate_bounds(model: LoopModel, q: Any, d: float, speed: float, accel: float, 
     ed = 2.0 * EPS * abs(d)  # the driver: a decimal value, then degrees to radians
     zero = [0.0] * n
     u0 = _Uncertainty(zero, zero, zero, ed, EPS * abs(speed), EPS * abs(accel))
-    g = _loop_residuals(model, q, d, qd, speed, qdd, accel, u0, 0)
-    guess = _through_inverse(inv, _jacobian_spread(model, q, d, u0), g)
+    data = [[_static(t, q, d, qd, speed, qdd, accel) for t in terms] for terms in model.terms]
+    g = _loop_residuals(data, u0, 0)
+    guess = _through_inverse(inv, _jacobian_spread(data, n, u0), g)
     if guess is None:
         return None
     eq: list[float] | None = None
     for _ in range(6):
         trial = [1.25 * x + EPS * abs(v) for x, v in zip(guess, q)]
-        spread = _jacobian_spread(model, q, d, _Uncertainty(trial, zero, zero, ed, 0.0, 0.0))
+        spread = _jacobian_spread(data, n, _Uncertainty(trial, zero, zero, ed, 0.0, 0.0))
         got = _through_inverse(inv, spread, g)
         if got is None:
             return None
@@ -399,11 +410,11 @@ def rate_bounds(model: LoopModel, q: Any, d: float, speed: float, accel: float, 
     if eq is None:
         return None
     uq = _Uncertainty(eq, zero, zero, ed, u0.evd, u0.evdd)
-    ev = _through_inverse(inv, spread, _loop_residuals(model, q, d, qd, speed, qdd, accel, uq, 1))
+    ev = _through_inverse(inv, spread, _loop_residuals(data, uq, 1))
     if ev is None:
         return None
     uv = _Uncertainty(eq, ev, zero, ed, u0.evd, u0.evdd)
-    ea = _through_inverse(inv, spread, _loop_residuals(model, q, d, qd, speed, qdd, accel, uv, 2))
+    ea = _through_inverse(inv, spread, _loop_residuals(data, uv, 2))
     if ea is None:
         return None
     return RateBounds(eq, ev, ea, _Uncertainty(eq, ev, ea, ed, u0.evd, u0.evdd))
