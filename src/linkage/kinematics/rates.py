@@ -178,8 +178,9 @@ def _bounds_of(s: tuple[Any, ...], u: _Uncertainty, orders: tuple[int, ...]) -> 
     li, lc, ai, ac, off, r, th, r1, w, r2, al, co, si = s[:13]
     ar, aw, ar1 = abs(r), abs(w), abs(r1)
     dr = _unc(li, lc, u.eq, u.ed)
-    # the angle: its uncertainty, the offset's decimal value, and the sum's rounding
-    dth = _unc(ai, ac, u.eq, u.ed) + EPS * (abs(off) + abs(th))
+    # the angle: its uncertainty, and with an offset the offset's decimal value and the
+    # sum's rounding (half an ulp each)
+    dth = _unc(ai, ac, u.eq, u.ed) + (0.5 * EPS * (abs(off) + abs(th)) if off else 0.0)
     dr1, dw = _dunc(li, u.ev, u.evd), _dunc(ai, u.ev, u.evd)
     out = []
     for order in orders:
@@ -214,8 +215,8 @@ def _loop_residuals(data: list[list[tuple[Any, ...]]], u: _Uncertainty, order: i
             total += z
             bx, by = bx + ex, by + ey
             sx, sy = sx + abs(z.real), sy + abs(z.imag)
-        # the sum's own rounding: each addition within an ulp of the partial sums
-        k = len(terms) * EPS
+        # the sum's own rounding: each addition within half an ulp of its partial sum
+        k = 0.5 * (len(terms) - 1) * EPS
         out += [abs(total.real) + bx + k * sx, abs(total.imag) + by + k * sy]
     return out
 
@@ -228,7 +229,7 @@ def _jacobian_spread(data: list[list[tuple[Any, ...]]], n: int, u: _Uncertainty)
         row_x, row_y = [0.0] * n, [0.0] * n
         for li, lc, ai, ac, off, r, th, _r1, _w, _r2, _al, co, si, *_ in terms:
             dr = _unc(li, lc, u.eq, u.ed)
-            dth = _unc(ai, ac, u.eq, u.ed) + EPS * (abs(off) + abs(th))
+            dth = _unc(ai, ac, u.eq, u.ed) + (0.5 * EPS * (abs(off) + abs(th)) if off else 0.0)
             if ai >= 0:
                 ex, ey = _parts_bounds(complex(0.0, r), dr, EPS * abs(r), co, si, dth)
                 row_x[ai] += ex
