@@ -163,16 +163,10 @@ def _static(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float) 
             *_term(t, q, d, qd, vd, qdd, vdd))
 
 
-def _term_bounds(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float,
-                 u: _Uncertainty, orders: tuple[int, ...] = (0, 1, 2)) -> list[tuple[float, float]]:
-    """Bounds on how far one vector's computed position, velocity and acceleration
-    (:func:`_term`), each as (x, y), may be from their exact values at the exact inputs:
-    see :func:`_bounds_of`."""
-    return _bounds_of(_static(t, q, d, qd, vd, qdd, vdd), u, orders)
-
-
 def _bounds_of(s: tuple[Any, ...], u: _Uncertainty, orders: tuple[int, ...]) -> list[tuple[float, float]]:
-    """:func:`_term_bounds` from the vector's :func:`_static` values: rounding in evaluating
+    """Bounds on how far one vector's computed position, velocity and acceleration
+    (:func:`_term`), each as (x, y), may be from their exact values at the exact inputs,
+    for the requested ``orders``, from its :func:`_static` values: rounding in evaluating
     it, plus the inputs' uncertainties propagated exactly (the products by |x y - x' y'| <=
     |x| |dy| + |y| |dx| + |dx| |dy|, the angle by :func:`_parts_bounds`)."""
     li, lc, ai, ac, off, r, th, r1, w, r2, al, co, si = s[:13]
@@ -437,11 +431,12 @@ def _place(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd
     qdd = qdd if qdd is not None else [0.0] * n
     placed: dict[str, tuple[complex, complex, complex, float, float]] = {}
 
-    def bounds(t: Any) -> tuple[float, float]:
+    def part(t: Any) -> tuple[tuple[complex, complex, complex], tuple[float, float]]:
         if unc is None:
-            return 0.0, 0.0
-        bv, ba = _term_bounds(t, q, d, qd, vd, qdd, vdd, unc, (1, 2))
-        return max(bv), max(ba)
+            return _term(t, q, d, qd, vd, qdd, vdd), (0.0, 0.0)
+        st = _static(t, q, d, qd, vd, qdd, vdd)
+        bv, ba = _bounds_of(st, unc, (1, 2))
+        return st[13:16], (max(bv), max(ba))
 
     def add(start: tuple[complex, complex, complex, float, float], parts: Any, sign: float
             ) -> tuple[complex, complex, complex, float, float]:
@@ -458,7 +453,7 @@ def _place(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd
         names = loop.joints
         start = placed.get(names[0]) if names and names[0] else None
         origin = start if start is not None else origin0
-        parts = [(_term(t, q, d, qd, vd, qdd, vdd), bounds(t)) for t in terms]
+        parts = [part(t) for t in terms]
         moving = [t[2] != FIXED or t[4] != FIXED for t in terms]
         for k in range(len(terms)):
             if not names or not names[k] or names[k] in placed:
@@ -472,7 +467,7 @@ def _place(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd
                                    1.0 if ahead else -1.0)
     for name, (origin_name, terms) in model.point_terms.items():
         start = placed.get(origin_name, origin0)
-        placed[name] = add(start, [(_term(t, q, d, qd, vd, qdd, vdd), bounds(t)) for t in terms], 1.0)
+        placed[name] = add(start, [part(t) for t in terms], 1.0)
     return placed
 
 
