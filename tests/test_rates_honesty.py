@@ -374,3 +374,15 @@ def test_table_and_plot_show_no_bare_number_where_rates_are_undefined(cli, tmp_p
     for label, ys in series.items():
         if label.startswith(("ds/dt", "d2s/dt2", "dtheta3/dt", "d2theta3/dt2")):
             assert math.isnan(ys[2]) and not math.isnan(ys[0]), label  # the line breaks at 90 deg only
+
+
+def test_parallelogram_sweep_lists_its_crossings_as_toggles(tmp_path):
+    """The antiparallelogram branch meets the parallelogram at 0 and 180 deg, where det J
+    touches zero without changing sign on the followed branch: toggles, located to 1e-6."""
+    text = ME581.read_text().replace("r1 = { value = 90", "r1 = { value = 60").replace(
+        "r4 = { value = 45", "r4 = { value = 30")
+    f = tmp_path / "parallelogram.toml"
+    f.write_text(text)
+    r = linkage.sweep(load_mechanism(f), [-10.0 + 5 * k for k in range(73)])
+    assert len(r.toggles) == 2
+    assert abs(r.toggles[0]) < 1e-6 and abs(r.toggles[1] - 180.0) < 1e-6

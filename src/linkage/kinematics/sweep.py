@@ -805,8 +805,14 @@ def _touch_det(solver: _Solver, a: Position, b: Position, c: Position) -> float 
         if v not in cache:
             # from the nearer end, where J is regular (not from b: J may be singular there)
             v0, q0 = min(ends, key=lambda e: abs(e[0] - v))
-            p, r = solver.solve(v, _predict(solver, v0, q0, v) or q0)
-            cache[v] = hadamard_ratio(p.J(list(r.x))) if r.converged else math.inf
+            # damped: next to a singular J the textbook step can jump to another assembly
+            p, r = solver.solve(v, _predict(solver, v0, q0, v) or q0, damped=True)
+            x = list(r.x)
+            # there Newton converges only linearly and may stop at max_iter short of tol:
+            # its last iterate still places the minimum when it nearly closes the loops
+            close = r.converged or (all(map(math.isfinite, x)) and
+                                    max_abs(p.F(x)) <= 1e-6 * solver.m.length_scale)
+            cache[v] = hadamard_ratio(p.J(x)) if close else math.inf
         return cache[v]
 
     lo, hi = a.input, c.input
