@@ -378,7 +378,8 @@ def rate_bounds(model: LoopModel, q: Any, d: float, speed: float, accel: float, 
     linear: J(q*) (q' - q'*) is the velocity residual at (q*, q'), bounded by the
     computed residual at (q, q') plus its rounding plus its change from q to q*; the same
     for the acceleration, whose right-hand side holds the velocities, with their bound.
-    First order in nothing: each change is bounded exactly (chords, products)."""
+    No step is a first-order estimate: each change is bounded whole (chords of
+    e^(i theta), products), and the rounding model allows an ulp or more per operation."""
     n = model.n
     inv = _abs_inverse(jac)
     if inv is None:
