@@ -490,16 +490,11 @@ def _largest(parts: Sequence[np.ndarray]) -> np.ndarray:
     return out
 
 
-def _on_branch(m: Mechanism, shown: np.ndarray, names: Sequence[str], det: np.ndarray,
-               target: str | None) -> np.ndarray:
-    """True where a solution lies on the target branch: the closed form's rule
-    (closed_form.branch_rule) over arrays, else the sign of det J."""
-    return _on_branch_columns(m, [shown[:, j] for j in range(len(names))], names, det, target)
-
-
 def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence[str], det: np.ndarray,
                        target: str | None) -> np.ndarray:
-    """:func:`_on_branch` with the solution given as one array per unknown."""
+    """True where a solution (one array per unknown, display units) lies on the target
+    branch: the closed form's configuration rule over arrays (the numpy twins of
+    closed_form.branch_rule, from problems/assembly.py), else the sign of det J."""
     if target is None:
         return np.ones(len(det), dtype=bool)
     idx = {n: j for j, n in enumerate(names)}
