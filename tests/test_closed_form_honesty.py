@@ -266,6 +266,23 @@ def test_branch_open_picks_the_same_assembly_in_both_files(cli):
     assert abs(doc4["solution"]["theta3"] - sol2["theta3"]) < 1e-9
 
 
+def test_both_rocker_driven_assemblies_of_one_label_are_selectable(cli):
+    """At the ME581's own theta4 both assemblies are open: `--branch open` starts from the
+    one with sin(theta3 - theta2) < 0 (theta2 = 65 deg), `--branch "open (mirror)"` from
+    the other; `--branch crossed` names the assemblies there."""
+    path = str(SAMPLES / "fourbar_me581_theta4.toml")
+    plain = json.loads(cli("solve", path, "--branch", "open", "--format", "json").out)
+    mirror = json.loads(cli("solve", path, "--branch", "open" + MIRROR, "--format", "json").out)
+    assert plain["branch"] == mirror["branch"] == "open"
+    assert abs(plain["solution"]["theta2"] - 65.0) < 1e-9
+    assert abs(mirror["solution"]["theta2"] - 65.0) > 1.0
+    for doc in (plain, mirror):
+        t3 = math.radians(doc["solution"]["theta3"])
+        assert math.sin(math.radians(114.827770616) - t3) > 0
+    run = cli("solve", path, "--branch", "crossed")
+    assert run.code == 2 and "assemblies: open, open (mirror)" in run.err
+
+
 @pytest.mark.parametrize("branch", ["open", "crossed"])
 def test_rocker_driven_sweeps_label_each_position_by_its_configuration(branch):
     """Every solved position of a rocker-driven sweep carries the label of its own
@@ -455,7 +472,7 @@ def test_the_branch_rule_twins_are_their_scalar_rules():
     from linkage.kinematics.batch import _on_branch_columns
     from linkage.problems.closed_form import branch_rule
 
-    for name in ("fourbar_me581.toml", "fourbar_me581_theta4.toml", "slider_crank.toml"):
+    for name in ("fourbar_me581.toml", "fourbar_me581_theta4.toml", "slider_crank.toml", "crank_rocker.toml"):
         m = load(SAMPLES / name)
         names = [u.name for u in m.unknowns]
         cols = [np.degrees(rng.uniform(-np.pi, np.pi, 400)) if u.kind == "angle" else rng.uniform(-9, 9, 400)
@@ -463,7 +480,7 @@ def test_the_branch_rule_twins_are_their_scalar_rules():
         rule = branch_rule(m)
         scalar = np.array([rule({n: float(c[i]) for n, c in zip(names, cols)}) == "open" for i in range(400)])
         vector = _on_branch_columns(m, cols, names, np.ones(400), "open")
-        assert (scalar == vector).mean() > 0.995  # an ulp apart only at the boundary
+        assert (scalar == vector).all(), name
 
 
 def test_the_transmission_angle_twin_is_its_scalar_rule():
