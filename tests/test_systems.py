@@ -322,20 +322,24 @@ def test_rocker_driven_fourbar_keeps_both_assemblies_and_labels_each_position():
     """Driven by theta4, the two assemblies are mirror images of A across O2-B, and
     sin(theta4 - theta3) can have the same sign on both (theta4 = 189 deg here): the
     closed form once labelled both "crossed" and lost one, and the sweep labelled every
-    position with the file's own theta4."""
+    position with the file's own theta4. (Issue 18 changed the label to the
+    configuration rule whatever the driver: both keep distinct keys, the second
+    "crossed (mirror)", and each sweep position carries its own configuration's label.)"""
     import math
 
     from linkage.kinematics.sweep import sweep
     from linkage.problems.closed_form import fourbar_positions
 
     sols = fourbar_positions(90.0, 20.0, 60.0, 45.0, 0.0, theta4=math.radians(189.0))
-    assert set(sols) == {"open", "crossed"}
-    assert all(math.sin(s["theta3"] - s["theta2"]) < 0 for b, s in sols.items() if b == "open")
+    assert set(sols) == {"crossed", "crossed (mirror)"}
+    assert sols["crossed"]["theta2"] != sols["crossed (mirror)"]["theta2"]
+    assert all(math.sin(s["theta4"] - s["theta3"]) < 0 for s in sols.values())
+    assert math.sin(sols["crossed"]["theta3"] - sols["crossed"]["theta2"]) < 0
     m = load_mechanism(SAMPLES / "fourbar_me581_theta4.toml").with_values({"r2": 20.0}, {})
     for branch in ("open", "crossed"):
         result = sweep(m, [float(v) for v in range(0, 360, 3)], branch=branch)
         solved = [p for p in result.positions if p.solution]
         assert solved and all(p.branch == branch for p in solved)
         for p in solved:
-            side = math.sin(math.radians(p.solution["theta3"] - p.solution["theta2"]))
-            assert (side < 0) == (branch == "open"), p
+            side = math.sin(math.radians(p.input - p.solution["theta3"]))
+            assert (side > 0) == (branch == "open"), p

@@ -365,23 +365,16 @@ def cold_start(repeats: int = 5, extra: dict[str, list[str]] | None = None) -> d
 
 def numpy_fourbar(theta2_deg: Any, r1: float, r2: float, r3: float, r4: float) -> Any:
     """Open-branch theta3, theta4 (deg) of a four-bar at every theta2, vectorised in numpy
-    (circle intersection): the baseline of the batch engine."""
+    (the closed form's numpy twin, :func:`~linkage.problems.assembly.fourbar_by_crank_np`):
+    the baseline of the batch engine."""
     import numpy as np
 
-    t2 = np.radians(theta2_deg)
-    ax, ay = r2 * np.cos(t2), r2 * np.sin(t2)
-    dx, dy = ax - r1, ay
-    d = np.hypot(dx, dy)
-    a = (r4 * r4 - r3 * r3 + d * d) / (2.0 * d)
-    h = np.sqrt(r4 * r4 - a * a)
-    ux, uy = dx / d, dy / d
-    bx, by = r1 + a * ux - h * uy, a * uy + h * ux
-    t3 = np.degrees(np.arctan2(by - ay, bx - ax))
-    t4 = np.degrees(np.arctan2(by, bx - r1))
-    open_side = np.sin(np.radians(t4 - t3)) > 0
-    bx2, by2 = r1 + a * ux + h * uy, a * uy - h * ux
-    t3 = np.where(open_side, t3, np.degrees(np.arctan2(by2 - ay, bx2 - ax)))
-    t4 = np.where(open_side, t4, np.degrees(np.arctan2(by2, bx2 - r1)))
+    from .problems.assembly import fourbar_by_crank_np, is_open_np
+
+    (first, second), _ = fourbar_by_crank_np(r1, r2, r3, r4, 0.0, np.radians(theta2_deg))
+    open_side = is_open_np(*first)
+    t3 = np.degrees(np.where(open_side, first[0], second[0]))
+    t4 = np.degrees(np.where(open_side, first[1], second[1]))
     return np.stack((t3, t4), axis=1)
 
 

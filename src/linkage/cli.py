@@ -424,8 +424,11 @@ def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol:
 
 
 def _start_on_branch(mechanism: Any, branch: str, guessed: bool) -> Any:
-    """The mechanism with its guess replaced by the closed form's solution on ``branch``."""
-    if branch not in ("open", "crossed"):
+    """The mechanism with its guess replaced by the closed form's solution on ``branch``
+    (a rocker-driven four-bar's second assembly of one label: "open (mirror)")."""
+    from .problems.closed_form import MIRROR
+
+    if branch.removesuffix(MIRROR) not in ("open", "crossed"):
         raise InputError(f"--branch must be open or crossed, got {branch!r}")
     if guessed:
         raise InputError("give --branch or --guess, not both")

@@ -26,6 +26,7 @@ import numpy as np
 
 from .errors import InputError, ParseError
 from .kinematics.designs import CONVERGED, DesignSolutions, engine_for, solve_designs
+from .problems.closed_form import grashof_np, transmission_np
 from .problems.loops import ANGLE_UNITS, Mechanism
 
 MAX_DESIGNS = 10_000_000
@@ -226,7 +227,7 @@ def design_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray, sol:
         if m.closed_form == "fourbar":
             out["grashof"] = grashof_class(*(_param(m, names, designs, k) for k in ("r1", "r2", "r3", "r4")))
             t3, t4 = (_angle_deg(m, sol, k) for k in ("theta3", "theta4"))
-            mu = np.abs((t4 - t3 + 180.0) % 360.0 - 180.0)
+            mu = transmission_np(t3, t4)
             folded = np.where(mu > 90.0, 180.0 - mu, mu)
             out["min_transmission_deg"], out["max_transmission_deg"] = _extent(folded, solved)
         for p in m.points:
@@ -259,21 +260,9 @@ def _angle_deg(m: Mechanism, sol: DesignSolutions, key: str) -> np.ndarray:
     return np.broadcast_to(shown[None, :], sol.status.shape)
 
 
-GRASHOF_CLASSES = ("double crank", "crank-rocker", "double rocker", "rocker-crank")
-
-
-def grashof_class(r1: np.ndarray, r2: np.ndarray, r3: np.ndarray, r4: np.ndarray) -> np.ndarray:
-    """The Grashof class of each four-bar (r1 ground, r2 input, r3 coupler, r4 output), as
-    :func:`~linkage.problems.closed_form.fourbar_class` names it, without its "Grashof"."""
-    links = np.stack([r1, r2, r3, r4], axis=1)
-    s, longest = links.min(axis=1), links.max(axis=1)
-    p_q = links.sum(axis=1) - s - longest
-    total = s + longest
-    # math.isclose(total, p_q, rel_tol=1e-12)
-    change = np.abs(total - p_q) <= 1e-12 * np.maximum(np.abs(total), np.abs(p_q))
-    kinds = np.array(GRASHOF_CLASSES, dtype=object)[np.argmin(links, axis=1)]
-    out = np.where(change, "change point", np.where(total > p_q, "triple rocker", kinds))
-    return out.astype(object)
+grashof_class = grashof_np
+"""The Grashof class of each four-bar (r1 ground, r2 input, r3 coupler, r4 output): the
+numpy twin of :func:`~linkage.problems.closed_form.grashof`."""
 
 
 # --- running the chunks -------------------------------------------------------------------------

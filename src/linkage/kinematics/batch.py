@@ -24,7 +24,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ..problems.closed_form import wrap_degrees
+from ..problems.assembly import is_open_np, rocker_angle_np, slider_is_open_np
+from ..problems.closed_form import transmission
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel, Mechanism
 from .sweep import (
     MAX_POSITIONS,
@@ -107,7 +108,7 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
 def _transmission_of(c: SweepResult, sol: dict[str, float] | None) -> float | None:
     if not c.classification or sol is None or "theta3" not in sol or "theta4" not in sol:
         return None
-    return abs(wrap_degrees(sol["theta4"] - sol["theta3"]))
+    return transmission(sol["theta3"], sol["theta4"])
 
 
 class VectorLoops:
@@ -317,7 +318,11 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
                     break
         if pos is None or pos.status != "converged":
             others = [rough.positions[c].status for c in near if rough.positions[c].status != "converged"]
-            if len(set(others)) > 1 and not have_closed:
+            closed = solver.problem(v).reference() if have_closed else None
+            if closed is not None and (closed == {} or target not in closed):
+                # as the one-at-a-time sweep: no assembly at all, or none with the label
+                status[i] = code["no_solution" if closed == {} else "off_branch"]
+            elif len(set(others)) > 1 and not have_closed:
                 # a boundary between two kinds of gap falls in this coarse interval
                 anchor = next((solver_q(solver, p) for p in rough.positions if p.solution), None)
                 tries = [g for g in (anchor, tuple(u.value for u in m.unknowns)) if g is not None]
@@ -485,26 +490,24 @@ def _largest(parts: Sequence[np.ndarray]) -> np.ndarray:
     return out
 
 
-def _on_branch(m: Mechanism, shown: np.ndarray, names: Sequence[str], det: np.ndarray,
-               target: str | None) -> np.ndarray:
-    """True where a solution lies on the target branch: the closed form's rule
-    (closed_form.branch_rule) over arrays, else the sign of det J."""
-    return _on_branch_columns(m, [shown[:, j] for j in range(len(names))], names, det, target)
-
-
 def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence[str], det: np.ndarray,
                        target: str | None) -> np.ndarray:
-    """:func:`_on_branch` with the solution given as one array per unknown."""
+    """True where a solution (one array per unknown, display units) lies on the target
+    branch: the closed form's configuration rule over arrays (the numpy twins of
+    closed_form.branch_rule, from problems/assembly.py), else the sign of det J."""
     if target is None:
         return np.ones(len(det), dtype=bool)
     idx = {n: j for j, n in enumerate(names)}
+    v = {k: q.value for k, q in m.parameters.items()}
     if m.closed_form == "fourbar" and "theta3" in idx and "theta4" in idx:
-        is_open = np.sin(np.radians(cols[idx["theta4"]] - cols[idx["theta3"]])) > 0
+        is_open = is_open_np(np.radians(cols[idx["theta3"]]), np.radians(cols[idx["theta4"]]))
     elif m.closed_form == "fourbar" and "theta2" in idx and "theta3" in idx:
-        # driven by theta4: the mirror images of A across O2-B (closed_form.branch_rule)
-        is_open = np.sin(np.radians(cols[idx["theta3"]] - cols[idx["theta2"]])) < 0
+        # driven by theta4: the same configuration rule, with each solution's own theta4
+        t3 = np.radians(cols[idx["theta3"]])
+        t4 = rocker_angle_np(v["r1"], v["r2"], v["r3"], v["theta1"], np.radians(cols[idx["theta2"]]), t3)
+        is_open = is_open_np(t3, t4)
     elif m.closed_form == "slider_crank" and "theta3" in idx:
-        is_open = np.cos(np.radians(cols[idx["theta3"]])) > 0
+        is_open = slider_is_open_np(np.radians(cols[idx["theta3"]]))
     else:
         return (det > 0) == (target == "det+")
     return is_open == (target == "open")

@@ -33,9 +33,17 @@ from typing import Any
 import numpy as np
 
 from ..methods.newton_system import SINGULAR_RATIO
+from ..problems.assembly import (
+    fourbar_by_crank_np,
+    fourbar_by_rocker_np,
+    is_open_np,
+    rocker_angle_np,
+    slider_crank_np,
+    slider_is_open_np,
+)
 from ..problems.closed_form import DRIVERS, REQUIRED_NAMES
 from ..problems.loops import ANGLE_UNITS, Mechanism, VectorTerm
-from .batch import STATUS_CODES, VectorLoops, _on_branch, _solve_linear
+from .batch import STATUS_CODES, VectorLoops, _solve_linear
 
 CONVERGED, NO_SOLUTION, FAILED, OFF_BRANCH = (STATUS_CODES[k] for k in
                                               ("converged", "no_solution", "failed", "off_branch"))
@@ -155,53 +163,49 @@ def _size(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray) -> Any:
     return np.where(size > 0.0, size, 1.0)
 
 
-def _circle(center: Any, radius: Any, other: Any, distance: Any) -> tuple[Any, Any, Any]:
-    """Both points X with |X - center| = radius and |X - other| = distance, and where they
-    exist (as closed_form.circle_points, over arrays)."""
-    w = other - center
-    d = np.abs(w)
-    ok = (d > 0.0) & (d <= radius + distance) & (d >= np.abs(radius - distance))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        a = (radius * radius - distance * distance + d * d) / (2.0 * d)
-        h = np.sqrt(np.maximum(radius * radius - a * a, 0.0))
-        u = w / d
-    base = center + a * u
-    return base + h * 1j * u, base - h * 1j * u, ok
-
-
 def _closed_form_seeds(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray,
-                       branch: str) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
-    """Each unknown (internal units) on ``branch`` at every position, where the linkage
-    can be assembled at all, and where the two branches meet (a limit position: the
-    branch label of a solution there is a matter of rounding)."""
+                       branch: str) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray, np.ndarray]:
+    """Each unknown (internal units) on ``branch`` at every position, from the closed form's
+    numpy twins (:mod:`linkage.problems.assembly`); where the linkage can be assembled at
+    all; where an assembly carries that label (a rocker-driven four-bar's two may both
+    carry the other); and where the two branches meet (a limit position: the branch label
+    of a solution there is a matter of rounding). The pick is the scalar closed form's
+    (closed_form.fourbar_positions): by label, and of two rocker-driven assemblies with
+    the same label the one with sin(theta3 - theta2) < 0."""
     want_open = branch == "open"
     if m.closed_form == "slider_crank":
-        r2, r3, e = grid["r2"], grid["r3"], grid["e"]
-        v = (e - r2 * np.sin(drv)) / r3
-        ok = np.abs(v) <= 1.0
-        t3 = np.arcsin(np.clip(v, -1.0, 1.0))
-        fold = np.abs(math.pi - 2.0 * t3) <= SEED_DISTANCE
-        if not want_open:
-            t3 = math.pi - t3
-        return {"theta3": t3, "s": r2 * np.cos(drv) + r3 * np.cos(t3)}, ok, fold
+        (open_, crossed), ok = slider_crank_np(grid["r2"], grid["r3"], grid["e"], drv)
+        fold = np.abs(math.pi - 2.0 * open_[0]) <= SEED_DISTANCE
+        t3, s = open_ if want_open else crossed
+        return {"theta3": t3, "s": s}, ok, ok, fold
     r1, r2, r3, r4, t1 = (grid[k] for k in ("r1", "r2", "r3", "r4", "theta1"))
-    o4 = r1 * np.exp(1j * t1)
     if m.driver.name == "theta2":
-        a = r2 * np.exp(1j * drv)
-        b1, b2, ok = _circle(o4, r4, a, r3)
-        t3s = (np.angle(b1 - a), np.angle(b2 - a))
-        t4s = (np.angle(b1 - o4), np.angle(b2 - o4))
-        first_open = np.sin(t4s[0] - t3s[0]) > 0.0
-        pick = first_open == want_open
-        return ({"theta3": np.where(pick, t3s[0], t3s[1]), "theta4": np.where(pick, t4s[0], t4s[1])}, ok,
-                _apart(t3s) <= SEED_DISTANCE)
-    b = o4 + r4 * np.exp(1j * drv)
-    a1, a2, ok = _circle(0j, r2, b, r3)
-    t3s = (np.angle(b - a1), np.angle(b - a2))
-    first_open = np.sin(t3s[0] - np.angle(a1)) < 0.0  # closed_form.branch_rule, theta4 driving
-    pick = first_open == want_open
-    return ({"theta2": np.where(pick, np.angle(a1), np.angle(a2)),
-             "theta3": np.where(pick, t3s[0], t3s[1])}, ok, _apart(t3s) <= SEED_DISTANCE)
+        (first, second), ok = fourbar_by_crank_np(r1, r2, r3, r4, t1, drv)
+        pick = is_open_np(*first) == want_open
+        fold = _apart((first[0], second[0])) <= SEED_DISTANCE
+        return ({"theta3": np.where(pick, first[0], second[0]),
+                 "theta4": np.where(pick, first[1], second[1])}, ok, ok, fold)
+    (first, second), ok = fourbar_by_rocker_np(r1, r2, r3, r4, t1, drv)
+    has_1, has_2 = (is_open_np(t3, drv) == want_open for _, t3 in (first, second))
+    plain_1 = np.sin(first[1] - first[0]) < 0.0
+    pick = np.where(has_1 & has_2, plain_1, has_1)
+    return ({"theta2": np.where(pick, first[0], second[0]), "theta3": np.where(pick, first[1], second[1])},
+            ok, has_1 | has_2, _apart((first[1], second[1])) <= SEED_DISTANCE)
+
+
+def _on_branch_here(m: Mechanism, grid: Mapping[str, Any], q: Sequence[np.ndarray], det: np.ndarray,
+                    branch: str) -> np.ndarray:
+    """The configuration rule of each solved position (internal units), with each design's
+    own lengths: what :func:`~linkage.problems.closed_form.branch_rule` says, over arrays."""
+    at = {u.name: c for u, c in zip(m.unknowns, q)}
+    if m.closed_form == "slider_crank":
+        is_open = slider_is_open_np(at["theta3"])
+    elif "theta4" in at:
+        is_open = is_open_np(at["theta3"], at["theta4"])
+    else:
+        t4 = rocker_angle_np(grid["r1"], grid["r2"], grid["r3"], grid["theta1"], at["theta2"], at["theta3"])
+        is_open = is_open_np(at["theta3"], t4)
+    return np.asarray(is_open == (branch == "open"))
 
 
 def _apart(angles: tuple[Any, Any]) -> Any:
@@ -213,7 +217,7 @@ def _closed_form_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np
                         tol: float, max_iter: int, n_designs: int) -> tuple[list[np.ndarray], np.ndarray,
                                                                             np.ndarray, str]:
     grid, drv = _grid(m, params, vals, n_designs)
-    seeds, feasible, fold = _closed_form_seeds(m, grid, drv, branch)
+    seeds, feasible, labelled, fold = _closed_form_seeds(m, grid, drv, branch)
     seed = [np.where(feasible, seeds[u.name], 0.0) for u in m.unknowns]
     size = _size(m, grid, drv)
     loops = VectorLoops.of_terms(_terms(m, grid, drv), len(m.unknowns), len(drv))
@@ -223,11 +227,10 @@ def _closed_form_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np
     moved = np.zeros(len(drv))
     for c, s, u in zip(q, seed, m.unknowns):
         np.maximum(moved, np.abs(c - s) / (size if u.kind == "length" else 1.0), out=moved)
-    names = [u.name for u in m.unknowns]
-    shown = np.stack([np.degrees(c) if u.kind == "angle" else c for c, u in zip(q, m.unknowns)], axis=1)
-    on_branch = _on_branch(m, shown, names, det, branch)
+    on_branch = _on_branch_here(m, grid, q, det, branch)
     status = np.where(feasible, FAILED, NO_SOLUTION).astype(np.int8)
-    status[done & (moved <= SEED_DISTANCE) & (on_branch | fold) & feasible] = CONVERGED
+    status[feasible & ~labelled & ~fold] = OFF_BRANCH
+    status[done & (moved <= SEED_DISTANCE) & (on_branch | fold) & feasible & (labelled | fold)] = CONVERGED
     return q, status, feasible, "closed form + vectorised Newton"
 
 

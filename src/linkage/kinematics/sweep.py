@@ -32,6 +32,7 @@ from ..problems.closed_form import (
     arcs_within,
     feasible_arcs,
     fourbar_class,
+    transmission,
     wrap_degrees,
 )
 from ..problems.loops import ANGLE_UNITS, Mechanism
@@ -138,7 +139,7 @@ class _Solver:
         if self.m.closed_form != "fourbar":
             return None
         if self.coupler_and_output:
-            return abs(wrap_degrees(sol["theta4"] - sol["theta3"]))
+            return transmission(sol["theta3"], sol["theta4"])
         fixed = self._fixed_deg
         if fixed is None:
             fixed = self._fixed_deg = {k: math.degrees(q.value) for k, q in self.m.parameters.items()
@@ -147,7 +148,7 @@ class _Solver:
         t4 = sol.get("theta4", fixed.get("theta4"))
         if t3 is None or t4 is None:
             return None
-        return abs(wrap_degrees(t4 - t3))
+        return transmission(t3, t4)
 
     def solve_lean(self, value: float, guess: Sequence[float]) -> tuple[Any, list[float], int] | None:
         """What :meth:`solve` does for textbook Newton, without building a problem or a
@@ -426,7 +427,11 @@ def _solve_position(solver: _Solver, v: float, last_q: tuple[float, ...] | None,
                               for n, k in zip(solver.names, solver.kinds))
                 p, r = solver.solve(v, guess)
                 if ok(p, r):
-                    return accept(p, r, note="re-entered from the closed form")
+                    return accept(p, r, note=REENTERED)
+            elif want:
+                # a rocker-driven four-bar: both assemblies here carry the other label
+                return Position(v, "off_branch", None, None, 0, None,
+                                note=f"every assembly here is {', '.join(ref)}"), None
     else:
         for guess in (anchor_q, tuple(u.value for u in solver.m.unknowns)):
             p, r = solver.solve(v, guess)
@@ -437,6 +442,9 @@ def _solve_position(solver: _Solver, v: float, last_q: tuple[float, ...] | None,
             return Position(v, "no_solution", None, None, r.iterations, None,
                             note="least squares: the loops cannot close here"), None
     return Position(v, "failed", None, None, 0, None, note="no convergence on the branch"), None
+
+
+REENTERED = "re-entered from the closed form"
 
 
 def _q_of(solver: _Solver, pos: Position | None) -> tuple[float, ...] | None:
@@ -763,6 +771,8 @@ def _toggles(solver: _Solver, positions: Sequence[Position], arcs: Any, lo: floa
     for a, b in pairs:
         if a.status == "converged" and b.status == "converged" and a.det and b.det \
                 and (a.det > 0) != (b.det > 0):
+            if REENTERED in (a.note, b.note):
+                continue  # not one assembly moving: the sweep re-entered on the other one
             found.append(_bisect_det(solver, a, b))
         elif not have_closed and (a.status == "converged") != (b.status == "converged"):
             found.append(_bisect_limit(solver, a, b))

@@ -3,12 +3,12 @@
 Four-bar (names r1..r4, theta1..theta4; loop r2 e^(i t2) + r3 e^(i t3) = r1 e^(i t1) +
 r4 e^(i t4)): with theta2 or theta4 given, the free joint lies on one circle at a
 fixed distance from a known point, so it is a circle-circle intersection with two
-solutions, labelled by assembly branch: open where sin(theta4 - theta3) > 0 (as in
-PROBLEMS.md P3), crossed where it is < 0. With theta4 driving, the two solutions are the
-mirror images of A across the line O2-B, which that sign need not tell apart; there open
-is where sin(theta3 - theta2) < 0 (det J < 0, PROBLEMS.md P3's alternative driver: the
-same label at P3's open position). No real intersection: the linkage cannot be assembled
-at that input.
+solutions, each labelled by the configuration rule whatever the driver: open where
+sin(theta4 - theta3) > 0 (as in PROBLEMS.md P3), crossed otherwise. With theta4 driving,
+the two solutions are the mirror images of A across the line O2-B and may carry the same
+label; the second is then keyed "open (mirror)" or "crossed (mirror)". No real
+intersection: the linkage cannot be assembled at that input. The formulas and the rules
+live in :mod:`linkage.problems.assembly` (scalar and numpy side by side).
 
 Slider-crank (names r2, r3, e, theta2, theta3, s; loop r2 e^(i t2) + r3 e^(i t3) =
 s + i e): sin(theta3) = (e - r2 sin(theta2)) / r3, s = r2 cos(theta2) + r3 cos(theta3);
@@ -18,10 +18,20 @@ coupler's turn), crossed otherwise.
 
 from __future__ import annotations
 
-import cmath
 import math
 from collections.abc import Callable
 from typing import Any
+
+from .assembly import (
+    fourbar_by_crank,
+    fourbar_by_rocker,
+    is_open,
+    label,
+    rocker_angle,
+    slider_crank,
+    slider_is_open,
+    triangle,
+)
 
 REQUIRED_NAMES = {
     "fourbar": ("r1", "r2", "r3", "r4", "theta1", "theta2", "theta3", "theta4"),
@@ -30,6 +40,11 @@ REQUIRED_NAMES = {
 
 Solutions = dict[str, dict[str, float]]
 
+MIRROR = " (mirror)"
+"""With theta4 driving, the two assemblies at one theta4 (mirror images of A across the
+line O2-B) can carry the same label; the second is then keyed with this suffix, so both
+stay in the dict (and reachable): e.g. "open" and "open (mirror)"."""
+
 
 class Indeterminate(ValueError):
     """Coincident circles: every point of the circle is a solution (a change point)."""
@@ -37,17 +52,17 @@ class Indeterminate(ValueError):
 
 def circle_points(center: complex, radius: float, other: complex, distance: float) -> list[complex]:
     """Points X with |X - center| = radius and |X - other| = distance (0, 1 or 2 of them);
-    raises Indeterminate when the two circles coincide."""
+    raises Indeterminate when the two circles coincide. The half-chord comes from
+    :func:`~.assembly.triangle` (no cancellation near tangency)."""
     d = abs(other - center)
     if d == 0.0:
         if radius == distance:
             raise Indeterminate("the two circles coincide")
         return []
-    if d > radius + distance or d < abs(radius - distance):
+    got = triangle(d, radius, distance)
+    if got is None:
         return []
-    a = (radius * radius - distance * distance + d * d) / (2.0 * d)
-    h2 = radius * radius - a * a
-    h = math.sqrt(max(h2, 0.0))
+    a, h = got
     u = (other - center) / d
     base = center + a * u
     return [base + h * 1j * u, base - h * 1j * u]
@@ -56,50 +71,47 @@ def circle_points(center: complex, radius: float, other: complex, distance: floa
 def fourbar_positions(r1: float, r2: float, r3: float, r4: float, theta1: float,
                       theta2: float | None = None, theta4: float | None = None) -> Solutions:
     """Both assembly branches, angles in radians; {} when it cannot be assembled.
-    Raises Indeterminate at a change point where a joint lies on the opposite pivot."""
-    o4 = r1 * cmath.exp(1j * theta1)
+    Raises Indeterminate at a change point where a joint lies on the opposite pivot.
+
+    Every solution is labelled by the configuration rule (:func:`~.assembly.is_open`),
+    whatever drives it. Driven by theta2 the two solutions always differ in label. Driven
+    by theta4 they are the mirror images of A across O2-B and may share one: the one with
+    sin(theta3 - theta2) < 0 (A on the right of O2 -> B) takes the plain label, the other
+    the label plus :data:`MIRROR`."""
     out: Solutions = {}
     if theta2 is not None:
-        a = r2 * cmath.exp(1j * theta2)
-        for b in circle_points(o4, r4, a, r3):
-            t3 = cmath.phase(b - a)
-            t4 = cmath.phase(b - o4)
-            out[_fourbar_branch(t3, t4)] = {"theta2": theta2, "theta3": t3, "theta4": t4}
-    elif theta4 is not None:
-        b = o4 + r4 * cmath.exp(1j * theta4)
-        for a in circle_points(0j, r2, b, r3):
-            t2 = cmath.phase(a)
-            t3 = cmath.phase(b - a)
-            out[_rocker_driven_branch(t2, t3)] = {"theta2": t2, "theta3": t3, "theta4": theta4}
-    else:
+        crank = fourbar_by_crank(r1, r2, r3, r4, theta1, theta2)
+        if crank is None:
+            raise Indeterminate("A lies on O4 and r3 = r4")
+        for t3, t4 in crank:
+            out.setdefault(label(is_open(t3, t4)), {"theta2": theta2, "theta3": t3, "theta4": t4})
+        return out
+    if theta4 is None:
         raise ValueError("give theta2 or theta4")
+    rocker = fourbar_by_rocker(r1, r2, r3, r4, theta1, theta4)
+    if rocker is None:
+        raise Indeterminate("B lies on O2 and r2 = r3")
+    if len(rocker) == 2 and rocker[0] == rocker[1]:
+        rocker = rocker[:1]  # tangent circles: one assembly
+    for t2, t3 in sorted(rocker, key=lambda s: math.sin(s[1] - s[0]) >= 0.0):
+        key = label(is_open(t3, theta4))
+        out[key + MIRROR if key in out else key] = {"theta2": t2, "theta3": t3, "theta4": theta4}
     return out
-
-
-def _fourbar_branch(t3: float, t4: float) -> str:
-    return "open" if math.sin(t4 - t3) > 0.0 else "crossed"
-
-
-def _rocker_driven_branch(t2: float, t3: float) -> str:
-    return "open" if math.sin(t3 - t2) < 0.0 else "crossed"
 
 
 def slider_crank_positions(r2: float, r3: float, e: float, theta2: float) -> Solutions:
-    v = (e - r2 * math.sin(theta2)) / r3
-    if abs(v) > 1.0:
-        return {}
-    out: Solutions = {}
-    for branch, t3 in (("open", math.asin(v)), ("crossed", math.pi - math.asin(v))):
-        out[branch] = {"theta3": t3, "s": r2 * math.cos(theta2) + r3 * math.cos(t3)}
-    return out
+    """Both branches (rad): open where cos(theta3) > 0; {} when it cannot be assembled."""
+    return {branch: {"theta3": t3, "s": s}
+            for branch, (t3, s) in zip(("open", "crossed"), slider_crank(r2, r3, e, theta2))}
 
 
-def reference_for(m: Any) -> Callable[[], Solutions | None]:
+def reference_for(m: Any, driver: float | None = None) -> Callable[[], Solutions | None]:
     """A function giving the closed-form solutions for a mechanism's current values,
     in display units (degrees for angles), keyed by branch, restricted to its unknowns;
-    None where the closed form is indeterminate."""
+    None where the closed form is indeterminate. ``driver``: the driver's value in
+    internal units (radians), exactly as the loops are solved at; default the file's."""
     values = {k: q.value for k, q in m.parameters.items()}
-    values[m.driver.name] = m.driver.value
+    values[m.driver.name] = m.driver.value if driver is None else driver
     unknown_names = [u.name for u in m.unknowns]
     kinds = {u.name: u.kind for u in m.unknowns}
 
@@ -133,16 +145,52 @@ def wrap_degrees(a: float) -> float:
     return w
 
 
+def transmission(t3_deg: float, t4_deg: float) -> float:
+    """The transmission angle between coupler and output link (deg, in [0, 180]):
+    |theta4 - theta3| wrapped; NaN for a non-finite angle."""
+    return abs(wrap_degrees(t4_deg - t3_deg))
+
+
+def transmission_np(t3_deg: Any, t4_deg: Any) -> Any:
+    """:func:`transmission` over arrays: the same operations as wrap_degrees."""
+    import numpy as np
+
+    w = np.fmod(np.asarray(t4_deg, float) - t3_deg, 360.0)
+    w = np.where(w <= -180.0, w + 360.0, np.where(w > 180.0, w - 360.0, w))
+    return np.abs(w)
+
+
 DRIVERS = {"fourbar": ("theta2", "theta4"), "slider_crank": ("theta2",)}
 """The driver each closed form can be given."""
+
+
+def claimed_loop(name: str, v: dict[str, float]) -> complex:
+    """The loop a closed form stands for, at the values ``v`` (internal units):
+    r2 e^(i t2) + r3 e^(i t3) - r4 e^(i t4) - r1 e^(i t1) for a four-bar,
+    r2 e^(i t2) + r3 e^(i t3) - s - i e for a slider-crank."""
+    def vec(r: float, t: float) -> complex:
+        return complex(r * math.cos(t), r * math.sin(t))
+
+    head = vec(v["r2"], v["theta2"]) + vec(v["r3"], v["theta3"])
+    if name == "fourbar":
+        return head - vec(v["r4"], v["theta4"]) - vec(v["r1"], v["theta1"])
+    return head - complex(v["s"], v["e"])
+
+
+IDENTITY_POINTS = 8
+"""Configurations at which a closed_form claim is checked as an identity."""
+_IRRATIONALS = (math.sqrt(2.0), math.sqrt(3.0), math.sqrt(5.0))
 
 
 def verify(m: Any) -> str | None:
     """Why the mechanism's loops are not the closed form it names, or None when they are.
 
-    The closed form is a claim about the loops: its solutions must close them. It is
-    checked at the file's driver value and, where that cannot be assembled, at every
-    30 degrees (a length driver: at its value only), to 1e-9 of the mechanism's size.
+    The closed form is a claim about the loops: its loop (:func:`claimed_loop`, with the
+    file's named parameters) must be the file's loop, up to its orientation (the sign of
+    the whole loop). That is checked as an identity at scattered configurations of the
+    driver and the unknowns (the same points every time: a file loads the same way), to 1e-9
+    of the loop's size, not only where the linkage assembles: a claim whose linkage
+    cannot be assembled where the file's can is refused.
     """
     name = m.closed_form
     drivers = DRIVERS[name]
@@ -154,69 +202,108 @@ def verify(m: Any) -> str | None:
     if unknowns != expected:
         return (f"{name} solves for {', '.join(sorted(expected))}; the file's unknowns are "
                 f"{', '.join(sorted(unknowns))}")
-    from .loops import ANGLE_UNITS
-
+    if len(m.loops) != 1:
+        return f"{name} is one loop; the file has {len(m.loops)}"
+    values = {k: q.value for k, q in m.parameters.items()}
+    size = max([abs(values[k]) for k in ("r1", "r2", "r3", "r4", "e") if k in values] + [m.length_scale])
     model = m.model
-    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-    shown0 = m.driver.value / scale
-    tries = [shown0] + ([shown0 + 30.0 * k for k in range(1, 12)] if m.driver.kind == "angle" else [])
-    limit = 1e-9 * m.length_scale
-    for shown in tries:
+    sign = 0.0
+    worst, where = 0.0, ""
+    for k in range(1, IDENTITY_POINTS + 1):
+        # scattered, reproducible points: k times an irrational per coordinate, mod 1
+        u0, u1, u2 = ((k * a) % 1.0 * 2.0 - 1.0 for a in _IRRATIONALS)
+        point = dict(values)
+        point[m.driver.name] = math.pi * u0
+        q = [math.pi * c if u.kind == "angle" else 2.0 * size * c for u, c in zip(m.unknowns, (u1, u2))]
+        point.update({u.name: x for u, x in zip(m.unknowns, q)})
         try:
-            sols = reference_for(m.with_values({m.driver.name: shown}, {}))()
+            fx, fy = model.functions(point[m.driver.name])[0](q)
+            claim = claimed_loop(name, point)
         except (ArithmeticError, ValueError, KeyError) as exc:
             return f"the closed form cannot be evaluated: {exc}"
-        if not sols:
-            continue
-        F = model.functions(shown * scale)[0]
-        for branch, sol in sols.items():
-            q = [math.radians(sol[u.name]) if u.kind == "angle" else sol[u.name] for u in m.unknowns]
-            worst = max(abs(v) for v in F(q))
-            if not worst <= limit:
-                return (f"its {branch} solution at {m.driver.name} = {shown:g} leaves the loops open by "
-                        f"{worst:.3g} {m.length_unit}: the loops are not that mechanism")
-        return None
+        got = complex(fx, fy)
+        if sign == 0.0:
+            sign = 1.0 if abs(got - claim) <= abs(got + claim) else -1.0
+        gap = abs(got - sign * claim)
+        if not gap <= worst:  # NaN included
+            worst = gap
+            where = ", ".join(f"{k} = {math.degrees(point[k]) if k.startswith('theta') else point[k]:.6g}"
+                              for k in (m.driver.name, *(u.name for u in m.unknowns)))
+    if not worst <= 1e-9 * size:
+        return (f"its loop differs from the file's by {worst:.3g} {m.length_unit} at scattered positions "
+                f"(e.g. {where}): the loops are not that mechanism")
     return None
 
 
 def branch_rule(m: Any) -> Callable[[dict[str, float]], str]:
-    """The branch label of a solution given in display units (degrees)."""
+    """The branch label of a solution given in display units (degrees): the configuration
+    rule (:func:`~.assembly.is_open`, :func:`~.assembly.slider_is_open`) whatever the
+    driver. A rocker-driven file's solution is labelled by its own theta3 and theta4."""
     values = {k: q.value for k, q in m.parameters.items()}
 
     if m.closed_form == "fourbar" and m.driver.name == "theta4":
         def rocker_driven(sol: dict[str, float]) -> str:
-            return _rocker_driven_branch(math.radians(sol["theta2"]), math.radians(sol["theta3"]))
+            t2, t3 = math.radians(sol["theta2"]), math.radians(sol["theta3"])
+            t4 = rocker_angle(values["r1"], values["r2"], values["r3"], values["theta1"], t2, t3)
+            return label(is_open(t3, t4))
         return rocker_driven
 
     if m.closed_form == "fourbar":
         def fourbar(sol: dict[str, float]) -> str:
             t3 = math.radians(sol["theta3"]) if "theta3" in sol else values["theta3"]
-            t4 = math.radians(sol["theta4"]) if "theta4" in sol else (
-                m.driver.value if m.driver.name == "theta4" else values["theta4"])
-            return _fourbar_branch(t3, t4)
+            t4 = math.radians(sol["theta4"]) if "theta4" in sol else values["theta4"]
+            return label(is_open(t3, t4))
         return fourbar
 
     def slider(sol: dict[str, float]) -> str:
-        return "open" if math.cos(math.radians(sol["theta3"])) > 0.0 else "crossed"
+        return label(slider_is_open(math.radians(sol["theta3"])))
     return slider
 
 
 # --- assembly: classification and feasible driver ranges ---------------------------------
 
-def fourbar_class(r1: float, r2: float, r3: float, r4: float) -> dict[str, Any]:
-    """Grashof classification with r1 ground, r2 input, r3 coupler, r4 output (Norton 2.8)."""
-    links = {"ground": r1, "input": r2, "coupler": r3, "output": r4}
-    s_name = min(links, key=links.__getitem__)
-    s, longest = min(links.values()), max(links.values())
-    others = sorted(links.values())[1:3]
-    p_q = sum(others)
-    total = s + longest
-    if math.isclose(total, p_q, rel_tol=1e-12):
-        return {"grashof": True, "type": "change point", "s_plus_l": total, "p_plus_q": p_q}
+GRASHOF_KINDS = ("double crank", "crank-rocker", "double rocker", "rocker-crank")
+"""The Grashof kind by the shortest link: ground, input, coupler, output."""
+
+
+def grashof(r1: float, r2: float, r3: float, r4: float) -> str:
+    """The class of a four-bar (r1 ground, r2 input, r3 coupler, r4 output; Norton 2.8):
+    "change point" (s + l = p + q to 1e-12 relative), "triple rocker" (non-Grashof), or
+    the Grashof kind named by the shortest link (the first of equals)."""
+    links = (r1, r2, r3, r4)
+    ordered = sorted(links)
+    total, p_q = ordered[0] + ordered[3], ordered[1] + ordered[2]
+    if abs(total - p_q) <= 1e-12 * max(abs(total), abs(p_q)):
+        return "change point"
     if total > p_q:
+        return "triple rocker"
+    return GRASHOF_KINDS[links.index(ordered[0])]
+
+
+def grashof_np(r1: Any, r2: Any, r3: Any, r4: Any) -> Any:
+    """:func:`grashof` over arrays (an object array of class names)."""
+    import numpy as np
+
+    links = np.stack(np.broadcast_arrays(*(np.asarray(x, float) for x in (r1, r2, r3, r4))), axis=-1)
+    ordered = np.sort(links, axis=-1)
+    total, p_q = ordered[..., 0] + ordered[..., 3], ordered[..., 1] + ordered[..., 2]
+    change = np.abs(total - p_q) <= 1e-12 * np.maximum(np.abs(total), np.abs(p_q))
+    kinds = np.array(GRASHOF_KINDS, dtype=object)[np.argmin(links, axis=-1)]
+    return np.where(change, "change point", np.where(total > p_q, "triple rocker", kinds)).astype(object)
+
+
+def fourbar_class(r1: float, r2: float, r3: float, r4: float) -> dict[str, Any]:
+    """Grashof classification with r1 ground, r2 input, r3 coupler, r4 output (Norton 2.8),
+    as :func:`grashof` decides it, with the sums it compares."""
+    links = {"ground": r1, "input": r2, "coupler": r3, "output": r4}
+    ordered = sorted(links.values())
+    total, p_q = ordered[0] + ordered[3], ordered[1] + ordered[2]
+    kind = grashof(r1, r2, r3, r4)
+    if kind == "change point":
+        return {"grashof": True, "type": "change point", "s_plus_l": total, "p_plus_q": p_q}
+    if kind == "triple rocker":
         return {"grashof": False, "type": "non-Grashof triple rocker", "s_plus_l": total, "p_plus_q": p_q}
-    kind = {"ground": "double crank", "input": "crank-rocker", "coupler": "double rocker",
-            "output": "rocker-crank"}[s_name]
+    s_name = min(links, key=links.__getitem__)
     return {"grashof": True, "type": f"Grashof {kind}", "shortest": s_name, "s_plus_l": total,
             "p_plus_q": p_q}
 

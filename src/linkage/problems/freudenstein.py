@@ -20,6 +20,7 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 from ..errors import InputError
+from .assembly import is_open, label
 from .scalar import ScalarProblem
 
 DEG = math.pi / 180.0
@@ -186,6 +187,6 @@ def file_convention(alpha_deg: float, phi_deg: float,
     def wrap(v: float) -> float:
         return (v + 180.0) % 360.0 - 180.0 if (v + 180.0) % 360.0 != 0.0 else 180.0
 
-    branch = "open" if math.sin(t4 - t3) > 0.0 else "crossed"
+    branch = label(is_open(t3, t4))
     return {"theta2": wrap(alpha_deg + 180.0), "theta3": wrap(math.degrees(t3)),
             "theta4": wrap(phi_deg + 180.0), "branch": branch}

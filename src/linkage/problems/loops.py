@@ -569,8 +569,10 @@ class LoopModel:
 
             def reference() -> Any:
                 # built when read: sweeps create several problems per position and
-                # rarely ask for the closed form
-                return reference_for(m.with_values({m.driver.name: shown}, {}))()
+                # rarely ask for the closed form. At the driver value the loops are
+                # solved at, not the 12-digit one shown: near a limit the answer moves
+                # like the square root of the distance to it
+                return reference_for(m, driver)()
 
             branch_of = branch_rule(m)
         return SystemProblem(

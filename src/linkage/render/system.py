@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..analysis.convergence import Convergence
+from ..problems.closed_form import MIRROR
 from ..problems.system import SystemProblem
 from ..result import Result
 from .report import Block, Text, fmt, history_blocks
@@ -65,6 +66,7 @@ def system_extra(problem: SystemProblem, result: Result, branch: str | None) -> 
         "units": {n: problem.unit(i) for i, n in enumerate(problem.names)},
         "driver": {"name": meta.get("driver"), "value": meta.get("driver_value"),
                    "unit": meta.get("driver_unit")},
-        "branch": branch,
+        # the configuration's label; the reference key may add " (mirror)" (theta4 driving)
+        "branch": branch.removesuffix(MIRROR) if branch else branch,
         "reference": meta.get("reference"),
     }
