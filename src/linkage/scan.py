@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError, ParseError
+from .kinematics.angles import angle_extent_array, closes_circle, driver_turn
 from .kinematics.designs import CONVERGED, DesignSolutions, engine_for, solve_designs
 from .problems.loops import ANGLE_UNITS, Mechanism
 
@@ -219,10 +220,18 @@ def design_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray, sol:
     out["feasible_fraction"] = sol.feasible.mean(axis=1) if n_pos else np.zeros(n_designs)
     out["solved_fraction"] = solved.mean(axis=1) if n_pos else np.zeros(n_designs)
     out["full_cycle"] = solved.all(axis=1) & (n_pos > 0)
+    # angles by the range rule of kinematics.angles (continuous around the circle, a full
+    # turn at most); lengths from their extremes
+    closes = m.driver.kind == "angle" and closes_circle([float(v) for v in sol.values],
+                                                        driver_turn(m.driver.unit))
     with np.errstate(invalid="ignore"):
         for j, u in enumerate(m.unknowns):
-            lo, hi = _extent(sol.solution[:, :, j], solved)
-            out[f"{u.name}_min"], out[f"{u.name}_max"], out[f"{u.name}_range"] = lo, hi, hi - lo
+            if u.kind == "angle":
+                lo, hi, span = angle_extent_array(np.where(solved, sol.solution[:, :, j], np.nan), closes)
+            else:
+                lo, hi = _extent(sol.solution[:, :, j], solved)
+                span = hi - lo
+            out[f"{u.name}_min"], out[f"{u.name}_max"], out[f"{u.name}_range"] = lo, hi, span
         if m.closed_form == "fourbar":
             out["grashof"] = grashof_class(*(_param(m, names, designs, k) for k in ("r1", "r2", "r3", "r4")))
             t3, t4 = (_angle_deg(m, sol, k) for k in ("theta3", "theta4"))
