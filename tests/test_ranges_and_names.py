@@ -254,3 +254,61 @@ def test_unwrapped_values_are_continuous_and_whole_turns_from_the_solved(values,
         assert -180.0 - 1e-9 <= b - a <= 180.0 + 1e-9
     if read:
         assert -180.0 - 1e-9 <= read[0] <= 180.0 + 1e-9
+
+
+# --- the finding: name clashes corrupt scan records ---------------------------------------------------
+
+def with_parameter(name: str, unit: str = "mm") -> str:
+    """The crank-rocker file with one more parameter, called ``name``."""
+    text = CRANK.read_text()
+    extra = f'{name} = {{ value = 5, unit = "{unit}" }}\n'
+    return text.replace("r2 = { value = 40", extra + "r2 = { value = 40", 1)
+
+
+def unknown_beside_point() -> str:
+    """The crank-rocker file without its closed form, its coupler angle renamed P_x: the
+    unknown's columns P_x_min/P_x_max (deg) and point P's P_x_min/P_x_max (mm)."""
+    text = CRANK.read_text().replace('closed_form = "fourbar"\n', "")
+    return text.replace("theta3 = { guess", "P_x = { guess").replace('angle = "theta3"', 'angle = "P_x"')
+
+
+@pytest.mark.parametrize("text,clash", [
+    (with_parameter("design"), "'design'"),
+    (with_parameter("full_cycle"), "'full_cycle'"),
+    (with_parameter("feasible_fraction"), "'feasible_fraction'"),
+    (with_parameter("theta4_range", "deg"), "'theta4_range'"),
+    (with_parameter("P_y_max"), "'P_y_max'"),
+    (with_parameter("min_transmission_deg", "deg"), "'min_transmission_deg'"),
+    (unknown_beside_point(), "'P_x_min'"),
+], ids=["design", "full_cycle", "feasible_fraction", "unknown-column", "point-column", "fourbar-column",
+        "unknown-P_x-beside-point-P"])
+def test_name_clashes_corrupt_scan_records_so_they_are_refused_at_load(cli, tmp_path, text, clash):
+    path = tmp_path / "clash.toml"
+    path.write_text(text)
+    for args in (("solve", str(path)), ("scan", str(path), "--vary", "r2=20:30:2")):
+        r = cli(*args)
+        assert r.code == 2 and r.out == ""
+        lines = r.err.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("error: ") and clash in lines[0], r.err
+    with pytest.raises(linkage.ParseError, match=clash):
+        load(path)
+
+
+def test_every_column_a_scan_writes_is_a_reserved_name(tmp_path):
+    """The reserved names are the scan's own columns (not a second list): every key of a
+    real scan's records, named as a parameter, is refused; the file as it is loads."""
+    rec = run_scan(np.array([[100.0, 40.0, 120.0, 80.0]]), "open")
+    from linkage.scan import columns_of
+
+    m = load(CRANK)
+    assert list(rec) == [c[0] for c in columns_of(m, LINKS)]
+    for key in rec:
+        if key in LINKS:
+            continue
+        path = tmp_path / f"{key}.toml"
+        path.write_text(with_parameter(key))
+        with pytest.raises(linkage.ParseError, match=f"'{key}'"):
+            load(path)
+    path = tmp_path / "fine.toml"
+    path.write_text(with_parameter("r9"))
+    assert "r9" in load(path).parameters
