@@ -9,6 +9,7 @@ equation sweep."""
 from __future__ import annotations
 
 import itertools
+import json
 import math
 from pathlib import Path
 
@@ -312,3 +313,76 @@ def test_every_column_a_scan_writes_is_a_reserved_name(tmp_path):
     path = tmp_path / "fine.toml"
     path.write_text(with_parameter("r9"))
     assert "r9" in load(path).parameters
+
+
+# --- the finding: the equation sweep ------------------------------------------------------------------
+
+def true_roots(alpha: float, r1: float, r2: float, r3: float) -> list[float]:
+    """Both roots phi (deg) of R1 cos a - R2 cos phi + R3 - cos(a - phi) = 0 to 50 digits:
+    (R2 + cos a) cos phi + sin a sin phi = R1 cos a + R3 is A cos(phi - delta) = k."""
+    mp = pytest.importorskip("mpmath")
+    with mp.workdps(50):
+        a = mp.radians(mp.mpf(alpha))
+        p, q = mp.mpf(r2) + mp.cos(a), mp.sin(a)
+        k, size = mp.mpf(r1) * mp.cos(a) + mp.mpf(r3), mp.hypot(p, q)
+        if abs(k) > size:
+            return []
+        base, spread = mp.atan2(q, p), mp.acos(k / size)
+        return [float(mp.degrees(base + s * spread)) for s in (1, -1)]
+
+
+def off_root(phi: float, roots: list[float]) -> float:
+    return min(abs((phi - r + 180.0) % 360.0 - 180.0) for r in roots)
+
+
+def test_the_equation_sweep_continues_where_solve_converges(cli):
+    """`linkage sweep --from 0 --to 3 --step 1` stopped at alpha = 2 with max_iter (Newton
+    from the tangent prediction started within rounding of the root and stepped between
+    its neighbouring floats); `solve --alpha 2` converges. Every alpha now converges, on
+    a true root, and the bare `linkage sweep` exits 0."""
+    from linkage.problems.freudenstein import SEED_R
+
+    run = cli("sweep", "--from", "0", "--to", "3", "--step", "1", "--format", "json")
+    assert run.code == 0, run.out
+    rows = json.loads(run.out)["positions"]
+    assert [r["alpha"] for r in rows] == [0, 1, 2, 3]
+    for r in rows:
+        assert r["status"].startswith("converged"), r
+        # alpha = 0 is a double root (phi = 0 exactly), determined only to sqrt(eps)
+        assert off_root(r["phi"], true_roots(r["alpha"], *SEED_R)) < (1e-7 if r["alpha"] == 0 else 1e-10)
+    full = cli("sweep", "--format", "json")
+    assert full.code == 0
+    rows = json.loads(full.out)["positions"]
+    assert len(rows) == 361 and all(r["status"].startswith("converged") for r in rows)
+    assert max(off_root(r["phi"], true_roots(r["alpha"], *SEED_R)) for r in rows if r["alpha"] % 360) < 1e-9
+
+
+def test_the_equation_sweep_honours_digits(cli):
+    run = cli("sweep", "--from", "0", "--to", "2", "--step", "1", "--digits", "5", "--format", "plain")
+    assert run.code == 0
+    cells = run.out.split()
+    assert "-0.23593" in cells and "-0.47189" in cells
+    assert not any(c.startswith("-0.235930") for c in cells)
+
+
+@pytest.mark.parametrize("seed", [5, 6])
+def test_the_equation_sweep_solves_every_assemblable_alpha_of_random_linkages(cli, seed):
+    """The class: for random link lengths over a full turn, every alpha with a real root
+    (50-digit closed form) converges onto one, and every alpha without is no_solution."""
+    rng = np.random.default_rng(seed)
+    for _ in range(6):
+        links = rng.uniform(0.3, 3.0, 4)
+        run = cli("sweep", "--links", *(repr(float(v)) for v in links), "--to", "359", "--format", "json")
+        out = json.loads(run.out)
+        from linkage.problems.freudenstein import coefficients_from_links
+
+        c = coefficients_from_links(*links)
+        for r in out["positions"]:
+            roots = true_roots(r["alpha"], c.r1, c.r2, c.r3)
+            if not roots:
+                assert r["status"] == "no_solution", r
+                continue
+            assert r["status"].startswith("converged"), (list(links), r)
+            # f' vanishes only at a limit position (a double root): there sqrt(eps) of a turn
+            assert off_root(r["phi"], roots) < (1e-6 if abs(roots[0] - roots[1]) < 1e-3 else 1e-9)
+        assert run.code == 0  # no_solution is an answer (as in a mechanism sweep), not a failure
