@@ -640,17 +640,18 @@ def _continuous_angles(solver: _Solver, positions: list[Position]) -> list[Posit
     if not angles:
         return positions
     closes = _closes(solver, positions)
-    turns = {n: unwrap_turns([p.solution[n] if p.solution else None for p in positions], closes)
-             for n in angles}
+    solved = {n: [p.solution[n] if p.solution else None for p in positions] for n in angles}
+    turns = {n: unwrap_turns(solved[n], closes) for n in angles}
     shift = _anchor(solver, positions, angles, turns, closes)
     for i, p in enumerate(positions):
         sol = p.solution
         if sol is None:
             continue
         # in place: each position and its solution dict were made by this sweep and are
-        # not yet anybody else's (a new Position per position cost 1.5 us each)
+        # not yet anybody else's (a new Position per position cost 1.5 us each); from the
+        # values as solved, so writing twice would write the same
         for n in angles:
-            sol[n] = continuous(sol[n], turns[n][i] + shift[n])  # type: ignore[operator]
+            sol[n] = continuous(solved[n][i], turns[n][i] + shift[n])  # type: ignore[arg-type,operator]
     return positions
 
 
