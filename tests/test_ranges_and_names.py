@@ -240,6 +240,18 @@ def test_the_numpy_twins_are_the_scalar_rule_bit_for_bit(rows, closes, v0, ref):
             assert angles.turn_shift(ref, at) == angles.turn_shift_array(ref, at)
 
 
+@settings(max_examples=300, deadline=None)
+@given(ref=st.floats(-1e4, 1e4), values=st.lists(st.floats(-1e4, 1e4), min_size=1, max_size=8))
+def test_the_nearest_turn_twin_is_the_scalar_and_within_half_a_turn(ref, values):
+    got = angles.nearest_turn_array(ref, np.array(values))
+    for v, g in zip(values, got):
+        x = angles.nearest_turn(ref, v)
+        assert x == g
+        assert -180.0 - 1e-9 <= x - ref <= 180.0 + 1e-9
+        turns = (x - v) / 360.0
+        assert abs(turns - round(turns)) < 1e-9
+
+
 @settings(max_examples=200, deadline=None)
 @given(values=st.lists(st.one_of(st.none(), st.floats(-1e3, 1e3)), min_size=2, max_size=20),
        closes=st.booleans())

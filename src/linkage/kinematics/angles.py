@@ -91,6 +91,20 @@ def circular_start_array(solved: Any, closes: bool) -> Any:
 
 # --- 2. unwrapping -----------------------------------------------------------------------------
 
+def nearest_turn(ref: float, value: float) -> float:
+    """The representative of ``value`` (mod 360) in (ref - 180, ref + 180]: one step of
+    rule 2, for an engine that continues an angle from one reference value."""
+    return continuous(value, math.floor((ref + 180.0 - value) / TURN))
+
+
+def nearest_turn_array(ref: Any, value: Any) -> Any:
+    """:func:`nearest_turn` of arrays (elementwise; NaN stays NaN)."""
+    import numpy as np
+
+    with np.errstate(invalid="ignore"):
+        return continuous(value, np.floor((ref + 180.0 - value) / TURN))
+
+
 def unwrap_turns(values: Sequence[float | None], closes: bool) -> list[int | None]:
     """Whole turns to add to each solved value (degrees, None where unsolved) so that
     ``value + 360 * turns`` is continuous in driver order around the circle (rule 2)."""
