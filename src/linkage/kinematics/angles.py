@@ -50,15 +50,16 @@ def closes_circle(values: Sequence[float], turn: float = TURN) -> bool:
     """True if driver ``values`` (of an angle, ``turn`` to a full turn in their unit) run
     one way and come round to their start within one of their own steps. The grid, not
     the designs: one answer for the scalar and the array engines alike."""
-    n = len(values)
-    if n < 2:
+    if len(values) < 2:
         return False
-    steps = [b - a for a, b in itertools.pairwise(values)]
-    if not (all(s > 0 for s in steps) or all(s < 0 for s in steps)):
-        return False
-    span = abs(values[-1] - values[0])
-    closing = turn - span
-    largest = max(abs(s) for s in steps)
+    rising = values[1] > values[0]
+    largest = 0.0
+    for a, b in itertools.pairwise(values):  # one pass, no list: a sweep may be long
+        step = b - a if rising else a - b
+        if not step > 0.0:
+            return False
+        largest = max(largest, step)
+    closing = turn - abs(values[-1] - values[0])
     # 1e-9 of a turn: a grid built by adding a step (0, 0.1, ...) drifts by rounding
     slack = 1e-9 * turn
     return -slack <= closing <= largest + slack
