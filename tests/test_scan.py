@@ -56,10 +56,14 @@ def reference_fourbar(r1: float, r2: float, r3: float, r4: float, branch: str) -
         psi = math.acos(max(-1.0, min(1.0, (r4 * r4 + d2 - r3 * r3) / (2 * r4 * d))))
         theta4.append(math.degrees(math.atan2(ay, ax - r1) + sign * psi))
         mus.append(min(mu, 180.0 - mu))
-    # continuous: each value the representative nearest the previous feasible one
+    # continuous: each value the representative nearest the previous feasible one, read
+    # around the circle from the start of a feasible arc (one across 359 -> 0 is one piece)
+    starts = [k for k in range(360) if theta4[k] is not None and theta4[k - 1] is None]
+    begin = starts[0] if starts else 0
     smooth = []
     prev = None
-    for v in theta4:
+    for k in range(360):
+        v = theta4[(begin + k) % 360]
         if v is None:
             continue
         if prev is not None:
@@ -68,7 +72,10 @@ def reference_fourbar(r1: float, r2: float, r3: float, r4: float, branch: str) -
         prev = v
     out = {"feasible_fraction": feasible / 360.0}
     if smooth:
-        out.update(theta4_range=max(smooth) - min(smooth), min_transmission_deg=min(mus),
+        # a full turn at most; a rocker that turns fully (back at its start a turn away) 360
+        turns_fully = feasible == 360 and abs(smooth[-1] - smooth[0]) > 180.0
+        swing = 360.0 if turns_fully else min(max(smooth) - min(smooth), 360.0)
+        out.update(theta4_range=swing, min_transmission_deg=min(mus),
                    max_transmission_deg=max(mus), theta4_any=smooth[0])
     return out
 

@@ -667,11 +667,22 @@ def _sweep_equation(a: float, b: float, step: float | None, points: int | None, 
                     r1: str | None, r2: str | None, r3: str | None, links: Any, tol: float, out_fmt: str,
                     output: Path | None, digits: int, plot: Path | None) -> None:
     """The four-bar input-output equation over alpha: seed 002's table, each alpha solved
-    from the previous alpha's root (the first from the equation's own default start)."""
+    from the previous alpha's root (the first from the equation's own default start).
+
+    Where the closed form (freudenstein.equation_roots) has no real root the position is
+    no_solution and continuation restarts after it. A run from the tangent prediction
+    can start within rounding of the root; Newton then steps between the root's
+    neighbouring floats with |f| at its rounding floor, and the loop's best-residual guard
+    (scaled by the start's residual, itself at that floor) never lets the step test pass:
+    such a run, stopped with its last step within the tolerance, is judged by the solver's
+    own root certificate (solve.certify_root: |f| within its rounding bound, or a sign
+    change across x +- tol)."""
     from .kinematics.sweep import driver_values
     from .methods import BRACKETING, SCALAR_METHODS
+    from .problems.freudenstein import equation_roots
     from .render.report import Text, table
-    from .solve import solve_scalar
+    from .result import Status
+    from .solve import certify_root, solve_scalar
 
     if method not in SCALAR_METHODS:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")
@@ -686,6 +697,7 @@ def _sweep_equation(a: float, b: float, step: float | None, points: int | None, 
         raise InputError(f"{len(values):,} values of alpha is more than 100,000; use a larger --step")
     first = _scalar_problem(None, None, values[0], r1, r2, r3, links)
     coeffs = first.title  # "..., R1 = ..., R2 = ..., R3 = ..." for the table's heading
+    rs, _ = _fourbar_coefficients(r1, r2, r3, links)
     rows: list[tuple[Any, ...]] = []
     previous: tuple[float, float] | None = None  # (alpha, phi) of the last root on the branch
 
@@ -694,12 +706,19 @@ def _sweep_equation(a: float, b: float, step: float | None, points: int | None, 
         kw: dict[str, Any] = dict(method=method, tol=tol, max_iter=200, record=False)
         if guess is None:
             if problem.guess is None:
-                return None
-            if method in BRACKETING:
+                # roots closer together than the default start's 10-degree grid (near a
+                # limit position): the closed form's, the first in [0, 180] as that grid
+                # would find it
+                roots = equation_roots(alpha, *rs)
+                if not roots:
+                    return None
+                guess = min(roots, key=lambda p: (p < 0.0, p))
+            elif method in BRACKETING:
                 return solve_scalar(problem, bracket=problem.guess, **kw)
-            # an open method starts inside the first bracket with a sign change, so every
-            # method anchors on the same root (the seed's branch)
-            guess = 0.5 * (problem.guess[0] + problem.guess[1])
+            else:
+                # an open method starts inside the first bracket with a sign change, so
+                # every method anchors on the same root (the seed's branch)
+                guess = 0.5 * (problem.guess[0] + problem.guess[1])
         if method in BRACKETING:
             width = 0.5
             while width < 90.0:  # the nearest bracket around the prediction
@@ -711,7 +730,28 @@ def _sweep_equation(a: float, b: float, step: float | None, points: int | None, 
         kw["x0"] = guess
         if method == "secant":
             kw["x1"] = guess + 1e-3
-        return solve_scalar(problem, **kw)
+        return certified(problem, solve_scalar(problem, **kw))
+
+    def certified(problem: Any, r: Any) -> Any:
+        """The run; or, where it stopped unconverged with its last step within the
+        tolerance, the solver's root certificate's verdict on its last iterate; or, where
+        f is zero to its rounding but the steps stay above the tolerance (f' so small that
+        rounding moves the root by more), precision_limit."""
+        from dataclasses import replace
+
+        if r.converged or r.status not in (Status.MAX_ITER, Status.STALLED, Status.PRECISION_LIMIT):
+            return r
+        if r.error <= tol:
+            verdict, why, n = certify_root(problem, r.x, r.residual, tol)
+            if verdict is Status.CONVERGED_STEP:
+                return replace(r, status=verdict, nfev=r.nfev + n,
+                               detail=why or f"certified after {r.status.value}: the last step is "
+                                             "within the tolerance and f is zero to its rounding")
+        elif isinstance(r.residual, float) and abs(r.residual) <= problem.fbound(r.x):
+            return replace(r, status=Status.PRECISION_LIMIT,
+                           detail=f"f is zero to its rounding, but rounding moves the root by about "
+                                  f"{r.error:.1g} deg, above the tolerance {tol:g}")
+        return r
 
     def slope(alpha: float, phi: float) -> float:
         """dphi/dalpha on the branch: -(df/dalpha) / (df/dphi), both per degree."""
@@ -724,6 +764,10 @@ def _sweep_equation(a: float, b: float, step: float | None, points: int | None, 
 
     for alpha in values:
         r = None
+        if not equation_roots(alpha, *rs):
+            rows.append((alpha, "no_solution", None, 0, None))
+            previous = None
+            continue
         if previous is None:
             r = solve_at(alpha, None)
         else:
@@ -739,7 +783,9 @@ def _sweep_equation(a: float, b: float, step: float | None, points: int | None, 
                     break
                 phi = r.x
         if r is None:
-            rows.append((alpha, "no_solution", None, 0, None))
+            # roots exist (above), but no sign change near the prediction for a bracketing
+            # method: a double root, at a limit position
+            rows.append((alpha, Status.INVALID_BRACKET.value, None, 0, None))
             previous = None
             continue
         if r.converged:
@@ -749,13 +795,14 @@ def _sweep_equation(a: float, b: float, step: float | None, points: int | None, 
     blocks: list[Any] = [
         Text(f"four-bar input-output equation over alpha ({method}, each from the previous root): "
              f"{coeffs.split(', ', 2)[2] if coeffs.count(', ') >= 2 else coeffs}", "bold"),
-        Text(""), table("", headers, rows, max(digits, 12))]
+        Text(""), table("", headers, rows, digits)]
     json_obj = {"equation": "f(phi) = R1 cos(alpha) - R2 cos(phi) + R3 - cos(alpha - phi)",
                 "method": method, "tol": tol,
                 "positions": [dict(zip(("alpha", "status", "phi", "iterations", "residual"), r))
                               for r in rows]}
     emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=(headers, rows))
-    if any(r[2] is None for r in rows):
+    # as a mechanism sweep: where the linkage cannot be assembled is an answer, not a failure
+    if any(r[2] is None and r[1] != "no_solution" for r in rows):
         raise typer.Exit(1)
 
 

@@ -25,8 +25,10 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError, ParseError
+from .kinematics.angles import angle_extent_array, closes_circle, driver_turn
 from .kinematics.designs import CONVERGED, DesignSolutions, engine_for, solve_designs
 from .problems.closed_form import grashof_np, transmission_np
+from .problems.columns import columns_of, extent_columns, path_columns
 from .problems.loops import ANGLE_UNITS, Mechanism
 
 MAX_DESIGNS = 10_000_000
@@ -192,24 +194,6 @@ def chunk_size(m: Mechanism, positions: int, branch: str | None) -> int:
 
 # --- metrics ---------------------------------------------------------------------------------
 
-def columns_of(m: Mechanism, names: Sequence[str]) -> list[tuple[str, str, str]]:
-    """Every record column: (name, type: number, bool, int or text, unit or "")."""
-    unit = {k: (q.unit if q.kind == "angle" else m.length_unit) for k, q in m.parameters.items()}
-    cols = [("design", "int", "")] + [(n, "number", unit[n]) for n in names]
-    cols += [("feasible_fraction", "number", ""), ("solved_fraction", "number", ""),
-             ("full_cycle", "bool", "")]
-    for u in m.unknowns:
-        uu = "deg" if u.kind == "angle" else m.length_unit
-        cols += [(f"{u.name}_min", "number", uu), (f"{u.name}_max", "number", uu),
-                 (f"{u.name}_range", "number", uu)]
-    if m.closed_form == "fourbar":
-        cols += [("grashof", "text", ""), ("min_transmission_deg", "number", "deg"),
-                 ("max_transmission_deg", "number", "deg")]
-    for p in m.points:
-        cols += [(f"{p}_{axis}_{end}", "number", m.length_unit) for axis in "xy" for end in ("min", "max")]
-    return cols
-
-
 def design_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray, sol: DesignSolutions,
                    start: int) -> dict[str, np.ndarray]:
     n_designs, n_pos = sol.status.shape
@@ -220,10 +204,19 @@ def design_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray, sol:
     out["feasible_fraction"] = sol.feasible.mean(axis=1) if n_pos else np.zeros(n_designs)
     out["solved_fraction"] = solved.mean(axis=1) if n_pos else np.zeros(n_designs)
     out["full_cycle"] = solved.all(axis=1) & (n_pos > 0)
+    # angles by the range rule of kinematics.angles (continuous around the circle, a full
+    # turn at most); lengths from their extremes
+    closes = m.driver.kind == "angle" and closes_circle([float(v) for v in sol.values],
+                                                        driver_turn(m.driver.unit))
     with np.errstate(invalid="ignore"):
         for j, u in enumerate(m.unknowns):
-            lo, hi = _extent(sol.solution[:, :, j], solved)
-            out[f"{u.name}_min"], out[f"{u.name}_max"], out[f"{u.name}_range"] = lo, hi, hi - lo
+            if u.kind == "angle":
+                lo, hi, span = angle_extent_array(np.where(solved, sol.solution[:, :, j], np.nan), closes)
+            else:
+                lo, hi = _extent(sol.solution[:, :, j], solved)
+                span = hi - lo
+            for key, col in zip(extent_columns(u.name), (lo, hi, span)):
+                out[key] = col
         if m.closed_form == "fourbar":
             out["grashof"] = grashof_class(*(_param(m, names, designs, k) for k in ("r1", "r2", "r3", "r4")))
             t3, t4 = (_angle_deg(m, sol, k) for k in ("theta3", "theta4"))
@@ -233,7 +226,8 @@ def design_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray, sol:
         for p in m.points:
             z = sol.paths[p]
             for axis, part in (("x", z.real), ("y", z.imag)):
-                out[f"{p}_{axis}_min"], out[f"{p}_{axis}_max"] = _extent(part, solved)
+                for key, col in zip(path_columns(p, axis), _extent(part, solved)):
+                    out[key] = col
     return out
 
 

@@ -27,6 +27,7 @@ from ..errors import InputError
 from ..problems.assembly import is_open_np, rocker_angle_np, slider_is_open_np
 from ..problems.closed_form import transmission
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel, Mechanism
+from .angles import nearest_turn, nearest_turn_array
 from .sweep import (
     MAX_POSITIONS,
     Position,
@@ -340,7 +341,7 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
         for j, k in enumerate(kinds):
             if k == "angle" and math.isfinite(ref[i, j]):
                 r = ref[i, j]
-                shown[i, j] = r + (shown[i, j] - r + 180.0) % 360.0 - 180.0
+                shown[i, j] = nearest_turn(r, shown[i, j])
     shown[status != code["converged"]] = np.nan
     return BatchResult(vals, status, shown, det_out, iters, rough.branch, rough, len(todo))
 
@@ -380,7 +381,7 @@ def _coarse(grid: np.ndarray, usable: np.ndarray, sol: np.ndarray, slopes: np.nd
     nxt = rows.copy() if one else np.concatenate((rows[:, 1:], rows[:, -1:]), axis=1)
     for j, k in enumerate(kinds):
         if k == "angle":
-            nxt[j] = rows[j] + (nxt[j] - rows[j] + 180.0) % 360.0 - 180.0
+            nxt[j] = nearest_turn_array(rows[j], nxt[j])
     with np.errstate(invalid="ignore"):
         spread = np.zeros(1) if one else np.nanmax(np.abs(sol[1:] - sol[:-1]), axis=1, initial=0.0)
     allowed = 2.0 * np.where(np.isfinite(spread), spread, 0.0) + 1e-6

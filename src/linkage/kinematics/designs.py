@@ -43,6 +43,14 @@ from ..problems.assembly import (
 )
 from ..problems.closed_form import DRIVERS, REQUIRED_NAMES
 from ..problems.loops import ANGLE_UNITS, Mechanism, VectorTerm
+from .angles import (
+    anchor_index_array,
+    closes_circle,
+    continuous,
+    driver_turn,
+    turn_shift_array,
+    unwrap_turns_array,
+)
 from .batch import STATUS_CODES, VectorLoops, _solve_linear
 
 CONVERGED, NO_SOLUTION, FAILED, OFF_BRANCH = (STATUS_CODES[k] for k in
@@ -505,14 +513,16 @@ def _paths(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, q: 
 
 
 def _continuous(m: Mechanism, shown: np.ndarray, vals: np.ndarray) -> None:
-    """In place: each angle the representative nearest its previous solved value, the
-    first in (-180, 180]; then each design's curve shifted by whole turns to lie within
-    half a turn of the file's guess at the solved position nearest the file's driver value."""
+    """In place: each angle continuous along the cycle by the rule of
+    :mod:`linkage.kinematics.angles` (driver order around the circle), each design's curve
+    in the turn within half a turn of the file's guess at the solved position nearest the
+    file's driver value."""
     if shown.size == 0:
         return
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     v0 = m.driver.value / scale
-    distance = np.abs(vals - v0)
+    turn = driver_turn(m.driver.unit)
+    closes = m.driver.kind == "angle" and closes_circle([float(v) for v in vals], turn)
     for j, u in enumerate(m.unknowns):
         if u.kind != "angle":
             continue
@@ -520,17 +530,8 @@ def _continuous(m: Mechanism, shown: np.ndarray, vals: np.ndarray) -> None:
         solved = np.isfinite(a)
         if not solved.any():
             continue
-        wrapped = np.where(solved, a - 360.0 * np.ceil((a - 180.0) / 360.0), np.nan)
-        # carry the last solved value over gaps, so each value is unwrapped against it
-        idx = np.where(solved, np.arange(a.shape[1]), 0)
-        np.maximum.accumulate(idx, axis=1, out=idx)
-        first = np.argmax(solved, axis=1)
-        filled = np.take_along_axis(wrapped, idx, axis=1)
-        lead = np.arange(a.shape[1])[None, :] < first[:, None]
-        filled[lead] = np.take_along_axis(wrapped, first[:, None], axis=1).repeat(a.shape[1], 1)[lead]
-        smooth = np.unwrap(filled, period=360.0, axis=1)
-        near = np.argmin(np.where(solved, distance[None, :], np.inf), axis=1)
-        at = np.take_along_axis(smooth, near[:, None], axis=1)[:, 0]
-        guess = math.degrees(u.value)
-        shift = 360.0 * np.round((guess - at) / 360.0)
-        shown[:, :, j] = np.where(solved, smooth + shift[:, None], np.nan)
+        turns = unwrap_turns_array(a, closes)
+        near = anchor_index_array(vals, solved, v0, closes, turn)[:, None]
+        at = continuous(np.take_along_axis(a, near, axis=1), np.take_along_axis(turns, near, axis=1))
+        shift = turn_shift_array(math.degrees(u.value), at)
+        shown[:, :, j] = np.where(solved, continuous(a, turns + shift), np.nan)

@@ -33,12 +33,12 @@ from ..problems.closed_form import (
     feasible_arcs,
     fourbar_class,
     transmission,
-    wrap_degrees,
 )
 from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..problems.system import LeanProblem
 from ..result import Status
 from ..solve import system_verdict
+from .angles import anchor_index, closes_circle, continuous, driver_turn, turn_shift, unwrap_turns
 
 MAX_HALVINGS = 6
 _DEG = 180.0 / math.pi  # math.degrees(x) is x * (180 / pi), bit for bit (CPython's mathmodule)
@@ -640,50 +640,56 @@ def _classify_gap(solver: _Solver, v: float, guesses: Sequence[tuple[float, ...]
 
 
 def _continuous_angles(solver: _Solver, positions: list[Position]) -> list[Position]:
-    """Report each angle as the representative (mod 360) nearest its previous solved value,
-    starting in (-180, 180]: curves stay continuous, across gaps too."""
-
+    """Report each angle continuously along the cycle, in driver order around the circle
+    (an arc across the grid's end is one piece), in the turn ``solve FILE`` gives at the
+    file's driver value: the rule of :mod:`linkage.kinematics.angles`."""
     angles = [n for n, k in zip(solver.names, solver.kinds) if k == "angle"]
-    prev: dict[str, float] = {}
-    wrap = wrap_degrees
-    for p in positions:
+    if not angles:
+        return positions
+    closes = _closes(solver, positions)
+    solved = {n: [p.solution[n] if p.solution else None for p in positions] for n in angles}
+    turns = {n: unwrap_turns(solved[n], closes) for n in angles}
+    shift = _anchor(solver, positions, angles, turns, closes)
+    for i, p in enumerate(positions):
         sol = p.solution
         if sol is None:
             continue
         # in place: each position and its solution dict were made by this sweep and are
-        # not yet anybody else's (a new Position per position cost 1.5 us each)
+        # not yet anybody else's (a new Position per position cost 1.5 us each); from the
+        # values as solved, so writing twice would write the same
         for n in angles:
-            v = sol[n]
-            ref = prev.get(n)
-            x = wrap(v if ref is None else v - ref)
-            prev[n] = sol[n] = x if ref is None else ref + x
-    return _anchor(solver, positions, angles)
+            sol[n] = continuous(solved[n][i], turns[n][i] + shift[n])  # type: ignore[arg-type,operator]
+    return positions
 
 
-def _anchor(solver: _Solver, positions: list[Position], angles: list[str]) -> list[Position]:
-    """Shift each angle's whole curve by a multiple of 360 so that at the position nearest
-    the file's own driver value it reads as `solve FILE` reports it there (Newton from the
-    file's guess): a sweep and a solve never disagree by a turn."""
-    from dataclasses import replace
+def _closes(solver: _Solver, positions: Sequence[Position]) -> bool:
+    """Whether the sweep's driver values close the circle (angles.closes_circle)."""
+    if solver.m.driver.kind != "angle":
+        return False
+    return closes_circle([p.input for p in positions], driver_turn(solver.m.driver.unit))
 
-    solved = [p for p in positions if p.solution is not None]
-    if not angles or not solved:
-        return positions
+
+def _anchor(solver: _Solver, positions: list[Position], angles: list[str],
+            turns: dict[str, list[int | None]], closes: bool) -> dict[str, int]:
+    """Whole turns to add to each angle's curve so that at the position nearest the file's
+    own driver value it reads as `solve FILE` reports it there (Newton from the file's
+    guess): a sweep and a solve never disagree by a turn."""
+    none = dict.fromkeys(angles, 0)
     m = solver.m
     v0 = m.driver.value / solver.scale
+    near = anchor_index([p.input for p in positions], [p.solution is not None for p in positions], v0,
+                        closes, driver_turn(m.driver.unit))
+    if near is None:
+        return none
     from ..solve import solve_system
 
     r = solve_system(solver.problem(v0), tuple(u.value for u in m.unknowns), tol=solver.tol, record=False)
     if not r.converged:
-        return positions
-    anchor = solver.display(r.x)
-    near = min(solved, key=lambda p: abs(p.input - v0))
-    shift = {n: 360.0 * round((anchor[n] - near.solution[n]) / 360.0) for n in angles}  # type: ignore[index]
-    if not any(shift.values()):
-        return positions
-    return [p if p.solution is None else
-            replace(p, solution={k: v + shift.get(k, 0.0) for k, v in p.solution.items()})
-            for p in positions]
+        return none
+    ref = solver.display(r.x)
+    sol = positions[near].solution
+    assert sol is not None
+    return {n: turn_shift(ref[n], continuous(sol[n], turns[n][near])) for n in angles}  # type: ignore[arg-type]
 
 
 def _follow(solver: _Solver, values: Sequence[float], seed: tuple[float, tuple[float, ...]],

@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from ..errors import ParseError
+from .columns import column_clash
 from .system import SystemProblem
 
 ANGLE_UNITS = {"deg": math.pi / 180.0, "rad": 1.0}
@@ -345,6 +346,9 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
     mechanism = Mechanism(name, source, length_unit, parameters, driver, unknowns, tuple(loops),
                           closed_form, str(doc.get("description", "")),
                           {"notes": doc.get("notes", "")}, points)
+    clash = column_clash(mechanism)
+    if clash:
+        raise fail(*clash)
     if closed_form is not None:
         from .closed_form import verify
 

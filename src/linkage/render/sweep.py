@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..kinematics.angles import angle_extent, closes_circle, driver_turn
 from ..kinematics.sweep import SweepResult
 from .rates import rate_cells, rate_headers, rates_dict
 from .report import Block, Text, fmt, table
@@ -61,14 +62,22 @@ def sweep_rows(s: SweepResult, kinematics: bool = True) -> list[tuple[Any, ...]]
 
 
 def ranges_of(s: SweepResult) -> dict[str, dict[str, float]]:
-    """Per unknown: min and max over solved positions, where they occur, and the stroke."""
+    """Per unknown: min and max over solved positions, where they occur, and the stroke
+    (an angle's by the range rule of kinematics.angles: a full turn at most, 360 for one
+    that turns fully)."""
     out = {}
-    for name in s.names:
+    inputs = [p.input for p in s.positions]
+    closes = s.driver_unit in ("deg", "rad") and closes_circle(inputs, driver_turn(s.driver_unit))
+    for name, unit in zip(s.names, s.units):
         pts = [(p.solution[name], p.input) for p in s.positions if p.solution]
         if not pts:
             continue
         lo, hi = min(pts), max(pts)
-        out[name] = {"min": lo[0], "at_min": lo[1], "max": hi[0], "at_max": hi[1], "stroke": hi[0] - lo[0]}
+        stroke = hi[0] - lo[0]
+        if unit == "deg":
+            stroke = angle_extent([p.solution[name] if p.solution else None for p in s.positions],
+                                  closes)[2]
+        out[name] = {"min": lo[0], "at_min": lo[1], "max": hi[0], "at_max": hi[1], "stroke": stroke}
     return out
 
 

@@ -1,0 +1,75 @@
+"""The columns of a scan's records, named from a mechanism: the one list of them.
+
+`linkage scan` (:func:`linkage.scan.columns_of`, :func:`linkage.scan.design_metrics`)
+names its columns here, and the file parser (:func:`linkage.problems.loops.parse_mechanism`)
+refuses a file whose names would give two columns the same name (a parameter called
+``design`` or ``full_cycle``, an unknown ``P_x`` beside a point ``P``): one record would
+overwrite or duplicate another, or put millimetres under a (deg) heading. Every parameter
+counts, since any may be varied. No numpy here: every file load reads this.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from .loops import Mechanism
+
+DESIGN = "design"
+SUMMARY = (("feasible_fraction", "number", ""), ("solved_fraction", "number", ""),
+           ("full_cycle", "bool", ""))
+FOURBAR = (("grashof", "text", ""), ("min_transmission_deg", "number", "deg"),
+           ("max_transmission_deg", "number", "deg"))
+
+
+def extent_columns(name: str) -> tuple[str, str, str]:
+    """An unknown's columns: its min, max and range."""
+    return f"{name}_min", f"{name}_max", f"{name}_range"
+
+
+def path_columns(point: str, axis: str) -> tuple[str, str]:
+    """A point's columns on one axis (x or y): the min and max of its path."""
+    return f"{point}_{axis}_min", f"{point}_{axis}_max"
+
+
+def sourced_columns(m: Mechanism, names: Sequence[str]) -> list[tuple[str, str, str, str, str]]:
+    """Every record column of a scan varying ``names``, in order, as (name, type, unit,
+    where it comes from, the file key that named it or "")."""
+    unit = {k: (q.unit if q.kind == "angle" else m.length_unit) for k, q in m.parameters.items()}
+    own = "a column every scan writes"
+    cols = [(DESIGN, "int", "", own, "")]
+    cols += [(n, "number", unit[n], f"parameter {n}", f"parameters.{n}") for n in names]
+    cols += [(c, t, u, own, "") for c, t, u in SUMMARY]
+    for q in m.unknowns:
+        uu = "deg" if q.kind == "angle" else m.length_unit
+        cols += [(c, "number", uu, f"unknown {q.name}", f"unknowns.{q.name}") for c in extent_columns(q.name)]
+    if m.closed_form == "fourbar":
+        cols += [(c, t, u, "a column every four-bar scan writes", "") for c, t, u in FOURBAR]
+    for p in m.points:
+        cols += [(c, "number", m.length_unit, f"point {p}", f"points.{p}")
+                 for axis in "xy" for c in path_columns(p, axis)]
+    return cols
+
+
+def columns_of(m: Mechanism, names: Sequence[str]) -> list[tuple[str, str, str]]:
+    """Every record column: (name, type: number, bool, int or text, unit or "")."""
+    return [c[:3] for c in sourced_columns(m, names)]
+
+
+def column_clash(m: Mechanism) -> tuple[str, str] | None:
+    """The first name that would give two scan columns one name, as (the file key to
+    blame, the clash in one line), or None."""
+    seen: dict[str, tuple[str, str]] = {}
+    for name, _type, _unit, origin, key in sourced_columns(m, tuple(m.parameters)):
+        if name not in seen:
+            seen[name] = (origin, key)
+            continue
+        (a, a_key), (b, b_key) = seen[name], (origin, key)
+        if not a_key or not b_key:  # one of them is a column the scan always writes
+            user, user_key, fixed = (b, b_key, a) if not a_key else (a, a_key, b)
+            return user_key, f"{user} gives the scan column {name!r}, which is {fixed}; rename it"
+        blame = a_key if a_key.startswith("parameters.") else b_key  # the name that is the column
+        return blame, f"{a} and {b} both give the scan column {name!r}; rename one of them"
+    return None
