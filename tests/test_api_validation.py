@@ -51,6 +51,11 @@ def _scan(vary=GRID, **options):
     return linkage.scan_designs(M, vary, **options)
 
 
+def _late(fn, above):
+    """fn, until x[0] passes ``above``: then None (a function wrong only away from x0)."""
+    return lambda x: fn(x) if x[0] <= above else None
+
+
 def _bisect_result():
     return linkage.solve_scalar(lambda x: x - 1.0, method="bisection", bracket=(0.0, 3.0))
 
@@ -172,6 +177,12 @@ BATTERY = [
      lambda: linkage.solve_system(_F, (1.0, 1.0), jac=lambda x: None), "jac"),
     ("solve_system", "jac returns None (recorded)",
      lambda: linkage.solve_system(_F, [1.0, 1.0], jac=lambda x: None), "jac"),
+    ("solve_system", "F returns None after x0",
+     lambda: linkage.solve_system(_late(_F, 1.2), (1.0, 1.0), jac=_J, record=False), "F"),
+    ("solve_system", "F returns None after x0 (lm)",
+     lambda: linkage.solve_system(_late(_F, 1.2), (1.0, 1.0), method="lm"), "F"),
+    ("solve_system", "jac returns None after x0",
+     lambda: linkage.solve_system(_F, (1.0, 1.0), jac=_late(_J, 1.2)), "jac"),
     ("solve_system", "jac not callable", lambda: linkage.solve_system(_F, (1.0, 1.0), jac=3), "jac"),
     ("solve_system", "x0 text", lambda: linkage.solve_system(_F, "ab", jac=_J), "x0"),
     ("solve_system", "x0 complex", lambda: linkage.solve_system(_F, (1j, 1.0), jac=_J), "x0"),
@@ -189,6 +200,12 @@ BATTERY = [
     # solve_scalar: g and the bracket
     ("solve_scalar", "g returns None",
      lambda: linkage.solve_scalar(lambda x: x - 1, method="fixed-point", x0=1.5, g=lambda x: None), "g"),
+    ("solve_scalar", "g returns None after x0",
+     lambda: linkage.solve_scalar(lambda x: x - 1, method="fixed-point", x0=3.0,
+                                  g=lambda x: 0.5 * x + 0.5 if x > 1.2 else None), "g"),
+    ("solve_scalar", "f returns None after x0",
+     lambda: linkage.solve_scalar(lambda x: x - 1 if x < 0.7 else None, method="secant",
+                                  x0=0.1, x1=0.2), "f"),
     ("solve_scalar", "g returns text",
      lambda: linkage.solve_scalar(lambda x: x - 1, method="fixed-point", x0=1.5, g=lambda x: "a"), "g"),
     ("solve_scalar", "g not callable",

@@ -135,9 +135,11 @@ def check_callable(name: str, value: Any, *, optional: bool = True) -> Any:
     return value
 
 
-def check_reals(name: str, values: Any, length: int | None = None, labels: Sequence[str] = ()) -> list[float]:
-    """A 1-D sequence of finite reals as a list of floats (``length`` of them when given;
-    ``labels`` name the entries in the message), or InputError naming the first bad entry."""
+def check_reals(name: str, values: Any, length: int | None = None, labels: Sequence[str] = (),
+                most: int | None = None) -> list[float]:
+    """A 1-D sequence of finite reals as a list of floats (``length`` of them when given, at
+    most ``most``, counted before any is read; ``labels`` name the entries in the message),
+    or InputError naming the first bad entry."""
     if values is None or isinstance(values, (str, bytes, Mapping)) or is_real(values):
         raise InputError(f"{name} must be a sequence of numbers (a list, tuple or 1-D array), "
                          f"got {_shown(values)}")
@@ -149,6 +151,8 @@ def check_reals(name: str, values: Any, length: int | None = None, labels: Seque
     ndim = getattr(values, "ndim", 1)
     if ndim != 1:
         raise InputError(f"{name} must be 1-D, got an array of shape {getattr(values, 'shape', '?')}")
+    if most is not None and len(values) > most:
+        raise InputError(f"{name} has {len(values):,} entries, more than {most:,}")
     if length is not None and len(values) != length:
         what = f" ({', '.join(labels)})" if labels else ""
         raise InputError(f"{name} needs {length} values{what}, got {len(values)}")

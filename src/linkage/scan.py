@@ -524,7 +524,7 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
               for name, lo, hi, n in specs]
     if values is None:
         values = [float(k) for k in range(360)]
-    values = check_reals("values", values)
+    values = check_reals("values", values, most=MAX_SCAN_POSITIONS)
     setup = prepare(m, varies, samples=samples, seed=seed, sampling=sampling, values=list(values),
                     branch=branch, tol=tol, where=where, sort=sort)
     job = ScanJob("", m.source, (), setup.plan.names, tuple(setup.values), setup.branch, tol, m)

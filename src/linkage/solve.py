@@ -176,18 +176,38 @@ def solve_scalar(
                             "tol": crit.tol, "rtol": crit.rtol, **start})
     # a g (or f') that returns something other than a number fails inside the loop: name it
     return guarded(lambda: finish(m, problem, state, crit, record, start),
-                   lambda: _diagnose_scalar(problem, args[0]))
+                   lambda: _diagnose_scalar(problem, args[0],
+                                            lambda p: finish(m, p, state, crit, record, start)))
 
 
-def _diagnose_scalar(problem: ScalarProblem, x0: float) -> None:
-    """InputError naming the user function that returns a non-number at x0, if one does."""
-    for name, fn in (("f", problem.f), ("fprime", problem.fprime), ("g", problem.g)):
-        if fn is not None:
+def _diagnose_scalar(problem: ScalarProblem, x0: float, rerun: Callable[[ScalarProblem], Any]) -> None:
+    """InputError naming the user function that returns a non-number, at x0 or (by a
+    re-run with every value checked) where the failed run met it."""
+    named = [(name, fn) for name, fn in (("f", problem.f), ("fprime", problem.fprime), ("g", problem.g))
+             if fn is not None]
+    for name, fn in named:
+        try:
+            value = fn(x0)
+        except Exception:
+            continue
+        real_result(name, value, f"at x = {x0!r}")
+
+    def checked(name: str, fn: Any) -> Any:
+        def call(x: float) -> Any:
+            value = fn(x)
             try:
-                value = fn(x0)
-            except Exception:
-                continue
-            real_result(name, value, f"at x = {x0!r}")
+                real_result(name, value, f"at x = {x!r}")
+            except InputError as exc:
+                raise _BadReturn(str(exc)) from None
+            return value
+        return call
+
+    try:
+        rerun(replace(problem, **{name: checked(name, fn) for name, fn in named}))
+    except _BadReturn as exc:
+        raise InputError(str(exc)) from None
+    except (TypeError, IndexError):
+        return  # not the user's functions: the original error stands
 
 
 _METHOD_MODULES = {"bisection": (".methods.bisection", "Bisection"),
@@ -512,9 +532,48 @@ def _names_bad_callables(solve: Callable[..., Result]) -> Callable[..., Result]:
             return solve(F, x0, **options)
         except (TypeError, IndexError):
             _diagnose_system(F, x0, options.get("jac"))
+            _rerun_checked(solve, F, x0, options)
             raise
 
     return front_door
+
+
+def _rerun_checked(solve: Callable[..., Result], F: Any, x0: Any, options: dict[str, Any]) -> None:
+    """A bare F or jac that returned the wrong kind of value after x0: the same solve once
+    more, each value they return checked, so the InputError names the function and the x."""
+    if not callable(F) or hasattr(F, "names"):
+        return
+    try:
+        n = len(check_reals("x0", x0))
+    except InputError:
+        return
+    jac = options.get("jac")
+
+    def checked(name: str, fn: Any, check: Any) -> Any:
+        def call(x: Any) -> Any:
+            value = fn(x)
+            try:
+                check(name, value, n, f"at x = {list(x)}")
+                if len(value) != n:
+                    raise InputError(f"{name} must return {n} numbers, got {len(value)} at x = {list(x)}")
+            except InputError as exc:
+                # past the solvers' handlers (an InputError is a ValueError, which they
+                # report as a domain error)
+                raise _BadReturn(str(exc)) from None
+            return value
+        return call
+
+    try:
+        solve(checked("F", F, real_vector), x0,
+              **{**options, "jac": checked("jac", jac, real_matrix) if callable(jac) else jac})
+    except _BadReturn as exc:
+        raise InputError(str(exc)) from None
+    except (TypeError, IndexError):
+        return  # not the user's functions: the original error stands
+
+
+class _BadReturn(Exception):
+    """A user function's wrong return value, carried out of a checked re-run."""
 
 
 def _diagnose_system(F: Any, x0: Any, jac: Any) -> None:

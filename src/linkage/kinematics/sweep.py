@@ -330,7 +330,7 @@ def sweep_mechanism(
 
     # the front door: every argument checked once, InputError naming it
     m = check_mechanism("mechanism", mechanism)
-    values = check_reals("values", values)
+    values = check_reals("values", values, most=MAX_POSITIONS)
     check_criteria(tol, 0.0, None, max_iter)
     check_text("branch", branch)
     check_callable("progress", progress)
