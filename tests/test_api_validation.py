@@ -452,3 +452,21 @@ def test_fuzz_solve_system_gives_a_result_or_input_error(phi, jac, x0, method, r
         J = _J
     _only_result_or_input_error(lambda: linkage.solve_system(lambda x: phi, x0, jac=J, method=method,
                                                              record=record, tol=tol))
+
+
+SCALAR_RETURNS = st.one_of(JUNK, st.floats(-5, 5))
+
+
+@FUZZ
+@given(fx=SCALAR_RETURNS, gx=SCALAR_RETURNS,
+       method=st.sampled_from(["bisection", "hybrid", "secant", "newton", "fixed-point"]),
+       x0=st.one_of(st.none(), SMALL_FLOAT),
+       bracket=st.one_of(st.none(), JUNK, st.tuples(st.floats(-3, 0), st.floats(0.5, 3))),
+       record=st.booleans())
+def test_fuzz_solve_scalar_gives_a_result_or_input_error(fx, gx, method, x0, bracket, record):
+    def f(x):
+        return x - 0.25 if x < 0.0 else fx  # a real function near the start, then the drawn value
+
+    _only_result_or_input_error(lambda: linkage.solve_scalar(
+        f, method=method, x0=x0, x1=None if x0 is None else 2.0, bracket=bracket,
+        fprime=lambda x: gx, g=lambda x: gx, record=record))
