@@ -277,6 +277,7 @@ def test_api_misuses_are_input_errors_not_type_value_or_index_errors():
 # --- the seven silent misuses ------------------------------------------------------------------
 
 def test_scan_designs_workers_minus_one_is_refused_not_run():
+    # it returned no records at all, silently
     with pytest.raises(InputError, match=r"workers must be a whole number from 1 to \d+.*got -1"):
         linkage.scan_designs(M, GRID, values=TWO, workers=-1)
 
@@ -286,8 +287,8 @@ def test_scan_designs_chunk_minus_three_is_refused_not_run():
         linkage.scan_designs(M, GRID, values=TWO, chunk=-3)
 
 
-def test_scan_designs_top_minus_one_is_refused_not_a_dropped_last_design():
-    # top=-1 kept order[:-1]: every design but the last, silently
+def test_scan_designs_top_minus_one_is_refused_not_an_empty_result():
+    # top=-1 returned no records at all, silently (as did workers=-1 and chunk=-3)
     with pytest.raises(InputError, match=r"top must be a whole number >= 1, got -1"):
         linkage.scan_designs(M, GRID, values=TWO, top=-1)
     assert len(linkage.scan_designs(M, GRID, values=TWO, top=1)["design"]) == 1
