@@ -863,11 +863,12 @@ def scan(
 
     Example: linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60:5 --vary r4=60:120:7
     """
+    from .arguments import check_scan_options
     from .files import read_input
     from .kinematics.sweep import driver_values
     from .problems.loops import load
     from .render.scan import RecordSink, scan_blocks
-    from .scan import Keeper, ScanJob, chunk_size, feed, parse_vary, prepare
+    from .scan import MAX_DESIGNS, Keeper, ScanJob, chunk_size, feed, parse_vary, prepare
     from .solve import check_criteria
 
     if output is not None and str(output) == "-":
@@ -880,9 +881,8 @@ def scan(
         raise InputError(f"unknown format {fmt!r} for scan; use table, plain, csv, json or parquet")
     check_paths([file], [("--output", output)])
     check_criteria(tol, 0.0, None, 50)
-    for name, v in (("--top", top), ("--workers", workers), ("--chunk", chunk)):
-        if v is not None and v < 1:
-            raise InputError(f"{name} must be at least 1, got {v}")
+    check_scan_options(seed=seed, samples=samples, top=top, chunk=chunk, workers=workers,
+                       scheduler=scheduler, max_designs=MAX_DESIGNS, prefix="--")
     if not vary:
         raise InputError("give at least one --vary NAME=LO:HI[:N]")
     varies = [parse_vary(v) for v in vary]

@@ -477,20 +477,37 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
     ``samples``), in the file's units; ``values`` are the driver values (default 0..359
     deg). Returns the kept records as columns (name -> numpy array), in design order or
     sorted by ``sort``: the columns ``linkage scan`` writes, with the same ``where``,
-    ``sort``, ``top``, ``scheduler`` and ``workers``.
+    ``sort``, ``top``, ``scheduler`` and ``workers``. Every argument is checked first
+    (:mod:`linkage.arguments`): a misuse raises InputError naming it; n, samples, seed,
+    top, chunk and workers are whole numbers (workers at most MAX_THREADS threads or
+    MAX_PROCESSES processes), the driver values finite reals.
     """
-    from .problems.loops import load
+    from .arguments import (
+        check_flag,
+        check_mechanism,
+        check_reals,
+        check_scan_options,
+        check_text,
+        check_vary,
+    )
+    from .solve import check_criteria
 
-    m = mechanism if isinstance(mechanism, Mechanism) else load(mechanism)
-    varies = []
-    for name, spec in vary.items():
-        if len(spec) not in (2, 3):
-            raise InputError(f"vary[{name!r}] must be (lo, hi) or (lo, hi, n)")
-        lo, hi = float(spec[0]), float(spec[1])
-        n = int(spec[2]) if len(spec) == 3 else None
-        varies.append(parse_vary(f"{name}={lo!r}:{hi!r}" + (f":{n}" if n is not None else "")))
+    m = check_mechanism("mechanism", mechanism)
+    specs = check_vary(vary, MAX_DESIGNS)
+    check_scan_options(seed=seed, samples=samples, top=top, chunk=chunk, workers=workers,
+                       scheduler=scheduler, max_designs=MAX_DESIGNS)
+    check_criteria(tol, 0.0, None, 50)
+    for name, text in (("where", where), ("sort", sort), ("branch", branch)):
+        check_text(name, text)
+    check_text("sampling", sampling, optional=False)
+    if sampling not in ("lhs", "random"):
+        raise InputError(f"sampling must be lhs or random, got {sampling!r}")
+    check_flag("descending", descending)
+    varies = [parse_vary(f"{name}={lo!r}:{hi!r}" + (f":{n}" if n is not None else ""))
+              for name, lo, hi, n in specs]
     if values is None:
         values = [float(k) for k in range(360)]
+    values = check_reals("values", values, most=MAX_SCAN_POSITIONS)
     setup = prepare(m, varies, samples=samples, seed=seed, sampling=sampling, values=list(values),
                     branch=branch, tol=tol, where=where, sort=sort)
     job = ScanJob("", m.source, (), setup.plan.names, tuple(setup.values), setup.branch, tol, m)

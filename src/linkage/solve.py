@@ -9,6 +9,15 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any
 
+from .arguments import (
+    check_callable,
+    check_number,
+    check_reals,
+    guarded,
+    real_matrix,
+    real_result,
+    real_vector,
+)
 from .errors import InputError
 from .iterate import MAX_ITER_LIMIT, Criteria, Rows, explain, run
 from .methods import SCALAR_METHODS
@@ -17,19 +26,6 @@ from .result import History, Result, Status
 
 # A scalar solve imports only its own method; the system solvers load with the first
 # system solve (python -X importtime: about 20 ms of every `linkage solve` otherwise).
-
-
-def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: bool = True) -> float:
-    """A finite float (and > 0 or >= 0 when asked), or an InputError naming the value."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise InputError(f"{name} must be finite, got {v!r}")
-    if positive and (v < 0.0 or (v == 0.0 and not allow_zero)):
-        raise InputError(f"{name} must be {'>' if not allow_zero else '>='} 0, got {v!r}")
-    return v
 
 
 def _short_int(v: int) -> str:
@@ -116,6 +112,8 @@ def solve_scalar(
     if method not in SCALAR_METHODS:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")
     crit = check_criteria(tol, rtol, ftol, max_iter)
+    check_callable("fprime", fprime)
+    check_callable("g", g)
     problem = _problem(f, fprime, g)
     guess = problem.guess
     m: Any
@@ -124,10 +122,7 @@ def solve_scalar(
             if guess is None:
                 raise InputError(f"{method} needs a bracket (a, b) with a sign change of f")
             bracket = guess
-        if len(bracket) != 2:
-            raise InputError(f"a bracket is two numbers, got {len(bracket)}")
-        a = check_number("bracket start", bracket[0])
-        b = check_number("bracket end", bracket[1])
+        a, b = check_reals("bracket", bracket, 2, ("start", "end"))
         if a == b:
             raise InputError(f"the bracket ends are equal ({a!r}); give an interval")
         cls = _method_class(method)
@@ -179,7 +174,40 @@ def solve_scalar(
                       history=History((), (), 0) if record else None,
                       meta={"var": problem.var, "unit": problem.unit, "title": problem.title,
                             "tol": crit.tol, "rtol": crit.rtol, **start})
-    return finish(m, problem, state, crit, record, start)
+    # a g (or f') that returns something other than a number fails inside the loop: name it
+    return guarded(lambda: finish(m, problem, state, crit, record, start),
+                   lambda: _diagnose_scalar(problem, args[0],
+                                            lambda p: finish(m, p, state, crit, record, start)))
+
+
+def _diagnose_scalar(problem: ScalarProblem, x0: float, rerun: Callable[[ScalarProblem], Any]) -> None:
+    """InputError naming the user function that returns a non-number, at x0 or (by a
+    re-run with every value checked) where the failed run met it."""
+    named = [(name, fn) for name, fn in (("f", problem.f), ("fprime", problem.fprime), ("g", problem.g))
+             if fn is not None]
+    for name, fn in named:
+        try:
+            value = fn(x0)
+        except Exception:
+            continue
+        real_result(name, value, f"at x = {x0!r}")
+
+    def checked(name: str, fn: Any) -> Any:
+        def call(x: float) -> Any:
+            value = fn(x)
+            try:
+                real_result(name, value, f"at x = {x!r}")
+            except InputError as exc:
+                raise _BadReturn(str(exc)) from None
+            return value
+        return call
+
+    try:
+        rerun(replace(problem, **{name: checked(name, fn) for name, fn in named}))
+    except _BadReturn as exc:
+        raise InputError(str(exc)) from None
+    except (TypeError, IndexError):
+        return  # not the user's functions: the original error stands
 
 
 _METHOD_MODULES = {"bisection": (".methods.bisection", "Bisection"),
@@ -493,6 +521,83 @@ MAX_RELATIVE_TOL = 1e-2
 """The loosest tolerance a mechanism accepts: 1% of its size, or 0.01 rad (0.57 deg)."""
 
 
+def _names_bad_callables(solve: Callable[..., Result]) -> Callable[..., Result]:
+    """A TypeError or IndexError out of a system solve is, on valid input, an F or jac that
+    returned the wrong kind of value (None, a string, a short list): name it (InputError).
+    Costs a call frame, not a check, on every solve."""
+
+    @functools.wraps(solve)
+    def front_door(F: Any, x0: Any = None, **options: Any) -> Result:
+        try:
+            return solve(F, x0, **options)
+        except (TypeError, IndexError):
+            _diagnose_system(F, x0, options.get("jac"))
+            _rerun_checked(solve, F, x0, options)
+            raise
+
+    return front_door
+
+
+def _rerun_checked(solve: Callable[..., Result], F: Any, x0: Any, options: dict[str, Any]) -> None:
+    """A bare F or jac that returned the wrong kind of value after x0: the same solve once
+    more, each value they return checked, so the InputError names the function and the x."""
+    if not callable(F) or hasattr(F, "names"):
+        return
+    try:
+        n = len(check_reals("x0", x0))
+    except InputError:
+        return
+    jac = options.get("jac")
+
+    def checked(name: str, fn: Any, check: Any) -> Any:
+        def call(x: Any) -> Any:
+            value = fn(x)
+            try:
+                check(name, value, n, f"at x = {list(x)}")
+                if len(value) != n:
+                    raise InputError(f"{name} must return {n} numbers, got {len(value)} at x = {list(x)}")
+            except InputError as exc:
+                # past the solvers' handlers (an InputError is a ValueError, which they
+                # report as a domain error)
+                raise _BadReturn(str(exc)) from None
+            return value
+        return call
+
+    try:
+        solve(checked("F", F, real_vector), x0,
+              **{**options, "jac": checked("jac", jac, real_matrix) if callable(jac) else jac})
+    except _BadReturn as exc:
+        raise InputError(str(exc)) from None
+    except (TypeError, IndexError):
+        return  # not the user's functions: the original error stands
+
+
+class _BadReturn(Exception):
+    """A user function's wrong return value, carried out of a checked re-run."""
+
+
+def _diagnose_system(F: Any, x0: Any, jac: Any) -> None:
+    """InputError naming F or jac when either returns a non-number or the wrong shape at x0."""
+    fn, J = (F.F, jac or F.J) if hasattr(F, "F") and hasattr(F, "names") else (F, jac)
+    x = x0 if x0 is not None else getattr(F, "x0", None)
+    try:
+        q = check_reals("x0", x)
+    except InputError:
+        return
+    n = len(q)
+    for name, f, check in (("F", fn, real_vector), ("jac", J, real_matrix)):
+        if not callable(f):
+            continue
+        try:
+            value = f(list(q))
+        except (TypeError, IndexError, KeyError, AttributeError) as exc:
+            raise InputError(f"{name} fails at x0 = {q}: {type(exc).__name__}: {exc}") from None
+        except Exception:
+            continue
+        check(name, value, n, "at x0")
+
+
+@_names_bad_callables
 def solve_system(
     F: Callable[..., list[float]] | Any,
     x0: Sequence[float] | None = None,
@@ -550,8 +655,10 @@ def solve_system(
             raise InputError(f"F must be callable or a SystemProblem, got {type(F).__name__}")
         if x0 is None:
             raise InputError("x0 is required for a bare residual function")
+        x0 = check_reals("x0", x0)
         problem = generic_system(F, len(x0), jac)
-    if x0 is None or len(x0) != problem.n:
+    check_callable("jac", jac)
+    if x0 is None or len(check_reals("x0", x0, None, problem.names)) != problem.n:
         raise InputError(f"x0 needs {problem.n} values ({', '.join(problem.names)}), "
                          f"got {0 if x0 is None else len(x0)}")
     if all(type(v) is float and v - v == 0.0 for v in x0):
@@ -577,6 +684,7 @@ def solve_system(
         phi0 = problem.F(list(q0))
     except (ArithmeticError, ValueError) as exc:
         raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
+    real_vector("F", phi0, problem.n, "at x0")
     if len(phi0) != problem.n:
         raise InputError(f"the system has {len(phi0)} equations for {problem.n} unknowns")
     scale = problem.length_scale
@@ -689,6 +797,7 @@ def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float,
         phi0 = F(list(x0))
     except (ArithmeticError, ValueError) as exc:
         raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
+    real_vector("F", phi0, 2, "at x0")
     if len(phi0) != 2:
         raise InputError(f"the system has {len(phi0)} equations for 2 unknowns")
     gate = crit.ftol if crit.ftol is not None else crit.tol

@@ -17,6 +17,7 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
+from ..errors import InputError
 from ..problems.scalar import ScalarProblem
 from ..result import Result
 
@@ -108,6 +109,11 @@ def _slope(points: list[tuple[float, float]]) -> float | None:
 
 def analyze(result: Result, problem: ScalarProblem | None = None) -> Convergence | None:
     """Estimate order, rate and constant from ``result.history``; None without history."""
+    if not isinstance(result, Result):
+        raise InputError(f"result must be a Result (from solve_scalar or solve_system), "
+                         f"got {type(result).__name__}")
+    if problem is not None and not isinstance(problem, ScalarProblem):
+        raise InputError(f"problem must be None or a ScalarProblem, got {type(problem).__name__}")
     h = result.history
     if h is None:
         return None

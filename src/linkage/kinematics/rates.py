@@ -537,7 +537,22 @@ def rates_at(mechanism: Any, q: Any, *, speed: float | None = None, accel: float
     """The public ``linkage.position_rates``: joints and points of ``mechanism`` at the
     solution ``q`` (radians and length units, as ``solve_system`` returns it), at its
     driver value (or ``driver``, internal units), with the rates of everything when a
-    driver ``speed`` (rad/s or length/s) and ``accel`` are given."""
+    driver ``speed`` (rad/s or length/s) and ``accel`` are given. ``mechanism`` may be a
+    path to a file. Numbers only, in those internal units (a unit string such as "10rpm"
+    is the command line's); every argument is checked first, and a misuse raises
+    :class:`~linkage.errors.InputError` naming it."""
+    from ..arguments import check_mechanism, check_number, check_rate, check_reals
+    from ..errors import InputError
+
+    mechanism = check_mechanism("mechanism", mechanism)
+    names = [u.name for u in mechanism.unknowns]
+    q = check_reals("q", q, len(names), names)
+    per_s = "rad/s" if mechanism.driver.kind == "angle" else f"{mechanism.length_unit or 'length unit'}/s"
+    if speed is not None:
+        speed = check_rate("speed", speed, per_s)
+    accel = check_rate("accel", accel, f"{per_s}^2")
+    if speed is None and accel != 0.0:
+        raise InputError("accel needs speed (the driver's velocity)")
     model = mechanism.model
-    d = mechanism.driver.value if driver is None else driver
-    return position_rates(model, list(q), d, speed, accel)
+    d = mechanism.driver.value if driver is None else check_number("driver", driver)
+    return position_rates(model, q, d, speed, accel)

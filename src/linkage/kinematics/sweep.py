@@ -319,12 +319,31 @@ def sweep_mechanism(
     with ``joints=True``, every solved position also has ``.rates``: its joints and named
     points and, with a speed, the velocity and acceleration of every unknown, joint and
     point (:class:`~linkage.kinematics.rates.Rates`; batch sweeps leave it None). Without
-    them the sweep does not pay for it.
+    them the sweep does not pay for it. ``speed`` and ``accel`` are numbers in those
+    internal units; a unit string such as "10rpm" is the command line's, and is refused
+    here. ``values`` must be finite reals in a sequence (not a generator).
+    Every argument is checked first (:mod:`linkage.arguments`): a misuse raises
+    :class:`~linkage.errors.InputError` naming the argument.
     """
+    from ..arguments import check_callable, check_flag, check_mechanism, check_rate, check_reals, check_text
     from ..errors import InputError
-    from ..problems.loops import load
+    from ..solve import check_criteria
 
-    m = mechanism if isinstance(mechanism, Mechanism) else load(mechanism)
+    # the front door: every argument checked once, InputError naming it
+    m = check_mechanism("mechanism", mechanism)
+    values = check_reals("values", values, most=MAX_POSITIONS)
+    check_criteria(tol, 0.0, None, max_iter)
+    check_text("branch", branch)
+    check_callable("progress", progress)
+    check_flag("joints", joints)
+    if batch is not None:
+        check_flag("batch", batch)
+    per_s = "rad/s" if m.driver.kind == "angle" else f"{m.length_unit or 'length unit'}/s"
+    if speed is not None:
+        speed = check_rate("speed", speed, per_s)
+    accel = check_rate("accel", accel, f"{per_s}^2")
+    if speed is None and accel != 0.0:
+        raise InputError("accel needs speed (the driver's velocity)")
     if method not in ("newton", "newton-fd", "lm"):
         raise InputError(f"unknown method {method!r}; choose from newton, newton-fd, lm")
     if branch is not None:

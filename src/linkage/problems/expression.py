@@ -508,6 +508,10 @@ def equation_problem(equation: str, g: str | None = None) -> ScalarProblem:
 
     Without ``g``, fixed-point iteration is not available for the equation.
     """
+    from ..arguments import check_text
+
+    check_text("equation", equation, optional=False)
+    check_text("g", g)
     f = Expression.parse(equation)
     gx = Expression.parse(g, what="iteration function g") if g is not None else None
     return ScalarProblem(

@@ -41,6 +41,9 @@ class FourBarCoefficients(NamedTuple):
 
 def coefficients_from_links(a: float, b: float, c: float, d: float) -> FourBarCoefficients:
     """R1, R2, R3 from the link lengths (input a, coupler b, output c, ground d)."""
+    from ..arguments import check_number
+
+    a, b, c, d = (check_number(f"link length {name}", v) for name, v in zip("abcd", (a, b, c, d)))
     for name, v in zip("abcd", (a, b, c, d)):
         if not math.isfinite(v) or v <= 0.0:
             raise InputError(f"link length {name} must be a finite number > 0, got {v!r}")
@@ -71,9 +74,10 @@ def fourbar_equation(
     g'(phi) = sin(alpha - phi) / (R2 sqrt(1 - u^2)), and a default start/bracket: the
     first sign change of f on a 10-degree grid over [0, 180] (see default_start).
     """
-    for name, v in (("alpha", alpha_deg), ("R1", r1), ("R2", r2), ("R3", r3)):
-        if not math.isfinite(v):
-            raise InputError(f"{name} must be finite, got {v!r}")
+    from ..arguments import check_number
+
+    alpha_deg, r1, r2, r3 = (check_number(name, v) for name, v in
+                             (("alpha", alpha_deg), ("R1", r1), ("R2", r2), ("R3", r3)))
     if r2 == 0.0:
         raise InputError("R2 must be non-zero (it divides in the fixed-point form)")
     alpha = alpha_deg * DEG

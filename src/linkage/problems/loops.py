@@ -192,7 +192,9 @@ def _requantify(q: Quantity, value: float) -> Quantity:
 
 def load(path: str | Path) -> Mechanism:
     """Read and validate a mechanism file; every error names the file and the key."""
-    p = Path(path)
+    from ..arguments import check_path
+
+    p = Path(check_path("path", path))
     if sys.version_info >= (3, 11):
         import tomllib
     else:  # pragma: no cover

@@ -1,0 +1,332 @@
+"""The checks every public function runs on its arguments, once, at its front door.
+
+Each check returns the value in the form the internals use (a float, an int, a list of
+floats) or raises :class:`~linkage.errors.InputError` with one line that names the
+argument and shows the offending value, so a misuse never surfaces as a TypeError,
+ValueError or IndexError from deep inside, and never runs on with a silently changed
+value (``n=2.7`` truncated, ``workers=-1``). The command line reaches the same checks
+(its option names are passed as the argument's name).
+
+Decisions recorded here, once:
+
+- A whole number is an ``int`` (or a numpy integer), never a ``bool`` and never a float,
+  even an integral one: ``2.7`` is refused, not truncated, and so is ``2.0``.
+- A real number is anything ``float()`` accepts except ``bool``, ``str``/``bytes`` and
+  complex numbers; it must be finite.
+- Driver values are a sequence (list, tuple, range, 1-D numpy array) of finite reals. A
+  generator or iterator is refused: a sweep needs the count first, and reading it would
+  consume it.
+- Rates in the API are numbers in internal units (rad/s and rad/s^2, or length unit/s and
+  /s^2); unit strings such as ``"10rpm"`` belong to the command line's ``--speed`` and are
+  refused here with the conversion to use.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from typing import Any
+
+from .errors import InputError
+
+MAX_RATE = 1e12
+"""The largest |speed| or |accel| accepted (the command line's --speed bound too)."""
+
+MAX_THREADS = min(256, 4 * (os.cpu_count() or 1))
+"""Local scan workers as threads: 4 per core, at most 256 (each holds a chunk's arrays)."""
+
+MAX_PROCESSES = max(2, os.cpu_count() or 1)
+"""Local scan workers as processes: one per core (each is a whole interpreter)."""
+
+MAX_SEED = 2**64 - 1
+"""numpy's generators take any whole number >= 0; this bound keeps the message short."""
+
+SCHEDULERS = ("threads", "processes", "synchronous")
+"""The local dask schedulers a scan may name (else the address of a cluster)."""
+
+
+def _shown(value: Any) -> str:
+    """The offending value for a message: its repr, cut short."""
+    try:
+        text = repr(value)
+    except Exception:  # a user object whose repr fails still gets a message
+        text = f"<{type(value).__name__}>"
+    text = " ".join(text.split())
+    return text if len(text) <= 60 else f"{text[:50]}...({type(value).__name__})"
+
+
+def is_real(value: Any) -> bool:
+    """True for an int, a float or a numpy real scalar (not a bool, a string or a complex)."""
+    if isinstance(value, (bool, str, bytes, complex)):
+        return False
+    if type(value) is float or type(value) is int:
+        return True
+    kind = getattr(getattr(value, "dtype", None), "kind", None)
+    if kind is not None:
+        return kind in "iuf" and getattr(value, "ndim", 0) == 0
+    try:
+        float(value)
+    except (TypeError, ValueError, OverflowError):
+        return False
+    return not hasattr(value, "imag") or getattr(value, "imag", 0) == 0
+
+
+def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: bool = True) -> float:
+    """A finite float (and > 0 or >= 0 when asked), or an InputError naming the value.
+    Whatever ``float()`` reads is a number here (a numeric string too), except a complex
+    one: numpy would drop its imaginary part with only a warning."""
+    if type(value) is not float and getattr(getattr(value, "dtype", None), "kind", "") == "c":
+        raise InputError(f"{name} must be a real number, got {_shown(value)}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"{name} must be a number, got {_shown(value)}") from None
+    if not math.isfinite(v):
+        raise InputError(f"{name} must be finite, got {v!r}")
+    if positive and (v < 0.0 or (v == 0.0 and not allow_zero)):
+        raise InputError(f"{name} must be {'>' if not allow_zero else '>='} 0, got {v!r}")
+    return v
+
+
+def check_whole(name: str, value: Any, lo: int = 1, hi: int | None = None, why: str = "") -> int:
+    """An int in [lo, hi] (no bools, no floats), or InputError: "NAME must be a whole
+    number from LO to HI, got V" (``why`` says where HI comes from)."""
+    import operator
+
+    if hi is None:
+        span = f">= {lo:,}"
+    else:
+        span = f"from {lo:,} to {'2**64 - 1' if hi == MAX_SEED else f'{hi:,}'}"
+    if isinstance(value, bool) or isinstance(value, float):
+        raise InputError(f"{name} must be a whole number {span}{why}, got {_shown(value)}")
+    try:
+        n = operator.index(value)
+    except TypeError:
+        raise InputError(f"{name} must be a whole number {span}{why}, got {_shown(value)}") from None
+    if n < lo or (hi is not None and n > hi):
+        shown = str(n) if abs(n) < 10**30 else f"about {'-' if n < 0 else ''}1e{len(str(abs(n))) - 1}"
+        raise InputError(f"{name} must be a whole number {span}{why}, got {shown}")
+    return n
+
+
+def check_flag(name: str, value: Any) -> bool:
+    """True or False (numpy's bool too), nothing else."""
+    if isinstance(value, bool) or type(value).__name__ == "bool_":
+        return bool(value)
+    raise InputError(f"{name} must be True or False, got {_shown(value)}")
+
+
+def check_text(name: str, value: Any, *, optional: bool = True) -> str | None:
+    """A string (or None when ``optional``)."""
+    if value is None and optional:
+        return None
+    if not isinstance(value, str):
+        raise InputError(f"{name} must be {'None or ' if optional else ''}a string, got {_shown(value)}")
+    return value
+
+
+def check_callable(name: str, value: Any, *, optional: bool = True) -> Any:
+    """A callable (or None when ``optional``)."""
+    if value is None and optional:
+        return None
+    if not callable(value):
+        raise InputError(f"{name} must be {'None or ' if optional else ''}a function, got {_shown(value)}")
+    return value
+
+
+def check_reals(name: str, values: Any, length: int | None = None, labels: Sequence[str] = (),
+                most: int | None = None) -> list[float]:
+    """A 1-D sequence of finite reals as a list of floats (``length`` of them when given, at
+    most ``most``, counted before any is read; ``labels`` name the entries in the message),
+    or InputError naming the first bad entry."""
+    if values is None or isinstance(values, (str, bytes, Mapping)) or is_real(values):
+        raise InputError(f"{name} must be a sequence of numbers (a list, tuple or 1-D array), "
+                         f"got {_shown(values)}")
+    listed = isinstance(values, Sequence) or hasattr(values, "__array__")
+    if isinstance(values, Iterator) or not listed:
+        raise InputError(f"{name} must be a sequence of numbers (a list, tuple or 1-D array), got "
+                         f"{type(values).__name__}: a generator or iterator is read once and has no "
+                         "length; pass list(...) of it")
+    ndim = getattr(values, "ndim", 1)
+    if ndim != 1:
+        raise InputError(f"{name} must be 1-D, got an array of shape {getattr(values, 'shape', '?')}")
+    if most is not None and len(values) > most:
+        raise InputError(f"{name} has {len(values):,} entries, more than {most:,}")
+    if length is not None and len(values) != length:
+        what = f" ({', '.join(labels)})" if labels else ""
+        raise InputError(f"{name} needs {length} values{what}, got {len(values)}")
+    kind = getattr(getattr(values, "dtype", None), "kind", None)
+    if kind is None and len(values) > 1000:
+        # a long list: numpy reads it at C speed (a short one is checked without it, so a
+        # scalar solve never imports numpy); anything but reals falls to the loop below
+        import numpy as np
+
+        try:
+            probe = np.asarray(values)
+        except (ValueError, TypeError):
+            probe = None
+        if probe is not None and probe.ndim == 1 and probe.dtype.kind in "iuf":
+            values, kind = probe, probe.dtype.kind
+    if kind is not None and kind in "iuf":
+        import numpy as np
+
+        arr = np.asarray(values, dtype=float)
+        bad = np.flatnonzero(~np.isfinite(arr))
+        if bad.size == 0:
+            return arr.tolist()  # type: ignore[no-any-return]
+        k = int(bad[0])
+        raise InputError(f"{name}[{labels[k] if labels else k}] must be finite, got {arr[k]!r}")
+    out = []
+    for k, v in enumerate(values):
+        if type(v) is float and v - v == 0.0:
+            out.append(v)
+            continue
+        where = labels[k] if k < len(labels) else k
+        if not is_real(v):
+            raise InputError(f"{name}[{where}] must be a real number, got {_shown(v)}")
+        x = float(v)
+        if not math.isfinite(x):
+            raise InputError(f"{name}[{where}] must be finite, got {x!r}")
+        out.append(x)
+    return out
+
+
+def check_rate(name: str, value: Any, unit: str) -> float:
+    """A driver speed or acceleration: a finite number of internal units (``unit``, e.g.
+    rad/s) with |value| <= MAX_RATE. A string such as "10rpm" is refused: units are for the
+    command line's --speed/--accel."""
+    if isinstance(value, (str, bool)):
+        raise InputError(f"{name} must be a number in {unit} (the API takes internal units: "
+                         f"rpm x pi/30 = rad/s, deg/s x pi/180 = rad/s), got {_shown(value)}")
+    v = check_number(name, value)
+    if abs(v) > MAX_RATE:
+        raise InputError(f"{name} must be at most {MAX_RATE:g} in size, got {v!r}")
+    return v
+
+
+def check_workers(name: str, value: Any, scheduler: str | None) -> int | None:
+    """Local workers: None (one per core), or a whole number up to MAX_PROCESSES for the
+    processes scheduler and MAX_THREADS otherwise."""
+    if value is None:
+        return None
+    if scheduler == "processes":
+        return check_whole(name, value, 1, MAX_PROCESSES,
+                           f" (one process per core: this machine has {os.cpu_count() or 1})")
+    return check_whole(name, value, 1, MAX_THREADS,
+                       f" (at most 4 threads per core, and 256: this machine has "
+                       f"{os.cpu_count() or 1} cores)")
+
+
+def check_scan_options(*, seed: Any = 0, samples: Any = None, top: Any = None, chunk: Any = None,
+                       workers: Any = None, scheduler: Any = None, max_designs: int,
+                       prefix: str = "") -> None:
+    """The scan options shared by ``linkage.scan_designs`` and ``linkage scan`` (``prefix``
+    is "--" for the command line's names)."""
+    check_text(f"{prefix}scheduler", scheduler)
+    if scheduler is not None and "://" not in scheduler and scheduler not in SCHEDULERS:
+        raise InputError(f"{prefix}scheduler must be threads, processes, synchronous or "
+                         f"tcp://HOST:PORT, got {_shown(scheduler)}")
+    check_whole(f"{prefix}seed", seed, 0, MAX_SEED)
+    if samples is not None:
+        check_whole(f"{prefix}samples", samples, 1, max_designs)
+    if top is not None:
+        check_whole(f"{prefix}top", top, 1)
+    if chunk is not None:
+        check_whole(f"{prefix}chunk", chunk, 1, max_designs)
+    check_workers(f"{prefix}workers", workers, scheduler)
+
+
+def check_vary(vary: Any, max_designs: int) -> list[tuple[str, float, float, int | None]]:
+    """``scan_designs``' ``vary``: a mapping of parameter name to (lo, hi) or (lo, hi, n),
+    as (name, lo, hi, n) with finite bounds and a whole n."""
+    if not isinstance(vary, Mapping):
+        raise InputError("vary must be a mapping of parameter name to (lo, hi) or (lo, hi, n), "
+                         f"got {_shown(vary)}")
+    out = []
+    for name, spec in vary.items():
+        if not isinstance(name, str):
+            raise InputError(f"vary's keys must be parameter names (strings), got {_shown(name)}")
+        label = f"vary[{name!r}]"
+        listed = isinstance(spec, Sequence) or hasattr(spec, "__array__")
+        if isinstance(spec, (str, bytes, Mapping)) or not listed or len(spec) not in (2, 3):
+            raise InputError(f"{label} must be (lo, hi) or (lo, hi, n), got {_shown(spec)}")
+        lo = check_number(f"{label} lo", spec[0])
+        hi = check_number(f"{label} hi", spec[1])
+        n = check_whole(f"{label} n", spec[2], 1, max_designs) if len(spec) == 3 else None
+        out.append((name, lo, hi, n))
+    return out
+
+
+def check_mechanism(name: str, value: Any) -> Any:
+    """A Mechanism, or a path (str or os.PathLike) to a mechanism file, loaded."""
+    from .problems.loops import Mechanism, load
+
+    if isinstance(value, Mechanism):
+        return value
+    if isinstance(value, (str, os.PathLike)):
+        return load(value)
+    raise InputError(f"{name} must be a Mechanism or a path to a mechanism file, got {_shown(value)}")
+
+
+def check_path(name: str, value: Any) -> Any:
+    """A file path: a str or an os.PathLike."""
+    if isinstance(value, (str, os.PathLike)):
+        return value
+    raise InputError(f"{name} must be a path to a mechanism file (a str or os.PathLike), "
+                     f"got {_shown(value)}")
+
+
+def real_result(name: str, value: Any, where: str) -> None:
+    """InputError unless a user function's return ``value`` is a real number (or a complex
+    one, which the solvers report as a domain error)."""
+    if not (is_real(value) or isinstance(value, complex)):
+        raise InputError(f"{name} must return a real number, got {_shown(value)} {where}")
+
+
+def real_vector(name: str, value: Any, n: int, where: str) -> None:
+    """InputError unless ``value`` (a residual F returned) is a sequence of n real numbers
+    (not complex: the system solvers work in real arithmetic)."""
+    if type(value) is list and all(type(v) is float for v in value):
+        return  # the common case, checked in a fraction of a microsecond
+    try:
+        size = len(value)
+    except TypeError:
+        size = None
+    if size is None or isinstance(value, (str, bytes)):
+        raise InputError(f"{name} must return a sequence of {n} real numbers, got {_shown(value)} {where}")
+    if size != n:
+        return  # the caller's own check names the count ("the system has 1 equations ...")
+    for k, v in enumerate(value):
+        if not is_real(v):
+            raise InputError(f"{name} must return {n} real numbers; entry {k} is {_shown(v)} {where}")
+
+
+def real_matrix(name: str, value: Any, n: int, where: str) -> None:
+    """InputError unless ``value`` (a Jacobian jac returned) is n rows of n numbers."""
+    shape = f"a {n} x {n} matrix (a sequence of {n} rows of {n} numbers)"
+    try:
+        rows = list(value)
+    except TypeError:
+        raise InputError(f"{name} must return {shape}, got {_shown(value)} {where}") from None
+    if isinstance(value, (str, bytes)) or len(rows) != n:
+        raise InputError(f"{name} must return {shape}, got {_shown(value)} {where}")
+    for row in rows:
+        try:
+            cells = list(row)
+        except TypeError:
+            raise InputError(f"{name} must return {shape}, got a row {_shown(row)} {where}") from None
+        if len(cells) != n or not all(is_real(c) for c in cells):
+            raise InputError(f"{name} must return {shape}, got a row {_shown(row)} {where}")
+
+
+def guarded(call: Callable[[], Any], diagnose: Callable[[], None]) -> Any:
+    """``call()``; if it raises TypeError or IndexError (what a user function that returns
+    the wrong kind of value causes inside a solver), run ``diagnose``, which raises an
+    InputError naming that function when it finds the fault, and otherwise re-raise: on
+    valid input this costs nothing."""
+    try:
+        return call()
+    except (TypeError, IndexError):
+        diagnose()
+        raise
