@@ -177,6 +177,18 @@ def test_a_scan_of_a_file_with_1000_points_is_refused_and_a_task_stays_bounded(c
     assert pick_chunk(m, 360, None, 1000, 2) == 1000  # only 2 designs: a task of 2
 
 
+def test_a_sorted_scan_that_would_hold_every_record_is_refused_before_solving(cli, monkeypatch):
+    import linkage.scan as scan
+
+    monkeypatch.setattr(scan, "run_chunk", lambda *a: pytest.fail("solved before refusing"))
+    big = ["--vary", "r2=20:60:3000", "--vary", "r3=80:160:1000", "--sort", "theta4_range"]
+    run = cli("scan", str(CRANK_ROCKER), *big, "-f", "csv")
+    one_line_exit_2(run)
+    assert "3,000,000 designs x 19 columns is 57,000,000 values" in run.err
+    with pytest.raises(InputError, match="give top of at most"):
+        scan.scan(str(CRANK_ROCKER), {"r2": (20, 60, 3000), "r3": (80, 160, 1000)})
+
+
 def test_ten_million_samples_of_ten_parameters_are_refused_before_drawing(cli, monkeypatch):
     import linkage.scan as scan
 

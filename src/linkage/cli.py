@@ -815,7 +815,7 @@ def scan(
     from .kinematics.sweep import driver_values
     from .problems.loops import from_text
     from .render.scan import RecordSink, scan_blocks
-    from .scan import Keeper, ScanJob, feed, parse_vary, pick_chunk, prepare
+    from .scan import Keeper, ScanJob, check_held, feed, parse_vary, pick_chunk, prepare
     from .solve import check_criteria
 
     if output is not None and str(output) == "-":
@@ -855,6 +855,8 @@ def scan(
         spec = [spec[0], *picked]
     if desc and sort is None:
         raise InputError("--desc orders by --sort: give --sort COLUMN")
+    if sort is not None and fmt not in ("table", "plain"):
+        check_held(plan.total, len(setup.spec), top, f"--sort {sort} with --format {fmt}")
     overrides = tuple((k, float(v)) for k, v in parse_assignments("--set", set_ or []).items())
     job = ScanJob(text, str(file), overrides, plan.names, tuple(values), chosen, tol)
     size = pick_chunk(mechanism, len(values), chosen, chunk, plan.total)
@@ -1336,14 +1338,14 @@ class _ClosedStdout:
 
         raise _StdoutClosed(errno.EBADF, os.strerror(errno.EBADF) + " (standard output is closed)")
 
+    def fileno(self) -> int:
+        return self.write("")  # descriptor 1 is /dev/null now: writing there would lose output
+
     def flush(self) -> None:
         return None
 
     def isatty(self) -> bool:
         return False
-
-    def fileno(self) -> int:
-        return 1
 
 
 def main() -> None:

@@ -41,6 +41,9 @@ CHUNK_CELLS = 16 * CHUNK_POSITIONS
 task: about 26 MB of results, whatever the file's size or --chunk."""
 MAX_SAMPLE_VALUES = 20_000_000
 """--samples x varied parameters: the drawn designs are held in memory (160 MB)."""
+MAX_HELD_VALUES = 50_000_000
+"""Designs x record columns a scan may hold at once (400 MB): a sorted file without --top,
+or the Python API's returned columns; streamed output holds one chunk."""
 
 
 @dataclass(frozen=True)
@@ -201,6 +204,16 @@ def cell_width(m: Mechanism) -> int:
     """Numbers a task holds per design and position: status, each unknown, x and y of each
     point."""
     return 1 + len(m.unknowns) + 2 * len(m.points)
+
+
+def check_held(designs: int, columns: int, top: int | None, what: str, option: str = "--top") -> None:
+    """Refuse, before any design is solved, a scan that would hold more than MAX_HELD_VALUES
+    record values at once (``what`` says why they are held, ``option`` names top)."""
+    held = min(designs, top if top is not None else designs) * columns
+    if held > MAX_HELD_VALUES:
+        raise InputError(f"{what} holds every record: {designs:,} designs x {columns} columns is "
+                         f"{held:,} values, more than {MAX_HELD_VALUES:,}; give {option} "
+                         f"of at most {MAX_HELD_VALUES // columns:,} designs, or fewer designs")
 
 
 def pick_chunk(m: Mechanism, positions: int, branch: str | None, chunk: int | None,
@@ -564,6 +577,7 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
         values = [float(k) for k in range(360)]
     setup = prepare(m, varies, samples=samples, seed=seed, sampling=sampling, values=list(values),
                     branch=branch, tol=tol, where=where, sort=sort)
+    check_held(setup.plan.total, len(setup.spec), top, "a scan returned as columns", "top")
     job = ScanJob("", m.source, (), setup.plan.names, tuple(setup.values), setup.branch, tol, m)
     keeper = Keeper(sort, descending, top, None)
     feed(keeper, job, setup, pick_chunk(m, len(setup.values), setup.branch, chunk,
