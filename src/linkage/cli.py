@@ -346,7 +346,8 @@ def parse_motion(speed: str | None, accel: str | None, mechanism: Any) -> tuple[
          "rpm/s": math.pi / 30.0} if angle else {"": 1.0, f"{unit}/s^2": 1.0, f"{unit}/s2": 1.0},
     )
     out = []
-    for option, text, units in (("--speed", speed, tables[0]), ("--accel", accel or "0", tables[1])):
+    accel = "0" if accel is None else accel  # an empty --accel '' is refused, not taken as 0
+    for option, text, units in (("--speed", speed, tables[0]), ("--accel", accel, tables[1])):
         m = re.fullmatch(r"\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*", text)
         if m is None or m.group(2) not in units:
             known = ", ".join(u for u in units if u) or "none"
@@ -615,7 +616,7 @@ def sweep(
     equation_only = {"--r1": r1, "--r2": r2, "--r3": r3, "--links": links}
     if file is None:
         given = [k for k, v in {"--branch": branch, "--set": set_, "--batch": batch, "--path": path,
-                                "--speed": speed, "--accel": accel}.items() if v]
+                                "--speed": speed, "--accel": accel}.items() if v or v == ""]
         if given:
             raise InputError(f"{', '.join(given)} apply to a mechanism FILE")
         _sweep_equation(a, b, step, points, method, r1, r2, r3, links, tol, out_fmt, output, digits, plot)
@@ -866,9 +867,18 @@ def scan(
     from .arguments import check_scan_options
     from .files import read_input
     from .kinematics.sweep import driver_values
-    from .problems.loops import load
+    from .problems.loops import from_text
     from .render.scan import RecordSink, scan_blocks
-    from .scan import MAX_DESIGNS, Keeper, ScanJob, chunk_size, feed, parse_vary, prepare
+    from .scan import (
+        MAX_DESIGNS,
+        Keeper,
+        ScanJob,
+        check_held,
+        feed,
+        parse_vary,
+        pick_chunk,
+        prepare,
+    )
     from .solve import check_criteria
 
     if output is not None and str(output) == "-":
@@ -887,7 +897,7 @@ def scan(
         raise InputError("give at least one --vary NAME=LO:HI[:N]")
     varies = [parse_vary(v) for v in vary]
     text = read_input(file)
-    mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
+    mechanism = from_text(text, str(file)).with_values(parse_assignments("--set", set_ or []), {})
     angle = mechanism.driver.kind == "angle"
     if not angle and (start is None or stop is None):
         raise InputError(f"{mechanism.driver.name} is a length: give --from and --to")
@@ -907,9 +917,11 @@ def scan(
         spec = [spec[0], *picked]
     if desc and sort is None:
         raise InputError("--desc orders by --sort: give --sort COLUMN")
+    if sort is not None and fmt not in ("table", "plain"):
+        check_held(plan.total, len(setup.spec), top, f"--sort {sort} with --format {fmt}")
     overrides = tuple((k, float(v)) for k, v in parse_assignments("--set", set_ or []).items())
     job = ScanJob(text, str(file), overrides, plan.names, tuple(values), chosen, tol)
-    size = chunk or chunk_size(mechanism, len(values), chosen)
+    size = pick_chunk(mechanism, len(values), chosen, chunk, plan.total)
     as_table = fmt in ("table", "plain")
     meta = {"mechanism": mechanism.name, "source": str(file), "branch": chosen,
             "driver": {"name": mechanism.driver.name, "unit": mechanism.driver.unit, "from": a,
@@ -1303,10 +1315,12 @@ def run_cli(argv: list[str] | None = None) -> int:
         typer.echo(f"error: {exc}", err=True)
         return 2
     except KeyboardInterrupt:
-        typer.echo("error: interrupted", err=True)
-        return 130
+        return _interrupted()
     except BrokenPipeError:
         typer.echo("error: cannot write to standard output: the pipe was closed", err=True)
+        return 2
+    except _StdoutClosed as exc:  # help or version text on a closed standard output
+        typer.echo(f"error: cannot write to standard output: {exc.strerror}", err=True)
         return 2
     except RecursionError:
         typer.echo("error: the input is nested too deeply to read", err=True)
@@ -1326,11 +1340,82 @@ def run_cli(argv: list[str] | None = None) -> int:
         return 1
     if rv == 130:
         # typer turns Ctrl-C into a silent return of 130 (no command returns a number)
-        typer.echo("error: interrupted", err=True)
+        return _interrupted()
     return rv if isinstance(rv, int) else 0
 
 
+_terminated: list[int] = []
+"""The signal number once SIGTERM arrived (see :func:`_on_sigterm`)."""
+
+
+def _on_sigterm(signum: int, frame: Any) -> None:
+    """SIGTERM is handled as Ctrl-C is: the KeyboardInterrupt unwinds every open output
+    (files.atomic_target removes its partial file), then one line and 128 + 15."""
+    _terminated.append(signum)
+    raise KeyboardInterrupt
+
+
+def _interrupted() -> int:
+    if _terminated:
+        typer.echo("error: terminated", err=True)
+        return 128 + _terminated[0]
+    typer.echo("error: interrupted", err=True)
+    return 130
+
+
+def _standard_streams() -> None:
+    """A closed standard stream (``>&-``, ``<&-``) gets /dev/null on its descriptor, so no
+    file opened later takes its number; standard output then refuses every write (one
+    error line, exit 2) and standard input reads as closed (sys.stdin stays None)."""
+    import io
+    import os
+
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+            continue
+        except OSError:
+            pass
+        null = os.open(os.devnull, os.O_RDWR)
+        if null != fd:
+            os.dup2(null, fd)
+            os.close(null)
+        if fd == 1:
+            sys.stdout = _ClosedStdout()
+        elif fd == 2:
+            sys.stderr = io.TextIOWrapper(io.FileIO(2, "w", closefd=False), write_through=True)
+
+
+class _StdoutClosed(OSError):
+    """A write to a standard output that was closed before the run."""
+
+
+class _ClosedStdout:
+    """Standard output that was closed before the run: every write fails as a closed
+    descriptor does."""
+
+    def write(self, text: str) -> int:
+        import errno
+        import os
+
+        raise _StdoutClosed(errno.EBADF, os.strerror(errno.EBADF) + " (standard output is closed)")
+
+    def fileno(self) -> int:
+        return self.write("")  # descriptor 1 is /dev/null now: writing there would lose output
+
+    def flush(self) -> None:
+        return None
+
+    def isatty(self) -> bool:
+        return False
+
+
 def main() -> None:
+    import signal
+
+    _standard_streams()
+    with contextlib.suppress(ValueError, OSError):  # not the main thread, or no signals
+        signal.signal(signal.SIGTERM, _on_sigterm)
     code = run_cli()
     try:
         sys.stdout.flush()

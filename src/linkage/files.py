@@ -15,14 +15,85 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import stat
 from collections.abc import Iterator, Sequence
 from pathlib import Path
+from typing import Any
 
 from .errors import InputError, OutputError, ParseError
 
 MAX_INPUT_BYTES = 1_000_000
 """A mechanism file is a page of TOML; a megabyte is far beyond any real one."""
+
+MAX_TOML_NESTING = 32
+"""Deepest nesting of arrays, inline tables and table headers: a mechanism file needs 3."""
+MAX_TOML_KEY_PARTS = 32
+"""Most parts in one dotted key or header (``a.b.c`` has 3): a mechanism file needs 3.
+tomllib's time grows with the square of a key's parts (160k parts: 55 s), so both are
+checked on the text, before it is parsed."""
+
+# an unclosed string runs to the end of its line (or text): never a failed match, so the
+# pass stays linear (tomllib then reports the unclosed string)
+_TOML_STRING = "|".join((
+    r'"{3}(?:\\[\s\S]|[^\\])*?(?:"{3,5}|\Z)',  # multi-line basic (escapes allowed)
+    r"'{3}[\s\S]*?(?:'{3,5}|\Z)",  # multi-line literal
+    r'"(?:\\.|[^"\\\n])*"?',  # basic
+    r"'[^'\n]*'?",  # literal
+))
+_TOML_TOKEN = re.compile(
+    rf"(?P<string>{_TOML_STRING})|(?P<comment>#[^\n]*)|(?P<word>[A-Za-z0-9_-]+)|(?P<space>[ \t]+)"
+    r"|(?P<open>[\[{])|(?P<close>[\]}])|(?P<dot>\.)|(?P<other>[^\[\]{}.\"'#A-Za-z0-9_ \t-]+)")
+
+
+def check_toml_shape(text: str, where: str) -> None:
+    """Refuse TOML nested deeper than MAX_TOML_NESTING or with a dotted key (or header) of
+    more than MAX_TOML_KEY_PARTS parts, in one linear pass over the text. Strings and
+    comments are skipped; a run of words, strings and dots counts as one key (a float's
+    one dot makes it a run of two, and no valid value outside a string has more)."""
+    depth = 0
+    parts = 1
+    for tok in _TOML_TOKEN.finditer(text):
+        kind = tok.lastgroup
+        if kind == "dot":
+            parts += 1
+            if parts > MAX_TOML_KEY_PARTS:
+                line = text.count("\n", 0, tok.start()) + 1
+                raise ParseError(f"{where}: line {line}: a dotted key with more than "
+                                 f"{MAX_TOML_KEY_PARTS} parts; a mechanism file needs a few")
+        elif kind in ("word", "string", "space"):
+            continue
+        else:
+            parts = 1
+            if kind == "open":
+                depth += 1
+                if depth > MAX_TOML_NESTING:
+                    line = text.count("\n", 0, tok.start()) + 1
+                    raise ParseError(f"{where}: line {line}: arrays and tables nested more than "
+                                     f"{MAX_TOML_NESTING} deep; a mechanism file needs a few")
+            elif kind == "close":
+                depth = max(0, depth - 1)
+
+
+def parse_toml(text: str, where: str) -> dict[str, Any]:
+    """The TOML document in ``text``, its shape checked first; any failure a ParseError
+    naming ``where``."""
+    import sys
+
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover
+        import tomli as tomllib
+    check_toml_shape(text, where)
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ParseError(f"{where}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ParseError(f"{where}: not valid TOML: nested too deeply") from None
+    except (ValueError, OverflowError, MemoryError) as exc:
+        # e.g. an integer of more digits than Python converts (ValueError)
+        raise ParseError(f"{where}: not valid TOML: {exc}") from None
 
 
 def read_input(path: Path, what: str = "mechanism file") -> str:
@@ -31,6 +102,8 @@ def read_input(path: Path, what: str = "mechanism file") -> str:
     if str(path) == "-":
         import sys
 
+        if sys.stdin is None:
+            raise ParseError("standard input is closed: give a FILE, or - with input piped in")
         data = sys.stdin.buffer.read(MAX_INPUT_BYTES + 1) if hasattr(sys.stdin, "buffer") else \
             sys.stdin.read(MAX_INPUT_BYTES + 1).encode()
         if len(data) > MAX_INPUT_BYTES:

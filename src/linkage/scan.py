@@ -39,6 +39,14 @@ CHUNK_DESIGNS_MAX = 20_000
 """At most this many designs per task, whatever the positions: records stay small."""
 CHUNK_DESIGNS_SWEEP = 16
 """Designs per task where every design is swept on its own (tens of ms per design)."""
+CHUNK_CELLS = 16 * CHUNK_POSITIONS
+"""Designs x positions x numbers held per position (unknowns, and two per point) in one
+task: about 26 MB of results, whatever the file's size or --chunk."""
+MAX_SAMPLE_VALUES = 20_000_000
+"""--samples x varied parameters: the drawn designs are held in memory (160 MB)."""
+MAX_HELD_VALUES = 50_000_000
+"""Designs x record columns a scan may hold at once (400 MB): a sorted file without --top,
+or the Python API's returned columns; streamed output holds one chunk."""
 
 
 @dataclass(frozen=True)
@@ -118,6 +126,10 @@ class DesignPlan:
                 raise InputError(f"--samples must be between 1 and {MAX_DESIGNS:,}, got {samples}")
             if method not in ("lhs", "random"):
                 raise InputError(f"--sampling must be lhs or random, got {method!r}")
+            if samples * len(varies) > MAX_SAMPLE_VALUES:
+                raise InputError(f"--samples {samples:,} x {len(varies)} varied parameters is "
+                                 f"{samples * len(varies):,} values, more than the "
+                                 f"{MAX_SAMPLE_VALUES:,} a scan holds; use fewer samples")
             total = samples
             self.samples = _draw(varies, samples, seed, method)
         if total > MAX_DESIGNS:
@@ -144,7 +156,10 @@ def _draw(varies: Sequence[Vary], n: int, seed: int, method: str) -> np.ndarray:
             u[:, j] = (rng.permutation(n) + u[:, j]) / n
     lo = np.array([v.lo for v in varies])
     hi = np.array([v.hi for v in varies])
-    return lo + u * (hi - lo)
+    # in place, the same operations as lo + u * (hi - lo): one array of the designs in memory
+    u *= hi - lo
+    u += lo
+    return u
 
 
 # --- one task ---------------------------------------------------------------------------------
@@ -167,14 +182,9 @@ class ScanJob:
 
 @functools.lru_cache(maxsize=8)
 def job_mechanism(text: str, source: str, overrides: tuple[tuple[str, float], ...]) -> Mechanism:
-    if sys.version_info >= (3, 11):
-        import tomllib
-    else:  # pragma: no cover
-        import tomli as tomllib
+    from .problems.loops import from_text
 
-    from .problems.loops import parse_mechanism
-
-    return parse_mechanism(tomllib.loads(text), source).with_values(dict(overrides), {})
+    return from_text(text, source).with_values(dict(overrides), {})
 
 
 def run_chunk(job: ScanJob, start: int, designs: np.ndarray) -> dict[str, np.ndarray]:
@@ -187,9 +197,41 @@ def run_chunk(job: ScanJob, start: int, designs: np.ndarray) -> dict[str, np.nda
 
 
 def chunk_size(m: Mechanism, positions: int, branch: str | None) -> int:
+    most = max(1, CHUNK_CELLS // (max(positions, 1) * cell_width(m)))
     if engine_for(m, branch) != "sweep":
-        return max(1, min(CHUNK_DESIGNS_MAX, CHUNK_POSITIONS // max(positions, 1)))
-    return CHUNK_DESIGNS_SWEEP
+        return max(1, min(CHUNK_DESIGNS_MAX, CHUNK_POSITIONS // max(positions, 1), most))
+    return min(CHUNK_DESIGNS_SWEEP, most)
+
+
+def cell_width(m: Mechanism) -> int:
+    """Numbers a task holds per design and position: status, each unknown, x and y of each
+    point."""
+    return 1 + len(m.unknowns) + 2 * len(m.points)
+
+
+def check_held(designs: int, columns: int, top: int | None, what: str, option: str = "--top") -> None:
+    """Refuse, before any design is solved, a scan that would hold more than MAX_HELD_VALUES
+    record values at once (``what`` says why they are held, ``option`` names top)."""
+    held = min(designs, top if top is not None else designs) * columns
+    if held > MAX_HELD_VALUES:
+        raise InputError(f"{what} holds every record: {designs:,} designs x {columns} columns is "
+                         f"{held:,} values, more than {MAX_HELD_VALUES:,}; give {option} "
+                         f"of at most {MAX_HELD_VALUES // columns:,} designs, or fewer designs")
+
+
+def pick_chunk(m: Mechanism, positions: int, branch: str | None, chunk: int | None,
+               designs: int) -> int:
+    """Designs per task: ``chunk`` if given and a task's results (of at most ``designs``)
+    fit in CHUNK_CELLS numbers (else an InputError with the numbers), or :func:`chunk_size`."""
+    if chunk is None:
+        return chunk_size(m, positions, branch)
+    cells = min(chunk, designs) * positions * cell_width(m)
+    if cells > CHUNK_CELLS:
+        raise InputError(f"--chunk {chunk:,}: {min(chunk, designs):,} designs x {positions:,} positions x "
+                         f"{cell_width(m)} numbers is {cells:,}, more than {CHUNK_CELLS:,} per "
+                         f"task; use --chunk {max(1, CHUNK_CELLS // (positions * cell_width(m))):,} "
+                         "or less")
+    return chunk
 
 
 # --- metrics ---------------------------------------------------------------------------------
@@ -273,6 +315,8 @@ def run_chunks(job: ScanJob, plan: DesignPlan, size: int, *, scheduler: str | No
     without importing dask."""
     bounds = chunk_bounds(plan.total, size)
     remote = scheduler is not None and "://" in scheduler
+    if remote:
+        check_scheduler(scheduler)  # type: ignore[arg-type]
     if not remote and (len(bounds) == 1 or scheduler == "synchronous" or workers == 1):
         for a, b in bounds:
             yield run_chunk(job, a, plan.chunk(a, b))
@@ -307,6 +351,29 @@ def _local(job: ScanJob, plan: DesignPlan, bounds: list[tuple[int, int]], kind: 
         part = bounds[w:w + window]
         graph = {("chunk", i): (run_chunk, job, a, plan.chunk(a, b)) for i, (a, b) in enumerate(part)}
         yield from get(graph, [("chunk", i) for i in range(len(part))], num_workers=n)
+
+
+def check_scheduler(address: str) -> tuple[str, int]:
+    """The host and port of ``tcp://HOST:PORT``, after one quick connection attempt (a
+    closed port answers at once, where dask's client retries for its whole timeout);
+    anything else an InputError."""
+    import socket
+    from urllib.parse import urlsplit
+
+    try:
+        parts = urlsplit(address)
+        host, port = parts.hostname, parts.port
+    except ValueError as exc:  # a port beyond 65535 or not a number
+        raise InputError(f"--scheduler {address!r}: {exc}; give tcp://HOST:PORT") from None
+    if parts.scheme != "tcp" or not host or port is None or parts.path not in ("", "/"):
+        raise InputError(f"--scheduler {address!r}: give tcp://HOST:PORT (threads, processes and "
+                         "synchronous run here; only tcp:// clusters are supported)")
+    try:
+        socket.create_connection((host, port), timeout=5.0).close()
+    except OSError as exc:
+        raise InputError(f"cannot reach the dask scheduler at {address}: "
+                         f"{exc.strerror or exc}") from None
+    return host, port
 
 
 def _distributed(job: ScanJob, plan: DesignPlan, bounds: list[tuple[int, int]],
@@ -510,9 +577,11 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
     values = check_reals("values", values, most=MAX_SCAN_POSITIONS)
     setup = prepare(m, varies, samples=samples, seed=seed, sampling=sampling, values=list(values),
                     branch=branch, tol=tol, where=where, sort=sort)
+    check_held(setup.plan.total, len(setup.spec), top, "a scan returned as columns", "top")
     job = ScanJob("", m.source, (), setup.plan.names, tuple(setup.values), setup.branch, tol, m)
     keeper = Keeper(sort, descending, top, None)
-    feed(keeper, job, setup, chunk or chunk_size(m, len(setup.values), setup.branch),
+    feed(keeper, job, setup, pick_chunk(m, len(setup.values), setup.branch, chunk,
+                                        setup.plan.total),
          scheduler=scheduler, workers=workers)
     return keeper.result() or {c[0]: np.array([]) for c in setup.spec}
 

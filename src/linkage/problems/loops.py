@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import functools
 import math
-import sys
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -46,6 +46,14 @@ LENGTH_RANGE = (1e-100, 1e100)
 """Magnitudes a nonzero length may have: squares and products of two stay normal doubles."""
 
 ANGLE_LIMIT_DEG = 1e6
+
+MAX_LOOPS = 12
+"""Most loops in a file, so at most 24 unknowns: a real mechanism has 1 to 5 loops, and the
+dense LU of each Newton step costs the cube of the unknowns in pure Python."""
+MAX_VECTORS = 24
+"""Most vectors in one loop or one point's path."""
+MAX_POINTS = 24
+"""Most ``[points]``: each is a column of every position of a sweep or a scan."""
 """Largest |angle| in degrees: beyond it a degree has too few bits to follow a sweep."""
 
 
@@ -193,25 +201,17 @@ def _requantify(q: Quantity, value: float) -> Quantity:
 def load(path: str | Path) -> Mechanism:
     """Read and validate a mechanism file; every error names the file and the key."""
     from ..arguments import check_path
-
-    p = Path(check_path("path", path))
-    if sys.version_info >= (3, 11):
-        import tomllib
-    else:  # pragma: no cover
-        import tomli as tomllib
     from ..files import read_input
 
-    text = read_input(p)
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ParseError(f"{p}: not valid TOML: {exc}") from None
-    except RecursionError:
-        raise ParseError(f"{p}: not valid TOML: nested too deeply") from None
-    except (ValueError, OverflowError, MemoryError) as exc:
-        # e.g. an integer of more digits than Python converts (ValueError)
-        raise ParseError(f"{p}: not valid TOML: {exc}") from None
-    return parse_mechanism(doc, str(p))
+    p = Path(check_path("path", path))
+    return from_text(read_input(p), str(p))
+
+
+def from_text(text: str, source: str) -> Mechanism:
+    """A mechanism from the text of a file (read once: ``-`` cannot be read twice)."""
+    from ..files import parse_toml
+
+    return parse_mechanism(parse_toml(text, source), source)
 
 
 def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:
@@ -220,6 +220,7 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
 
     allowed = {"name", "description", "length_unit", "closed_form", "parameters", "driver",
                "unknowns", "loops", "notes", "points"}
+    _check_printable(doc, fail)
     for key in doc:
         if key not in allowed:
             raise fail(key, f"unknown key (expected one of {', '.join(sorted(allowed))})")
@@ -283,6 +284,9 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
     unk_doc = doc.get("unknowns")
     if not isinstance(unk_doc, Mapping) or not unk_doc:
         raise fail("unknowns", "missing: list each unknown with its guess and unit")
+    if len(unk_doc) > 2 * MAX_LOOPS:
+        raise fail("unknowns", f"{len(unk_doc):,} unknowns; at most {2 * MAX_LOOPS} ({MAX_LOOPS} "
+                               "loops) are accepted, far above any real mechanism")
     unknowns = tuple(quantity(f"unknowns.{k}", k, v, "guess") for k, v in unk_doc.items())
     clash = [u.name for u in unknowns if u.name in parameters or u.name == drv_name]
     if clash:
@@ -310,6 +314,9 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
     loops_doc = doc.get("loops")
     if not isinstance(loops_doc, list) or not loops_doc:
         raise fail("loops", "missing: give at least one [[loops]] with its vectors")
+    if len(loops_doc) > MAX_LOOPS:
+        raise fail("loops", f"{len(loops_doc):,} loops; at most {MAX_LOOPS} are accepted, far "
+                            "above any real mechanism")
     loops = []
     used: set[str] = set()
     for li, loop in enumerate(loops_doc):
@@ -324,6 +331,9 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
                 joints and len(joints) != len(loop["vectors"])):
             raise fail(f"{lkey}.joints", f"must list one name per vector ({len(loop['vectors'])}), "
                                          "\"\" for an unnamed point")
+        if len(loop["vectors"]) > MAX_VECTORS:
+            raise fail(f"{lkey}.vectors", f"{len(loop['vectors']):,} vectors; at most {MAX_VECTORS} "
+                                          "are accepted in one loop")
         terms = []
         for vi, vec in enumerate(loop["vectors"]):
             terms.append(vector(vec, f"{lkey}.vectors[{vi}]", used))
@@ -365,6 +375,9 @@ def _points(spec: Any, loops: list[Loop], vector: Any,
     """``[points.NAME]`` tables: a named joint to start from and vectors to add."""
     if not isinstance(spec, Mapping):
         raise fail("points", "must be a table of points, like [points.P]")
+    if len(spec) > MAX_POINTS:
+        raise fail("points", f"{len(spec):,} points; at most {MAX_POINTS} are accepted (each is a "
+                             "column at every position)")
     joints = {j for loop in loops for j in loop.joints if j}
     out = {}
     for pname, p in spec.items():
@@ -383,9 +396,40 @@ def _points(spec: Any, loops: list[Loop], vector: Any,
         vecs = p.get("vectors")
         if not isinstance(vecs, list) or not vecs:
             raise fail(f"{key}.vectors", "must list at least one vector")
+        if len(vecs) > MAX_VECTORS:
+            raise fail(f"{key}.vectors", f"{len(vecs):,} vectors; at most {MAX_VECTORS} are accepted")
         out[str(pname)] = (origin, tuple(vector(v, f"{key}.vectors[{i}]", set())
                                          for i, v in enumerate(vecs)))
     return out
+
+
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f]")
+"""Control characters (ESC, CR, NUL, tab, newline, DEL, C1): printed raw they would drive
+the terminal or break a line."""
+_PROSE = ("description", "notes", "note")
+"""Keys whose text may have tabs and newlines."""
+
+
+def _check_printable(doc: Mapping[str, Any], fail: Any) -> None:
+    """Refuse a control character in any key or string (tab and newline are allowed in the
+    prose of _PROSE): everything read may be printed."""
+    stack: list[tuple[str, str, Any]] = [("", "", doc)]
+    while stack:
+        where, last, value = stack.pop()
+        if isinstance(value, str):
+            bad = _CONTROL.search(value.replace("\n", "").replace("\t", "") if last in _PROSE
+                                  else value)
+            if bad:
+                raise fail(where, f"contains the control character {bad.group()!r}; use "
+                                  "printable text")
+        elif isinstance(value, Mapping):
+            for k, v in value.items():
+                key = f"{where}.{k}" if where else str(k)
+                if isinstance(k, str) and _CONTROL.search(k):
+                    raise fail(ascii(key), "a name may not contain control characters")
+                stack.append((key, str(k), v))
+        elif isinstance(value, list):
+            stack.extend((f"{where}[{i}]", last, v) for i, v in enumerate(value))
 
 
 def _short(value: Any) -> str:
