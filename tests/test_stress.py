@@ -444,3 +444,103 @@ def test_cli_fuzz_mechanism_mutations_and_extremes(cli, tmp_path, monkeypatch):
         count += 1
     assert count >= 2000
     assert all(codes.values()), codes
+
+
+# --- rates, points and scan options (issue 18) -------------------------------------------------
+
+SPEEDS = ["10", "600rpm", "90deg/s", "10rad/s", "250mm/s", "-3", "0", "1e308", "nan", "inf", "", "abc",
+          "10rpm/s", "5rad/s^2", "1e-320", "3e", "5/3"]
+SCAN_OPTIONS = {
+    "--vary": ["r2=20:60:3", "r2=20:60", "r4=60:120:2", "r2=60:20:3", "r2=1:1:1", "nosuch=1:2:2",
+               "r2=nan:1:2", "r2=0:-5:2", "r2", "r2=1:2:0", "r2=1:2:1e9", "theta2=10:20:2"],
+    "--samples": ["3", "0", "-1", "2.5", "1e9", "abc"],
+    "--sampling": ["lhs", "random", "sobol"],
+    "--seed": ["0", "-1", "7", "1e30", "99999999999999999999"],
+    "--from": ["0", "-180", "nan", "1e308"],
+    "--to": ["90", "359", "-1", "inf"],
+    "--step": ["30", "45", "0", "-30", "1e-9"],
+    "--branch": ["open", "crossed", "sideways"],
+    "--set": ["r3=80", "r1=-3", "theta2=10", "nosuch=1"],
+    "--tol": ["1e-9", "0", "-1", "nan"],
+    "--where": ["full_cycle", "theta4_range > 10", "__import__('os')", "nosuch > 1", "1 +"],
+    "--sort": ["theta4_range", "nosuch", "design"],
+    "--top": ["2", "0", "-1", "1e9"],
+    "--scheduler": ["threads", "synchronous", "bogus", "tls://127.0.0.1:1", "tcp://127.0.0.1:99999",
+                    "ucx://127.0.0.1:1"],
+    "--workers": ["1", "2", "0", "-1", "100000"],
+    "--chunk": ["1", "7", "0", "-3"],
+    "--format": ["csv", "json", "plain", "table", "nosuch"],
+    "--digits": ["5", "2", "40"],
+}
+
+
+def rate_invocation(rng: random.Random) -> list[str]:
+    """solve FILE or sweep FILE with --speed/--accel (and sometimes --path, --batch)."""
+    file = str(SAMPLES / rng.choice(["fourbar_me581.toml", "slider_crank.toml", "crank_rocker.toml",
+                                      "watt_sixbar.toml", "fourbar_me581_theta4.toml"]))
+    if rng.random() < 0.5:
+        args = ["solve", file]
+        if rng.random() < 0.3:
+            args += ["--set", f"theta2={rng.choice(['112.024312837', '0', '90', '180', '360', '1e-9'])}"]
+    else:
+        args = ["sweep", file, "--step", rng.choice(["30", "45", "90"])]
+        if rng.random() < 0.3:
+            args.append("--batch")
+        if rng.random() < 0.3:
+            args += ["--path", rng.choice(["P", "A", "nosuch", ""])]
+    args += ["--speed", rng.choice(SPEEDS)]
+    if rng.random() < 0.7:
+        args += ["--accel", rng.choice(SPEEDS)]
+    if rng.random() < 0.4:
+        args += ["--format", rng.choice(["json", "csv", "plain"])]
+    return args
+
+
+def scan_invocation(rng: random.Random) -> list[str]:
+    """A small scan of the crank-rocker (at most a few designs x a dozen positions) with
+    random options, valid and not."""
+    args = ["scan", str(SAMPLES / "crank_rocker.toml"), "--step", "30"]
+    if rng.random() < 0.8:
+        args += ["--vary", "r2=20:60:3"]
+    for opt in rng.sample(sorted(SCAN_OPTIONS), rng.randint(1, 4)):
+        value = rng.choice(SCAN_OPTIONS[opt])
+        if opt == "--samples" and value in ("1e9",):
+            value = "5"  # a valid huge draw is a size test (tests/test_bounds.py), not a fuzz case
+        args += [opt, value]
+    if rng.random() < 0.2:
+        args.append("--desc")
+    return args
+
+
+def with_points(text: str, rng: random.Random) -> str:
+    """A [points] table added to a mechanism, valid or not."""
+    start = rng.choice(['"A"', '"B"', '"O2"', '"nosuch"', '""', "7"])
+    length = _toml_value(rng.choice([60, 0, -5, 1e308, float("nan"), "theta3", "r2", "nosuch", 1e-320]))
+    angle = _toml_value(rng.choice(["theta3", "theta4", "theta2", 30, float("inf"), "nosuch", "s"]))
+    offset = _toml_value(rng.choice([30, 0, -720, 1e308, float("nan"), "x"]))
+    name = rng.choice(["Q", "P", "A", "theta3", "Q_x", "design", "x" * 100])
+    return text + f'\n[points.{name}]\nfrom = {start}\nvectors = [ {{ length = {length}, angle = {angle}, ' \
+                  f'offset = {offset} }} ]\n'
+
+
+def test_cli_fuzz_rates_points_and_scan_options(cli, tmp_path, monkeypatch):
+    """Rates (--speed/--accel), [points] tables and scan options, valid and not: the CLI's
+    contract holds (exit 0, 1 or 2; no traceback or internal error; exit 2 is one line)."""
+    monkeypatch.chdir(tmp_path)
+    rng = random.Random(18)
+    codes = {0: 0, 1: 0, 2: 0}
+    samples = sorted(SAMPLES.glob("*.toml"))
+    for i in range(240):
+        pick = i % 3
+        if pick == 0:
+            args = rate_invocation(rng)
+        elif pick == 1:
+            args = scan_invocation(rng)
+        else:
+            path = tmp_path / f"p{i % 5}.toml"
+            path.write_text(with_points(rng.choice(samples).read_text(), rng))
+            args = rng.choice([["solve", str(path), "--speed", "10"], ["sweep", str(path), "--step", "60",
+                               "--speed", "10", "--format", "json"], ["scan", str(path), "--step", "60"],
+                               ["solve", str(path)]])
+        codes[well_behaved(cli(*args), args)] += 1
+    assert codes[0] and codes[2], codes
