@@ -317,8 +317,8 @@ def sweep_mechanism(
     With a driver ``speed`` (rad/s, or length unit/s for a linear driver) and ``accel``, or
     with ``joints=True``, every solved position also has ``.rates``: its joints and named
     points and, with a speed, the velocity and acceleration of every unknown, joint and
-    point (:class:`~linkage.kinematics.rates.Rates`; batch sweeps leave it None). Without
-    them the sweep does not pay for it.
+    point (:class:`~linkage.kinematics.rates.Rates`; a batch sweep computes it as positions
+    are read). Without them the sweep does not pay for it.
     """
     from ..errors import InputError
     from ..problems.loops import load
@@ -341,7 +341,8 @@ def sweep_mechanism(
 
         from .batch import batch_sweep
 
-        return replace(batch_sweep(m, values, branch=branch, tol=tol).to_sweep(), method="newton (batch)")
+        return replace(batch_sweep(m, values, branch=branch, tol=tol, speed=speed, accel=accel,
+                                   joints=joints).to_sweep(), method="newton (batch)")
     result = sweep(m, check_driver_values(m, values), method=method, branch=branch, tol=tol,
                    max_iter=max_iter, progress=progress)
     return with_rates(m, result, speed, accel) if speed is not None or joints else result
