@@ -38,6 +38,7 @@ from .sweep import (
     _Solver,
     check_driver_values,
     driver_values,
+    solved_ranges_array,
     solver_q,
     sweep,
     tangent,
@@ -371,6 +372,10 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
                 r = ref[i, j]
                 shown[i, j] = r + (shown[i, j] - r + 180.0) % 360.0 - 180.0
     shown[status != code["converged"]] = np.nan
+    if not have_closed:
+        # the ranges the positions themselves solved on, as the one-at-a-time sweep reports
+        # them (the coarse pass's are only as fine as its grid)
+        rough = replace(rough, feasible_ranges=solved_ranges_array(vals, status == code["converged"]))
     return BatchResult(vals, status, shown, det_out, iters, rough.branch, rough, len(todo), m, rates)
 
 

@@ -755,6 +755,23 @@ def _solved_ranges(positions: Sequence[Position]) -> tuple[tuple[float, float], 
     return tuple(out)  # type: ignore[arg-type]
 
 
+def solved_ranges_array(values: Any, converged: Any) -> tuple[tuple[float, float], ...]:
+    """:func:`_solved_ranges` over arrays (the batch engine's): each run of converged
+    positions as (first driver value, last driver value), in position order."""
+    import numpy as np
+
+    c = np.asarray(converged, dtype=bool)
+    if not c.size:
+        return ()
+    edges = np.diff(c.astype(np.int8))
+    starts, ends = np.flatnonzero(edges == 1) + 1, np.flatnonzero(edges == -1)
+    if c[0]:
+        starts = np.concatenate(([0], starts))
+    if c[-1]:
+        ends = np.concatenate((ends, [len(c) - 1]))
+    return tuple((float(values[a]), float(values[b])) for a, b in zip(starts, ends))
+
+
 def _toggles(solver: _Solver, positions: Sequence[Position], arcs: Any, lo: float, hi: float,
              have_closed: bool) -> list[float]:
     found: list[float] = []
