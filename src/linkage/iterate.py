@@ -44,6 +44,7 @@ from collections.abc import Callable
 from typing import Any, NamedTuple
 
 from .result import Status
+from .rules import step_limit, system_converged
 
 UNCERTIFIED_LIMIT = 4
 """Small steps without evidence of a root after which an open scalar method stops."""
@@ -210,7 +211,7 @@ def run(
                 status = Status.CONVERGED_RESIDUAL
                 break
         x = state.x
-        limit = tol + rtol * magnitude(x) if rtol else tol
+        limit = step_limit(tol, rtol, magnitude(x)) if rtol else tol
         if err <= limit and plausible is not None and not plausible(state):
             limit = -1.0  # the method's own evidence says the small step is not convergence
         if check_best and fx is not None:
@@ -224,7 +225,8 @@ def run(
             elif size < best_fx:
                 best_fx = size
         if err <= limit:
-            if needs_residual and (fx is None or abs(fx) > gate):
+            # systems: the step and the residual (linkage.rules, the one definition)
+            if needs_residual and not (fx is not None and system_converged(err, abs(fx), limit, gate)):
                 if minimizes:
                     status = Status.LOCAL_MINIMUM
                     detail = (f"the least-squares residual stalls at {abs(fx or math.nan):.3g}, "
