@@ -37,6 +37,7 @@ from ..problems.closed_form import (
 from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..problems.system import LeanProblem
 from ..result import Status
+from ..rules import continues, continuity_measures
 from ..solve import system_verdict
 
 MAX_HALVINGS = 6
@@ -482,10 +483,8 @@ def _continue(solver: _Solver, v: float, history: list[tuple[float, tuple[float,
                 ok = False
                 break
             dv = abs(vk - vq[0]) * solver.scale
-            size = 1.0 + max(abs(c) for c in q)
-            moved = max(abs(a - b) for a, b in zip(pred, vq[1]))
-            correction = max(abs(a - b) for a, b in zip(q, pred))
-            if correction > 0.5 * moved + (1e-7 + 10.0 * dv * dv) * size:
+            correction, moved, size = continuity_measures(vq[1], pred, q)
+            if not continues(correction, moved, dv, size):
                 ok = False
                 break
             vq = (vk, q)
@@ -519,10 +518,8 @@ def _lean_step(solver: _Solver, v: float, v_last: float, q_last: tuple[float, ..
     if target is not None and branch != target:
         return None
     dv = abs(v - v_last) * solver.scale
-    size = 1.0 + max(abs(c) for c in q)
-    moved = max(abs(a - b) for a, b in zip(pred, q_last))
-    correction = max(abs(a - b) for a, b in zip(q, pred))
-    if correction > 0.5 * moved + (1e-7 + 10.0 * dv * dv) * size:
+    correction, moved, size = continuity_measures(q_last, pred, q)
+    if not continues(correction, moved, dv, size):
         return None
     sol = solver.display(q)
     return Position(v, "converged", sol, branch, iterations, det, solver.transmission(sol)), q
@@ -577,7 +574,7 @@ def _step_two(solver: _Solver, v: float, v_last: float, q_last: tuple[float, ...
     moved = e0 if e0 >= e1 else e1
     e0, e1 = abs(x0 - pred0), abs(x1 - pred1)
     correction = e0 if e0 >= e1 else e1
-    if correction > 0.5 * moved + (1e-7 + 10.0 * dv * dv) * size:
+    if not continues(correction, moved, dv, size):
         return None
     return _converged(v, sol, branch, k, det, solver.transmission(sol)), q
 
