@@ -18,6 +18,7 @@ from typing import Any, ClassVar, NamedTuple
 from ..iterate import DIVERGE_STREAK, ROUNDING, explain, judge_certificate, rounding_stall
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
+from ..rules import step_limit
 from ._common import new_state
 
 
@@ -142,7 +143,7 @@ def newton_lean(problem: ScalarProblem, x0: float, tol: float, rtol: float, ftol
         if ftol is not None and size <= ftol:
             return x, fx, err, Status.CONVERGED_RESIDUAL, "", k
         ax = x if x >= 0.0 else -x
-        limit = tol + rtol * ax if rtol else tol
+        limit = step_limit(tol, rtol, ax) if rtol else tol
         if err <= limit:
             if size > best and size > 1e-8 * start:
                 limit = -1.0
