@@ -60,6 +60,33 @@ def slider_crank_exact(theta2_deg: float, w2: float = 0.0, a2: float = 0.0, scal
 # --- finding: batch tolerances ------------------------------------------------------------------
 
 @pytest.mark.parametrize("scale", [1e-6, 1.0, 1e6])
+def test_batch_newton_takes_a_single_solves_iterations_from_the_same_start(scale, monkeypatch):
+    """Batch tolerances, position by position: from the batch's own warm start, a single
+    solve (textbook Newton, the stopping rule every solve uses) takes exactly the batch's
+    iterations, at every scale. Before, the batch stopped early at 1e-6 and late at 1e6."""
+    import linkage.kinematics.batch as batch
+    from linkage.solve import solve_system
+
+    starts: list[list[np.ndarray]] = []
+    evaluate = batch.VectorLoops.evaluate
+
+    def spy(self, q, rows, near=False):
+        if rows is None and not near:  # the first evaluation of a block: the warm starts
+            starts.append([c.copy() for c in q])
+        return evaluate(self, q, rows, near)
+
+    monkeypatch.setattr(batch.VectorLoops, "evaluate", spy)
+    m = slider_crank(scale)
+    values = driver_values(0.0, 360.0, None, 1501)
+    result = batch.batch_sweep(m, values)
+    (t3, s), = starts  # one block
+    for i in range(0, len(values), 3):
+        r = solve_system(m.model.problem_at(math.radians(values[i])), (t3[i], s[i]), tol=1e-12,
+                         record=False, damped=False)
+        assert r.converged and r.iterations == result.iterations[i], (scale, values[i])
+
+
+@pytest.mark.parametrize("scale", [1e-6, 1.0, 1e6])
 def test_batch_tolerances_scale_with_the_mechanism_as_one_at_a_time(scale):
     """Batch tolerances: the batch's Newton compared step and residual with tol, not tol x
     the length scale: the slider-crank scaled by 1e-6 or 1e6 took 1.86 and 2.73 iterations
