@@ -44,7 +44,7 @@ from collections.abc import Callable
 from typing import Any, NamedTuple
 
 from .result import Status
-from .rules import step_limit, system_converged
+from .rules import step_limit, system_converged, worse_than_seen
 
 UNCERTIFIED_LIMIT = 4
 """Small steps without evidence of a root after which an open scalar method stops."""
@@ -216,7 +216,7 @@ def run(
             limit = -1.0  # the method's own evidence says the small step is not convergence
         if check_best and fx is not None:
             size = abs(fx)
-            if err <= limit and size > best_fx and size > 1e-8 * start_fx:
+            if err <= limit and worse_than_seen(size, best_fx, start_fx):
                 # A small step to a point worse than one already seen, with a residual
                 # still of the order of the start's, is not convergence: the slope came
                 # from far away (a secant chord through a huge f). Differences at rounding

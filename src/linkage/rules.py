@@ -19,6 +19,9 @@ Continuity: a continuation step from (v_last, q_last) through the tangent predic
 the predicted change plus a term in dv^2 (the path's curvature) and rounding, relative to
 the size of q.
 
+The open scalar methods' guard (:func:`worse_than_seen`): a small step to a point worse
+than one already seen is not convergence.
+
 This module imports nothing at load time: the numpy twins take numpy arrays and import
 numpy only when called.
 """
@@ -82,6 +85,21 @@ def system_converged(err: float, resid: float, limit: float, gate: float) -> boo
 def system_converged_array(err: Any, resid: Any, limit: Any, gate: Any) -> Any:
     """:func:`system_converged` position by position (numpy booleans)."""
     return (err <= limit) & (resid <= gate)
+
+
+# --- the open scalar methods' guard on a small step ---------------------------------------------
+
+FAR_SLOPE = 1e-8
+"""Below this fraction of the starting |f|, a residual worse than the best seen is rounding."""
+
+
+def worse_than_seen(size: float, best: float, start: float) -> bool:
+    """A step within tolerance is no convergence for an open scalar method (Newton, secant,
+    fixed point; iterate.py test 5) when it lands where |f| = ``size`` is worse than the
+    ``best`` |f| already seen and still above FAR_SLOPE times the ``start``'s: the slope
+    came from far away (a secant chord through a huge f). Scalar only: no array engine
+    runs these methods."""
+    return size > best and size > FAR_SLOPE * start
 
 
 # --- the continuity test ----------------------------------------------------------------------
