@@ -399,3 +399,17 @@ def test_solved_ranges_twin_equals_the_sweeps(seed):
             positions = [Position(float(v), "converged" if c else "no_solution", None, None, 0, None)
                          for v, c in zip(values, ok)]
             assert solved_ranges_array(values, ok) == _solved_ranges(positions)
+
+
+@pytest.mark.parametrize("max_iter", [1, 2])
+def test_batch_sweep_honours_the_iteration_cap(max_iter):
+    """The iteration cap is a stopping rule too: the batch ran up to 30 vectorised and 50
+    one-at-a-time iterations whatever ``max_iter`` the caller gave (with max_iter=1 it
+    reported positions that took 2). Now no position takes more, and the statuses are the
+    one-at-a-time sweep's."""
+    m = load(SAMPLES / "crank_rocker.toml")
+    values = driver_values(0.0, 360.0, None, 361)
+    one = linkage.sweep(m, values, batch=False, max_iter=max_iter)
+    many = linkage.sweep(m, values, batch=True, max_iter=max_iter)
+    assert max(p.iterations for p in many.positions) <= max_iter
+    assert [p.status for p in many.positions] == [p.status for p in one.positions]

@@ -269,11 +269,13 @@ def _solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[
 
 
 def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: str | None = None,
-                tol: float = 1e-12, max_iter: int = 30, coarse: int = 361, speed: float | None = None,
+                tol: float = 1e-12, max_iter: int = 50, coarse: int = 361, speed: float | None = None,
                 accel: float = 0.0, joints: bool = False) -> BatchResult:
     """Solve ``m`` at every driver value in ``values`` (display units, ascending). With a
     driver ``speed`` (and ``accel``) or ``joints``, every solved position read from the
-    result carries ``.rates`` as the one-at-a-time sweep's do."""
+    result carries ``.rates`` as the one-at-a-time sweep's do. ``max_iter`` caps every
+    Newton run, as in the one-at-a-time sweep (the vectorised one at VECTOR_ITER at most:
+    a position slower than that goes the one-at-a-time way)."""
     rates = (speed, accel) if speed is not None or joints else None
     vals = np.asarray(values, dtype=float)
     if vals.ndim != 1:
@@ -292,8 +294,8 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
                            np.zeros(0, dtype=np.int32), rough.branch, rough, 0, m, rates)
     lo, hi = float(vals[0]), float(vals[-1])
     grid = driver_values(lo, hi, None, min(coarse, n_pos))
-    rough = sweep(m, grid, branch=branch, tol=tol)
-    solver = _Solver(m, "newton", tol, 50)
+    rough = sweep(m, grid, branch=branch, tol=tol, max_iter=max_iter)
+    solver = _Solver(m, "newton", tol, max_iter)
     names, kinds = solver.names, solver.kinds
     n = len(names)
     ok_coarse = np.array([p.status == "converged" for p in rough.positions])
@@ -324,7 +326,8 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
     # engine waited on memory).
     for lo_i in range(0, n_pos, BLOCK):
         hi_i = min(n_pos, lo_i + BLOCK)
-        _settle(m, solver.model, coarse, names, kinds, scale, vals[lo_i:hi_i], drv_scale, tol, max_iter,
+        _settle(m, solver.model, coarse, names, kinds, scale, vals[lo_i:hi_i], drv_scale, tol,
+                min(max_iter, VECTOR_ITER),
                 rough.branch, status[lo_i:hi_i], iters[lo_i:hi_i], det_out[lo_i:hi_i],
                 shown[lo_i:hi_i], ref[lo_i:hi_i])
 
@@ -388,6 +391,9 @@ def _grid_index(grid: np.ndarray, vals: np.ndarray) -> np.ndarray:
     first = np.searchsorted(vals, grid, side="left")
     return np.cumsum(np.bincount(first, minlength=len(vals) + 1)[:len(vals)])
 
+
+VECTOR_ITER = 30
+"""The most iterations of the vectorised Newton (the few slower positions go one at a time)."""
 
 BLOCK = 16_384
 """Positions per block of the batch engine's vectorised steps (temporaries of 128 kB)."""

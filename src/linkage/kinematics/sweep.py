@@ -342,8 +342,8 @@ def sweep_mechanism(
 
         from .batch import batch_sweep
 
-        return replace(batch_sweep(m, values, branch=branch, tol=tol, speed=speed, accel=accel,
-                                   joints=joints).to_sweep(), method="newton (batch)")
+        return replace(batch_sweep(m, values, branch=branch, tol=tol, max_iter=max_iter, speed=speed,
+                                   accel=accel, joints=joints).to_sweep(), method="newton (batch)")
     result = sweep(m, check_driver_values(m, values), method=method, branch=branch, tol=tol,
                    max_iter=max_iter, progress=progress)
     return with_rates(m, result, speed, accel) if speed is not None or joints else result
