@@ -151,6 +151,10 @@ def build(terms: Any, n: int, newton: bool = False) -> Callable[..., Any]:
     return namespace["newton2" if newton else "make"]  # type: ignore[no-any-return]
 
 
+# The convergence test below, "err <= tol and resid <= gate", is
+# linkage.rules.system_converged written in (the hottest loop; no call per iteration):
+# tests/test_compile.py holds this Newton equal, bit for bit, to
+# methods.newton_system._newton_2x2, which calls the rule.
 _NEWTON_TWO = """\
 def newton2(d, x0, x1, tol, gate, max_iter):
     # Newton-Raphson on the loop equations at driver value d from (x0, x1), with damping

@@ -44,6 +44,7 @@ from collections.abc import Callable
 from typing import Any, NamedTuple
 
 from .result import Status
+from .rules import step_limit, system_converged, worse_than_seen
 
 UNCERTIFIED_LIMIT = 4
 """Small steps without evidence of a root after which an open scalar method stops."""
@@ -210,12 +211,12 @@ def run(
                 status = Status.CONVERGED_RESIDUAL
                 break
         x = state.x
-        limit = tol + rtol * magnitude(x) if rtol else tol
+        limit = step_limit(tol, rtol, magnitude(x)) if rtol else tol
         if err <= limit and plausible is not None and not plausible(state):
             limit = -1.0  # the method's own evidence says the small step is not convergence
         if check_best and fx is not None:
             size = abs(fx)
-            if err <= limit and size > best_fx and size > 1e-8 * start_fx:
+            if err <= limit and worse_than_seen(size, best_fx, start_fx):
                 # A small step to a point worse than one already seen, with a residual
                 # still of the order of the start's, is not convergence: the slope came
                 # from far away (a secant chord through a huge f). Differences at rounding
@@ -224,7 +225,8 @@ def run(
             elif size < best_fx:
                 best_fx = size
         if err <= limit:
-            if needs_residual and (fx is None or abs(fx) > gate):
+            # systems: the step and the residual (linkage.rules, the one definition)
+            if needs_residual and not (fx is not None and system_converged(err, abs(fx), limit, gate)):
                 if minimizes:
                     status = Status.LOCAL_MINIMUM
                     detail = (f"the least-squares residual stalls at {abs(fx or math.nan):.3g}, "

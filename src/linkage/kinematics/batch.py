@@ -6,8 +6,9 @@
    continuously, so interpolation is safe).
 3. Newton-Raphson runs vectorised over every position whose coarse neighbours both
    solved, iterating only the unconverged ones; two unknowns use Cramer's rule, more
-   a stacked ``numpy.linalg.solve``. Same stopping rule as a single solve: max|dq| and
-   max|Phi| at most ``tol``.
+   a stacked ``numpy.linalg.solve``. Same stopping rule as a single solve
+   (:mod:`linkage.rules`): the step (lengths relative to the mechanism's size) within
+   ``tol`` and max|Phi| within ``tol`` x size.
 4. Positions it cannot settle (next to a gap, unconverged, or on another branch) go
    through the one-at-a-time path. No per-iteration history is recorded.
 
@@ -18,7 +19,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -27,6 +28,7 @@ from ..errors import InputError
 from ..problems.assembly import is_open_np, rocker_angle_np, slider_is_open_np
 from ..problems.closed_form import transmission
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel, Mechanism
+from ..rules import residual_gate, step_scales, step_size_array, system_converged_array
 from .angles import nearest_turn, nearest_turn_array
 from .sweep import (
     MAX_POSITIONS,
@@ -38,9 +40,11 @@ from .sweep import (
     _Solver,
     check_driver_values,
     driver_values,
+    solved_ranges_array,
     solver_q,
     sweep,
     tangent,
+    with_rates,
 )
 
 STATUS_CODES = {"converged": 0, "no_solution": 1, "failed": 2, "off_branch": 3}
@@ -60,14 +64,24 @@ class BatchResult:
     branch: str | None  # every converged position is on this branch
     coarse: SweepResult
     fallback: int
+    source: Mechanism | None = None
+    rates: tuple[float | None, float] | None = None
+    """(driver speed or None, acceleration) when each position's joints (and with a speed
+    its rates) were asked for: computed by the one-at-a-time sweep's own
+    :func:`~linkage.kinematics.sweep.with_rates` as positions are read."""
 
     def to_sweep(self) -> SweepResult:
         """The same result as a SweepResult whose positions are built only when read
         (a million positions cost nothing until a caller asks for one)."""
         c = self.coarse
+        motion = self.rates if self.rates is not None and self.rates[0] is not None else None
         return SweepResult(c.mechanism, c.driver, c.driver_unit, c.names, c.units, BatchPositions(self),
                            c.feasible_ranges, c.toggles, c.branch, c.classification, c.method,
-                           length_unit=c.length_unit)
+                           motion=motion, length_unit=c.length_unit)
+
+
+RATES_CHUNK = 4096
+"""Positions whose rates a batch result computes at once when one of them is read."""
 
 
 class BatchPositions(Sequence):  # type: ignore[type-arg]
@@ -76,6 +90,7 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
 
     def __init__(self, batch: BatchResult) -> None:
         self.batch = batch
+        self._chunk: tuple[int, Sequence[Position]] = (-1, ())  # the last chunk with rates
 
     def __len__(self) -> int:
         return len(self.batch.values)
@@ -83,11 +98,27 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
     def __getitem__(self, i: Any) -> Any:
         if isinstance(i, slice):
             return [self[k] for k in range(*i.indices(len(self)))]
-        b = self.batch
         if i < 0:
             i += len(self)
         if not 0 <= i < len(self):
             raise IndexError(i)
+        if self.batch.rates is None:
+            return self._position(i)
+        # the rates a chunk at a time, by the one definition (with_rates), the last chunk
+        # kept: reading in order costs one with_rates call per RATES_CHUNK positions, and
+        # memory stays bounded whatever the sweep's size
+        start = i - i % RATES_CHUNK
+        if self._chunk[0] != start:
+            b = self.batch
+            assert b.source is not None
+            part = tuple(self._position(k) for k in range(start, min(len(self), start + RATES_CHUNK)))
+            speed, accel = b.rates  # type: ignore[misc]
+            self._chunk = (start, with_rates(b.source, replace(b.coarse, positions=part), speed,
+                                             accel).positions)
+        return self._chunk[1][i - start]
+
+    def _position(self, i: int) -> Position:
+        b = self.batch
         st = CODE_STATUS[int(b.status[i])]
         sol = ({n: float(b.solution[i, j]) for j, n in enumerate(b.coarse.names)}
                if st == "converged" else None)
@@ -240,8 +271,14 @@ def _solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[
 
 
 def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: str | None = None,
-                tol: float = 1e-12, max_iter: int = 30, coarse: int = 361) -> BatchResult:
-    """Solve ``m`` at every driver value in ``values`` (display units, ascending)."""
+                tol: float = 1e-12, max_iter: int = 50, coarse: int = 361, speed: float | None = None,
+                accel: float = 0.0, joints: bool = False) -> BatchResult:
+    """Solve ``m`` at every driver value in ``values`` (display units, ascending). With a
+    driver ``speed`` (and ``accel``) or ``joints``, every solved position read from the
+    result carries ``.rates`` as the one-at-a-time sweep's do. ``max_iter`` caps every
+    Newton run, as in the one-at-a-time sweep (the vectorised one at VECTOR_ITER at most:
+    a position slower than that goes the one-at-a-time way)."""
+    rates = (speed, accel) if speed is not None or joints else None
     vals = np.asarray(values, dtype=float)
     if vals.ndim != 1:
         raise InputError("the driver values must be a one-dimensional sequence")
@@ -256,11 +293,11 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
         rough = sweep(m, [], branch=branch, tol=tol)
         empty = np.zeros(0)
         return BatchResult(vals, np.zeros(0, dtype=np.int8), np.zeros((0, len(m.unknowns))), empty,
-                           np.zeros(0, dtype=np.int32), rough.branch, rough, 0)
+                           np.zeros(0, dtype=np.int32), rough.branch, rough, 0, m, rates)
     lo, hi = float(vals[0]), float(vals[-1])
     grid = driver_values(lo, hi, None, min(coarse, n_pos))
-    rough = sweep(m, grid, branch=branch, tol=tol)
-    solver = _Solver(m, "newton", tol, 50)
+    rough = sweep(m, grid, branch=branch, tol=tol, max_iter=max_iter)
+    solver = _Solver(m, "newton", tol, max_iter)
     names, kinds = solver.names, solver.kinds
     n = len(names)
     ok_coarse = np.array([p.status == "converged" for p in rough.positions])
@@ -291,7 +328,8 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
     # engine waited on memory).
     for lo_i in range(0, n_pos, BLOCK):
         hi_i = min(n_pos, lo_i + BLOCK)
-        _settle(m, solver.model, coarse, names, kinds, scale, vals[lo_i:hi_i], drv_scale, tol, max_iter,
+        _settle(m, solver.model, coarse, names, kinds, scale, vals[lo_i:hi_i], drv_scale, tol,
+                min(max_iter, VECTOR_ITER),
                 rough.branch, status[lo_i:hi_i], iters[lo_i:hi_i], det_out[lo_i:hi_i],
                 shown[lo_i:hi_i], ref[lo_i:hi_i])
 
@@ -343,7 +381,11 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
                 r = ref[i, j]
                 shown[i, j] = nearest_turn(r, shown[i, j])
     shown[status != code["converged"]] = np.nan
-    return BatchResult(vals, status, shown, det_out, iters, rough.branch, rough, len(todo))
+    if not have_closed:
+        # the ranges the positions themselves solved on, as the one-at-a-time sweep reports
+        # them (the coarse pass's are only as fine as its grid)
+        rough = replace(rough, feasible_ranges=solved_ranges_array(vals, status == code["converged"]))
+    return BatchResult(vals, status, shown, det_out, iters, rough.branch, rough, len(todo), m, rates)
 
 
 def _grid_index(grid: np.ndarray, vals: np.ndarray) -> np.ndarray:
@@ -355,6 +397,9 @@ def _grid_index(grid: np.ndarray, vals: np.ndarray) -> np.ndarray:
     first = np.searchsorted(vals, grid, side="left")
     return np.cumsum(np.bincount(first, minlength=len(vals) + 1)[:len(vals)])
 
+
+VECTOR_ITER = 30
+"""The most iterations of the vectorised Newton (the few slower positions go one at a time)."""
 
 BLOCK = 16_384
 """Positions per block of the batch engine's vectorised steps (temporaries of 128 kB)."""
@@ -425,6 +470,10 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     # later ones gather the few left. Position by position the iterates do not depend on
     # the block they are in.
     loops = VectorLoops(model, vals * drv_scale)
+    # the single solve's stopping rule, scaled as there (linkage.rules): a length step
+    # relative to the mechanism's size, max|Phi| within tol x size
+    size = m.length_scale
+    gate, steps = residual_gate(tol, size), step_scales(kinds, size)
     q_all = [r * sc for r, sc in zip(refs, scale)]
     live = usable.copy()
     done = np.zeros(n_pos, dtype=bool)
@@ -433,13 +482,13 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
         it += 1
         phi, jac = loops.evaluate(q_all, None, near=it > 1)
         dq, det = _solve_linear(jac, phi, n_pos)
-        step, resid = _largest(dq), _largest(phi)
+        step, resid = step_size_array(dq, steps), _largest(phi)
         finite = np.isfinite(step)
         for j in range(n):
             np.add(q_all[j], dq[j], out=q_all[j], where=live & finite)
         iters[live] = it
         det_out[live] = det[live]
-        finished = live & (step <= tol) & (resid <= tol)
+        finished = live & system_converged_array(step, resid, tol, gate)
         done |= finished
         live &= ~finished & finite
     active = np.flatnonzero(live)
@@ -448,10 +497,10 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
         it += 1
         phi, jac = loops.evaluate(q, active)
         dq, det = _solve_linear(jac, phi, active.size)
-        step, resid = _largest(dq), _largest(phi)
+        step, resid = step_size_array(dq, steps), _largest(phi)
         for j in range(n):
             q[j] += dq[j]
-        finished = (step <= tol) & (resid <= tol)
+        finished = system_converged_array(step, resid, tol, gate)
         keep = ~finished & np.isfinite(step)
         for j in range(n):
             q_all[j][active] = q[j]

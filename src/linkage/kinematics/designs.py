@@ -43,6 +43,13 @@ from ..problems.assembly import (
 )
 from ..problems.closed_form import DRIVERS, REQUIRED_NAMES
 from ..problems.loops import ANGLE_UNITS, Mechanism, VectorTerm
+from ..rules import (
+    continues_array,
+    continuity_measures_array,
+    residual_gate,
+    step_size_array,
+    system_converged_array,
+)
 from .angles import (
     anchor_index_array,
     closes_circle,
@@ -277,7 +284,7 @@ def _newton(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol
     done = np.zeros(n_pos, dtype=bool)
     det_out = np.full(n_pos, np.nan)
     iterations = np.zeros(n_pos, dtype=np.int32)
-    gate_all = tol * size
+    gate_all = residual_gate(tol, size)
     q = [c[active] for c in q_all]
     for _ in range(max_iter):
         if active.size == 0:
@@ -293,16 +300,15 @@ def _newton(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol
             (a, b), (c, d) = jac
             with np.errstate(invalid="ignore"):
                 singular |= ~(np.abs(det) > SINGULAR_RATIO * (np.abs(a * d) + np.abs(b * c)))
-        step = np.zeros(active.size)
+        dq = [np.where(singular, 0.0, d_j) for d_j in dq]
         for j, d_j in enumerate(dq):
-            d_j = np.where(singular, 0.0, d_j)
-            np.maximum(step, np.abs(d_j) / scale if is_length[j] else np.abs(d_j), out=step)
             q[j] += d_j
+        step = step_size_array(dq, [scale if length else 1.0 for length in is_length])
+        gate = gate_all[active]
         with np.errstate(invalid="ignore"):
-            within = resid <= gate_all[active]
             # as a single solve: a singular J with max|Phi| already within tolerance is a
             # root to that tolerance (a limit position); otherwise the step test decides
-            finished = np.where(singular, within, (step <= tol) & within)
+            finished = np.where(singular, resid <= gate, system_converged_array(step, resid, tol, gate))
             keep = ~finished & ~singular & np.isfinite(step)
         for j in range(len(q)):
             q_all[j][active] = q[j]
@@ -389,11 +395,9 @@ def _continuation_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: n
             det = _det_at(loops_v, q, live.size)
             ok &= np.isfinite(det) & ((det > 0.0) == positive[live]) & (det != 0.0)
             dv = abs(v - v_last) * scale
-            mag = 1.0 + np.max(np.abs(np.stack(q)), axis=0)
-            moved = np.max(np.abs(np.stack(pred) - np.stack(q_last)), axis=0)
-            correction = np.max(np.abs(np.stack(q) - np.stack(pred)), axis=0)
+            correction, moved, mag = continuity_measures_array(q_last, pred, q)
             with np.errstate(invalid="ignore"):
-                ok &= correction <= 0.5 * moved + (1e-7 + 10.0 * dv * dv) * mag
+                ok &= continues_array(correction, moved, dv, mag)
             clean[live[~ok]] = False
             keep = ok
             here = (loops_v, sub_v) if keep.all() else None

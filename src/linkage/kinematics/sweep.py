@@ -37,6 +37,7 @@ from ..problems.closed_form import (
 from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..problems.system import LeanProblem
 from ..result import Status
+from ..rules import continues, continuity_measures
 from ..solve import system_verdict
 from .angles import anchor_index, closes_circle, continuous, driver_turn, turn_shift, unwrap_turns
 
@@ -318,10 +319,10 @@ def sweep_mechanism(
     With a driver ``speed`` (rad/s, or length unit/s for a linear driver) and ``accel``, or
     with ``joints=True``, every solved position also has ``.rates``: its joints and named
     points and, with a speed, the velocity and acceleration of every unknown, joint and
-    point (:class:`~linkage.kinematics.rates.Rates`; batch sweeps leave it None). Without
-    them the sweep does not pay for it. ``speed`` and ``accel`` are numbers in those
-    internal units; a unit string such as "10rpm" is the command line's, and is refused
-    here. ``values`` must be finite reals in a sequence (not a generator).
+    point (:class:`~linkage.kinematics.rates.Rates`; a batch sweep computes it as positions
+    are read). Without them the sweep does not pay for it. ``speed`` and ``accel`` are
+    numbers in those internal units; a unit string such as "10rpm" is the command line's,
+    and is refused here. ``values`` must be finite reals in a sequence (not a generator).
     Every argument is checked first (:mod:`linkage.arguments`): a misuse raises
     :class:`~linkage.errors.InputError` naming the argument.
     """
@@ -361,7 +362,8 @@ def sweep_mechanism(
 
         from .batch import batch_sweep
 
-        return replace(batch_sweep(m, values, branch=branch, tol=tol).to_sweep(), method="newton (batch)")
+        return replace(batch_sweep(m, values, branch=branch, tol=tol, max_iter=max_iter, speed=speed,
+                                   accel=accel, joints=joints).to_sweep(), method="newton (batch)")
     result = sweep(m, check_driver_values(m, values), method=method, branch=branch, tol=tol,
                    max_iter=max_iter, progress=progress)
     return with_rates(m, result, speed, accel) if speed is not None or joints else result
@@ -508,10 +510,8 @@ def _continue(solver: _Solver, v: float, history: list[tuple[float, tuple[float,
                 ok = False
                 break
             dv = abs(vk - vq[0]) * solver.scale
-            size = 1.0 + max(abs(c) for c in q)
-            moved = max(abs(a - b) for a, b in zip(pred, vq[1]))
-            correction = max(abs(a - b) for a, b in zip(q, pred))
-            if correction > 0.5 * moved + (1e-7 + 10.0 * dv * dv) * size:
+            correction, moved, size = continuity_measures(vq[1], pred, q)
+            if not continues(correction, moved, dv, size):
                 ok = False
                 break
             vq = (vk, q)
@@ -545,10 +545,8 @@ def _lean_step(solver: _Solver, v: float, v_last: float, q_last: tuple[float, ..
     if target is not None and branch != target:
         return None
     dv = abs(v - v_last) * solver.scale
-    size = 1.0 + max(abs(c) for c in q)
-    moved = max(abs(a - b) for a, b in zip(pred, q_last))
-    correction = max(abs(a - b) for a, b in zip(q, pred))
-    if correction > 0.5 * moved + (1e-7 + 10.0 * dv * dv) * size:
+    correction, moved, size = continuity_measures(q_last, pred, q)
+    if not continues(correction, moved, dv, size):
         return None
     sol = solver.display(q)
     return Position(v, "converged", sol, branch, iterations, det, solver.transmission(sol)), q
@@ -603,7 +601,7 @@ def _step_two(solver: _Solver, v: float, v_last: float, q_last: tuple[float, ...
     moved = e0 if e0 >= e1 else e1
     e0, e1 = abs(x0 - pred0), abs(x1 - pred1)
     correction = e0 if e0 >= e1 else e1
-    if correction > 0.5 * moved + (1e-7 + 10.0 * dv * dv) * size:
+    if not continues(correction, moved, dv, size):
         return None
     return _converged(v, sol, branch, k, det, solver.transmission(sol)), q
 
@@ -785,6 +783,23 @@ def _solved_ranges(positions: Sequence[Position]) -> tuple[tuple[float, float], 
     if start is not None:
         out.append((start, prev))
     return tuple(out)  # type: ignore[arg-type]
+
+
+def solved_ranges_array(values: Any, converged: Any) -> tuple[tuple[float, float], ...]:
+    """:func:`_solved_ranges` over arrays (the batch engine's): each run of converged
+    positions as (first driver value, last driver value), in position order."""
+    import numpy as np
+
+    c = np.asarray(converged, dtype=bool)
+    if not c.size:
+        return ()
+    edges = np.diff(c.astype(np.int8))
+    starts, ends = np.flatnonzero(edges == 1) + 1, np.flatnonzero(edges == -1)
+    if c[0]:
+        starts = np.concatenate(([0], starts))
+    if c[-1]:
+        ends = np.concatenate((ends, [len(c) - 1]))
+    return tuple((float(values[a]), float(values[b])) for a, b in zip(starts, ends))
 
 
 def _toggles(solver: _Solver, positions: Sequence[Position], arcs: Any, lo: float, hi: float,

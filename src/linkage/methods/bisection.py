@@ -18,6 +18,7 @@ from typing import Any, ClassVar, NamedTuple
 from ..iterate import ROUNDING, explain, rounding_stall
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
+from ..rules import step_limit
 from ._common import new_state, same_sign
 
 
@@ -139,7 +140,7 @@ class Bisection:
             if ftol is not None and abs(fx) <= ftol:
                 status = Status.CONVERGED_RESIDUAL
                 break
-            limit = tol + rtol * abs(x) if rtol else tol
+            limit = step_limit(tol, rtol, abs(x)) if rtol else tol
             if err <= limit:
                 status = Status.CONVERGED_STEP
                 break

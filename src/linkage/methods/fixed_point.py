@@ -20,6 +20,7 @@ from typing import Any, ClassVar, NamedTuple
 from ..iterate import DIVERGE_STREAK, ROUNDING, explain, judge_certificate, rounding_stall
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
+from ..rules import step_limit, worse_than_seen
 from ._common import display, new_state
 
 
@@ -104,10 +105,10 @@ class FixedPoint:
                 if ftol is not None and abs(fx) <= ftol:
                     status = Status.CONVERGED_RESIDUAL
                     break
-            limit = tol + rtol * abs(x) if rtol else tol
+            limit = step_limit(tol, rtol, abs(x)) if rtol else tol
             if fx is not None:
                 size = abs(fx)
-                if err <= limit and size > best and size > 1e-8 * start:
+                if err <= limit and worse_than_seen(size, best, start):
                     limit = -1.0
                 elif size < best:
                     best = size

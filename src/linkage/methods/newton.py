@@ -18,6 +18,7 @@ from typing import Any, ClassVar, NamedTuple
 from ..iterate import DIVERGE_STREAK, ROUNDING, explain, judge_certificate, rounding_stall
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
+from ..rules import step_limit, worse_than_seen
 from ._common import new_state
 
 
@@ -142,9 +143,9 @@ def newton_lean(problem: ScalarProblem, x0: float, tol: float, rtol: float, ftol
         if ftol is not None and size <= ftol:
             return x, fx, err, Status.CONVERGED_RESIDUAL, "", k
         ax = x if x >= 0.0 else -x
-        limit = tol + rtol * ax if rtol else tol
+        limit = step_limit(tol, rtol, ax) if rtol else tol
         if err <= limit:
-            if size > best and size > 1e-8 * start:
+            if worse_than_seen(size, best, start):
                 limit = -1.0
             else:
                 if size < best:

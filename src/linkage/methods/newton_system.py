@@ -22,6 +22,7 @@ from typing import Any, ClassVar, NamedTuple
 from ..iterate import DIVERGE_STREAK, ROUNDING, RUNAWAY, explain, rounding_stall
 from ..problems.system import SystemProblem
 from ..result import Column, Status
+from ..rules import step_limit, step_size, system_converged
 from ._common import new_state
 from ._linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve, pivot_ratio
 
@@ -133,11 +134,9 @@ def lm_direction(jac: list[list[float]], phi: list[float], mu: float) -> list[fl
         return None
 
 
-def step_measure(step: Any, scales: tuple[float, ...] | None) -> float:
-    """max |dq_i| / scale_i: angles in rad, lengths relative to the mechanism's size."""
-    if scales is None:
-        return max_abs(step)
-    return max(abs(d) / sc for d, sc in zip(step, scales))
+step_measure = step_size
+"""max |dq_i| / scale_i: angles in rad, lengths relative to the mechanism's size
+(:func:`linkage.rules.step_size`, the one definition)."""
 
 
 def _sumsq(v: Any) -> float:
@@ -401,9 +400,9 @@ def newton_system_lean(problem: SystemProblem, q0: tuple[float, ...], phi0: list
         if resid == 0.0:
             return q, phi, err, Status.CONVERGED_EXACT, "", k, nfev, njev
         size_q = max_abs(q)
-        if err <= (tol + rtol * size_q if rtol else tol) and resid <= gate:
+        limit = step_limit(tol, rtol, size_q) if rtol else tol
+        if system_converged(err, resid, limit, gate):
             return q, phi, err, Status.CONVERGED_STEP, "", k, nfev, njev
-        limit = tol + rtol * size_q if rtol else tol
         if not damped:
             growth = growth + 1 if err > prev_err else 0
             if growth >= DIVERGE_STREAK and size_q > runaway:
@@ -491,8 +490,8 @@ def _newton_2x2(problem: SystemProblem, q0: tuple[float, ...], phi0: list[float]
             return [x0, x1], [p0, p1], err, Status.CONVERGED_EXACT, "", k, nfev, njev
         e0, e1 = abs(x0), abs(x1)
         size_q = nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
-        limit = tol + rtol * size_q if rtol else tol
-        if err <= limit and resid <= gate:
+        limit = step_limit(tol, rtol, size_q) if rtol else tol
+        if system_converged(err, resid, limit, gate):
             return [x0, x1], [p0, p1], err, Status.CONVERGED_STEP, "", k, nfev, njev
         if not damped:
             growth = growth + 1 if err > prev_err else 0

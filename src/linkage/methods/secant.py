@@ -17,6 +17,7 @@ from typing import Any, ClassVar, NamedTuple
 from ..iterate import DIVERGE_STREAK, ROUNDING, explain, judge_certificate, rounding_stall
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
+from ..rules import step_limit, worse_than_seen
 from ._common import new_state
 
 _NAN = float("nan")
@@ -144,12 +145,12 @@ class Secant:
             if ftol is not None and size <= ftol:
                 status = Status.CONVERGED_RESIDUAL
                 break
-            limit = tol + rtol * abs(x) if rtol else tol
+            limit = step_limit(tol, rtol, abs(x)) if rtol else tol
             if err <= limit:
                 ratio = slope / slope_before if slope_before else _NAN
                 if not 0.5 <= ratio <= 2.0:
                     limit = -1.0
-            if err <= limit and size > best and size > 1e-8 * start:
+            if err <= limit and worse_than_seen(size, best, start):
                 limit = -1.0
             elif size < best:
                 best = size

@@ -1,0 +1,143 @@
+"""The stopping and continuity rules, each defined once: a scalar function and its numpy
+twin side by side. Every loop calls these (the generic loop, the lean loops, the batch
+and design engines); tests/test_batch_parity.py holds each twin equal to its scalar on
+random inputs, NaN and infinities included.
+
+A system of loop equations has converged (PROBLEMS.md P3, seed 001 section 3.9) when the
+step just taken and the residual it was taken from are both within tolerance, measured
+so that the answer does not depend on the mechanism's size or units:
+
+- the step, max |dq_i| / scale_i: angles in radians, lengths relative to the mechanism's
+  length scale (its longest length);
+- the residual, max |Phi_i| <= tol x length scale (Phi is a length).
+
+A mechanism scaled by 1e6 therefore takes the same iterations as the original, on every
+engine. NaN anywhere fails every test (a comparison with NaN is False).
+
+Continuity: a continuation step from (v_last, q_last) through the tangent prediction
+``pred`` to the solution ``q`` stays on its branch when the correction is at most half
+the predicted change plus a term in dv^2 (the path's curvature) and rounding, relative to
+the size of q.
+
+The open scalar methods' guard (:func:`worse_than_seen`): a small step to a point worse
+than one already seen is not convergence.
+
+This module imports nothing at load time: the numpy twins take numpy arrays and import
+numpy only when called.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+# --- the system convergence test ------------------------------------------------------------
+
+def residual_gate(tol: float, length_scale: Any) -> Any:
+    """The residual tolerance: ``tol`` times the mechanism's length scale (a float, or an
+    array of scales, one per design, for the numpy engines)."""
+    return tol * length_scale
+
+
+def step_scales(kinds: Sequence[str], length_scale: float) -> tuple[float, ...] | None:
+    """Per-unknown step scales (lengths by the length scale, angles by 1), or None where
+    every scale is 1 (the step is then measured as it is)."""
+    if length_scale == 1.0 or "length" not in kinds:
+        return None
+    return tuple(length_scale if k == "length" else 1.0 for k in kinds)
+
+
+def step_size(step: Sequence[float], scales: Sequence[float] | None) -> float:
+    """max |dq_i| / scale_i; NaN if any entry is NaN (the builtin max would skip it)."""
+    out = 0.0
+    for i, d in enumerate(step):
+        a = abs(d) if scales is None else abs(d) / scales[i]
+        if a != a:
+            return a
+        if a > out:
+            out = a
+    return out
+
+
+def step_size_array(step: Sequence[Any], scales: Sequence[Any] | None) -> Any:
+    """:func:`step_size` position by position: ``step`` one array per unknown; a scale may
+    be a float or an array (one per position)."""
+    import numpy as np
+
+    out = None
+    for i, d in enumerate(step):
+        a = np.abs(d) if scales is None else np.abs(d) / scales[i]
+        out = a if out is None else np.maximum(out, a)  # (NaN propagates, as in the scalar)
+    return np.zeros(0) if out is None else out
+
+
+def step_limit(tol: float, rtol: float, size_q: Any) -> Any:
+    """The step tolerance: ``tol``, plus ``rtol`` times the iterate's size when given."""
+    return tol + rtol * size_q if rtol else tol
+
+
+def system_converged(err: float, resid: float, limit: float, gate: float) -> bool:
+    """The step ``err`` (see :func:`step_size`) within ``limit`` and the residual max|Phi|
+    at the point it was taken from within ``gate`` (:func:`residual_gate`)."""
+    return err <= limit and resid <= gate
+
+
+def system_converged_array(err: Any, resid: Any, limit: Any, gate: Any) -> Any:
+    """:func:`system_converged` position by position (numpy booleans)."""
+    return (err <= limit) & (resid <= gate)
+
+
+# --- the open scalar methods' guard on a small step ---------------------------------------------
+
+FAR_SLOPE = 1e-8
+"""Below this fraction of the starting |f|, a residual worse than the best seen is rounding."""
+
+
+def worse_than_seen(size: float, best: float, start: float) -> bool:
+    """A step within tolerance is no convergence for an open scalar method (Newton, secant,
+    fixed point; iterate.py test 5) when it lands where |f| = ``size`` is worse than the
+    ``best`` |f| already seen and still above FAR_SLOPE times the ``start``'s: the slope
+    came from far away (a secant chord through a huge f). Scalar only: no array engine
+    runs these methods."""
+    return size > best and size > FAR_SLOPE * start
+
+
+# --- the continuity test ----------------------------------------------------------------------
+
+CONTINUITY_ROUNDING = 1e-7
+"""The rounding allowance of the continuity test, relative to 1 + max|q|."""
+
+CONTINUITY_CURVATURE = 10.0
+"""The allowance for the path's curvature, times dv^2 (rad^2 of driver), relative to 1 + max|q|."""
+
+
+def continues(correction: float, moved: float, dv: float, size: float) -> bool:
+    """A continuation step stays on its branch: the correction max|q - pred| is at most
+    half the predicted change max|pred - q_last| plus (1e-7 + 10 dv^2) x size, with dv
+    the driver step (rad, or length units) and size 1 + max|q|. NaN fails."""
+    return correction <= 0.5 * moved + (CONTINUITY_ROUNDING + CONTINUITY_CURVATURE * dv * dv) * size
+
+
+def continues_array(correction: Any, moved: Any, dv: Any, size: Any) -> Any:
+    """:func:`continues` position by position (numpy booleans)."""
+    return correction <= 0.5 * moved + (CONTINUITY_ROUNDING + CONTINUITY_CURVATURE * dv * dv) * size
+
+
+def continuity_measures(q_last: Sequence[float], pred: Sequence[float],
+                        q: Sequence[float]) -> tuple[float, float, float]:
+    """(correction, moved, size) of :func:`continues` from the three points."""
+    correction = max(abs(a - b) for a, b in zip(q, pred))
+    moved = max(abs(a - b) for a, b in zip(pred, q_last))
+    size = 1.0 + max(abs(c) for c in q)
+    return correction, moved, size
+
+
+def continuity_measures_array(q_last: Sequence[Any], pred: Sequence[Any],
+                              q: Sequence[Any]) -> tuple[Any, Any, Any]:
+    """:func:`continuity_measures` position by position: each point one array per unknown."""
+    import numpy as np
+
+    correction = np.max(np.abs(np.stack(q) - np.stack(pred)), axis=0)
+    moved = np.max(np.abs(np.stack(pred) - np.stack(q_last)), axis=0)
+    size = 1.0 + np.max(np.abs(np.stack(q)), axis=0)
+    return correction, moved, size
