@@ -163,6 +163,11 @@ def test_batch_sweeps_keep_rate_and_joint_columns(cli):
             except ValueError:
                 assert a == b
                 continue
+            if " bound" in head_b[j]:
+                # a bound is an estimate from each engine's own position (equal to ~tol),
+                # not a result: the same size, not the same digits
+                assert 0.5 * x <= y <= 2.0 * x, (head_b[j], a, b)
+                continue
             assert abs(x - y) <= 1e-12 * max(1.0, abs(x)), (head_b[j], a, b)
     col = {h: j for j, h in enumerate(head_b)}
     for row in rows_b:
