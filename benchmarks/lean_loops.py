@@ -70,7 +70,7 @@ def parts() -> None:
     input, the Result), beside the hand loops; for the README's account of targets 1-2."""
     from linkage.bench import hand_newton, hand_newton_2x2, scalar_problem, system_problem
     from linkage.methods.newton import newton_lean
-    from linkage.methods.newton_system import _newton_2x2
+    from linkage.methods.newton_system import newton_2x2
     from linkage.problems.system import LeanProblem
     from linkage.solve import certify_root
 
@@ -93,10 +93,10 @@ def parts() -> None:
     light = LeanProblem(q.F, q.J, None, lambda: q)
     phi0 = q.F(list(q0))
     whole = best(lambda: solve_system(q.F, q0, jac=q.J, tol=1e-12, record=False), 5000)
-    loop = best(lambda: _newton_2x2(light, q0, phi0, 1e-12, 0.0, 1e-12, 50, True), 5000)
+    loop = best(lambda: newton_2x2(light, q0, phi0, 1e-12, 0.0, 1e-12, 50, True), 5000)
     hand = best(lambda: hand_newton_2x2(q.F, q.J, q0, 1e-12), 5000)
     print(f"four-bar Newton, F and J as callables ({r.iterations} iterations): solve {whole * 1e6:.2f} us = "
-          f"_newton_2x2 {loop * 1e6:.2f} us + front door and Result {(whole - loop) * 1e6:.2f} us; "
+          f"newton_2x2 {loop * 1e6:.2f} us + front door and Result {(whole - loop) * 1e6:.2f} us; "
           f"hand loop {hand * 1e6:.2f} us")
 
 

@@ -20,7 +20,8 @@ import tomllib
 import linkage
 from linkage import rules
 from linkage.kinematics.batch import batch_sweep
-from linkage.kinematics.sweep import LOCATE_TOL, driver_values, solved_ranges_array, sweep
+from linkage.kinematics.limits import LOCATE_TOL, solved_ranges_array
+from linkage.kinematics.sweep import driver_values, sweep
 from linkage.problems.loops import load, parse_mechanism
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
@@ -394,7 +395,8 @@ def test_solved_ranges_twin_equals_the_sweeps(seed):
     """The batch's feasible ranges (without a closed form) were the coarse pass's, as coarse
     as its grid (offset_slider: [16, 132] where the sweep says [15.5, 132]). Now they are
     the positions' own, by the array twin of the sweep's rule."""
-    from linkage.kinematics.sweep import Position, _solved_ranges
+    from linkage.kinematics.limits import solved_ranges
+    from linkage.kinematics.positions import Position
 
     rng = np.random.default_rng(300 + seed)
     for n in (0, 1, 2, 3, 10, 200):
@@ -403,7 +405,7 @@ def test_solved_ranges_twin_equals_the_sweeps(seed):
             ok = rng.random(n) < p_on
             positions = [Position(float(v), "converged" if c else "no_solution", None, None, 0, None)
                          for v, c in zip(values, ok)]
-            assert solved_ranges_array(values, ok) == _solved_ranges(positions)
+            assert solved_ranges_array(values, ok) == solved_ranges(positions)
 
 
 @pytest.mark.parametrize("max_iter", [1, 2])

@@ -221,7 +221,7 @@ def test_branch_labels_of_theta4_driven_fourbars_follow_the_configuration_rule()
     > 0 (README). The same configuration once was "open" in fourbar_me581.toml and
     "crossed" in fourbar_me581_theta4.toml (about 200 of the random positions tried).
     Both rocker-driven assemblies stay in the closed form under distinct keys."""
-    from linkage.kinematics.sweep import _Solver
+    from linkage.kinematics.continuation import Solver
 
     rng = random.Random(18)
     base = load(SAMPLES / "fourbar_me581.toml")
@@ -246,7 +246,7 @@ def test_branch_labels_of_theta4_driven_fourbars_follow_the_configuration_rule()
             assert key.removesuffix(MIRROR) == rule, (lengths, theta2, branch, key)
             # the sweep's label of that solution, in each file
             for m, q in ((m2, (t3, t4)), (m4, (ref4[key]["theta2"], ref4[key]["theta3"]))):
-                solver = _Solver(m, "newton", 1e-12, 50)
+                solver = Solver(m, "newton", 1e-12, 50)
                 assert solver.branch([math.radians(v) for v in q], 1.0) == rule
             checked += 1
     assert checked > 100 and shared > 10

@@ -309,9 +309,9 @@ def _two_unknown_mechanisms():
 
 def test_compiled_newton_two_equals_the_lean_loop():
     """The model's generated Newton (one function, Phi and J written in) gives the same
-    iterations and root, bit for bit, as _newton_2x2 with the verdict, wherever it returns
+    iterations and root, bit for bit, as newton_2x2 with the verdict, wherever it returns
     a result; it hands back (None) only runs that did not converge by whole steps."""
-    from linkage.methods.newton_system import _newton_2x2, max_abs
+    from linkage.methods.newton_system import max_abs, newton_2x2
     from linkage.problems.system import LeanProblem
     from linkage.solve import system_verdict
 
@@ -332,7 +332,7 @@ def test_compiled_newton_two_equals_the_lean_loop():
             except (ArithmeticError, ValueError):
                 continue
             light = LeanProblem(F, J, None, lambda m=m, d=d: m.model.problem_at(d))
-            x, phi, _e, status, detail, k, _nf, _nj = _newton_2x2(light, tuple(q), phi0, tol, 0.0, gate,
+            x, phi, _e, status, detail, k, _nf, _nj = newton_2x2(light, tuple(q), phi0, tol, 0.0, gate,
                                                                   50, False)
             status, _ = system_verdict(status, detail, max_abs(phi), gate)
             got = model.newton_two(d, q[0], q[1], tol, gate, 50)
@@ -350,20 +350,21 @@ def test_compiled_newton_two_equals_the_lean_loop():
 
 
 def _sweep_both_ways(m, values, **kw):
-    from linkage.kinematics import sweep as S
+    from linkage.kinematics import continuation as C
+    from linkage.kinematics import stepwise as S
 
-    init = S._Solver.__init__
+    init = C.Solver.__init__
 
     def general(self, *a, **k):
         init(self, *a, **k)
         self.two = False
 
     out = [S.sweep(m, values, **kw)]
-    S._Solver.__init__ = general
+    C.Solver.__init__ = general
     try:
         out.append(S.sweep(m, values, **kw))
     finally:
-        S._Solver.__init__ = init
+        C.Solver.__init__ = init
     return out
 
 
@@ -371,32 +372,32 @@ def test_the_two_unknown_sweep_step_equals_the_general_step():
     """A continuation step on two unknowns runs on scalars with the generated Newton;
     every position of every sweep equals the general step's, bit for bit (gaps, re-entry,
     halved steps and both branches included)."""
-    from linkage.kinematics.sweep import _Solver
+    from linkage.kinematics.continuation import Solver
 
     checked = fast = 0
     for m in _two_unknown_mechanisms()[:40]:
         values = ([float(v) for v in range(0, 361, 3)] if m.driver.kind == "angle"
                   else [m.driver.value * (0.5 + k / 100) for k in range(100)])
-        assert _Solver(m, "newton", 1e-12, 50).two == (m.length_scale == 1.0 or
+        assert Solver(m, "newton", 1e-12, 50).two == (m.length_scale == 1.0 or
                                                        all(u.kind == "angle" for u in m.unknowns))
         for branch in (None, "crossed"):
             a, b = _sweep_both_ways(m, values, branch=branch)
             assert repr(a) == repr(b), (m.name, branch)
             checked += 1
-            fast += _Solver(m, "newton", 1e-12, 50).two
+            fast += Solver(m, "newton", 1e-12, 50).two
     assert checked >= 80 and fast >= 70
 
 
 def test_a_converged_position_built_fast_equals_the_constructor():
     from dataclasses import fields
 
-    from linkage.kinematics.sweep import Position, _converged
+    from linkage.kinematics.positions import Position, converged_position
 
     assert [f.name for f in fields(Position)] == ["input", "status", "solution", "branch", "iterations",
                                                  "det", "transmission", "substeps", "note", "rates"]
     sol = {"theta3": 12.5, "theta4": 80.0}
-    fast, slow = _converged(3.0, sol, "open", 3, -1.5, 67.5), Position(3.0, "converged", sol, "open", 3, -1.5,
-                                                                       67.5)
+    fast = converged_position(3.0, sol, "open", 3, -1.5, 67.5)
+    slow = Position(3.0, "converged", sol, "open", 3, -1.5, 67.5)
     assert fast == slow and repr(fast) == repr(slow)
 
 

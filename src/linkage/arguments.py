@@ -46,7 +46,7 @@ SCHEDULERS = ("threads", "processes", "synchronous")
 """The local dask schedulers a scan may name (else the address of a cluster)."""
 
 
-def _shown(value: Any) -> str:
+def describe(value: Any) -> str:
     """The offending value for a message: its repr, cut short."""
     try:
         text = repr(value)
@@ -77,11 +77,11 @@ def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: b
     Whatever ``float()`` reads is a number here (a numeric string too), except a complex
     one: numpy would drop its imaginary part with only a warning."""
     if type(value) is not float and getattr(getattr(value, "dtype", None), "kind", "") == "c":
-        raise InputError(f"{name} must be a real number, got {_shown(value)}")
+        raise InputError(f"{name} must be a real number, got {describe(value)}")
     try:
         v = float(value)
     except (TypeError, ValueError, OverflowError):
-        raise InputError(f"{name} must be a number, got {_shown(value)}") from None
+        raise InputError(f"{name} must be a number, got {describe(value)}") from None
     if not math.isfinite(v):
         raise InputError(f"{name} must be finite, got {v!r}")
     if positive and (v < 0.0 or (v == 0.0 and not allow_zero)):
@@ -99,11 +99,11 @@ def check_whole(name: str, value: Any, lo: int = 1, hi: int | None = None, why: 
     else:
         span = f"from {lo:,} to {'2**64 - 1' if hi == MAX_SEED else f'{hi:,}'}"
     if isinstance(value, bool) or isinstance(value, float):
-        raise InputError(f"{name} must be a whole number {span}{why}, got {_shown(value)}")
+        raise InputError(f"{name} must be a whole number {span}{why}, got {describe(value)}")
     try:
         n = operator.index(value)
     except TypeError:
-        raise InputError(f"{name} must be a whole number {span}{why}, got {_shown(value)}") from None
+        raise InputError(f"{name} must be a whole number {span}{why}, got {describe(value)}") from None
     if n < lo or (hi is not None and n > hi):
         shown = str(n) if abs(n) < 10**30 else f"about {'-' if n < 0 else ''}1e{len(str(abs(n))) - 1}"
         raise InputError(f"{name} must be a whole number {span}{why}, got {shown}")
@@ -114,7 +114,7 @@ def check_flag(name: str, value: Any) -> bool:
     """True or False (numpy's bool too), nothing else."""
     if isinstance(value, bool) or type(value).__name__ == "bool_":
         return bool(value)
-    raise InputError(f"{name} must be True or False, got {_shown(value)}")
+    raise InputError(f"{name} must be True or False, got {describe(value)}")
 
 
 def check_text(name: str, value: Any, *, optional: bool = True) -> str | None:
@@ -122,7 +122,7 @@ def check_text(name: str, value: Any, *, optional: bool = True) -> str | None:
     if value is None and optional:
         return None
     if not isinstance(value, str):
-        raise InputError(f"{name} must be {'None or ' if optional else ''}a string, got {_shown(value)}")
+        raise InputError(f"{name} must be {'None or ' if optional else ''}a string, got {describe(value)}")
     return value
 
 
@@ -131,7 +131,7 @@ def check_callable(name: str, value: Any, *, optional: bool = True) -> Any:
     if value is None and optional:
         return None
     if not callable(value):
-        raise InputError(f"{name} must be {'None or ' if optional else ''}a function, got {_shown(value)}")
+        raise InputError(f"{name} must be {'None or ' if optional else ''}a function, got {describe(value)}")
     return value
 
 
@@ -142,7 +142,7 @@ def check_reals(name: str, values: Any, length: int | None = None, labels: Seque
     or InputError naming the first bad entry."""
     if values is None or isinstance(values, (str, bytes, Mapping)) or is_real(values):
         raise InputError(f"{name} must be a sequence of numbers (a list, tuple or 1-D array), "
-                         f"got {_shown(values)}")
+                         f"got {describe(values)}")
     listed = isinstance(values, Sequence) or hasattr(values, "__array__")
     if isinstance(values, Iterator) or not listed:
         raise InputError(f"{name} must be a sequence of numbers (a list, tuple or 1-D array), got "
@@ -184,7 +184,7 @@ def check_reals(name: str, values: Any, length: int | None = None, labels: Seque
             continue
         where = labels[k] if k < len(labels) else k
         if not is_real(v):
-            raise InputError(f"{name}[{where}] must be a real number, got {_shown(v)}")
+            raise InputError(f"{name}[{where}] must be a real number, got {describe(v)}")
         x = float(v)
         if not math.isfinite(x):
             raise InputError(f"{name}[{where}] must be finite, got {x!r}")
@@ -198,7 +198,7 @@ def check_rate(name: str, value: Any, unit: str) -> float:
     command line's --speed/--accel."""
     if isinstance(value, (str, bool)):
         raise InputError(f"{name} must be a number in {unit} (the API takes internal units: "
-                         f"rpm x pi/30 = rad/s, deg/s x pi/180 = rad/s), got {_shown(value)}")
+                         f"rpm x pi/30 = rad/s, deg/s x pi/180 = rad/s), got {describe(value)}")
     v = check_number(name, value)
     if abs(v) > MAX_RATE:
         raise InputError(f"{name} must be at most {MAX_RATE:g} in size, got {v!r}")
@@ -226,7 +226,7 @@ def check_scan_options(*, seed: Any = 0, samples: Any = None, top: Any = None, c
     check_text(f"{prefix}scheduler", scheduler)
     if scheduler is not None and "://" not in scheduler and scheduler not in SCHEDULERS:
         raise InputError(f"{prefix}scheduler must be threads, processes, synchronous or "
-                         f"tcp://HOST:PORT, got {_shown(scheduler)}")
+                         f"tcp://HOST:PORT, got {describe(scheduler)}")
     check_whole(f"{prefix}seed", seed, 0, MAX_SEED)
     if samples is not None:
         check_whole(f"{prefix}samples", samples, 1, max_designs)
@@ -242,15 +242,15 @@ def check_vary(vary: Any, max_designs: int) -> list[tuple[str, float, float, int
     as (name, lo, hi, n) with finite bounds and a whole n."""
     if not isinstance(vary, Mapping):
         raise InputError("vary must be a mapping of parameter name to (lo, hi) or (lo, hi, n), "
-                         f"got {_shown(vary)}")
+                         f"got {describe(vary)}")
     out = []
     for name, spec in vary.items():
         if not isinstance(name, str):
-            raise InputError(f"vary's keys must be parameter names (strings), got {_shown(name)}")
+            raise InputError(f"vary's keys must be parameter names (strings), got {describe(name)}")
         label = f"vary[{name!r}]"
         listed = isinstance(spec, Sequence) or hasattr(spec, "__array__")
         if isinstance(spec, (str, bytes, Mapping)) or not listed or len(spec) not in (2, 3):
-            raise InputError(f"{label} must be (lo, hi) or (lo, hi, n), got {_shown(spec)}")
+            raise InputError(f"{label} must be (lo, hi) or (lo, hi, n), got {describe(spec)}")
         lo = check_number(f"{label} lo", spec[0])
         hi = check_number(f"{label} hi", spec[1])
         n = check_whole(f"{label} n", spec[2], 1, max_designs) if len(spec) == 3 else None
@@ -258,30 +258,19 @@ def check_vary(vary: Any, max_designs: int) -> list[tuple[str, float, float, int
     return out
 
 
-def check_mechanism(name: str, value: Any) -> Any:
-    """A Mechanism, or a path (str or os.PathLike) to a mechanism file, loaded."""
-    from .problems.loops import Mechanism, load
-
-    if isinstance(value, Mechanism):
-        return value
-    if isinstance(value, (str, os.PathLike)):
-        return load(value)
-    raise InputError(f"{name} must be a Mechanism or a path to a mechanism file, got {_shown(value)}")
-
-
 def check_path(name: str, value: Any) -> Any:
     """A file path: a str or an os.PathLike."""
     if isinstance(value, (str, os.PathLike)):
         return value
     raise InputError(f"{name} must be a path to a mechanism file (a str or os.PathLike), "
-                     f"got {_shown(value)}")
+                     f"got {describe(value)}")
 
 
 def real_result(name: str, value: Any, where: str) -> None:
     """InputError unless a user function's return ``value`` is a real number (or a complex
     one, which the solvers report as a domain error)."""
     if not (is_real(value) or isinstance(value, complex)):
-        raise InputError(f"{name} must return a real number, got {_shown(value)} {where}")
+        raise InputError(f"{name} must return a real number, got {describe(value)} {where}")
 
 
 def real_vector(name: str, value: Any, n: int, where: str) -> None:
@@ -294,12 +283,12 @@ def real_vector(name: str, value: Any, n: int, where: str) -> None:
     except TypeError:
         size = None
     if size is None or isinstance(value, (str, bytes)):
-        raise InputError(f"{name} must return a sequence of {n} real numbers, got {_shown(value)} {where}")
+        raise InputError(f"{name} must return a sequence of {n} real numbers, got {describe(value)} {where}")
     if size != n:
         return  # the caller's own check names the count ("the system has 1 equations ...")
     for k, v in enumerate(value):
         if not is_real(v):
-            raise InputError(f"{name} must return {n} real numbers; entry {k} is {_shown(v)} {where}")
+            raise InputError(f"{name} must return {n} real numbers; entry {k} is {describe(v)} {where}")
 
 
 def real_matrix(name: str, value: Any, n: int, where: str) -> None:
@@ -308,16 +297,16 @@ def real_matrix(name: str, value: Any, n: int, where: str) -> None:
     try:
         rows = list(value)
     except TypeError:
-        raise InputError(f"{name} must return {shape}, got {_shown(value)} {where}") from None
+        raise InputError(f"{name} must return {shape}, got {describe(value)} {where}") from None
     if isinstance(value, (str, bytes)) or len(rows) != n:
-        raise InputError(f"{name} must return {shape}, got {_shown(value)} {where}")
+        raise InputError(f"{name} must return {shape}, got {describe(value)} {where}")
     for row in rows:
         try:
             cells = list(row)
         except TypeError:
-            raise InputError(f"{name} must return {shape}, got a row {_shown(row)} {where}") from None
+            raise InputError(f"{name} must return {shape}, got a row {describe(row)} {where}") from None
         if len(cells) != n or not all(is_real(c) for c in cells):
-            raise InputError(f"{name} must return {shape}, got a row {_shown(row)} {where}")
+            raise InputError(f"{name} must return {shape}, got a row {describe(row)} {where}")
 
 
 def guarded(call: Callable[[], Any], diagnose: Callable[[], None]) -> Any:

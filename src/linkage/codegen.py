@@ -154,12 +154,12 @@ def build(terms: Any, n: int, newton: bool = False) -> Callable[..., Any]:
 # The convergence test below, "err <= tol and resid <= gate", is
 # linkage.rules.system_converged written in (the hottest loop; no call per iteration):
 # tests/test_compile.py holds this Newton equal, bit for bit, to
-# methods.newton_system._newton_2x2, which calls the rule.
+# methods.newton_system.newton_2x2, which calls the rule.
 _NEWTON_TWO = """\
 def newton2(d, x0, x1, tol, gate, max_iter):
     # Newton-Raphson on the loop equations at driver value d from (x0, x1), with damping
     # off and recording off: the stopping rules of linkage.iterate as
-    # methods.newton_system._newton_2x2 applies them (the same operations in the same
+    # methods.newton_system.newton_2x2 applies them (the same operations in the same
     # order). Returns (iterations, x0, x1, J row by row, dPhi/dv) at a root whose
     # max|Phi| is within gate; None for any other outcome, which the caller hands to the
     # full solver. |v| is written "v if v >= 0.0 else -v" (no call; NaN stays NaN).

@@ -551,15 +551,15 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
     """
     from .arguments import (
         check_flag,
-        check_mechanism,
         check_reals,
         check_scan_options,
         check_text,
         check_vary,
     )
+    from .problems.loops import mechanism_of
     from .solve import check_criteria
 
-    m = check_mechanism("mechanism", mechanism)
+    m = mechanism_of("mechanism", mechanism)
     specs = check_vary(vary, MAX_DESIGNS)
     check_scan_options(seed=seed, samples=samples, top=top, chunk=chunk, workers=workers,
                        scheduler=scheduler, max_designs=MAX_DESIGNS)

@@ -748,10 +748,10 @@ def _system_solvers() -> tuple[Any, ...]:
 @functools.lru_cache(maxsize=1)
 def _two_unknowns() -> tuple[Any, ...]:
     """What :func:`_newton_two` needs, imported once (a scalar solve never pays for it)."""
-    from .methods.newton_system import _newton_2x2, max_abs
-    from .problems.system import LeanProblem, _generic_labels, generic_system
+    from .methods.newton_system import max_abs, newton_2x2
+    from .problems.system import LeanProblem, generic_labels, generic_system
 
-    return _newton_2x2, max_abs, LeanProblem, _generic_labels(2), generic_system
+    return newton_2x2, max_abs, LeanProblem, generic_labels(2), generic_system
 
 
 def system_verdict(status: Status, detail: str, residual: float, gate: float,
@@ -774,10 +774,10 @@ _STOPPED = frozenset({Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN})
 
 def _two_unknown_result(problem: Any, q0: tuple[float, ...], phi0: Any, crit: Criteria, gate: float,
                         damped: bool, meta: dict[str, Any], loaded: tuple[Any, ...]) -> Result:
-    """Newton on two unknowns by :func:`~linkage.methods.newton_system._newton_2x2`,
+    """Newton on two unknowns by :func:`~linkage.methods.newton_system.newton_2x2`,
     judged and packaged as :func:`solve_system` does (``loaded``: :func:`_two_unknowns`)."""
-    _newton_2x2, max_abs = loaded[0], loaded[1]
-    q, phi, err, status, detail, iterations, nfev, njev = _newton_2x2(
+    newton_2x2, max_abs = loaded[0], loaded[1]
+    q, phi, err, status, detail, iterations, nfev, njev = newton_2x2(
         problem, q0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
     residual = max_abs(phi)
     status, detail = system_verdict(status, detail, residual, gate)

@@ -30,22 +30,11 @@ from ..problems.closed_form import transmission
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel, Mechanism
 from ..rules import residual_gate, step_scales, step_size_array, system_converged_array
 from .angles import nearest_turn, nearest_turn_array
-from .sweep import (
-    MAX_POSITIONS,
-    Position,
-    SweepResult,
-    _classify_gap,
-    _continue,
-    _solve_position,
-    _Solver,
-    check_driver_values,
-    driver_values,
-    solved_ranges_array,
-    solver_q,
-    sweep,
-    tangent,
-    with_rates,
-)
+from .continuation import Solver, classify_gap, continue_step, solve_position, solver_q, tangent
+from .limits import solved_ranges_array
+from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
+from .rates import with_rates
+from .stepwise import sweep
 
 STATUS_CODES = {"converged": 0, "no_solution": 1, "failed": 2, "off_branch": 3}
 CODE_STATUS = {v: k for k, v in STATUS_CODES.items()}
@@ -246,7 +235,7 @@ class VectorLoops:
         return c, s
 
 
-def _solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[list[np.ndarray], np.ndarray]:
+def solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[list[np.ndarray], np.ndarray]:
     """dq with J dq = -Phi at every position, and det J. Cramer's rule for 2x2."""
     if len(jac) == 2 and len(jac[0]) == 2:
         a, b = np.broadcast_to(jac[0][0], (k,)), np.broadcast_to(jac[0][1], (k,))
@@ -297,7 +286,7 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
     lo, hi = float(vals[0]), float(vals[-1])
     grid = driver_values(lo, hi, None, min(coarse, n_pos))
     rough = sweep(m, grid, branch=branch, tol=tol, max_iter=max_iter)
-    solver = _Solver(m, "newton", tol, max_iter)
+    solver = Solver(m, "newton", tol, max_iter)
     names, kinds = solver.names, solver.kinds
     n = len(names)
     ok_coarse = np.array([p.status == "converged" for p in rough.positions])
@@ -350,9 +339,9 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
             if cp.status == "converged":
                 qc = solver_q(solver, cp)
                 if have_closed:
-                    pos, _ = _solve_position(solver, v, qc, cp.input, qc, target, True)
+                    pos, _ = solve_position(solver, v, qc, cp.input, qc, target, True)
                 else:
-                    pos, _ = _continue(solver, v, [(cp.input, qc)], target)
+                    pos, _ = continue_step(solver, v, [(cp.input, qc)], target)
                 if pos.status == "converged":
                     break
         if pos is None or pos.status != "converged":
@@ -365,7 +354,7 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
                 # a boundary between two kinds of gap falls in this coarse interval
                 anchor = next((solver_q(solver, p) for p in rough.positions if p.solution), None)
                 tries = [g for g in (anchor, tuple(u.value for u in m.unknowns)) if g is not None]
-                status[i] = code[_classify_gap(solver, v, tries)[0].status]
+                status[i] = code[classify_gap(solver, v, tries)[0].status]
             else:
                 status[i] = code[others[0]] if others else code["failed"]
             continue
@@ -481,7 +470,7 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     while it < min(2, max_iter) and live.any():
         it += 1
         phi, jac = loops.evaluate(q_all, None, near=it > 1)
-        dq, det = _solve_linear(jac, phi, n_pos)
+        dq, det = solve_linear(jac, phi, n_pos)
         step, resid = step_size_array(dq, steps), _largest(phi)
         finite = np.isfinite(step)
         for j in range(n):
@@ -496,7 +485,7 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     while it < max_iter and active.size:
         it += 1
         phi, jac = loops.evaluate(q, active)
-        dq, det = _solve_linear(jac, phi, active.size)
+        dq, det = solve_linear(jac, phi, active.size)
         step, resid = step_size_array(dq, steps), _largest(phi)
         for j in range(n):
             q[j] += dq[j]

@@ -58,7 +58,7 @@ from .angles import (
     turn_shift_array,
     unwrap_turns_array,
 )
-from .batch import STATUS_CODES, VectorLoops, _solve_linear
+from .batch import STATUS_CODES, VectorLoops, solve_linear
 
 CONVERGED, NO_SOLUTION, FAILED, OFF_BRANCH = (STATUS_CODES[k] for k in
                                               ("converged", "no_solution", "failed", "off_branch"))
@@ -290,7 +290,7 @@ def _newton(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol
         if active.size == 0:
             break
         phi, jac = loops.evaluate(q, active)
-        dq, det = _solve_linear(jac, phi, active.size)
+        dq, det = solve_linear(jac, phi, active.size)
         scale = size[active]
         resid = np.abs(phi[0])
         for f in phi[1:]:
@@ -429,7 +429,7 @@ def _det_at(loops: VectorLoops, q: list[np.ndarray], count: int) -> np.ndarray:
     """det J at q (every entry)."""
     _, jac = loops.evaluate(q, None)
     zeros = [np.zeros(count) for _ in q]
-    _, det = _solve_linear(jac, zeros, count)
+    _, det = solve_linear(jac, zeros, count)
     return np.broadcast_to(det, (count,)).astype(float)
 
 
@@ -456,14 +456,14 @@ def _tangent(m: Mechanism, loops: VectorLoops, grid: Mapping[str, Any], drv: flo
                 dy = dy + t.sign * np.sin(th)
         rhs += [-scale * np.broadcast_to(dx, (count,)), -scale * np.broadcast_to(dy, (count,))]
     _, jac = loops.evaluate(q, None)
-    # J t = rhs, i.e. J t + (-rhs) = 0: _solve_linear solves J dq = -phi
-    dq, _ = _solve_linear(jac, [-c for c in rhs], count)
+    # J t = rhs, i.e. J t + (-rhs) = 0: solve_linear solves J dq = -phi
+    dq, _ = solve_linear(jac, [-c for c in rhs], count)
     return [np.asarray(c, dtype=float) for c in dq]
 
 
 def _sweep_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, branch: str | None,
                   tol: float, n_designs: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray, str]:
-    from .sweep import sweep
+    from .stepwise import sweep
 
     n, k = len(m.unknowns), len(vals)
     q = [np.full(n_designs * k, np.nan) for _ in range(n)]

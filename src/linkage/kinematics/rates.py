@@ -33,7 +33,8 @@ from typing import Any
 
 from ..methods._linalg import SingularMatrix, lu, lu_solve
 from ..methods.newton_system import max_abs, newton_direction
-from ..problems.loops import DRIVER, LoopModel
+from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel
+from .positions import SweepResult
 
 FIXED = -1
 
@@ -541,10 +542,11 @@ def rates_at(mechanism: Any, q: Any, *, speed: float | None = None, accel: float
     path to a file. Numbers only, in those internal units (a unit string such as "10rpm"
     is the command line's); every argument is checked first, and a misuse raises
     :class:`~linkage.errors.InputError` naming it."""
-    from ..arguments import check_mechanism, check_number, check_rate, check_reals
+    from ..arguments import check_number, check_rate, check_reals
     from ..errors import InputError
+    from ..problems.loops import mechanism_of
 
-    mechanism = check_mechanism("mechanism", mechanism)
+    mechanism = mechanism_of("mechanism", mechanism)
     names = [u.name for u in mechanism.unknowns]
     q = check_reals("q", q, len(names), names)
     per_s = "rad/s" if mechanism.driver.kind == "angle" else f"{mechanism.length_unit or 'length unit'}/s"
@@ -556,3 +558,22 @@ def rates_at(mechanism: Any, q: Any, *, speed: float | None = None, accel: float
     model = mechanism.model
     d = mechanism.driver.value if driver is None else check_number("driver", driver)
     return position_rates(model, q, d, speed, accel)
+
+
+def with_rates(m: Any, result: SweepResult, speed: float | None, accel: float) -> SweepResult:
+    """Joints, and with a driver speed velocities and accelerations, at every solved position."""
+    from dataclasses import replace
+
+    model = m.model
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    kinds = [u.kind for u in m.unknowns]
+    positions = []
+    for p in result.positions:
+        if p.solution is None:
+            positions.append(p)
+            continue
+        q = [math.radians(p.solution[u.name]) if k == "angle" else p.solution[u.name]
+             for u, k in zip(m.unknowns, kinds)]
+        positions.append(replace(p, rates=position_rates(model, q, p.input * scale, speed, accel)))
+    motion = (speed, accel) if speed is not None else None
+    return replace(result, positions=tuple(positions), motion=motion)

@@ -335,7 +335,7 @@ def newton_system_lean(problem: SystemProblem, q0: tuple[float, ...], phi0: list
     F, Jf = problem.F, problem.J
     scales = problem.step_scales
     if scales is None and len(q0) == 2 and len(phi0) == 2:
-        return _newton_2x2(problem, q0, phi0, tol, rtol, gate, max_iter, damped)
+        return newton_2x2(problem, q0, phi0, tol, rtol, gate, max_iter, damped)
     method = NewtonSystem("analytic", None, damped, diagnostics=False)
     isfinite = math.isfinite
     q = list(q0)
@@ -415,7 +415,7 @@ def newton_system_lean(problem: SystemProblem, q0: tuple[float, ...], phi0: list
     return q, phi, err, Status.MAX_ITER, "", k, nfev, njev
 
 
-def _newton_2x2(problem: SystemProblem, q0: tuple[float, ...], phi0: list[float], tol: float, rtol: float,
+def newton_2x2(problem: SystemProblem, q0: tuple[float, ...], phi0: list[float], tol: float, rtol: float,
                 gate: float, max_iter: int, damped: bool) -> tuple[Any, ...]:
     """:func:`newton_system_lean` for two unknowns measured as they are (every four-bar),
     on scalars: the same operations in the same order, so the same iterates, status and

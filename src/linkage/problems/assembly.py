@@ -30,6 +30,12 @@ from typing import Any
 
 # --- circle intersection --------------------------------------------------------------------
 
+TANGENT_SLACK = 4.0 * 2.220446049250313e-16
+"""Circles that miss each other by at most this times the largest of the three distances
+are tangent (one double solution), not apart: the distances carry that much rounding
+(a four-bar at its exact limit, r1 = r4 = 3, r2 = r3 = 0.2, theta2 = 0, closes, and
+"no_solution" there would be a false claim)."""
+
 
 def triangle(d: float, r: float, rho: float) -> tuple[float, float] | None:
     """Where X lies with |X - P| = r and |X - Q| = rho, |Q - P| = d > 0: (a, h), the
@@ -38,8 +44,9 @@ def triangle(d: float, r: float, rho: float) -> tuple[float, float] | None:
     accurate to a few ulps of the triangle the three distances describe."""
     x, y, z = sorted((d, r, rho), reverse=True)
     gap = z - (x - y)
-    if not gap >= 0.0:  # NaN included
+    if not gap >= -TANGENT_SLACK * x:  # NaN included
         return None
+    gap = max(gap, 0.0)
     area4 = (x + (y + z)) * gap * (z + (x - y)) * (x + (y - z))
     h = math.sqrt(max(area4, 0.0)) / (2.0 * d)
     a = ((r - rho) * (r + rho) + d * d) / (2.0 * d)
@@ -54,7 +61,8 @@ def triangle_np(d: Any, r: Any, rho: Any) -> tuple[Any, Any, Any]:
     s = -np.sort(-np.stack((d, r, rho)), axis=0)
     x, y, z = s[0], s[1], s[2]
     gap = z - (x - y)
-    ok = (gap >= 0.0) & (d > 0.0)
+    ok = (gap >= -TANGENT_SLACK * x) & (d > 0.0)
+    gap = np.maximum(gap, 0.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         area4 = (x + (y + z)) * gap * (z + (x - y)) * (x + (y - z))
         h = np.where(ok, np.sqrt(np.maximum(area4, 0.0)) / (2.0 * d), np.nan)

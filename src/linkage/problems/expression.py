@@ -129,7 +129,7 @@ class Op:
     rounding of a literal such as 0.1 or pi, and of every operation folded into it)."""
 
 
-_BINOPS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Pow: "**"}
+BINOPS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Pow: "**"}
 _FOLD: dict[str, Callable[..., float]] = {
     "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
     "/": lambda a, b: a / b, "**": math.pow, "neg": lambda a: -a,
@@ -280,7 +280,7 @@ def _check(node: ast.AST, shown: str, what: str) -> list[ast.AST]:
                          f"{', '.join(sorted(FUNCTIONS))}")
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub)):
         return [node.operand]
-    if isinstance(node, ast.BinOp) and type(node.op) in _BINOPS:
+    if isinstance(node, ast.BinOp) and type(node.op) in BINOPS:
         return [node.left, node.right]
     if isinstance(node, ast.Call):
         return [call_argument(node, f"in the {what} {shown!r}")]
@@ -299,7 +299,7 @@ def _emit(node: ast.AST, b: _Builder, out: list[int]) -> int:
         return a if isinstance(node.op, ast.UAdd) else b.add(Op("neg", (a,)))
     if isinstance(node, ast.BinOp):
         right, left = out.pop(), out.pop()
-        return b.add(Op(_BINOPS[type(node.op)], (left, right)))
+        return b.add(Op(BINOPS[type(node.op)], (left, right)))
     assert isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
     return b.add(Op(node.func.id, (out.pop(),)))
 

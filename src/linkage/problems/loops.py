@@ -33,10 +33,11 @@ import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from os import PathLike
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from ..errors import ParseError
+from ..errors import InputError, ParseError
 from .columns import column_clash
 from .system import SystemProblem
 
@@ -200,11 +201,23 @@ def _requantify(q: Quantity, value: float) -> Quantity:
 
 def load(path: str | Path) -> Mechanism:
     """Read and validate a mechanism file; every error names the file and the key."""
-    from ..arguments import check_path
+    from ..arguments import check_path  # (arguments imports nothing of ours: no cycle)
     from ..files import read_input
 
     p = Path(check_path("path", path))
     return from_text(read_input(p), str(p))
+
+
+def mechanism_of(name: str, value: Any) -> Mechanism:
+    """A Mechanism, or a path (str or os.PathLike) to a mechanism file, loaded: the API's
+    front doors take either (:mod:`linkage.arguments` checks everything else)."""
+    from ..arguments import describe
+
+    if isinstance(value, Mechanism):
+        return value
+    if isinstance(value, (str, PathLike)):
+        return load(value)
+    raise InputError(f"{name} must be a Mechanism or a path to a mechanism file, got {describe(value)}")
 
 
 def from_text(text: str, source: str) -> Mechanism:

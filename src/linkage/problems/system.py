@@ -66,12 +66,12 @@ class SystemProblem:
 
 def generic_system(F: Residual, n: int, J: Jacobian | None = None) -> SystemProblem:
     """Wrap a bare residual function of n unknowns (no units, names x1..xn)."""
-    names, kinds, equations = _generic_labels(n)
+    names, kinds, equations = generic_labels(n)
     return SystemProblem(F=F, J=J, names=names, kinds=kinds, equation_names=equations)
 
 
 @functools.lru_cache(maxsize=64)
-def _generic_labels(n: int) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
+def generic_labels(n: int) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
     return tuple(f"x{i + 1}" for i in range(n)), ("",) * n, tuple(f"F{i + 1}" for i in range(n))
 
 

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import ParseError
 from .expression import (
-    _BINOPS,
+    BINOPS,
     CONSTANTS,
     FUNCTIONS,
     MAX_OPERATIONS,
@@ -140,7 +140,7 @@ def _children(node: ast.AST, shown: str, columns: Mapping[str, str]) -> list[ast
                          f"{', '.join(columns)}")
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub, ast.Not)):
         return [node.operand]
-    if isinstance(node, ast.BinOp) and type(node.op) in _BINOPS:
+    if isinstance(node, ast.BinOp) and type(node.op) in BINOPS:
         return [node.left, node.right]
     if isinstance(node, ast.BoolOp) and isinstance(node.op, (ast.And, ast.Or)):
         return list(node.values)
@@ -191,7 +191,7 @@ def _emit(node: ast.AST, ops: list[_Op], out: list[int], shown: str, columns: Ma
         b, a = out.pop(), out.pop()
         need(a, "number", "arithmetic")
         need(b, "number", "arithmetic")
-        add(_Op(_BINOPS[type(node.op)], (a, b)))
+        add(_Op(BINOPS[type(node.op)], (a, b)))
         return
     if isinstance(node, ast.Call):
         a = out.pop()

@@ -1,0 +1,228 @@
+"""Limit positions and toggles of a swept branch, and the driver ranges it solved on.
+
+Limits (where the branch or the feasible range ends) and toggles (det J changes sign
+between solved positions, or touches zero between them) are located by bisection to
+``LOCATE_TOL`` of the driver's unit, or taken from the closed form where it gives them
+exactly.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve
+from ..methods.newton_system import max_abs
+from ..problems.closed_form import (
+    arc_limits,
+)
+from .continuation import REENTERED, Solver, predict, solver_q
+from .positions import Position
+
+LOCATE_TOL = 1e-9  # driver units (deg for angles)
+
+
+def solved_ranges(positions: Sequence[Position]) -> tuple[tuple[float, float], ...]:
+    out = []
+    start = None
+    prev = None
+    for p in positions:
+        if p.status == "converged":
+            if start is None:
+                start = p.input
+            prev = p.input
+        elif start is not None:
+            out.append((start, prev))
+            start = None
+    if start is not None:
+        out.append((start, prev))
+    return tuple(out)  # type: ignore[arg-type]
+
+
+def solved_ranges_array(values: Any, converged: Any) -> tuple[tuple[float, float], ...]:
+    """:func:`solved_ranges` over arrays (the batch engine's): each run of converged
+    positions as (first driver value, last driver value), in position order."""
+    import numpy as np
+
+    c = np.asarray(converged, dtype=bool)
+    if not c.size:
+        return ()
+    edges = np.diff(c.astype(np.int8))
+    starts, ends = np.flatnonzero(edges == 1) + 1, np.flatnonzero(edges == -1)
+    if c[0]:
+        starts = np.concatenate(([0], starts))
+    if c[-1]:
+        ends = np.concatenate((ends, [len(c) - 1]))
+    return tuple((float(values[a]), float(values[b])) for a, b in zip(starts, ends))
+
+
+def toggles(solver: Solver, positions: Sequence[Position], arcs: Any, lo: float, hi: float,
+             have_closed: bool) -> list[float]:
+    found: list[float] = []
+    if have_closed:
+        found += arc_limits(arcs, lo, hi)
+    pairs = list(itertools.pairwise(positions))
+    for a, b in pairs:
+        if a.status == "converged" and b.status == "converged" and a.det and b.det \
+                and (a.det > 0) != (b.det > 0):
+            if REENTERED in (a.note, b.note):
+                continue  # not one assembly moving: the sweep re-entered on the other one
+            found.append(_bisect_det(solver, a, b))
+        elif not have_closed and (a.status == "converged") != (b.status == "converged"):
+            found.append(_bisect_limit(solver, a, b))
+    # det J can also touch zero without changing sign (two assemblies crossing, as an
+    # in-line slider-crank with r3 = r2 at 90 deg): a local minimum of |det J| over the
+    # solved positions is refined, and is a toggle where J is singular there
+    for a, b, c in zip(positions, positions[1:], positions[2:]):
+        if a.det is not None and b.det is not None and c.det is not None \
+                and a.status == b.status == c.status == "converged" \
+                and (a.det > 0) == (b.det > 0) == (c.det > 0) \
+                and abs(b.det) <= abs(a.det) and abs(b.det) <= abs(c.det):
+            touch = _touch_det(solver, a, b, c)
+            if touch is not None and not any(abs(touch - t) <= 2 * LOCATE_TOL for t in found):
+                found.append(touch)
+    return sorted(found)
+
+
+TOUCH_RATIO = 1e-5
+"""A minimum of |det J| / (its columns' lengths) at most this is a toggle (see hadamard_ratio)."""
+
+
+TOUCH_CANDIDATE = 0.1
+"""A local minimum of |det J| over the solved positions is searched only where
+hadamard_ratio is below this there (a transmission angle under 5.7 deg): near a touch it
+falls like the distance to it (0.017 a degree on the in-line slider-crank), while an
+ordinary mechanism's smallest transmission angle is far above, and costs nothing."""
+
+
+def _touch_det(solver: Solver, a: Position, b: Position, c: Position) -> float | None:
+    """The driver value in [a, c] where the branch's J is nearest singular (golden-section
+    search on hadamard_ratio, to LOCATE_TOL), if J is singular there; else None."""
+    from ..methods._linalg import hadamard_ratio
+
+    q_b = solver_q(solver, b)
+    if not hadamard_ratio(solver.problem(b.input).J(list(q_b))) <= TOUCH_CANDIDATE:
+        return None
+    ends = ((a.input, solver_q(solver, a)), (c.input, solver_q(solver, c)))
+    cache: dict[float, float] = {}
+
+    def ratio(v: float) -> float:
+        if v not in cache:
+            # from the nearer end, where J is regular (not from b: J may be singular there)
+            v0, q0 = min(ends, key=lambda e: abs(e[0] - v))
+            # damped: next to a singular J the textbook step can jump to another assembly
+            p, r = solver.solve(v, predict(solver, v0, q0, v) or q0, damped=True)
+            x = list(r.x)
+            # there Newton converges only linearly and may stop at max_iter short of tol:
+            # its last iterate still places the minimum when it nearly closes the loops
+            close = r.converged or (all(map(math.isfinite, x)) and
+                                    max_abs(p.F(x)) <= 1e-6 * solver.m.length_scale)
+            cache[v] = hadamard_ratio(p.J(x)) if close else math.inf
+        return cache[v]
+
+    lo, hi = a.input, c.input
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+    while abs(hi - lo) > LOCATE_TOL:
+        if ratio(x1) <= ratio(x2):
+            hi, x2 = x2, x1
+            x1 = hi - g * (hi - lo)
+        else:
+            lo, x1 = x1, x2
+            x2 = lo + g * (hi - lo)
+    best = min(cache, key=cache.__getitem__, default=None)
+    if best is None or not cache[best] <= TOUCH_RATIO:
+        return None
+    return best
+
+
+def _bisect_det(solver: Solver, a: Position, b: Position) -> float:
+    """det J changes sign between two solved positions: bisect on its sign."""
+    qa = solver_q(solver, a)
+    va, vb, det_a = a.input, b.input, a.det or 0.0
+    while abs(vb - va) > LOCATE_TOL:
+        vm = 0.5 * (va + vb)
+        p, r = solver.solve(vm, qa)
+        if not r.converged:
+            break
+        d = solver.det(p, r.x)
+        if (d > 0) == (det_a > 0):
+            va, qa = vm, tuple(r.x)
+        else:
+            vb = vm
+    return 0.5 * (va + vb)
+
+
+def _bisect_limit(solver: Solver, a: Position, b: Position) -> float:
+    """One side is on the branch, the other is not (no solution, or another assembly):
+    bisect on "Newton from the branch's nearest solution stays on it" (see _reaches)."""
+    good, bad = (a, b) if a.status == "converged" else (b, a)
+    q = solver_q(solver, good)
+    vg, vb = good.input, bad.input
+    while abs(vb - vg) > 1e-6:
+        vm = 0.5 * (vg + vb)
+        qm = _reaches(solver, vm, vg, q, good.branch)
+        if qm is not None:
+            vg, q = vm, qm
+        else:
+            vb = vm
+    refined = _refine_limit(solver, vg, q)
+    if refined is not None and min(good.input, bad.input) <= refined <= max(good.input, bad.input):
+        return refined
+    return 0.5 * (vg + vb)
+
+
+def _refine_limit(solver: Solver, v0: float, q0: tuple[float, ...]) -> float | None:
+    """The limit exactly: Newton on Phi(q, v) = 0, det J(q, v) = 0 for (q, v), from a
+    point near it (the fold or assembly limit is where det J vanishes on the branch)."""
+
+    def g(x: list[float]) -> list[float]:
+        *q, v = x
+        p = solver.problem(v, tuple(q))
+        try:
+            d = det_from_lu(lu(p.J(q)))
+        except SingularMatrix:
+            d = 0.0
+        return [*p.F(q), d]
+
+    x = [*q0, v0]
+    for _ in range(30):
+        gx = g(x)
+        cols = []
+        for j in range(len(x)):
+            h = 1e-7 * max(1.0, abs(x[j]))
+            xj = list(x)
+            xj[j] += h
+            cols.append([(a - b) / h for a, b in zip(g(xj), gx)])
+        jac = [[cols[j][i] for j in range(len(x))] for i in range(len(x))]
+        try:
+            dx = lu_solve(lu(jac), [-c for c in gx])
+        except SingularMatrix:
+            return None
+        x = [a + b for a, b in zip(x, dx)]
+        if not all(math.isfinite(c) for c in x):
+            return None
+        if abs(dx[-1]) <= 1e-12 * max(1.0, abs(x[-1])) and max(abs(c) for c in dx[:-1]) <= 1e-12:
+            return x[-1]
+    return None
+
+
+def _reaches(solver: Solver, v: float, v_good: float, q_good: tuple[float, ...],
+             branch: str | None) -> tuple[float, ...] | None:
+    """The solution at v on the branch through (v_good, q_good), or None.
+
+    Near a limit or a fold the branch moves like sqrt(v* - v), so a solution within
+    2 sqrt(|v - v_good|) (radians, scaled by the size of q) counts as the same branch;
+    a jump to another assembly is larger once the interval is small.
+    """
+    p, r = solver.solve(v, q_good)
+    if not r.converged:
+        return None
+    q = tuple(r.x)
+    if branch is not None and solver.branch(q, solver.det(p, q)) != branch:
+        return None
+    dist = max(abs(x - y) for x, y in zip(q, q_good))
+    allow = 2.0 * math.sqrt(abs(v - v_good) * solver.scale) * (1.0 + max(abs(c) for c in q_good))
+    return q if dist <= allow + 1e-12 else None

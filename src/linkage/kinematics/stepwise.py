@@ -1,0 +1,151 @@
+"""The one-at-a-time sweep engine: the seed position, continuation both ways from it
+(:mod:`.continuation`), the gaps, continuous angles (:mod:`.angles`), limits and toggles
+(:mod:`.limits`). For a full turn, a backward pass from the start covers the end of the
+cycle. The batch and design engines start from it and use the same rules."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from ..problems.closed_form import (
+    arcs_within,
+    feasible_arcs,
+    fourbar_class,
+)
+from ..problems.loops import Mechanism
+from .angles import anchor_index, closes_circle, continuous, driver_turn, turn_shift, unwrap_turns
+from .continuation import Solver, classify_gap, follow, q_of, solve_position
+from .limits import solved_ranges, toggles
+from .positions import Position, SweepResult, check_driver_values
+
+
+def sweep(
+    m: Mechanism,
+    values: Sequence[float],
+    *,
+    method: str = "newton",
+    branch: str | None = None,
+    tol: float = 1e-12,
+    max_iter: int = 50,
+    progress: Callable[[int], None] | None = None,
+) -> SweepResult:
+    """Solve the mechanism at each driver value (display units), by continuation."""
+    values = check_driver_values(m, values)
+    solver = Solver(m, method, tol, max_iter)
+    lo, hi = (min(values), max(values)) if values else (0.0, 0.0)
+    arcs = feasible_arcs(m) if m.closed_form and m.driver.kind == "angle" else None
+    have_closed = m.closed_form is not None and m.driver.kind == "angle"
+    guess0 = tuple(u.value for u in m.unknowns)
+    full_turn = m.driver.kind == "angle" and bool(values) and values[-1] - values[0] >= 360.0 - 1e-9
+    done: dict[int, Position] = {}
+    target = branch
+    anchor_q = guess0
+    # The seed: where the branch to follow is known. With a closed form, the first
+    # position that can be assembled, on the requested branch (or the guess's);
+    # otherwise the file's own driver value, whose guess names the assembly.
+    seed: tuple[float, tuple[float, ...]] | None = None
+    if have_closed:
+        for i, v in enumerate(values):
+            pos, q = solve_position(solver, v, None, None, guess0, target, True)
+            if pos.status == "converged" and q is not None:
+                seed, target = (v, q), pos.branch
+                done[i] = pos
+                break
+            done[i] = pos
+    else:
+        v0 = m.driver.value / solver.scale
+        p0, r0 = solver.solve(v0, guess0)
+        if r0.converged:
+            q0 = tuple(r0.x)
+            seed = (v0, q0)
+            target = solver.branch(q0, solver.det(p0, q0))
+    if seed is not None:
+        anchor_q = seed[1]
+        for i, pos in follow(solver, values, seed, target, full_turn, progress, done).items():
+            done[i] = pos
+    # The rest: re-entry on the same branch where a closed form names it; otherwise the
+    # position is no_solution (no assembly at all) or off_branch (one not connected),
+    # trying the last other assembly found first (continuation along it).
+    other: tuple[float, ...] | None = None
+    for j, v in enumerate(values):
+        if j in done:
+            continue
+        prev = done.get(j - 1)
+        if have_closed:
+            last = (q_of(solver, prev), values[j - 1]) if prev else (None, None)
+            pos, q = solve_position(solver, v, last[0], last[1], anchor_q, target, True)
+        else:
+            tries = [g for g in (other, anchor_q, guess0) if g is not None]
+            pos, found = classify_gap(solver, v, tries)
+            other = found or other
+        if target is None and pos.status == "converged":
+            target = pos.branch
+        done[j] = pos
+        if progress is not None:
+            progress(len(done))
+    positions = [done[j] for j in range(len(values))]
+    positions = _continuous_angles(solver, positions)
+    found = toggles(solver, positions, arcs, lo, hi, have_closed)
+    ranges = (tuple(arcs_within(arcs, lo, hi)) if have_closed else solved_ranges(positions))
+    classification: dict[str, Any] = {}
+    if m.closed_form == "fourbar":
+        v = {k: q.value for k, q in m.parameters.items()}
+        classification = fourbar_class(v["r1"], v["r2"], v["r3"], v["r4"])
+    return SweepResult(m.name, m.driver.name, m.driver.unit, solver.names,
+                       tuple("deg" if k == "angle" else m.length_unit for k in solver.kinds),
+                       tuple(positions), ranges, tuple(found), target, classification, method,
+                       length_unit=m.length_unit)
+
+
+def _continuous_angles(solver: Solver, positions: list[Position]) -> list[Position]:
+    """Report each angle continuously along the cycle, in driver order around the circle
+    (an arc across the grid's end is one piece), in the turn ``solve FILE`` gives at the
+    file's driver value: the rule of :mod:`linkage.kinematics.angles`."""
+    angles = [n for n, k in zip(solver.names, solver.kinds) if k == "angle"]
+    if not angles:
+        return positions
+    closes = _closes(solver, positions)
+    solved = {n: [p.solution[n] if p.solution else None for p in positions] for n in angles}
+    turns = {n: unwrap_turns(solved[n], closes) for n in angles}
+    shift = _anchor(solver, positions, angles, turns, closes)
+    for i, p in enumerate(positions):
+        sol = p.solution
+        if sol is None:
+            continue
+        # in place: each position and its solution dict were made by this sweep and are
+        # not yet anybody else's (a new Position per position cost 1.5 us each); from the
+        # values as solved, so writing twice would write the same
+        for n in angles:
+            sol[n] = continuous(solved[n][i], turns[n][i] + shift[n])  # type: ignore[arg-type,operator]
+    return positions
+
+
+def _closes(solver: Solver, positions: Sequence[Position]) -> bool:
+    """Whether the sweep's driver values close the circle (angles.closes_circle)."""
+    if solver.m.driver.kind != "angle":
+        return False
+    return closes_circle([p.input for p in positions], driver_turn(solver.m.driver.unit))
+
+
+def _anchor(solver: Solver, positions: list[Position], angles: list[str],
+            turns: dict[str, list[int | None]], closes: bool) -> dict[str, int]:
+    """Whole turns to add to each angle's curve so that at the position nearest the file's
+    own driver value it reads as `solve FILE` reports it there (Newton from the file's
+    guess): a sweep and a solve never disagree by a turn."""
+    none = dict.fromkeys(angles, 0)
+    m = solver.m
+    v0 = m.driver.value / solver.scale
+    near = anchor_index([p.input for p in positions], [p.solution is not None for p in positions], v0,
+                        closes, driver_turn(m.driver.unit))
+    if near is None:
+        return none
+    from ..solve import solve_system
+
+    r = solve_system(solver.problem(v0), tuple(u.value for u in m.unknowns), tol=solver.tol, record=False)
+    if not r.converged:
+        return none
+    ref = solver.display(r.x)
+    sol = positions[near].solution
+    assert sol is not None
+    return {n: turn_shift(ref[n], continuous(sol[n], turns[n][near])) for n in angles}  # type: ignore[arg-type]
