@@ -205,6 +205,19 @@ def check_rate(name: str, value: Any, unit: str) -> float:
     return v
 
 
+def check_motion(speed: Any, accel: Any, driver_kind: str, length_unit: str) -> tuple[float | None, float]:
+    """The driver's (speed, accel) for rates: speed None (no rates) or a rate in rad/s (a
+    turning driver) or length unit/s (a sliding one), accel in the same per second; an
+    acceleration without a speed is refused."""
+    per_s = "rad/s" if driver_kind == "angle" else f"{length_unit or 'length unit'}/s"
+    if speed is not None:
+        speed = check_rate("speed", speed, per_s)
+    accel = check_rate("accel", accel, f"{per_s}^2")
+    if speed is None and accel != 0.0:
+        raise InputError("accel needs speed (the driver's velocity)")
+    return speed, accel
+
+
 def check_workers(name: str, value: Any, scheduler: str | None) -> int | None:
     """Local workers: None (one per core), or a whole number up to MAX_PROCESSES for the
     processes scheduler and MAX_THREADS otherwise."""

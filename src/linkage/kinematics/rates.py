@@ -542,19 +542,13 @@ def rates_at(mechanism: Any, q: Any, *, speed: float | None = None, accel: float
     path to a file. Numbers only, in those internal units (a unit string such as "10rpm"
     is the command line's); every argument is checked first, and a misuse raises
     :class:`~linkage.errors.InputError` naming it."""
-    from ..arguments import check_number, check_rate, check_reals
-    from ..errors import InputError
+    from ..arguments import check_motion, check_number, check_reals
     from ..problems.loops import mechanism_of
 
     mechanism = mechanism_of("mechanism", mechanism)
     names = [u.name for u in mechanism.unknowns]
     q = check_reals("q", q, len(names), names)
-    per_s = "rad/s" if mechanism.driver.kind == "angle" else f"{mechanism.length_unit or 'length unit'}/s"
-    if speed is not None:
-        speed = check_rate("speed", speed, per_s)
-    accel = check_rate("accel", accel, f"{per_s}^2")
-    if speed is None and accel != 0.0:
-        raise InputError("accel needs speed (the driver's velocity)")
+    speed, accel = check_motion(speed, accel, mechanism.driver.kind, mechanism.length_unit)
     model = mechanism.model
     d = mechanism.driver.value if driver is None else check_number("driver", driver)
     return position_rates(model, q, d, speed, accel)

@@ -58,7 +58,7 @@ def sweep_mechanism(
     Every argument is checked first (:mod:`linkage.arguments`): a misuse raises
     :class:`~linkage.errors.InputError` naming the argument.
     """
-    from ..arguments import check_callable, check_flag, check_rate, check_reals, check_text
+    from ..arguments import check_callable, check_flag, check_motion, check_reals, check_text
     from ..errors import InputError
     from ..problems.loops import mechanism_of
     from ..solve import check_criteria
@@ -72,12 +72,7 @@ def sweep_mechanism(
     check_flag("joints", joints)
     if batch is not None:
         check_flag("batch", batch)
-    per_s = "rad/s" if m.driver.kind == "angle" else f"{m.length_unit or 'length unit'}/s"
-    if speed is not None:
-        speed = check_rate("speed", speed, per_s)
-    accel = check_rate("accel", accel, f"{per_s}^2")
-    if speed is None and accel != 0.0:
-        raise InputError("accel needs speed (the driver's velocity)")
+    speed, accel = check_motion(speed, accel, m.driver.kind, m.length_unit)
     if method not in ("newton", "newton-fd", "lm"):
         raise InputError(f"unknown method {method!r}; choose from newton, newton-fd, lm")
     if branch is not None:
