@@ -249,12 +249,27 @@ def _flat(p) -> dict[tuple[str, ...], float]:
     return out
 
 
+def _bounds(p) -> dict[tuple[str, ...], float]:
+    """Each rate's stated error bound, keyed as :func:`_flat` keys its value."""
+    r = p.rates
+    out: dict[tuple[str, ...], float] = {}
+    if r is None:
+        return out
+    for attr, bounds in (("velocities", r.velocity_bounds), ("accelerations", r.acceleration_bounds)):
+        out.update({(attr, k): b for k, b in bounds.items()})
+    for attr, bounds in (("joint_velocities", r.joint_velocity_bounds),
+                         ("joint_accelerations", r.joint_acceleration_bounds)):
+        for k, b in bounds.items():
+            out[(attr, k, "x")] = out[(attr, k, "y")] = b
+    return out
+
+
 @pytest.mark.parametrize("name", SAMPLE_NAMES)
 def test_batch_and_one_at_a_time_sweeps_agree_on_every_sample(name):
     """Same statuses, branch, toggles, columns and numbers (positions, rates, joints and
-    points) to 1e-12 of each column's largest value. Within 1 degree of a limit or toggle
-    the rates amplify the positions' last-digit differences (each engine stops at tol from
-    its own start) by the conditioning of J: there 1e-9."""
+    points) to 1e-12 of each column's largest value. A rate may differ by more only within
+    the two engines' stated bounds added up (each is within its bound of the truth): near
+    a limit the conditioning of J amplifies the positions' last-digit differences."""
     m = load(SAMPLES / f"{name}.toml")
     # offset_slider's gaps are classified one position at a time (Newton, damped Newton and
     # least squares from several guesses): fewer positions keep the test fast
@@ -275,16 +290,19 @@ def test_batch_and_one_at_a_time_sweeps_agree_on_every_sample(name):
     for f in flat_1:
         for k, v in f.items():
             size[k] = max(size.get(k, 0.0), abs(v))
-    limits = list(one.toggles) + [x for r in one.feasible_ranges for x in r if 0.0 < x < 360.0]
+    wider = 0
     for p1, pb, f1, fb in zip(one.positions, many.positions, flat_1, flat_b, strict=True):
         assert (pb.rates is None) == (p1.rates is None)
         if p1.rates is not None:
             assert pb.rates.status == p1.rates.status
         assert fb.keys() == f1.keys(), p1.input
-        near = any(abs(p1.input - x) <= 1.0 for x in limits)
+        b1, bb = _bounds(p1), _bounds(pb)
         for k, v in f1.items():
-            bound = (1e-9 if near and k[0] != "q" else 1e-12) * max(size[k], 1e-300)
-            assert abs(fb[k] - v) <= bound, (name, p1.input, k, v, fb[k])
+            close = abs(fb[k] - v) <= 1e-12 * max(size[k], 1e-300)
+            if not close:
+                wider += 1
+                assert abs(fb[k] - v) <= b1[k] + bb[k], (name, p1.input, k, v, fb[k], b1.get(k))
+    assert wider <= 0.01 * sum(len(f) for f in flat_1)  # the rule, not the exception
 
 
 # --- the rules: each numpy twin equals its scalar ---------------------------------------------------
