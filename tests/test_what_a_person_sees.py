@@ -5,11 +5,15 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from pathlib import Path
 
 import pytest
 
+from pty_run import run
+
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
+LINKAGE = [sys.executable, "-m", "linkage"]
 
 
 def law_of_cosines_transmission(r1: float, r2: float, r3: float, r4: float, theta2_deg: float) -> float:
@@ -41,3 +45,57 @@ def test_rocker_driven_table_has_a_transmission_angle_in_every_solved_row(cli):
     j = header.index("transmission angle (deg)")
     assert [r[1] for r in rows] == ["converged"] * 3
     assert all(r[j] for r in rows), rows
+
+
+HELP_COMMANDS = [["--help"], ["solve", "--help"], ["sweep", "--help"], ["scan", "--help"]]
+
+
+@pytest.mark.parametrize("args", HELP_COMMANDS, ids=" ".join)
+def test_help_text_at_80_columns_is_not_squeezed_into_a_narrow_column(args):
+    """--digits' type label "<int range> [3<=x<=17]" widened the type column of every
+    command's options so that their help wrapped at 23 characters (--speed took 11
+    lines). Now each option's help has at least 34 characters a line, and no word is cut."""
+    seen = run([*LINKAGE, *args], 80)
+    assert "3<=x<=17" not in seen
+    rows = [line for line in seen.splitlines() if line.startswith("│ --")]
+    assert rows, seen
+    # the help column starts after the option, its short form and the type label
+    for line in rows:
+        assert len(line) <= 80
+    widths = []
+    for line in seen.splitlines():
+        inner = line.strip("│").rstrip()
+        if line.startswith("│ --speed"):
+            widths.append(len(inner) - inner.index("SPEED") - len("SPEED"))
+    if args[0] in ("solve", "sweep"):
+        assert widths and widths[0] >= 34, seen
+
+
+def test_digits_out_of_range_is_one_line_naming_the_range(cli):
+    for value in ("2", "18", "x"):
+        r = cli("solve", "--digits", value)
+        assert r.code == 2 and r.err.startswith("error: ") and len(r.err.strip().splitlines()) == 1, r.err
+        assert "--digits" in r.err
+    assert "3 to 17" in cli("sweep", "--digits", "40").err
+    assert cli("solve", "--digits", "17", "--format", "plain").code == 0
+
+
+@pytest.mark.parametrize("command", ["solve", "sweep"])
+def test_help_explains_the_rate_statuses(cli, monkeypatch, command):
+    """ill_conditioned and undefined appear in output with --speed; the help said nothing
+    of them."""
+    monkeypatch.setenv("COLUMNS", "200")
+    text = " ".join(cli(command, "--help").out.split())
+    assert "ill_conditioned" in text and "undefined" in text and "error bound" in text
+
+
+def test_sweep_help_names_every_position_status(cli, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "200")
+    text = " ".join(cli("sweep", "--help").out.split())
+    for status in ("converged", "no_solution", "off_branch"):
+        assert status in text, status
+
+
+def test_solve_help_names_the_mirror_branch_key(cli, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "200")
+    assert "open (mirror)" in " ".join(cli("solve", "--help").out.split())
