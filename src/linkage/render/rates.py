@@ -108,16 +108,19 @@ def rates_blocks(rates: Any, names: Any, kinds: Any, length_unit: str, digits: i
     if rates is None:
         return blocks
     if rates.velocities:
+        # one row per rate, named as the sweep's columns, the CSV and the ill-conditioned
+        # note name it, its unit beside the name: seven columns (unknown, velocity, bound,
+        # unit, acceleration, bound, unit) were 82 wide and split at 80 columns, leaving the
+        # acceleration's unit alone in a second table
         rows = []
-        for n, k in zip(names, kinds):
-            v, a = rate_units(k, length_unit)
-            vel, acc = (_shown(rates, rate_label(n, order), value, bound) for order, value, bound in (
-                (1, rates.velocities[n], rates.velocity_bounds.get(n)),
-                (2, rates.accelerations[n], rates.acceleration_bounds.get(n))))
-            rows.append((n, vel, _bound(rates.velocity_bounds.get(n)), v, acc,
-                         _bound(rates.acceleration_bounds.get(n)), a))
-        headers = ("unknown", "velocity", "± bound", "unit", "acceleration", "± bound", "unit")
-        blocks.append(table("Velocities and accelerations", headers, rows, digits))
+        for order in (1, 2):
+            for n, k in zip(names, kinds):
+                unit = rate_units(k, length_unit)[order - 1]
+                label = rate_label(n, order)
+                value = rates.velocities[n] if order == 1 else rates.accelerations[n]
+                bound = (rates.velocity_bounds if order == 1 else rates.acceleration_bounds).get(n)
+                rows.append((f"{label} ({unit})", _shown(rates, label, value, bound), _bound(bound)))
+        blocks.append(table("Velocities and accelerations", ("rate", "value", "± bound"), rows, digits))
     L = length_unit
     if rates.velocities:
         headers = ("joint", f"x ({L})", f"y ({L})", f"vx ({L}/s)", f"vy ({L}/s)", f"± v ({L}/s)",
