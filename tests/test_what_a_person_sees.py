@@ -140,3 +140,25 @@ def test_rates_table_names_the_ill_conditioned_rates_as_the_note_does():
     # exact (PROBLEMS.md-style 50-digit closed form, README): theta3' = -3.40e6 rad/s
     value, bound = float(rows["dtheta3/dt"][0]), float(rows["dtheta3/dt"][1])
     assert rows["dtheta3/dt"][0] == "-3.4e+06" and abs(value - -3401211.6) <= bound
+
+
+@pytest.mark.parametrize("engine", [[], ["--batch"]], ids=["stepwise", "batch"])
+def test_json_rates_status_is_there_whenever_the_csv_has_one(cli, engine):
+    """The CSV's "rates status" column says ok, ill_conditioned or undefined at every
+    solved position; the JSON left the key out where the rates were ok, so a reader of
+    p["rates_status"] met a KeyError at every ordinary position. An in-line slider-crank
+    with r3 = r2 has its toggles at 90 and 270 deg (undefined there)."""
+    args = ["sweep", str(SAMPLES / "slider_crank.toml"), "--set", "e=0", "--set", "r3=40", "--speed", "10",
+            "--step", "45", *engine]
+    doc = json.loads(cli(*args, "--format", "json").out)
+    header, *rows = [line.split(",") for line in cli(*args, "--format", "csv").out.splitlines()]
+    j = header.index("rates status")
+    got = [p.get("rates_status") for p in doc["positions"]]
+    assert got == [r[j] for r in rows]
+    assert {p["input"] for p in doc["positions"] if p["rates_status"] == "undefined"} == {90.0, 270.0}
+    assert set(got) == {"ok", "undefined"}
+
+
+def test_json_has_no_rates_status_without_a_speed(cli):
+    doc = json.loads(cli("solve", str(SAMPLES / "fourbar_me581.toml"), "--format", "json").out)
+    assert "rates_status" not in doc and "joints" in doc

@@ -27,11 +27,12 @@ def uncertain(value: float, bound: float, with_bound: bool = True) -> str:
 
 def rates_dict(rates: Any) -> dict[str, Any]:
     """The JSON fields of one position's kinematics (rate fields only with a driver speed):
-    each rate's absolute error bound beside it, and the labels of the ill-conditioned ones."""
+    the rates' status (ok, ill_conditioned or undefined), each rate's absolute error bound
+    beside it, and the labels of the ill-conditioned ones."""
     if rates is None:
         return {}
     out: dict[str, Any] = {"joints": {k: list(v) for k, v in rates.joints.items()}}
-    if rates.status != "ok":
+    if rates.status != "ok" or rates.velocities:  # as the CSV's "rates status" column: "ok" too
         out["rates_status"] = rates.status
     if rates.velocities:
         out["velocities"] = rates.velocities
