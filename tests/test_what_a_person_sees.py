@@ -162,3 +162,14 @@ def test_json_rates_status_is_there_whenever_the_csv_has_one(cli, engine):
 def test_json_has_no_rates_status_without_a_speed(cli):
     doc = json.loads(cli("solve", str(SAMPLES / "fourbar_me581.toml"), "--format", "json").out)
     assert "rates_status" not in doc and "joints" in doc
+
+
+def test_scan_help_states_the_step_default_once_and_names_top_k(cli, monkeypatch):
+    """scan --help said "Driver increment (default 1). [default: 1.0]" and "--top <int>
+    Keep only the first K designs" (K named nowhere else)."""
+    monkeypatch.setenv("COLUMNS", "200")
+    lines = cli("scan", "--help").out.splitlines()
+    step = next(ln for ln in lines if "--step" in ln)
+    assert "(default 1)" in step and "[default: 1.0]" not in step, step
+    top = next(ln for ln in lines if "--top" in ln)
+    assert " K " in top and "<int>" not in top, top

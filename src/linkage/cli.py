@@ -842,7 +842,7 @@ def scan(
                     "designs).")] = 0,
     start: Annotated[Optional[float], typer.Option("--from", help="First driver value (default 0).")] = None,
     stop: Annotated[Optional[float], typer.Option("--to", help="Last driver value (default 359).")] = None,
-    step: Annotated[float, typer.Option(help="Driver increment (default 1).")] = 1.0,
+    step: Annotated[float, typer.Option(help="Driver increment (default 1).", show_default=False)] = 1.0,
     branch: Annotated[Optional[str], typer.Option(help="Assembly branch every design follows: "
                       "open or crossed (mechanisms with a closed form); default: the branch of "
                       "the file's guess.")] = None,
@@ -854,7 +854,7 @@ def scan(
     sort: Annotated[Optional[str], typer.Option(metavar="COLUMN", help="Order the kept designs "
                     "by this column (ascending; NaN last).")] = None,
     desc: Annotated[bool, typer.Option("--desc", help="With --sort: largest first.")] = False,
-    top: Annotated[Optional[int], typer.Option(help="Keep only the first K designs (after "
+    top: Annotated[Optional[int], typer.Option(metavar="K", help="Keep only the first K designs (after "
                    "--where and --sort). A table shows 20 unless given.")] = None,
     scheduler: Annotated[Optional[str], typer.Option(help="Where the chunks run: threads "
                          "(default), processes, synchronous, or tcp://HOST:PORT (a "
