@@ -173,3 +173,16 @@ def test_scan_help_states_the_step_default_once_and_names_top_k(cli, monkeypatch
     assert "(default 1)" in step and "[default: 1.0]" not in step, step
     top = next(ln for ln in lines if "--top" in ln)
     assert " K " in top and "<int>" not in top, top
+
+
+def test_rocker_driven_sweep_and_scan_agree_on_the_transmission_extremes(cli):
+    """The scan of the rocker-driven file reported min/max_transmission_deg while its sweep
+    showed none; folded into 0..90, the sweep's extremes are now the scan's."""
+    args = ("--from", "0", "--to", "359", "--step", "1")
+    doc = json.loads(cli("sweep", str(SAMPLES / "fourbar_me581_theta4.toml"), *args, "--format", "json").out)
+    folded = [min(t, 180.0 - t) for t in (p["transmission"] for p in doc["positions"]
+                                          if p["status"] == "converged")]
+    scan = json.loads(cli("scan", str(SAMPLES / "fourbar_me581_theta4.toml"), "--vary", "r2=30:30:1", *args,
+                          "-f", "json").out)[0]
+    assert min(folded) == pytest.approx(scan["min_transmission_deg"], abs=1e-9)
+    assert max(folded) == pytest.approx(scan["max_transmission_deg"], abs=1e-9)
