@@ -186,3 +186,19 @@ def test_rocker_driven_sweep_and_scan_agree_on_the_transmission_extremes(cli):
                           "-f", "json").out)[0]
     assert min(folded) == pytest.approx(scan["min_transmission_deg"], abs=1e-9)
     assert max(folded) == pytest.approx(scan["max_transmission_deg"], abs=1e-9)
+
+
+@pytest.mark.parametrize("command", ["solve", "sweep"])
+def test_json_rates_carry_their_units_not_only_the_positions_deg(cli, command):
+    """JSON's `units` says theta3 is in deg; its velocity is in rad/s, and the driver's
+    speed (600rpm given) is stored as 62.83: nothing in the JSON said so."""
+    args = [command, str(SAMPLES / "slider_crank.toml"), "--speed", "600rpm", "--format", "json"]
+    doc = json.loads(cli(*args, *(["--step", "90"] if command == "sweep" else [])).out)
+    assert doc["units"] == {"theta3": "deg", "s": "mm"}
+    assert doc["rate_units"] == {"speed": "rad/s", "accel": "rad/s^2",
+                                 "velocities": {"theta3": "rad/s", "s": "mm/s"},
+                                 "accelerations": {"theta3": "rad/s^2", "s": "mm/s^2"},
+                                 "joint_velocities": "mm/s", "joint_accelerations": "mm/s^2"}
+    speed = doc["driver"]["speed"] if command == "solve" else doc["driver_motion"]["speed"]
+    assert speed == pytest.approx(600 * 2 * math.pi / 60, rel=1e-15)
+    assert "rate_units" not in json.loads(cli(*args[:2], "--format", "json").out)

@@ -414,7 +414,11 @@ def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol:
         rates = position_rates(mechanism.model, result.x, mechanism.driver.value, speed, accel)
         extra.update(rates_dict(rates))
         if speed is not None:
+            from .render.rates import rate_units_dict
+
             extra["driver"].update(speed=speed, accel=accel)
+            extra["rate_units"] = rate_units_dict(problem.names, problem.kinds, mechanism.length_unit,
+                                                  mechanism.driver.kind)
         blocks += rates_blocks(rates, problem.names, problem.kinds, mechanism.length_unit, digits)
         if rates.status != "ok":
             from .render.report import Text

@@ -25,6 +25,17 @@ def uncertain(value: float, bound: float, with_bound: bool = True) -> str:
     return f"{value:.{digits}g} ±{bound:.2g}" if with_bound else f"{value:.{digits}g}"
 
 
+def rate_units_dict(names: Any, kinds: Any, length_unit: str, driver_kind: str) -> dict[str, Any]:
+    """The JSON's ``rate_units``: the unit of the driver's speed and acceleration and of
+    every rate field (``units`` gives the positions' display units, deg for an angle,
+    while its rates are in rad/s and rad/s^2)."""
+    speed, accel = rate_units(driver_kind, length_unit)
+    return {"speed": speed, "accel": accel,
+            "velocities": {n: rate_units(k, length_unit)[0] for n, k in zip(names, kinds)},
+            "accelerations": {n: rate_units(k, length_unit)[1] for n, k in zip(names, kinds)},
+            "joint_velocities": f"{length_unit}/s", "joint_accelerations": f"{length_unit}/s^2"}
+
+
 def rates_dict(rates: Any) -> dict[str, Any]:
     """The JSON fields of one position's kinematics (rate fields only with a driver speed):
     the rates' status (ok, ill_conditioned or undefined), each rate's absolute error bound
