@@ -73,8 +73,17 @@ ColumnsOpt = Annotated[
                  "the CSV: comma-separated names or their beginnings, e.g. theta3,theta4,det "
                  "(the first column always stays)."),
 ]
+def _digits(value: int) -> int:
+    """--digits: checked here, not by a click range, whose "<int range> [3<=x<=17]" label
+    widened every help page's type column until the help text wrapped at 23 characters."""
+    if not 3 <= value <= 17:
+        raise typer.BadParameter(f"{value} is not from 3 to 17")
+    return value
+
+
 DigitsOpt = Annotated[
-    int, typer.Option("--digits", min=3, max=17, help="Significant digits printed in tables.")
+    int, typer.Option("--digits", metavar="N", callback=_digits,
+                      help="Significant digits printed in tables (3 to 17).")
 ]
 
 
@@ -83,7 +92,9 @@ SpeedOpt = Annotated[
     typer.Option("--speed", metavar="SPEED", help="Driver speed, for velocities and "
                  "accelerations of every unknown, joint and point: a number in rad/s (or the "
                  "file's length unit per second for a sliding driver), or with a unit: 600rpm, "
-                 "10rad/s, 90deg/s, 250mm/s."),
+                 "10rad/s, 90deg/s, 250mm/s. Every rate has an error bound: near a toggle or "
+                 "limit a rate is ill_conditioned (printed to the digits its bound leaves), at "
+                 "one undefined (no number)."),
 ]
 AccelOpt = Annotated[
     Optional[str],
@@ -217,7 +228,8 @@ def solve(
     plot: Annotated[Optional[Path], typer.Option(help="Also plot log10 error against iteration "
                     "for the method(s) run (.png, .svg or .pdf; needs matplotlib).")] = None,
     branch: Annotated[Optional[str], typer.Option(help="With FILE (one with a closed form): the "
-                      "assembly to solve for, open or crossed (its closed form is the start).")] = None,
+                      "assembly to solve for, open or crossed (its closed form is the start; a rocker-driven "
+                      "four-bar's second assembly of one label: 'open (mirror)').")] = None,
     speed: SpeedOpt = None,
     accel: AccelOpt = None,
     fmt: FormatOpt = None,
@@ -402,7 +414,11 @@ def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol:
         rates = position_rates(mechanism.model, result.x, mechanism.driver.value, speed, accel)
         extra.update(rates_dict(rates))
         if speed is not None:
+            from .render.rates import rate_units_dict
+
             extra["driver"].update(speed=speed, accel=accel)
+            extra["rate_units"] = rate_units_dict(problem.names, problem.kinds, mechanism.length_unit,
+                                                  mechanism.driver.kind)
         blocks += rates_blocks(rates, problem.names, problem.kinds, mechanism.length_unit, digits)
         if rates.status != "ok":
             from .render.report import Text
@@ -594,8 +610,10 @@ def sweep(
 ) -> None:
     """Solve a mechanism over a range of its driver, each position from the previous one.
 
-    Reports every position (solved, or no_solution where the linkage cannot be assembled),
-    the branch, det J, the feasible ranges and the limit/toggle positions. Without FILE:
+    Reports every position (converged; no_solution where the linkage cannot be assembled;
+    off_branch where it can, but not on the followed branch), the branch, det J, a
+    four-bar's transmission angle, the feasible ranges and the limit/toggle positions
+    (with --speed, each unknown's rates too). Without FILE:
     the four-bar input-output equation (solve's --r1/--r2/--r3/--links and --method) at
     each alpha from --from to --to, each from the previous root.
 
@@ -828,7 +846,7 @@ def scan(
                     "designs).")] = 0,
     start: Annotated[Optional[float], typer.Option("--from", help="First driver value (default 0).")] = None,
     stop: Annotated[Optional[float], typer.Option("--to", help="Last driver value (default 359).")] = None,
-    step: Annotated[float, typer.Option(help="Driver increment (default 1).")] = 1.0,
+    step: Annotated[float, typer.Option(help="Driver increment (default 1).", show_default=False)] = 1.0,
     branch: Annotated[Optional[str], typer.Option(help="Assembly branch every design follows: "
                       "open or crossed (mechanisms with a closed form); default: the branch of "
                       "the file's guess.")] = None,
@@ -840,7 +858,7 @@ def scan(
     sort: Annotated[Optional[str], typer.Option(metavar="COLUMN", help="Order the kept designs "
                     "by this column (ascending; NaN last).")] = None,
     desc: Annotated[bool, typer.Option("--desc", help="With --sort: largest first.")] = False,
-    top: Annotated[Optional[int], typer.Option(help="Keep only the first K designs (after "
+    top: Annotated[Optional[int], typer.Option(metavar="K", help="Keep only the first K designs (after "
                    "--where and --sort). A table shows 20 unless given.")] = None,
     scheduler: Annotated[Optional[str], typer.Option(help="Where the chunks run: threads "
                          "(default), processes, synchronous, or tcp://HOST:PORT (a "

@@ -112,7 +112,8 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         sol = ({n: float(b.solution[i, j]) for j, n in enumerate(b.coarse.names)}
                if st == "converged" else None)
         return Position(float(b.values[i]), st, sol, b.branch if sol else None, int(b.iterations[i]),
-                        float(b.det[i]) if sol else None, _transmission_of(b.coarse, sol))
+                        float(b.det[i]) if sol else None,
+                        _transmission_of(b.coarse, sol, float(b.values[i])))
 
     def summary(self) -> dict[str, int]:
         codes, counts = np.unique(self.batch.status, return_counts=True)
@@ -126,8 +127,13 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         return out
 
 
-def _transmission_of(c: SweepResult, sol: dict[str, float] | None) -> float | None:
-    if not c.classification or sol is None or "theta3" not in sol or "theta4" not in sol:
+def _transmission_of(c: SweepResult, sol: dict[str, float] | None, value: float) -> float | None:
+    """As :meth:`Solver.transmission`: theta4 from the driver's value where it drives."""
+    if not c.classification or sol is None:
+        return None
+    if c.driver in ("theta3", "theta4") and c.driver_unit in ANGLE_UNITS:
+        sol = {**sol, c.driver: value * (ANGLE_UNITS[c.driver_unit] / ANGLE_UNITS["deg"])}
+    if "theta3" not in sol or "theta4" not in sol:
         return None
     return transmission(sol["theta3"], sol["theta4"])
 

@@ -78,8 +78,9 @@ class Solver:
             self._compiled = (value, fns)
         return fns
 
-    def transmission(self, sol: dict[str, float]) -> float | None:
-        """Four-bars: the transmission angle between coupler and output link, in [0, 180]."""
+    def transmission(self, sol: dict[str, float], value: float | None = None) -> float | None:
+        """Four-bars: the transmission angle between coupler and output link, in [0, 180];
+        theta4 (or theta3) from the driver's ``value`` (display units) where it drives."""
         if self.m.closed_form != "fourbar":
             return None
         if self.coupler_and_output:
@@ -88,6 +89,8 @@ class Solver:
         if fixed is None:
             fixed = self._fixed_deg = {k: math.degrees(q.value) for k, q in self.m.parameters.items()
                                        if q.kind == "angle" and k != self.m.driver.name}
+        if value is not None and self.m.driver.kind == "angle":
+            fixed = {**fixed, self.m.driver.name: value * (self.scale / ANGLE_UNITS["deg"])}
         t3 = sol.get("theta3", fixed.get("theta3"))
         t4 = sol.get("theta4", fixed.get("theta4"))
         if t3 is None or t4 is None:
@@ -172,7 +175,7 @@ def solve_position(solver: Solver, v: float, last_q: tuple[float, ...] | None, l
         det = solver.det(p, q)
         sol = solver.display(q)
         return Position(v, "converged", sol, solver.branch(q, det), r.iterations, det,
-                        solver.transmission(sol), substeps, note), q
+                        solver.transmission(sol, v), substeps, note), q
 
     def ok(p: Any, r: Any) -> bool:
         return r.converged and (target is None or solver.branch(r.x, solver.det(p, r.x)) == target)
@@ -266,7 +269,7 @@ def continue_step(solver: Solver, v: float, history: list[tuple[float, tuple[flo
             sol = solver.display(q)
             note = f"step halved to 1/{n}" if n > 1 else ""
             return Position(v, "converged", sol, solver.branch(q, det), r.iterations, det,
-                            solver.transmission(sol), n if n > 1 else 0, note), q
+                            solver.transmission(sol, v), n if n > 1 else 0, note), q
     return Position(v, "failed", None, None, 0, None, note="the branch could not be continued"), None
 
 
@@ -295,7 +298,7 @@ def lean_step(solver: Solver, v: float, v_last: float, q_last: tuple[float, ...]
     if not continues(correction, moved, dv, size):
         return None
     sol = solver.display(q)
-    return Position(v, "converged", sol, branch, iterations, det, solver.transmission(sol)), q
+    return Position(v, "converged", sol, branch, iterations, det, solver.transmission(sol, v)), q
 
 
 def step_two(solver: Solver, v: float, v_last: float, q_last: tuple[float, ...],
@@ -349,7 +352,7 @@ def step_two(solver: Solver, v: float, v_last: float, q_last: tuple[float, ...],
     correction = e0 if e0 >= e1 else e1
     if not continues(correction, moved, dv, size):
         return None
-    return converged_position(v, sol, branch, k, det, solver.transmission(sol)), q
+    return converged_position(v, sol, branch, k, det, solver.transmission(sol, v)), q
 
 
 def tangent(solver: Solver, v0: float, q0: Sequence[float]) -> list[float] | None:

@@ -25,13 +25,25 @@ def uncertain(value: float, bound: float, with_bound: bool = True) -> str:
     return f"{value:.{digits}g} ±{bound:.2g}" if with_bound else f"{value:.{digits}g}"
 
 
+def rate_units_dict(names: Any, kinds: Any, length_unit: str, driver_kind: str) -> dict[str, Any]:
+    """The JSON's ``rate_units``: the unit of the driver's speed and acceleration and of
+    every rate field (``units`` gives the positions' display units, deg for an angle,
+    while its rates are in rad/s and rad/s^2)."""
+    speed, accel = rate_units(driver_kind, length_unit)
+    return {"speed": speed, "accel": accel,
+            "velocities": {n: rate_units(k, length_unit)[0] for n, k in zip(names, kinds)},
+            "accelerations": {n: rate_units(k, length_unit)[1] for n, k in zip(names, kinds)},
+            "joint_velocities": f"{length_unit}/s", "joint_accelerations": f"{length_unit}/s^2"}
+
+
 def rates_dict(rates: Any) -> dict[str, Any]:
     """The JSON fields of one position's kinematics (rate fields only with a driver speed):
-    each rate's absolute error bound beside it, and the labels of the ill-conditioned ones."""
+    the rates' status (ok, ill_conditioned or undefined), each rate's absolute error bound
+    beside it, and the labels of the ill-conditioned ones."""
     if rates is None:
         return {}
     out: dict[str, Any] = {"joints": {k: list(v) for k, v in rates.joints.items()}}
-    if rates.status != "ok":
+    if rates.status != "ok" or rates.velocities:  # as the CSV's "rates status" column: "ok" too
         out["rates_status"] = rates.status
     if rates.velocities:
         out["velocities"] = rates.velocities
@@ -108,16 +120,19 @@ def rates_blocks(rates: Any, names: Any, kinds: Any, length_unit: str, digits: i
     if rates is None:
         return blocks
     if rates.velocities:
+        # one row per rate, named as the sweep's columns, the CSV and the ill-conditioned
+        # note name it, its unit beside the name: seven columns (unknown, velocity, bound,
+        # unit, acceleration, bound, unit) were 82 wide and split at 80 columns, leaving the
+        # acceleration's unit alone in a second table
         rows = []
-        for n, k in zip(names, kinds):
-            v, a = rate_units(k, length_unit)
-            vel, acc = (_shown(rates, rate_label(n, order), value, bound) for order, value, bound in (
-                (1, rates.velocities[n], rates.velocity_bounds.get(n)),
-                (2, rates.accelerations[n], rates.acceleration_bounds.get(n))))
-            rows.append((n, vel, _bound(rates.velocity_bounds.get(n)), v, acc,
-                         _bound(rates.acceleration_bounds.get(n)), a))
-        headers = ("unknown", "velocity", "± bound", "unit", "acceleration", "± bound", "unit")
-        blocks.append(table("Velocities and accelerations", headers, rows, digits))
+        for order in (1, 2):
+            for n, k in zip(names, kinds):
+                unit = rate_units(k, length_unit)[order - 1]
+                label = rate_label(n, order)
+                value = rates.velocities[n] if order == 1 else rates.accelerations[n]
+                bound = (rates.velocity_bounds if order == 1 else rates.acceleration_bounds).get(n)
+                rows.append((f"{label} ({unit})", _shown(rates, label, value, bound), _bound(bound)))
+        blocks.append(table("Velocities and accelerations", ("rate", "value", "± bound"), rows, digits))
     L = length_unit
     if rates.velocities:
         headers = ("joint", f"x ({L})", f"y ({L})", f"vx ({L}/s)", f"vy ({L}/s)", f"± v ({L}/s)",

@@ -6,7 +6,7 @@ from typing import Any
 
 from ..kinematics.angles import angle_extent, closes_circle, driver_turn
 from ..kinematics.sweep import SweepResult
-from .rates import rate_cells, rate_headers, rates_dict
+from .rates import rate_cells, rate_headers, rate_units_dict, rates_dict
 from .report import Block, Text, fmt, table
 
 
@@ -91,6 +91,9 @@ def sweep_dict(s: SweepResult) -> dict[str, Any]:
         "units": dict(zip(s.names, s.units)),
         "length_unit": s.length_unit,
         "driver_motion": ({"speed": s.motion[0], "accel": s.motion[1]} if s.motion else None),
+        **({"rate_units": rate_units_dict(s.names, _kinds(s), s.length_unit,
+                                          "angle" if s.driver_unit in ("deg", "rad") else "length")}
+           if s.motion else {}),
         "positions": [
             {"input": p.input, "status": p.status, "solution": p.solution, "branch": p.branch,
              "iterations": p.iterations, "det": p.det, "transmission": p.transmission,
