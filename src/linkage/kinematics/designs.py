@@ -102,8 +102,14 @@ ENGINES = {
 
 
 def engine_for(m: Mechanism, branch: str | None) -> str:
-    """The engine :func:`solve_designs` runs for ``m``: a key of :data:`ENGINES`."""
-    if closed_form_applies(m) and branch is not None:
+    """The engine :func:`solve_designs` runs for ``m``: a key of :data:`ENGINES`.
+
+    The closed-form engine picks each position's assembly by its label, which is right
+    where the two solutions at a driver value always carry the two labels (a crank-driven
+    four-bar, a slider-crank). A rocker-driven four-bar's two assemblies can share a label
+    (the mirror images of A across O2-B), and which one a design is on is then a matter of
+    continuity: those designs are swept, as ``linkage sweep`` does."""
+    if closed_form_applies(m) and branch is not None and m.driver.name != "theta4":
         return "closed form"
     if branch is None and m.closed_form is None and m.driver.kind == "angle":
         return "continuation"
