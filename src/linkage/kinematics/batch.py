@@ -520,8 +520,7 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
         if k == "angle":
             far = ~(np.abs(cols[j] - refs[j]) < 180.0)  # (NaN included)
             if far.any():
-                r, c = refs[j][far], cols[j][far]
-                cols[j][far] = r + (c - r + 180.0) % 360.0 - 180.0
+                cols[j][far] = nearest_turn_array(refs[j][far], cols[j][far])
     for j in range(n):
         shown[:, j] = cols[j]
         ref[:, j] = refs[j]
