@@ -23,6 +23,7 @@ from .iterate import MAX_ITER_LIMIT, Criteria, Rows, explain, run
 from .methods import SCALAR_METHODS
 from .problems.scalar import ScalarProblem
 from .result import History, Result, Status
+from .rules import residual_gate
 
 # A scalar solve imports only its own method; the system solvers load with the first
 # system solve (python -X importtime: about 20 ms of every `linkage solve` otherwise).
@@ -687,8 +688,7 @@ def solve_system(
     real_vector("F", phi0, problem.n, "at x0")
     if len(phi0) != problem.n:
         raise InputError(f"the system has {len(phi0)} equations for {problem.n} unknowns")
-    scale = problem.length_scale
-    gate = (crit.ftol if crit.ftol is not None else crit.tol) * scale
+    gate = residual_gate(crit.ftol if crit.ftol is not None else crit.tol, problem.length_scale)
     rows = None
     if method == "newton" and kind == "analytic" and not record:
         q, phi, err, status, detail, iterations, nfev, njev = newton_system_lean(
@@ -824,7 +824,7 @@ def _mechanism_two(problem: Any, x0: Any, crit: Criteria, damped: bool) -> Resul
         return None
     if len(phi0) != 2:
         return None
-    gate = (crit.ftol if crit.ftol is not None else crit.tol) * scale
+    gate = residual_gate(crit.ftol if crit.ftol is not None else crit.tol, scale)
     meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names, "kinds": problem.kinds,
             "title": problem.title, **problem.meta}
     result = _two_unknown_result(problem, q0, phi0, crit, gate, damped, meta, _two_unknowns())

@@ -29,7 +29,7 @@ from ..problems.closed_form import (
 from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..problems.system import LeanProblem
 from ..result import Status
-from ..rules import continues, continuity_measures
+from ..rules import continues, continuity_measures, residual_gate, step_scales
 from ..solve import system_verdict
 from .positions import Position, converged_position
 
@@ -56,10 +56,8 @@ class Solver:
         self.rule = branch_rule(m) if m.closed_form else None
         self._problems: dict[float, Any] = {}
         self._compiled: tuple[float, Any] = (math.nan, None)
-        size = m.length_scale
-        self.gate = tol * size
-        self.step_scales = (None if size == 1.0 or "length" not in self.kinds else
-                            tuple(size if k == "length" else 1.0 for k in self.kinds))
+        self.gate = residual_gate(tol, m.length_scale)
+        self.step_scales = step_scales(self.kinds, m.length_scale)
         # two unknowns measured as they are: the continuation step on scalars (step_two)
         self.two_angles = self.kinds == ("angle", "angle")
         self.two = len(self.names) == 2 and self.step_scales is None and len(m.loops) == 1

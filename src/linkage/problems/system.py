@@ -42,9 +42,9 @@ class SystemProblem:
     def step_scales(self) -> tuple[float, ...] | None:
         """Per unknown, what a step is measured against: 1 for angles (rad), the length
         scale for lengths; None when every unknown is measured as it is."""
-        if self.length_scale == 1.0 or "length" not in self.kinds:
-            return None
-        return tuple(self.length_scale if k == "length" else 1.0 for k in self.kinds)
+        from ..rules import step_scales
+
+        return step_scales(self.kinds, self.length_scale)
 
     @property
     def n(self) -> int:
