@@ -9,6 +9,7 @@ import pytest
 
 import linkage
 from linkage import load_mechanism
+from linkage.errors import InputError
 from linkage.render.sweep import ranges_of
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
@@ -50,3 +51,9 @@ def test_scans_of_rocker_driven_fourbars_follow_the_sweeps_assembly(branch):
         one = ranges_of(linkage.sweep(_rocker_driven(*designs[0]), [float(v) for v in range(360)],
                                       branch="crossed"))
         assert abs(one["theta2"]["stroke"] - 154.56692312112133) < 1e-6
+
+
+def test_a_scan_of_no_driver_values_is_refused_not_a_zero_fraction():
+    """scan_designs(values=[]) reported feasible_fraction 0.0 for every design."""
+    with pytest.raises(InputError, match="values"):
+        linkage.scan_designs(SAMPLES / "crank_rocker.toml", {"r2": (20.0, 60.0, 3)}, values=[])

@@ -575,6 +575,9 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
     if values is None:
         values = [float(k) for k in range(360)]
     values = check_reals("values", values, most=MAX_SCAN_POSITIONS)
+    if not values:
+        # a fraction of no positions is no fraction: feasible_fraction would read 0
+        raise InputError("values must hold at least one driver value")
     setup = prepare(m, varies, samples=samples, seed=seed, sampling=sampling, values=list(values),
                     branch=branch, tol=tol, where=where, sort=sort)
     check_held(setup.plan.total, len(setup.spec), top, "a scan returned as columns", "top")
