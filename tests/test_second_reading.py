@@ -57,3 +57,21 @@ def test_a_scan_of_no_driver_values_is_refused_not_a_zero_fraction():
     """scan_designs(values=[]) reported feasible_fraction 0.0 for every design."""
     with pytest.raises(InputError, match="values"):
         linkage.scan_designs(SAMPLES / "crank_rocker.toml", {"r2": (20.0, 60.0, 3)}, values=[])
+
+
+@pytest.mark.parametrize("method", ["newton", "newton-fd", "lm"])
+def test_a_system_of_no_unknowns_is_refused_not_a_domain_error(method):
+    """solve_system(lambda x: [], [], method="newton-fd") was a DOMAIN_ERROR whose detail
+    read 'max() arg is an empty sequence'."""
+    with pytest.raises(InputError, match="x0"):
+        linkage.solve_system(lambda x: [], [], method=method)
+
+
+@pytest.mark.parametrize("method", ["newton-fd", "lm"])
+def test_a_residual_that_recurses_without_end_is_an_input_error(method):
+    """An F that recursed without end raised a raw RecursionError under newton-fd and lm."""
+    def F(x):
+        return F(x)
+
+    with pytest.raises(InputError, match="recursed"):
+        linkage.solve_system(F, [1.0, 2.0], method=method)

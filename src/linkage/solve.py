@@ -531,6 +531,8 @@ def _names_bad_callables(solve: Callable[..., Result]) -> Callable[..., Result]:
     def front_door(F: Any, x0: Any = None, **options: Any) -> Result:
         try:
             return solve(F, x0, **options)
+        except RecursionError:
+            raise InputError("F or jac recursed without end (RecursionError)") from None
         except (TypeError, IndexError):
             _diagnose_system(F, x0, options.get("jac"))
             _rerun_checked(solve, F, x0, options)
@@ -657,6 +659,8 @@ def solve_system(
         if x0 is None:
             raise InputError("x0 is required for a bare residual function")
         x0 = check_reals("x0", x0)
+        if not x0:
+            raise InputError("x0 must hold at least one value (a system of no unknowns has nothing to solve)")
         problem = generic_system(F, len(x0), jac)
     check_callable("jac", jac)
     if x0 is None or len(check_reals("x0", x0, None, problem.names)) != problem.n:
