@@ -75,3 +75,17 @@ def test_a_residual_that_recurses_without_end_is_an_input_error(method):
 
     with pytest.raises(InputError, match="recursed"):
         linkage.solve_system(F, [1.0, 2.0], method=method)
+
+
+@pytest.mark.parametrize("char", ["\u202e", "\u2067", "\u200f"])
+def test_a_bidirectional_control_in_a_name_is_refused(cli, tmp_path, char):
+    """A name with U+202E (right-to-left override) was printed raw: the terminal then shows
+    the rest of the line reversed."""
+    text = (SAMPLES / "crank_rocker.toml").read_text()
+    start = text.index("name = ")
+    end = text.index("\n", start)
+    path = tmp_path / "bidi.toml"
+    path.write_text(text[:start] + f'name = "crank{char}rocker"' + text[end:])
+    run = cli("solve", str(path))
+    assert run.code == 2 and len(run.err.strip().splitlines()) == 1, run.err
+    assert "control character" in run.err and char not in run.err

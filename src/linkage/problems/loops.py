@@ -416,9 +416,10 @@ def _points(spec: Any, loops: list[Loop], vector: Any,
     return out
 
 
-_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f]")
-"""Control characters (ESC, CR, NUL, tab, newline, DEL, C1): printed raw they would drive
-the terminal or break a line."""
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u061c\u200e\u200f\u202a-\u202e\u2066-\u2069]")
+"""Control characters (ESC, CR, NUL, tab, newline, DEL, C1) and the bidirectional ones
+(U+202E and its kin): printed raw they would drive the terminal, break a line, or make
+text read in an order other than the one it is in."""
 _PROSE = ("description", "notes", "note")
 """Keys whose text may have tabs and newlines."""
 
