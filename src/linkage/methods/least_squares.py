@@ -20,7 +20,7 @@ from ..problems.system import SystemProblem
 from ..result import Column, Status
 from ._common import new_state
 from ._linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve
-from .newton_system import fd_jacobian, max_abs, step_measure, system_columns, system_row
+from .newton_system import fd_jacobian, max_abs, normal_equations, step_measure, system_columns, system_row
 
 MU_MAX = 1e16
 
@@ -76,9 +76,8 @@ class LevenbergMarquardt:
         else:
             jac = problem.J(q)  # type: ignore[misc]
             njev += 1
-        n, m = len(q), len(phi)
-        jtj = [[sum(jac[k][i] * jac[k][j] for k in range(m)) for j in range(n)] for i in range(n)]
-        g = [sum(jac[k][i] * phi[k] for k in range(m)) for i in range(n)]
+        n = len(q)
+        jtj, g = normal_equations(jac, phi)
         try:
             fj = lu(jac)
             det, cond = det_from_lu(fj), (cond1(jac, fj) if self.diagnostics else math.nan)

@@ -15,6 +15,7 @@ condition number. Rows follow P3: k, q_k, Phi(q_k), max|Phi|, dq (rad and deg), 
 from __future__ import annotations
 
 import math
+import operator
 import sys
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
@@ -119,12 +120,27 @@ def newton_direction(jac: list[list[float]], phi: list[float]) -> tuple[list[flo
     return lu_solve(f, [-v for v in phi]), det, ratio
 
 
-def lm_direction(jac: list[list[float]], phi: list[float], mu: float) -> list[float] | None:
+def normal_equations(jac: list[list[float]], phi: list[float]) -> tuple[list[list[float]], list[float]]:
+    """(J^T J, J^T Phi), each entry summed over the rows in order; formed once per step,
+    whatever the number of damping values tried (a 24-unknown mechanism spent most of a
+    sweep forming it again for each)."""
+    cols = [list(c) for c in zip(*jac)]
+    n = len(cols)
+    jtj = [[0.0] * n for _ in range(n)]
+    for i in range(n):
+        ci, row = cols[i], jtj[i]
+        for j in range(i, n):
+            row[j] = jtj[j][i] = sum(map(operator.mul, ci, cols[j]))
+    return jtj, [sum(map(operator.mul, c, phi)) for c in cols]
+
+
+def lm_direction(normal: tuple[list[list[float]], list[float]], mu: float) -> list[float] | None:
     """(J^T J + mu diag(J^T J)) dq = -J^T Phi: a step between Newton's (mu -> 0) and a
-    scaled steepest descent (mu large), defined where J is singular."""
-    n = len(phi)
-    jtj = [[sum(jac[k][i] * jac[k][j] for k in range(n)) for j in range(n)] for i in range(n)]
-    g = [sum(jac[k][i] * phi[k] for k in range(n)) for i in range(n)]
+    scaled steepest descent (mu large), defined where J is singular; ``normal`` is
+    :func:`normal_equations`' (J^T J, J^T Phi)."""
+    jtj = [list(row) for row in normal[0]]
+    g = normal[1]
+    n = len(g)
     top = max((jtj[i][i] for i in range(n)), default=0.0)
     for i in range(n):
         jtj[i][i] += mu * max(jtj[i][i], 1e-12 * top, 1e-300)
@@ -237,8 +253,9 @@ class NewtonSystem:
                 alpha *= 0.5
         # Newton's direction failed (or J is singular): damped steps toward lower |Phi|^2
         mu = 1e-3
+        normal = normal_equations(jac, phi)
         while mu <= 1e12:
-            d = lm_direction(jac, phi, mu)
+            d = lm_direction(normal, mu)
             if d is not None and all(map(math.isfinite, d)):
                 phi_t = problem.F([qi + di for qi, di in zip(q, d)])
                 nfev += 1
@@ -247,7 +264,7 @@ class NewtonSystem:
                 if max(abs(di) for di in d) <= 1e-15 * (1.0 + max_abs(q)):
                     break  # the steps no longer move q: nothing lower is reachable
             mu *= 10.0
-        grad = max(abs(sum(jac[k][i] * phi[k] for k in range(len(phi)))) for i in range(len(q)))
+        grad = max(abs(v) for v in normal[1])
         if dq is None:
             why = (Status.SINGULAR_JACOBIAN, f"{singular_detail(det, cond)}; no damped step lowers "
                                              f"max|Phi| = {resid:.3g}")
