@@ -106,3 +106,11 @@ def test_the_normal_equations_are_the_sums_they_were_written_as():
             jtj, g = normal_equations(jac, phi)
             assert jtj == [[sum(jac[k][i] * jac[k][j] for k in range(n)) for j in range(n)] for i in range(n)]
             assert g == [sum(jac[k][i] * phi[k] for k in range(n)) for i in range(n)]
+
+
+def test_a_parameter_both_set_and_varied_is_refused(cli):
+    """scan --vary r2=20:60:3 --set r2=30 was accepted silently (which one wins?)."""
+    run = cli("scan", str(SAMPLES / "crank_rocker.toml"), "--vary", "r2=20:60:3", "--set", "r2=30",
+              "--step", "30", "-f", "csv")
+    assert run.code == 2 and len(run.err.strip().splitlines()) == 1, run.err
+    assert "r2" in run.err and "--set" in run.err and "--vary" in run.err

@@ -915,7 +915,12 @@ def scan(
         raise InputError("give at least one --vary NAME=LO:HI[:N]")
     varies = [parse_vary(v) for v in vary]
     text = read_input(file)
-    mechanism = from_text(text, str(file)).with_values(parse_assignments("--set", set_ or []), {})
+    fixed = parse_assignments("--set", set_ or [])
+    both = sorted({v.name for v in varies} & set(fixed))
+    if both:
+        raise InputError(f"{both[0]} is given by --set and by --vary; a scanned parameter takes its "
+                         "values from --vary only")
+    mechanism = from_text(text, str(file)).with_values(fixed, {})
     angle = mechanism.driver.kind == "angle"
     if not angle and (start is None or stop is None):
         raise InputError(f"{mechanism.driver.name} is a length: give --from and --to")
