@@ -40,6 +40,9 @@ MAX_PROCESSES = max(2, os.cpu_count() or 1)
 """Local scan workers as processes: one per core (each is a whole interpreter)."""
 
 MAX_SEED = 2**64 - 1
+
+MAX_INT_FLOAT = 2**1023
+"""An int of at most this size converts to a finite float (a larger one may overflow)."""
 """numpy's generators take any whole number >= 0; this bound keeps the message short."""
 
 SCHEDULERS = ("threads", "processes", "synchronous")
@@ -182,6 +185,9 @@ def check_reals(name: str, values: Any, length: int | None = None, labels: Seque
         if type(v) is float and v - v == 0.0:
             out.append(v)
             continue
+        if type(v) is int and -MAX_INT_FLOAT <= v <= MAX_INT_FLOAT:
+            out.append(float(v))  # range(361) and the like: finite, no check needed
+            continue
         where = labels[k] if k < len(labels) else k
         if not is_real(v):
             raise InputError(f"{name}[{where}] must be a real number, got {describe(v)}")
@@ -276,8 +282,12 @@ def real_result(name: str, value: Any, where: str) -> None:
 def real_vector(name: str, value: Any, n: int, where: str) -> None:
     """InputError unless ``value`` (a residual F returned) is a sequence of n real numbers
     (not complex: the system solvers work in real arithmetic)."""
-    if type(value) is list and all(type(v) is float for v in value):
-        return  # the common case, checked in a fraction of a microsecond
+    if type(value) is list:
+        for v in value:  # the common case, a list of floats: a plain loop, no generator
+            if type(v) is not float:
+                break
+        else:
+            return
     try:
         size = len(value)
     except TypeError:

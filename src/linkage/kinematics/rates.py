@@ -30,12 +30,15 @@ import math
 import sys
 from dataclasses import dataclass, field
 from operator import mul
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from ..methods._linalg import SingularMatrix, lu, lu_solve
 from ..methods.newton_system import max_abs, newton_direction
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel
-from .positions import SweepResult, with_position_rates
+from .labels import rate_label
+
+if TYPE_CHECKING:  # a solve's rates do not load the sweep's types
+    from .positions import SweepResult
 
 FIXED = -1
 
@@ -86,13 +89,6 @@ class Rates:
     def flagged(self, label: str) -> bool:
         """Whether the rate labelled ``label`` (see :func:`rate_label`) is ill-conditioned."""
         return label in self.ill_conditioned
-
-
-def rate_label(name: str, order: int, joint: bool = False) -> str:
-    """The label of a rate: ``dtheta3/dt``, ``d2theta3/dt2``, ``B.v``, ``B.a``."""
-    if joint:
-        return f"{name}.v" if order == 1 else f"{name}.a"
-    return f"d{name}/dt" if order == 1 else f"d2{name}/dt2"
 
 
 def _value(idx: int, const: float, q: Any, d: float) -> float:
@@ -593,6 +589,8 @@ def rates_at(mechanism: Any, q: Any, *, speed: float | None = None, accel: float
 def with_rates(m: Any, result: SweepResult, speed: float | None, accel: float) -> SweepResult:
     """Joints, and with a driver speed velocities and accelerations, at every solved position."""
     from dataclasses import replace
+
+    from .positions import with_position_rates
 
     model = m.model
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
