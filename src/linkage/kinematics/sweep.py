@@ -64,7 +64,7 @@ def sweep_mechanism(
 
     # the front door: every argument checked once, InputError naming it
     m = mechanism_of("mechanism", mechanism)
-    values = check_reals("values", values, most=MAX_POSITIONS)
+    values = check_reals("values", values, most=MAX_POSITIONS, keep_array=True)
     check_criteria(tol, 0.0, None, max_iter)
     check_text("branch", branch)
     check_callable("progress", progress)
