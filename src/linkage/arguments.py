@@ -145,6 +145,16 @@ def check_reals(name: str, values: Any, length: int | None = None, labels: Seque
     or InputError naming the first bad entry. ``keep_array``: a numpy array (or a long
     list read through one) comes back as a float array, not a list (a million positions
     for the batch engine: 30 ms to make the list and as much to make the array again)."""
+    if type(values) is tuple or type(values) is list:
+        # the common case (a bracket, x0, a short list of floats) without the abstract-class
+        # checks below, which cost microseconds on a solve of a few
+        size = len(values)
+        if size <= 1000 and (most is None or size <= most) and (length is None or size == length):
+            for v in values:
+                if type(v) is not float or v - v != 0.0:
+                    break
+            else:
+                return list(values)
     if values is None or isinstance(values, (str, bytes, Mapping)) or is_real(values):
         raise InputError(f"{name} must be a sequence of numbers (a list, tuple or 1-D array), "
                          f"got {describe(values)}")
