@@ -203,7 +203,11 @@ def check_reals(name: str, values: Any, length: int | None = None, labels: Seque
         where = labels[k] if k < len(labels) else k
         if not is_real(v):
             raise InputError(f"{name}[{where}] must be a real number, got {describe(v)}")
-        x = float(v)
+        try:
+            x = float(v)
+        except OverflowError:  # an int beyond the float range
+            raise InputError(f"{name}[{where}] must be finite, got an integer beyond the float "
+                             "range") from None
         if not math.isfinite(x):
             raise InputError(f"{name}[{where}] must be finite, got {x!r}")
         out.append(x)
