@@ -158,15 +158,11 @@ def _static(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float) 
     velocity, acceleration (as :func:`_term`), |r|, |w|, |r'|, |w'|, and the
     :func:`_shape` of its position, velocity and acceleration coefficients and of its
     Jacobian columns (angle, length; None where fixed))."""
-    sign, lc, li, ac, ai, off = t
+    _sign, lc, li, ac, ai, off = t
     r, th = _value(li, lc, q, d), _value(ai, ac, q, d) + off
     r1, w = _rate(li, qd, vd), _rate(ai, qd, vd)
     r2, al = _rate(li, qdd, vdd), _rate(ai, qdd, vdd)
-    # _term's arithmetic, operation for operation
-    e = cmath.exp(1j * th)
-    pos = sign * r * e
-    vel = sign * (r1 + 1j * r * w) * e
-    acc = sign * (r2 + 1j * r * al + 2j * r1 * w - r * w * w) * e
+    pos, vel, acc = _term(t, q, d, qd, vd, qdd, vdd)  # the one definition of the three
     co, si = abs(math.cos(th)), abs(math.sin(th))
     ar, aw, ar1, aal = abs(r), abs(w), abs(r1), abs(al)
     # the coefficients' own rounding: each product and sum within an ulp
