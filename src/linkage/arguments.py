@@ -40,6 +40,9 @@ MAX_PROCESSES = max(2, os.cpu_count() or 1)
 """Local scan workers as processes: one per core (each is a whole interpreter)."""
 
 MAX_SEED = 2**64 - 1
+
+MAX_INT_FLOAT = 2**1023
+"""An int of at most this size converts to a finite float (a larger one may overflow)."""
 """numpy's generators take any whole number >= 0; this bound keeps the message short."""
 
 SCHEDULERS = ("threads", "processes", "synchronous")
@@ -136,10 +139,22 @@ def check_callable(name: str, value: Any, *, optional: bool = True) -> Any:
 
 
 def check_reals(name: str, values: Any, length: int | None = None, labels: Sequence[str] = (),
-                most: int | None = None) -> list[float]:
+                most: int | None = None, keep_array: bool = False) -> list[float]:
     """A 1-D sequence of finite reals as a list of floats (``length`` of them when given, at
     most ``most``, counted before any is read; ``labels`` name the entries in the message),
-    or InputError naming the first bad entry."""
+    or InputError naming the first bad entry. ``keep_array``: a numpy array (or a long
+    list read through one) comes back as a float array, not a list (a million positions
+    for the batch engine: 30 ms to make the list and as much to make the array again)."""
+    if type(values) is tuple or type(values) is list:
+        # the common case (a bracket, x0, a short list of floats) without the abstract-class
+        # checks below, which cost microseconds on a solve of a few
+        size = len(values)
+        if size <= 1000 and (most is None or size <= most) and (length is None or size == length):
+            for v in values:
+                if type(v) is not float or v - v != 0.0:
+                    break
+            else:
+                return list(values)
     if values is None or isinstance(values, (str, bytes, Mapping)) or is_real(values):
         raise InputError(f"{name} must be a sequence of numbers (a list, tuple or 1-D array), "
                          f"got {describe(values)}")
@@ -174,7 +189,7 @@ def check_reals(name: str, values: Any, length: int | None = None, labels: Seque
         arr = np.asarray(values, dtype=float)
         bad = np.flatnonzero(~np.isfinite(arr))
         if bad.size == 0:
-            return arr.tolist()  # type: ignore[no-any-return]
+            return arr if keep_array else arr.tolist()  # type: ignore[no-any-return]
         k = int(bad[0])
         raise InputError(f"{name}[{labels[k] if labels else k}] must be finite, got {arr[k]!r}")
     out = []
@@ -182,10 +197,17 @@ def check_reals(name: str, values: Any, length: int | None = None, labels: Seque
         if type(v) is float and v - v == 0.0:
             out.append(v)
             continue
+        if type(v) is int and -MAX_INT_FLOAT <= v <= MAX_INT_FLOAT:
+            out.append(float(v))  # range(361) and the like: finite, no check needed
+            continue
         where = labels[k] if k < len(labels) else k
         if not is_real(v):
             raise InputError(f"{name}[{where}] must be a real number, got {describe(v)}")
-        x = float(v)
+        try:
+            x = float(v)
+        except OverflowError:  # an int beyond the float range
+            raise InputError(f"{name}[{where}] must be finite, got an integer beyond the float "
+                             "range") from None
         if not math.isfinite(x):
             raise InputError(f"{name}[{where}] must be finite, got {x!r}")
         out.append(x)
@@ -289,8 +311,12 @@ def real_result(name: str, value: Any, where: str) -> None:
 def real_vector(name: str, value: Any, n: int, where: str) -> None:
     """InputError unless ``value`` (a residual F returned) is a sequence of n real numbers
     (not complex: the system solvers work in real arithmetic)."""
-    if type(value) is list and all(type(v) is float for v in value):
-        return  # the common case, checked in a fraction of a microsecond
+    if type(value) is list:
+        for v in value:  # the common case, a list of floats: a plain loop, no generator
+            if type(v) is not float:
+                break
+        else:
+            return
     try:
         size = len(value)
     except TypeError:

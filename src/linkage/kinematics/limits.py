@@ -75,12 +75,14 @@ def toggles(solver: Solver, positions: Sequence[Position], arcs: Any, lo: float,
     # det J can also touch zero without changing sign (two assemblies crossing, as an
     # in-line slider-crank with r3 = r2 at 90 deg): a local minimum of |det J| over the
     # solved positions is refined, and is a toggle where J is singular there
-    for a, b, c in zip(positions, positions[1:], positions[2:]):
-        if a.det is not None and b.det is not None and c.det is not None \
-                and a.status == b.status == c.status == "converged" \
-                and (a.det > 0) == (b.det > 0) == (c.det > 0) \
-                and abs(b.det) <= abs(a.det) and abs(b.det) <= abs(c.det):
-            touch = _touch_det(solver, a, b, c)
+    # (each position's det read once: this scan runs on every sweep)
+    dets = [p.det if p.status == "converged" else None for p in positions]
+    for i in range(1, len(dets) - 1):
+        ad, bd, cd = dets[i - 1], dets[i], dets[i + 1]
+        if ad is not None and bd is not None and cd is not None \
+                and abs(bd) <= abs(ad) and abs(bd) <= abs(cd) \
+                and (ad > 0) == (bd > 0) == (cd > 0):
+            touch = _touch_det(solver, positions[i - 1], positions[i], positions[i + 1])
             if touch is not None and not any(abs(touch - t) <= 2 * LOCATE_TOL for t in found):
                 found.append(touch)
     return sorted(found)

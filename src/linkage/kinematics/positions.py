@@ -76,6 +76,14 @@ def converged_position(v: float, sol: dict[str, float], branch: str, iterations:
     return p
 
 
+def with_position_rates(p: Position, rates: Any) -> Position:
+    """``dataclasses.replace(p, rates=rates)`` without its ``__init__`` (as
+    :func:`converged_position`; a sweep with rates makes one per position)."""
+    out = _new(Position)
+    out.__dict__.update(p.__dict__, rates=rates)
+    return out
+
+
 MAX_POSITIONS = 2_000_000
 """The most positions one sweep may ask for (the batch engine holds them all in memory)."""
 

@@ -29,12 +29,16 @@ import cmath
 import math
 import sys
 from dataclasses import dataclass, field
-from typing import Any
+from operator import mul
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from ..methods._linalg import SingularMatrix, lu, lu_solve
 from ..methods.newton_system import max_abs, newton_direction
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel
-from .positions import SweepResult
+from .labels import rate_label
+
+if TYPE_CHECKING:  # a solve's rates do not load the sweep's types
+    from .positions import SweepResult
 
 FIXED = -1
 
@@ -87,13 +91,6 @@ class Rates:
         return label in self.ill_conditioned
 
 
-def rate_label(name: str, order: int, joint: bool = False) -> str:
-    """The label of a rate: ``dtheta3/dt``, ``d2theta3/dt2``, ``B.v``, ``B.a``."""
-    if joint:
-        return f"{name}.v" if order == 1 else f"{name}.a"
-    return f"d{name}/dt" if order == 1 else f"d2{name}/dt2"
-
-
 def _value(idx: int, const: float, q: Any, d: float) -> float:
     return q[idx] if idx >= 0 else (d if idx == DRIVER else const)
 
@@ -116,8 +113,7 @@ def _term(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any,
     return pos, vel, acc
 
 
-@dataclass(frozen=True)
-class _Uncertainty:
+class _Uncertainty(NamedTuple):
     """How far each input of the rate equations may be from its exact value: the
     unknowns' position, velocity and acceleration (``eq``, ``ev``, ``ea``, absolute) and
     the driver's value, speed and acceleration (``ed``, ``evd``, ``evdd``). Constants
@@ -131,67 +127,81 @@ class _Uncertainty:
     evdd: float
 
 
-def _unc(idx: int, const: float, vec: Any, drv: float) -> float:
-    return vec[idx] if idx >= 0 else (drv if idx == DRIVER else EPS * abs(const))
+Shape = tuple[float, float, float, float, float, float]
+"""What :func:`_parts_bounds` needs of z = c e^(i theta) that does not depend on the
+inputs' uncertainties, computed once per vector and order (:func:`_shape`)."""
 
 
-def _dunc(idx: int, vec: Any, drv: float) -> float:
-    return vec[idx] if idx >= 0 else (drv if idx == DRIVER else 0.0)
-
-
-def _parts_bounds(c: complex, dc: float, rc: float, co: float, si: float, dth: float) -> tuple[float, float]:
-    """Bounds on the x and y error of z = c e^(i theta) computed in floating point: c within
-    dc of exact (and rounded within rc), theta within dth (|cos theta| = co, |sin theta| =
-    si). The change of angle moves x by at most |Im z| dth + |z| dth^2 / 2 (and y by
-    |Re z| dth + ...), a change of c by dc."""
+def _shape(c: complex, rc: float, co: float, si: float) -> Shape:
+    """(rc, |c|, x, y, 3 eps x, 3 eps y) with |Re z| <= x, |Im z| <= y (see
+    :func:`_parts_bounds`)."""
     cr, ci = abs(c.real), abs(c.imag)
-    x = cr * co + ci * si  # |Re z| <= x, |Im z| <= y (the rounding scales too)
+    x = cr * co + ci * si
     y = cr * si + ci * co
-    big = abs(c)
+    return rc, abs(c), x, y, 3.0 * EPS * x, 3.0 * EPS * y
+
+
+def _parts_bounds(sh: Shape, dc: float, dth: float) -> tuple[float, float]:
+    """Bounds on the x and y error of z = c e^(i theta) computed in floating point: c within
+    dc of exact (and rounded within rc), theta within dth; ``sh`` is :func:`_shape` of c
+    (|Re z| <= x, |Im z| <= y, and the rounding scales with them). The change of angle
+    moves x by at most |Im z| dth + |z| dth^2 / 2 (and y by |Re z| dth + ...), a change of
+    c by dc."""
+    rc, big, x, y, x3, y3 = sh
     common = dc + rc + (big + dc) * dth * dth / 2.0
-    return common + 3.0 * EPS * x + (y + dc) * dth, common + 3.0 * EPS * y + (x + dc) * dth
+    return common + x3 + (y + dc) * dth, common + y3 + (x + dc) * dth
 
 
 def _static(t: Any, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float) -> tuple[Any, ...]:
     """One vector's values at a position, computed once for all its bounds: (length
-    index and constant, angle index and constant, offset, r, theta, r', w, r'', w',
-    |cos theta|, |sin theta|, position, velocity, acceleration)."""
+    index and constant, angle index and constant, the offset's rounding, position,
+    velocity, acceleration (as :func:`_term`), |r|, |w|, |r'|, |w'|, and the
+    :func:`_shape` of its position, velocity and acceleration coefficients and of its
+    Jacobian columns (angle, length; None where fixed))."""
     _sign, lc, li, ac, ai, off = t
     r, th = _value(li, lc, q, d), _value(ai, ac, q, d) + off
     r1, w = _rate(li, qd, vd), _rate(ai, qd, vd)
     r2, al = _rate(li, qdd, vdd), _rate(ai, qdd, vdd)
-    return (li, lc, ai, ac, off, r, th, r1, w, r2, al, abs(math.cos(th)), abs(math.sin(th)),
-            *_term(t, q, d, qd, vd, qdd, vdd))
+    pos, vel, acc = _term(t, q, d, qd, vd, qdd, vdd)  # the one definition of the three
+    co, si = abs(math.cos(th)), abs(math.sin(th))
+    ar, aw, ar1, aal = abs(r), abs(w), abs(r1), abs(al)
+    # the coefficients' own rounding: each product and sum within an ulp
+    rm = 2.0 * EPS * (abs(r2) + ar * w * w + ar * aal + 2.0 * ar1 * aw)
+    return (li, lc, ai, ac,
+            # with an offset, the offset's decimal value and the sum's rounding (half an ulp each)
+            0.5 * EPS * (abs(off) + abs(th)) if off else 0.0,
+            pos, vel, acc, ar, aw, ar1, aal,
+            _shape(complex(r), 0.0, co, si),
+            _shape(complex(r1, r * w), EPS * ar * aw, co, si),
+            _shape(complex(r2 - r * w * w, r * al + 2.0 * r1 * w), rm, co, si),
+            _shape(complex(0.0, r), EPS * ar, co, si) if ai >= 0 else None,
+            _shape(complex(1.0), 0.0, co, si) if li >= 0 else None)
 
 
-def _bounds_of(s: tuple[Any, ...], u: _Uncertainty, orders: tuple[int, ...]) -> list[tuple[float, float]]:
-    """Bounds on how far one vector's computed position, velocity and acceleration
-    (:func:`_term`), each as (x, y), may be from their exact values at the exact inputs,
-    for the requested ``orders``, from its :func:`_static` values: rounding in evaluating
-    it, plus the inputs' uncertainties propagated exactly (the products by |x y - x' y'| <=
-    |x| |dy| + |y| |dx| + |dx| |dy|, the angle by :func:`_parts_bounds`)."""
-    li, lc, ai, ac, off, r, th, r1, w, r2, al, co, si = s[:13]
-    ar, aw, ar1 = abs(r), abs(w), abs(r1)
-    dr = _unc(li, lc, u.eq, u.ed)
-    # the angle: its uncertainty, and with an offset the offset's decimal value and the
-    # sum's rounding (half an ulp each)
-    dth = _unc(ai, ac, u.eq, u.ed) + (0.5 * EPS * (abs(off) + abs(th)) if off else 0.0)
-    dr1, dw = _dunc(li, u.ev, u.evd), _dunc(ai, u.ev, u.evd)
-    out = []
-    for order in orders:
-        if order == 0:
-            out.append(_parts_bounds(complex(r), dr, 0.0, co, si, dth))
-        elif order == 1:
-            dn = dr1 + dr * aw + ar * dw + dr * dw
-            # the coefficient's own rounding: each product and sum within an ulp
-            out.append(_parts_bounds(complex(r1, r * w), dn, EPS * ar * aw, co, si, dth))
-        else:
-            dr2, dal = _dunc(li, u.ea, u.evdd), _dunc(ai, u.ea, u.evdd)
-            dm = (dr2 + dr * abs(al) + ar * dal + dr * dal + 2.0 * (ar1 * dw + aw * dr1 + dr1 * dw)
-                  + dr * (aw + dw) ** 2 + ar * (2.0 * aw * dw + dw * dw))
-            rm = 2.0 * EPS * (abs(r2) + ar * w * w + ar * abs(al) + 2.0 * ar1 * aw)
-            out.append(_parts_bounds(complex(r2 - r * w * w, r * al + 2.0 * r1 * w), dm, rm, co, si, dth))
-    return out
+def _bounds_of(s: tuple[Any, ...], u: _Uncertainty, order: int) -> tuple[float, float]:
+    """Bounds on how far one vector's computed position, velocity or acceleration
+    (``order`` 0, 1, 2; :func:`_term`), as (x, y), may be from its exact value at the
+    exact inputs, from its :func:`_static` values: rounding in evaluating it, plus the
+    inputs' uncertainties propagated exactly (the products by |x y - x' y'| <= |x| |dy| +
+    |y| |dx| + |dx| |dy|, the angle by :func:`_parts_bounds`)."""
+    li, lc, ai, ac, offr = s[:5]
+    eq = u.eq
+    dr = eq[li] if li >= 0 else (u.ed if li == DRIVER else EPS * abs(lc))
+    dth = (eq[ai] if ai >= 0 else (u.ed if ai == DRIVER else EPS * abs(ac))) + offr
+    if order == 0:
+        return _parts_bounds(s[12], dr, dth)
+    ar, aw, ar1, aal = s[8:12]
+    ev = u.ev
+    dr1 = ev[li] if li >= 0 else (u.evd if li == DRIVER else 0.0)
+    dw = ev[ai] if ai >= 0 else (u.evd if ai == DRIVER else 0.0)
+    if order == 1:
+        return _parts_bounds(s[13], dr1 + dr * aw + ar * dw + dr * dw, dth)
+    ea = u.ea
+    dr2 = ea[li] if li >= 0 else (u.evdd if li == DRIVER else 0.0)
+    dal = ea[ai] if ai >= 0 else (u.evdd if ai == DRIVER else 0.0)
+    dm = (dr2 + dr * aal + ar * dal + dr * dal + 2.0 * (ar1 * dw + aw * dr1 + dr1 * dw)
+          + dr * (aw + dw) ** 2 + ar * (2.0 * aw * dw + dw * dw))
+    return _parts_bounds(s[14], dm, dth)
 
 
 def _loop_residuals(data: list[list[tuple[Any, ...]]], u: _Uncertainty, order: int) -> list[float]:
@@ -200,13 +210,14 @@ def _loop_residuals(data: list[list[tuple[Any, ...]]], u: _Uncertainty, order: i
     exact inputs, for the computed values: |computed residual| plus its bound. ``data``:
     each loop's vectors' :func:`_static` values."""
     out: list[float] = []
+    at = 5 + order
     for terms in data:
         total = 0j
         bx = by = 0.0
         sx = sy = 0.0
         for s in terms:
-            z = s[13 + order]
-            ex, ey = _bounds_of(s, u, (order,))[0]
+            z = s[at]
+            ex, ey = _bounds_of(s, u, order)
             total += z
             bx, by = bx + ex, by + ey
             sx, sy = sx + abs(z.real), sy + abs(z.imag)
@@ -220,17 +231,19 @@ def _jacobian_spread(data: list[list[tuple[Any, ...]]], n: int, u: _Uncertainty)
     """|J(exact) - J(computed)| entry by entry, from the position's uncertainty: column j
     of an angle is sum sign i r e^(i theta), of a length sum sign e^(i theta)."""
     rows: list[list[float]] = []
+    eq, ed = u.eq, u.ed
     for terms in data:
         row_x, row_y = [0.0] * n, [0.0] * n
-        for li, lc, ai, ac, off, r, th, _r1, _w, _r2, _al, co, si, *_ in terms:
-            dr = _unc(li, lc, u.eq, u.ed)
-            dth = _unc(ai, ac, u.eq, u.ed) + (0.5 * EPS * (abs(off) + abs(th)) if off else 0.0)
+        for s in terms:
+            li, lc, ai, ac, offr = s[:5]
+            dth = (eq[ai] if ai >= 0 else (ed if ai == DRIVER else EPS * abs(ac))) + offr
             if ai >= 0:
-                ex, ey = _parts_bounds(complex(0.0, r), dr, EPS * abs(r), co, si, dth)
+                dr = eq[li] if li >= 0 else (ed if li == DRIVER else EPS * abs(lc))
+                ex, ey = _parts_bounds(s[15], dr, dth)
                 row_x[ai] += ex
                 row_y[ai] += ey
             if li >= 0:
-                ex, ey = _parts_bounds(complex(1.0), 0.0, 0.0, co, si, dth)
+                ex, ey = _parts_bounds(s[16], 0.0, dth)
                 row_x[li] += ex
                 row_y[li] += ey
         rows += [row_x, row_y]
@@ -267,7 +280,7 @@ def _abs_inverse(jac: list[list[float]]) -> list[list[float]] | None:
 
 
 def _matvec(a: list[list[float]], x: list[float]) -> list[float]:
-    return [sum(ai * xi for ai, xi in zip(row, x)) for row in a]
+    return [sum(map(mul, row, x)) for row in a]
 
 
 def _through_inverse(inv: list[list[float]], spread: list[list[float]], g: list[float]) -> list[float] | None:
@@ -293,13 +306,13 @@ def _through_inverse(inv: list[list[float]], spread: list[list[float]], g: list[
     return None
 
 
-def polish(model: LoopModel, q: Any, d: float) -> list[float]:
+def polish(model: LoopModel, q: Any, d: float, funcs: Any = None) -> list[float]:
     """The position q made as exact as double precision allows: Newton steps (quadratic
     there, so usually one or two) while each step is smaller than the last and max|Phi|
     does not grow; q as given if the first step is refused. A solve stopped at its
     tolerance can be 1e-7 rad from the root near a limit, where the rates' sensitivity
-    turns that into percent."""
-    F, J, _ = model.factory(d)
+    turns that into percent. ``funcs``: ``model.factory(d)`` if already built."""
+    F, J, _ = funcs if funcs is not None else model.factory(d)
     q = [float(x) for x in q]
     phi = F(q)
     res = max_abs(phi)
@@ -355,8 +368,7 @@ def solve_rates(model: LoopModel, q: Any, d: float, speed: float,
     return _solve(J(q), V(q), model, q, d, speed, accel)
 
 
-@dataclass(frozen=True)
-class RateBounds:
+class RateBounds(NamedTuple):
     """Absolute error bounds of one position's rates: per unknown (``velocity``,
     ``acceleration``, and ``position`` for the polished q) in internal units."""
 
@@ -367,7 +379,8 @@ class RateBounds:
 
 
 def rate_bounds(model: LoopModel, q: Any, d: float, speed: float, accel: float, qd: Any, qdd: Any,
-                jac: list[list[float]]) -> RateBounds | None:
+                jac: list[list[float]], data: list[list[tuple[Any, ...]]] | None = None
+                ) -> RateBounds | None:
     """Error bounds for (q, q', q'') at driver (d, speed, accel), or None where J is
     singular within its own uncertainty (the rates are then undefined).
 
@@ -388,7 +401,8 @@ def rate_bounds(model: LoopModel, q: Any, d: float, speed: float, accel: float, 
     ed = 2.0 * EPS * abs(d)  # the driver: a decimal value, then degrees to radians
     zero = [0.0] * n
     u0 = _Uncertainty(zero, zero, zero, ed, EPS * abs(speed), EPS * abs(accel))
-    data = [[_static(t, q, d, qd, speed, qdd, accel) for t in terms] for terms in model.terms]
+    if data is None:
+        data = [[_static(t, q, d, qd, speed, qdd, accel) for t in terms] for terms in model.terms]
     g = _loop_residuals(data, u0, 0)
     guess = _through_inverse(inv, _jacobian_spread(data, n, u0), g)
     if guess is None:
@@ -424,21 +438,24 @@ def place(model: LoopModel, q: Any, d: float, qd: Any = None, vd: float = 0.0, q
 
 
 def _place(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd: float,
-           unc: _Uncertainty | None) -> dict[str, tuple[complex, complex, complex, float, float]]:
+           unc: _Uncertainty | None, data: list[list[tuple[Any, ...]]] | None = None
+           ) -> dict[str, tuple[complex, complex, complex, float, float]]:
     """:func:`place`, each joint and point with bounds on its velocity and acceleration
-    (each of x and y) when ``unc`` gives the inputs' uncertainties (else 0)."""
+    (each of x and y) when ``unc`` gives the inputs' uncertainties (else 0). ``data``: the
+    loops' :func:`_static` values at these arguments, if already computed."""
     m = model.mechanism
     n = model.n
     qd = qd if qd is not None else [0.0] * n
     qdd = qdd if qdd is not None else [0.0] * n
     placed: dict[str, tuple[complex, complex, complex, float, float]] = {}
 
-    def part(t: Any) -> tuple[tuple[complex, complex, complex], tuple[float, float]]:
+    def part(t: Any, st: tuple[Any, ...] | None = None
+             ) -> tuple[tuple[complex, complex, complex], tuple[float, float]]:
         if unc is None:
             return _term(t, q, d, qd, vd, qdd, vdd), (0.0, 0.0)
-        st = _static(t, q, d, qd, vd, qdd, vdd)
-        bv, ba = _bounds_of(st, unc, (1, 2))
-        return st[13:16], (max(bv), max(ba))
+        if st is None:
+            st = _static(t, q, d, qd, vd, qdd, vdd)
+        return st[5:8], (max(_bounds_of(st, unc, 1)), max(_bounds_of(st, unc, 2)))
 
     def add(start: tuple[complex, complex, complex, float, float], parts: Any, sign: float
             ) -> tuple[complex, complex, complex, float, float]:
@@ -451,11 +468,11 @@ def _place(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd
         return p, v, a, bv, ba
 
     origin0 = (0j, 0j, 0j, 0.0, 0.0)
-    for loop, terms in zip(m.loops, model.terms):
+    for i, (loop, terms) in enumerate(zip(m.loops, model.terms)):
         names = loop.joints
         start = placed.get(names[0]) if names and names[0] else None
         origin = start if start is not None else origin0
-        parts = [part(t) for t in terms]
+        parts = [part(t, data[i][j] if data is not None else None) for j, t in enumerate(terms)]
         moving = [t[2] != FIXED or t[4] != FIXED for t in terms]
         for k in range(len(terms)):
             if not names or not names[k] or names[k] in placed:
@@ -487,15 +504,20 @@ def position_rates(model: LoopModel, q: Any, d: float, speed: float | None = Non
     names = [u.name for u in model.mechanism.unknowns]
     if speed is None:
         return Rates({k: _xy(p) for k, (p, _, _) in place(model, q, d).items()})
-    q = polish(model, q, d)
-    _, J, V = model.factory(d)
+    funcs = model.factory(d)
+    q = polish(model, q, d, funcs)
+    _, J, V = funcs
     jac = J(q)
     solved = _solve(jac, V(q), model, q, d, speed, accel)
-    bounds = rate_bounds(model, q, d, speed, accel, solved[0], solved[1], jac) if solved else None
-    if solved is None or bounds is None:
+    if solved is None:
         return Rates({k: _xy(p) for k, (p, _, _) in place(model, q, d).items()}, status="undefined")
     qd, qdd = solved
-    pts = _place(model, q, d, qd, speed, qdd, accel, bounds.uncertainty)
+    # each vector's values, once for its bounds and for the joints
+    data = [[_static(t, q, d, qd, speed, qdd, accel) for t in terms] for terms in model.terms]
+    bounds = rate_bounds(model, q, d, speed, accel, qd, qdd, jac, data)
+    if bounds is None:
+        return Rates({k: _xy(p) for k, (p, _, _) in place(model, q, d).items()}, status="undefined")
+    pts = _place(model, q, d, qd, speed, qdd, accel, bounds.uncertainty, data)
     # the scale below which a rate is judged against the driver's own motion instead
     size = model.mechanism.length_scale
     omega = abs(speed) / (1.0 if model.mechanism.driver.kind == "angle" else size)
@@ -558,6 +580,8 @@ def with_rates(m: Any, result: SweepResult, speed: float | None, accel: float) -
     """Joints, and with a driver speed velocities and accelerations, at every solved position."""
     from dataclasses import replace
 
+    from .positions import with_position_rates
+
     model = m.model
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     kinds = [u.kind for u in m.unknowns]
@@ -568,6 +592,6 @@ def with_rates(m: Any, result: SweepResult, speed: float | None, accel: float) -
             continue
         q = [math.radians(p.solution[u.name]) if k == "angle" else p.solution[u.name]
              for u, k in zip(m.unknowns, kinds)]
-        positions.append(replace(p, rates=position_rates(model, q, p.input * scale, speed, accel)))
+        positions.append(with_position_rates(p, position_rates(model, q, p.input * scale, speed, accel)))
     motion = (speed, accel) if speed is not None else None
     return replace(result, positions=tuple(positions), motion=motion)

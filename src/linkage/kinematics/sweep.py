@@ -15,7 +15,6 @@ from typing import Any
 
 from ..problems.loops import Mechanism
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
-from .rates import with_rates
 from .stepwise import sweep
 
 BATCH_ABOVE = 20_000
@@ -65,7 +64,7 @@ def sweep_mechanism(
 
     # the front door: every argument checked once, InputError naming it
     m = mechanism_of("mechanism", mechanism)
-    values = check_reals("values", values, most=MAX_POSITIONS)
+    values = check_reals("values", values, most=MAX_POSITIONS, keep_array=True)
     check_criteria(tol, 0.0, None, max_iter)
     check_text("branch", branch)
     check_callable("progress", progress)
@@ -94,8 +93,20 @@ def sweep_mechanism(
                                    accel=accel, joints=joints).to_sweep(), method="newton (batch)")
     result = sweep(m, check_driver_values(m, values), method=method, branch=branch, tol=tol,
                    max_iter=max_iter, progress=progress)
-    return with_rates(m, result, speed, accel) if speed is not None or joints else result
+    if speed is None and not joints:
+        return result
+    from .rates import with_rates  # here: a sweep without rates does not load them
+
+    return with_rates(m, result, speed, accel)
+
+
+def __getattr__(name: str) -> Any:
+    if name == "with_rates":  # still importable from here, loaded when first asked for
+        from .rates import with_rates
+
+        return with_rates
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 __all__ = ["BATCH_ABOVE", "MAX_POSITIONS", "Position", "SweepResult", "check_driver_values",
-           "driver_values", "sweep", "sweep_mechanism", "with_rates"]
+           "driver_values", "sweep", "sweep_mechanism"]

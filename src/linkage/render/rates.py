@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from ..kinematics.rates import rate_label
+from ..kinematics.labels import rate_label
 from .report import Block, table
 
 
