@@ -114,3 +114,25 @@ def test_a_parameter_both_set_and_varied_is_refused(cli):
               "--step", "30", "-f", "csv")
     assert run.code == 2 and len(run.err.strip().splitlines()) == 1, run.err
     assert "r2" in run.err and "--set" in run.err and "--vary" in run.err
+
+
+@pytest.mark.parametrize("speed", ["1e-320", "1e-318", "5e-324", "1e-13"])
+def test_a_tiny_speed_is_refused_not_an_internal_error(cli, speed):
+    """--speed 1e-320 was 'internal error: ZeroDivisionError'; 1e-318 printed a rate off by
+    6.6e-6 relative with a bound of 0 (the bound's products underflowed)."""
+    run = cli("solve", str(SAMPLES / "fourbar_me581.toml"), "--speed", speed)
+    assert run.code == 2 and len(run.err.strip().splitlines()) == 1, run.err
+    assert "out of range" in run.err
+
+
+def test_a_tiny_speed_in_the_api_is_an_input_error_naming_it():
+    m = load_mechanism(SAMPLES / "fourbar_me581.toml")
+    q = linkage.solve_system(m.problem(), tol=1e-12).x
+    for speed in (5e-324, 1e-300, 1e-13):
+        with pytest.raises(InputError, match="speed"):
+            linkage.position_rates(m, q, speed=speed)
+    small = linkage.position_rates(m, q, speed=1e-12, accel=1e-12)
+    big = linkage.position_rates(m, q, speed=1.0, accel=1.0)
+    for name, v in big.velocities.items():
+        assert small.velocities[name] == pytest.approx(1e-12 * v, rel=1e-12)
+        assert small.velocity_bounds[name] > 0.0

@@ -33,6 +33,18 @@ from .errors import InputError
 MAX_RATE = 1e12
 """The largest |speed| or |accel| accepted (the command line's --speed bound too)."""
 
+MIN_RATE = 1e-12
+"""The smallest nonzero |speed| or |accel| accepted: rates are linear in the speed (and
+accelerations in its square), so a slower driver's rates are these scaled; below it the
+products in a rate's error bound leave double precision's normal range."""
+
+
+def rate_in_range(value: float) -> bool:
+    """0, or a finite size from MIN_RATE to MAX_RATE: the range of a driver's speed or
+    acceleration, for the API and the command line alike."""
+    size = abs(value)
+    return size == 0.0 or MIN_RATE <= size <= MAX_RATE
+
 MAX_THREADS = min(256, 4 * (os.cpu_count() or 1))
 """Local scan workers as threads: 4 per core, at most 256 (each holds a chunk's arrays)."""
 
@@ -222,8 +234,8 @@ def check_rate(name: str, value: Any, unit: str) -> float:
         raise InputError(f"{name} must be a number in {unit} (the API takes internal units: "
                          f"rpm x pi/30 = rad/s, deg/s x pi/180 = rad/s), got {describe(value)}")
     v = check_number(name, value)
-    if abs(v) > MAX_RATE:
-        raise InputError(f"{name} must be at most {MAX_RATE:g} in size, got {v!r}")
+    if not rate_in_range(v):
+        raise InputError(f"{name} must be 0 or from {MIN_RATE:g} to {MAX_RATE:g} in size, got {v!r}")
     return v
 
 

@@ -345,6 +345,8 @@ def parse_motion(speed: str | None, accel: str | None, mechanism: Any) -> tuple[
     """--speed and --accel in internal units (rad/s, rad/s^2, or length/s, length/s^2)."""
     import re
 
+    from .arguments import MAX_RATE, MIN_RATE, rate_in_range
+
     if speed is None:
         if accel is not None:
             raise InputError("--accel needs --speed (the driver's velocity)")
@@ -365,8 +367,9 @@ def parse_motion(speed: str | None, accel: str | None, mechanism: Any) -> tuple[
             known = ", ".join(u for u in units if u) or "none"
             raise InputError(f"{option} {text!r}: give a number, optionally with one of these units: {known}")
         value = parse_number(option, m.group(1)) * units[m.group(2)]
-        if not math.isfinite(value) or abs(value) > 1e12:
-            raise InputError(f"{option} {text!r} is out of range (at most 1e12)")
+        if not rate_in_range(value):
+            raise InputError(f"{option} {text!r} is out of range "
+                             f"(0, or {MIN_RATE:g} to {MAX_RATE:g} in size)")
         out.append(value)
     return out[0], out[1]
 
