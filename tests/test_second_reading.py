@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -136,3 +137,18 @@ def test_a_tiny_speed_in_the_api_is_an_input_error_naming_it():
     for name, v in big.velocities.items():
         assert small.velocities[name] == pytest.approx(1e-12 * v, rel=1e-12)
         assert small.velocity_bounds[name] > 0.0
+
+
+def test_position_rates_refuses_a_q_that_is_not_a_solution():
+    """A q 60 deg from the solution got the root's rates with status ok (and, without a
+    speed, the joints at q itself); q = [0, 0] was called 'undefined', as if J were singular."""
+    m = load_mechanism(SAMPLES / "fourbar_me581.toml")
+    q = linkage.solve_system(m.problem(), tol=1e-12).x
+    far = [q[0] + math.radians(60.0), q[1] - math.radians(60.0)]
+    for bad in (far, [0.0, 0.0]):
+        for speed in (None, 10.0):
+            with pytest.raises(InputError, match="not a solution"):
+                linkage.position_rates(m, bad, speed=speed)
+    near = [q[0] + 1e-9, q[1] - 1e-9]  # a solve at a loose tolerance: accepted, polished
+    assert linkage.position_rates(m, near, speed=10.0).velocities == pytest.approx(
+        linkage.position_rates(m, q, speed=10.0).velocities, rel=1e-12)

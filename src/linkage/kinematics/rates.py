@@ -573,6 +573,18 @@ def rates_at(mechanism: Any, q: Any, *, speed: float | None = None, accel: float
     speed, accel = check_motion(speed, accel, mechanism.driver.kind, mechanism.length_unit)
     model = mechanism.model
     d = mechanism.driver.value if driver is None else check_number("driver", driver)
+    # the rates are those of the solution through q (polished to full precision): a q that
+    # closes no loop would silently get another position's rates, or be called singular
+    from ..errors import InputError
+    from ..solve import MAX_RELATIVE_TOL
+
+    gap = max(map(abs, model.functions(d)[0](list(q))), default=0.0)
+    allowed = MAX_RELATIVE_TOL * mechanism.length_scale
+    if not gap <= allowed:
+        unit = f" {mechanism.length_unit}" if mechanism.length_unit else ""
+        raise InputError(f"q is not a solution at this driver value: it leaves the loops open by "
+                         f"{gap:.3g}{unit}, more than the {allowed:.3g}{unit} (1% of the mechanism's "
+                         "size) any solve's tolerance allows; solve first (solve_system)")
     return position_rates(model, q, d, speed, accel)
 
 
