@@ -152,3 +152,22 @@ def test_position_rates_refuses_a_q_that_is_not_a_solution():
     near = [q[0] + 1e-9, q[1] - 1e-9]  # a solve at a loose tolerance: accepted, polished
     assert linkage.position_rates(m, near, speed=10.0).velocities == pytest.approx(
         linkage.position_rates(m, q, speed=10.0).velocities, rel=1e-12)
+
+
+def _toggles_mod_turn(result) -> list[float]:
+    return sorted(round(t % 360.0, 4) % 360.0 for t in result.toggles)
+
+
+@pytest.mark.parametrize("grid", [(0.0, 359.0), (-180.0, 180.0), (0.0, 360.0), (-10.0, 349.0)])
+def test_a_toggle_at_the_grids_end_is_listed(grid):
+    """A toggle at the start or end of a full-turn grid had no neighbour on one side and was
+    not listed, though the rates there were undefined: the parallelogram's crossing at 0 in
+    a 0..359 sweep, at 180 in -180..180; the in-line slider-crank's at 270 in -90..270."""
+    lo, hi = grid
+    values = [lo + k for k in range(int(hi - lo) + 1)]
+    parallelogram = {"r1": 60.0, "r3": 60.0, "r4": 30.0}
+    para = load_mechanism(SAMPLES / "fourbar_me581.toml").with_values(parallelogram, {})
+    assert _toggles_mod_turn(linkage.sweep(para, values)) == [0.0, 180.0]
+    slider = load_mechanism(SAMPLES / "slider_crank.toml").with_values({"e": 0.0, "r3": 40.0}, {})
+    for shift in (0.0, -90.0, 90.0):
+        assert _toggles_mod_turn(linkage.sweep(slider, [v + shift for v in values])) == [90.0, 270.0]

@@ -18,6 +18,7 @@ from ..methods.newton_system import max_abs
 from ..problems.closed_form import (
     arc_limits,
 )
+from .angles import closes_circle, driver_turn
 from .continuation import REENTERED, Solver, predict, solver_q
 from .positions import Position
 
@@ -59,12 +60,16 @@ def solved_ranges_array(values: Any, converged: Any) -> tuple[tuple[float, float
 
 
 def toggles(solver: Solver, positions: Sequence[Position], arcs: Any, lo: float, hi: float,
-             have_closed: bool) -> list[float]:
+            have_closed: bool) -> list[float]:
     found: list[float] = []
     if have_closed:
         found += arc_limits(arcs, lo, hi)
-    pairs = list(itertools.pairwise(positions))
-    for a, b in pairs:
+    n = len(positions)
+    ring = _around(solver, positions)
+    # pairs and triples across the grid's end too, where the grid closes the circle: a
+    # toggle at 0 of a 0..359 sweep has neighbours at 359 and 1
+    last_pair = max(n - 1 if len(ring) == n + 2 else n - 2, -1)
+    for a, b in itertools.islice(itertools.pairwise(ring), last_pair + 1):
         if a.status == "converged" and b.status == "converged" and a.det and b.det \
                 and (a.det > 0) != (b.det > 0):
             if REENTERED in (a.note, b.note):
@@ -76,16 +81,44 @@ def toggles(solver: Solver, positions: Sequence[Position], arcs: Any, lo: float,
     # in-line slider-crank with r3 = r2 at 90 deg): a local minimum of |det J| over the
     # solved positions is refined, and is a toggle where J is singular there
     # (each position's det read once: this scan runs on every sweep)
-    dets = [p.det if p.status == "converged" else None for p in positions]
+    dets = [p.det if p.status == "converged" else None for p in ring]
     for i in range(1, len(dets) - 1):
         ad, bd, cd = dets[i - 1], dets[i], dets[i + 1]
-        if ad is not None and bd is not None and cd is not None \
-                and abs(bd) <= abs(ad) and abs(bd) <= abs(cd) \
-                and (ad > 0) == (bd > 0) == (cd > 0):
-            touch = _touch_det(solver, positions[i - 1], positions[i], positions[i + 1])
-            if touch is not None and not any(abs(touch - t) <= 2 * LOCATE_TOL for t in found):
-                found.append(touch)
-    return sorted(found)
+        if ad is None or bd is None or cd is None:
+            continue
+        if bd == 0.0:
+            touch: float | None = ring[i].input  # J singular at the grid point itself
+        elif abs(bd) <= abs(ad) and abs(bd) <= abs(cd) and (ad > 0) == (bd > 0) == (cd > 0):
+            touch = _touch_det(solver, ring[i - 1], ring[i], ring[i + 1])
+        else:
+            continue
+        if touch is not None:
+            found.append(touch)
+    # back onto the grid's own turn, each toggle once
+    turn = driver_turn(solver.m.driver.unit) if solver.m.driver.kind == "angle" else 0.0
+    out: list[float] = []
+    for t in sorted(t - turn if t > hi + LOCATE_TOL and len(ring) > n else t for t in found):
+        if not any(abs(t - u) <= 2 * LOCATE_TOL for u in out):
+            out.append(t)
+    return out
+
+
+def _around(solver: Solver, positions: Sequence[Position]) -> list[Position]:
+    """The positions in driver order and, where the driver is an angle whose grid closes the
+    circle, continued a turn on by the first ones (the first two; or the second, where the
+    last position is the first one a turn on): every position then has neighbours."""
+    from dataclasses import replace
+
+    ring = list(positions)
+    if solver.m.driver.kind != "angle" or len(ring) < 3 or not ring[1].input > ring[0].input:
+        return ring
+    turn = driver_turn(solver.m.driver.unit)
+    if not closes_circle([p.input for p in ring], turn):
+        return ring
+    first, second = ring[0], ring[1]
+    if ring[-1].input - first.input >= turn - LOCATE_TOL:
+        return [*ring, replace(second, input=second.input + turn)]
+    return [*ring, replace(first, input=first.input + turn), replace(second, input=second.input + turn)]
 
 
 TOUCH_RATIO = 1e-5
