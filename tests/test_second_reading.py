@@ -171,3 +171,17 @@ def test_a_toggle_at_the_grids_end_is_listed(grid):
     slider = load_mechanism(SAMPLES / "slider_crank.toml").with_values({"e": 0.0, "r3": 40.0}, {})
     for shift in (0.0, -90.0, 90.0):
         assert _toggles_mod_turn(linkage.sweep(slider, [v + shift for v in values])) == [90.0, 270.0]
+
+
+def test_integers_beyond_the_float_range_are_input_errors_at_every_front_door():
+    """sweep, scan_designs and solve_system (newton-fd, lm) let an OverflowError out."""
+    m = load_mechanism(SAMPLES / "fourbar_me581.toml")
+    calls = [
+        lambda: linkage.sweep(m, [10**400]),
+        lambda: linkage.scan_designs(SAMPLES / "crank_rocker.toml", {"r2": (20, 60, 3)}, values=[10**400]),
+        lambda: linkage.solve_system(lambda x: [x[0] - 1, x[1] - 2], [10**400, 0], method="newton-fd"),
+        lambda: linkage.solve_system(lambda x: [x[0] - 1, x[1] - 2], [10**400, 0], method="lm"),
+    ]
+    for call in calls:
+        with pytest.raises(InputError, match="beyond the float range"):
+            call()
