@@ -18,27 +18,18 @@ def _modules() -> dict[str, Path]:
     return out
 
 
-def _type_checking_nodes(tree: ast.Module) -> set[int]:
-    """Imports under ``if TYPE_CHECKING:`` (never run, so never a cycle)."""
-    skip: set[int] = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
-            skip.update(id(n) for n in ast.walk(node))
-    return skip
-
-
 def _imports() -> tuple[dict[str, set[str]], list[tuple[str, str, str]]]:
-    """Module -> the package modules it imports (anywhere in it, functions included), and
+    """Module -> the package modules it imports (anywhere in it: functions and typing-only
+    imports count too, as the layout reads them), and
     every (importer, module, name) whose name is private."""
     mods = _modules()
     edges: dict[str, set[str]] = {}
     private = []
     for name, path in mods.items():
         tree = ast.parse(path.read_text())
-        skip = _type_checking_nodes(tree)
         package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
         for node in ast.walk(tree):
-            if not isinstance(node, ast.ImportFrom) or id(node) in skip:
+            if not isinstance(node, ast.ImportFrom):
                 continue
             if node.level:
                 base = package.split(".")

@@ -10,12 +10,11 @@ counts, since any may be varied. No numpy here: every file load reads this.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Sequence
+from typing import Any
 
-if TYPE_CHECKING:
-    from collections.abc import Sequence
-
-    from .loops import Mechanism
+# ``m`` below is a linkage.problems.loops.Mechanism; not imported, even for typing, since
+# loops reads this module (no import cycle)
 
 DESIGN = "design"
 SUMMARY = (("feasible_fraction", "number", ""), ("solved_fraction", "number", ""),
@@ -34,7 +33,7 @@ def path_columns(point: str, axis: str) -> tuple[str, str]:
     return f"{point}_{axis}_min", f"{point}_{axis}_max"
 
 
-def sourced_columns(m: Mechanism, names: Sequence[str]) -> list[tuple[str, str, str, str, str]]:
+def sourced_columns(m: Any, names: Sequence[str]) -> list[tuple[str, str, str, str, str]]:
     """Every record column of a scan varying ``names``, in order, as (name, type, unit,
     where it comes from, the file key that named it or "")."""
     unit = {k: (q.unit if q.kind == "angle" else m.length_unit) for k, q in m.parameters.items()}
@@ -53,12 +52,12 @@ def sourced_columns(m: Mechanism, names: Sequence[str]) -> list[tuple[str, str, 
     return cols
 
 
-def columns_of(m: Mechanism, names: Sequence[str]) -> list[tuple[str, str, str]]:
+def columns_of(m: Any, names: Sequence[str]) -> list[tuple[str, str, str]]:
     """Every record column: (name, type: number, bool, int or text, unit or "")."""
     return [c[:3] for c in sourced_columns(m, names)]
 
 
-def column_clash(m: Mechanism) -> tuple[str, str] | None:
+def column_clash(m: Any) -> tuple[str, str] | None:
     """The first name that would give two scan columns one name, as (the file key to
     blame, the clash in one line), or None."""
     seen: dict[str, tuple[str, str]] = {}
