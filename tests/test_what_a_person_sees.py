@@ -202,3 +202,25 @@ def test_json_rates_carry_their_units_not_only_the_positions_deg(cli, command):
     speed = doc["driver"]["speed"] if command == "solve" else doc["driver_motion"]["speed"]
     assert speed == pytest.approx(600 * 2 * math.pi / 60, rel=1e-15)
     assert "rate_units" not in json.loads(cli(*args[:2], "--format", "json").out)
+
+
+def test_a_rocker_driven_plot_breaks_its_line_at_a_re_entry(monkeypatch, tmp_path):
+    """The plot drew the re-entry on the mirror assembly (theta2 112 -> 268 deg between
+    theta4 164 and 165) as a vertical stroke, as if the linkage moved there."""
+    import math as _math
+
+    import linkage
+    from linkage.kinematics.continuation import REENTERED
+    from linkage.render import plots
+
+    result = linkage.sweep(linkage.load_mechanism(SAMPLES / "fourbar_me581_theta4.toml"),
+                           [float(v) for v in range(360)])
+    jumps = [p.input for p in result.positions if p.note == REENTERED]
+    assert jumps
+    seen = {}
+    monkeypatch.setattr(plots, "_save", lambda fig, path: seen.setdefault("fig", fig))
+    plots.sweep_plot(result, tmp_path / "p.png")
+    xs, ys = seen["fig"].axes[0].lines[0].get_data()
+    for x in jumps:
+        k = list(xs).index(x)
+        assert _math.isnan(ys[k]) and not _math.isnan(ys[k + 1])

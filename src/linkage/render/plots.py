@@ -79,8 +79,13 @@ def sweep_plot(result: Any, path: Path) -> None:
                              squeeze=False)
     xs = [p.input for p in result.positions]
     gaps = _runs([p.status for p in result.positions], xs)
+    # a re-entry on the other assembly that carries the branch's label is a jump, not a
+    # motion: the line breaks before it
+    from ..kinematics.continuation import REENTERED
+
+    jumps = {i for i, p in enumerate(result.positions) if i and p.note == REENTERED}
     for ax, (label, ys) in zip(axes[:, 0], series):
-        ax.plot(xs, ys, color="tab:blue", lw=1.6)
+        ax.plot(*_broken(xs, ys, jumps), color="tab:blue", lw=1.6)
         ax.set_ylabel(label, fontsize=9)
         ax.grid(True, alpha=0.3)
         for a, b, status in gaps:
@@ -96,12 +101,17 @@ def sweep_plot(result: Any, path: Path) -> None:
         legend.append("orange band: another assembly, not connected")
     if result.toggles:
         legend.append("dashed: limit/toggle positions")
+    if jumps:
+        legend.append("a break in a line: re-entered on the other assembly")
     title = f"{result.mechanism}: " + (f"{result.branch} branch" if result.branch in ("open", "crossed")
                                        else "the branch of the file's guess")
     if result.motion is not None:
         per = "rad" if result.driver_unit == "deg" else result.driver_unit
         title += f"; driver at {result.motion[0]:g} {per}/s, {result.motion[1]:g} {per}/s^2"
-    fig.suptitle(title + ("\n" + "; ".join(legend) if legend else ""), fontsize=10)
+    import textwrap
+
+    notes = "\n".join(textwrap.wrap("; ".join(legend), 100))
+    fig.suptitle(title + ("\n" + notes if legend else ""), fontsize=10)
     _save(fig, path)
 
 
@@ -126,6 +136,19 @@ def path_plot(result: Any, mechanism: Any, names: Sequence[str], path: Path) -> 
                                                                         "tab:brown")[k % 3], label=name)
     ax.legend(fontsize=9)
     _save(fig, path)
+
+
+def _broken(xs: Sequence[float], ys: Sequence[float], before: set[int]) -> tuple[list[float], list[float]]:
+    """The curve with a NaN point before each index in ``before`` (matplotlib breaks there)."""
+    bx: list[float] = []
+    by: list[float] = []
+    for i, (x, y) in enumerate(zip(xs, ys)):
+        if i in before:
+            bx.append(x)
+            by.append(math.nan)
+        bx.append(x)
+        by.append(y)
+    return bx, by
 
 
 def _runs(statuses: Sequence[str], xs: Sequence[float]) -> list[tuple[float, float, str]]:
