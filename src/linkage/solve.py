@@ -663,13 +663,12 @@ def solve_system(
             raise InputError("x0 must hold at least one value (a system of no unknowns has nothing to solve)")
         problem = generic_system(F, len(x0), jac)
     check_callable("jac", jac)
-    if x0 is None or len(check_reals("x0", x0, None, problem.names)) != problem.n:
-        raise InputError(f"x0 needs {problem.n} values ({', '.join(problem.names)}), "
-                         f"got {0 if x0 is None else len(x0)}")
-    if all(type(v) is float and v - v == 0.0 for v in x0):
-        q0 = tuple(x0)  # finite floats already: what check_number would return
-    else:
-        q0 = tuple(check_number(f"x0[{n}]", v) for n, v in zip(problem.names, x0))
+    if x0 is None:
+        raise InputError(f"x0 needs {problem.n} values ({', '.join(problem.names)}), got 0")
+    checked = check_reals("x0", x0, None, problem.names)  # finite floats, each entry named
+    if len(checked) != problem.n:
+        raise InputError(f"x0 needs {problem.n} values ({', '.join(problem.names)}), got {len(checked)}")
+    q0 = tuple(checked)
     if problem.length_scale != 1.0 or "length" in problem.kinds or problem.length_unit:
         for name, value in (("tol", crit.tol), ("ftol", crit.ftol)):
             if value is not None and value > MAX_RELATIVE_TOL:

@@ -47,6 +47,7 @@ LENGTH_RANGE = (1e-100, 1e100)
 """Magnitudes a nonzero length may have: squares and products of two stay normal doubles."""
 
 ANGLE_LIMIT_DEG = 1e6
+"""Largest |angle| in degrees: beyond it a degree has too few bits to follow a sweep."""
 
 MAX_LOOPS = 12
 """Most loops in a file, so at most 24 unknowns: a real mechanism has 1 to 5 loops, and the
@@ -55,7 +56,6 @@ MAX_VECTORS = 24
 """Most vectors in one loop or one point's path."""
 MAX_POINTS = 24
 """Most ``[points]``: each is a column of every position of a sweep or a scan."""
-"""Largest |angle| in degrees: beyond it a degree has too few bits to follow a sweep."""
 
 
 def magnitude_problem(value: float, kind: str, unit: str, signed: bool = False) -> str | None:
