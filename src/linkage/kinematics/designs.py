@@ -35,9 +35,7 @@ import numpy as np
 from ..methods.newton_system import SINGULAR_RATIO
 from ..problems.assembly import (
     fourbar_by_crank_np,
-    fourbar_by_rocker_np,
     is_open_np,
-    rocker_angle_np,
     slider_crank_np,
     slider_is_open_np,
 )
@@ -86,8 +84,16 @@ class DesignSolutions:
 
 
 def closed_form_applies(m: Mechanism) -> bool:
-    """True when the vectorised closed-form engine can run this mechanism."""
+    """True when the vectorised closed-form engine can run this mechanism.
+
+    That engine picks each position's assembly by its label, which is right where the two
+    solutions at a driver value always carry the two labels (a crank-driven four-bar, a
+    slider-crank). A rocker-driven four-bar's two assemblies can share a label (the mirror
+    images of A across O2-B), and which one a design is on is then a matter of
+    continuity: those designs are swept, as ``linkage sweep`` does."""
     if m.closed_form is None or m.driver.kind != "angle" or m.driver.name not in DRIVERS[m.closed_form]:
+        return False
+    if m.driver.name == "theta4":
         return False
     expected = set(REQUIRED_NAMES[m.closed_form]) - set(m.parameters) - {m.driver.name}
     return {u.name for u in m.unknowns} == expected
@@ -102,14 +108,8 @@ ENGINES = {
 
 
 def engine_for(m: Mechanism, branch: str | None) -> str:
-    """The engine :func:`solve_designs` runs for ``m``: a key of :data:`ENGINES`.
-
-    The closed-form engine picks each position's assembly by its label, which is right
-    where the two solutions at a driver value always carry the two labels (a crank-driven
-    four-bar, a slider-crank). A rocker-driven four-bar's two assemblies can share a label
-    (the mirror images of A across O2-B), and which one a design is on is then a matter of
-    continuity: those designs are swept, as ``linkage sweep`` does."""
-    if closed_form_applies(m) and branch is not None and m.driver.name != "theta4":
+    """The engine :func:`solve_designs` runs for ``m``: a key of :data:`ENGINES`."""
+    if closed_form_applies(m) and branch is not None:
         return "closed form"
     if branch is None and m.closed_form is None and m.driver.kind == "angle":
         return "continuation"
@@ -185,47 +185,35 @@ def _size(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray) -> Any:
 
 
 def _closed_form_seeds(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray,
-                       branch: str) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray, np.ndarray]:
+                       branch: str) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
     """Each unknown (internal units) on ``branch`` at every position, from the closed form's
-    numpy twins (:mod:`linkage.problems.assembly`); where the linkage can be assembled at
-    all; where an assembly carries that label (a rocker-driven four-bar's two may both
-    carry the other); and where the two branches meet (a limit position: the branch label
-    of a solution there is a matter of rounding). The pick is the scalar closed form's
-    (closed_form.fourbar_positions): by label, and of two rocker-driven assemblies with
-    the same label the one with sin(theta3 - theta2) < 0."""
+    numpy twins (:mod:`linkage.problems.assembly`); where the linkage can be assembled;
+    and where the two branches meet (a limit position: the branch label of a solution
+    there is a matter of rounding). The pick is the scalar closed form's
+    (closed_form.fourbar_positions): by label. Crank-driven four-bars and slider-cranks
+    only (:func:`closed_form_applies`)."""
     want_open = branch == "open"
     if m.closed_form == "slider_crank":
         (open_, crossed), ok = slider_crank_np(grid["r2"], grid["r3"], grid["e"], drv)
         fold = np.abs(math.pi - 2.0 * open_[0]) <= SEED_DISTANCE
         t3, s = open_ if want_open else crossed
-        return {"theta3": t3, "s": s}, ok, ok, fold
+        return {"theta3": t3, "s": s}, ok, fold
     r1, r2, r3, r4, t1 = (grid[k] for k in ("r1", "r2", "r3", "r4", "theta1"))
-    if m.driver.name == "theta2":
-        (first, second), ok = fourbar_by_crank_np(r1, r2, r3, r4, t1, drv)
-        pick = is_open_np(*first) == want_open
-        fold = _apart((first[0], second[0])) <= SEED_DISTANCE
-        return ({"theta3": np.where(pick, first[0], second[0]),
-                 "theta4": np.where(pick, first[1], second[1])}, ok, ok, fold)
-    (first, second), ok = fourbar_by_rocker_np(r1, r2, r3, r4, t1, drv)
-    has_1, has_2 = (is_open_np(t3, drv) == want_open for _, t3 in (first, second))
-    plain_1 = np.sin(first[1] - first[0]) < 0.0
-    pick = np.where(has_1 & has_2, plain_1, has_1)
-    return ({"theta2": np.where(pick, first[0], second[0]), "theta3": np.where(pick, first[1], second[1])},
-            ok, has_1 | has_2, _apart((first[1], second[1])) <= SEED_DISTANCE)
+    (first, second), ok = fourbar_by_crank_np(r1, r2, r3, r4, t1, drv)
+    pick = is_open_np(*first) == want_open
+    fold = _apart((first[0], second[0])) <= SEED_DISTANCE
+    return ({"theta3": np.where(pick, first[0], second[0]),
+             "theta4": np.where(pick, first[1], second[1])}, ok, fold)
 
 
-def _on_branch_here(m: Mechanism, grid: Mapping[str, Any], q: Sequence[np.ndarray], det: np.ndarray,
-                    branch: str) -> np.ndarray:
-    """The configuration rule of each solved position (internal units), with each design's
-    own lengths: what :func:`~linkage.problems.closed_form.branch_rule` says, over arrays."""
+def _on_branch_here(m: Mechanism, q: Sequence[np.ndarray], branch: str) -> np.ndarray:
+    """The configuration rule of each solved position (internal units): what
+    :func:`~linkage.problems.closed_form.branch_rule` says, over arrays."""
     at = {u.name: c for u, c in zip(m.unknowns, q)}
     if m.closed_form == "slider_crank":
         is_open = slider_is_open_np(at["theta3"])
-    elif "theta4" in at:
-        is_open = is_open_np(at["theta3"], at["theta4"])
     else:
-        t4 = rocker_angle_np(grid["r1"], grid["r2"], grid["r3"], grid["theta1"], at["theta2"], at["theta3"])
-        is_open = is_open_np(at["theta3"], t4)
+        is_open = is_open_np(at["theta3"], at["theta4"])
     return np.asarray(is_open == (branch == "open"))
 
 
@@ -238,20 +226,19 @@ def _closed_form_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np
                         tol: float, max_iter: int, n_designs: int) -> tuple[list[np.ndarray], np.ndarray,
                                                                             np.ndarray, str]:
     grid, drv = _grid(m, params, vals, n_designs)
-    seeds, feasible, labelled, fold = _closed_form_seeds(m, grid, drv, branch)
+    seeds, feasible, fold = _closed_form_seeds(m, grid, drv, branch)
     seed = [np.where(feasible, seeds[u.name], 0.0) for u in m.unknowns]
     size = _size(m, grid, drv)
     loops = VectorLoops.of_terms(_terms(m, grid, drv), len(m.unknowns), len(drv))
     q = [c.copy() for c in seed]
-    done, det = _newton(loops, q, np.flatnonzero(feasible), tol, size,
+    done, _det = _newton(loops, q, np.flatnonzero(feasible), tol, size,
                         [k == "length" for k in (u.kind for u in m.unknowns)], max_iter)
     moved = np.zeros(len(drv))
     for c, s, u in zip(q, seed, m.unknowns):
         np.maximum(moved, np.abs(c - s) / (size if u.kind == "length" else 1.0), out=moved)
-    on_branch = _on_branch_here(m, grid, q, det, branch)
+    on_branch = _on_branch_here(m, q, branch)
     status = np.where(feasible, FAILED, NO_SOLUTION).astype(np.int8)
-    status[feasible & ~labelled & ~fold] = OFF_BRANCH
-    status[done & (moved <= SEED_DISTANCE) & (on_branch | fold) & feasible & (labelled | fold)] = CONVERGED
+    status[done & (moved <= SEED_DISTANCE) & (on_branch | fold) & feasible] = CONVERGED
     return q, status, feasible, "closed form + vectorised Newton"
 
 
