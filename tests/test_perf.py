@@ -90,3 +90,15 @@ def test_keep_array_gives_the_batch_engine_an_array_with_the_same_values():
     assert check_reals("values", values) == values.tolist()
     with pytest.raises(InputError, match=r"values\[3\] must be finite"):
         check_reals("values", np.array([0.0, 1.0, 2.0, np.nan]), keep_array=True)
+
+
+def test_a_scan_does_not_load_the_rate_engine():
+    """batch.py imported the rates at its top, so every scan (designs imports batch) loaded
+    the rate engine it never uses."""
+    code = ("import sys, linkage.scan; "
+            "print('linkage.kinematics.rates' in sys.modules)")
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "False"

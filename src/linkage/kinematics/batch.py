@@ -33,7 +33,6 @@ from .angles import nearest_turn, nearest_turn_array
 from .continuation import Solver, classify_gap, continue_step, solve_position, solver_q, tangent
 from .limits import solved_ranges_array
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
-from .rates import with_rates
 from .stepwise import sweep
 
 STATUS_CODES = {"converged": 0, "no_solution": 1, "failed": 2, "off_branch": 3}
@@ -98,6 +97,8 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         # memory stays bounded whatever the sweep's size
         start = i - i % RATES_CHUNK
         if self._chunk[0] != start:
+            from .rates import with_rates  # a batch without rates (a scan's) never loads them
+
             b = self.batch
             assert b.source is not None
             part = tuple(self._position(k) for k in range(start, min(len(self), start + RATES_CHUNK)))
