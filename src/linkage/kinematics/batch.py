@@ -353,6 +353,9 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
                     break
         if pos is None or pos.status != "converged":
             others = [rough.positions[c].status for c in near if rough.positions[c].status != "converged"]
+            if have_closed and pos is not None and pos.status in ("no_solution", "off_branch"):
+                status[i] = code[pos.status]  # solve_position read the closed form already
+                continue
             closed = solver.problem(v).reference() if have_closed else None
             if closed is not None and (closed == {} or target not in closed):
                 # as the one-at-a-time sweep: no assembly at all, or none with the label
