@@ -945,7 +945,7 @@ def scan(
         raise InputError("--desc orders by --sort: give --sort COLUMN")
     if sort is not None and fmt not in ("table", "plain"):
         check_held(plan.total, len(setup.spec), top, f"--sort {sort} with --format {fmt}")
-    overrides = tuple((k, float(v)) for k, v in parse_assignments("--set", set_ or []).items())
+    overrides = tuple((k, float(v)) for k, v in fixed.items())
     job = ScanJob(text, str(file), overrides, plan.names, tuple(values), chosen, tol)
     size = pick_chunk(mechanism, len(values), chosen, chunk, plan.total)
     as_table = fmt in ("table", "plain")

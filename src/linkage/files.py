@@ -51,6 +51,10 @@ def check_toml_shape(text: str, where: str) -> None:
     more than MAX_TOML_KEY_PARTS parts, in one linear pass over the text. Strings and
     comments are skipped; a run of words, strings and dots counts as one key (a float's
     one dot makes it a run of two, and no valid value outside a string has more)."""
+    def refuse(tok: re.Match[str], what: str) -> ParseError:
+        line = text.count("\n", 0, tok.start()) + 1
+        return ParseError(f"{where}: line {line}: {what}; a mechanism file needs a few")
+
     depth = 0
     parts = 1
     for tok in _TOML_TOKEN.finditer(text):
@@ -58,9 +62,7 @@ def check_toml_shape(text: str, where: str) -> None:
         if kind == "dot":
             parts += 1
             if parts > MAX_TOML_KEY_PARTS:
-                line = text.count("\n", 0, tok.start()) + 1
-                raise ParseError(f"{where}: line {line}: a dotted key with more than "
-                                 f"{MAX_TOML_KEY_PARTS} parts; a mechanism file needs a few")
+                raise refuse(tok, f"a dotted key with more than {MAX_TOML_KEY_PARTS} parts")
         elif kind in ("word", "string", "space"):
             continue
         else:
@@ -68,9 +70,7 @@ def check_toml_shape(text: str, where: str) -> None:
             if kind == "open":
                 depth += 1
                 if depth > MAX_TOML_NESTING:
-                    line = text.count("\n", 0, tok.start()) + 1
-                    raise ParseError(f"{where}: line {line}: arrays and tables nested more than "
-                                     f"{MAX_TOML_NESTING} deep; a mechanism file needs a few")
+                    raise refuse(tok, f"arrays and tables nested more than {MAX_TOML_NESTING} deep")
             elif kind == "close":
                 depth = max(0, depth - 1)
 
