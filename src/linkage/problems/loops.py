@@ -35,11 +35,14 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from os import PathLike
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from ..errors import InputError, ParseError
 from .columns import column_clash
 from .system import SystemProblem
+
+if TYPE_CHECKING:
+    from .derive import Derivation
 
 ANGLE_UNITS = {"deg": math.pi / 180.0, "rad": 1.0}
 
@@ -160,6 +163,14 @@ class Mechanism:
 
     def problem(self) -> SystemProblem:
         return build_problem(self)
+
+    @functools.cached_property
+    def derivation(self) -> Derivation:
+        """The stepwise closed form derived from the loops (:mod:`.derive`), or why there
+        is none (``.complete`` is False)."""
+        from .derive import derive
+
+        return derive(self)
 
     @functools.cached_property
     def model(self) -> LoopModel:

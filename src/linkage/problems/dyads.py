@@ -1,0 +1,235 @@
+"""The four classical cases of a planar vector loop with two unknowns, each a scalar
+function with its numpy twin beside it (the one home every engine reads).
+
+After substituting what is known, a loop reads ``sum(unknown terms) + K = 0`` with K the
+sum of its known vectors. With the coefficients gathered from the loop (complex numbers
+given as (x, y) pairs):
+
+- **two angles** a, b: ``P e^(ia) + Q e^(ib) + K = 0``. X = P e^(ia) lies at |P| from the
+  origin and |Q| from -K: a circle intersection (:func:`~.assembly.triangle`, Kahan's
+  area, so the half-chord is accurate at tangency). sigma = +1 puts X on the left of the
+  line from the origin to -K.
+- **an angle and the length of the same vector**: ``e^(ia) (P + s D) + K = 0``, so
+  |s + P/D| = |K| / |D|: a line meets a circle.
+- **an angle and the length of a different vector**: ``P e^(ia) + s E + K = 0``, so
+  |s + K/E| = |P| / |E|: a line meets a circle.
+- **two lengths**: ``s E + t F + K = 0``: linear (Cramer), one solution.
+
+Line and circle: s = -Re z + sigma sqrt((R - |Im z|)(R + |Im z|)); sigma = +1 is the
+larger s. Each two-way case reports its *margin*, the relative amount by which it
+assembles (negative: it does not): the triangle's gap for two circles, R - |Im z| for a
+line and a circle. A limit position is where a margin crosses zero.
+
+Accuracy: no acos or asin of a rounded number; the angles come from atan2 of unnormalised
+products (atan2 is scale-free), the half-chord from :func:`~.assembly.triangle`, and
+R^2 - (Im z)^2 from its two factors. Pure math here: numpy is imported only by the twins.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .assembly import TANGENT_SLACK, triangle, triangle_np
+
+Pair = tuple[float, float]
+
+
+def _cmul(ax: float, ay: float, bx: float, by: float) -> Pair:
+    return ax * bx - ay * by, ax * by + ay * bx
+
+
+def _cmul_conj(ax: float, ay: float, bx: float, by: float) -> Pair:
+    """a * conj(b)."""
+    return ax * bx + ay * by, ay * bx - ax * by
+
+
+# --- two angles ------------------------------------------------------------------------------
+
+def two_angles(p: Pair, q: Pair, k: Pair, sigma: float) -> tuple[float, float] | None:
+    """(a, b) with P e^(ia) + Q e^(ib) + K = 0 on side ``sigma``; None when the circles
+    miss. Raises ZeroDivisionError when K = 0 (the circles are concentric)."""
+    d = math.hypot(k[0], k[1])
+    if d == 0.0:
+        raise ZeroDivisionError("the known vectors sum to zero")
+    rp, rq = math.hypot(*p), math.hypot(*q)
+    got = triangle(d, rp, rq)
+    if got is None:
+        return None
+    a, h = got
+    b = ((rq - rp) * (rq + rp) + d * d) / (2.0 * d)  # d - a, without cancelling
+    # X = (a + i sigma h) u with u = -K / d; e^(ia) ~ X conj(P), e^(ib) ~ (-X - K) conj(Q)
+    wx, wy = _cmul_conj(-k[0], -k[1], p[0], p[1])
+    ex, ey = _cmul(a, sigma * h, wx, wy)
+    vx, vy = _cmul_conj(-k[0], -k[1], q[0], q[1])
+    fx, fy = _cmul(b, -sigma * h, vx, vy)
+    return math.atan2(ey, ex), math.atan2(fy, fx)
+
+
+def two_angles_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any],
+                  sigma: float) -> tuple[Any, Any, Any]:
+    """:func:`two_angles` over arrays: (a, b, ok); NaN where ``ok`` is False."""
+    import numpy as np
+
+    d = np.hypot(k[0], k[1])
+    rp, rq = np.hypot(p[0], p[1]), np.hypot(q[0], q[1])
+    a, h, ok = triangle_np(d, rp, rq)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        b = ((rq - rp) * (rq + rp) + d * d) / (2.0 * d)
+    wx, wy = _cmul_conj(-k[0], -k[1], p[0], p[1])
+    ex, ey = _cmul(a, sigma * h, wx, wy)
+    vx, vy = _cmul_conj(-k[0], -k[1], q[0], q[1])
+    fx, fy = _cmul(b, -sigma * h, vx, vy)
+    return np.arctan2(ey, ex), np.arctan2(fy, fx), ok
+
+
+def two_angles_side(p: Pair, k: Pair, alpha: float) -> float:
+    """sigma of a configuration: the side of X = P e^(i alpha) from the line 0 -> -K
+    (+1 left, -1 right, 0 on it)."""
+    x, y = _cmul(p[0], p[1], math.cos(alpha), math.sin(alpha))
+    c = -k[0] * y + k[1] * x  # cross(-K, X)
+    return 1.0 if c > 0.0 else -1.0 if c < 0.0 else 0.0
+
+
+def two_angles_side_np(p: tuple[Any, Any], k: tuple[Any, Any], alpha: Any) -> Any:
+    import numpy as np
+
+    x, y = _cmul(p[0], p[1], np.cos(alpha), np.sin(alpha))
+    return np.sign(-k[0] * y + k[1] * x)
+
+
+def two_angles_margin(p: Pair, q: Pair, k: Pair) -> float:
+    """How far the two circles are from parting, relative to the largest distance:
+    min of the triangle's three slacks (negative: they miss)."""
+    d = math.hypot(k[0], k[1])
+    x, y, z = sorted((d, math.hypot(*p), math.hypot(*q)), reverse=True)
+    return (z - (x - y)) / x if x > 0.0 else 0.0
+
+
+def two_angles_margin_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any]) -> Any:
+    import numpy as np
+
+    s = -np.sort(-np.stack(np.broadcast_arrays(np.hypot(k[0], k[1]), np.hypot(p[0], p[1]),
+                                               np.hypot(q[0], q[1]))), axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(s[0] > 0.0, (s[2] - (s[0] - s[1])) / s[0], 0.0)
+
+
+# --- a line and a circle ---------------------------------------------------------------------
+
+def line_circle(z: Pair, r: float, sigma: float) -> float | None:
+    """s with |s + z| = r on side ``sigma`` (+1: the larger s); None when the line misses
+    the circle (by more than the rounding of a tangent)."""
+    m = abs(z[1])
+    lo = r - m
+    if not lo >= -TANGENT_SLACK * max(r, m):  # NaN included
+        return None
+    return -z[0] + sigma * math.sqrt(max(lo, 0.0) * (r + m))
+
+
+def line_circle_np(z: tuple[Any, Any], r: Any, sigma: float) -> tuple[Any, Any]:
+    """:func:`line_circle` over arrays: (s, ok)."""
+    import numpy as np
+
+    m = np.abs(z[1])
+    lo = r - m
+    ok = lo >= -TANGENT_SLACK * np.maximum(r, m)
+    with np.errstate(invalid="ignore"):
+        return np.where(ok, -z[0] + sigma * np.sqrt(np.maximum(lo, 0.0) * (r + m)), np.nan), ok
+
+
+def line_circle_margin(z: Pair, r: float) -> float:
+    big = max(r, abs(z[1]))
+    return (r - abs(z[1])) / big if big > 0.0 else 0.0
+
+
+def line_circle_margin_np(z: tuple[Any, Any], r: Any) -> Any:
+    import numpy as np
+
+    big = np.maximum(r, np.abs(z[1]))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(big > 0.0, (r - np.abs(z[1])) / big, 0.0)
+
+
+def _cdiv(a: Pair, b: Pair) -> Pair:
+    n = b[0] * b[0] + b[1] * b[1]
+    x, y = _cmul_conj(a[0], a[1], b[0], b[1])
+    return x / n, y / n
+
+
+def angle_and_its_length(p: Pair, dd: Pair, k: Pair, sigma: float) -> tuple[float, float] | None:
+    """(a, s) with e^(ia) (P + s D) + K = 0; None when it cannot close. Raises
+    ZeroDivisionError when D = 0."""
+    s = line_circle(_cdiv(p, dd), math.hypot(*k) / math.hypot(*dd), sigma)
+    if s is None:
+        return None
+    wx, wy = p[0] + s * dd[0], p[1] + s * dd[1]
+    ex, ey = _cmul_conj(-k[0], -k[1], wx, wy)
+    return math.atan2(ey, ex), s
+
+
+def angle_and_its_length_np(p: tuple[Any, Any], dd: tuple[Any, Any], k: tuple[Any, Any],
+                            sigma: float) -> tuple[Any, Any, Any]:
+    import numpy as np
+
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s, ok = line_circle_np(_cdiv(p, dd), np.hypot(k[0], k[1]) / np.hypot(dd[0], dd[1]), sigma)
+    wx, wy = p[0] + s * dd[0], p[1] + s * dd[1]
+    ex, ey = _cmul_conj(-k[0], -k[1], wx, wy)
+    return np.arctan2(ey, ex), s, ok
+
+
+def angle_and_other_length(p: Pair, e: Pair, k: Pair, sigma: float) -> tuple[float, float] | None:
+    """(a, s) with P e^(ia) + s E + K = 0; None when it cannot close. Raises
+    ZeroDivisionError when E = 0."""
+    s = line_circle(_cdiv(k, e), math.hypot(*p) / math.hypot(*e), sigma)
+    if s is None:
+        return None
+    wx, wy = -(k[0] + s * e[0]), -(k[1] + s * e[1])
+    ex, ey = _cmul_conj(wx, wy, p[0], p[1])
+    return math.atan2(ey, ex), s
+
+
+def angle_and_other_length_np(p: tuple[Any, Any], e: tuple[Any, Any], k: tuple[Any, Any],
+                              sigma: float) -> tuple[Any, Any, Any]:
+    import numpy as np
+
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s, ok = line_circle_np(_cdiv(k, e), np.hypot(p[0], p[1]) / np.hypot(e[0], e[1]), sigma)
+    wx, wy = -(k[0] + s * e[0]), -(k[1] + s * e[1])
+    ex, ey = _cmul_conj(wx, wy, p[0], p[1])
+    return np.arctan2(ey, ex), s, ok
+
+
+def line_side(z: Pair, s: float) -> float:
+    """sigma of a configuration on a line and a circle: the sign of s + Re z."""
+    v = s + z[0]
+    return 1.0 if v > 0.0 else -1.0 if v < 0.0 else 0.0
+
+
+def line_side_np(z: tuple[Any, Any], s: Any) -> Any:
+    import numpy as np
+
+    return np.sign(s + z[0])
+
+
+# --- two lengths -----------------------------------------------------------------------------
+
+def two_lengths(e: Pair, f: Pair, k: Pair) -> tuple[float, float] | None:
+    """(s, t) with s E + t F + K = 0; None when E and F are parallel."""
+    det = e[0] * f[1] - e[1] * f[0]
+    if det == 0.0 or not math.isfinite(det):
+        return None
+    return -(k[0] * f[1] - k[1] * f[0]) / det, -(e[0] * k[1] - e[1] * k[0]) / det
+
+
+def two_lengths_np(e: tuple[Any, Any], f: tuple[Any, Any],
+                   k: tuple[Any, Any]) -> tuple[Any, Any, Any]:
+    import numpy as np
+
+    det = e[0] * f[1] - e[1] * f[0]
+    ok = (det != 0.0) & np.isfinite(det)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = np.where(ok, -(k[0] * f[1] - k[1] * f[0]) / det, np.nan)
+        t = np.where(ok, -(e[0] * k[1] - e[1] * k[0]) / det, np.nan)
+    return s, t, ok
