@@ -60,9 +60,10 @@ def two_angles(p: Pair, q: Pair, k: Pair, sigma: float) -> tuple[float, float] |
     b = ((rq - rp) * (rq + rp) + d * d) / (2.0 * d)  # d - a, without cancelling
     # X = (a + i sigma h) u with u = -K / d; e^(ia) ~ X conj(P), e^(ib) ~ (-X - K) conj(Q)
     wx, wy = _cmul_conj(-k[0], -k[1], p[0], p[1])
-    ex, ey = _cmul(a, sigma * h, wx, wy)
+    # + 0.0: at tangency (h = 0) both sides give one answer, not atan2 of -0 and +0
+    ex, ey = _cmul(a, sigma * h + 0.0, wx, wy)
     vx, vy = _cmul_conj(-k[0], -k[1], q[0], q[1])
-    fx, fy = _cmul(b, -sigma * h, vx, vy)
+    fx, fy = _cmul(b, -sigma * h + 0.0, vx, vy)
     return math.atan2(ey, ex), math.atan2(fy, fx)
 
 
@@ -77,9 +78,9 @@ def two_angles_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any],
     with np.errstate(invalid="ignore", divide="ignore"):
         b = ((rq - rp) * (rq + rp) + d * d) / (2.0 * d)
     wx, wy = _cmul_conj(-k[0], -k[1], p[0], p[1])
-    ex, ey = _cmul(a, sigma * h, wx, wy)
+    ex, ey = _cmul(a, sigma * h + 0.0, wx, wy)
     vx, vy = _cmul_conj(-k[0], -k[1], q[0], q[1])
-    fx, fy = _cmul(b, -sigma * h, vx, vy)
+    fx, fy = _cmul(b, -sigma * h + 0.0, vx, vy)
     return np.arctan2(ey, ex), np.arctan2(fy, fx), ok
 
 
