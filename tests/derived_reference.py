@@ -546,3 +546,50 @@ def limits(case: Case, inp: Inputs) -> list[Any]:
         im = p[0] * mpmath.sin(p[1])
         both(mpmath.arg(gv), (im * im - a * a - gm * gm) / (2 * a * gm))
     return out
+
+
+def redrive(case: Case, name: str, value: float, family: str) -> Case:
+    """The same loops driven by ``name`` (an angle in degrees or a length in mm), the old
+    driver now unknown; ``family`` picks the reference formula."""
+    old, _ = case.driver
+    units = dict(case.unknowns)
+    unit = units.pop(name)
+    unknowns = [*units.items(), (old, "deg")]
+    roles = dict(case.roles, length_driver=unit == "mm")
+    return Case(family, dict(case.params), (name, value), unknowns, case.loops, roles, case.signed)
+
+
+def reference_redriven(case: Case, inp: Inputs) -> tuple[list[Sol], Any]:
+    """The solutions of :func:`redrive`'s cases, from formulas written out here."""
+    drv = inp.m.driver.name
+    dv = inp.vals[drv]
+    if case.family == "slider_by_s":
+        # a e^(i t2) + b e^(i t3) = B := s u - E: A on the circles about 0 (a) and B (b)
+        ang = case.roles["angles"]
+        _, phi = inp.term(0, 2, {drv: dv})
+        pb = dv * cis(phi) - inp.vector(0, 3)
+        pts, disc = circles(mpc(0), inp.length(0, 0), pb, inp.length(0, 1))
+        return [{ang["in"]: mpmath.arg(pa), ang["cp"]: mpmath.arg(pb - pa)} for pa in pts], disc
+    if case.family == "inverted_by_t4":
+        # a e^(i t2) = s u - W, W = the offset term + the ground term: |s - W/u| = a
+        s, t2 = case.roles["s"], inp.m.loops[0].vectors[0].angle
+        vecs = inp.m.loops[0].vectors
+        u = cis(dv)
+        w = inp.vector(0, len(vecs) - 1, {}) + (inp.vector(0, 2, {}) if len(vecs) == 4 else 0)
+        roots, disc = line_circle(-w / u, inp.length(0, 0))
+        return [{s: x, t2: mpmath.arg(x * u - w)} for x in roots], disc
+    # a Watt six-bar driven by its last link: loop 2 gives theta4 and theta6, then loop 1
+    # is a four-bar driven by its output
+    ang = case.roles["angles"]
+    off = inp.vals[("off", 1, 0)]
+    pd = -inp.vector(1, 3) + inp.length(1, 2) * cis(dv)
+    pts, disc = circles(mpc(0), inp.length(1, 0), pd, inp.length(1, 1))
+    out: list[Sol] = []
+    sub = Case("fourbar", case.params, case.driver, case.unknowns, case.loops,
+               {"angles": ang, "driven": "out"})
+    for pc in pts:
+        known = {ang["out"]: mpmath.arg(pc) - off, ang["cp2"]: mpmath.arg(pd - pc)}
+        sols, d1 = _fourbar(sub, inp, 0, {"in": 0, "cp": 1, "out": 2, "g": 3}, known)
+        disc = min(disc, d1)
+        out += sols
+    return out, disc

@@ -638,3 +638,79 @@ def test_exactly_at_a_limit_one_finite_solution() -> None:
         inp = ref.Inputs(m)
         assert abs(inp.residual(0, ref.as_sol(m, q))) <= 8 * EPS * inp.size(0, ref.as_sol(m, q))
     assert _no_nan(m.derivation, 0.0) == "solved"
+
+
+def test_fourbar_view_and_transmission_under_every_driver() -> None:
+    """Each random four-bar, however written (ground first or last, negated, any names)
+    and whichever angle drives, is seen as input, coupler, output, ground in the roles it
+    was built with, and its transmission angle is the law of cosines' at B:
+    cos mu = (b^2 + c^2 - |A - O4|^2) / (2 b c), computed here in mpmath."""
+    worst = 0.0
+    with mpmath.workdps(ref.DPS):
+        for case, m, _ in MECHANISMS[:120]:
+            der = m.derivation
+            t = case.roles["terms"]
+            (view,) = der.fourbars
+            assert (view.loop, view.input, view.coupler, view.output, view.ground) == (
+                0, t["in"], t["cp"], t["out"], t["g"])
+            terms = derive.loop_terms(m)[0]
+            inp = ref.Inputs(m)
+            for _, q in der.solutions(m.driver.value):
+                sol = {**ref.as_sol(m, q), m.driver.name: mpf(m.driver.value)}
+                flip = m.loops[0].vectors[t["in"]].sign
+                pa = flip * inp.vector(0, t["in"], sol)
+                o4 = -flip * inp.vector(0, t["g"])
+                b, c = inp.length(0, t["cp"]), inp.length(0, t["out"])
+                mu = mpmath.acos((b * b + c * c - abs(pa - o4) ** 2) / (2 * b * c))
+                got = derive.fourbar_transmission(view, terms, der.params, m.driver.value, q)
+                worst = max(worst, float(abs(mu - got)))
+    FIGURES["transmission"] = (worst, "rad, 120 four-bars")
+    assert worst <= 1e-12
+
+
+def _redriven() -> list[tuple[ref.Case, Any, ref.Sol]]:
+    """Slider-cranks driven by the slide s, inverted slider-cranks driven by the turning
+    link, Watt six-bars driven by their last link, each at a configuration of the
+    original mechanism (given as the third item)."""
+    out = []
+    with mpmath.workdps(ref.DPS):
+        for lo, hi, family, new in ((120, 130, "slider_by_s", lambda c: c.roles["s"]),
+                                    (150, 180, "inverted_by_t4", lambda c: c.roles["t4"]),
+                                    (180, 195, "watt_by_t7", lambda c: c.roles["angles"]["out2"])):
+            for case, m, _ in MECHANISMS[lo:hi:3]:
+                config = ref.reference(case, ref.Inputs(m))[0][0]
+                name = new(case)
+                unit = dict(case.unknowns)[name]
+                value = float(config[name]) if unit == "mm" else math.degrees(float(config[name]))
+                other = ref.redrive(case, name, value, family)
+                out.append((other, other.mechanism(), {**config, case.driver[0]: mpf(m.driver.value)}))
+    return out
+
+
+def test_other_drivers_stepwise_closed_form_is_newton_polished() -> None:
+    """The same loops driven from elsewhere (the slide, the turning link, the six-bar's
+    last link, which makes loop 2 the first step): every solution is Newton polished
+    (1e-12), there are as many as the formulas here give, and the original configuration
+    is among them."""
+    worst, checked = 0.0, 0
+    with mpmath.workdps(ref.DPS):
+        for case, m, config in _redriven():
+            der = m.derivation
+            assert der.complete, case.family
+            inp = ref.Inputs(m)
+            refs, disc = ref.reference_redriven(case, inp)
+            if disc < 1e-6:
+                continue
+            checked += 1
+            sols = der.solutions(m.driver.value)
+            assert len(sols) == len(refs), case.family
+            scale = _scale(m)
+            for _, q in sols:
+                root = ref.polish(inp, ref.as_sol(m, q))
+                dist = float(ref.distance(m, root, q, scale))
+                worst = max(worst, dist)
+                assert dist <= 1e-12, case.family
+                assert min(ref.distance(m, r, root, scale) for r in refs) < mpf(10) ** -40
+            assert min(ref.distance(m, config, q, scale) for _, q in sols) < 1e-9, case.family
+    _worst("newton_redriven", worst, f"{checked} mechanisms driven from elsewhere")
+    assert checked >= 15
