@@ -331,7 +331,10 @@ class Derivation:
                     out.append(_margin_np(step.case, first, second, k))
                 q[step.unknowns[0]], q[step.unknowns[1]], _ = _solve_step_np(
                     step.case, first, second, k, sigma)
-        return out
+        # a step the driver does not reach (two loops whose difference drops it) has one
+        # margin for every driver: give it the drivers' shape like the other columns
+        shape = np.broadcast_shapes(d.shape, *(np.shape(v) for v in p.values()))
+        return [np.broadcast_to(x, shape).copy() for x in out]
 
     # --- names -----------------------------------------------------------------------------
     def words_of(self, q: Sequence[float], driver: float,

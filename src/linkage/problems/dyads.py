@@ -75,12 +75,12 @@ def two_angles_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any],
     d = np.hypot(k[0], k[1])
     rp, rq = np.hypot(p[0], p[1]), np.hypot(q[0], q[1])
     a, h, ok = triangle_np(d, rp, rq)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore"):  # K = 0: a and b are inf
         b = ((rq - rp) * (rq + rp) + d * d) / (2.0 * d)
-    wx, wy = _cmul_conj(-k[0], -k[1], p[0], p[1])
-    ex, ey = _cmul(a, sigma * h + 0.0, wx, wy)
-    vx, vy = _cmul_conj(-k[0], -k[1], q[0], q[1])
-    fx, fy = _cmul(b, -sigma * h + 0.0, vx, vy)
+        wx, wy = _cmul_conj(-k[0], -k[1], p[0], p[1])
+        ex, ey = _cmul(a, sigma * h + 0.0, wx, wy)
+        vx, vy = _cmul_conj(-k[0], -k[1], q[0], q[1])
+        fx, fy = _cmul(b, -sigma * h + 0.0, vx, vy)
     return np.arctan2(ey, ex), np.arctan2(fy, fx), ok
 
 
@@ -160,10 +160,13 @@ def _cdiv(a: Pair, b: Pair) -> Pair:
 
 def angle_and_its_length(p: Pair, dd: Pair, k: Pair, sigma: float) -> tuple[float, float] | None:
     """(a, s) with e^(ia) (P + s D) + K = 0; None when it cannot close. Raises
-    ZeroDivisionError when D = 0."""
+    ZeroDivisionError when D = 0, or K = 0 where it closes (then P + s D = 0 and every
+    angle a is a solution: an inverted slider-crank's pin on the slide's pivot)."""
     s = line_circle(_cdiv(p, dd), math.hypot(*k) / math.hypot(*dd), sigma)
     if s is None:
         return None
+    if k[0] == 0.0 and k[1] == 0.0:
+        raise ZeroDivisionError("the known vectors sum to zero")
     wx, wy = p[0] + s * dd[0], p[1] + s * dd[1]
     ex, ey = _cmul_conj(-k[0], -k[1], wx, wy)
     return math.atan2(ey, ex), s
@@ -175,6 +178,8 @@ def angle_and_its_length_np(p: tuple[Any, Any], dd: tuple[Any, Any], k: tuple[An
 
     with np.errstate(invalid="ignore", divide="ignore"):
         s, ok = line_circle_np(_cdiv(p, dd), np.hypot(k[0], k[1]) / np.hypot(dd[0], dd[1]), sigma)
+    ok = ok & ((k[0] != 0.0) | (k[1] != 0.0))  # K = 0: the angle is indeterminate
+    s = np.where(ok, s, np.nan)
     wx, wy = p[0] + s * dd[0], p[1] + s * dd[1]
     ex, ey = _cmul_conj(-k[0], -k[1], wx, wy)
     return np.arctan2(ey, ex), s, ok
