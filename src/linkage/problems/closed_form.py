@@ -19,7 +19,7 @@ coupler's turn), crossed otherwise.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from .assembly import (
@@ -306,6 +306,39 @@ def fourbar_class(r1: float, r2: float, r3: float, r4: float) -> dict[str, Any]:
     s_name = min(links, key=links.__getitem__)
     return {"grashof": True, "type": f"Grashof {kind}", "shortest": s_name, "s_plus_l": total,
             "p_plus_q": p_q}
+
+
+def fourbar_facts(m: Any, q: Sequence[float] | None = None,
+                  driver: float | None = None) -> list[dict[str, Any]]:
+    """For every loop of the mechanism that is a four-bar (``m.derivation.fourbars``,
+    whatever its parameter names and whichever joint drives): the loop's name, its links'
+    lengths, its Grashof class (:func:`fourbar_class`, with the loop's ground, input,
+    coupler and output read as written with the ground last) and, given a configuration
+    ``q`` (internal units) at ``driver`` (default the file's), its transmission angle in
+    degrees (:func:`~.derive.fourbar_transmission`, in [0, 180])."""
+    from .derive import fourbar_transmission, loop_terms
+
+    derivation = m.derivation
+    if not derivation.fourbars:
+        return []
+    params = {k: p.value for k, p in m.parameters.items()}
+    d = m.driver.value if driver is None else driver
+    loops = loop_terms(m)
+    out = []
+    for view in derivation.fourbars:
+        terms = loops[view.loop]
+        # a four-bar's links are fixed: each length a parameter's name or a number
+        ground, inp, coupler, output = (abs(params[r] if isinstance(r, str) else r) for r in
+                                        (terms[i][1] for i in (view.ground, view.input,
+                                                               view.coupler, view.output)))
+        fact: dict[str, Any] = {"loop": m.loops[view.loop].name,
+                                "links": {"ground": ground, "input": inp, "coupler": coupler,
+                                          "output": output},
+                                **fourbar_class(ground, inp, coupler, output)}
+        if q is not None:
+            fact["transmission_deg"] = math.degrees(fourbar_transmission(view, terms, params, d, q))
+        out.append(fact)
+    return out
 
 
 Arc = tuple[float, float]
