@@ -1,4 +1,12 @@
-"""Closed-form position solutions, the independent reference for the iterative solvers.
+"""The old named closed forms (``closed_form = "fourbar"`` or ``"slider_crank"``), kept for
+their check and their remaining readers, and the four-bar facts of any mechanism.
+
+What solve shows (the reference, branch names, --branch) now comes from the closed form
+derived from the loops (:mod:`.derive`, :attr:`~.loops.Mechanism.derivation`), whatever
+the names and the driver: :func:`fourbar_facts` reads every four-bar loop from it. A file's
+``closed_form`` key is still read and checked (:func:`verify`, REQUIRED_NAMES) as a claim
+about its loops. The formulas below serve the sweeps and scans still keyed on it
+(:func:`branch_rule`, :func:`feasible_arcs`, DRIVERS) and the tests.
 
 Four-bar (names r1..r4, theta1..theta4; loop r2 e^(i t2) + r3 e^(i t3) = r1 e^(i t1) +
 r4 e^(i t4)): with theta2 or theta4 given, the free joint lies on one circle at a
@@ -103,34 +111,6 @@ def slider_crank_positions(r2: float, r3: float, e: float, theta2: float) -> Sol
     """Both branches (rad): open where cos(theta3) > 0; {} when it cannot be assembled."""
     return {branch: {"theta3": t3, "s": s}
             for branch, (t3, s) in zip(("open", "crossed"), slider_crank(r2, r3, e, theta2))}
-
-
-def reference_for(m: Any, driver: float | None = None) -> Callable[[], Solutions | None]:
-    """A function giving the closed-form solutions for a mechanism's current values,
-    in display units (degrees for angles), keyed by branch, restricted to its unknowns;
-    None where the closed form is indeterminate. ``driver``: the driver's value in
-    internal units (radians), exactly as the loops are solved at; default the file's."""
-    values = {k: q.value for k, q in m.parameters.items()}
-    values[m.driver.name] = m.driver.value if driver is None else driver
-    unknown_names = [u.name for u in m.unknowns]
-    kinds = {u.name: u.kind for u in m.unknowns}
-
-    def solve() -> Solutions | None:
-        if m.closed_form == "fourbar":
-            given = {k: values.get(k) for k in ("theta2", "theta4")}
-            try:
-                sols = fourbar_positions(values["r1"], values["r2"], values["r3"], values["r4"],
-                                         values["theta1"], theta2=given["theta2"],
-                                         theta4=given["theta4"] if given["theta2"] is None else None)
-            except Indeterminate:
-                return None
-        else:
-            sols = slider_crank_positions(values["r2"], values["r3"], values["e"], values["theta2"])
-        return {branch: {k: (math.degrees(v) if kinds[k] == "angle" else v)
-                         for k, v in sol.items() if k in unknown_names}
-                for branch, sol in sols.items()}
-
-    return solve
 
 
 def wrap_degrees(a: float) -> float:
