@@ -1379,12 +1379,12 @@ def _app_for(args: list[str]) -> typer.Typer:
 
 def run_cli(argv: list[str] | None = None) -> int:
     """Run the app and turn every error into one stderr line and an exit code; the notes
-    a command made (:func:`note_closed_form`) follow its output, unless it was refused
-    (exit 2: the error is then the one line)."""
+    a command made (:func:`note_closed_form`) follow its output when it ran (exit 0 or 1),
+    not when it was refused or stopped (the error is then the one line)."""
     args = list(sys.argv[1:] if argv is None else argv)
     _NOTED.clear()  # each command says its notes once
     code = _run_command(args)
-    if code != 2:
+    if code in (0, 1):
         for note in _NOTED:
             typer.echo(_for_stderr(f"note: {note}"), err=True)
     return code
