@@ -257,6 +257,36 @@ def test_crank_rocker_facts_by_the_law_of_cosines(cli):
     assert fact["transmission_deg"] == pytest.approx(transmission(40.0, 120.0, 80.0, 100.0, 30.0), abs=1e-9)
 
 
+def test_a_closed_form_with_no_choice_names_its_one_assembly(cli, tmp_path):
+    """Two lengths (s along x, t along y, closing on r e^(i theta)): linear, one assembly,
+    s = r cos(theta), t = r sin(theta); it is called 'only', and --branch says there is
+    nothing to choose."""
+    path = tmp_path / "xy.toml"
+    path.write_text("""name = "xy"
+length_unit = "mm"
+[parameters]
+r = { value = 50, unit = "mm" }
+[driver]
+name = "theta"
+value = 30
+unit = "deg"
+[unknowns]
+s = { guess = 10, unit = "mm" }
+t = { guess = 10, unit = "mm" }
+[[loops]]
+name = "L"
+vectors = [{ length = "s", angle = 0 }, { length = "t", angle = 90 },
+           { length = "r", angle = "theta", sign = -1 }]
+""")
+    doc = solve_json(cli, path)
+    assert doc["branch"] == "only" and set(doc["reference"]) == {"only"}
+    assert doc["reference"]["only"]["s"] == pytest.approx(50 * math.cos(math.radians(30)), abs=1e-12)
+    assert doc["reference"]["only"]["t"] == pytest.approx(25.0, abs=1e-12)
+    assert "true error (mm) vs only" in doc["iterations"][0]
+    run = cli("solve", str(path), "--branch", "+")
+    assert run.code == 2 and "no branch to choose" in run.err
+
+
 # --- 2. the header ----------------------------------------------------------------------------
 
 @pytest.mark.parametrize("sample, summary", [

@@ -671,6 +671,10 @@ class LoopModel:
         )
 
 
+ONLY = "only"
+"""The name of the one assembly of a closed form with no two-way step (every step linear)."""
+
+
 def derived_reference(m: Mechanism, driver: float) -> tuple[Callable[[], dict[str, dict[str, float]] | None],
                                                             Callable[[dict[str, float]], str]]:
     """The closed form derived from the loops (:attr:`Mechanism.derivation`, complete) at a
@@ -696,12 +700,13 @@ def derived_reference(m: Mechanism, driver: float) -> tuple[Callable[[], dict[st
             named = derivation.named_solutions(driver)
         except (Indeterminate, ArithmeticError):
             return None
-        return {key: {n: wrap_degrees(math.degrees(v)) if a else v for n, a, v in zip(names, angles, q)}
+        return {key or ONLY: {n: wrap_degrees(math.degrees(v)) if a else v
+                              for n, a, v in zip(names, angles, q)}
                 for key, (_, q) in named.items()}
 
     def branch_of(solution: dict[str, float]) -> str:
         q = [math.radians(solution[n]) if a else solution[n] for n, a in zip(names, angles)]
-        return derivation.name_of(q, driver)
+        return derivation.name_of(q, driver) or ONLY
 
     return reference, branch_of
 
