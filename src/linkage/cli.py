@@ -227,9 +227,11 @@ def solve(
                       "damped one) or the textbook iteration (--plain).")] = True,
     plot: Annotated[Optional[Path], typer.Option(help="Also plot log10 error against iteration "
                     "for the method(s) run (.png, .svg or .pdf; needs matplotlib).")] = None,
-    branch: Annotated[Optional[str], typer.Option(help="With FILE (one with a closed form): the "
-                      "assembly to solve for, open or crossed (its closed form is the start; a rocker-driven "
-                      "four-bar's second assembly of one label: 'open (mirror)').")] = None,
+    branch: Annotated[Optional[str], typer.Option(help="With FILE (one whose loops have a closed "
+                      "form: the header says): the assembly to solve for, by name (open or crossed per "
+                      "four-bar or slider-crank loop, e.g. open/crossed for a six-bar; a rocker-driven "
+                      "four-bar's second assembly of one name: 'open (mirror)') or by the sign of each "
+                      "two-way step, e.g. +-. Its closed form is the start.")] = None,
     speed: SpeedOpt = None,
     accel: AccelOpt = None,
     fmt: FormatOpt = None,
@@ -389,7 +391,10 @@ def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol:
                 show_jacobian: bool, out_fmt: str, output: Path | None, digits: int,
                 plot: Path | None = None, motion: tuple[str | None, str | None] = (None, None),
                 branch_wanted: str | None = None, columns: str | None = None) -> None:
+    import dataclasses
+
     from .analysis.convergence import analyze
+    from .problems.closed_form import fourbar_facts
     from .problems.loops import load
     from .render.export import result_dict
     from .render.system import branch_label, system_blocks, system_extra, system_solution
@@ -400,16 +405,21 @@ def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol:
                          f"{', '.join(SYSTEM_METHODS)}")
     mechanism = load(file).with_values(parse_assignments("--set", set_),
                                        parse_assignments("--guess", guess))
+    note_closed_form(mechanism)
     if branch_wanted is not None:
         mechanism = _start_on_branch(mechanism, branch_wanted, bool(guess))
     speed, accel = parse_motion(*motion, mechanism)
     problem = mechanism.problem()
+    # the header says which loops are closed-form and which coupled (solve_system copies meta)
+    problem = dataclasses.replace(problem, meta={**problem.meta, "closed_form": mechanism.derivation.summary})
     result = solve_system(problem, method=method, tol=tol, rtol=rtol, ftol=ftol, max_iter=max_iter,
                           fd_step=fd_step, damped=damped, show_jacobian=show_jacobian)
     conv = analyze(result)
     branch = branch_label(problem, result) if result.converged else None
-    blocks = system_blocks(problem, result, conv, digits, branch)
+    fourbars = fourbar_facts(mechanism, result.x if result.converged else None)
+    blocks = system_blocks(problem, result, conv, digits, branch, fourbars)
     extra = system_extra(problem, result, branch)
+    extra["fourbars"] = fourbars
     if result.converged:
         from .kinematics.rates import position_rates
         from .render.rates import rates_blocks, rates_dict
@@ -444,24 +454,61 @@ def _solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol:
 
 
 def _start_on_branch(mechanism: Any, branch: str, guessed: bool) -> Any:
-    """The mechanism with its guess replaced by the closed form's solution on ``branch``
-    (a rocker-driven four-bar's second assembly of one label: "open (mirror)")."""
-    from .problems.closed_form import MIRROR
+    """The mechanism with its guess replaced by the closed form's solution on ``branch``:
+    a name at the driver's value (open, crossed, open/crossed, a rocker-driven four-bar's
+    second assembly of one name 'open (mirror)') or the signs of the two-way steps (+-),
+    as :meth:`~linkage.problems.derive.Derivation.branch_signs` reads them."""
+    from .problems.derive import Indeterminate, sign_text
+    from .problems.loops import ANGLE_UNITS
 
-    if branch.removesuffix(MIRROR) not in ("open", "crossed"):
-        raise InputError(f"--branch must be open or crossed, got {branch!r}")
     if guessed:
         raise InputError("give --branch or --guess, not both")
-    if mechanism.closed_form is None:
-        raise InputError(f"--branch needs a mechanism with a closed form; {mechanism.source} has none "
-                         "(its assembly follows the file's guess)")
-    reference = mechanism.problem().reference() or {}
-    if branch not in reference:
-        found = ", ".join(reference) or "none: it cannot be assembled there"
-        raise InputError(f"no {branch} assembly at {mechanism.driver.name} = "
-                         f"{mechanism.problem().meta['driver_value']:g} {mechanism.driver.unit} "
-                         f"(assemblies: {found})")
-    return mechanism.with_values({}, reference[branch])
+    derivation = mechanism.derivation
+    if not derivation.complete:
+        raise InputError(f"--branch needs a closed form; {mechanism.source} has none: {derivation.summary}")
+    count = len(derivation.two_way)
+    if not count:
+        raise InputError(f"--branch: {mechanism.source} has one assembly (no step of its closed form "
+                         "has a choice): there is no branch to choose")
+    driver = mechanism.driver.value
+    at = f"{mechanism.driver.name} = {mechanism.problem().meta['driver_value']:g} {mechanism.driver.unit}"
+    try:
+        try:
+            signs = derivation.branch_signs(branch, driver)
+        except Indeterminate:
+            raise
+        except ValueError:
+            signs = None
+        q = derivation.solve(driver, signs) if signs is not None else None
+        if q is None:
+            named = derivation.named_solutions(driver)
+    except Indeterminate as exc:
+        raise InputError(f"--branch: the closed form is indeterminate at {at} (a change point: {exc}); "
+                         "give --guess instead") from None
+    if q is None:
+        what = f"{branch!r}"
+        if signs is not None and branch != sign_text(signs):
+            what += f" ({sign_text(signs)})"
+        there = (f"assemblies: {', '.join(named)}; or their signs, one per two-way step: "
+                 f"{', '.join(sign_text(s) for s, _ in named.values())}" if named else
+                 "assemblies: none: it cannot be assembled there")
+        raise InputError(f"--branch {what}: no such assembly at {at} ({there})")
+    return mechanism.with_values({}, {u.name: v / ANGLE_UNITS[u.unit] if u.kind == "angle" else v
+                                      for u, v in zip(mechanism.unknowns, q)})
+
+
+def note_closed_form(mechanism: Any) -> None:
+    """Once per command, a one-line note on standard error for a file that still says
+    ``closed_form = ...`` (read and checked, but derived from the loops now): kept here,
+    printed by :func:`run_cli` when the command ends."""
+    note = mechanism.closed_form_note
+    if note is not None and note not in _NOTED:
+        _NOTED.append(note)
+
+
+_NOTED: list[str] = []
+"""The notes of this command, printed by :func:`run_cli` after its output (emptied as each
+command starts: tests run many commands in one process)."""
 
 
 def _fourbar_coefficients(r1: str | None, r2: str | None, r3: str | None,
@@ -657,6 +704,7 @@ def sweep(
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SYSTEM_METHODS)}")
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
+    note_closed_form(mechanism)
     w, a_ = parse_motion(speed, accel, mechanism)
     if path:
         if plot is None:
@@ -924,6 +972,7 @@ def scan(
         raise InputError(f"{both[0]} is given by --set and by --vary; a scanned parameter takes its "
                          "values from --vary only")
     mechanism = from_text(text, str(file)).with_values(fixed, {})
+    note_closed_form(mechanism)
     angle = mechanism.driver.kind == "angle"
     if not angle and (start is None or stop is None):
         raise InputError(f"{mechanism.driver.name} is a length: give --from and --to")
@@ -1020,6 +1069,7 @@ def draw(
     check_paths([file], [("--output", output), ("--animate", animate)],
                 {"--output": (output, PICTURES), "--animate": (animate, (".gif",))})
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
+    note_closed_form(mechanism)
     if output is not None:
         from .render.plots import draw_mechanism
 
@@ -1328,8 +1378,32 @@ def _app_for(args: list[str]) -> typer.Typer:
 
 
 def run_cli(argv: list[str] | None = None) -> int:
-    """Run the app and turn every error into one stderr line and an exit code."""
+    """Run the app and turn every error into one stderr line and an exit code; the notes
+    a command made (:func:`note_closed_form`) follow its output when it ran (exit 0 or 1),
+    not when it was refused or stopped (the error is then the one line)."""
     args = list(sys.argv[1:] if argv is None else argv)
+    _NOTED.clear()  # each command says its notes once
+    code = _run_command(args)
+    if code in (0, 1):
+        for note in _NOTED:
+            typer.echo(_for_stderr(f"note: {note}"), err=True)
+    return code
+
+
+def _for_stderr(line: str) -> str:
+    """A message as one line, or wrapped at words to a terminal's width (a person's
+    terminal would otherwise fold it anywhere, mid-word or mid-path)."""
+    if not sys.stderr.isatty():
+        return line
+    import shutil
+    import textwrap
+
+    width = shutil.get_terminal_size().columns
+    return "\n".join(textwrap.wrap(line, width, subsequent_indent="  ", break_long_words=False,
+                                    break_on_hyphens=False)) if len(line) > width else line
+
+
+def _run_command(args: list[str]) -> int:
     try:
         rv = _app_for(args)(args=args, prog_name="linkage", standalone_mode=False)
     except typer.Exit as exc:

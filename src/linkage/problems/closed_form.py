@@ -1,4 +1,12 @@
-"""Closed-form position solutions, the independent reference for the iterative solvers.
+"""The old named closed forms (``closed_form = "fourbar"`` or ``"slider_crank"``), kept for
+their check and their remaining readers, and the four-bar facts of any mechanism.
+
+What solve shows (the reference, branch names, --branch) now comes from the closed form
+derived from the loops (:mod:`.derive`, :attr:`~.loops.Mechanism.derivation`), whatever
+the names and the driver: :func:`fourbar_facts` reads every four-bar loop from it. A file's
+``closed_form`` key is still read and checked (:func:`verify`, REQUIRED_NAMES) as a claim
+about its loops. The formulas below serve the sweeps and scans still keyed on it
+(:func:`branch_rule`, :func:`feasible_arcs`, DRIVERS) and the tests.
 
 Four-bar (names r1..r4, theta1..theta4; loop r2 e^(i t2) + r3 e^(i t3) = r1 e^(i t1) +
 r4 e^(i t4)): with theta2 or theta4 given, the free joint lies on one circle at a
@@ -19,7 +27,7 @@ coupler's turn), crossed otherwise.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from .assembly import (
@@ -103,34 +111,6 @@ def slider_crank_positions(r2: float, r3: float, e: float, theta2: float) -> Sol
     """Both branches (rad): open where cos(theta3) > 0; {} when it cannot be assembled."""
     return {branch: {"theta3": t3, "s": s}
             for branch, (t3, s) in zip(("open", "crossed"), slider_crank(r2, r3, e, theta2))}
-
-
-def reference_for(m: Any, driver: float | None = None) -> Callable[[], Solutions | None]:
-    """A function giving the closed-form solutions for a mechanism's current values,
-    in display units (degrees for angles), keyed by branch, restricted to its unknowns;
-    None where the closed form is indeterminate. ``driver``: the driver's value in
-    internal units (radians), exactly as the loops are solved at; default the file's."""
-    values = {k: q.value for k, q in m.parameters.items()}
-    values[m.driver.name] = m.driver.value if driver is None else driver
-    unknown_names = [u.name for u in m.unknowns]
-    kinds = {u.name: u.kind for u in m.unknowns}
-
-    def solve() -> Solutions | None:
-        if m.closed_form == "fourbar":
-            given = {k: values.get(k) for k in ("theta2", "theta4")}
-            try:
-                sols = fourbar_positions(values["r1"], values["r2"], values["r3"], values["r4"],
-                                         values["theta1"], theta2=given["theta2"],
-                                         theta4=given["theta4"] if given["theta2"] is None else None)
-            except Indeterminate:
-                return None
-        else:
-            sols = slider_crank_positions(values["r2"], values["r3"], values["e"], values["theta2"])
-        return {branch: {k: (math.degrees(v) if kinds[k] == "angle" else v)
-                         for k, v in sol.items() if k in unknown_names}
-                for branch, sol in sols.items()}
-
-    return solve
 
 
 def wrap_degrees(a: float) -> float:
@@ -306,6 +286,39 @@ def fourbar_class(r1: float, r2: float, r3: float, r4: float) -> dict[str, Any]:
     s_name = min(links, key=links.__getitem__)
     return {"grashof": True, "type": f"Grashof {kind}", "shortest": s_name, "s_plus_l": total,
             "p_plus_q": p_q}
+
+
+def fourbar_facts(m: Any, q: Sequence[float] | None = None,
+                  driver: float | None = None) -> list[dict[str, Any]]:
+    """For every loop of the mechanism that is a four-bar (``m.derivation.fourbars``,
+    whatever its parameter names and whichever joint drives): the loop's name, its links'
+    lengths, its Grashof class (:func:`fourbar_class`, with the loop's ground, input,
+    coupler and output read as written with the ground last) and, given a configuration
+    ``q`` (internal units) at ``driver`` (default the file's), its transmission angle in
+    degrees (:func:`~.derive.fourbar_transmission`, in [0, 180])."""
+    from .derive import fourbar_transmission, loop_terms
+
+    derivation = m.derivation
+    if not derivation.fourbars:
+        return []
+    params = {k: p.value for k, p in m.parameters.items()}
+    d = m.driver.value if driver is None else driver
+    loops = loop_terms(m)
+    out = []
+    for view in derivation.fourbars:
+        terms = loops[view.loop]
+        # a four-bar's links are fixed: each length a parameter's name or a number
+        ground, inp, coupler, output = (abs(params[r] if isinstance(r, str) else r) for r in
+                                        (terms[i][1] for i in (view.ground, view.input,
+                                                               view.coupler, view.output)))
+        fact: dict[str, Any] = {"loop": m.loops[view.loop].name,
+                                "links": {"ground": ground, "input": inp, "coupler": coupler,
+                                          "output": output},
+                                **fourbar_class(ground, inp, coupler, output)}
+        if q is not None:
+            fact["transmission_deg"] = math.degrees(fourbar_transmission(view, terms, params, d, q))
+        out.append(fact)
+    return out
 
 
 Arc = tuple[float, float]

@@ -10,7 +10,8 @@ File layout (see sample_inputs/ for complete, commented examples)::
 
     name = "..."
     length_unit = "cm"                      # every length shares it
-    closed_form = "fourbar"                 # optional: "fourbar" or "slider_crank"
+    closed_form = "fourbar"                 # no longer needed (derived from the loops);
+                                            # still read and checked: "fourbar", "slider_crank"
     [parameters]                            # fixed values; angles in deg unless unit = "rad"
     r1 = { value = 90, unit = "cm" }        # a link: must be > 0
     e = { value = 0, unit = "cm", signed = true }   # an offset: any sign
@@ -31,7 +32,7 @@ from __future__ import annotations
 import functools
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from os import PathLike
 from pathlib import Path
@@ -163,6 +164,15 @@ class Mechanism:
 
     def problem(self) -> SystemProblem:
         return build_problem(self)
+
+    @property
+    def closed_form_note(self) -> str | None:
+        """What to tell the reader of a file that still says ``closed_form = ...`` (None
+        for one that does not): the key is read and checked, but the closed form now comes
+        from the loops (:attr:`derivation`). A program prints it; the library does not."""
+        if self.closed_form is None:
+            return None
+        return f"{self.source}: closed_form is no longer needed: the closed form is derived from the loops"
 
     @functools.cached_property
     def derivation(self) -> Derivation:
@@ -391,6 +401,9 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         why = verify(mechanism)
         if why:
             raise fail("closed_form", f"{closed_form!r} does not describe this file: {why}")
+        if not mechanism.derivation.complete:
+            raise fail("closed_form", f"{closed_form!r} does not describe this file: "
+                                      f"{mechanism.derivation.summary}")
     return mechanism
 
 
@@ -639,17 +652,9 @@ class LoopModel:
         # the value as typed: degrees -> radians -> degrees leaves 59.99999999999999 for 60
         shown = float(f"{shown:.12g}")
         reference = branch_of = None
-        if m.closed_form is not None:
-            from .closed_form import branch_rule, reference_for
-
-            def reference() -> Any:
-                # built when read: sweeps create several problems per position and
-                # rarely ask for the closed form. At the driver value the loops are
-                # solved at, not the 12-digit one shown: near a limit the answer moves
-                # like the square root of the distance to it
-                return reference_for(m, driver)()
-
-            branch_of = branch_rule(m)
+        if m.derivation.complete:
+            # any parameter names, any driver, any number of loops: what the loops give
+            reference, branch_of = derived_reference(m, driver)
         return SystemProblem(
             F=F, J=J,
             names=tuple(u.name for u in m.unknowns),
@@ -664,6 +669,46 @@ class LoopModel:
                   "source": m.source},
             length_scale=m.length_scale,
         )
+
+
+ONLY = "only"
+"""The name of the one assembly of a closed form with no two-way step (every step linear)."""
+
+
+def derived_reference(m: Mechanism, driver: float) -> tuple[Callable[[], dict[str, dict[str, float]] | None],
+                                                            Callable[[dict[str, float]], str]]:
+    """The closed form derived from the loops (:attr:`Mechanism.derivation`, complete) at a
+    driver value (internal units): ``reference()`` gives every assembly in display units,
+    keyed by its branch name ({} where it cannot be assembled, None at a change point);
+    ``branch_of(solution in display units)`` names a configuration's branch.
+
+    Angles are shown in (-180, 180], as solve's true error compares them (the difference
+    brought within a turn): a crossed slider-crank's theta3 = -171.24 is the same angle
+    as 188.76, and no false 360 appears."""
+    from .closed_form import wrap_degrees
+    from .derive import Indeterminate
+
+    derivation = m.derivation
+    names = tuple(u.name for u in m.unknowns)
+    angles = tuple(u.kind == "angle" for u in m.unknowns)
+
+    def reference() -> dict[str, dict[str, float]] | None:
+        # built when read: sweeps create several problems per position and rarely ask for
+        # the closed form. At the driver value the loops are solved at, not the 12-digit
+        # one shown: near a limit the answer moves like the square root of the distance
+        try:
+            named = derivation.named_solutions(driver)
+        except (Indeterminate, ArithmeticError):
+            return None
+        return {key or ONLY: {n: wrap_degrees(math.degrees(v)) if a else v
+                              for n, a, v in zip(names, angles, q)}
+                for key, (_, q) in named.items()}
+
+    def branch_of(solution: dict[str, float]) -> str:
+        q = [math.radians(solution[n]) if a else solution[n] for n, a in zip(names, angles)]
+        return derivation.name_of(q, driver) or ONLY
+
+    return reference, branch_of
 
 
 def build_problem(m: Mechanism) -> SystemProblem:
