@@ -91,6 +91,18 @@ def sweep_mechanism(
 
         return replace(batch_sweep(m, values, branch=branch, tol=tol, max_iter=max_iter, speed=speed,
                                    accel=accel, joints=joints).to_sweep(), method="newton (batch)")
+    if batch is None and method == "newton" and n:
+        # a dyadic mechanism on one branch: its closed form at every position at once
+        # (kinematics/closed.py), where it applies; otherwise the engines below, unchanged
+        from .closed import closed_sweep
+
+        check_driver_values(m, [min(values), max(values)])
+        fast = closed_sweep(m, values, branch=branch, tol=tol, max_iter=max_iter, speed=speed,
+                            accel=accel, joints=joints)
+        if fast is not None:
+            if progress is not None:
+                progress(n)
+            return fast.to_sweep()
     result = sweep(m, check_driver_values(m, values), method=method, branch=branch, tol=tol,
                    max_iter=max_iter, progress=progress)
     if speed is None and not joints:
