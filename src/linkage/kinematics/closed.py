@@ -15,9 +15,10 @@ a sweep that stays on one branch needs no continuation:
    (:mod:`linkage.rules`, the batch engine's :class:`~.batch.VectorLoops` and
    :func:`~.batch.solve_linear`): a position is converged only where the rule holds; the
    few where it does not take more steps, up to ``POLISH_ITER``.
-4. The checks that make it the one-at-a-time engine's answer: det J of one sign and no
-   near-singular J anywhere (no toggle between grid points), one branch name throughout
-   (a rocker-driven four-bar's name can change along one sign branch).
+4. The checks that make it the one-at-a-time engine's answer: det J of one sign, no
+   position where that engine would search for a touch of det J = 0 between grid points
+   (a local minimum of |det J| with J near singular), one branch name throughout (a
+   rocker-driven four-bar's name can change along one sign branch).
 
 Anything else (a limit inside the sweep, a gap, a position the rule does not accept, a
 name or det sign that changes) returns None, and the caller runs the one-at-a-time
@@ -36,8 +37,17 @@ import numpy as np
 from ..problems.derive import is_open_np, sign_text
 from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..rules import residual_gate, step_scales, step_size_array, system_converged_array
-from .angles import anchor_index_array, closes_circle, continuous, driver_turn, turn_shift, unwrap_turns_array
+from .angles import (
+    anchor_index_array,
+    closes_circle_array,
+    continuous,
+    driver_turn,
+    turn_shift,
+    unwrap_turns_array,
+)
 from .batch import STATUS_CODES, BatchResult, VectorLoops, _largest, solve_linear
+from .continuation import Solver
+from .limits import TOUCH_CANDIDATE
 from .positions import SweepResult
 
 MARGIN_FLOOR = 1e-8
@@ -51,10 +61,6 @@ only where rounding left the first's residual above the gate)."""
 BLOCK = 65_536
 """Positions per block (the temporaries stay small for a million positions)."""
 
-TOUCH_CANDIDATE = 0.1
-"""A position whose J is this near singular (|det J| over its columns' lengths, the
-one-at-a-time engine's test for a toggle between grid points, see
-:data:`~.limits.TOUCH_CANDIDATE`) sends the sweep to that engine."""
 
 
 def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: float = 1e-12,
@@ -70,7 +76,8 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     if vals.ndim != 1 or n_pos < 2 or not (vals[1:] > vals[:-1]).all():
         return None
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-    signs = _followed_signs(m, float(vals[0]), scale, branch, tol, max_iter)
+    solver = Solver(m, "newton", tol, max_iter)
+    signs = _followed_signs(m, solver, float(vals[0]), scale, branch)
     if signs is None:
         return None
     kinds = tuple(u.kind for u in m.unknowns)
@@ -78,13 +85,14 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     cols = np.empty((n, n_pos))
     det = np.empty(n_pos)
     iters = np.empty(n_pos, dtype=np.int32)
+    ratio = np.empty(n_pos)
     words: list[str] | None = None
     det_sign = 0.0
     for lo in range(0, n_pos, BLOCK):
         got = _block(m, vals[lo:lo + BLOCK] * scale, signs, kinds, tol, min(max_iter, POLISH_ITER))
         if got is None:
             return None
-        q, dt, it, w = got
+        q, dt, it, rt, w = got
         s = float(np.sign(dt[0]))
         if words is None:
             words, det_sign = w, s
@@ -93,8 +101,11 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
         cols[:, lo:lo + BLOCK] = q
         det[lo:lo + BLOCK] = dt
         iters[lo:lo + BLOCK] = it
+        ratio[lo:lo + BLOCK] = rt
     assert words is not None
-    shown = _display(m, vals, cols, kinds, tol)
+    if _touch_candidate(m, vals, det, ratio):
+        return None
+    shown = _display(m, solver, vals, cols, kinds)
     label = "/".join(words)
     from .stepwise import classification_of
 
@@ -107,8 +118,8 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
                        np.ascontiguousarray(shown.T), det, iters, label, meta, 0, m, rates)
 
 
-def _followed_signs(m: Mechanism, first: float, scale: float, branch: str | None, tol: float,
-                    max_iter: int) -> tuple[float, ...] | None:
+def _followed_signs(m: Mechanism, solver: Solver, first: float, scale: float,
+                    branch: str | None) -> tuple[float, ...] | None:
     """The signs of the branch to follow, or None (this engine then does not apply)."""
     d = m.derivation
     if branch is not None:
@@ -116,36 +127,31 @@ def _followed_signs(m: Mechanism, first: float, scale: float, branch: str | None
             return d.branch_signs(branch, first * scale)
         except (ValueError, ArithmeticError):
             return None  # the one-at-a-time engine says what is wrong, as it always has
-    from ..solve import solve_system
-
     guess = tuple(u.value for u in m.unknowns)
-    # as the one-at-a-time engine computes them: a display value times the scale
-    starts = [first * scale]
-    seed = (m.driver.value / scale) * scale
-    if seed != starts[0]:
-        starts.append(seed)  # where it seeds a mechanism without the old key
+    starts = [first]
+    if m.driver.value / scale != first:
+        starts.append(m.driver.value / scale)  # where it seeds a mechanism without the old key
     found = []
     for v in starts:
-        r = solve_system(m.model.problem_at(v), guess, tol=tol, max_iter=max_iter, record=False,
-                         damped=False)
-        if not r.converged:
+        # the one-at-a-time engine's first solve (Solver.solve: textbook Newton), on
+        # compiled functions (solve_lean: the same iterates and verdict)
+        got = solver.solve_lean(v, guess)
+        if got is None:
             return None
-        found.append(d.signs_of(list(r.x), v))
+        found.append(d.signs_of(got[1], v * scale))
     if any(f != found[0] for f in found) or 0.0 in found[0]:
         return None
     return found[0]
 
 
 def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Sequence[str], tol: float,
-           max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]] | None:
+           max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[str]] | None:
     """One block of driver values (internal units): (unknowns (n, k) internal, det J,
-    iterations, the branch's words), or None where the engine does not apply."""
+    iterations, |det J| over J's columns' lengths, the branch's words), or None where the
+    engine does not apply."""
     d = m.derivation
-    for margin in d.margins_np(drv, signs):
-        if not (margin > MARGIN_FLOOR).all():  # (NaN included)
-            return None
-    q, ok = d.solve_np(drv, signs)
-    if not ok.all():
+    q, ok, margins = d.solve_margins_np(drv, signs)
+    if not ok.all() or not all((margin > MARGIN_FLOOR).all() for margin in margins):  # (NaN too)
         return None
     q = [np.array(c, dtype=float) for c in q]  # own, writable copies
     k = len(drv)
@@ -174,14 +180,25 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
         ratio[active] = np.abs(dt) / _column_lengths(jac, active.size)
         iters[active] = it
         active = active[~system_converged_array(step, resid, tol, gate)]
-    # no toggle: det J of one sign and J nowhere near singular (the one-at-a-time engine
-    # would look for a touch of det J = 0 between grid points there)
-    if not ((det > 0).all() or (det < 0).all()) or not (ratio > TOUCH_CANDIDATE).all():
-        return None
+    if not ((det > 0).all() or (det < 0).all()):
+        return None  # det J changes sign: a toggle, the one-at-a-time engine's to locate
     words = _words(m, drv, q, signs)
     if words is None:
         return None
-    return np.array(q), det, iters, words
+    return np.array(q), det, iters, ratio, words
+
+
+def _touch_candidate(m: Mechanism, vals: np.ndarray, det: np.ndarray, ratio: np.ndarray) -> bool:
+    """Whether the one-at-a-time engine would search for a touch of det J = 0 here
+    (:func:`~.limits.toggles`): a local minimum of |det J| where J is near singular, the
+    neighbours taken around the circle where the grid closes it (more often than that
+    engine: a candidate only sends the sweep to it)."""
+    a = np.abs(det)
+    if m.driver.kind == "angle" and closes_circle_array(vals, driver_turn(m.driver.unit)):
+        left, right, mid, near = np.roll(a, 1), np.roll(a, -1), a, ratio
+    else:
+        left, right, mid, near = a[:-2], a[2:], a[1:-1], ratio[1:-1]
+    return bool(((mid <= left) & (mid <= right) & ~(near > TOUCH_CANDIDATE)).any())
 
 
 def _column_lengths(jac: list[list[Any]], k: int) -> np.ndarray:
@@ -220,8 +237,8 @@ def _words(m: Mechanism, drv: np.ndarray, q: list[np.ndarray], signs: tuple[floa
     return out
 
 
-def _display(m: Mechanism, vals: np.ndarray, cols: np.ndarray, kinds: Sequence[str],
-             tol: float) -> np.ndarray:
+def _display(m: Mechanism, solver: Solver, vals: np.ndarray, cols: np.ndarray,
+             kinds: Sequence[str]) -> np.ndarray:
     """The unknowns in display units, each angle continuous along the cycle and anchored to
     what ``solve FILE`` gives (the rule of :mod:`.angles`, as the one-at-a-time engine)."""
     out = np.empty_like(cols)
@@ -231,26 +248,20 @@ def _display(m: Mechanism, vals: np.ndarray, cols: np.ndarray, kinds: Sequence[s
     if not angles:
         return out
     turn = driver_turn(m.driver.unit)
-    closes = m.driver.kind == "angle" and closes_circle(vals.tolist(), turn)
+    closes = m.driver.kind == "angle" and closes_circle_array(vals, turn)
     turns = unwrap_turns_array(out[angles], closes)
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     v0 = m.driver.value / scale
     near = int(anchor_index_array(vals, np.ones((1, len(vals)), dtype=bool), v0, closes, turn)[0])
     shift = np.zeros(len(angles))
-    ref = _file_solution(m, v0 * scale, tol)
-    if ref is not None:
+    # solve FILE's answer, as the one-at-a-time engine anchors (solve_system's damped
+    # Newton from the file's guess, on compiled functions: the same iterates and verdict)
+    got = solver.solve_lean(v0, tuple(u.value for u in m.unknowns), damped=True)
+    if got is not None:
+        ref = got[1]
         for a, j in enumerate(angles):
             at = continuous(float(out[j, near]), float(turns[a, near]))
             shift[a] = turn_shift(math.degrees(ref[j]), at)
     for a, j in enumerate(angles):
         out[j] = continuous(out[j], turns[a] + shift[a])
     return out
-
-
-def _file_solution(m: Mechanism, drv: float, tol: float) -> list[float] | None:
-    """``solve FILE``: Newton from the file's guess at its driver value (internal units)."""
-    from ..solve import solve_system
-
-    r = solve_system(m.model.problem_at(drv), tuple(u.value for u in m.unknowns), tol=tol,
-                     record=False)
-    return list(r.x) if r.converged else None

@@ -40,9 +40,12 @@ def sweep_mechanism(
 
     ``mechanism``: a :class:`~linkage.problems.loops.Mechanism` or a path to a file.
     ``values``: a list or a numpy array. ``branch``: "open" or "crossed" for a mechanism
-    with a closed form, else the branch of the file's guess. More than ``BATCH_ABOVE``
-    values with Newton go through the numpy batch engine (``batch`` forces the choice);
-    its result keeps columns and builds a position only when one is read.
+    with a closed form, else the branch of the file's guess. A mechanism whose loops solve
+    stepwise in closed form, swept with Newton on one branch with no limit position
+    inside, goes through the closed-form engine (:mod:`.closed`); otherwise more than
+    ``BATCH_ABOVE`` values with Newton go through the numpy batch engine. Both results
+    keep columns and build a position only when one is read. ``batch`` forces the
+    choice: True the batch engine, False the one-at-a-time engine.
 
     Each position has ``.input``, ``.status`` ("converged", "no_solution", "off_branch",
     "failed"), ``.solution`` (unknown name -> value, display units), ``.branch``,
