@@ -36,6 +36,11 @@ CASES = [
     ("fourbar_me581.toml", "open", [float(k) for k in range(248, 361)]),
     ("fourbar_me581.toml", "crossed", [float(k) for k in range(0, 113)]),
     ("fourbar_me581.toml", "crossed", [float(k) for k in range(248, 361)]),
+    # driven by its rocker (feasible from 104.48 to 255.52 deg): the configuration's name
+    # is the same as under the crank; each name on an arc where it stays on one sign
+    ("fourbar_me581_theta4.toml", None, [float(k) for k in range(106, 130)]),
+    ("fourbar_me581_theta4.toml", "open", [float(k) for k in range(106, 130)]),
+    ("fourbar_me581_theta4.toml", "crossed", [float(k) for k in range(210, 250)]),
 ]
 
 
@@ -139,6 +144,16 @@ def test_a_limit_inside_falls_back_to_the_one_at_a_time_engine():
     assert fast.method == "newton"
     assert fast.toggles == ref.toggles and len(fast.toggles) == 2
     assert fast.summary == ref.summary
+
+
+def test_a_branch_name_with_no_assembly_falls_back():
+    """Driven by its rocker, both assemblies of the four-bar at 106..129 deg are named open
+    (open and open (mirror)): there is no crossed one to follow, the one-at-a-time engine
+    reports every position off_branch, and this engine leaves it to that engine."""
+    m = load(sample_path("fourbar_me581_theta4.toml"))
+    values = [float(k) for k in range(106, 130)]
+    fast = sweep_mechanism(m, values, branch="crossed")
+    assert fast.method == "newton" and fast.summary == one_at_a_time(m, values, branch="crossed").summary
 
 
 @pytest.mark.parametrize("kw", [{"method": "lm"}, {"method": "newton-fd"}, {"batch": False}])

@@ -103,9 +103,10 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
         iters[lo:lo + BLOCK] = it
         ratio[lo:lo + BLOCK] = rt
     assert words is not None
-    if _touch_candidate(m, vals, det, ratio):
+    closes = m.driver.kind == "angle" and closes_circle_array(vals, driver_turn(m.driver.unit))
+    if _touch_candidate(closes, det, ratio):
         return None
-    shown = _display(m, solver, vals, cols, kinds)
+    shown = _display(m, solver, vals, cols, kinds, closes)
     label = "/".join(words)
     from .stepwise import classification_of
 
@@ -188,13 +189,13 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
     return np.array(q), det, iters, ratio, words
 
 
-def _touch_candidate(m: Mechanism, vals: np.ndarray, det: np.ndarray, ratio: np.ndarray) -> bool:
+def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray) -> bool:
     """Whether the one-at-a-time engine would search for a touch of det J = 0 here
     (:func:`~.limits.toggles`): a local minimum of |det J| where J is near singular, the
     neighbours taken around the circle where the grid closes it (more often than that
     engine: a candidate only sends the sweep to it)."""
     a = np.abs(det)
-    if m.driver.kind == "angle" and closes_circle_array(vals, driver_turn(m.driver.unit)):
+    if closes:
         left, right, mid, near = np.roll(a, 1), np.roll(a, -1), a, ratio
     else:
         left, right, mid, near = a[:-2], a[2:], a[1:-1], ratio[1:-1]
@@ -238,7 +239,7 @@ def _words(m: Mechanism, drv: np.ndarray, q: list[np.ndarray], signs: tuple[floa
 
 
 def _display(m: Mechanism, solver: Solver, vals: np.ndarray, cols: np.ndarray,
-             kinds: Sequence[str]) -> np.ndarray:
+             kinds: Sequence[str], closes: bool) -> np.ndarray:
     """The unknowns in display units, each angle continuous along the cycle and anchored to
     what ``solve FILE`` gives (the rule of :mod:`.angles`, as the one-at-a-time engine)."""
     out = np.empty_like(cols)
@@ -248,7 +249,6 @@ def _display(m: Mechanism, solver: Solver, vals: np.ndarray, cols: np.ndarray,
     if not angles:
         return out
     turn = driver_turn(m.driver.unit)
-    closes = m.driver.kind == "angle" and closes_circle_array(vals, turn)
     turns = unwrap_turns_array(out[angles], closes)
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     v0 = m.driver.value / scale
