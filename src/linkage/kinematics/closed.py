@@ -45,7 +45,7 @@ from .angles import (
     turn_shift,
     unwrap_turns_array,
 )
-from .batch import STATUS_CODES, BatchResult, VectorLoops, _largest, solve_linear
+from .batch import STATUS_CODES, BatchResult, VectorLoops, solve_linear
 from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
 from .positions import SweepResult
@@ -172,7 +172,8 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
         sub = q if rows is None else [c[rows] for c in q]
         phi, jac = loops.evaluate(sub, rows)
         dq, dt = solve_linear(jac, phi, active.size)
-        step, resid = step_size_array(dq, steps), _largest(phi)
+        # max |Phi| at the point the step was taken from (NaN propagates)
+        step, resid = step_size_array(dq, steps), np.max(np.abs(phi), axis=0)
         if not np.isfinite(step).all():
             return None
         for j in range(len(q)):
