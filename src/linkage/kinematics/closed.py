@@ -48,7 +48,7 @@ from .angles import (
 from .batch import STATUS_CODES, BatchResult, VectorLoops, solve_linear
 from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
-from .positions import SweepResult
+from .positions import SweepResult, check_driver_values
 
 MARGIN_FLOOR = 1e-8
 """The smallest relative margin of a step at a grid point for this engine: closer to a
@@ -66,8 +66,10 @@ BLOCK = 65_536
 def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: float = 1e-12,
                  max_iter: int = 50, speed: float | None = None, accel: float = 0.0,
                  joints: bool = False) -> BatchResult | None:
-    """The sweep of ``m`` over ``values`` (display units, ascending, checked by the caller)
-    by its closed form, or None where this engine does not apply (see the module)."""
+    """The sweep of ``m`` over ``values`` (finite reals in display units, as the front
+    door leaves them; this engine takes them strictly ascending) by its closed form, or
+    None where this engine does not apply (see the module). The other arguments are
+    :func:`~.sweep.sweep_mechanism`'s, checked there."""
     d = m.derivation
     if not d.complete or not d.two_way or m.driver.kind not in ("angle", "length"):
         return None
@@ -75,6 +77,8 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     n_pos = len(vals)
     if vals.ndim != 1 or n_pos < 2 or not (vals[1:] > vals[:-1]).all():
         return None
+    # the driver's magnitude, refused as the one-at-a-time engine refuses it
+    check_driver_values(m, [float(vals[0]), float(vals[-1])])
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     solver = Solver(m, "newton", tol, max_iter)
     signs = _followed_signs(m, solver, float(vals[0]), scale, branch)

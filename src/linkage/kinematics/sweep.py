@@ -40,12 +40,12 @@ def sweep_mechanism(
 
     ``mechanism``: a :class:`~linkage.problems.loops.Mechanism` or a path to a file.
     ``values``: a list or a numpy array. ``branch``: "open" or "crossed" for a mechanism
-    with a closed form, else the branch of the file's guess. A mechanism whose loops solve
-    stepwise in closed form, swept with Newton on one branch with no limit position
-    inside, goes through the closed-form engine (:mod:`.closed`); otherwise more than
-    ``BATCH_ABOVE`` values with Newton go through the numpy batch engine. Both results
-    keep columns and build a position only when one is read. ``batch`` forces the
-    choice: True the batch engine, False the one-at-a-time engine.
+    with a closed form, else the branch of the file's guess. More than ``BATCH_ABOVE``
+    values with Newton go through the numpy batch engine; fewer, of a mechanism whose
+    loops solve stepwise in closed form, on one branch with no limit position inside,
+    through the closed-form engine (:mod:`.closed`). Both results keep columns and build
+    a position only when one is read. ``batch`` forces the choice: True the batch
+    engine, False the one-at-a-time engine.
 
     Each position has ``.input``, ``.status`` ("converged", "no_solution", "off_branch",
     "failed"), ``.solution`` (unknown name -> value, display units), ``.branch``,
@@ -99,7 +99,6 @@ def sweep_mechanism(
         # (kinematics/closed.py), where it applies; otherwise the engines below, unchanged
         from .closed import closed_sweep
 
-        check_driver_values(m, [min(values), max(values)])
         fast = closed_sweep(m, values, branch=branch, tol=tol, max_iter=max_iter, speed=speed,
                             accel=accel, joints=joints)
         if fast is not None:
