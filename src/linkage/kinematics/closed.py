@@ -62,7 +62,6 @@ BLOCK = 65_536
 """Positions per block (the temporaries stay small for a million positions)."""
 
 
-
 def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: float = 1e-12,
                  max_iter: int = 50, speed: float | None = None, accel: float = 0.0,
                  joints: bool = False) -> BatchResult | None:
