@@ -671,7 +671,7 @@ def sweep(
 
     Example: linkage sweep --from 10 --to 160 --step 30
     """
-    from .kinematics.sweep import driver_values, sweep_mechanism
+    from .kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
     from .problems.loops import load
     from .render.sweep import sweep_blocks, sweep_dict, sweep_headers, sweep_rows
     from .solve import SYSTEM_METHODS, check_criteria, check_number
@@ -714,6 +714,10 @@ def sweep(
             if name not in named:
                 raise InputError(f"--path {name}: no joint or point of that name in {file} "
                                  f"(named: {', '.join(dict.fromkeys(named)) or 'none'})")
+    if batch is None and len(values) <= BATCH_ABOVE:
+        # the numpy engines (closed form, batch) cost a fresh process numpy's import, more
+        # than the one-at-a-time sweep of this many positions (the cold-start target)
+        batch = False
     with _progress(len(values)) as advance:
         result = sweep_mechanism(mechanism, values, method=method, branch=branch, tol=tol, batch=batch,
                                  progress=advance, speed=w, accel=a_,

@@ -65,6 +65,21 @@ def closes_circle(values: Sequence[float], turn: float = TURN) -> bool:
     return -slack <= closing <= largest + slack
 
 
+def closes_circle_array(values: Any, turn: float = TURN) -> bool:
+    """:func:`closes_circle` of a 1-D array of driver values (one grid, read at C speed)."""
+    import numpy as np
+
+    v = np.asarray(values, dtype=float)
+    if len(v) < 2:
+        return False
+    steps = np.diff(v) if v[1] > v[0] else -np.diff(v)
+    if not (steps > 0.0).all():
+        return False
+    closing = turn - abs(float(v[-1]) - float(v[0]))
+    slack = 1e-9 * turn
+    return bool(-slack <= closing <= float(steps.max()) + slack)
+
+
 def circular_start(solved: Sequence[bool], closes: bool) -> int:
     """Where the reading starts: on a closing grid the first solved position that follows
     an unsolved one (circularly); 0 otherwise, or when every position or none is solved."""
@@ -139,6 +154,11 @@ def unwrap_turns_array(values: Any, closes: bool) -> Any:
     if n == 0:
         return a.copy()
     solved = np.isfinite(a)
+    if solved.all():
+        # every position solved: read in grid order from the first (rule 1), each step
+        # from the previous value (0 before the first); the general path's result
+        prev = np.concatenate([np.zeros((rows, 1)), a[:, :-1]], axis=1)
+        return np.cumsum(np.floor((prev + 180.0 - a) / TURN), axis=1)
     start = circular_start_array(solved, closes)
     idx = (np.arange(n)[None, :] + start[:, None]) % n
     r = np.take_along_axis(a, idx, axis=1)

@@ -83,6 +83,15 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
     def __len__(self) -> int:
         return len(self.batch.values)
 
+    def __repr__(self) -> str:
+        """The positions, as a tuple of them shows them (the first and last of a long
+        sweep): one sweep's repr is the same in every process, as the one-at-a-time
+        engine's tuple is."""
+        n = len(self)
+        if n <= 100:
+            return f"BatchPositions({tuple(self)!r})"
+        return f"BatchPositions({n:,} positions: {self[0]!r}, ..., {self[n - 1]!r})"
+
     def __getitem__(self, i: Any) -> Any:
         if isinstance(i, slice):
             return [self[k] for k in range(*i.indices(len(self)))]

@@ -95,7 +95,8 @@ class Solver:
             return None
         return transmission(t3, t4)
 
-    def solve_lean(self, value: float, guess: Sequence[float]) -> tuple[Any, list[float], int] | None:
+    def solve_lean(self, value: float, guess: Sequence[float],
+                   damped: bool = False) -> tuple[Any, list[float], int] | None:
         """What :meth:`solve` does for textbook Newton, without building a problem or a
         Result: (J, x, iterations) when it converges, None otherwise (the caller then
         takes the full path, which computes the same and says why)."""
@@ -106,7 +107,7 @@ class Solver:
             return None
         light = LeanProblem(F, J, self.step_scales, lambda: self.problem(value))
         q, phi, _err, status, _detail, iterations, _nfev, _njev = newton_system_lean(
-            light, tuple(guess), phi0, self.tol, 0.0, self.gate, self.max_iter, False)
+            light, tuple(guess), phi0, self.tol, 0.0, self.gate, self.max_iter, damped)
         status, _ = system_verdict(status, "", max_abs(phi), self.gate)
         return (J, q, iterations) if status.converged else None
 

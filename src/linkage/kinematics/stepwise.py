@@ -88,14 +88,18 @@ def sweep(
     positions = _continuous_angles(solver, positions)
     found = toggles(solver, positions, arcs, lo, hi, have_closed)
     ranges = (tuple(arcs_within(arcs, lo, hi)) if have_closed else solved_ranges(positions))
-    classification: dict[str, Any] = {}
-    if m.closed_form == "fourbar":
-        v = {k: q.value for k, q in m.parameters.items()}
-        classification = fourbar_class(v["r1"], v["r2"], v["r3"], v["r4"])
     return SweepResult(m.name, m.driver.name, m.driver.unit, solver.names,
                        tuple("deg" if k == "angle" else m.length_unit for k in solver.kinds),
-                       tuple(positions), ranges, tuple(found), target, classification, method,
+                       tuple(positions), ranges, tuple(found), target, classification_of(m), method,
                        length_unit=m.length_unit)
+
+
+def classification_of(m: Mechanism) -> dict[str, Any]:
+    """A sweep's four-bar class (Grashof), or {} (every sweep engine reads it here)."""
+    if m.closed_form == "fourbar":
+        v = {k: q.value for k, q in m.parameters.items()}
+        return fourbar_class(v["r1"], v["r2"], v["r3"], v["r4"])
+    return {}
 
 
 def _continuous_angles(solver: Solver, positions: list[Position]) -> list[Position]:

@@ -41,8 +41,11 @@ def sweep_mechanism(
     ``mechanism``: a :class:`~linkage.problems.loops.Mechanism` or a path to a file.
     ``values``: a list or a numpy array. ``branch``: "open" or "crossed" for a mechanism
     with a closed form, else the branch of the file's guess. More than ``BATCH_ABOVE``
-    values with Newton go through the numpy batch engine (``batch`` forces the choice);
-    its result keeps columns and builds a position only when one is read.
+    values with Newton go through the numpy batch engine; fewer, of a mechanism whose
+    loops solve stepwise in closed form, on one branch with no limit position inside,
+    through the closed-form engine (:mod:`.closed`). Both results keep columns and build
+    a position only when one is read. ``batch`` forces the choice: True the batch
+    engine, False the one-at-a-time engine.
 
     Each position has ``.input``, ``.status`` ("converged", "no_solution", "off_branch",
     "failed"), ``.solution`` (unknown name -> value, display units), ``.branch``,
@@ -91,6 +94,17 @@ def sweep_mechanism(
 
         return replace(batch_sweep(m, values, branch=branch, tol=tol, max_iter=max_iter, speed=speed,
                                    accel=accel, joints=joints).to_sweep(), method="newton (batch)")
+    if batch is None and method == "newton" and n:
+        # a dyadic mechanism on one branch: its closed form at every position at once
+        # (kinematics/closed.py), where it applies; otherwise the engines below, unchanged
+        from .closed import closed_sweep
+
+        fast = closed_sweep(m, values, branch=branch, tol=tol, max_iter=max_iter, speed=speed,
+                            accel=accel, joints=joints)
+        if fast is not None:
+            if progress is not None:
+                progress(n)
+            return fast.to_sweep()
     result = sweep(m, check_driver_values(m, values), method=method, branch=branch, tol=tol,
                    max_iter=max_iter, progress=progress)
     if speed is None and not joints:

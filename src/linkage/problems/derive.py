@@ -281,22 +281,35 @@ class Derivation:
                  params: Mapping[str, Any] | None = None) -> tuple[list[Any], Any]:
         """:meth:`solve` over arrays (drivers and, for a scan, parameters broadcast
         together): (unknowns, ok); NaN where ``ok`` is False."""
+        q, ok, _ = self.solve_margins_np(driver, signs, params)
+        return q, ok
+
+    def solve_margins_np(self, driver: Any, signs: Sequence[float],
+                         params: Mapping[str, Any] | None = None) -> tuple[list[Any], Any, list[Any]]:
+        """:meth:`solve_np` and :meth:`margins_np` in one pass (a sweep needs both):
+        (unknowns, ok, margins)."""
         import numpy as np
 
         p = self._params(params)
         d = np.asarray(driver, float)
         q: list[Any] = [None] * self.n
         ok = np.ones(np.broadcast_shapes(d.shape, *(np.shape(v) for v in p.values())), bool)
+        out = []
         signs_left = iter(signs)
         with np.errstate(invalid="ignore", divide="ignore"):
             for step in self.steps:
                 sigma = next(signs_left) if step.two_way else 0.0
                 first, second, k = _coefficients(step, p, d, q, np)
+                if step.two_way:
+                    out.append(_margin_np(step.case, first, second, k))
                 a, b, fine = _solve_step_np(step.case, first, second, k, sigma)
                 ok = ok & fine
                 q[step.unknowns[0]], q[step.unknowns[1]] = a, b
         shape = ok.shape
-        return [np.where(ok, np.broadcast_to(x, shape), np.nan) for x in q], ok
+        # a step the driver does not reach (two loops whose difference drops it) has one
+        # margin for every driver: give it the drivers' shape like the other columns
+        return ([np.where(ok, np.broadcast_to(x, shape), np.nan) for x in q], ok,
+                [np.broadcast_to(x, shape).copy() for x in out])
 
     def signs_of_np(self, q: Sequence[Any], driver: Any,
                     params: Mapping[str, Any] | None = None) -> list[Any]:
@@ -316,25 +329,7 @@ class Derivation:
     def margins_np(self, driver: Any, signs: Sequence[float],
                    params: Mapping[str, Any] | None = None) -> list[Any]:
         """:meth:`margins` over arrays."""
-        import numpy as np
-
-        p = self._params(params)
-        d = np.asarray(driver, float)
-        q: list[Any] = [None] * self.n
-        out = []
-        signs_left = iter(signs)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            for step in self.steps:
-                sigma = next(signs_left) if step.two_way else 0.0
-                first, second, k = _coefficients(step, p, d, q, np)
-                if step.two_way:
-                    out.append(_margin_np(step.case, first, second, k))
-                q[step.unknowns[0]], q[step.unknowns[1]], _ = _solve_step_np(
-                    step.case, first, second, k, sigma)
-        # a step the driver does not reach (two loops whose difference drops it) has one
-        # margin for every driver: give it the drivers' shape like the other columns
-        shape = np.broadcast_shapes(d.shape, *(np.shape(v) for v in p.values()))
-        return [np.broadcast_to(x, shape).copy() for x in out]
+        return self.solve_margins_np(driver, signs, params)[2]
 
     # --- names -----------------------------------------------------------------------------
     def words_of(self, q: Sequence[float], driver: float,

@@ -1,0 +1,271 @@
+"""The closed-form sweep engine: a dyadic mechanism over all its positions at once.
+
+Where the mechanism's loops solve stepwise in closed form (``m.derivation.complete``),
+a sweep that stays on one branch needs no continuation:
+
+1. The followed branch, as signs (one per two-way step): ``branch`` names it, or, with
+   none, the configuration Newton-Raphson finds from the file's guess at the first driver
+   value (the one-at-a-time engine's start; also at the file's own driver value, where
+   that engine seeds a mechanism without the old key: both must agree).
+2. Every step's margin (:meth:`~linkage.problems.derive.Derivation.margins_np`) on that
+   branch at every driver value: all above ``MARGIN_FLOOR`` means no limit position at a
+   grid point, so each position is that branch's closed form
+   (:meth:`~linkage.problems.derive.Derivation.solve_np`), for all positions at once.
+3. One vectorised Newton-Raphson step from it under the single solve's stopping rule
+   (:mod:`linkage.rules`, the batch engine's :class:`~.batch.VectorLoops` and
+   :func:`~.batch.solve_linear`): a position is converged only where the rule holds; the
+   few where it does not take more steps, up to ``POLISH_ITER``.
+4. The checks that make it the one-at-a-time engine's answer: det J of one sign, no
+   position where that engine would search for a touch of det J = 0 between grid points
+   (a local minimum of |det J| with J near singular), one branch name throughout (a
+   rocker-driven four-bar's name can change along one sign branch).
+
+Anything else (a limit inside the sweep, a gap, a position the rule does not accept, a
+name or det sign that changes) returns None, and the caller runs the one-at-a-time
+engine unchanged. The result is a :class:`~.batch.BatchResult`: columns, with a position
+built only when it is read.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ..problems.derive import is_open_np, sign_text
+from ..problems.loops import ANGLE_UNITS, Mechanism
+from ..rules import residual_gate, step_scales, step_size_array, system_converged_array
+from .angles import (
+    anchor_index_array,
+    closes_circle_array,
+    continuous,
+    driver_turn,
+    turn_shift,
+    unwrap_turns_array,
+)
+from .batch import STATUS_CODES, BatchResult, VectorLoops, solve_linear
+from .continuation import Solver
+from .limits import TOUCH_CANDIDATE
+from .positions import SweepResult, check_driver_values
+
+MARGIN_FLOOR = 1e-8
+"""The smallest relative margin of a step at a grid point for this engine: closer to a
+limit than that, the one-at-a-time engine decides (continuation, step halving, gaps)."""
+
+POLISH_ITER = 3
+"""The most Newton steps after the closed form (one is all a position needs; a second
+only where rounding left the first's residual above the gate)."""
+
+BLOCK = 65_536
+"""Positions per block (the temporaries stay small for a million positions)."""
+
+
+def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: float = 1e-12,
+                 max_iter: int = 50, speed: float | None = None, accel: float = 0.0,
+                 joints: bool = False) -> BatchResult | None:
+    """The sweep of ``m`` over ``values`` (finite reals in display units, as the front
+    door leaves them; this engine takes them strictly ascending) by its closed form, or
+    None where this engine does not apply (see the module). The other arguments are
+    :func:`~.sweep.sweep_mechanism`'s, checked there."""
+    d = m.derivation
+    if not d.complete or not d.two_way or m.driver.kind not in ("angle", "length"):
+        return None
+    vals = np.asarray(values, dtype=float)
+    n_pos = len(vals)
+    if vals.ndim != 1 or n_pos < 2 or not (vals[1:] > vals[:-1]).all():
+        return None
+    # the driver's magnitude, refused as the one-at-a-time engine refuses it
+    check_driver_values(m, [float(vals[0]), float(vals[-1])])
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    solver = Solver(m, "newton", tol, max_iter)
+    signs = _followed_signs(m, solver, float(vals[0]), scale, branch)
+    if signs is None:
+        return None
+    kinds = tuple(u.kind for u in m.unknowns)
+    n = len(kinds)
+    cols = np.empty((n, n_pos))
+    det = np.empty(n_pos)
+    iters = np.empty(n_pos, dtype=np.int32)
+    ratio = np.empty(n_pos)
+    words: list[str] | None = None
+    det_sign = 0.0
+    for lo in range(0, n_pos, BLOCK):
+        got = _block(m, vals[lo:lo + BLOCK] * scale, signs, kinds, tol, min(max_iter, POLISH_ITER))
+        if got is None:
+            return None
+        q, dt, it, rt, w = got
+        s = float(np.sign(dt[0]))
+        if words is None:
+            words, det_sign = w, s
+        elif w != words or s != det_sign:
+            return None
+        cols[:, lo:lo + BLOCK] = q
+        det[lo:lo + BLOCK] = dt
+        iters[lo:lo + BLOCK] = it
+        ratio[lo:lo + BLOCK] = rt
+    assert words is not None
+    closes = m.driver.kind == "angle" and closes_circle_array(vals, driver_turn(m.driver.unit))
+    if _touch_candidate(closes, det, ratio):
+        return None
+    shown = _display(m, solver, vals, cols, kinds, closes)
+    label = "/".join(words)
+    from .stepwise import classification_of
+
+    meta = SweepResult(m.name, m.driver.name, m.driver.unit, tuple(u.name for u in m.unknowns),
+                       tuple("deg" if k == "angle" else m.length_unit for k in kinds), (),
+                       ((float(vals[0]), float(vals[-1])),), (), label, classification_of(m),
+                       "newton (closed form)", length_unit=m.length_unit)
+    rates = (speed, accel) if speed is not None or joints else None
+    return BatchResult(vals, np.full(n_pos, STATUS_CODES["converged"], dtype=np.int8),
+                       np.ascontiguousarray(shown.T), det, iters, label, meta, 0, m, rates)
+
+
+def _followed_signs(m: Mechanism, solver: Solver, first: float, scale: float,
+                    branch: str | None) -> tuple[float, ...] | None:
+    """The signs of the branch to follow, or None (this engine then does not apply)."""
+    d = m.derivation
+    if branch is not None:
+        try:
+            return d.branch_signs(branch, first * scale)
+        except (ValueError, ArithmeticError):
+            return None  # the one-at-a-time engine says what is wrong, as it always has
+    guess = tuple(u.value for u in m.unknowns)
+    starts = [first]
+    if m.driver.value / scale != first:
+        starts.append(m.driver.value / scale)  # where it seeds a mechanism without the old key
+    found = []
+    for v in starts:
+        # the one-at-a-time engine's first solve (Solver.solve: textbook Newton), on
+        # compiled functions (solve_lean: the same iterates and verdict)
+        got = solver.solve_lean(v, guess)
+        if got is None:
+            return None
+        found.append(d.signs_of(got[1], v * scale))
+    if any(f != found[0] for f in found) or 0.0 in found[0]:
+        return None
+    return found[0]
+
+
+def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Sequence[str], tol: float,
+           max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[str]] | None:
+    """One block of driver values (internal units): (unknowns (n, k) internal, det J,
+    iterations, |det J| over J's columns' lengths, the branch's words), or None where the
+    engine does not apply."""
+    d = m.derivation
+    q, ok, margins = d.solve_margins_np(drv, signs)
+    if not ok.all() or not all((margin > MARGIN_FLOOR).all() for margin in margins):  # (NaN too)
+        return None
+    q = [np.array(c, dtype=float) for c in q]  # own, writable copies
+    k = len(drv)
+    loops = VectorLoops(m.model, drv)
+    size = m.length_scale
+    gate, steps = residual_gate(tol, size), step_scales(kinds, size)
+    det = np.empty(k)
+    iters = np.zeros(k, dtype=np.int32)
+    ratio = np.empty(k)
+    active = np.arange(k)
+    it = 0
+    while active.size:
+        if it >= max_iter:
+            return None  # not every position met the rule: the one-at-a-time engine decides
+        it += 1
+        rows = None if active.size == k else active
+        sub = q if rows is None else [c[rows] for c in q]
+        phi, jac = loops.evaluate(sub, rows)
+        dq, dt = solve_linear(jac, phi, active.size)
+        # max |Phi| at the point the step was taken from (NaN propagates)
+        step, resid = step_size_array(dq, steps), np.max(np.abs(phi), axis=0)
+        if not np.isfinite(step).all():
+            return None
+        for j in range(len(q)):
+            q[j][active] = sub[j] + dq[j]
+        det[active] = dt
+        ratio[active] = np.abs(dt) / _column_lengths(jac, active.size)
+        iters[active] = it
+        active = active[~system_converged_array(step, resid, tol, gate)]
+    if not ((det > 0).all() or (det < 0).all()):
+        return None  # det J changes sign: a toggle, the one-at-a-time engine's to locate
+    words = _words(m, drv, q, signs)
+    if words is None:
+        return None
+    return np.array(q), det, iters, ratio, words
+
+
+def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray) -> bool:
+    """Whether the one-at-a-time engine would search for a touch of det J = 0 here
+    (:func:`~.limits.toggles`): a local minimum of |det J| where J is near singular, the
+    neighbours taken around the circle where the grid closes it (more often than that
+    engine: a candidate only sends the sweep to it)."""
+    a = np.abs(det)
+    if closes:
+        left, right, mid, near = np.roll(a, 1), np.roll(a, -1), a, ratio
+    else:
+        left, right, mid, near = a[:-2], a[2:], a[1:-1], ratio[1:-1]
+    return bool(((mid <= left) & (mid <= right) & ~(near > TOUCH_CANDIDATE)).any())
+
+
+def _column_lengths(jac: list[list[Any]], k: int) -> np.ndarray:
+    """The product of J's columns' Euclidean lengths, position by position."""
+    out = np.ones(k)
+    for j in range(len(jac[0])):
+        sq = np.zeros(k)
+        for row in jac:
+            sq = sq + np.square(row[j])
+        out = out * np.sqrt(sq)
+    return out
+
+
+def _words(m: Mechanism, drv: np.ndarray, q: list[np.ndarray], signs: tuple[float, ...]) -> list[str] | None:
+    """Each two-way step's name for the block (:meth:`Derivation.words_of` over arrays), or
+    None where one changes within it."""
+    d = m.derivation
+    params = d.params
+    assert params is not None
+    out = []
+    it = iter(signs)
+    for step in d.steps:
+        if not step.two_way:
+            continue
+        sigma = next(it)
+        if not step.word_rule:
+            out.append(sign_text((sigma,)))
+            continue
+        is_open = is_open_np(step, params, drv, q)
+        if is_open.all():
+            out.append("open")
+        elif not is_open.any():
+            out.append("crossed")
+        else:
+            return None
+    return out
+
+
+def _display(m: Mechanism, solver: Solver, vals: np.ndarray, cols: np.ndarray,
+             kinds: Sequence[str], closes: bool) -> np.ndarray:
+    """The unknowns in display units, each angle continuous along the cycle and anchored to
+    what ``solve FILE`` gives (the rule of :mod:`.angles`, as the one-at-a-time engine)."""
+    out = np.empty_like(cols)
+    angles = [j for j, k in enumerate(kinds) if k == "angle"]
+    for j, k in enumerate(kinds):
+        out[j] = np.degrees(cols[j]) if k == "angle" else cols[j]
+    if not angles:
+        return out
+    turn = driver_turn(m.driver.unit)
+    turns = unwrap_turns_array(out[angles], closes)
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    v0 = m.driver.value / scale
+    near = int(anchor_index_array(vals, np.ones((1, len(vals)), dtype=bool), v0, closes, turn)[0])
+    shift = np.zeros(len(angles))
+    # solve FILE's answer, as the one-at-a-time engine anchors (solve_system's damped
+    # Newton from the file's guess, on compiled functions: the same iterates and verdict)
+    got = solver.solve_lean(v0, tuple(u.value for u in m.unknowns), damped=True)
+    if got is not None:
+        ref = got[1]
+        for a, j in enumerate(angles):
+            at = continuous(float(out[j, near]), float(turns[a, near]))
+            shift[a] = turn_shift(math.degrees(ref[j]), at)
+    for a, j in enumerate(angles):
+        out[j] = continuous(out[j], turns[a] + shift[a])
+    return out
