@@ -364,29 +364,19 @@ def _same(a: Any, b: Any) -> bool:
     return a.shape == b.shape and bool(np.all((a == b) | (np.isnan(a) & np.isnan(b))))
 
 
-def _math_hypot(monkeypatch: pytest.MonkeyPatch) -> None:
-    """numpy's hypot (the C library's) and math.hypot (Python's own, correctly rounded
-    nearly always) differ by 1 ulp in about 0.6% of random pairs; that is the one
-    operation the twins do not share with the scalar functions (atan2, cos, sin and the
-    arithmetic agree bit for bit). With np.hypot computed by math.hypot the twins must
-    equal the scalar functions exactly."""
-    vec = np.vectorize(math.hypot, otypes=[float])
-    monkeypatch.setattr(np, "hypot", lambda x, y: vec(x, y))
-
-
-def test_hypot_is_the_only_difference_between_the_twins() -> None:
+def test_twins_share_every_operation_bit_for_bit() -> None:
+    """The twins use norm (sqrt(x^2 + y^2)), cos, sin, atan2 and arithmetic, all of which
+    numpy and math compute to the same bits (hypot is not among them: numpy's and
+    Python's differ by 1 ulp in about 0.6% of pairs, hence dyads.norm)."""
     rng = np.random.default_rng(7)
     x, y = rng.uniform(-100, 100, (2, 20000))
-    got = np.hypot(x, y)
-    want = np.array([math.hypot(a, b) for a, b in zip(x, y)])
-    assert np.all(np.abs(got - want) <= np.spacing(want))  # within 1 ulp
+    assert _same(dyads.norm_np(x, y), [dyads.norm(a, b) for a, b in zip(x, y)])
     for f in (np.cos, np.sin):
         assert _same(f(x), [getattr(math, f.__name__)(a) for a in x])
     assert _same(np.arctan2(x, y), [math.atan2(a, b) for a, b in zip(x, y)])
 
 
-def test_dyad_twins_equal_their_scalar_functions(monkeypatch: pytest.MonkeyPatch) -> None:
-    _math_hypot(monkeypatch)
+def test_dyad_twins_equal_their_scalar_functions() -> None:
     rng = np.random.default_rng(8)
     n = 3000
     p, q, k = (tuple(rng.uniform(-100, 100, (2, n))) for _ in range(3))
@@ -429,45 +419,35 @@ def _twin_mechanisms() -> list[Any]:
                                                 "slider_crank.toml", "fourbar_me581_theta4.toml")]
 
 
-def test_derivation_twins_equal_the_scalar_path(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_derivation_twins_equal_the_scalar_path() -> None:
     """solve_np, signs_of_np and margins_np against solve, signs_of and margins at 360
-    random drivers on every branch (assembled or not): equal bit for bit once np.hypot is
-    math.hypot (see _math_hypot); with numpy's own hypot, within 1e-13 rad or relative
-    (1.0e-15 measured at 3,600 random drivers of these mechanisms)."""
+    random drivers on every branch (assembled or not): equal bit for bit."""
     rng = np.random.default_rng(9)
-    for patched in (False, True):
-        if patched:
-            _math_hypot(monkeypatch)
-        for m in _twin_mechanisms():
-            der = m.derivation
-            d = rng.uniform(-math.pi, math.pi, 360)
-            if m.driver.kind == "length":
-                d = rng.uniform(-2, 2, 360) * m.driver.value
-            for signs in der.branches:
-                q_np, ok = der.solve_np(d, signs)
-                want = [der.solve(float(x), signs) for x in d]
-                assert np.array_equal(ok, [w is not None for w in want]), m.name
-                rows = np.array([w if w is not None else [np.nan] * der.n for w in want]).T
-                for j in range(der.n):
-                    if patched:
-                        assert _same(q_np[j], rows[j]), (m.name, j)
-                    else:
-                        size = _scale(m) if m.unknowns[j].kind == "length" else 1.0
-                        assert np.nanmax(np.abs(q_np[j] - rows[j])) <= 1e-13 * size, m.name
-                marg = der.margins_np(d, signs)
-                want_m = [der.margins(float(x), signs) for x in d]
-                for j in range(len(marg)):
-                    col = [w[j] for w in want_m]
-                    if patched:
-                        # NaN after the first step that does not assemble: the twin goes on
-                        # with NaN unknowns, so compare where the scalar has a number
-                        keep = ~np.isnan(col)
-                        assert _same(np.asarray(marg[j])[keep], np.asarray(col)[keep]), m.name
-                good = np.nonzero(ok)[0]
-                sg = der.signs_of_np([x[good] for x in q_np], d[good])
-                for j, col in enumerate(sg):
-                    assert _same(col, [der.signs_of([x[i] for x in q_np], d[i])[j] for i in good])
-                    assert np.all(col == signs[j]), m.name
+    for m in _twin_mechanisms():
+        der = m.derivation
+        d = rng.uniform(-math.pi, math.pi, 360)
+        if m.driver.kind == "length":
+            d = rng.uniform(-2, 2, 360) * m.driver.value
+        for signs in der.branches:
+            q_np, ok = der.solve_np(d, signs)
+            want = [der.solve(float(x), signs) for x in d]
+            assert np.array_equal(ok, [w is not None for w in want]), m.name
+            rows = np.array([w if w is not None else [np.nan] * der.n for w in want]).T
+            for j in range(der.n):
+                assert _same(q_np[j], rows[j]), (m.name, j)
+            marg = der.margins_np(d, signs)
+            want_m = [der.margins(float(x), signs) for x in d]
+            for j in range(len(marg)):
+                col = [w[j] for w in want_m]
+                # NaN after the first step that does not assemble: the twin goes on with NaN
+                # unknowns, so compare where the scalar has a number
+                keep = ~np.isnan(col)
+                assert _same(np.asarray(marg[j])[keep], np.asarray(col)[keep]), m.name
+            good = np.nonzero(ok)[0]
+            sg = der.signs_of_np([x[good] for x in q_np], d[good])
+            for j, col in enumerate(sg):
+                assert _same(col, [der.signs_of([x[i] for x in q_np], d[i])[j] for i in good])
+                assert np.all(col == signs[j]), m.name
 
 
 # --- 4. the derivation's structure ----------------------------------------------------------

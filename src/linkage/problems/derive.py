@@ -478,22 +478,21 @@ def _margin(case: str, first: Any, second: Any, k: Any) -> float:
     try:
         if case == ITS_LENGTH:
             return dyads.line_circle_margin(dyads._cdiv(first, second),
-                                            math.hypot(*k) / math.hypot(*second))
-        return dyads.line_circle_margin(dyads._cdiv(k, second), math.hypot(*first) / math.hypot(*second))
+                                            dyads.norm(*k) / dyads.norm(*second))
+        return dyads.line_circle_margin(dyads._cdiv(k, second), dyads.norm(*first) / dyads.norm(*second))
     except ZeroDivisionError:
         return math.nan
 
 
 def _margin_np(case: str, first: Any, second: Any, k: Any) -> Any:
-    import numpy as np
-
     if case == TWO_ANGLES:
         return dyads.two_angles_margin_np(first, second, k)
+    norm = dyads.norm_np
     if case == ITS_LENGTH:
         return dyads.line_circle_margin_np(dyads._cdiv(first, second),
-                                           np.hypot(k[0], k[1]) / np.hypot(second[0], second[1]))
+                                           norm(k[0], k[1]) / norm(second[0], second[1]))
     return dyads.line_circle_margin_np(dyads._cdiv(k, second),
-                                       np.hypot(first[0], first[1]) / np.hypot(second[0], second[1]))
+                                       norm(first[0], first[1]) / norm(second[0], second[1]))
 
 
 # --- the derivation --------------------------------------------------------------------------

@@ -35,6 +35,21 @@ from .assembly import TANGENT_SLACK, triangle, triangle_np
 Pair = tuple[float, float]
 
 
+def norm(x: float, y: float) -> float:
+    """|x + iy| as sqrt(x^2 + y^2): every operation is correctly rounded, so the numpy twin
+    (:func:`norm_np`) gives the same bits, which math.hypot and numpy.hypot do not (1 ulp
+    apart in about 0.6% of inputs). Lengths are bounded (loops.LENGTH_RANGE), so the
+    squares neither overflow nor underflow."""
+    return math.sqrt(x * x + y * y)
+
+
+def norm_np(x: Any, y: Any) -> Any:
+    """:func:`norm` over arrays."""
+    import numpy as np
+
+    return np.sqrt(x * x + y * y)
+
+
 def _cmul(ax: float, ay: float, bx: float, by: float) -> Pair:
     return ax * bx - ay * by, ax * by + ay * bx
 
@@ -49,10 +64,10 @@ def _cmul_conj(ax: float, ay: float, bx: float, by: float) -> Pair:
 def two_angles(p: Pair, q: Pair, k: Pair, sigma: float) -> tuple[float, float] | None:
     """(a, b) with P e^(ia) + Q e^(ib) + K = 0 on side ``sigma``; None when the circles
     miss. Raises ZeroDivisionError when K = 0 (the circles are concentric)."""
-    d = math.hypot(k[0], k[1])
+    d = norm(k[0], k[1])
     if d == 0.0:
         raise ZeroDivisionError("the known vectors sum to zero")
-    rp, rq = math.hypot(*p), math.hypot(*q)
+    rp, rq = norm(*p), norm(*q)
     got = triangle(d, rp, rq)
     if got is None:
         return None
@@ -72,8 +87,8 @@ def two_angles_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any],
     """:func:`two_angles` over arrays: (a, b, ok); NaN where ``ok`` is False."""
     import numpy as np
 
-    d = np.hypot(k[0], k[1])
-    rp, rq = np.hypot(p[0], p[1]), np.hypot(q[0], q[1])
+    d = norm_np(k[0], k[1])
+    rp, rq = norm_np(p[0], p[1]), norm_np(q[0], q[1])
     a, h, ok = triangle_np(d, rp, rq)
     with np.errstate(invalid="ignore", divide="ignore"):  # K = 0: a and b are inf
         b = ((rq - rp) * (rq + rp) + d * d) / (2.0 * d)
@@ -102,16 +117,16 @@ def two_angles_side_np(p: tuple[Any, Any], k: tuple[Any, Any], alpha: Any) -> An
 def two_angles_margin(p: Pair, q: Pair, k: Pair) -> float:
     """How far the two circles are from parting, relative to the largest distance:
     min of the triangle's three slacks (negative: they miss)."""
-    d = math.hypot(k[0], k[1])
-    x, y, z = sorted((d, math.hypot(*p), math.hypot(*q)), reverse=True)
+    d = norm(k[0], k[1])
+    x, y, z = sorted((d, norm(*p), norm(*q)), reverse=True)
     return (z - (x - y)) / x if x > 0.0 else 0.0
 
 
 def two_angles_margin_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any]) -> Any:
     import numpy as np
 
-    s = -np.sort(-np.stack(np.broadcast_arrays(np.hypot(k[0], k[1]), np.hypot(p[0], p[1]),
-                                               np.hypot(q[0], q[1]))), axis=0)
+    s = -np.sort(-np.stack(np.broadcast_arrays(norm_np(k[0], k[1]), norm_np(p[0], p[1]),
+                                               norm_np(q[0], q[1]))), axis=0)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(s[0] > 0.0, (s[2] - (s[0] - s[1])) / s[0], 0.0)
 
@@ -162,7 +177,7 @@ def angle_and_its_length(p: Pair, dd: Pair, k: Pair, sigma: float) -> tuple[floa
     """(a, s) with e^(ia) (P + s D) + K = 0; None when it cannot close. Raises
     ZeroDivisionError when D = 0, or K = 0 where it closes (then P + s D = 0 and every
     angle a is a solution: an inverted slider-crank's pin on the slide's pivot)."""
-    s = line_circle(_cdiv(p, dd), math.hypot(*k) / math.hypot(*dd), sigma)
+    s = line_circle(_cdiv(p, dd), norm(*k) / norm(*dd), sigma)
     if s is None:
         return None
     if k[0] == 0.0 and k[1] == 0.0:
@@ -177,7 +192,7 @@ def angle_and_its_length_np(p: tuple[Any, Any], dd: tuple[Any, Any], k: tuple[An
     import numpy as np
 
     with np.errstate(invalid="ignore", divide="ignore"):
-        s, ok = line_circle_np(_cdiv(p, dd), np.hypot(k[0], k[1]) / np.hypot(dd[0], dd[1]), sigma)
+        s, ok = line_circle_np(_cdiv(p, dd), norm_np(k[0], k[1]) / norm_np(dd[0], dd[1]), sigma)
     ok = ok & ((k[0] != 0.0) | (k[1] != 0.0))  # K = 0: the angle is indeterminate
     s = np.where(ok, s, np.nan)
     wx, wy = p[0] + s * dd[0], p[1] + s * dd[1]
@@ -188,7 +203,7 @@ def angle_and_its_length_np(p: tuple[Any, Any], dd: tuple[Any, Any], k: tuple[An
 def angle_and_other_length(p: Pair, e: Pair, k: Pair, sigma: float) -> tuple[float, float] | None:
     """(a, s) with P e^(ia) + s E + K = 0; None when it cannot close. Raises
     ZeroDivisionError when E = 0."""
-    s = line_circle(_cdiv(k, e), math.hypot(*p) / math.hypot(*e), sigma)
+    s = line_circle(_cdiv(k, e), norm(*p) / norm(*e), sigma)
     if s is None:
         return None
     wx, wy = -(k[0] + s * e[0]), -(k[1] + s * e[1])
@@ -201,7 +216,7 @@ def angle_and_other_length_np(p: tuple[Any, Any], e: tuple[Any, Any], k: tuple[A
     import numpy as np
 
     with np.errstate(invalid="ignore", divide="ignore"):
-        s, ok = line_circle_np(_cdiv(k, e), np.hypot(p[0], p[1]) / np.hypot(e[0], e[1]), sigma)
+        s, ok = line_circle_np(_cdiv(k, e), norm_np(p[0], p[1]) / norm_np(e[0], e[1]), sigma)
     wx, wy = -(k[0] + s * e[0]), -(k[1] + s * e[1])
     ex, ey = _cmul_conj(wx, wy, p[0], p[1])
     return np.arctan2(ey, ex), s, ok
