@@ -23,9 +23,7 @@ from typing import Any
 
 from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve, lu_two
 from ..methods.newton_system import max_abs, newton_system_lean
-from ..problems.closed_form import (
-    transmission,
-)
+from ..problems.derive import fourbar_transmission, loop_terms, parse_signs, sign_text
 from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..problems.system import LeanProblem
 from ..result import Status
@@ -51,9 +49,13 @@ class Solver:
         self.scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
         self.kinds = tuple(u.kind for u in m.unknowns)
         self.names = tuple(u.name for u in m.unknowns)
-        from ..problems.closed_form import branch_rule
-
-        self.rule = branch_rule(m) if m.closed_form else None
+        d = m.derivation
+        # the derived closed form names each position's branch and re-enters it (None:
+        # the sign of det J labels it, and Newton from the anchors re-enters it)
+        self.derivation = d if d.complete and d.two_way else None
+        self.count = len(d.two_way)
+        self._loop_terms = loop_terms(m) if d.fourbars else None
+        self._params = {k: q.value for k, q in m.parameters.items()}
         self._problems: dict[float, Any] = {}
         self._compiled: tuple[float, Any] = (math.nan, None)
         self.gate = residual_gate(tol, m.length_scale)
@@ -64,8 +66,6 @@ class Solver:
         # (v, q0, q1, LU of J, dPhi/dv) where step_two last solved: the next tangent
         self.solved_at: tuple[float, float, float, Any, float, float] | None = None
         self.newton_two = self.model.newton_two if self.two else None
-        self._fixed_deg: dict[str, float] | None = None
-        self.coupler_and_output = "theta3" in self.names and "theta4" in self.names
 
     def compiled(self, value: float) -> Any:
         """(F, J, dPhi/dv) at a driver value (display units), the last one kept: a
@@ -76,24 +76,22 @@ class Solver:
             self._compiled = (value, fns)
         return fns
 
-    def transmission(self, sol: dict[str, float], value: float | None = None) -> float | None:
-        """Four-bars: the transmission angle between coupler and output link, in [0, 180];
-        theta4 (or theta3) from the driver's ``value`` (display units) where it drives."""
-        if self.m.closed_form != "fourbar":
+    def transmission(self, q: Sequence[float], value: float) -> float | None:
+        """The transmission angle (deg, in [0, 180]) of a mechanism whose loops include
+        four-bars (:func:`~linkage.problems.derive.fourbar_transmission`: the coupler as
+        traversed against the output link from its pivot), at unknowns ``q`` (internal
+        units) and the driver's ``value`` (display units). With several four-bar loops, the
+        one farthest from 90 deg: the loop that transmits worst."""
+        terms = self._loop_terms
+        if terms is None:
             return None
-        if self.coupler_and_output:
-            return transmission(sol["theta3"], sol["theta4"])
-        fixed = self._fixed_deg
-        if fixed is None:
-            fixed = self._fixed_deg = {k: math.degrees(q.value) for k, q in self.m.parameters.items()
-                                       if q.kind == "angle" and k != self.m.driver.name}
-        if value is not None and self.m.driver.kind == "angle":
-            fixed = {**fixed, self.m.driver.name: value * (self.scale / ANGLE_UNITS["deg"])}
-        t3 = sol.get("theta3", fixed.get("theta3"))
-        t4 = sol.get("theta4", fixed.get("theta4"))
-        if t3 is None or t4 is None:
-            return None
-        return transmission(t3, t4)
+        d = value * self.scale
+        worst = None
+        for view in self.m.derivation.fourbars:
+            mu = fourbar_transmission(view, terms[view.loop], self._params, d, q) * _DEG
+            if worst is None or abs(mu - 90.0) > abs(worst - 90.0):
+                worst = mu
+        return worst
 
     def solve_lean(self, value: float, guess: Sequence[float]) -> tuple[Any, list[float], int] | None:
         """What :meth:`solve` does for textbook Newton, without building a problem or a
@@ -146,10 +144,25 @@ class Solver:
         except SingularMatrix:
             return 0.0
 
-    def branch(self, q: Sequence[float], det: float) -> str:
-        if self.rule is not None:
-            return self.rule(self.display(q))
+    def branch(self, q: Sequence[float], det: float, value: float | None = None) -> str:
+        """A position's branch label: the derivation's name for its configuration
+        (:meth:`~linkage.problems.derive.Derivation.name_of`) at the driver's ``value``
+        (display units; default the file's), else the sign of det J."""
+        d = self.derivation
+        if d is not None:
+            return d.name_of(q, self.m.driver.value if value is None else value * self.scale)
         return "det+" if det > 0 else "det-"
+
+    def on_target(self, q: Sequence[float], det: float, value: float, target: str | None,
+                  label: str | None = None) -> bool:
+        """Whether a configuration is on the followed branch: a sign string (``+-``) is
+        followed by the configuration's signs, a name (or det+/det-) by its label."""
+        if target is None:
+            return True
+        d = self.derivation
+        if d is not None and parse_signs(target, self.count) is not None:
+            return sign_text(d.signs_of(q, value * self.scale)) == target
+        return (label if label is not None else self.branch(q, det, value)) == target
 
 
 def solver_q(solver: Solver, pos: Position) -> tuple[float, ...]:
@@ -165,6 +178,35 @@ def q_of(solver: Solver, pos: Position | None) -> tuple[float, ...] | None:
 REENTERED = "re-entered from the closed form"
 
 
+def assemblies(solver: Solver, v: float) -> dict[str, tuple[tuple[float, ...], list[float]]] | None:
+    """Every assembly at driver value ``v`` (display units) from the derived closed form,
+    keyed by name (:meth:`~linkage.problems.derive.Derivation.named_solutions`); None
+    where it says nothing (no derivation, or a change point)."""
+    from ..problems.derive import Indeterminate
+
+    d = solver.derivation
+    if d is None:
+        return None
+    try:
+        return d.named_solutions(v * solver.scale)
+    except Indeterminate:
+        return None
+
+
+def on_branch_guess(solver: Solver, v: float, target: str,
+                    found: dict[str, tuple[tuple[float, ...], list[float]]]) -> list[float] | None:
+    """The closed form's configuration on the followed branch at ``v``: by its signs for a
+    sign string, else the first assembly carrying the name (the plain key before its
+    mirror)."""
+    d = solver.derivation
+    assert d is not None
+    signs = parse_signs(target, solver.count)
+    if signs is not None:
+        return d.solve(v * solver.scale, signs)
+    got = found.get(target)
+    return got[1] if got is not None else None
+
+
 def solve_position(solver: Solver, v: float, last_q: tuple[float, ...] | None, last_v: float | None,
                     anchor_q: tuple[float, ...], target: str | None,
                     have_closed: bool) -> tuple[Position, tuple[float, ...] | None]:
@@ -172,13 +214,13 @@ def solve_position(solver: Solver, v: float, last_q: tuple[float, ...] | None, l
         q = tuple(r.x)
         det = solver.det(p, q)
         sol = solver.display(q)
-        return Position(v, "converged", sol, solver.branch(q, det), r.iterations, det,
-                        solver.transmission(sol, v), substeps, note), q
+        return Position(v, "converged", sol, solver.branch(q, det, v), r.iterations, det,
+                        solver.transmission(q, v), substeps, note), q
 
     def ok(p: Any, r: Any) -> bool:
-        return r.converged and (target is None or solver.branch(r.x, solver.det(p, r.x)) == target)
+        return r.converged and solver.on_target(r.x, solver.det(p, r.x), v, target)
 
-    ref = solver.problem(v, anchor_q).reference() if have_closed else None
+    ref = assemblies(solver, v) if have_closed else None
     if have_closed and ref == {}:
         return Position(v, "no_solution", None, None, 0, None,
                         note="the closed form has no real solution"), None
@@ -190,21 +232,20 @@ def solve_position(solver: Solver, v: float, last_q: tuple[float, ...] | None, l
     # 3. re-entry (or first position): the closed form on the target branch, else anchors
     if have_closed:
         if ref:
-            want = target if target is not None else solver.branch(anchor_q, 1.0)
             if target is None:
                 # first position: keep the branch nearest the file's guess
                 p, r = solver.solve(v, anchor_q)
                 if r.converged:
                     return accept(p, r)
-            sol = ref.get(want) if want else None
-            if sol is not None:
-                guess = tuple(math.radians(sol[n]) if k == "angle" else sol[n]
-                              for n, k in zip(solver.names, solver.kinds))
+                target = solver.branch(anchor_q, 1.0, v)
+            guess = on_branch_guess(solver, v, target, ref)
+            if guess is not None:
                 p, r = solver.solve(v, guess)
                 if ok(p, r):
                     return accept(p, r, note=REENTERED)
-            elif want:
-                # a rocker-driven four-bar: both assemblies here carry the other label
+            else:
+                # no assembly here is on the branch (a rocker-driven four-bar's mirror
+                # assemblies can both carry the other name)
                 return Position(v, "off_branch", None, None, 0, None,
                                 note=f"every assembly here is {', '.join(ref)}"), None
     else:
@@ -253,7 +294,7 @@ def continue_step(solver: Solver, v: float, history: list[tuple[float, tuple[flo
                 break
             q = tuple(r.x)
             det = solver.det(p, q)
-            if target is not None and solver.branch(q, det) != target:
+            if not solver.on_target(q, det, vk, target):
                 ok = False
                 break
             dv = abs(vk - vq[0]) * solver.scale
@@ -266,8 +307,8 @@ def continue_step(solver: Solver, v: float, history: list[tuple[float, tuple[flo
             q = tuple(r.x)
             sol = solver.display(q)
             note = f"step halved to 1/{n}" if n > 1 else ""
-            return Position(v, "converged", sol, solver.branch(q, det), r.iterations, det,
-                            solver.transmission(sol, v), n if n > 1 else 0, note), q
+            return Position(v, "converged", sol, solver.branch(q, det, v), r.iterations, det,
+                            solver.transmission(q, v), n if n > 1 else 0, note), q
     return Position(v, "failed", None, None, 0, None, note="the branch could not be continued"), None
 
 
@@ -288,15 +329,15 @@ def lean_step(solver: Solver, v: float, v_last: float, q_last: tuple[float, ...]
         det = det_from_lu(lu(J(list(q))))
     except SingularMatrix:
         det = 0.0
-    branch = solver.branch(q, det)
-    if target is not None and branch != target:
+    branch = solver.branch(q, det, v)
+    if not solver.on_target(q, det, v, target, branch):
         return None
     dv = abs(v - v_last) * solver.scale
     correction, moved, size = continuity_measures(q_last, pred, q)
     if not continues(correction, moved, dv, size):
         return None
     sol = solver.display(q)
-    return Position(v, "converged", sol, branch, iterations, det, solver.transmission(sol, v)), q
+    return Position(v, "converged", sol, branch, iterations, det, solver.transmission(q, v)), q
 
 
 def step_two(solver: Solver, v: float, v_last: float, q_last: tuple[float, ...],
@@ -338,8 +379,8 @@ def step_two(solver: Solver, v: float, v_last: float, q_last: tuple[float, ...],
     solver.solved_at = (v, x0, x1, factors, w0, w1)
     q = (x0, x1)
     sol = solver.display(q)
-    branch = solver.rule(sol) if solver.rule is not None else ("det+" if det > 0 else "det-")
-    if target is not None and branch != target:
+    branch = solver.branch(q, det, v)
+    if not solver.on_target(q, det, v, target, branch):
         return None
     dv = abs(dv) * solver.scale
     e0, e1 = abs(x0), abs(x1)
@@ -350,7 +391,7 @@ def step_two(solver: Solver, v: float, v_last: float, q_last: tuple[float, ...],
     correction = e0 if e0 >= e1 else e1
     if not continues(correction, moved, dv, size):
         return None
-    return converged_position(v, sol, branch, k, det, solver.transmission(sol, v)), q
+    return converged_position(v, sol, branch, k, det, solver.transmission(q, v)), q
 
 
 def tangent(solver: Solver, v0: float, q0: Sequence[float]) -> list[float] | None:

@@ -8,15 +8,11 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from ..problems.closed_form import (
-    arcs_within,
-    feasible_arcs,
-    fourbar_class,
-)
+from ..problems.closed_form import fourbar_class
 from ..problems.loops import Mechanism
 from .angles import anchor_index, closes_circle, continuous, driver_turn, turn_shift, unwrap_turns
 from .continuation import Solver, classify_gap, follow, q_of, solve_position
-from .limits import solved_ranges, toggles
+from .limits import closed_form_limits, solved_ranges, toggles
 from .positions import Position, SweepResult, check_driver_values
 
 
@@ -34,12 +30,11 @@ def sweep(
     values = check_driver_values(m, values)
     solver = Solver(m, method, tol, max_iter)
     lo, hi = (min(values), max(values)) if values else (0.0, 0.0)
-    arcs = feasible_arcs(m) if m.closed_form and m.driver.kind == "angle" else None
-    have_closed = m.closed_form is not None and m.driver.kind == "angle"
+    have_closed = solver.derivation is not None
     guess0 = tuple(u.value for u in m.unknowns)
     full_turn = m.driver.kind == "angle" and bool(values) and values[-1] - values[0] >= 360.0 - 1e-9
     done: dict[int, Position] = {}
-    target = branch
+    target = follow_target(solver, values, branch)
     anchor_q = guess0
     # The seed: where the branch to follow is known. With a closed form, the first
     # position that can be assembled, on the requested branch (or the guess's);
@@ -59,7 +54,7 @@ def sweep(
         if r0.converged:
             q0 = tuple(r0.x)
             seed = (v0, q0)
-            target = solver.branch(q0, solver.det(p0, q0))
+            target = solver.branch(q0, solver.det(p0, q0), v0)
     if seed is not None:
         anchor_q = seed[1]
         for i, pos in follow(solver, values, seed, target, full_turn, progress, done).items():
@@ -86,16 +81,64 @@ def sweep(
             progress(len(done))
     positions = [done[j] for j in range(len(values))]
     positions = _continuous_angles(solver, positions)
-    found = toggles(solver, positions, arcs, lo, hi, have_closed)
-    ranges = (tuple(arcs_within(arcs, lo, hi)) if have_closed else solved_ranges(positions))
-    classification: dict[str, Any] = {}
-    if m.closed_form == "fourbar":
-        v = {k: q.value for k, q in m.parameters.items()}
-        classification = fourbar_class(v["r1"], v["r2"], v["r3"], v["r4"])
+    limits, ranges = closed_form_limits(solver, positions, lo, hi, target) if have_closed else \
+        ([], solved_ranges(positions))
+    found = toggles(solver, positions, limits, lo, hi, have_closed)
     return SweepResult(m.name, m.driver.name, m.driver.unit, solver.names,
                        tuple("deg" if k == "angle" else m.length_unit for k in solver.kinds),
-                       tuple(positions), ranges, tuple(found), target, classification, method,
-                       length_unit=m.length_unit)
+                       tuple(positions), ranges, tuple(found), target,
+                       classification_of(m), method, length_unit=m.length_unit)
+
+
+def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -> str | None:
+    """What the sweep follows for a ``branch`` text: a sign string as it is (followed by
+    the configurations' signs), a name as it is (followed by the configurations' names; for
+    a crank-driven four-bar loop those are one sign branch), and a name only one
+    assembly can carry at a driver value (``open (mirror)``) as the signs of that assembly
+    at the first value where the linkage assembles."""
+    from ..errors import InputError
+    from ..problems.derive import MIRROR, Indeterminate, sign_text
+
+    d = solver.derivation
+    if branch is None or d is None or not branch.endswith(MIRROR):
+        return branch
+    for v in values:
+        try:
+            named = d.named_solutions(v * solver.scale)
+        except Indeterminate:
+            continue
+        if named:
+            try:
+                return sign_text(d.branch_signs(branch, v * solver.scale))
+            except ValueError as exc:
+                raise InputError(f"branch: {exc} at {solver.m.driver.name} = {v:g}") from None
+    return branch
+
+
+def classification_of(m: Mechanism) -> dict[str, Any]:
+    """The Grashof class (Norton 2.8) of each loop that is a four-bar, read as written with
+    the ground last: input, coupler, output (:func:`~linkage.problems.closed_form.fourbar_class`).
+    One such loop: its class; several: the first's, with every loop's under ``loops``."""
+    from ..problems.derive import loop_terms
+
+    views = m.derivation.fourbars
+    if not views:
+        return {}
+    terms = loop_terms(m)
+    values = {k: q.value for k, q in m.parameters.items()}
+
+    def length(term: Any) -> float:
+        ref = term[1]
+        return abs(values[ref] if isinstance(ref, str) else float(ref))
+
+    out = []
+    for view in views:
+        t = terms[view.loop]
+        c = fourbar_class(*(length(t[i]) for i in (view.ground, view.input, view.coupler, view.output)))
+        out.append({"loop": m.loops[view.loop].name, **c})
+    if len(out) == 1:
+        return {k: v for k, v in out[0].items() if k != "loop"}
+    return {**{k: v for k, v in out[0].items() if k != "loop"}, "loops": out}
 
 
 def _continuous_angles(solver: Solver, positions: list[Position]) -> list[Position]:
