@@ -44,7 +44,7 @@ def sweep(
         for i, v in enumerate(values):
             pos, q = solve_position(solver, v, None, None, guess0, target, True)
             if pos.status == "converged" and q is not None:
-                seed, target = (v, q), pos.branch
+                seed, target = (v, q), target if target is not None else pos.branch
                 done[i] = pos
                 break
             done[i] = pos
