@@ -56,6 +56,7 @@ class Solver:
         self.count = len(d.two_way)
         self._loop_terms = loop_terms(m) if d.fourbars else None
         self._params = {k: q.value for k, q in m.parameters.items()}
+        self._by_signs: dict[str, bool] = {}  # a target: followed by its signs (else its name)
         self._problems: dict[float, Any] = {}
         self._compiled: tuple[float, Any] = (math.nan, None)
         self.gate = residual_gate(tol, m.length_scale)
@@ -160,8 +161,12 @@ class Solver:
         if target is None:
             return True
         d = self.derivation
-        if d is not None and parse_signs(target, self.count) is not None:
-            return sign_text(d.signs_of(q, value * self.scale)) == target
+        if d is not None:
+            by_signs = self._by_signs.get(target)
+            if by_signs is None:
+                by_signs = self._by_signs[target] = parse_signs(target, self.count) is not None
+            if by_signs:
+                return sign_text(d.signs_of(q, value * self.scale)) == target
         return (label if label is not None else self.branch(q, det, value)) == target
 
 

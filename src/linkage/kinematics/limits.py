@@ -17,7 +17,14 @@ from typing import Any
 from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve
 from ..methods.newton_system import max_abs
 from ..problems.derive import sign_text
-from ..problems.derive_limits import Signs, assembles, assembles_np, dip_between, limits_between_np
+from ..problems.derive_limits import (
+    Signs,
+    assembles,
+    assembles_np,
+    dip_between,
+    limit_between,
+    limits_between_np,
+)
 from .angles import closes_circle, driver_turn
 from .continuation import REENTERED, Solver, predict, solver_q
 from .positions import Position
@@ -63,14 +70,19 @@ def followed_branches(solver: Solver, positions: Sequence[Position], target: str
     """The sign tuples of the assemblies a sweep solved (one for a branch followed by its
     signs, or by a name that is one sign branch; both mirror assemblies of a rocker-driven
     four-bar followed by name); with none solved, the target's signs or every branch."""
+    import numpy as np
+
     d = solver.derivation
     assert d is not None
+    solved = [p for p in positions if p.solution is not None]
     out: list[Signs] = []
-    for p in positions:
-        if p.solution is not None:
-            signs = d.signs_of(solver_q(solver, p), p.input * solver.scale)
-            if 0.0 not in signs and signs not in out:
-                out.append(signs)
+    if solved:
+        # every position at once, by the numpy twin of signs_of
+        q = [np.radians([p.solution[n] for p in solved]) if k == "angle" else  # type: ignore[index]
+             np.array([p.solution[n] for p in solved]) for n, k in zip(solver.names, solver.kinds)]  # type: ignore[index]
+        signs = np.stack(d.signs_of_np(q, np.array([p.input for p in solved]) * solver.scale), axis=-1)
+        for row in np.unique(signs[(signs != 0.0).all(axis=-1)], axis=0)[::-1]:  # "+" first
+            out.append(tuple(float(s) for s in row))
     if out:
         return out
     if target is not None:
@@ -78,6 +90,11 @@ def followed_branches(solver: Solver, positions: Sequence[Position], target: str
         if wanted:
             return wanted
     return list(d.branches)
+
+
+FEW_BRACKETS = 8
+"""Up to this many limits between grid points are bisected by the scalar function, more by
+its numpy twin (the same halvings, every bracket at once)."""
 
 
 LIMIT_CANDIDATE = 0.1
@@ -110,7 +127,10 @@ def closed_form_limits(solver: Solver, positions: Sequence[Position], lo: float,
     g = assembles_np(d, x, branches, scale)
     ok = g >= 0.0
     change = np.flatnonzero(ok[:-1] != ok[1:])
-    found = [float(t) for t in limits_between_np(d, x[change], x[change + 1], branches, scale)]
+    if len(change) > FEW_BRACKETS:  # all at once; a few are quicker one by one (no array overhead)
+        found = [float(t) for t in limits_between_np(d, x[change], x[change + 1], branches, scale)]
+    else:
+        found = [limit_between(d, float(x[i]), float(x[i + 1]), branches, scale) for i in change]
     for i in range(1, len(ring) - 1):
         if ok[i - 1] and ok[i + 1] and g[i] <= g[i - 1] and g[i] <= g[i + 1] and g[i] < LIMIT_CANDIDATE:
             for a, c in ((ring[i - 1], ring[i]), (ring[i], ring[i + 1])):

@@ -339,15 +339,15 @@ class Derivation:
         """Each two-way step's name for a configuration: open/crossed for a four-bar or
         slider-crank loop, its sign (+ or -) otherwise."""
         p = self._params(params)
-        signs = iter(self.signs_of(q, driver, p))
         out = []
         for step in self.steps:
             if not step.two_way:
                 continue
-            sigma = next(signs)
             if step.word_rule:
                 out.append("open" if _is_open(step, p, driver, q) else "crossed")
-            else:
+            else:  # the sign, computed only here: a sweep names every position
+                first, second, k = _coefficients(step, p, driver, q, math)
+                sigma = _side(step.case, first, second, k, q[step.unknowns[0]], q[step.unknowns[1]])
                 out.append("+" if sigma >= 0.0 else "-")
         return out
 
