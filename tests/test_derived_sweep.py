@@ -351,3 +351,37 @@ def test_branch_on_the_command_line(cli):
     assert {p["branch"] for p in doc["positions"]} == {"crossed/open"}
     bad = cli("sweep", str(SAMPLES / "watt_sixbar.toml"), "--branch", "sideways")
     assert bad.code == 2 and bad.err.startswith("error: --branch must be") and len(bad.err.splitlines()) == 1
+
+
+def test_slider_crank_limits_are_the_arcsines_and_each_arc_is_reentered(tmp_path):
+    """A slider-crank whose coupler (25) is shorter than crank plus offset (40 + 10): it
+    assembles where |e - r2 sin(theta2)| <= r3, two arcs bounded by arcsin((e +- r3) / r2)
+    (mpmath); a sweep on one branch solves both arcs (re-entering the second), labelled
+    open where the coupler points the way the slide grows (cos(theta3) > 0)."""
+    text = (SAMPLES / "slider_crank.toml").read_text()
+    assert 'r3 = { value = 120' in text
+    path = tmp_path / "short_slider.toml"
+    path.write_text(text.replace('r3 = { value = 120', 'r3 = { value = 25'))
+    m = load(path)
+    r2, r3, e = mp.mpf(40), mp.mpf(25), mp.mpf(10)
+    hi, lo = deg(mp.asin((e + r3) / r2)), deg(mp.asin((e - r3) / r2))
+    want = sorted(float(t) for t in (hi, 180 - hi, 180 - lo, 360 + lo))
+    values = [float(v) for v in range(0, 360)]
+    for branch in ("open", "crossed", "+", "-"):
+        r = linkage.sweep(m, values, branch=branch)
+        assert len(r.toggles) == 4
+        for got, w in zip(r.toggles, want):
+            assert abs(got - w) <= 8 * math.ulp(w), (branch, got, w)
+        ranges = [(0.0, want[0]), (want[1], want[2]), (want[3], 359.0)]
+        assert len(r.feasible_ranges) == len(ranges)
+        for got_range, want_range in zip(r.feasible_ranges, ranges):
+            assert list(got_range) == pytest.approx(list(want_range), abs=1e-12)
+        for p in r.positions:
+            inside = any(a <= p.input <= b for a, b in ranges)
+            assert (p.status == "converged") == inside, (branch, p)
+            if p.solution is not None:
+                label = "open" if math.cos(math.radians(p.solution["theta3"])) > 0 else "crossed"
+                assert p.branch == label
+                if branch in ("open", "crossed"):
+                    assert label == branch
+        assert any("re-entered" in p.note for p in r.positions)

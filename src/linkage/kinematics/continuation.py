@@ -203,11 +203,16 @@ def on_branch_guess(solver: Solver, v: float, target: str,
     """The closed form's configuration on the followed branch at ``v``: by its signs for a
     sign string, else the first assembly carrying the name (the plain key before its
     mirror)."""
+    from ..problems.derive import Indeterminate
+
     d = solver.derivation
     assert d is not None
     signs = parse_signs(target, solver.count)
     if signs is not None:
-        return d.solve(v * solver.scale, signs)
+        try:
+            return d.solve(v * solver.scale, signs)
+        except Indeterminate:
+            return None
     got = found.get(target)
     return got[1] if got is not None else None
 
