@@ -4,15 +4,20 @@ Each position starts from the previous solution (seed 001, section 3.9): the tan
 predictor dq/dv = -J^-1 dPhi/dv, then Newton. A solve that fails, or lands on another
 branch, is retried from the last solved position in 2, 4, ... 64 sub-steps; a step is
 accepted only on the target branch and close to the prediction
-(:func:`linkage.rules.continues`). Branches: the closed form's open/crossed rule for
-four-bars and slider-cranks, the sign of det J otherwise. A followed branch also ends at
+(:func:`linkage.rules.continues`). Branches: where the loops have a derived closed form
+(``m.derivation``, complete), each position is labelled with its configuration's name
+(open/crossed per four-bar or slider-crank loop, + or - per other two-way step) and a
+branch given as a sign string (``+-``) is followed by the configurations' signs, one given
+as a name by their names (the same thing for a crank-driven loop; a rocker-driven
+four-bar's two mirror assemblies can share a name, and the sweep takes whichever carries
+it); otherwise by the sign of det J. A followed branch also ends at
 a fold, where det J goes to zero and the driver cannot advance on that assembly; there
 continuation would jump to another assembly with no warning, so such positions are
 ``off_branch`` (another assembly exists, not connected) rather than silently solved. A
 position that still fails is ``no_solution`` when the closed form (or, without one,
 Levenberg-Marquardt's residual floor) shows the loops cannot close there; it is never
 given numbers. After a gap the sweep re-enters on the branch it started on (from the
-closed form where there is one).
+closed form on the branch's signs, or the first assembly of its name, where there is one).
 """
 
 from __future__ import annotations
