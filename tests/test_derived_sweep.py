@@ -385,3 +385,27 @@ def test_slider_crank_limits_are_the_arcsines_and_each_arc_is_reentered(tmp_path
                 if branch in ("open", "crossed"):
                     assert label == branch
         assert any("re-entered" in p.note for p in r.positions)
+
+
+def test_an_unassembled_sliver_between_two_grid_points_is_found(tmp_path):
+    """b + c = 139.99 just short of the crank's farthest reach a + d = 140: the four-bar
+    parts for 2.9 deg either side of theta2 = 180, between the grid points 175 and 185.
+    Both limits are found (the margin's dip, then bisection), to a few ulps of the law of
+    cosines, and the feasible ranges leave the sliver out."""
+    links = (40.0, 69.99, 70.0, 100.0)
+    m = abcd(tmp_path, links, "theta2")
+    values = [float(v) for v in range(5, 360, 10)]
+    r = linkage.sweep(m, values, branch="open")
+    a, b, c, d = (mp.mpf(x) for x in links)
+    t = deg(mp.acos((a * a + d * d - (b + c) ** 2) / (2 * a * d)))
+    want = [float(t), float(360 - t)]
+    assert 177.0 < want[0] < 180.0 < want[1] < 183.0
+    assert len(r.toggles) == 2
+    for got, w in zip(r.toggles, want):
+        # near 180 deg the reach |A - O4| is nearly stationary, so its rounding moves the
+        # root by eps |A - O4| / (d|A - O4| / dtheta2): that, in degrees, plus a few ulps
+        reach = mp.sqrt(a * a + d * d - 2 * a * d * mp.cos(rad(w)))
+        slope = a * d * abs(mp.sin(rad(w))) / reach
+        bound = 8 * math.ulp(w) + 8 * 2.0**-52 * float(deg(reach / slope))
+        assert abs(got - w) <= bound, (got, w, bound)
+    assert [list(x) for x in r.feasible_ranges] == [[5.0, r.toggles[0]], [r.toggles[1], 355.0]]

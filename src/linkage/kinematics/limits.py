@@ -182,6 +182,8 @@ def toggles(solver: Solver, positions: Sequence[Position], limits: Sequence[floa
         if bd == 0.0:
             touch: float | None = ring[i].input  # J singular at the grid point itself
         elif abs(bd) <= abs(ad) and abs(bd) <= abs(cd) and (ad > 0) == (bd > 0) == (cd > 0):
+            if _near_a_limit(solver, limits, ring[i - 1].input, ring[i + 1].input):
+                continue  # |det J| falls towards the branch's end, located exactly already
             touch = _touch_det(solver, ring[i - 1], ring[i], ring[i + 1])
         else:
             continue
@@ -194,6 +196,12 @@ def toggles(solver: Solver, positions: Sequence[Position], limits: Sequence[floa
         if not any(abs(t - u) <= 2 * LOCATE_TOL for u in out):
             out.append(t)
     return out
+
+
+def _near_a_limit(solver: Solver, limits: Sequence[float] | None, a: float, c: float) -> bool:
+    """Whether a closed-form limit lies in [a, c] (or a turn on: the ring's last pairs)."""
+    turn = driver_turn(solver.m.driver.unit) if solver.m.driver.kind == "angle" else 0.0
+    return any(a <= t <= c or (turn and a <= t + turn <= c) for t in limits or ())
 
 
 def _around(solver: Solver, positions: Sequence[Position]) -> list[Position]:
