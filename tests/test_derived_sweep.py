@@ -286,17 +286,22 @@ def test_the_watt_sixbar_is_named_and_followed_by_loop(tmp_path):
     assert [x["type"] for x in c["loops"]] == ["Grashof crank-rocker", "change point"]  # 70+120 = 110+80
 
 
-def test_watt_sixbar_second_loop_limits_and_reentry_on_its_signs(tmp_path):
-    """With r6 = r7 = 60 the second loop parts where |O6 - C| = 120 (C on the rocker's
-    extension): its two limits in theta2 are those roots (mpmath), the feasible ranges lie
-    between them, and after the gap the sweep re-enters on the same signs."""
+def short_watt(tmp_path: Path):
+    """watt_sixbar.toml with r6 = r7 = 60: its second loop parts over part of the cycle."""
     text = (SAMPLES / "watt_sixbar.toml").read_text()
     for old, new in (("r6 = { value = 110", "r6 = { value = 60"), ("r7 = { value = 80", "r7 = { value = 60")):
         assert old in text
         text = text.replace(old, new)
     path = tmp_path / "watt_short.toml"
     path.write_text(text)
-    m = load(path)
+    return load(path)
+
+
+def test_watt_sixbar_second_loop_limits_and_reentry_on_its_signs(tmp_path):
+    """With r6 = r7 = 60 the second loop parts where |O6 - C| = 120 (C on the rocker's
+    extension): its two limits in theta2 are those roots (mpmath), the feasible ranges lie
+    between them, and after the gap the sweep re-enters on the same signs."""
+    m = short_watt(tmp_path)
     values = [float(v) for v in range(0, 360)]
     r = linkage.sweep(m, values, branch="open/crossed")
 
@@ -409,3 +414,28 @@ def test_an_unassembled_sliver_between_two_grid_points_is_found(tmp_path):
         bound = 8 * math.ulp(w) + 8 * 2.0**-52 * float(deg(reach / slope))
         assert abs(got - w) <= bound, (got, w, bound)
     assert [list(x) for x in r.feasible_ranges] == [[5.0, r.toggles[0]], [r.toggles[1], 355.0]]
+
+
+def test_watt_positions_within_1e_9_deg_of_the_second_loops_limit_are_accurate(tmp_path):
+    """1e-9 deg inside each limit of the short Watt six-bar's second loop, every angle
+    agrees with 50-digit mpmath at the same double theta2 within a few ulps of its own
+    sensitivity to theta2 (theta6 and theta7 move like the square root of the distance)."""
+    m = short_watt(tmp_path)
+    branch = "open/crossed"
+    ranges = linkage.sweep(m, [float(v) for v in range(0, 360, 5)], branch=branch).feasible_ranges
+    ref = watt_refs(r6=60.0, r7=60.0)
+    ends = [(b, -1.0) for a, b in ranges if b < 355.0] + [(a, 1.0) for a, b in ranges if a > 0.0]
+    assert len(ends) == 2
+    for end, inward in ends:
+        v = end + inward * 1e-9
+        r = linkage.sweep(m, [v + inward * 2.0, v + inward * 1.0, v], branch=branch)
+        p = r.positions[-1]
+        assert p.status == "converged" and p.branch == branch
+        h = mp.mpf("1e-30") * inward
+        here, near = ref(mp.mpf(v))[branch], ref(mp.mpf(v) + h)[branch]
+        for j, name in enumerate(("theta3", "theta4", "theta6", "theta7")):
+            slope = abs((near[j] - here[j]) / h)
+            bound = 8 * (float(slope) * math.ulp(v) + math.ulp(float(here[j])))
+            assert abs(wrap(p.solution[name] - float(here[j]))) <= bound, (end, name, bound)
+            if j >= 2:
+                assert slope > 1e3  # the second loop is near its limit indeed
