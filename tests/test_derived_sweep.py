@@ -125,6 +125,9 @@ def test_a_configuration_has_its_name_under_every_driver(tmp_path, links, driver
             if branch in ("open", "crossed"):
                 assert label == branch
         if branch in ("+", "-"):
+            # crank-driven, each name is one sign branch and the sweep reports it by name;
+            # driven by the coupler or the rocker the names cut across the signs
+            assert (r.branch in ("open", "crossed")) == (driver == "theta2"), r.branch
             d = m.derivation
             signs = {d.signs_of([math.radians(p.solution[u.name]) for u in m.unknowns],
                                 math.radians(p.input)) for p in solved}
@@ -439,3 +442,13 @@ def test_watt_positions_within_1e_9_deg_of_the_second_loops_limit_are_accurate(t
             assert abs(wrap(p.solution[name] - float(here[j]))) <= bound, (end, name, bound)
             if j >= 2:
                 assert slope > 1e3  # the second loop is near its limit indeed
+
+
+def test_a_sign_string_on_the_batch_engine_is_the_branch_of_that_name():
+    """A sign string is followed as the name of its sign branch where each name is one (a
+    crank-driven four-bar), so the batch engine, which follows names, follows it too."""
+    values = np.linspace(0.0, 360.0, 2001)
+    r = linkage.sweep(SAMPLES / "crank_rocker.toml", values, branch="-", batch=True)
+    assert r.branch == "crossed" and r.summary == {"converged": 2001}
+    for p in r.positions[::97]:
+        assert p.branch == "crossed" and not is_open(p.solution["theta3"], p.solution["theta4"])

@@ -91,16 +91,29 @@ def sweep(
 
 
 def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -> str | None:
-    """What the sweep follows for a ``branch`` text: a sign string as it is (followed by
-    the configurations' signs), a name as it is (followed by the configurations' names; for
-    a crank-driven four-bar loop those are one sign branch), and a name only one
-    assembly can carry at a driver value (``open (mirror)``) as the signs of that assembly
-    at the first value where the linkage assembles."""
+    """What the sweep follows for a ``branch`` text: a name as it is (followed by the
+    configurations' names); a sign string as the name of that sign branch where each name
+    is one (:func:`names_follow_signs`), else as it is (followed by the configurations'
+    signs); and a name only one assembly can carry at a driver value (``open (mirror)``)
+    as the signs of that assembly at the first value where the linkage assembles."""
     from ..errors import InputError
-    from ..problems.derive import MIRROR, Indeterminate, sign_text
+    from ..problems.derive import MIRROR, Indeterminate, parse_signs, sign_text
 
     d = solver.derivation
-    if branch is None or d is None or not branch.endswith(MIRROR):
+    if branch is None or d is None:
+        return branch
+    if parse_signs(branch, solver.count) is not None and names_follow_signs(solver.m):
+        # each name is one sign branch: follow (and report) it by its name
+        for v in values:
+            try:
+                named = d.named_solutions(v * solver.scale)
+            except Indeterminate:
+                continue
+            for name, (signs, _) in named.items():
+                if sign_text(signs) == branch:
+                    return name
+        return branch
+    if not branch.endswith(MIRROR):
         return branch
     for v in values:
         try:
@@ -113,6 +126,27 @@ def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -
             except ValueError as exc:
                 raise InputError(f"branch: {exc} at {solver.m.driver.name} = {v:g}") from None
     return branch
+
+
+def names_follow_signs(m: Mechanism) -> bool:
+    """Whether each branch name of ``m``'s derivation is one sign branch: every step's word
+    is its own sign's (a slider-crank loop, a step with no word, a four-bar loop solved for
+    its coupler and output). A four-bar loop driven by its rocker or coupler is solved for
+    two other links, and its open and crossed then cut across the signs."""
+    from ..problems.derive import loop_terms
+
+    d = m.derivation
+    views = {v.loop: v for v in d.fourbars}
+    terms = loop_terms(m)
+    for i in d.two_way:
+        step = d.steps[i]
+        if step.word_rule != "fourbar":
+            continue
+        view = views[step.loops[0]]
+        t = terms[view.loop]
+        if {t[view.coupler][2], t[view.output][2]} != set(step.unknowns):
+            return False
+    return True
 
 
 def classification_of(m: Mechanism) -> dict[str, Any]:
