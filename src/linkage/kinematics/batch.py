@@ -26,7 +26,6 @@ import numpy as np
 
 from ..errors import InputError
 from ..problems.assembly import is_open_np, rocker_angle_np, slider_is_open_np
-from ..problems.closed_form import transmission
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel, Mechanism
 from ..rules import residual_gate, step_scales, step_size_array, system_converged_array
 from .angles import nearest_turn, nearest_turn_array
@@ -122,8 +121,19 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         sol = ({n: float(b.solution[i, j]) for j, n in enumerate(b.coarse.names)}
                if st == "converged" else None)
         return Position(float(b.values[i]), st, sol, b.branch if sol else None, int(b.iterations[i]),
-                        float(b.det[i]) if sol else None,
-                        _transmission_of(b.coarse, sol, float(b.values[i])))
+                        float(b.det[i]) if sol else None, self._transmission(sol, float(b.values[i])))
+
+    def _transmission(self, sol: dict[str, float] | None, value: float) -> float | None:
+        """The transmission angle of a solved position (deg), by the derivation's rule
+        (:meth:`~linkage.problems.derive.Derivation.transmission`), as the one-at-a-time
+        sweep reports it."""
+        m = self.batch.source
+        if sol is None or m is None or not m.derivation.fourbars:
+            return None
+        scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+        q = [math.radians(sol[u.name]) if u.kind == "angle" else sol[u.name] for u in m.unknowns]
+        mu = m.derivation.transmission(q, value * scale)
+        return None if mu is None else math.degrees(mu)
 
     def summary(self) -> dict[str, int]:
         codes, counts = np.unique(self.batch.status, return_counts=True)
@@ -135,17 +145,6 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         out = self.batch.solution[:, j].copy()
         out[self.batch.status != STATUS_CODES["converged"]] = np.nan
         return out
-
-
-def _transmission_of(c: SweepResult, sol: dict[str, float] | None, value: float) -> float | None:
-    """As :meth:`Solver.transmission`: theta4 from the driver's value where it drives."""
-    if not c.classification or sol is None:
-        return None
-    if c.driver in ("theta3", "theta4") and c.driver_unit in ANGLE_UNITS:
-        sol = {**sol, c.driver: value * (ANGLE_UNITS[c.driver_unit] / ANGLE_UNITS["deg"])}
-    if "theta3" not in sol or "theta4" not in sol:
-        return None
-    return transmission(sol["theta3"], sol["theta4"])
 
 
 class VectorLoops:

@@ -4,15 +4,20 @@ Each position starts from the previous solution (seed 001, section 3.9): the tan
 predictor dq/dv = -J^-1 dPhi/dv, then Newton. A solve that fails, or lands on another
 branch, is retried from the last solved position in 2, 4, ... 64 sub-steps; a step is
 accepted only on the target branch and close to the prediction
-(:func:`linkage.rules.continues`). Branches: the closed form's open/crossed rule for
-four-bars and slider-cranks, the sign of det J otherwise. A followed branch also ends at
+(:func:`linkage.rules.continues`). Branches: where the loops have a derived closed form
+(``m.derivation``, complete), each position is labelled with its configuration's name
+(open/crossed per four-bar or slider-crank loop, + or - per other two-way step) and a
+branch given as a sign string (``+-``) is followed by the configurations' signs, one given
+as a name by their names (the same thing for a crank-driven loop; a rocker-driven
+four-bar's two mirror assemblies can share a name, and the sweep takes whichever carries
+it); otherwise by the sign of det J. A followed branch also ends at
 a fold, where det J goes to zero and the driver cannot advance on that assembly; there
 continuation would jump to another assembly with no warning, so such positions are
 ``off_branch`` (another assembly exists, not connected) rather than silently solved. A
 position that still fails is ``no_solution`` when the closed form (or, without one,
 Levenberg-Marquardt's residual floor) shows the loops cannot close there; it is never
 given numbers. After a gap the sweep re-enters on the branch it started on (from the
-closed form where there is one).
+closed form on the branch's signs, or the first assembly of its name, where there is one).
 """
 
 from __future__ import annotations
@@ -23,9 +28,7 @@ from typing import Any
 
 from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve, lu_two
 from ..methods.newton_system import max_abs, newton_system_lean
-from ..problems.closed_form import (
-    transmission,
-)
+from ..problems.derive import parse_signs, sign_text
 from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..problems.system import LeanProblem
 from ..result import Status
@@ -51,9 +54,13 @@ class Solver:
         self.scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
         self.kinds = tuple(u.kind for u in m.unknowns)
         self.names = tuple(u.name for u in m.unknowns)
-        from ..problems.closed_form import branch_rule
-
-        self.rule = branch_rule(m) if m.closed_form else None
+        d = m.derivation
+        # the derived closed form names each position's branch and re-enters it (None:
+        # the sign of det J labels it, and Newton from the anchors re-enters it)
+        self.derivation = d if d.complete and d.two_way else None
+        self.count = len(d.two_way)
+        self._params = {k: q.value for k, q in m.parameters.items()}
+        self._by_signs: dict[str, bool] = {}  # a target: followed by its signs (else its name)
         self._problems: dict[float, Any] = {}
         self._compiled: tuple[float, Any] = (math.nan, None)
         self.gate = residual_gate(tol, m.length_scale)
@@ -64,8 +71,6 @@ class Solver:
         # (v, q0, q1, LU of J, dPhi/dv) where step_two last solved: the next tangent
         self.solved_at: tuple[float, float, float, Any, float, float] | None = None
         self.newton_two = self.model.newton_two if self.two else None
-        self._fixed_deg: dict[str, float] | None = None
-        self.coupler_and_output = "theta3" in self.names and "theta4" in self.names
 
     def compiled(self, value: float) -> Any:
         """(F, J, dPhi/dv) at a driver value (display units), the last one kept: a
@@ -76,24 +81,16 @@ class Solver:
             self._compiled = (value, fns)
         return fns
 
-    def transmission(self, sol: dict[str, float], value: float | None = None) -> float | None:
-        """Four-bars: the transmission angle between coupler and output link, in [0, 180];
-        theta4 (or theta3) from the driver's ``value`` (display units) where it drives."""
-        if self.m.closed_form != "fourbar":
+    def transmission(self, q: Sequence[float], value: float) -> float | None:
+        """The transmission angle (deg, in [0, 180]) of a mechanism whose loops include
+        four-bars (:func:`~linkage.problems.derive.fourbar_transmission`: the coupler as
+        traversed against the output link from its pivot), at unknowns ``q`` (internal
+        units) and the driver's ``value`` (display units). With several four-bar loops, the
+        one farthest from 90 deg: the loop that transmits worst."""
+        if not self.m.derivation.fourbars:
             return None
-        if self.coupler_and_output:
-            return transmission(sol["theta3"], sol["theta4"])
-        fixed = self._fixed_deg
-        if fixed is None:
-            fixed = self._fixed_deg = {k: math.degrees(q.value) for k, q in self.m.parameters.items()
-                                       if q.kind == "angle" and k != self.m.driver.name}
-        if value is not None and self.m.driver.kind == "angle":
-            fixed = {**fixed, self.m.driver.name: value * (self.scale / ANGLE_UNITS["deg"])}
-        t3 = sol.get("theta3", fixed.get("theta3"))
-        t4 = sol.get("theta4", fixed.get("theta4"))
-        if t3 is None or t4 is None:
-            return None
-        return transmission(t3, t4)
+        mu = self.m.derivation.transmission(q, value * self.scale, self._params)
+        return None if mu is None else mu * _DEG
 
     def solve_lean(self, value: float, guess: Sequence[float],
                    damped: bool = False) -> tuple[Any, list[float], int] | None:
@@ -147,10 +144,29 @@ class Solver:
         except SingularMatrix:
             return 0.0
 
-    def branch(self, q: Sequence[float], det: float) -> str:
-        if self.rule is not None:
-            return self.rule(self.display(q))
+    def branch(self, q: Sequence[float], det: float, value: float | None = None) -> str:
+        """A position's branch label: the derivation's name for its configuration
+        (:meth:`~linkage.problems.derive.Derivation.name_of`) at the driver's ``value``
+        (display units; default the file's), else the sign of det J."""
+        d = self.derivation
+        if d is not None:
+            return d.name_of(q, self.m.driver.value if value is None else value * self.scale)
         return "det+" if det > 0 else "det-"
+
+    def on_target(self, q: Sequence[float], det: float, value: float, target: str | None,
+                  label: str | None = None) -> bool:
+        """Whether a configuration is on the followed branch: a sign string (``+-``) is
+        followed by the configuration's signs, a name (or det+/det-) by its label."""
+        if target is None:
+            return True
+        d = self.derivation
+        if d is not None:
+            by_signs = self._by_signs.get(target)
+            if by_signs is None:
+                by_signs = self._by_signs[target] = parse_signs(target, self.count) is not None
+            if by_signs:
+                return sign_text(d.signs_of(q, value * self.scale)) == target
+        return (label if label is not None else self.branch(q, det, value)) == target
 
 
 def solver_q(solver: Solver, pos: Position) -> tuple[float, ...]:
@@ -166,6 +182,60 @@ def q_of(solver: Solver, pos: Position | None) -> tuple[float, ...] | None:
 REENTERED = "re-entered from the closed form"
 
 
+def assemblies(solver: Solver, v: float) -> dict[str, tuple[tuple[float, ...], list[float]]] | None:
+    """Every assembly at driver value ``v`` (display units) from the derived closed form,
+    keyed by name (:meth:`~linkage.problems.derive.Derivation.named_solutions`); None
+    where it says nothing (no derivation, or a change point)."""
+    from ..problems.derive import Indeterminate
+
+    d = solver.derivation
+    if d is None:
+        return None
+    try:
+        return d.named_solutions(v * solver.scale)
+    except Indeterminate:
+        return None
+
+
+def on_branch_guess(solver: Solver, v: float, target: str,
+                    found: dict[str, tuple[tuple[float, ...], list[float]]]) -> list[float] | None:
+    """The closed form's configuration on the followed branch at ``v``: by its signs for a
+    sign string, else the first assembly carrying the name (the plain key before its
+    mirror)."""
+    from ..problems.derive import Indeterminate
+
+    d = solver.derivation
+    assert d is not None
+    signs = parse_signs(target, solver.count)
+    if signs is not None:
+        try:
+            return d.solve(v * solver.scale, signs)
+        except Indeterminate:
+            return None
+    got = found.get(target)
+    return got[1] if got is not None else None
+
+
+CLOSED_FORM_KEPT = "the closed form: Newton's step cannot settle here (J nearly singular)"
+
+
+def closed_form_kept(solver: Solver, p: Any, v: float, q: Sequence[float],
+                     target: str | None) -> Position | None:
+    """The closed form's own position where Newton from it cannot meet the step test
+    (within a hair of a limit, J is so nearly singular that its steps bounce at the
+    rounding of Phi): kept when its residual is within the single solve's gate and it is
+    on the branch. Its error is a few ulps of the answer's own sensitivity (tests hold it
+    to 50-digit references), which is all any method can deliver there."""
+    F, _, _ = solver.compiled(v)
+    if not max_abs(F(q)) <= solver.gate:
+        return None
+    det = solver.det(p, q)
+    if not solver.on_target(q, det, v, target):
+        return None
+    return Position(v, "converged", solver.display(q), solver.branch(q, det, v), 0, det,
+                    solver.transmission(q, v), 0, CLOSED_FORM_KEPT)
+
+
 def solve_position(solver: Solver, v: float, last_q: tuple[float, ...] | None, last_v: float | None,
                     anchor_q: tuple[float, ...], target: str | None,
                     have_closed: bool) -> tuple[Position, tuple[float, ...] | None]:
@@ -173,13 +243,13 @@ def solve_position(solver: Solver, v: float, last_q: tuple[float, ...] | None, l
         q = tuple(r.x)
         det = solver.det(p, q)
         sol = solver.display(q)
-        return Position(v, "converged", sol, solver.branch(q, det), r.iterations, det,
-                        solver.transmission(sol, v), substeps, note), q
+        return Position(v, "converged", sol, solver.branch(q, det, v), r.iterations, det,
+                        solver.transmission(q, v), substeps, note), q
 
     def ok(p: Any, r: Any) -> bool:
-        return r.converged and (target is None or solver.branch(r.x, solver.det(p, r.x)) == target)
+        return r.converged and solver.on_target(r.x, solver.det(p, r.x), v, target)
 
-    ref = solver.problem(v, anchor_q).reference() if have_closed else None
+    ref = assemblies(solver, v) if have_closed else None
     if have_closed and ref == {}:
         return Position(v, "no_solution", None, None, 0, None,
                         note="the closed form has no real solution"), None
@@ -191,21 +261,23 @@ def solve_position(solver: Solver, v: float, last_q: tuple[float, ...] | None, l
     # 3. re-entry (or first position): the closed form on the target branch, else anchors
     if have_closed:
         if ref:
-            want = target if target is not None else solver.branch(anchor_q, 1.0)
             if target is None:
                 # first position: keep the branch nearest the file's guess
                 p, r = solver.solve(v, anchor_q)
                 if r.converged:
                     return accept(p, r)
-            sol = ref.get(want) if want else None
-            if sol is not None:
-                guess = tuple(math.radians(sol[n]) if k == "angle" else sol[n]
-                              for n, k in zip(solver.names, solver.kinds))
+                target = solver.branch(anchor_q, 1.0, v)
+            guess = on_branch_guess(solver, v, target, ref)
+            if guess is not None:
                 p, r = solver.solve(v, guess)
                 if ok(p, r):
                     return accept(p, r, note=REENTERED)
-            elif want:
-                # a rocker-driven four-bar: both assemblies here carry the other label
+                kept = closed_form_kept(solver, p, v, guess, target)
+                if kept is not None:
+                    return kept, tuple(guess)
+            else:
+                # no assembly here is on the branch (a rocker-driven four-bar's mirror
+                # assemblies can both carry the other name)
                 return Position(v, "off_branch", None, None, 0, None,
                                 note=f"every assembly here is {', '.join(ref)}"), None
     else:
@@ -254,7 +326,7 @@ def continue_step(solver: Solver, v: float, history: list[tuple[float, tuple[flo
                 break
             q = tuple(r.x)
             det = solver.det(p, q)
-            if target is not None and solver.branch(q, det) != target:
+            if not solver.on_target(q, det, vk, target):
                 ok = False
                 break
             dv = abs(vk - vq[0]) * solver.scale
@@ -267,8 +339,8 @@ def continue_step(solver: Solver, v: float, history: list[tuple[float, tuple[flo
             q = tuple(r.x)
             sol = solver.display(q)
             note = f"step halved to 1/{n}" if n > 1 else ""
-            return Position(v, "converged", sol, solver.branch(q, det), r.iterations, det,
-                            solver.transmission(sol, v), n if n > 1 else 0, note), q
+            return Position(v, "converged", sol, solver.branch(q, det, v), r.iterations, det,
+                            solver.transmission(q, v), n if n > 1 else 0, note), q
     return Position(v, "failed", None, None, 0, None, note="the branch could not be continued"), None
 
 
@@ -289,15 +361,15 @@ def lean_step(solver: Solver, v: float, v_last: float, q_last: tuple[float, ...]
         det = det_from_lu(lu(J(list(q))))
     except SingularMatrix:
         det = 0.0
-    branch = solver.branch(q, det)
-    if target is not None and branch != target:
+    branch = solver.branch(q, det, v)
+    if not solver.on_target(q, det, v, target, branch):
         return None
     dv = abs(v - v_last) * solver.scale
     correction, moved, size = continuity_measures(q_last, pred, q)
     if not continues(correction, moved, dv, size):
         return None
     sol = solver.display(q)
-    return Position(v, "converged", sol, branch, iterations, det, solver.transmission(sol, v)), q
+    return Position(v, "converged", sol, branch, iterations, det, solver.transmission(q, v)), q
 
 
 def step_two(solver: Solver, v: float, v_last: float, q_last: tuple[float, ...],
@@ -339,8 +411,8 @@ def step_two(solver: Solver, v: float, v_last: float, q_last: tuple[float, ...],
     solver.solved_at = (v, x0, x1, factors, w0, w1)
     q = (x0, x1)
     sol = solver.display(q)
-    branch = solver.rule(sol) if solver.rule is not None else ("det+" if det > 0 else "det-")
-    if target is not None and branch != target:
+    branch = solver.branch(q, det, v)
+    if not solver.on_target(q, det, v, target, branch):
         return None
     dv = abs(dv) * solver.scale
     e0, e1 = abs(x0), abs(x1)
@@ -351,7 +423,7 @@ def step_two(solver: Solver, v: float, v_last: float, q_last: tuple[float, ...],
     correction = e0 if e0 >= e1 else e1
     if not continues(correction, moved, dv, size):
         return None
-    return converged_position(v, sol, branch, k, det, solver.transmission(sol, v)), q
+    return converged_position(v, sol, branch, k, det, solver.transmission(q, v)), q
 
 
 def tangent(solver: Solver, v0: float, q0: Sequence[float]) -> list[float] | None:

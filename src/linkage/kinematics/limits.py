@@ -2,8 +2,9 @@
 
 Limits (where the branch or the feasible range ends) and toggles (det J changes sign
 between solved positions, or touches zero between them) are located by bisection to
-``LOCATE_TOL`` of the driver's unit, or taken from the closed form where it gives them
-exactly.
+``LOCATE_TOL`` of the driver's unit; where the loops have a derived closed form, the limits
+and the feasible ranges come from its margins instead (:func:`closed_form_limits`), to a few
+ulps of the driver.
 """
 
 from __future__ import annotations
@@ -15,8 +16,14 @@ from typing import Any
 
 from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve
 from ..methods.newton_system import max_abs
-from ..problems.closed_form import (
-    arc_limits,
+from ..problems.derive import sign_text
+from ..problems.derive_limits import (
+    Signs,
+    assembles,
+    assembles_np,
+    dip_between,
+    limit_between,
+    limits_between_np,
 )
 from .angles import closes_circle, driver_turn
 from .continuation import REENTERED, Solver, predict, solver_q
@@ -59,11 +66,97 @@ def solved_ranges_array(values: Any, converged: Any) -> tuple[tuple[float, float
     return tuple((float(values[a]), float(values[b])) for a, b in zip(starts, ends))
 
 
-def toggles(solver: Solver, positions: Sequence[Position], arcs: Any, lo: float, hi: float,
-            have_closed: bool) -> list[float]:
-    found: list[float] = []
-    if have_closed:
-        found += arc_limits(arcs, lo, hi)
+def followed_branches(solver: Solver, positions: Sequence[Position], target: str | None) -> list[Signs]:
+    """The sign tuples of the assemblies a sweep solved (one for a branch followed by its
+    signs, or by a name that is one sign branch; both mirror assemblies of a rocker-driven
+    four-bar followed by name); with none solved, the target's signs or every branch."""
+    import numpy as np
+
+    d = solver.derivation
+    assert d is not None
+    solved = [p for p in positions if p.solution is not None]
+    out: list[Signs] = []
+    if solved:
+        # every position at once, by the numpy twin of signs_of
+        q = [np.radians([p.solution[n] for p in solved]) if k == "angle" else  # type: ignore[index]
+             np.array([p.solution[n] for p in solved]) for n, k in zip(solver.names, solver.kinds)]  # type: ignore[index]
+        signs = np.stack(d.signs_of_np(q, np.array([p.input for p in solved]) * solver.scale), axis=-1)
+        for row in np.unique(signs[(signs != 0.0).all(axis=-1)], axis=0)[::-1]:  # "+" first
+            out.append(tuple(float(s) for s in row))
+    if out:
+        return out
+    if target is not None:
+        wanted = [b for b in d.branches if sign_text(b) == target]
+        if wanted:
+            return wanted
+    return list(d.branches)
+
+
+FEW_BRACKETS = 8
+"""Up to this many limits between grid points are bisected by the scalar function, more by
+its numpy twin (the same halvings, every bracket at once)."""
+
+
+LIMIT_CANDIDATE = 0.1
+"""A local minimum of the margin over the grid is searched for an unassembled sliver between
+grid points only where it is below this (a tenth of the loop's size)."""
+
+
+def closed_form_limits(solver: Solver, positions: Sequence[Position], lo: float, hi: float,
+                       target: str | None) -> tuple[list[float], tuple[tuple[float, float], ...]]:
+    """The limit positions in [lo, hi] and the feasible ranges of the followed branches,
+    from the derived closed form's margins (:mod:`linkage.problems.derive_limits`): each
+    sign change of :func:`~linkage.problems.derive_limits.assembles` between neighbouring
+    driver values (across the grid's end where it closes the circle) is bisected to
+    adjacent doubles, and a dip below zero between two that assemble is found by its
+    minimum."""
+    import numpy as np
+
+    d = solver.derivation
+    assert d is not None
+    branches = followed_branches(solver, positions, target)
+    grid = sorted({p.input for p in positions})
+    if not grid:
+        return [], ()
+    scale = solver.scale
+    turn = driver_turn(solver.m.driver.unit) if solver.m.driver.kind == "angle" else 0.0
+    ring = list(grid)
+    if turn and len(grid) > 2 and closes_circle(grid, turn):
+        ring.append(grid[0] + turn)
+    x = np.array(ring)
+    g = assembles_np(d, x, branches, scale)
+    ok = g >= 0.0
+    change = np.flatnonzero(ok[:-1] != ok[1:])
+    if len(change) > FEW_BRACKETS:  # all at once; a few are quicker one by one (no array overhead)
+        found = [float(t) for t in limits_between_np(d, x[change], x[change + 1], branches, scale)]
+    else:
+        found = [limit_between(d, float(x[i]), float(x[i + 1]), branches, scale) for i in change]
+    for i in range(1, len(ring) - 1):
+        if ok[i - 1] and ok[i + 1] and g[i] <= g[i - 1] and g[i] <= g[i + 1] and g[i] < LIMIT_CANDIDATE:
+            for a, c in ((ring[i - 1], ring[i]), (ring[i], ring[i + 1])):
+                dip = dip_between(d, a, c, branches, scale)
+                if dip is not None:
+                    found += dip
+    limits = sorted({t - turn if t > hi else t for t in found})
+    limits = [t for t in limits if lo <= t <= hi]
+    cuts = [lo, *(t for t in limits if lo < t < hi), hi]
+    ranges: list[tuple[float, float]] = []
+    for a, b in itertools.pairwise(cuts):
+        if b > a and assembles(d, 0.5 * (a + b), branches, scale) >= 0.0:
+            if ranges and ranges[-1][1] == a:
+                ranges[-1] = (ranges[-1][0], b)
+            else:
+                ranges.append((a, b))
+    if lo == hi and assembles(d, lo, branches, scale) >= 0.0:
+        ranges.append((lo, hi))
+    return limits, tuple(ranges)
+
+
+def toggles(solver: Solver, positions: Sequence[Position], limits: Sequence[float] | None, lo: float,
+            hi: float, have_closed: bool) -> list[float]:
+    """The limit positions (``limits``, from the closed form where there is one) and the
+    toggles of a swept branch, sorted, each once."""
+    found: list[float] = list(limits or ())
     n = len(positions)
     ring = _around(solver, positions)
     # pairs and triples across the grid's end too, where the grid closes the circle: a
@@ -89,6 +182,8 @@ def toggles(solver: Solver, positions: Sequence[Position], arcs: Any, lo: float,
         if bd == 0.0:
             touch: float | None = ring[i].input  # J singular at the grid point itself
         elif abs(bd) <= abs(ad) and abs(bd) <= abs(cd) and (ad > 0) == (bd > 0) == (cd > 0):
+            if _near_a_limit(solver, limits, ring[i - 1].input, ring[i + 1].input):
+                continue  # |det J| falls towards the branch's end, located exactly already
             touch = _touch_det(solver, ring[i - 1], ring[i], ring[i + 1])
         else:
             continue
@@ -101,6 +196,12 @@ def toggles(solver: Solver, positions: Sequence[Position], arcs: Any, lo: float,
         if not any(abs(t - u) <= 2 * LOCATE_TOL for u in out):
             out.append(t)
     return out
+
+
+def _near_a_limit(solver: Solver, limits: Sequence[float] | None, a: float, c: float) -> bool:
+    """Whether a closed-form limit lies in [a, c] (or a turn on: the ring's last pairs)."""
+    turn = driver_turn(solver.m.driver.unit) if solver.m.driver.kind == "angle" else 0.0
+    return any(a <= t <= c or (turn and a <= t + turn <= c) for t in limits or ())
 
 
 def _around(solver: Solver, positions: Sequence[Position]) -> list[Position]:
@@ -256,7 +357,7 @@ def _reaches(solver: Solver, v: float, v_good: float, q_good: tuple[float, ...],
     if not r.converged:
         return None
     q = tuple(r.x)
-    if branch is not None and solver.branch(q, solver.det(p, q)) != branch:
+    if not solver.on_target(q, solver.det(p, q), v, branch):
         return None
     dist = max(abs(x - y) for x, y in zip(q, q_good))
     allow = 2.0 * math.sqrt(abs(v - v_good) * solver.scale) * (1.0 + max(abs(c) for c in q_good))

@@ -8,15 +8,11 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from ..problems.closed_form import (
-    arcs_within,
-    feasible_arcs,
-    fourbar_class,
-)
+from ..problems.closed_form import fourbar_class
 from ..problems.loops import Mechanism
 from .angles import anchor_index, closes_circle, continuous, driver_turn, turn_shift, unwrap_turns
 from .continuation import Solver, classify_gap, follow, q_of, solve_position
-from .limits import solved_ranges, toggles
+from .limits import closed_form_limits, solved_ranges, toggles
 from .positions import Position, SweepResult, check_driver_values
 
 
@@ -34,12 +30,11 @@ def sweep(
     values = check_driver_values(m, values)
     solver = Solver(m, method, tol, max_iter)
     lo, hi = (min(values), max(values)) if values else (0.0, 0.0)
-    arcs = feasible_arcs(m) if m.closed_form and m.driver.kind == "angle" else None
-    have_closed = m.closed_form is not None and m.driver.kind == "angle"
+    have_closed = solver.derivation is not None
     guess0 = tuple(u.value for u in m.unknowns)
     full_turn = m.driver.kind == "angle" and bool(values) and values[-1] - values[0] >= 360.0 - 1e-9
     done: dict[int, Position] = {}
-    target = branch
+    target = follow_target(solver, values, branch)
     anchor_q = guess0
     # The seed: where the branch to follow is known. With a closed form, the first
     # position that can be assembled, on the requested branch (or the guess's);
@@ -49,7 +44,7 @@ def sweep(
         for i, v in enumerate(values):
             pos, q = solve_position(solver, v, None, None, guess0, target, True)
             if pos.status == "converged" and q is not None:
-                seed, target = (v, q), pos.branch
+                seed, target = (v, q), target if target is not None else pos.branch
                 done[i] = pos
                 break
             done[i] = pos
@@ -59,7 +54,7 @@ def sweep(
         if r0.converged:
             q0 = tuple(r0.x)
             seed = (v0, q0)
-            target = solver.branch(q0, solver.det(p0, q0))
+            target = solver.branch(q0, solver.det(p0, q0), v0)
     if seed is not None:
         anchor_q = seed[1]
         for i, pos in follow(solver, values, seed, target, full_turn, progress, done).items():
@@ -86,20 +81,98 @@ def sweep(
             progress(len(done))
     positions = [done[j] for j in range(len(values))]
     positions = _continuous_angles(solver, positions)
-    found = toggles(solver, positions, arcs, lo, hi, have_closed)
-    ranges = (tuple(arcs_within(arcs, lo, hi)) if have_closed else solved_ranges(positions))
+    limits, ranges = closed_form_limits(solver, positions, lo, hi, target) if have_closed else \
+        ([], solved_ranges(positions))
+    found = toggles(solver, positions, limits, lo, hi, have_closed)
     return SweepResult(m.name, m.driver.name, m.driver.unit, solver.names,
                        tuple("deg" if k == "angle" else m.length_unit for k in solver.kinds),
-                       tuple(positions), ranges, tuple(found), target, classification_of(m), method,
-                       length_unit=m.length_unit)
+                       tuple(positions), ranges, tuple(found), target,
+                       classification_of(m), method, length_unit=m.length_unit)
+
+
+def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -> str | None:
+    """What the sweep follows for a ``branch`` text: a name as it is (followed by the
+    configurations' names); a sign string as the name of that sign branch where each name
+    is one (:func:`names_follow_signs`), else as it is (followed by the configurations'
+    signs); and a name only one assembly can carry at a driver value (``open (mirror)``)
+    as the signs of that assembly at the first value where the linkage assembles."""
+    from ..errors import InputError
+    from ..problems.derive import MIRROR, Indeterminate, parse_signs, sign_text
+
+    d = solver.derivation
+    if branch is None or d is None:
+        return branch
+    if parse_signs(branch, solver.count) is not None and names_follow_signs(solver.m):
+        # each name is one sign branch: follow (and report) it by its name
+        for v in values:
+            try:
+                named = d.named_solutions(v * solver.scale)
+            except Indeterminate:
+                continue
+            for name, (signs, _) in named.items():
+                if sign_text(signs) == branch:
+                    return name
+        return branch
+    if not branch.endswith(MIRROR):
+        return branch
+    for v in values:
+        try:
+            named = d.named_solutions(v * solver.scale)
+        except Indeterminate:
+            continue
+        if named:
+            try:
+                return sign_text(d.branch_signs(branch, v * solver.scale))
+            except ValueError as exc:
+                raise InputError(f"branch: {exc} at {solver.m.driver.name} = {v:g}") from None
+    return branch
+
+
+def names_follow_signs(m: Mechanism) -> bool:
+    """Whether each branch name of ``m``'s derivation is one sign branch: every step's word
+    is its own sign's (a slider-crank loop, a step with no word, a four-bar loop solved for
+    its coupler and output). A four-bar loop driven by its rocker or coupler is solved for
+    two other links, and its open and crossed then cut across the signs."""
+    from ..problems.derive import loop_terms
+
+    d = m.derivation
+    views = {v.loop: v for v in d.fourbars}
+    terms = loop_terms(m)
+    for i in d.two_way:
+        step = d.steps[i]
+        if step.word_rule != "fourbar":
+            continue
+        view = views[step.loops[0]]
+        t = terms[view.loop]
+        if {t[view.coupler][2], t[view.output][2]} != set(step.unknowns):
+            return False
+    return True
 
 
 def classification_of(m: Mechanism) -> dict[str, Any]:
-    """A sweep's four-bar class (Grashof), or {} (every sweep engine reads it here)."""
-    if m.closed_form == "fourbar":
-        v = {k: q.value for k, q in m.parameters.items()}
-        return fourbar_class(v["r1"], v["r2"], v["r3"], v["r4"])
-    return {}
+    """The Grashof class (Norton 2.8) of each loop that is a four-bar, read as written with
+    the ground last: input, coupler, output (:func:`~linkage.problems.closed_form.fourbar_class`).
+    One such loop: its class; several: the first's, with every loop's under ``loops``."""
+    from ..problems.derive import loop_terms
+
+    views = m.derivation.fourbars
+    if not views:
+        return {}
+    terms = loop_terms(m)
+    values = {k: q.value for k, q in m.parameters.items()}
+
+    def length(term: Any) -> float:
+        ref = term[1]
+        return abs(values[ref] if isinstance(ref, str) else float(ref))
+
+    out = []
+    for view in views:
+        t = terms[view.loop]
+        c = fourbar_class(*(length(t[i]) for i in (view.ground, view.input, view.coupler, view.output)))
+        out.append({"loop": m.loops[view.loop].name, **c})
+    if len(out) == 1:
+        return {k: v for k, v in out[0].items() if k != "loop"}
+    return {**{k: v for k, v in out[0].items() if k != "loop"}, "loops": out}
 
 
 def _continuous_angles(solver: Solver, positions: list[Position]) -> list[Position]:

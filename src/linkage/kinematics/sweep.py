@@ -39,13 +39,15 @@ def sweep_mechanism(
     position from the previous one; the public ``linkage.sweep``.
 
     ``mechanism``: a :class:`~linkage.problems.loops.Mechanism` or a path to a file.
-    ``values``: a list or a numpy array. ``branch``: "open" or "crossed" for a mechanism
-    with a closed form, else the branch of the file's guess. More than ``BATCH_ABOVE``
-    values with Newton go through the numpy batch engine; fewer, of a mechanism whose
-    loops solve stepwise in closed form, on one branch with no limit position inside,
-    through the closed-form engine (:mod:`.closed`). Both results keep columns and build
-    a position only when one is read. ``batch`` forces the choice: True the batch
-    engine, False the one-at-a-time engine.
+    ``values``: a list or a numpy array. ``branch``: for a mechanism whose loops have a
+    derived closed form, a branch name (``open``, ``crossed``; ``open/crossed`` for two
+    four-bar loops; ``open (mirror)``) or its signs (``+-``: one per two-way step); else
+    the branch of the file's guess. More than ``BATCH_ABOVE`` values with Newton go
+    through the numpy batch engine; fewer, of a mechanism whose loops solve stepwise in
+    closed form, on one branch with no limit position inside, through the closed-form
+    engine (:mod:`.closed`). Both results keep columns and build a position only when one
+    is read. ``batch`` forces the choice: True the batch engine, False the one-at-a-time
+    engine.
 
     Each position has ``.input``, ``.status`` ("converged", "no_solution", "off_branch",
     "failed"), ``.solution`` (unknown name -> value, display units), ``.branch``,
@@ -78,11 +80,7 @@ def sweep_mechanism(
     if method not in ("newton", "newton-fd", "lm"):
         raise InputError(f"unknown method {method!r}; choose from newton, newton-fd, lm")
     if branch is not None:
-        if branch not in ("open", "crossed"):
-            raise InputError(f"--branch must be open or crossed, got {branch!r}")
-        if m.closed_form is None:
-            raise InputError(f"--branch needs a mechanism with a closed form; {m.source} has none "
-                             "(its branch follows the file's guess)")
+        check_branch(m, branch)
     n = len(values)
     use_batch = batch if batch is not None else (n > BATCH_ABOVE and method == "newton")
     if use_batch:
@@ -112,6 +110,39 @@ def sweep_mechanism(
     from .rates import with_rates  # here: a sweep without rates does not load them
 
     return with_rates(m, result, speed, accel)
+
+
+def branch_choices(m: Mechanism) -> list[str]:
+    """Every name a branch of ``m``'s derived closed form can carry: each two-way step's
+    words (open/crossed for a four-bar or slider-crank loop, + or - otherwise) joined by
+    "/", each also as its ``(mirror)``; and the sign strings."""
+    import itertools
+
+    from ..problems.derive import MIRROR, sign_text
+
+    d = m.derivation
+    words = [("open", "crossed") if d.steps[i].word_rule else ("+", "-") for i in d.two_way]
+    names = ["/".join(w) for w in itertools.product(*words)]
+    signs = [sign_text(b) for b in d.branches]
+    return [*names, *(n + MIRROR for n in names), *(s for s in signs if s not in names)]
+
+
+def check_branch(m: Mechanism, branch: str) -> None:
+    """InputError naming ``branch`` unless it is a name or sign string of ``m``'s derived
+    closed form (:func:`branch_choices`)."""
+    from ..errors import InputError
+
+    d = m.derivation
+    if not (d.complete and d.two_way):
+        why = d.summary if not d.complete else "closed form with no choice of assembly"
+        raise InputError(f"--branch needs a closed form; {m.source} has none: {why} "
+                         "(its branch follows the file's guess)")
+    choices = branch_choices(m)
+    if branch not in choices:
+        names = choices[:len(m.derivation.branches)]
+        main = ", ".join(names[:-1]) + " or " + names[-1] if len(names) > 1 else names[0]
+        raise InputError(f"--branch must be {main} (or {', '.join(choices[len(names):])}), "
+                         f"got {branch!r}")
 
 
 def __getattr__(name: str) -> Any:

@@ -240,7 +240,9 @@ def branch_rule(m: Any) -> Callable[[dict[str, float]], str]:
     return slider
 
 
-# --- assembly: classification and feasible driver ranges ---------------------------------
+# --- assembly: classification ------------------------------------------------------------
+# (the feasible driver ranges and limit positions of every mechanism with a derived closed
+# form come from its steps' margins: :mod:`linkage.problems.derive_limits`)
 
 GRASHOF_KINDS = ("double crank", "crank-rocker", "double rocker", "rocker-crank")
 """The Grashof kind by the shortest link: ground, input, coupler, output."""
@@ -338,61 +340,3 @@ def cos_band_arcs(c_lo: float, c_hi: float, shift: float) -> list[Arc] | None:
     if c_lo <= -1.0:
         return [(shift + a_hi, shift + 360.0 - a_hi)]
     return [(shift - a_lo, shift - a_hi), (shift + a_hi, shift + a_lo)]
-
-
-def feasible_arcs(m: Any) -> list[Arc] | None:
-    """Driver values (deg) where the mechanism can be assembled, from its closed form.
-
-    Four-bar driven by theta2: |A - O4|^2 = r1^2 + r2^2 - 2 r1 r2 cos(theta2 - theta1)
-    must lie in [(r3 - r4)^2, (r3 + r4)^2]; driven by theta4, the same with r2 and r4
-    exchanged and the sign of the cosine flipped. Slider-crank:
-    |e - r2 sin(theta2)| <= r3. None: the whole circle.
-    """
-    v = {k: q.value for k, q in m.parameters.items()}
-    drv = m.driver.name
-    if m.closed_form == "fourbar":
-        r1, r2, r3, r4, t1 = v["r1"], v["r2"], v["r3"], v["r4"], math.degrees(v["theta1"])
-        if drv == "theta2":
-            lo, hi = (r3 - r4) ** 2, (r3 + r4) ** 2
-            # cos(phi) = (r1^2 + r2^2 - d^2) / (2 r1 r2): decreasing in d
-            return cos_band_arcs((r1 * r1 + r2 * r2 - hi) / (2 * r1 * r2),
-                                 (r1 * r1 + r2 * r2 - lo) / (2 * r1 * r2), t1)
-        if drv == "theta4":
-            lo, hi = (r2 - r3) ** 2, (r2 + r3) ** 2
-            return cos_band_arcs((lo - r1 * r1 - r4 * r4) / (2 * r1 * r4),
-                                 (hi - r1 * r1 - r4 * r4) / (2 * r1 * r4), t1)
-        return None
-    if m.closed_form == "slider_crank" and drv == "theta2":
-        r2, r3, e = v["r2"], v["r3"], v["e"]
-        # sin(theta2) = cos(theta2 - 90) in [(e - r3)/r2, (e + r3)/r2]
-        return cos_band_arcs((e - r3) / r2, (e + r3) / r2, 90.0)
-    return None
-
-
-def arcs_within(arcs: list[Arc] | None, lo: float, hi: float) -> list[Arc]:
-    """Intersect circle arcs (deg) with the interval [lo, hi], unwrapping by 360s."""
-    if arcs is None:
-        return [(lo, hi)]
-    out: list[Arc] = []
-    for a, b in arcs:
-        k = math.floor((lo - b) / 360.0)
-        while a + 360.0 * k <= hi:
-            s, t = max(a + 360.0 * k, lo), min(b + 360.0 * k, hi)
-            if s <= t:
-                out.append((s, t))
-            k += 1
-    return sorted(out)
-
-
-def arc_limits(arcs: list[Arc] | None, lo: float, hi: float) -> list[float]:
-    """Ends of the feasible arcs (limit positions) that fall inside [lo, hi]."""
-    if not arcs:
-        return []
-    out = []
-    for a, b in arcs:
-        for end in (a, b):
-            k = math.ceil((lo - end) / 360.0)
-            while end + 360.0 * k <= hi:
-                out.append(end + 360.0 * k)
-                k += 1
-    return sorted(set(out))

@@ -169,6 +169,7 @@ class Derivation:
     coupled: tuple[tuple[int, int], ...] = ()  # (loop, unknowns left) that no step solved
     fourbars: tuple[FourbarLoop, ...] = ()
     params: Mapping[str, float] | None = None  # the mechanism's parameter values (internal units)
+    loops: tuple[tuple[Term, ...], ...] = ()  # every loop's terms (loop_terms)
 
     @property
     def complete(self) -> bool:
@@ -331,21 +332,47 @@ class Derivation:
         """:meth:`margins` over arrays."""
         return self.solve_margins_np(driver, signs, params)[2]
 
+    def transmission(self, q: Sequence[float], driver: float,
+                     params: Mapping[str, float] | None = None) -> float | None:
+        """The transmission angle of a configuration (rad, in [0, pi]): of its four-bar loop,
+        or with several the one farthest from pi/2 (the loop that transmits worst); None
+        with no four-bar loop."""
+        p = self._params(params)
+        worst = None
+        for view in self.fourbars:
+            mu = fourbar_transmission(view, self.loops[view.loop], p, driver, q)
+            if worst is None or abs(mu - 0.5 * math.pi) > abs(worst - 0.5 * math.pi):
+                worst = mu
+        return worst
+
+    def transmission_np(self, q: Sequence[Any], driver: Any,
+                        params: Mapping[str, Any] | None = None) -> Any:
+        """:meth:`transmission` over arrays (None with no four-bar loop)."""
+        import numpy as np
+
+        p = self._params(params)
+        worst = None
+        for view in self.fourbars:
+            mu = fourbar_transmission(view, self.loops[view.loop], p, driver, q, np)
+            worst = mu if worst is None else np.where(
+                np.abs(mu - 0.5 * math.pi) > np.abs(worst - 0.5 * math.pi), mu, worst)
+        return worst
+
     # --- names -----------------------------------------------------------------------------
     def words_of(self, q: Sequence[float], driver: float,
                  params: Mapping[str, float] | None = None) -> list[str]:
         """Each two-way step's name for a configuration: open/crossed for a four-bar or
         slider-crank loop, its sign (+ or -) otherwise."""
         p = self._params(params)
-        signs = iter(self.signs_of(q, driver, p))
         out = []
         for step in self.steps:
             if not step.two_way:
                 continue
-            sigma = next(signs)
             if step.word_rule:
                 out.append("open" if _is_open(step, p, driver, q) else "crossed")
-            else:
+            else:  # the sign, computed only here: a sweep names every position
+                first, second, k = _coefficients(step, p, driver, q, math)
+                sigma = _side(step.case, first, second, k, q[step.unknowns[0]], q[step.unknowns[1]])
                 out.append("+" if sigma >= 0.0 else "-")
         return out
 
@@ -637,4 +664,4 @@ def derive(m: Any) -> Derivation:
                     for i in pool) if len(known) < n else ()
     return Derivation(tuple(steps), n, tuple(u.name for u in m.unknowns),
                       tuple(loop.name for loop in m.loops), coupled, views,
-                      {k: q.value for k, q in m.parameters.items()})
+                      {k: q.value for k, q in m.parameters.items()}, tuple(map(tuple, loops)))

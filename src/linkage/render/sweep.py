@@ -112,9 +112,10 @@ def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400) -> list[Block
     blocks: list[Block] = [Text(f"{s.mechanism}: sweep of {s.driver} over {len(s.positions)} positions "
                                 f"({s.method}, continuation)", "bold")]
     if s.classification:
-        c = s.classification
-        blocks.append(Text(f"four-bar: {c['type']} (s + l = {fmt(c['s_plus_l'], 6)}, "
-                           f"p + q = {fmt(c['p_plus_q'], 6)})"))
+        for c in s.classification.get("loops", [s.classification]):
+            where = f" loop {c['loop']}" if "loop" in c else ""
+            blocks.append(Text(f"four-bar{where}: {c['type']} (s + l = {fmt(c['s_plus_l'], 6)}, "
+                               f"p + q = {fmt(c['p_plus_q'], 6)})"))
     rows = sweep_rows(s, kinematics=False)
     headers = sweep_headers(s, kinematics=False)
     if s.motion is not None:  # the unknowns' rates beside their values (joints: csv, json)
