@@ -63,11 +63,15 @@ def _cmul_conj(ax: float, ay: float, bx: float, by: float) -> Pair:
 
 def two_angles(p: Pair, q: Pair, k: Pair, sigma: float) -> tuple[float, float] | None:
     """(a, b) with P e^(ia) + Q e^(ib) + K = 0 on side ``sigma``; None when the circles
-    miss. Raises ZeroDivisionError when K = 0 (the circles are concentric)."""
+    miss (concentric ones included). Raises ZeroDivisionError when they coincide (K = 0
+    and |P| = |Q|)."""
     d = norm(k[0], k[1])
-    if d == 0.0:
-        raise ZeroDivisionError("the known vectors sum to zero")
     rp, rq = norm(*p), norm(*q)
+    if d == 0.0:
+        # concentric circles: every angle when they coincide, none when they do not
+        if rp == rq:
+            raise ZeroDivisionError("the known vectors sum to zero")
+        return None
     got = triangle(d, rp, rq)
     if got is None:
         return None
