@@ -284,7 +284,7 @@ vectors = [{ length = "s", angle = 0 }, { length = "t", angle = 90 },
     assert doc["reference"]["only"]["t"] == pytest.approx(25.0, abs=1e-12)
     assert "true error (mm) vs only" in doc["iterations"][0]
     run = cli("solve", str(path), "--branch", "+")
-    assert run.code == 2 and "no branch to choose" in run.err
+    assert run.code == 2 and "nothing to choose" in run.err
 
 
 # --- 2. the header ----------------------------------------------------------------------------
@@ -366,14 +366,23 @@ def test_mirror_key_still_selects_the_rocker_driven_second_assembly(cli):
 
 # --- 4. the old closed_form key ------------------------------------------------------------------
 
-def test_old_key_is_noted_once_per_command(cli):
-    for args in (["solve", str(SAMPLES / "crank_rocker.toml")],
-                 ["sweep", str(SAMPLES / "crank_rocker.toml"), "--from", "0", "--to", "20", "--step", "10"]):
+def _with_old_key(tmp_path, name: str, key: str) -> Path:
+    """A sample with the old closed_form key put back (the samples no longer carry it)."""
+    text = (SAMPLES / name).read_text()
+    path = tmp_path / name
+    path.write_text(text.replace('length_unit = ', f'closed_form = "{key}"\nlength_unit = ', 1))
+    return path
+
+
+def test_old_key_is_noted_once_per_command(cli, tmp_path):
+    old = _with_old_key(tmp_path, "crank_rocker.toml", "fourbar")
+    for args in (["solve", str(old)], ["sweep", str(old), "--from", "0", "--to", "20", "--step", "10"]):
         run = cli(*args, "--format", "json")
         assert run.code == 0
-        assert run.err == (f"note: {SAMPLES / 'crank_rocker.toml'}: closed_form is no longer needed: "
+        assert run.err == (f"note: {old}: closed_form is no longer needed: "
                            "the closed form is derived from the loops\n"), args
-    assert cli("solve", str(SAMPLES / "watt_sixbar.toml"), "--format", "json").err == ""
+    for name in ("crank_rocker.toml", "watt_sixbar.toml"):
+        assert cli("solve", str(SAMPLES / name), "--format", "json").err == ""
 
 
 def test_a_refused_command_says_only_its_error(cli):
@@ -382,11 +391,12 @@ def test_a_refused_command_says_only_its_error(cli):
 
 
 def test_library_exposes_the_note_and_prints_nothing(capsys, tmp_path):
-    m = load(SAMPLES / "slider_crank.toml")
+    old = _with_old_key(tmp_path, "slider_crank.toml", "slider_crank")
+    m = load(old)
     assert m.closed_form == "slider_crank"
-    assert m.closed_form_note == (f"{SAMPLES / 'slider_crank.toml'}: closed_form is no longer needed: "
+    assert m.closed_form_note == (f"{old}: closed_form is no longer needed: "
                                   "the closed form is derived from the loops")
-    assert load(SAMPLES / "watt_sixbar.toml").closed_form_note is None
+    assert load(SAMPLES / "slider_crank.toml").closed_form_note is None
     assert capsys.readouterr().err == ""
 
 

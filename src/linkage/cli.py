@@ -464,12 +464,9 @@ def _start_on_branch(mechanism: Any, branch: str, guessed: bool) -> Any:
     if guessed:
         raise InputError("give --branch or --guess, not both")
     derivation = mechanism.derivation
-    if not derivation.complete:
-        raise InputError(f"--branch needs a closed form; {mechanism.source} has none: {derivation.summary}")
-    count = len(derivation.two_way)
-    if not count:
-        raise InputError(f"--branch: {mechanism.source} has one assembly (no step of its closed form "
-                         "has a choice): there is no branch to choose")
+    refusal = derivation.branch_refusal(mechanism.source)
+    if refusal:
+        raise InputError(refusal)
     driver = mechanism.driver.value
     at = f"{mechanism.driver.name} = {mechanism.problem().meta['driver_value']:g} {mechanism.driver.unit}"
     try:

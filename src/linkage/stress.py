@@ -440,7 +440,6 @@ def fourbar_mechanism(it: dict[str, Any]) -> Any:
     doc = {
         "name": "random four-bar",
         "length_unit": "m",
-        "closed_form": "fourbar",
         "parameters": {
             "r1": {"value": r1, **unit},
             "r2": {"value": r2, **unit},

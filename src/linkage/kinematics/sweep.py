@@ -132,11 +132,9 @@ def check_branch(m: Mechanism, branch: str) -> None:
     closed form (:func:`branch_choices`)."""
     from ..errors import InputError
 
-    d = m.derivation
-    if not (d.complete and d.two_way):
-        why = d.summary if not d.complete else "closed form with no choice of assembly"
-        raise InputError(f"--branch needs a closed form; {m.source} has none: {why} "
-                         "(its branch follows the file's guess)")
+    refusal = m.derivation.branch_refusal(m.source)
+    if refusal:
+        raise InputError(f"{refusal} (its branch follows the file's guess)")
     choices = branch_choices(m)
     if branch not in choices:
         names = choices[:len(m.derivation.branches)]

@@ -200,11 +200,27 @@ class Derivation:
                 head += " (stepwise)"
         if self.complete:
             return f"closed form: {head}"
+        if head:
+            return f"closed form: {head}; no closed form for the rest: {self.coupled_text}"
+        return f"no closed form: {self.coupled_text}"
+
+    @property
+    def coupled_text(self) -> str:
+        """What no step solves, and why: "loop 1 has 3 unknowns, loop 2 has 3 unknowns
+        (coupled)"; "" when every unknown has a closed form."""
+        if self.complete:
+            return ""
         left = ", ".join(f"loop {i + 1} has {k} unknown{'s' if k != 1 else ''}"
                          for i, k in self.coupled)
-        if head:
-            return f"closed form: {head}; no closed form for the rest: {left} (coupled)"
-        return f"no closed form: {left} (coupled)"
+        return f"{left} (coupled)"
+
+    def branch_refusal(self, source: str) -> str | None:
+        """Why ``--branch`` cannot choose an assembly of this mechanism (None: it can)."""
+        if not self.complete:
+            return f"--branch needs a closed form; {source} has none: {self.coupled_text}"
+        if not self.two_way:
+            return f"--branch has nothing to choose: {source} has one assembly (its closed form is linear)"
+        return None
 
     def _params(self, params: Mapping[str, Any] | None) -> Mapping[str, Any]:
         return self.params if params is None else params  # type: ignore[return-value]
