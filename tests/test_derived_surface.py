@@ -335,7 +335,7 @@ def test_branch_without_a_closed_form_says_why(cli):
     path = SAMPLES / "offset_slider.toml"
     run = cli("solve", str(path), "--branch", "open")
     assert run.code == 2 and run.out == ""
-    assert run.err == (f"error: --branch needs a closed form; {path} has none: no closed form: "
+    assert run.err == (f"error: --branch needs a closed form; {path} has none: "
                        "loop 1 has 3 unknowns, loop 2 has 3 unknowns (coupled)\n")
 
 
