@@ -25,8 +25,6 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ..problems.assembly import is_open_np, rocker_angle_np, slider_is_open_np
-from ..problems.closed_form import transmission
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel, Mechanism
 from ..rules import residual_gate, step_scales, step_size_array, system_converged_array
 from .angles import nearest_turn, nearest_turn_array
@@ -79,6 +77,7 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
     def __init__(self, batch: BatchResult) -> None:
         self.batch = batch
         self._chunk: tuple[int, Sequence[Position]] = (-1, ())  # the last chunk with rates
+        self._solver: Solver | None = None  # for the transmission angle, made when first read
 
     def __len__(self) -> int:
         return len(self.batch.values)
@@ -113,8 +112,17 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         sol = ({n: float(b.solution[i, j]) for j, n in enumerate(b.coarse.names)}
                if st == "converged" else None)
         return Position(float(b.values[i]), st, sol, b.branch if sol else None, int(b.iterations[i]),
-                        float(b.det[i]) if sol else None,
-                        _transmission_of(b.coarse, sol, float(b.values[i])))
+                        float(b.det[i]) if sol else None, self._transmission(sol, float(b.values[i])))
+
+    def _transmission(self, sol: dict[str, float] | None, value: float) -> float | None:
+        """The transmission angle of a solved position, by the one-at-a-time sweep's own
+        definition (:meth:`Solver.transmission`: the driver's value where it is one of
+        the angles)."""
+        if sol is None or self.batch.source is None:
+            return None
+        if self._solver is None:
+            self._solver = Solver(self.batch.source, "newton", 1e-12, 50)
+        return self._solver.transmission(sol, value)
 
     def summary(self) -> dict[str, int]:
         codes, counts = np.unique(self.batch.status, return_counts=True)
@@ -126,17 +134,6 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         out = self.batch.solution[:, j].copy()
         out[self.batch.status != STATUS_CODES["converged"]] = np.nan
         return out
-
-
-def _transmission_of(c: SweepResult, sol: dict[str, float] | None, value: float) -> float | None:
-    """As :meth:`Solver.transmission`: theta4 from the driver's value where it drives."""
-    if not c.classification or sol is None:
-        return None
-    if c.driver in ("theta3", "theta4") and c.driver_unit in ANGLE_UNITS:
-        sol = {**sol, c.driver: value * (ANGLE_UNITS[c.driver_unit] / ANGLE_UNITS["deg"])}
-    if "theta3" not in sol or "theta4" not in sol:
-        return None
-    return transmission(sol["theta3"], sol["theta4"])
 
 
 class VectorLoops:
@@ -335,7 +332,7 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
     right = np.full(n_pos, -1)
     right[todo] = np.clip(np.searchsorted(grid_arr, vals[todo], side="right"), 1, len(grid_arr) - 1)
     left = right - 1
-    have_closed = m.closed_form is not None and m.driver.kind == "angle"
+    have_closed = _have_closed(m, solver, lo)
     target = rough.branch
     for i in todo:
         v = float(vals[i])
@@ -517,7 +514,7 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     for j in range(1, n):
         np.maximum(moved, np.abs(cols[j] - refs[j]), out=moved)
     status[done & (moved > take(coarse.allowed, left))] = code["failed"]
-    status[done & ~_on_branch_columns(m, cols, names, det_out, branch)] = code["failed"]
+    status[done & ~_on_branch_columns(m, cols, names, det_out, branch, vals * drv_scale)] = code["failed"]
     # angles reported continuously with the guess (the one-at-a-time sweep's convention):
     # a solution within half a turn of its guess is already the representative nearest it
     for j, k in enumerate(kinds):
@@ -538,24 +535,39 @@ def _largest(parts: Sequence[np.ndarray]) -> np.ndarray:
     return out
 
 
+def _have_closed(m: Mechanism, solver: Solver, value: float) -> bool:
+    """Whether the one-at-a-time sweep re-enters gaps from the closed form and classifies
+    them by it, so the fallback here does too: an angle-driven mechanism whose loops have
+    a closed form (``m.derivation.complete``) that its problem carries as the reference."""
+    return (m.driver.kind == "angle" and m.derivation.complete
+            and solver.problem(value).reference is not None)
+
+
 def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence[str], det: np.ndarray,
-                       target: str | None) -> np.ndarray:
-    """True where a solution (one array per unknown, display units) lies on the target
-    branch: the closed form's configuration rule over arrays (the numpy twins of
-    closed_form.branch_rule, from problems/assembly.py), else the sign of det J."""
+                       target: str | None, drivers: np.ndarray) -> np.ndarray:
+    """True where a solution (one array per unknown, display units, at ``drivers`` in
+    internal units) lies on the target branch: a branch of the derivation (its signs, or
+    its name: each two-way step's word by the derivation's own rule, as
+    :func:`~linkage.kinematics.designs.design_signs` reads them), else the sign of det J
+    (``det+``, ``det-``)."""
     if target is None:
         return np.ones(len(det), dtype=bool)
-    idx = {n: j for j, n in enumerate(names)}
-    v = {k: q.value for k, q in m.parameters.items()}
-    if m.closed_form == "fourbar" and "theta3" in idx and "theta4" in idx:
-        is_open = is_open_np(np.radians(cols[idx["theta3"]]), np.radians(cols[idx["theta4"]]))
-    elif m.closed_form == "fourbar" and "theta2" in idx and "theta3" in idx:
-        # driven by theta4: the same configuration rule, with each solution's own theta4
-        t3 = np.radians(cols[idx["theta3"]])
-        t4 = rocker_angle_np(v["r1"], v["r2"], v["r3"], v["theta1"], np.radians(cols[idx["theta2"]]), t3)
-        is_open = is_open_np(t3, t4)
-    elif m.closed_form == "slider_crank" and "theta3" in idx:
-        is_open = slider_is_open_np(np.radians(cols[idx["theta3"]]))
-    else:
+    der = m.derivation
+    if not der.complete or target in ("det+", "det-"):
         return (det > 0) == (target == "det+")
-    return is_open == (target == "open")
+    from .designs import _words_np, read_branch  # (designs imports this module)
+
+    want = read_branch(der, target)
+    kinds = {u.name: u.kind for u in m.unknowns}
+    q = [np.radians(c) if kinds[n] == "angle" else c for n, c in zip(names, cols)]
+    ok = np.ones(len(det), dtype=bool)
+    with np.errstate(invalid="ignore"):
+        if want.signs is not None:
+            for side, sign in zip(der.signs_of_np(q, drivers), want.signs):
+                ok &= (side == sign) | (side == 0.0)
+        else:
+            # the name's words; which of two assemblies of one name (a mirror) a position
+            # is on, the continuity test has already decided
+            for word, wanted in zip(_words_np(der, q, drivers, der.params or {}), want.words):
+                ok &= word == wanted
+    return ok
