@@ -134,7 +134,7 @@ def solve_designs(m: Mechanism, params: Mapping[str, np.ndarray], values: Sequen
     shown = np.stack([np.degrees(c) if k == "angle" else c for c, k in zip(q, kinds)], axis=-1)
     shown[status != CONVERGED] = np.nan
     shown = shown.reshape(n_designs, len(vals), len(kinds))
-    _continuous(m, shown, vals)
+    _continuous(m, shown, vals, _turn_references(m, params, n_designs, tol))
     return DesignSolutions(tuple(u.name for u in m.unknowns), kinds, vals,
                            status.reshape(n_designs, len(vals)), feasible.reshape(n_designs, len(vals)),
                            shown, branch, engine,
@@ -703,11 +703,69 @@ def _paths(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, q: 
     return out
 
 
-def _continuous(m: Mechanism, shown: np.ndarray, vals: np.ndarray) -> None:
+def _turn_references(m: Mechanism, params: Mapping[str, np.ndarray], n_designs: int,
+                     tol: float) -> np.ndarray:
+    """What ``solve FILE`` gives each design at the file's driver value from the file's
+    guess (display units, designs x unknowns; NaN where it does not converge): the turn a
+    sweep reports its angles in (:func:`~linkage.kinematics.stepwise.sweep`). Newton from
+    the guess for every design at once; a design where some whole step would not have
+    lowered |Phi|^2 (where the single solve's globalised Newton takes another step) is
+    solved by that solve itself."""
+    from ..solve import solve_system
+
+    n = len(m.unknowns)
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    grid, drv = _grid(m, params, np.array([m.driver.value / scale]), n_designs)
+    loops = VectorLoops.of_terms(_terms(m, grid, drv), n, n_designs)
+    size = _size(m, grid, drv)
+    is_length = [u.kind == "length" for u in m.unknowns]
+    gate = residual_gate(tol, size)
+    q = [np.full(n_designs, u.value) for u in m.unknowns]
+    plain = np.ones(n_designs, dtype=bool)  # every step so far the globalised solve's too
+    done = np.zeros(n_designs, dtype=bool)
+    phi, jac = loops.evaluate(q, None)
+    with np.errstate(invalid="ignore", over="ignore"):
+        for _ in range(50):
+            live = plain & ~done
+            if not live.any():
+                break
+            dq, _ = solve_linear(jac, phi, n_designs)
+            trial = [c + d for c, d in zip(q, dq)]
+            phi_t, jac_t = loops.evaluate(trial, None)
+            tiny = _largest(dq) <= 64.0 * np.finfo(float).eps * (1.0 + _largest(q))
+            plain &= ~live | (_sumsq(phi_t) <= (1.0 - 1e-4) * _sumsq(phi)) | tiny
+            step = step_size_array(dq, [size if length else 1.0 for length in is_length])
+            done |= live & plain & system_converged_array(step, _largest(phi), tol, gate)
+            q = [np.where(live, t, c) for t, c in zip(trial, q)]
+            phi = [np.where(live, t, c) for t, c in zip(phi_t, phi)]
+            jac = [[np.where(live, t, c) for t, c in zip(rt, rc)] for rt, rc in zip(jac_t, jac)]
+    out = np.stack([np.degrees(c) if u.kind == "angle" else c for c, u in zip(q, m.unknowns)], axis=1)
+    out[~done] = np.nan
+    for d in np.flatnonzero(~plain):
+        design = m.with_values({k: float(np.atleast_1d(a)[d]) for k, a in params.items()}, {})
+        r = solve_system(design.problem(), tol=tol, record=False)
+        if r.converged:
+            out[d] = [math.degrees(x) if u.kind == "angle" else x for x, u in zip(r.x, m.unknowns)]
+    return out
+
+
+def _largest(parts: Sequence[Any]) -> Any:
+    out = np.abs(parts[0])
+    for p in parts[1:]:
+        out = np.maximum(out, np.abs(p))
+    return out
+
+
+def _sumsq(parts: Sequence[Any]) -> Any:
+    return sum(p * p for p in parts)
+
+
+def _continuous(m: Mechanism, shown: np.ndarray, vals: np.ndarray, refs: np.ndarray) -> None:
     """In place: each angle continuous along the cycle by the rule of
     :mod:`linkage.kinematics.angles` (driver order around the circle), each design's curve
-    in the turn within half a turn of the file's guess at the solved position nearest the
-    file's driver value."""
+    shifted by whole turns to the turn ``refs`` gives (:func:`_turn_references`: what
+    ``solve FILE`` gives the design) at the solved position nearest the file's driver
+    value, as the sweep does; not shifted where that solve does not converge."""
     if shown.size == 0:
         return
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
@@ -724,5 +782,5 @@ def _continuous(m: Mechanism, shown: np.ndarray, vals: np.ndarray) -> None:
         turns = unwrap_turns_array(a, closes)
         near = anchor_index_array(vals, solved, v0, closes, turn)[:, None]
         at = continuous(np.take_along_axis(a, near, axis=1), np.take_along_axis(turns, near, axis=1))
-        shift = turn_shift_array(math.degrees(u.value), at)
+        shift = np.nan_to_num(turn_shift_array(refs[:, j:j + 1], at), nan=0.0)
         shown[:, :, j] = np.where(solved, continuous(a, turns + shift), np.nan)
