@@ -295,3 +295,37 @@ def test_the_scan_target_is_judged_at_two_thousand_designs():
     assert row({six: 3.5, four: 1.0})[2:] == (3.5, False)
     six, four = scan_keys(SCAN_DESIGNS // 10)  # --quick: measured, not judged
     assert row({six: 2.0, four: 1.0})[2:] == (2.0, None)
+
+
+@pytest.mark.parametrize("name,varied", [
+    ("crank_rocker", ("r1", "r2", "r3", "r4", "theta1")), ("slider_crank", ("r2", "r3", "e")),
+    ("watt_sixbar", ("r2", "r3", "r4", "r5", "r6", "r7", "g", "gamma")),
+    ("fourbar_me581_theta4", ("r1", "r2", "r3", "r4"))])
+def test_a_name_is_one_sign_tuple_exactly_where_the_engine_says_so(name, varied):
+    """Where designs.py takes a name's signs from one design for all (_names_are_signs),
+    every configuration of random designs at random driver values on one sign tuple
+    carries one name, by the name rule written out here (sin of the output from the
+    coupler; the coupler against the slide); a rocker-driven four-bar's does not."""
+    from linkage.kinematics.designs import _names_are_signs
+
+    m = load(SAMPLES / f"{name}.toml")
+    der = m.derivation
+    rng = np.random.default_rng(5)
+    params = {k: q.value * rng.uniform(0.5, 1.5, (400, 1)) if q.kind == "length"
+              else rng.uniform(-np.pi, np.pi, (400, 1)) for k, q in m.parameters.items() if k in varied}
+    params = {**{k: q.value for k, q in m.parameters.items()}, **params}
+    drivers = rng.uniform(-np.pi, np.pi, (1, 50))
+    constant = True
+    for signs in der.branches:
+        q, ok = der.solve_np(drivers, signs, params)
+        at = {u.name: c for u, c in zip(m.unknowns, q)}
+        at[m.driver.name] = np.broadcast_to(drivers, ok.shape)
+        if name == "slider_crank":
+            words = [np.cos(at["theta3"]) > 0]  # the coupler points the way s grows
+        else:
+            words = [np.sin(at["theta4"] - at["theta3"]) > 0]
+            if name == "watt_sixbar":
+                words.append(np.sin(at["theta7"] - at["theta6"]) > 0)
+        for w in words:
+            constant &= len(np.unique(w[ok])) == 1
+    assert constant == _names_are_signs(der)

@@ -40,7 +40,7 @@ import numpy as np
 
 from ..methods.newton_system import SINGULAR_RATIO
 from ..problems.derive import MIRROR, Derivation, is_open_np, parse_signs
-from ..problems.loops import ANGLE_UNITS, Mechanism, VectorTerm
+from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism, VectorTerm
 from ..rules import (
     continues_array,
     continuity_measures_array,
@@ -211,6 +211,21 @@ def _words_np(der: Derivation, q: Sequence[Any], d: Any, params: Mapping[str, An
     return out
 
 
+def _names_are_signs(der: Derivation) -> bool:
+    """True where each two-way step's word is a function of its sign alone, whatever the
+    design and the driver value: a four-bar step that solves the coupler and the output
+    (open/crossed is the side of the coupler from the diagonal), a slider step (open is
+    the larger root), or a step named by its sign. Not so for a four-bar driven by its
+    output, whose step solves the input and the coupler."""
+    for i in der.two_way:
+        step = der.steps[i]
+        if step.word_rule == "fourbar":
+            assert step.word_terms is not None
+            if {t[2] for t in step.word_terms} != set(step.unknowns):
+                return False
+    return True
+
+
 def design_signs(der: Derivation, text: str, drivers: np.ndarray, columns: Mapping[str, Any],
                  n_designs: int) -> tuple[np.ndarray, np.ndarray]:
     """The sign tuple each design follows on branch ``text`` (designs x two-way steps) and
@@ -262,6 +277,11 @@ def design_signs(der: Derivation, text: str, drivers: np.ndarray, columns: Mappi
         out[todo[found]] = branches[pick[found]]
         named[todo[found]] = True
         todo = todo[~found]
+        agreed = np.unique(out[named], axis=0)
+        if todo.size and len(agreed) == 1 and _names_are_signs(der):
+            # the name is one sign tuple for every design: the rest need no search
+            out[todo], named[todo] = agreed[0], True
+            todo = todo[:0]
     return out, named
 
 
@@ -741,9 +761,18 @@ def _turn_references(m: Mechanism, params: Mapping[str, np.ndarray], n_designs: 
             jac = [[np.where(live, t, c) for t, c in zip(rt, rc)] for rt, rc in zip(jac_t, jac)]
     out = np.stack([np.degrees(c) if u.kind == "angle" else c for c, u in zip(q, m.unknowns)], axis=1)
     out[~done] = np.nan
-    for d in np.flatnonzero(~plain):
+    rest = ~plain
+    if rest.any() and m.derivation.complete:
+        # no assembly there on any branch: that solve cannot converge either
+        there = np.zeros(n_designs, dtype=bool)
+        for signs in m.derivation.branches:
+            there |= np.broadcast_to(m.derivation.solve_np(drv, signs, grid)[1], there.shape)
+        rest &= there
+    for d in np.flatnonzero(rest):
         design = m.with_values({k: float(np.atleast_1d(a)[d]) for k, a in params.items()}, {})
-        r = solve_system(design.problem(), tol=tol, record=False)
+        # its loops walked, not compiled (the same Phi and J; compiling costs more than the solve)
+        F, J = LoopModel.compile(design).interpreted_functions(float(drv[d]))
+        r = solve_system(F, tuple(u.value for u in m.unknowns), jac=J, tol=tol, record=False)
         if r.converged:
             out[d] = [math.degrees(x) if u.kind == "angle" else x for x, u in zip(r.x, m.unknowns)]
     return out
