@@ -4,6 +4,7 @@ four-bar metrics, and the local scheduler against a two-worker dask LocalCluster
     python benchmarks/scan.py                 # 2,000 designs x 360 positions
     python benchmarks/scan.py --designs 20000 --repeats 1 --no-cluster
     python benchmarks/scan.py --continuation  # six-bar designs: batch against one at a time
+    python benchmarks/scan.py --sixbar        # Watt six-bar against crank-rocker, same scan
     python benchmarks/scan.py --writers       # 10^6 three-position designs to Parquet and CSV
 
 Every figure is a median of repeats measured in this run (the machines are shared and
@@ -124,6 +125,29 @@ def continuation(designs: int = 200, one_at_a_time: int = 20) -> None:
     print(f"  same statuses: {bool((status[:k] == status1).all())}; largest difference {worst:.2g}")
 
 
+def sixbar(n: int, repeats: int) -> tuple[float, float]:
+    """The same scan (r2, r3, r4 sampled as VARY, n designs x 360 positions, in-process,
+    synchronous) of watt_sixbar.toml and of crank_rocker.toml, interleaved run by run:
+    (six-bar, four-bar) median seconds. Issue 19's target: the six-bar within 3x."""
+    from linkage.scan import scan
+
+    vary = {"r2": (20.0, 60.0), "r3": (80.0, 160.0), "r4": (50.0, 120.0)}
+    times: dict[str, list[float]] = {"watt_sixbar": [], "crank_rocker": []}
+    for name in times:  # warm: imports, the derivation, numpy's first calls
+        scan(str(ROOT / "sample_inputs" / f"{name}.toml"), vary, samples=10, scheduler="synchronous")
+    for _ in range(repeats):
+        for name in times:
+            t = time.perf_counter()
+            scan(str(ROOT / "sample_inputs" / f"{name}.toml"), vary, samples=n, scheduler="synchronous")
+            times[name].append(time.perf_counter() - t)
+    six, four = (statistics.median(times[k]) for k in ("watt_sixbar", "crank_rocker"))
+    print(f"{n:,} designs x 360 positions (r2, r3, r4 sampled), in-process, synchronous, "
+          f"median of {repeats}")
+    print(f"  crank_rocker.toml  {four * 1e3:8.1f} ms")
+    print(f"  watt_sixbar.toml   {six * 1e3:8.1f} ms  {six / four:4.2f}x the four-bar (target: 3x)")
+    return six, four
+
+
 def writers(n_r2: int = 1000, n_r4: int = 1000) -> None:
     """A grid of n_r2 x n_r4 designs at 3 positions each to Parquet and to CSV: the
     time is mostly writing."""
@@ -146,7 +170,11 @@ def main() -> None:
     ap.add_argument("--no-cluster", action="store_true")
     ap.add_argument("--continuation", action="store_true", help="only the six-bar comparison")
     ap.add_argument("--writers", action="store_true", help="only the Parquet and CSV writing rates")
+    ap.add_argument("--sixbar", action="store_true", help="only the Watt six-bar against the crank-rocker")
     args = ap.parse_args()
+    if args.sixbar:
+        sixbar(args.designs, args.repeats)
+        return
     if args.continuation:
         continuation()
         return

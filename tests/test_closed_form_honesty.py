@@ -289,7 +289,6 @@ def test_rocker_driven_sweeps_label_each_position_by_its_configuration(branch):
     configuration; positions where neither assembly has that label are off_branch,
     never given numbers; the batch engine and the scan's engine say the same."""
     from linkage.kinematics.batch import CODE_STATUS, batch_sweep
-    from linkage.kinematics.designs import solve_designs
     from linkage.kinematics.sweep import sweep
 
     m = load(SAMPLES / "fourbar_me581_theta4.toml")
@@ -307,9 +306,7 @@ def test_rocker_driven_sweeps_label_each_position_by_its_configuration(branch):
     assert not [t for t in result.toggles if 105 < t < 255]  # a re-entry is no toggle
     batch = batch_sweep(m, values, branch=branch)
     assert [CODE_STATUS[int(c)] for c in batch.status] == [p.status for p in result.positions]
-    designs = solve_designs(m, {}, np.array(values), branch=branch)
-    codes = {0: "converged", 1: "no_solution", 2: "failed", 3: "off_branch"}
-    assert [codes[int(c)] for c in designs.status[0]] == [p.status for p in result.positions]
+    # (the scan follows a branch by its signs, as issue 19 asks: tests/test_derived_scan.py)
 
 
 # --- closed_form claims ---------------------------------------------------------------------
@@ -470,16 +467,28 @@ def test_the_branch_rule_twins_are_their_scalar_rules():
     assert _close(got, want, 64).all()
     # every engine's label of the same solution: the sweep's rule, the batch's columns
     from linkage.kinematics.batch import _on_branch_columns
-    from linkage.problems.closed_form import branch_rule
-
     for name in ("fourbar_me581.toml", "fourbar_me581_theta4.toml", "slider_crank.toml", "crank_rocker.toml"):
         m = load(SAMPLES / name)
         names = [u.name for u in m.unknowns]
         cols = [np.degrees(rng.uniform(-np.pi, np.pi, 400)) if u.kind == "angle" else rng.uniform(-9, 9, 400)
                 for u in m.unknowns]
-        rule = branch_rule(m)
-        scalar = np.array([rule({n: float(c[i]) for n, c in zip(names, cols)}) == "open" for i in range(400)])
-        vector = _on_branch_columns(m, cols, names, np.ones(400), "open")
+        drivers = np.zeros(400)  # (a crank's value does not enter the open/crossed rule)
+        if m.driver.name == "theta4":  # the rocker's angle that closes each configuration
+            v = {k: q.value for k, q in m.parameters.items()}
+            drivers = assembly.rocker_angle_np(v["r1"], v["r2"], v["r3"], v["theta1"],
+                                               np.radians(cols[0]), np.radians(cols[1]))
+        # the scalar rule, written here: open where sin(theta4 - theta3) > 0 (four-bar, theta4
+        # the rocker's, the driver where it drives), cos(theta3) > 0 (slider-crank)
+        t3 = np.radians(cols[names.index("theta3")])
+        if name == "slider_crank.toml":
+            scalar = np.array([math.cos(a) > 0.0 for a in t3])
+        else:
+            t4 = drivers if m.driver.name == "theta4" else np.radians(cols[names.index("theta4")])
+            scalar = np.array([math.sin(b - a) > 0.0 for a, b in zip(t3, t4)])
+        assert (scalar == [m.derivation.words_of([math.radians(c[i]) if u.kind == "angle" else c[i]
+                                                  for c, u in zip(cols, m.unknowns)], float(drivers[i]))
+                           == ["open"] for i in range(400)]).all(), name
+        vector = _on_branch_columns(m, cols, names, np.ones(400), "open", drivers)
         assert (scalar == vector).all(), name
 
 

@@ -428,7 +428,33 @@ def sweep_times(repeats: int = 5, batch_positions: int | None = 1_000_000) -> di
         f"linkage.sweep {batch_positions:,} positions (batch)": lambda: sweep_mechanism(m, grid, batch=True),
     }, max(3, min(5, repeats)))
     out.update({k: t for k, (t, _, _) in big.items()})
+    out.update(scan_times(repeats, SCAN_DESIGNS if batch_positions >= 1_000_000 else SCAN_DESIGNS // 10))
     return out
+
+
+SCAN_DESIGNS = 2_000
+"""Designs in the scan target's comparison (issue 19); --quick scans a tenth."""
+
+
+def scan_keys(designs: int) -> tuple[str, str]:
+    """The sweep-table keys of the six-bar scan and the four-bar scan."""
+    return (f"linkage.scan {designs:,} Watt six-bar designs x 360 positions",
+            f"linkage.scan {designs:,} crank-rocker designs x 360 positions")
+
+
+def scan_times(repeats: int, designs: int) -> dict[str, float]:
+    """Median seconds of the same scan (r2, r3, r4 sampled; 0..359 deg; in-process, one
+    chunk after another) of watt_sixbar.toml and crank_rocker.toml, taken in turn
+    (benchmarks/scan.py --sixbar is the same comparison)."""
+    from .samples import sample_path
+    from .scan import scan
+
+    vary = {"r2": (20.0, 60.0), "r3": (80.0, 160.0), "r4": (50.0, 120.0)}
+    six, four = scan_keys(designs)
+    runs = interleaved({
+        key: (lambda f=f: scan(str(sample_path(f)), vary, samples=designs, scheduler="synchronous"))
+        for key, f in ((six, "watt_sixbar.toml"), (four, "crank_rocker.toml"))}, max(3, min(5, repeats)))
+    return {k: t for k, (t, _, _) in runs.items()}
 
 
 def interleaved(fns: dict[str, Callable[[], Any]], repeats: int) -> dict[str, tuple[float, list[float], Any]]:
@@ -496,6 +522,16 @@ def targets(ms: Sequence[Measurement], cold: dict[str, float],
     else:
         rows.append(("4. linkage.sweep of 1,000,000 positions within 2x of numpy closed form",
                      "linkage / numpy", r, r is not None and r <= 2.0))
+    six, four = scan_keys(SCAN_DESIGNS)
+    r = ratio(sw.get(six), sw.get(four))
+    if r is None and any(k.startswith("linkage.scan") for k in sw):  # --quick: fewer designs
+        six, four = scan_keys(SCAN_DESIGNS // 10)
+        rows.append((f"issue 19: scan of {SCAN_DESIGNS // 10:,} Watt six-bar designs (the target: "
+                     f"{SCAN_DESIGNS:,}) against the crank-rocker's", "six-bar / four-bar",
+                     ratio(sw.get(six), sw.get(four)), None))
+    else:
+        rows.append((f"issue 19: scan of {SCAN_DESIGNS:,} Watt six-bar designs x 360 positions within 3x "
+                     "of the crank-rocker's", "six-bar / four-bar", r, r is not None and r <= 3.0))
     floor = cold.get("python -c 'import rich.table' (floor)")
     for label, key, bound in (
             ("5. linkage solve cold start within 1.6x of import rich.table", "linkage solve", 1.6),

@@ -27,8 +27,8 @@ import numpy as np
 from .errors import InputError, ParseError
 from .kinematics.angles import angle_extent_array, closes_circle, driver_turn
 from .kinematics.designs import CONVERGED, DesignSolutions, engine_for, solve_designs
-from .problems.closed_form import grashof_np, transmission_np
-from .problems.columns import columns_of, extent_columns, path_columns
+from .problems.closed_form import grashof_np
+from .problems.columns import columns_of, extent_columns, fourbar_columns, fourbar_loops, path_columns
 from .problems.loops import ANGLE_UNITS, Mechanism
 
 MAX_DESIGNS = 10_000_000
@@ -259,12 +259,7 @@ def design_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray, sol:
                 span = hi - lo
             for key, col in zip(extent_columns(u.name), (lo, hi, span)):
                 out[key] = col
-        if m.closed_form == "fourbar":
-            out["grashof"] = grashof_class(*(_param(m, names, designs, k) for k in ("r1", "r2", "r3", "r4")))
-            t3, t4 = (_angle_deg(m, sol, k) for k in ("theta3", "theta4"))
-            mu = transmission_np(t3, t4)
-            folded = np.where(mu > 90.0, 180.0 - mu, mu)
-            out["min_transmission_deg"], out["max_transmission_deg"] = _extent(folded, solved)
+        out.update(fourbar_metrics(m, names, designs, sol))
         for p in m.points:
             z = sol.paths[p]
             for axis, part in (("x", z.real), ("y", z.imag)):
@@ -281,24 +276,51 @@ def _extent(values: np.ndarray, solved: np.ndarray) -> tuple[np.ndarray, np.ndar
     return np.where(any_solved, lo, np.nan), np.where(any_solved, hi, np.nan)
 
 
-def _param(m: Mechanism, names: Sequence[str], designs: np.ndarray, key: str) -> np.ndarray:
-    if key in names:
-        return np.asarray(designs[:, list(names).index(key)], dtype=float)
-    return np.full(len(designs), m.parameters[key].value)
+def fourbar_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray,
+                    sol: DesignSolutions) -> dict[str, np.ndarray]:
+    """For every four-bar loop of the derivation (columns named by
+    :func:`~linkage.problems.columns.fourbar_loops`): its Grashof class, from the lengths
+    of its ground, input, coupler and output as each design has them, and the extremes of
+    its transmission angle over the solved positions (derive.fourbar_transmission, folded
+    into [0, 90] deg)."""
+    from .problems.derive import fourbar_transmission, loop_terms
 
+    views = fourbar_loops(m)
+    if not views:
+        return {}
+    n_designs, n_pos = sol.status.shape
+    solved = sol.status == CONVERGED
+    varied = {n: np.asarray(designs[:, j], dtype=float) for j, n in enumerate(names)}
+    # the derivation's parameters (internal units): a varied one a column per design
+    params: dict[str, Any] = {k: q.value for k, q in m.parameters.items()}
+    for k, col in varied.items():
+        q = m.parameters[k]
+        params[k] = (col * ANGLE_UNITS[q.unit] if q.kind == "angle" else col)[:, None]
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    drv = (np.asarray(sol.values, dtype=float) * scale)[None, :]
+    q = [np.radians(sol.solution[:, :, j]) if kind == "angle" else sol.solution[:, :, j]
+         for j, kind in enumerate(sol.kinds)]
+    terms = loop_terms(m)
+    out: dict[str, np.ndarray] = {}
+    for view, suffix in views:
+        loop = terms[view.loop]
 
-def _angle_deg(m: Mechanism, sol: DesignSolutions, key: str) -> np.ndarray:
-    """theta3 or theta4 at every position (deg): solved, or the driver (a four-bar file's
-    closed form is checked on reading: both are unknowns or the driver)."""
-    if key in sol.names:
-        return sol.solution[:, :, sol.names.index(key)]
-    shown = sol.values * (ANGLE_UNITS[m.driver.unit] / ANGLE_UNITS["deg"])
-    return np.broadcast_to(shown[None, :], sol.status.shape)
+        lengths = []
+        for i in (view.ground, view.input, view.coupler, view.output):
+            ref = loop[i][1]
+            v = params[ref] if isinstance(ref, str) else ref
+            lengths.append(np.broadcast_to(np.abs(np.asarray(v, dtype=float)).reshape(-1), (n_designs,)))
+        (g, lo, hi) = (c for c, _, _ in fourbar_columns(suffix))
+        out[g] = grashof_class(*lengths)
+        mu = np.degrees(fourbar_transmission(view, loop, params, drv, q, xp=np))
+        mu = np.broadcast_to(mu, (n_designs, n_pos))
+        out[lo], out[hi] = _extent(np.where(mu > 90.0, 180.0 - mu, mu), solved)
+    return out
 
 
 grashof_class = grashof_np
-"""The Grashof class of each four-bar (r1 ground, r2 input, r3 coupler, r4 output): the
-numpy twin of :func:`~linkage.problems.closed_form.grashof`."""
+"""The Grashof class of each four-bar (ground, input, coupler, output): the numpy twin of
+:func:`~linkage.problems.closed_form.grashof`."""
 
 
 # --- running the chunks -------------------------------------------------------------------------
@@ -478,25 +500,36 @@ class Keeper:
 
 
 def default_branch(m: Mechanism, branch: str | None, tol: float) -> str | None:
-    """The branch every design follows: the one asked for, else (with a closed form) the
-    branch the file's own guess solves to at its driver value, else None (continuation
-    from the file's guess, design by design)."""
+    """The branch every design follows: the one asked for (a name or the signs of the
+    derivation's two-way steps, checked here), else (with a closed form) the branch the
+    file's own guess solves to at its driver value, by name where it has one, else None
+    (continuation from the file's guess, design by design)."""
+    from .kinematics.designs import read_branch
+    from .problems.derive import Indeterminate, sign_text
+
+    der = m.derivation
     if branch is not None:
-        if branch not in ("open", "crossed"):
-            raise InputError(f"--branch must be open or crossed, got {branch!r}")
-        if m.closed_form is None:
-            raise InputError(f"--branch needs a mechanism with a closed form; {m.source} has none")
+        if not der.complete:
+            raise InputError(f"--branch needs a mechanism whose loops have a closed form; "
+                             f"{m.source}: {der.summary}")
+        try:
+            read_branch(der, branch)
+        except ValueError as exc:
+            raise InputError(f"--branch {exc}") from None
         return branch
-    if m.closed_form is None:
+    if not der.complete:
         return None
-    from .problems.closed_form import branch_rule
     from .solve import solve_system
 
     r = solve_system(m.problem(), tol=max(tol, 1e-12), record=False)
     if not r.converged:
-        return "open"
-    shown = {u.name: (math.degrees(x) if u.kind == "angle" else x) for u, x in zip(m.unknowns, r.x)}
-    return branch_rule(m)(shown)
+        return sign_text(der.branches[0])
+    try:
+        signs = der.signs_of(list(r.x), m.driver.value)
+        named = der.named_solutions(m.driver.value)
+    except Indeterminate:
+        return sign_text(der.branches[0])
+    return next((name for name, (s, _) in named.items() if s == signs), sign_text(signs))
 
 
 @dataclass(frozen=True)

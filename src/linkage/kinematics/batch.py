@@ -25,7 +25,6 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ..problems.assembly import is_open_np, rocker_angle_np, slider_is_open_np
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel, Mechanism
 from ..rules import residual_gate, step_scales, step_size_array, system_converged_array
 from .angles import nearest_turn, nearest_turn_array
@@ -343,7 +342,7 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
     right = np.full(n_pos, -1)
     right[todo] = np.clip(np.searchsorted(grid_arr, vals[todo], side="right"), 1, len(grid_arr) - 1)
     left = right - 1
-    have_closed = m.closed_form is not None and m.driver.kind == "angle"
+    have_closed = _have_closed(m, solver, lo)
     target = rough.branch
     for i in todo:
         v = float(vals[i])
@@ -525,7 +524,7 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     for j in range(1, n):
         np.maximum(moved, np.abs(cols[j] - refs[j]), out=moved)
     status[done & (moved > take(coarse.allowed, left))] = code["failed"]
-    status[done & ~_on_branch_columns(m, cols, names, det_out, branch)] = code["failed"]
+    status[done & ~_on_branch_columns(m, cols, names, det_out, branch, vals * drv_scale)] = code["failed"]
     # angles reported continuously with the guess (the one-at-a-time sweep's convention):
     # a solution within half a turn of its guess is already the representative nearest it
     for j, k in enumerate(kinds):
@@ -546,24 +545,39 @@ def _largest(parts: Sequence[np.ndarray]) -> np.ndarray:
     return out
 
 
+def _have_closed(m: Mechanism, solver: Solver, value: float) -> bool:
+    """Whether the one-at-a-time sweep re-enters gaps from the closed form and classifies
+    them by it, so the fallback here does too: an angle-driven mechanism whose loops have
+    a closed form (``m.derivation.complete``) that its problem carries as the reference."""
+    return (m.driver.kind == "angle" and m.derivation.complete
+            and solver.problem(value).reference is not None)
+
+
 def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence[str], det: np.ndarray,
-                       target: str | None) -> np.ndarray:
-    """True where a solution (one array per unknown, display units) lies on the target
-    branch: the closed form's configuration rule over arrays (the numpy twins of
-    closed_form.branch_rule, from problems/assembly.py), else the sign of det J."""
+                       target: str | None, drivers: np.ndarray) -> np.ndarray:
+    """True where a solution (one array per unknown, display units, at ``drivers`` in
+    internal units) lies on the target branch: a branch of the derivation (its signs, or
+    its name: each two-way step's word by the derivation's own rule, as
+    :func:`~linkage.kinematics.designs.design_signs` reads them), else the sign of det J
+    (``det+``, ``det-``)."""
     if target is None:
         return np.ones(len(det), dtype=bool)
-    idx = {n: j for j, n in enumerate(names)}
-    v = {k: q.value for k, q in m.parameters.items()}
-    if m.closed_form == "fourbar" and "theta3" in idx and "theta4" in idx:
-        is_open = is_open_np(np.radians(cols[idx["theta3"]]), np.radians(cols[idx["theta4"]]))
-    elif m.closed_form == "fourbar" and "theta2" in idx and "theta3" in idx:
-        # driven by theta4: the same configuration rule, with each solution's own theta4
-        t3 = np.radians(cols[idx["theta3"]])
-        t4 = rocker_angle_np(v["r1"], v["r2"], v["r3"], v["theta1"], np.radians(cols[idx["theta2"]]), t3)
-        is_open = is_open_np(t3, t4)
-    elif m.closed_form == "slider_crank" and "theta3" in idx:
-        is_open = slider_is_open_np(np.radians(cols[idx["theta3"]]))
-    else:
+    der = m.derivation
+    if not der.complete or target in ("det+", "det-"):
         return (det > 0) == (target == "det+")
-    return is_open == (target == "open")
+    from .designs import _words_np, read_branch  # (designs imports this module)
+
+    want = read_branch(der, target)
+    kinds = {u.name: u.kind for u in m.unknowns}
+    q = [np.radians(c) if kinds[n] == "angle" else c for n, c in zip(names, cols)]
+    ok = np.ones(len(det), dtype=bool)
+    with np.errstate(invalid="ignore"):
+        if want.signs is not None:
+            for side, sign in zip(der.signs_of_np(q, drivers), want.signs):
+                ok &= (side == sign) | (side == 0.0)
+        else:
+            # the name's words; which of two assemblies of one name (a mirror) a position
+            # is on, the continuity test has already decided
+            for word, wanted in zip(_words_np(der, q, drivers, der.params or {}), want.words):
+                ok &= word == wanted
+    return ok

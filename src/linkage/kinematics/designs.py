@@ -1,17 +1,23 @@
 """Many designs at once: a mechanism whose parameters are arrays, solved at every driver
 value for every design, vectorised over designs x positions (the engine of ``scan``).
 
-Mechanisms with a closed form (four-bars driven by theta2 or theta4, slider-cranks):
+Mechanisms whose every unknown has a closed form derived from the loops
+(``m.derivation.complete``: four-bars whichever joint drives, slider-cranks, the Watt
+six-bar, any dyadic mechanism):
 
-1. The closed form gives every position of every design at once, on the branch asked
-   for, or shows that the linkage cannot be assembled there (``no_solution``).
+1. The derivation (:meth:`~linkage.problems.derive.Derivation.solve_np`) gives every
+   position of every design at once, designs against positions, on the branch's signs
+   (one per two-way step; a branch given by name is the assembly of that name where each
+   design's sweep would start: :func:`design_signs`), or shows that the branch cannot be
+   assembled there (``off_branch`` if another can, else ``no_solution``).
 2. Newton-Raphson on the loop equations polishes every assembled position, vectorised,
    with the single solve's stopping rule: max|dq| <= tol (a length step relative to the
    design's size) and max|Phi| <= tol x size. A position counts as solved only when
    Newton converges there, stays within 1e-6 (rad, or of the size) of the closed form
-   and lies on the branch; otherwise it is ``failed`` (never given numbers).
+   and lies on the branch's side of every step; otherwise it is ``failed`` (never given
+   numbers).
 
-Mechanisms without a closed form (six-bars, the rapier drive) follow the sweep's
+Mechanisms without one (coupled loops: the offset slider, the rapier drive) follow the sweep's
 continuation for every design at once (:func:`_continuation_engine`); a design that
 would need more than a plain step anywhere (a halved step, a gap, a fold) is swept on
 its own by :func:`~linkage.kinematics.sweep.sweep`. Either way every design gets the
@@ -26,21 +32,15 @@ of the file's guess: both engines report the same numbers for the same design.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..methods.newton_system import SINGULAR_RATIO
-from ..problems.assembly import (
-    fourbar_by_crank_np,
-    is_open_np,
-    slider_crank_np,
-    slider_is_open_np,
-)
-from ..problems.closed_form import DRIVERS, REQUIRED_NAMES
-from ..problems.loops import ANGLE_UNITS, Mechanism, VectorTerm
+from ..problems.derive import MIRROR, Derivation, is_open_np, parse_signs
+from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism, VectorTerm
 from ..rules import (
     continues_array,
     continuity_measures_array,
@@ -84,19 +84,11 @@ class DesignSolutions:
 
 
 def closed_form_applies(m: Mechanism) -> bool:
-    """True when the vectorised closed-form engine can run this mechanism.
-
-    That engine picks each position's assembly by its label, which is right where the two
-    solutions at a driver value always carry the two labels (a crank-driven four-bar, a
-    slider-crank). A rocker-driven four-bar's two assemblies can share a label (the mirror
-    images of A across O2-B), and which one a design is on is then a matter of
-    continuity: those designs are swept, as ``linkage sweep`` does."""
-    if m.closed_form is None or m.driver.kind != "angle" or m.driver.name not in DRIVERS[m.closed_form]:
-        return False
-    if m.driver.name == "theta4":
-        return False
-    expected = set(REQUIRED_NAMES[m.closed_form]) - set(m.parameters) - {m.driver.name}
-    return {u.name for u in m.unknowns} == expected
+    """True when the vectorised closed-form engine can run this mechanism: every unknown
+    has a closed form derived from its loops (``m.derivation.complete``). Its branches are
+    followed by their signs, so a rocker-driven four-bar's two mirror assemblies (which
+    may share a name) are two branches like any other."""
+    return m.derivation.complete
 
 
 ENGINES = {
@@ -109,11 +101,11 @@ ENGINES = {
 
 def engine_for(m: Mechanism, branch: str | None) -> str:
     """The engine :func:`solve_designs` runs for ``m``: a key of :data:`ENGINES`."""
-    if closed_form_applies(m) and branch is not None:
-        return "closed form"
-    if branch is None and m.closed_form is None and m.driver.kind == "angle":
-        return "continuation"
-    return "sweep"
+    if closed_form_applies(m):
+        # without a branch (the scan always gives one: scan.default_branch), each design
+        # is the sweep's from the file's guess
+        return "closed form" if branch is not None else "sweep"
+    return "continuation" if branch is None and m.driver.kind == "angle" else "sweep"
 
 
 def solve_designs(m: Mechanism, params: Mapping[str, np.ndarray], values: Sequence[float] | np.ndarray,
@@ -121,8 +113,8 @@ def solve_designs(m: Mechanism, params: Mapping[str, np.ndarray], values: Sequen
                   paths: bool = False) -> DesignSolutions:
     """Solve ``m`` with each named parameter taking the values of its array (file units,
     one entry per design) at every driver value in ``values`` (display units).
-    ``branch``: open or crossed (mechanisms with a closed form), else None (the branch of
-    the file's guess, by continuation)."""
+    ``branch``: a branch name or sign string (mechanisms with a closed form: see
+    :func:`design_signs`), else None (the branch of the file's guess, by continuation)."""
     vals = np.asarray(values, dtype=float)
     sizes = {len(np.atleast_1d(a)) for a in params.values()}
     if len(sizes) > 1:
@@ -142,7 +134,7 @@ def solve_designs(m: Mechanism, params: Mapping[str, np.ndarray], values: Sequen
     shown = np.stack([np.degrees(c) if k == "angle" else c for c, k in zip(q, kinds)], axis=-1)
     shown[status != CONVERGED] = np.nan
     shown = shown.reshape(n_designs, len(vals), len(kinds))
-    _continuous(m, shown, vals)
+    _continuous(m, shown, vals, _turn_references(m, params, n_designs, tol))
     return DesignSolutions(tuple(u.name for u in m.unknowns), kinds, vals,
                            status.reshape(n_designs, len(vals)), feasible.reshape(n_designs, len(vals)),
                            shown, branch, engine,
@@ -150,6 +142,148 @@ def solve_designs(m: Mechanism, params: Mapping[str, np.ndarray], values: Sequen
 
 
 # --- the closed-form engine ----------------------------------------------------------------
+
+def _param_columns(m: Mechanism, params: Mapping[str, np.ndarray]) -> dict[str, Any]:
+    """Every parameter in internal units, as the derivation reads them: a float, or (a
+    varied one) a column of shape (designs, 1) that broadcasts against a row of positions."""
+    out: dict[str, Any] = {}
+    for name, q in m.parameters.items():
+        if name in params:
+            a = np.asarray(params[name], dtype=float).reshape(-1, 1)
+            out[name] = a * ANGLE_UNITS[q.unit] if q.kind == "angle" else a
+        else:
+            out[name] = q.value
+    return out
+
+
+def _rows(columns: Mapping[str, Any], rows: np.ndarray) -> dict[str, Any]:
+    """The parameter columns of some designs only."""
+    return {k: (v[rows] if isinstance(v, np.ndarray) else v) for k, v in columns.items()}
+
+
+@dataclass(frozen=True)
+class BranchText:
+    """A ``--branch`` text read against a derivation: the signs themselves (``+-``), or a
+    name: one word per two-way step (True for open or +) and how many ``(mirror)``
+    suffixes it carries (the second assembly of one name at a driver value)."""
+
+    signs: tuple[float, ...] | None
+    words: tuple[bool, ...] = ()
+    mirrors: int = 0
+
+
+def read_branch(der: Derivation, text: str) -> BranchText:
+    """What a ``--branch`` text asks of this derivation (:meth:`Derivation.branch_signs`
+    reads the same texts); a ValueError saying what the choices are otherwise."""
+    count = len(der.two_way)
+    signs = parse_signs(text, count)
+    if signs is not None:
+        return BranchText(signs)
+    base, mirrors = text, 0
+    while base.endswith(MIRROR):
+        base, mirrors = base[: -len(MIRROR)], mirrors + 1
+    parts = base.split("/") if count else []
+    choices = [("open", "crossed") if der.steps[i].word_rule else ("+", "-") for i in der.two_way]
+    if len(parts) != count or any(w not in c for w, c in zip(parts, choices)):
+        example = "/".join(a for a, _ in choices)
+        if count == 1:
+            named = f"{choices[0][0]} or {choices[0][1]}"
+        else:
+            named = (f"a name, one word per two-way step joined by / "
+                     f"({' / '.join(f'{a} or {b}' for a, b in choices)}, e.g. {example})")
+        raise ValueError(f"{text!r} is not a branch of this mechanism: give {named}, or the signs "
+                         f"of its {count} two-way step{'s' if count != 1 else ''} (e.g. {'+' * count}); "
+                         f"a second assembly of one name is NAME{MIRROR}")
+    return BranchText(None, tuple(w in ("open", "+") for w in parts), mirrors)
+
+
+def _words_np(der: Derivation, q: Sequence[Any], d: Any, params: Mapping[str, Any]) -> list[Any]:
+    """Each two-way step's word for configurations ``q`` (arrays), as
+    :meth:`Derivation.words_of` gives it: True for open (a four-bar or slider-crank loop)
+    or + (the step's sign, 0 counting as +)."""
+    sides = iter(der.signs_of_np(q, d, params))
+    out = []
+    for step in der.steps:
+        if not step.two_way:
+            continue
+        side = next(sides)
+        out.append(is_open_np(step, params, d, q) if step.word_rule else side >= 0.0)
+    return out
+
+
+def _names_are_signs(der: Derivation) -> bool:
+    """True where each two-way step's word is a function of its sign alone, whatever the
+    design and the driver value: a four-bar step that solves the coupler and the output
+    (open/crossed is the side of the coupler from the diagonal), a slider step (open is
+    the larger root), or a step named by its sign. Not so for a four-bar driven by its
+    output, whose step solves the input and the coupler."""
+    for i in der.two_way:
+        step = der.steps[i]
+        if step.word_rule == "fourbar":
+            assert step.word_terms is not None
+            if {t[2] for t in step.word_terms} != set(step.unknowns):
+                return False
+    return True
+
+
+def design_signs(der: Derivation, text: str, drivers: np.ndarray, columns: Mapping[str, Any],
+                 n_designs: int) -> tuple[np.ndarray, np.ndarray]:
+    """The sign tuple each design follows on branch ``text`` (designs x two-way steps) and
+    which designs have it at all. Signs are the same for every design. A name is each
+    design's own: the assembly of that name (:meth:`Derivation.named_solutions`, distinct
+    configurations in :attr:`Derivation.branches` order, the second of one name its
+    mirror) at the first driver value (internal units, in the order given) where the
+    design has one, as a sweep of that design given ``--branch NAME`` starts on it. Where
+    the name is a function of the signs alone (a crank-driven four-bar, a slider-crank,
+    the Watt six-bar's two four-bar loops) that is one sign tuple for every design."""
+    want = read_branch(der, text)
+    count = len(der.two_way)
+    if want.signs is not None:
+        return np.tile(np.array(want.signs, dtype=float), (n_designs, 1)), np.ones(n_designs, bool)
+    branches = np.array(der.branches, dtype=float).reshape(len(der.branches), count)
+    out = np.tile(branches[0], (n_designs, 1))
+    named = np.zeros(n_designs, dtype=bool)
+    todo = np.arange(n_designs)
+    # the first driver value for every design (most find the name there), then all the
+    # others at once for those that did not
+    for cols in (drivers[:1], drivers[1:]):
+        if todo.size == 0 or cols.size == 0:
+            break
+        sub = _rows(columns, todo)
+        drv = cols[None, :]
+        first = np.full(todo.size, cols.size)  # the first column where a branch has the name
+        pick = np.zeros(todo.size, dtype=np.int64)  # which branch
+        seen: list[tuple[list[Any], Any, list[Any]]] = []  # (q, distinct, words) of earlier branches
+        for b, signs in enumerate(der.branches):
+            q, ok = der.solve_np(drv, signs, sub)
+            q = [np.broadcast_to(c, ok.shape) for c in q]
+            words = [np.broadcast_to(w, ok.shape) for w in _words_np(der, q, drv, sub)]
+            same_name = np.zeros(ok.shape, dtype=np.int64)
+            distinct = ok.copy()
+            for q_e, distinct_e, words_e in seen:
+                equal = np.logical_and.reduce([a == c for a, c in zip(q_e, q)]) if q else ok
+                distinct &= ~(distinct_e & equal)
+                alike = np.logical_and.reduce([a == c for a, c in zip(words_e, words)]) if words else ok
+                same_name += distinct_e & alike
+            hit = distinct & (same_name == want.mirrors)
+            for w, word in zip(words, want.words):
+                hit &= w == word
+            col = np.where(hit.any(axis=1), hit.argmax(axis=1), cols.size)
+            # names are unique at a driver value: an earlier column wins, never a tie
+            earlier = col < first
+            first[earlier], pick[earlier] = col[earlier], b
+            seen.append((q, distinct, words))
+        found = first < cols.size
+        out[todo[found]] = branches[pick[found]]
+        named[todo[found]] = True
+        todo = todo[~found]
+        agreed = np.unique(out[named], axis=0)
+        if todo.size and len(agreed) == 1 and _names_are_signs(der):
+            # the name is one sign tuple for every design: the rest need no search
+            out[todo], named[todo] = agreed[0], True
+            todo = todo[:0]
+    return out, named
+
 
 def _grid(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray,
           n_designs: int) -> tuple[dict[str, Any], np.ndarray]:
@@ -184,62 +318,97 @@ def _size(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray) -> Any:
     return np.where(size > 0.0, size, 1.0)
 
 
-def _closed_form_seeds(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray,
-                       branch: str) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
-    """Each unknown (internal units) on ``branch`` at every position, from the closed form's
-    numpy twins (:mod:`linkage.problems.assembly`); where the linkage can be assembled;
-    and where the two branches meet (a limit position: the branch label of a solution
-    there is a matter of rounding). The pick is the scalar closed form's
-    (closed_form.fourbar_positions): by label. Crank-driven four-bars and slider-cranks
-    only (:func:`closed_form_applies`)."""
-    want_open = branch == "open"
-    if m.closed_form == "slider_crank":
-        (open_, crossed), ok = slider_crank_np(grid["r2"], grid["r3"], grid["e"], drv)
-        fold = np.abs(math.pi - 2.0 * open_[0]) <= SEED_DISTANCE
-        t3, s = open_ if want_open else crossed
-        return {"theta3": t3, "s": s}, ok, fold
-    r1, r2, r3, r4, t1 = (grid[k] for k in ("r1", "r2", "r3", "r4", "theta1"))
-    (first, second), ok = fourbar_by_crank_np(r1, r2, r3, r4, t1, drv)
-    pick = is_open_np(*first) == want_open
-    fold = _apart((first[0], second[0])) <= SEED_DISTANCE
-    return ({"theta3": np.where(pick, first[0], second[0]),
-             "theta4": np.where(pick, first[1], second[1])}, ok, fold)
-
-
-def _on_branch_here(m: Mechanism, q: Sequence[np.ndarray], branch: str) -> np.ndarray:
-    """The configuration rule of each solved position (internal units): what
-    :func:`~linkage.problems.closed_form.branch_rule` says, over arrays."""
-    at = {u.name: c for u, c in zip(m.unknowns, q)}
-    if m.closed_form == "slider_crank":
-        is_open = slider_is_open_np(at["theta3"])
-    else:
-        is_open = is_open_np(at["theta3"], at["theta4"])
-    return np.asarray(is_open == (branch == "open"))
-
-
 def _apart(angles: tuple[Any, Any]) -> Any:
     """How far apart two angles are (rad, the short way round)."""
-    return np.abs(np.angle(np.exp(1j * (angles[0] - angles[1]))))
+    d = angles[0] - angles[1]
+    return np.abs(d - (2.0 * math.pi) * np.round(d / (2.0 * math.pi)))
+
+
+def _distance(m: Mechanism, a: Sequence[np.ndarray], b: Sequence[np.ndarray], size: np.ndarray) -> np.ndarray:
+    """max over unknowns of how far apart two configurations are (rad, or relative to the
+    size); NaN where either is NaN."""
+    out = np.zeros(len(size))
+    for x, y, u in zip(a, b, m.unknowns):
+        far = _apart((x, y)) if u.kind == "angle" else np.abs(x - y) / size
+        out = np.maximum(out, far)
+    return out
 
 
 def _closed_form_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, branch: str,
                         tol: float, max_iter: int, n_designs: int) -> tuple[list[np.ndarray], np.ndarray,
                                                                             np.ndarray, str]:
+    """The derivation's closed form (:meth:`Derivation.solve_np`) for every design at every
+    position at once, designs (D, 1) against positions (1, P), on each design's sign tuple
+    (:func:`design_signs`); then Newton on the loops polishes every assembled position,
+    vectorised, with the single solve's stopping rule (:func:`_newton`). A position counts
+    as solved only when Newton converges there, stays within SEED_DISTANCE of the closed
+    form and lies on the branch's side of every two-way step (or where the two sides meet
+    within SEED_DISTANCE: a limit position, whose side is a matter of rounding). Where the
+    branch does not assemble it is ``off_branch`` if another branch does, else
+    ``no_solution``."""
+    der = m.derivation
+    k = len(vals)
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    row = (vals * scale)[None, :]
+    columns = _param_columns(m, params)
+    signs, named = design_signs(der, branch, row[0], columns, n_designs)
+    n = len(m.unknowns)
+    seed = [np.full((n_designs, k), np.nan) for _ in range(n)]
+    ok = np.zeros((n_designs, k), dtype=bool)
+    groups, which = np.unique(signs, axis=0, return_inverse=True)
+    for g, tup in enumerate(groups):
+        rows = np.flatnonzero((which.reshape(-1) == g) & named)
+        if rows.size == 0:
+            continue
+        q, good = der.solve_np(row, tuple(float(s) for s in tup), _rows(columns, rows))
+        for j in range(n):
+            seed[j][rows] = q[j]
+        ok[rows] = good
+    seed = [c.reshape(-1) for c in seed]
+    ok = ok.reshape(-1)
     grid, drv = _grid(m, params, vals, n_designs)
-    seeds, feasible, fold = _closed_form_seeds(m, grid, drv, branch)
-    seed = [np.where(feasible, seeds[u.name], 0.0) for u in m.unknowns]
+    # where the followed branch does not assemble: does any other? (off_branch, not no_solution)
+    feasible = ok.copy()
+    miss = np.flatnonzero(~ok)
+    if miss.size:
+        sub = _rows(grid, miss)
+        for other in der.branches:
+            _, good = der.solve_np(drv[miss], other, sub)
+            feasible[miss] |= np.broadcast_to(good, miss.shape)
     size = _size(m, grid, drv)
-    loops = VectorLoops.of_terms(_terms(m, grid, drv), len(m.unknowns), len(drv))
-    q = [c.copy() for c in seed]
-    done, _det = _newton(loops, q, np.flatnonzero(feasible), tol, size,
-                        [k == "length" for k in (u.kind for u in m.unknowns)], max_iter)
-    moved = np.zeros(len(drv))
-    for c, s, u in zip(q, seed, m.unknowns):
-        np.maximum(moved, np.abs(c - s) / (size if u.kind == "length" else 1.0), out=moved)
-    on_branch = _on_branch_here(m, q, branch)
-    status = np.where(feasible, FAILED, NO_SOLUTION).astype(np.int8)
-    status[done & (moved <= SEED_DISTANCE) & (on_branch | fold) & feasible] = CONVERGED
-    return q, status, feasible, "closed form + vectorised Newton"
+    loops = VectorLoops.of_terms(_terms(m, grid, drv), n, len(drv))
+    q = [np.where(ok, c, 0.0) for c in seed]
+    # one loop: Cramer's rule as for every 2 x 2; more: the derivation's blocks
+    linear = _stepwise_linear(der) if len(m.loops) > 1 else None
+    done, _det = _newton(loops, q, np.flatnonzero(ok), tol, size,
+                        [u.kind == "length" for u in m.unknowns], max_iter, linear=linear)
+    moved = _distance(m, q, seed, size)
+    accept = done & (moved <= SEED_DISTANCE) & ok
+    # the side of every two-way step, as the branch says; where Newton landed on another
+    # side, only if that side's closed form is the same position (a limit position)
+    target = np.repeat(signs, k, axis=0)
+    where = np.flatnonzero(accept)
+    sides = der.signs_of_np([c[where] for c in q], drv[where], _rows(grid, where))
+    landed = target[where].copy()
+    for i, side in enumerate(sides):
+        side = np.broadcast_to(side, where.shape)
+        landed[:, i] = np.where(side != 0.0, side, landed[:, i])
+    wrong = (landed != target[where]).any(axis=1)
+    if wrong.any():
+        rows = where[wrong]
+        fold = np.zeros(rows.size, dtype=bool)
+        tuples, back = np.unique(landed[wrong], axis=0, return_inverse=True)
+        for g, tup in enumerate(tuples):
+            part = np.flatnonzero(back.reshape(-1) == g)
+            at = rows[part]
+            other, _ = der.solve_np(drv[at], tuple(float(s) for s in tup), _rows(grid, at))
+            near = _distance(m, [np.broadcast_to(c, at.shape) for c in other], [c[at] for c in seed],
+                             size[at])
+            fold[part] = near <= SEED_DISTANCE
+        accept[rows[~fold]] = False
+    status = np.where(feasible, np.where(ok, FAILED, OFF_BRANCH), NO_SOLUTION).astype(np.int8)
+    status[accept] = CONVERGED
+    return q, status, feasible, ENGINES["closed form"]
 
 
 def _resolver(m: Mechanism, grid: Mapping[str, Any], drv: Any,
@@ -268,11 +437,53 @@ def _terms(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray) -> list[list[
     return [[(t.sign, *ref(t.length), *ref(t.angle), t.offset) for t in loop.vectors] for loop in m.loops]
 
 
+Linear = Callable[[list[list[Any]], list[np.ndarray], int], tuple[list[Any], Any, Any]]
+"""J dq = -Phi at every position: (dq, det J, where J is singular)."""
+
+
+def _stepwise_linear(der: Derivation) -> Linear:
+    """J dq = -Phi by the derivation's steps, as the closed form solves the loops: each
+    step's two equations (its loop, or its two loops combined with the step's weights)
+    hold only its two unknowns and those of earlier steps, so J is block triangular and
+    every block is a 2 x 2 solved by Cramer's rule (a Watt six-bar's 4 x 4 at a fifth of
+    the cost of a stacked numpy solve). J is singular where a block is, by the 2 x 2 test
+    :func:`_newton` applies to a one-loop J."""
+    plan = [(tuple(zip(step.loops, step.weights)), step.unknowns) for step in der.steps]
+
+    def solve(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[list[Any], Any, Any]:
+        dq: list[Any] = [None] * len(jac[0])
+        det: Any = 1.0
+        singular = np.zeros(k, dtype=bool)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            for rows, (a, b) in plan:
+                ex: Any = 0.0
+                ey: Any = 0.0
+                jx: list[Any] = [0.0] * len(dq)
+                jy: list[Any] = [0.0] * len(dq)
+                for loop, w in rows:
+                    ex, ey = ex - w * phi[2 * loop], ey - w * phi[2 * loop + 1]
+                    for j in range(len(dq)):
+                        jx[j] = jx[j] + w * jac[2 * loop][j]
+                        jy[j] = jy[j] + w * jac[2 * loop + 1][j]
+                for j, d_j in enumerate(dq):
+                    if d_j is not None:  # an unknown of an earlier step
+                        ex, ey = ex - jx[j] * d_j, ey - jy[j] * d_j
+                pa, pb, pc, pd = jx[a], jx[b], jy[a], jy[b]
+                det_s = pa * pd - pb * pc
+                singular |= ~(np.abs(det_s) > SINGULAR_RATIO * (np.abs(pa * pd) + np.abs(pb * pc)))
+                dq[a], dq[b] = (ex * pd - pb * ey) / det_s, (pa * ey - pc * ex) / det_s
+                det = det * det_s
+        return [np.broadcast_to(d_j, (k,)) for d_j in dq], np.broadcast_to(det, (k,)), singular
+
+    return solve
+
+
 def _newton(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol: float, size: np.ndarray,
-            is_length: list[bool], max_iter: int, count: bool = False) -> Any:
+            is_length: list[bool], max_iter: int, count: bool = False, linear: Linear | None = None) -> Any:
     """Newton-Raphson at every ``active`` position at once, updating ``q_all`` in place;
     only unconverged positions keep iterating. Returns (converged, det J), and with
-    ``count`` the iterations each took as well."""
+    ``count`` the iterations each took as well. ``linear``: how J dq = -Phi is solved
+    (default: Cramer's rule for 2 x 2, else a stacked numpy solve)."""
     n_pos = len(size)
     done = np.zeros(n_pos, dtype=bool)
     det_out = np.full(n_pos, np.nan)
@@ -283,13 +494,16 @@ def _newton(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol
         if active.size == 0:
             break
         phi, jac = loops.evaluate(q, active)
-        dq, det = solve_linear(jac, phi, active.size)
         scale = size[active]
         resid = np.abs(phi[0])
         for f in phi[1:]:
             np.maximum(resid, np.abs(f), out=resid)
-        singular = ~np.isfinite(det) | (det == 0.0)
-        if len(jac) == 2 and len(jac[0]) == 2:
+        if linear is not None:
+            dq, det, singular = linear(jac, phi, active.size)
+        else:
+            dq, det = solve_linear(jac, phi, active.size)
+            singular = ~np.isfinite(det) | (det == 0.0)
+        if linear is None and len(jac) == 2 and len(jac[0]) == 2:
             (a, b), (c, d) = jac
             with np.errstate(invalid="ignore"):
                 singular |= ~(np.abs(det) > SINGULAR_RATIO * (np.abs(a * d) + np.abs(b * c)))
@@ -509,11 +723,78 @@ def _paths(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, q: 
     return out
 
 
-def _continuous(m: Mechanism, shown: np.ndarray, vals: np.ndarray) -> None:
+def _turn_references(m: Mechanism, params: Mapping[str, np.ndarray], n_designs: int,
+                     tol: float) -> np.ndarray:
+    """What ``solve FILE`` gives each design at the file's driver value from the file's
+    guess (display units, designs x unknowns; NaN where it does not converge): the turn a
+    sweep reports its angles in (:func:`~linkage.kinematics.stepwise.sweep`). Newton from
+    the guess for every design at once; a design where some whole step would not have
+    lowered |Phi|^2 (where the single solve's globalised Newton takes another step) is
+    solved by that solve itself."""
+    from ..solve import solve_system
+
+    n = len(m.unknowns)
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    grid, drv = _grid(m, params, np.array([m.driver.value / scale]), n_designs)
+    loops = VectorLoops.of_terms(_terms(m, grid, drv), n, n_designs)
+    size = _size(m, grid, drv)
+    is_length = [u.kind == "length" for u in m.unknowns]
+    gate = residual_gate(tol, size)
+    q = [np.full(n_designs, u.value) for u in m.unknowns]
+    plain = np.ones(n_designs, dtype=bool)  # every step so far the globalised solve's too
+    done = np.zeros(n_designs, dtype=bool)
+    phi, jac = loops.evaluate(q, None)
+    with np.errstate(invalid="ignore", over="ignore"):
+        for _ in range(50):
+            live = plain & ~done
+            if not live.any():
+                break
+            dq, _ = solve_linear(jac, phi, n_designs)
+            trial = [c + d for c, d in zip(q, dq)]
+            phi_t, jac_t = loops.evaluate(trial, None)
+            tiny = _largest(dq) <= 64.0 * np.finfo(float).eps * (1.0 + _largest(q))
+            plain &= ~live | (_sumsq(phi_t) <= (1.0 - 1e-4) * _sumsq(phi)) | tiny
+            step = step_size_array(dq, [size if length else 1.0 for length in is_length])
+            done |= live & plain & system_converged_array(step, _largest(phi), tol, gate)
+            q = [np.where(live, t, c) for t, c in zip(trial, q)]
+            phi = [np.where(live, t, c) for t, c in zip(phi_t, phi)]
+            jac = [[np.where(live, t, c) for t, c in zip(rt, rc)] for rt, rc in zip(jac_t, jac)]
+    out = np.stack([np.degrees(c) if u.kind == "angle" else c for c, u in zip(q, m.unknowns)], axis=1)
+    out[~done] = np.nan
+    rest = ~plain
+    if rest.any() and m.derivation.complete:
+        # no assembly there on any branch: that solve cannot converge either
+        there = np.zeros(n_designs, dtype=bool)
+        for signs in m.derivation.branches:
+            there |= np.broadcast_to(m.derivation.solve_np(drv, signs, grid)[1], there.shape)
+        rest &= there
+    for d in np.flatnonzero(rest):
+        design = m.with_values({k: float(np.atleast_1d(a)[d]) for k, a in params.items()}, {})
+        # its loops walked, not compiled (the same Phi and J; compiling costs more than the solve)
+        F, J = LoopModel.compile(design).interpreted_functions(float(drv[d]))
+        r = solve_system(F, tuple(u.value for u in m.unknowns), jac=J, tol=tol, record=False)
+        if r.converged:
+            out[d] = [math.degrees(x) if u.kind == "angle" else x for x, u in zip(r.x, m.unknowns)]
+    return out
+
+
+def _largest(parts: Sequence[Any]) -> Any:
+    out = np.abs(parts[0])
+    for p in parts[1:]:
+        out = np.maximum(out, np.abs(p))
+    return out
+
+
+def _sumsq(parts: Sequence[Any]) -> Any:
+    return sum(p * p for p in parts)
+
+
+def _continuous(m: Mechanism, shown: np.ndarray, vals: np.ndarray, refs: np.ndarray) -> None:
     """In place: each angle continuous along the cycle by the rule of
     :mod:`linkage.kinematics.angles` (driver order around the circle), each design's curve
-    in the turn within half a turn of the file's guess at the solved position nearest the
-    file's driver value."""
+    shifted by whole turns to the turn ``refs`` gives (:func:`_turn_references`: what
+    ``solve FILE`` gives the design) at the solved position nearest the file's driver
+    value, as the sweep does; not shifted where that solve does not converge."""
     if shown.size == 0:
         return
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
@@ -530,5 +811,5 @@ def _continuous(m: Mechanism, shown: np.ndarray, vals: np.ndarray) -> None:
         turns = unwrap_turns_array(a, closes)
         near = anchor_index_array(vals, solved, v0, closes, turn)[:, None]
         at = continuous(np.take_along_axis(a, near, axis=1), np.take_along_axis(turns, near, axis=1))
-        shift = turn_shift_array(math.degrees(u.value), at)
+        shift = np.nan_to_num(turn_shift_array(refs[:, j:j + 1], at), nan=0.0)
         shown[:, :, j] = np.where(solved, continuous(a, turns + shift), np.nan)

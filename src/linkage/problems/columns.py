@@ -21,6 +21,21 @@ SUMMARY = (("feasible_fraction", "number", ""), ("solved_fraction", "number", ""
            ("full_cycle", "bool", ""))
 FOURBAR = (("grashof", "text", ""), ("min_transmission_deg", "number", "deg"),
            ("max_transmission_deg", "number", "deg"))
+"""A four-bar loop's columns: its Grashof class and the extremes of its transmission angle
+(folded into [0, 90] deg)."""
+
+
+def fourbar_loops(m: Any) -> list[tuple[Any, str]]:
+    """Each four-bar loop of the mechanism's derivation (``m.derivation.fourbars``) with
+    the suffix of its columns: none for the first (a four-bar's columns keep their plain
+    names), ``_N`` for any other, N its loop's number as ``solve``'s header counts loops
+    (a Watt six-bar's second four-bar gives ``min_transmission_deg_2``)."""
+    return [(v, "" if i == 0 else f"_{v.loop + 1}") for i, v in enumerate(m.derivation.fourbars)]
+
+
+def fourbar_columns(suffix: str) -> tuple[tuple[str, str, str], ...]:
+    """The columns of one four-bar loop, as FOURBAR names them, with its suffix."""
+    return tuple((f"{c}{suffix}", t, u) for c, t, u in FOURBAR)
 
 
 def extent_columns(name: str) -> tuple[str, str, str]:
@@ -44,8 +59,9 @@ def sourced_columns(m: Any, names: Sequence[str]) -> list[tuple[str, str, str, s
     for q in m.unknowns:
         uu = "deg" if q.kind == "angle" else m.length_unit
         cols += [(c, "number", uu, f"unknown {q.name}", f"unknowns.{q.name}") for c in extent_columns(q.name)]
-    if m.closed_form == "fourbar":
-        cols += [(c, t, u, "a column every four-bar scan writes", "") for c, t, u in FOURBAR]
+    for view, suffix in fourbar_loops(m):
+        origin = f"a column of four-bar loop {view.loop + 1} ({m.loops[view.loop].name})"
+        cols += [(c, t, u, origin, "") for c, t, u in fourbar_columns(suffix)]
     for p in m.points:
         cols += [(c, "number", m.length_unit, f"point {p}", f"points.{p}")
                  for axis in "xy" for c in path_columns(p, axis)]
