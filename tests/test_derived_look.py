@@ -134,3 +134,11 @@ def test_watt_sweep_says_its_transmission_column_is_the_worst_loops(cli):
         switched.add(worst)
         assert p["transmission"] == pytest.approx(loops[worst], abs=1e-8), (p["input"], loops)
     assert switched == {0, 1}  # the column is not one loop's throughout
+
+
+def test_sweep_refusal_of_a_name_absent_at_the_start_says_what_a_sign_is(cli):
+    """It said 'or give the signs of the 1 two-way step, e.g. +'."""
+    run_ = cli("sweep", str(SAMPLES / "crank_rocker.toml"), "--step", "60", "--branch", "open (mirror)")
+    assert run_.code == 2 and len(run_.err.splitlines()) == 1
+    assert "assemblies: open, crossed; or their signs, one + or - per closed-form step with two roots" \
+        in run_.err and "two-way" not in run_.err
