@@ -142,3 +142,14 @@ def test_sweep_refusal_of_a_name_absent_at_the_start_says_what_a_sign_is(cli):
     assert run_.code == 2 and len(run_.err.splitlines()) == 1
     assert "assemblies: open, crossed; or their signs, one + or - per closed-form step with two roots" \
         in run_.err and "two-way" not in run_.err
+
+
+def test_a_six_bar_sweep_names_its_one_four_bar_loop(cli):
+    """The Stephenson six-bar's sweep said 'four-bar: Grashof crank-rocker' of a six-bar;
+    solve names the loop, and now the sweep does too (a single four-bar stays 'four-bar')."""
+    short, p, q, long_ = sorted((40.0, 120.0, 80.0, 100.0))  # r2, r3, r4, r1 of loop O2-A-B-O4
+    facts = f"Grashof crank-rocker (s + l = {short + long_:g}, p + q = {p + q:g})"
+    six = cli("sweep", str(SAMPLES / "stephenson_sixbar.toml"), "--step", "120", "--format", "plain").out
+    assert f"four-bar loop O2-A-B-O4: {facts}" in six.splitlines()
+    four = cli("sweep", str(SAMPLES / "crank_rocker.toml"), "--step", "120", "--format", "plain").out
+    assert f"four-bar: {facts}" in four.splitlines()
