@@ -153,3 +153,11 @@ def test_a_six_bar_sweep_names_its_one_four_bar_loop(cli):
     assert f"four-bar loop O2-A-B-O4: {facts}" in six.splitlines()
     four = cli("sweep", str(SAMPLES / "crank_rocker.toml"), "--step", "120", "--format", "plain").out
     assert f"four-bar: {facts}" in four.splitlines()
+
+
+def test_sweep_refusal_of_a_coupled_file_says_how_to_choose_its_assembly(cli):
+    """The sweep has no --guess: the way to another assembly is the file's guesses."""
+    run_ = cli("sweep", str(SAMPLES / "offset_slider.toml"), "--branch", "open")
+    assert run_.code == 2 and len(run_.err.splitlines()) == 1
+    assert "loop 1 has 3 unknowns, loop 2 has 3 unknowns (coupled); its sweep follows the assembly " \
+           "of the file's guesses (change them under [unknowns] to follow another)" in run_.err

@@ -135,7 +135,8 @@ def check_branch(m: Mechanism, branch: str) -> None:
 
     refusal = m.derivation.branch_refusal(m.source)
     if refusal:
-        raise InputError(f"{refusal} (its branch follows the file's guess)")
+        raise InputError(f"{refusal}; its sweep follows the assembly of the file's guesses "
+                         "(change them under [unknowns] to follow another)")
     choices = branch_choices(m)
     if branch not in choices:
         names = choices[:len(m.derivation.branches)]
