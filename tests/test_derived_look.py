@@ -161,3 +161,14 @@ def test_sweep_refusal_of_a_coupled_file_says_how_to_choose_its_assembly(cli):
     assert run_.code == 2 and len(run_.err.splitlines()) == 1
     assert "loop 1 has 3 unknowns, loop 2 has 3 unknowns (coupled); its sweep follows the assembly " \
            "of the file's guesses (change them under [unknowns] to follow another)" in run_.err
+
+
+def test_counts_agree_with_their_number(cli):
+    """--branch starts on the closed form, so one step is usual: '1 iterations' read oddly."""
+    one = cli("solve", str(SAMPLES / "crank_rocker.toml"), "--branch", "crossed", "--format", "plain").out
+    doc = json.loads(cli("solve", str(SAMPLES / "crank_rocker.toml"), "--branch", "crossed",
+                         "--format", "json").out)
+    assert doc["iteration_count"] == 1 and doc["njev"] == 1 and doc["nfev"] == 2
+    assert "1 iteration, 2 residual evaluations, 1 Jacobian evaluation, max|Phi|" in one
+    four = cli("solve", str(SAMPLES / "crank_rocker.toml"), "--format", "plain").out
+    assert "4 iterations, 5 residual evaluations, 4 Jacobian evaluations, max|Phi|" in four
