@@ -172,3 +172,11 @@ def test_counts_agree_with_their_number(cli):
     assert "1 iteration, 2 residual evaluations, 1 Jacobian evaluation, max|Phi|" in one
     four = cli("solve", str(SAMPLES / "crank_rocker.toml"), "--format", "plain").out
     assert "4 iterations, 5 residual evaluations, 4 Jacobian evaluations, max|Phi|" in four
+
+
+def test_solve_help_says_what_the_closed_form_header_means(cli):
+    """The header's 'closed form: loops 1, 2 (stepwise)' and '(coupled)' were explained nowhere
+    a student would look first."""
+    text = _words(cli("solve", "--help").out)
+    assert '("loops 1, 2 (stepwise)": loop 1 solved first, then loop 2 with its answers)' in text
+    assert "which are coupled (Newton only)" in text

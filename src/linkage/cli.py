@@ -244,7 +244,10 @@ def solve(
 
     Without options: Newton's method on the four-bar input-output equation (the course
     notes' example, alpha = 70 deg) from phi = 50 deg. With FILE (or - for standard
-    input): Newton-Raphson on the mechanism's loop equations.
+    input): Newton-Raphson on the mechanism's loop equations. Its header says which loops
+    also have an exact closed form ("loops 1, 2 (stepwise)": loop 1 solved first, then loop 2
+    with its answers) and which are coupled (Newton only); with one, the table has the
+    iterates' true error and the answer its closed-form value beside it.
 
     Example: linkage solve --method secant --x0 50 --x1 60
 
