@@ -230,8 +230,9 @@ def solve(
     branch: Annotated[Optional[str], typer.Option(help="With FILE (one whose loops have a closed "
                       "form: the header says): the assembly to solve for, by name (open or crossed per "
                       "four-bar or slider-crank loop, e.g. open/crossed for a six-bar; a rocker-driven "
-                      "four-bar's second assembly of one name: 'open (mirror)') or by the sign of each "
-                      "two-way step, e.g. +-. Its closed form is the start.")] = None,
+                      "four-bar's second assembly of one name: 'open (mirror)') or by signs: + or - "
+                      "for the root taken in each closed-form step with two, in loop order (e.g. +- "
+                      "for a six-bar). Its closed form is the start.")] = None,
     speed: SpeedOpt = None,
     accel: AccelOpt = None,
     fmt: FormatOpt = None,
@@ -243,7 +244,10 @@ def solve(
 
     Without options: Newton's method on the four-bar input-output equation (the course
     notes' example, alpha = 70 deg) from phi = 50 deg. With FILE (or - for standard
-    input): Newton-Raphson on the mechanism's loop equations.
+    input): Newton-Raphson on the mechanism's loop equations. Its header says which loops
+    also have an exact closed form ("loops 1, 2 (stepwise)": loop 1 solved first, then loop 2
+    with its answers) and which are coupled (Newton only); with one, the table has the
+    iterates' true error and the answer its closed-form value beside it.
 
     Example: linkage solve --method secant --x0 50 --x1 60
 
@@ -486,7 +490,7 @@ def _start_on_branch(mechanism: Any, branch: str, guessed: bool) -> Any:
         what = f"{branch!r}"
         if signs is not None and branch != sign_text(signs):
             what += f" ({sign_text(signs)})"
-        there = (f"assemblies: {', '.join(named)}; or their signs, one per two-way step: "
+        there = (f"assemblies: {', '.join(named)}; or their signs, one per closed-form step with two roots: "
                  f"{', '.join(sign_text(s) for s, _ in named.values())}" if named else
                  "assemblies: none: it cannot be assembled there")
         raise InputError(f"--branch {what}: no such assembly at {at} ({there})")
@@ -636,9 +640,10 @@ def sweep(
     points: Annotated[Optional[int], typer.Option(help="Number of evenly spaced positions "
                       "instead of --step.")] = None,
     method: Annotated[str, typer.Option("--method", "-m", help="newton, newton-fd or lm.")] = "newton",
-    branch: Annotated[Optional[str], typer.Option(help="Assembly branch to follow: open or "
-                      "crossed (mechanisms with a closed form); default: the branch of the "
-                      "file's guess.")] = None,
+    branch: Annotated[Optional[str], typer.Option(help="Assembly branch to follow (mechanisms "
+                      "whose loops have a closed form), by name or signs as in solve --branch: open, "
+                      "crossed, open/crossed for a six-bar, 'open (mirror)', +-; default: the "
+                      "branch of the file's guess.")] = None,
     set_: SetOpt = None,
     tol: Annotated[float, typer.Option(help="Step and residual tolerance per position.")] = 1e-12,
     batch: Annotated[Optional[bool], typer.Option("--batch/--no-batch", help="Use the numpy "

@@ -170,8 +170,8 @@ def classification_of(m: Mechanism) -> dict[str, Any]:
         t = terms[view.loop]
         c = fourbar_class(*(length(t[i]) for i in (view.ground, view.input, view.coupler, view.output)))
         out.append({"loop": m.loops[view.loop].name, **c})
-    if len(out) == 1:
-        return {k: v for k, v in out[0].items() if k != "loop"}
+    if len(out) == 1:  # named when the mechanism has other loops (a Stephenson six-bar)
+        return {k: v for k, v in out[0].items() if k != "loop" or len(m.loops) > 1}
     return {**{k: v for k, v in out[0].items() if k != "loop"}, "loops": out}
 
 

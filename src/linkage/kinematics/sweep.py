@@ -131,16 +131,22 @@ def check_branch(m: Mechanism, branch: str) -> None:
     """InputError naming ``branch`` unless it is a name or sign string of ``m``'s derived
     closed form (:func:`branch_choices`)."""
     from ..errors import InputError
+    from ..problems.derive import sign_text
 
     refusal = m.derivation.branch_refusal(m.source)
     if refusal:
-        raise InputError(f"{refusal} (its branch follows the file's guess)")
+        raise InputError(f"{refusal}; its sweep follows the assembly of the file's guesses "
+                         "(change them under [unknowns] to follow another)")
     choices = branch_choices(m)
     if branch not in choices:
         names = choices[:len(m.derivation.branches)]
         main = ", ".join(names[:-1]) + " or " + names[-1] if len(names) > 1 else names[0]
-        raise InputError(f"--branch must be {main} (or {', '.join(choices[len(names):])}), "
-                         f"got {branch!r}")
+        signs = [sign_text(b) for b in m.derivation.branches]
+        # the signs and the (mirror) rule once each, not every name twice over
+        also = ("" if signs == names else
+                f", or their signs {', '.join(signs)} (one per closed-form step with two roots)")
+        raise InputError(f"--branch must be {main}{also}; a second assembly of the same name "
+                         f"is 'NAME (mirror)'; got {branch!r}")
 
 
 def __getattr__(name: str) -> Any:

@@ -426,8 +426,8 @@ class Derivation:
         if text in named:
             return named[text][0]
         where = ", ".join(named) or "none: it cannot be assembled there"
-        raise ValueError(f"no {text!r} assembly here (assemblies: {where}; or give the signs of "
-                         f"the {count} two-way step{'s' if count != 1 else ''}, e.g. {'+' * count})")
+        raise ValueError(f"no {text!r} assembly here (assemblies: {where}; or their signs, one + "
+                         f"or - per closed-form step with two roots, e.g. {'+' * count})")
 
 
 MIRROR = " (mirror)"

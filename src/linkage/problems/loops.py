@@ -382,7 +382,7 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
 
         missing = [k for k in REQUIRED_NAMES[closed_form] if k not in known]
         if missing:
-            raise fail("closed_form", f"{closed_form} needs the names {', '.join(missing)}")
+            raise fail("closed_form", f"{closed_form} needs the names {', '.join(missing)}{KEY_HINT}")
     unused = [u.name for u in unknowns if u.name not in used]
     if unused:
         raise fail(f"unknowns.{unused[0]}", "appears in no loop")
@@ -400,11 +400,15 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
 
         why = verify(mechanism)
         if why:
-            raise fail("closed_form", f"{closed_form!r} does not describe this file: {why}")
+            raise fail("closed_form", f"{closed_form!r} does not describe this file: {why}{KEY_HINT}")
         if not mechanism.derivation.complete:
             raise fail("closed_form", f"{closed_form!r} does not describe this file: "
-                                      f"{mechanism.derivation.summary}")
+                                      f"{mechanism.derivation.summary}{KEY_HINT}")
     return mechanism
+
+
+KEY_HINT = "; the key is no longer needed: delete it and the closed form is derived from the loops"
+"""What a refused ``closed_form = ...`` claim adds: the way out (the claim is the old way)."""
 
 
 def _points(spec: Any, loops: list[Loop], vector: Any,

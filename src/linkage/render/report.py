@@ -194,6 +194,20 @@ def column_groups(headers: Sequence[str], rows: Sequence[Sequence[str]], width: 
     return groups
 
 
+def widen_headers(headers: Sequence[str], cols: Sequence[int], widths: list[int], width: int) -> list[int]:
+    """The widths of one group of columns, with the room the group leaves in ``width``
+    given, left to right, to columns whose header would wrap (a header such as
+    "true error (deg) vs crossed" over narrow numbers reads on one line where it fits,
+    not one word a line)."""
+    out = [widths[j] for j in cols]
+    spare = width - 1 - sum(w + 3 for w in out)
+    for i, j in enumerate(cols):
+        extra = min(max(len(headers[j]) - out[i], 0), max(spare, 0))
+        out[i] += extra
+        spare -= extra
+    return out
+
+
 def print_rich(blocks: Sequence[Block], file: Any = None) -> None:
     """Render to a terminal with rich (imported only here). A table wider than the
     terminal is split into stacked tables (:func:`column_groups`): numbers and status
@@ -217,12 +231,18 @@ def print_rich(blocks: Sequence[Block], file: Any = None) -> None:
             title = b.title or None
             if len(groups) > 1:
                 title = f"{b.title + ' ' if b.title else ''}(columns part {k + 1} of {len(groups)})"
-            t = RichTable(title=title, box=box.SIMPLE_HEAVY, title_justify="left", title_style="bold")
             widths = column_widths(b.headers, b.rows, console.width)
-            for j in cols:
+            shown = widen_headers(b.headers, cols, widths, console.width)
+            if title and len(title) > 1 + sum(w + 3 for w in shown):
+                # rich wraps a title to its table's width: a narrow table's long title
+                # would break every few words, so it is printed above, as one line
+                console.print(title, style="bold", markup=False)
+                title = None
+            t = RichTable(title=title, box=box.SIMPLE_HEAVY, title_justify="left", title_style="bold")
+            for j, w in zip(cols, shown):
                 # a fixed width: rich wraps the header in it and never shrinks a number
                 t.add_column(b.headers[j], justify="left" if is_prose(b.rows, j, widths[j]) else "right",
-                             overflow="fold", width=widths[j])
+                             overflow="fold", width=w)
             for r in b.rows:
                 t.add_row(*(r[j] for j in cols))
             console.print(t)

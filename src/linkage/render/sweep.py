@@ -116,6 +116,9 @@ def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400) -> list[Block
             where = f" loop {c['loop']}" if "loop" in c else ""
             blocks.append(Text(f"four-bar{where}: {c['type']} (s + l = {fmt(c['s_plus_l'], 6)}, "
                                f"p + q = {fmt(c['p_plus_q'], 6)})"))
+        if len(s.classification.get("loops", ())) > 1:  # one column for several loops
+            blocks.append(Text("transmission angle: at each position, of the four-bar loop "
+                               "farthest from 90 deg"))
     rows = sweep_rows(s, kinematics=False)
     headers = sweep_headers(s, kinematics=False)
     if s.motion is not None:  # the unknowns' rates beside their values (joints: csv, json)

@@ -51,8 +51,9 @@ def system_blocks(problem: SystemProblem, result: Result, conv: Convergence | No
             shown = _turn_of(ref[name], value, problem.kinds[i])
             line += f"   (closed form, {branch} branch: {fmt(shown, max(digits, 15))})"
         blocks.append(Text(line, "bold"))
-    blocks.append(Text(f"{result.iterations} iterations, {result.nfev} residual evaluations, "
-                       f"{result.njev} Jacobian evaluations, max|Phi| at the "
+    blocks.append(Text(f"{_count(result.iterations, 'iteration')}, "
+                       f"{_count(result.nfev, 'residual evaluation')}, "
+                       f"{_count(result.njev, 'Jacobian evaluation')}, max|Phi| at the "
                        f"{'solution' if result.converged else 'last iterate'} = "
                        f"{fmt(result.residual, 3)} {problem.length_unit}".rstrip()))
     blocks.extend(Text(fourbar_line(fact, digits)) for fact in fourbars)
@@ -71,6 +72,11 @@ def _turn_of(ref: float, value: float, kind: str) -> float:
     from ..problems.closed_form import wrap_degrees
 
     return value + wrap_degrees(ref - value)
+
+
+def _count(n: int, noun: str) -> str:
+    """'1 iteration', '4 iterations' (--branch starts on the closed form: often 1)."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
 
 
 def fourbar_line(fact: dict[str, Any], digits: int) -> str:
