@@ -302,11 +302,10 @@ def test_the_scan_target_is_judged_at_two_thousand_designs():
     ("watt_sixbar", ("r2", "r3", "r4", "r5", "r6", "r7", "g", "gamma")),
     ("fourbar_me581_theta4", ("r1", "r2", "r3", "r4"))])
 def test_a_name_is_one_sign_tuple_exactly_where_the_engine_says_so(name, varied):
-    """Where designs.py takes a name's signs from one design for all (_names_are_signs),
+    """Where designs.py takes a name's signs from one design for all (Derivation.names_are_signs),
     every configuration of random designs at random driver values on one sign tuple
     carries one name, by the name rule written out here (sin of the output from the
     coupler; the coupler against the slide); a rocker-driven four-bar's does not."""
-    from linkage.kinematics.designs import _names_are_signs
 
     m = load(SAMPLES / f"{name}.toml")
     der = m.derivation
@@ -328,4 +327,4 @@ def test_a_name_is_one_sign_tuple_exactly_where_the_engine_says_so(name, varied)
                 words.append(np.sin(at["theta7"] - at["theta6"]) > 0)
         for w in words:
             constant &= len(np.unique(w[ok])) == 1
-    assert constant == _names_are_signs(der)
+    assert constant == der.names_are_signs

@@ -504,8 +504,7 @@ def default_branch(m: Mechanism, branch: str | None, tol: float) -> str | None:
     derivation's two-way steps, checked here), else (with a closed form) the branch the
     file's own guess solves to at its driver value, by name where it has one, else None
     (continuation from the file's guess, design by design)."""
-    from .kinematics.designs import read_branch
-    from .problems.derive import Indeterminate, sign_text
+    from .problems.derive import Indeterminate, read_branch, sign_text
 
     der = m.derivation
     if branch is not None:

@@ -565,7 +565,7 @@ def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence
     der = m.derivation
     if not der.complete or target in ("det+", "det-"):
         return (det > 0) == (target == "det+")
-    from .designs import _words_np, read_branch  # (designs imports this module)
+    from ..problems.derive import read_branch
 
     want = read_branch(der, target)
     kinds = {u.name: u.kind for u in m.unknowns}
@@ -578,6 +578,6 @@ def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence
         else:
             # the name's words; which of two assemblies of one name (a mirror) a position
             # is on, the continuity test has already decided
-            for word, wanted in zip(_words_np(der, q, drivers, der.params or {}), want.words):
+            for word, wanted in zip(der.words_of_np(q, drivers), want.words):
                 ok &= word == wanted
     return ok

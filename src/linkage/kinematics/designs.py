@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from ..methods.newton_system import SINGULAR_RATIO
-from ..problems.derive import MIRROR, Derivation, is_open_np, parse_signs
+from ..problems.derive import Derivation, read_branch
 from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism, VectorTerm
 from ..rules import (
     continues_array,
@@ -161,71 +161,6 @@ def _rows(columns: Mapping[str, Any], rows: np.ndarray) -> dict[str, Any]:
     return {k: (v[rows] if isinstance(v, np.ndarray) else v) for k, v in columns.items()}
 
 
-@dataclass(frozen=True)
-class BranchText:
-    """A ``--branch`` text read against a derivation: the signs themselves (``+-``), or a
-    name: one word per two-way step (True for open or +) and how many ``(mirror)``
-    suffixes it carries (the second assembly of one name at a driver value)."""
-
-    signs: tuple[float, ...] | None
-    words: tuple[bool, ...] = ()
-    mirrors: int = 0
-
-
-def read_branch(der: Derivation, text: str) -> BranchText:
-    """What a ``--branch`` text asks of this derivation (:meth:`Derivation.branch_signs`
-    reads the same texts); a ValueError saying what the choices are otherwise."""
-    count = len(der.two_way)
-    signs = parse_signs(text, count)
-    if signs is not None:
-        return BranchText(signs)
-    base, mirrors = text, 0
-    while base.endswith(MIRROR):
-        base, mirrors = base[: -len(MIRROR)], mirrors + 1
-    parts = base.split("/") if count else []
-    choices = [("open", "crossed") if der.steps[i].word_rule else ("+", "-") for i in der.two_way]
-    if len(parts) != count or any(w not in c for w, c in zip(parts, choices)):
-        example = "/".join(a for a, _ in choices)
-        if count == 1:
-            named = f"{choices[0][0]} or {choices[0][1]}"
-        else:
-            named = (f"a name, one word per two-way step joined by / "
-                     f"({' / '.join(f'{a} or {b}' for a, b in choices)}, e.g. {example})")
-        raise ValueError(f"{text!r} is not a branch of this mechanism: give {named}, or the signs "
-                         f"of its {count} two-way step{'s' if count != 1 else ''} (e.g. {'+' * count}); "
-                         f"a second assembly of one name is NAME{MIRROR}")
-    return BranchText(None, tuple(w in ("open", "+") for w in parts), mirrors)
-
-
-def _words_np(der: Derivation, q: Sequence[Any], d: Any, params: Mapping[str, Any]) -> list[Any]:
-    """Each two-way step's word for configurations ``q`` (arrays), as
-    :meth:`Derivation.words_of` gives it: True for open (a four-bar or slider-crank loop)
-    or + (the step's sign, 0 counting as +)."""
-    sides = iter(der.signs_of_np(q, d, params))
-    out = []
-    for step in der.steps:
-        if not step.two_way:
-            continue
-        side = next(sides)
-        out.append(is_open_np(step, params, d, q) if step.word_rule else side >= 0.0)
-    return out
-
-
-def _names_are_signs(der: Derivation) -> bool:
-    """True where each two-way step's word is a function of its sign alone, whatever the
-    design and the driver value: a four-bar step that solves the coupler and the output
-    (open/crossed is the side of the coupler from the diagonal), a slider step (open is
-    the larger root), or a step named by its sign. Not so for a four-bar driven by its
-    output, whose step solves the input and the coupler."""
-    for i in der.two_way:
-        step = der.steps[i]
-        if step.word_rule == "fourbar":
-            assert step.word_terms is not None
-            if {t[2] for t in step.word_terms} != set(step.unknowns):
-                return False
-    return True
-
-
 def design_signs(der: Derivation, text: str, drivers: np.ndarray, columns: Mapping[str, Any],
                  n_designs: int) -> tuple[np.ndarray, np.ndarray]:
     """The sign tuple each design follows on branch ``text`` (designs x two-way steps) and
@@ -257,7 +192,7 @@ def design_signs(der: Derivation, text: str, drivers: np.ndarray, columns: Mappi
         for b, signs in enumerate(der.branches):
             q, ok = der.solve_np(drv, signs, sub)
             q = [np.broadcast_to(c, ok.shape) for c in q]
-            words = [np.broadcast_to(w, ok.shape) for w in _words_np(der, q, drv, sub)]
+            words = [np.broadcast_to(w, ok.shape) for w in der.words_of_np(q, drv, sub)]
             same_name = np.zeros(ok.shape, dtype=np.int64)
             distinct = ok.copy()
             for q_e, distinct_e, words_e in seen:
@@ -278,7 +213,7 @@ def design_signs(der: Derivation, text: str, drivers: np.ndarray, columns: Mappi
         named[todo[found]] = True
         todo = todo[~found]
         agreed = np.unique(out[named], axis=0)
-        if todo.size and len(agreed) == 1 and _names_are_signs(der):
+        if todo.size and len(agreed) == 1 and der.names_are_signs:
             # the name is one sign tuple for every design: the rest need no search
             out[todo], named[todo] = agreed[0], True
             todo = todo[:0]

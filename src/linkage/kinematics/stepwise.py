@@ -129,24 +129,9 @@ def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -
 
 
 def names_follow_signs(m: Mechanism) -> bool:
-    """Whether each branch name of ``m``'s derivation is one sign branch: every step's word
-    is its own sign's (a slider-crank loop, a step with no word, a four-bar loop solved for
-    its coupler and output). A four-bar loop driven by its rocker or coupler is solved for
-    two other links, and its open and crossed then cut across the signs."""
-    from ..problems.derive import loop_terms
-
-    d = m.derivation
-    views = {v.loop: v for v in d.fourbars}
-    terms = loop_terms(m)
-    for i in d.two_way:
-        step = d.steps[i]
-        if step.word_rule != "fourbar":
-            continue
-        view = views[step.loops[0]]
-        t = terms[view.loop]
-        if {t[view.coupler][2], t[view.output][2]} != set(step.unknowns):
-            return False
-    return True
+    """Whether each branch name of ``m``'s derivation is one sign branch
+    (:attr:`~linkage.problems.derive.Derivation.names_are_signs`)."""
+    return m.derivation.names_are_signs
 
 
 def classification_of(m: Mechanism) -> dict[str, Any]:

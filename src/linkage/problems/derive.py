@@ -392,6 +392,35 @@ class Derivation:
                 out.append("+" if sigma >= 0.0 else "-")
         return out
 
+    def words_of_np(self, q: Sequence[Any], d: Any, params: Mapping[str, Any] | None = None) -> list[Any]:
+        """:meth:`words_of` over arrays: each two-way step's word as a bool, True for open
+        (a four-bar or slider-crank loop) or + (the step's sign, 0 counting as +)."""
+        p = self._params(params)
+        sides = iter(self.signs_of_np(q, d, p))
+        out = []
+        for step in self.steps:
+            if not step.two_way:
+                continue
+            side = next(sides)
+            out.append(is_open_np(step, p, d, q) if step.word_rule else side >= 0.0)
+        return out
+
+    @property
+    def names_are_signs(self) -> bool:
+        """Whether each branch name is one sign branch, whatever the design and the driver
+        value: every two-way step's word is a function of its sign alone (a four-bar step
+        that solves the coupler and the output, whose open/crossed is the side of the
+        coupler from the diagonal; a slider step; a step named by its sign). Not so for a
+        four-bar driven by its rocker or coupler: its step solves two other links, and open
+        and crossed cut across the signs."""
+        for i in self.two_way:
+            step = self.steps[i]
+            if step.word_rule == "fourbar":
+                assert step.word_terms is not None
+                if {t[2] for t in step.word_terms} != set(step.unknowns):
+                    return False
+        return True
+
     def name_of(self, q: Sequence[float], driver: float,
                 params: Mapping[str, float] | None = None) -> str:
         """A configuration's branch name: its steps' words joined by "/"."""
@@ -443,6 +472,42 @@ def parse_signs(text: str, count: int) -> tuple[float, ...] | None:
     if len(text) != count or any(c not in "+-" for c in text):
         return None
     return tuple(1.0 if c == "+" else -1.0 for c in text)
+
+
+@dataclass(frozen=True)
+class BranchText:
+    """A ``--branch`` text read against a derivation: the signs themselves (``+-``), or a
+    name: one word per two-way step (True for open or +) and how many ``(mirror)``
+    suffixes it carries (the second assembly of one name at a driver value)."""
+
+    signs: tuple[float, ...] | None
+    words: tuple[bool, ...] = ()
+    mirrors: int = 0
+
+
+def read_branch(der: Derivation, text: str) -> BranchText:
+    """What a ``--branch`` text asks of this derivation (:meth:`Derivation.branch_signs`
+    reads the same texts); a ValueError saying what the choices are otherwise."""
+    count = len(der.two_way)
+    signs = parse_signs(text, count)
+    if signs is not None:
+        return BranchText(signs)
+    base, mirrors = text, 0
+    while base.endswith(MIRROR):
+        base, mirrors = base[: -len(MIRROR)], mirrors + 1
+    parts = base.split("/") if count else []
+    choices = [("open", "crossed") if der.steps[i].word_rule else ("+", "-") for i in der.two_way]
+    if len(parts) != count or any(w not in c for w, c in zip(parts, choices)):
+        example = "/".join(a for a, _ in choices)
+        if count == 1:
+            named = f"{choices[0][0]} or {choices[0][1]}"
+        else:
+            named = (f"a name, one word per two-way step joined by / "
+                     f"({' / '.join(f'{a} or {b}' for a, b in choices)}, e.g. {example})")
+        raise ValueError(f"{text!r} is not a branch of this mechanism: give {named}, or the signs "
+                         f"of its {count} two-way step{'s' if count != 1 else ''} (e.g. {'+' * count}); "
+                         f"a second assembly of one name is NAME{MIRROR}")
+    return BranchText(None, tuple(w in ("open", "+") for w in parts), mirrors)
 
 
 def _is_open(step: Step, params: Mapping[str, Any], d: Any, q: Sequence[Any], xp: Any = math) -> Any:
