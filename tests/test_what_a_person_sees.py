@@ -227,6 +227,7 @@ def test_a_rocker_driven_plot_draws_one_assembly_as_one_line(monkeypatch, tmp_pa
     monkeypatch.setattr(plots, "_save", lambda fig, path: seen.setdefault("fig", fig))
     plots.sweep_plot(result, tmp_path / "p.png")
     xs, ys = seen["fig"].axes[0].lines[0].get_data()
+    assert result.branch == "+" and "+ branch" in seen["fig"]._suptitle.get_text()
     drawn = [(x, y) for x, y in zip(xs, ys) if 105 <= x <= 255]
     assert [x for x, _ in drawn] == [p.input for p in solved]
     assert not any(_math.isnan(y) for _, y in drawn)
