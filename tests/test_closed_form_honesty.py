@@ -286,24 +286,39 @@ def test_both_rocker_driven_assemblies_of_one_label_are_selectable(cli):
 @pytest.mark.parametrize("branch", ["open", "crossed"])
 def test_rocker_driven_sweeps_label_each_position_by_its_configuration(branch):
     """Every solved position of a rocker-driven sweep carries the label of its own
-    configuration; positions where neither assembly has that label are off_branch,
-    never given numbers; the batch engine and the scan's engine say the same."""
+    configuration. The sweep follows one assembly by its signs (issue 19): the one that
+    carries the requested name where the name first appears; along it the label turns
+    from open to crossed, every position where the linkage assembles is solved on it
+    (none off_branch, none jumping to the mirror assembly); the batch engine says the same."""
     from linkage.kinematics.batch import CODE_STATUS, batch_sweep
     from linkage.kinematics.sweep import sweep
 
     m = load(SAMPLES / "fourbar_me581_theta4.toml")
     values = [float(v) for v in range(100, 260)]
     result = sweep(m, values, branch=branch)
+    first, assembly = None, set()
     for p in result.positions:
         ref = fourbar_positions(90.0, 30.0, 60.0, 45.0, 0.0, theta4=math.radians(p.input))
         labels = {k.removesuffix(MIRROR) for k in ref}
-        if p.status == "converged":
-            assert p.branch == branch
-            assert (math.sin(math.radians(p.input - p.solution["theta3"])) > 0) == (branch == "open")
-        elif ref:
-            assert p.status == "off_branch" and branch not in labels, p
-    assert result.summary.get("off_branch") and result.summary.get("converged")
-    assert not [t for t in result.toggles if 105 < t < 255]  # a re-entry is no toggle
+        if p.status != "converged":
+            assert not ref and p.status == "no_solution", p
+            continue
+        side = math.sin(math.radians(p.input - p.solution["theta3"]))
+        assert p.branch == ("open" if side > 0 else "crossed"), p
+        # one of the reference's two assemblies, on one side of O2-B throughout
+        near = [s for s in ref.values() if abs(math.remainder(
+            math.degrees(s["theta2"]) - p.solution["theta2"], 360.0)) < 1e-7]
+        assert len(near) == 1, p
+        t2, t4 = math.radians(p.solution["theta2"]), math.radians(p.input)
+        bx, by = 90.0 + 45.0 * math.cos(t4), 45.0 * math.sin(t4)
+        assembly.add(math.cos(t2) * by - math.sin(t2) * bx > 0)
+        if first is None and branch in labels:
+            first = p
+    assert len(assembly) == 1
+    assert first is not None and first.branch == branch
+    assert result.summary.get("converged") and not result.summary.get("off_branch")
+    assert {p.branch for p in result.positions if p.solution} == {"open", "crossed"}
+    assert not [t for t in result.toggles if 105 < t < 255]
     batch = batch_sweep(m, values, branch=branch)
     assert [CODE_STATUS[int(c)] for c in batch.status] == [p.status for p in result.positions]
     # (the scan follows a branch by its signs, as issue 19 asks: tests/test_derived_scan.py)

@@ -117,10 +117,22 @@ def _assert_same(m, values, branch):
     assert fast.classification == ref.classification
     # the labels: where the one-at-a-time engine names the branch (the old closed-form key),
     # the same name; where it can only give the sign of det J (the Watt six-bar), the name
-    # of its own configurations (the derivation's word rule), the same at every position
+    # of its own configurations (the derivation's word rule), the same at every position;
+    # where the names cut across the signs (driven by the rocker), the followed signs, the
+    # same as the one-at-a-time engine's, and each position its own configuration's name
     labels = {p.branch for p in fast.positions}
-    assert labels == {fast.branch}
-    if ref.branch.startswith("det"):
+    if m.driver.name == "theta4":
+        d = m.derivation
+        signs = {d.signs_of([math.radians(p.solution[n]) for n in ref.names], math.radians(p.input))
+                 for p in fast.positions}
+        assert len(signs) == 1 and fast.branch == ref.branch == "+-"[signs.pop()[0] < 0]
+        assert [p.branch for p in fast.positions] == [p.branch for p in ref.positions]
+        for p in fast.positions:
+            t3 = math.radians(p.solution["theta3"])
+            assert p.branch == ("open" if math.sin(math.radians(p.input) - t3) > 0 else "crossed")
+        assert branch is None or branch in labels
+    elif ref.branch.startswith("det"):
+        assert labels == {fast.branch}
         d = m.derivation
         first = ref.positions[0]
         q = [math.radians(first.solution[n]) if u.kind == "angle" else first.solution[n]
@@ -128,6 +140,7 @@ def _assert_same(m, values, branch):
         drv = math.radians(first.input) if m.driver.kind == "angle" else first.input
         assert fast.branch == d.name_of(q, drv)
     else:
+        assert labels == {fast.branch}
         assert [p.branch for p in fast.positions] == [p.branch for p in ref.positions]
         assert fast.branch == ref.branch == (branch or ref.branch)
     # one Newton step from the closed form is all a position needs here

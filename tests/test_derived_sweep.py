@@ -107,31 +107,45 @@ GRASHOF = (40.0, 120.0, 80.0, 100.0)      # the crank-rocker of crank_rocker.tom
 def test_a_configuration_has_its_name_under_every_driver(tmp_path, links, driver):
     """A four-bar written with names a, b, c, d (no closed_form key) driven by the crank,
     the coupler or the rocker: every swept position is labelled open exactly where
-    sin(theta4 - theta3) > 0 of that configuration; --branch open / crossed keep that label,
-    and a sign string (+, -) follows one assembly whatever its name."""
+    sin(theta4 - theta3) > 0 of that configuration. A sweep follows one assembly by its
+    signs (issue 19): a sign string (+, -) that assembly whatever its name; --branch open /
+    crossed the assembly that carries the name where it first appears, which keeps the
+    label under the crank (each name is one sign branch, reported by its name) and may
+    change it under the coupler or the rocker (reported by its signs)."""
     m = abcd(tmp_path, links, driver)
     assert m.closed_form is None and m.derivation.summary == "closed form: loop 1"
+    d = m.derivation
     values = [float(v) for v in range(0, 360, 3)]
     seen = set()
-    for branch in (None, "open", "crossed", "+", "-"):
+    runs = {}
+    for branch in ("+", "-", None, "open", "crossed"):
         r = linkage.sweep(m, values, branch=branch)
         solved = [p for p in r.positions if p.solution]
         assert solved, branch
+        labels = {}
         for p in solved:
             full = {**p.solution, driver: p.input}
             label = "open" if is_open(full["theta3"], full["theta4"]) else "crossed"
             assert p.branch == label, (branch, p)
             seen.add(label)
-            if branch in ("open", "crossed"):
-                assert label == branch
+            labels[p.input] = label
+        signs = {d.signs_of([math.radians(p.solution[u.name]) for u in m.unknowns],
+                            math.radians(p.input)) for p in solved}
+        assert len(signs) == 1, (branch, signs)
+        runs[branch] = labels
         if branch in ("+", "-"):
             # crank-driven, each name is one sign branch and the sweep reports it by name;
             # driven by the coupler or the rocker the names cut across the signs
             assert (r.branch in ("open", "crossed")) == (driver == "theta2"), r.branch
-            d = m.derivation
-            signs = {d.signs_of([math.radians(p.solution[u.name]) for u in m.unknowns],
-                                math.radians(p.input)) for p in solved}
             assert signs == {(1.0,) if branch == "+" else (-1.0,)}
+        if branch in ("open", "crossed"):
+            if driver == "theta2":
+                assert set(labels.values()) == {branch} and r.branch == branch
+            else:
+                assert r.branch == ("+" if signs == {(1.0,)} else "-")
+            # the first driver value where either assembly carries the name
+            first = min(v for side in ("+", "-") for v, name in runs[side].items() if name == branch)
+            assert labels[first] == branch, (branch, first)
     assert seen == {"open", "crossed"}
 
 

@@ -324,8 +324,12 @@ def test_rocker_driven_fourbar_keeps_both_assemblies_and_labels_each_position():
     closed form once labelled both "crossed" and lost one, and the sweep labelled every
     position with the file's own theta4. (Issue 18 changed the label to the
     configuration rule whatever the driver: both keep distinct keys, the second
-    "crossed (mirror)", and each sweep position carries its own configuration's label.)"""
+    "crossed (mirror)", and each sweep position carries its own configuration's label.
+    Issue 19: a sweep follows one assembly by its signs, the one that carries the
+    requested name where the name first appears; its positions turn from open to crossed
+    along it, and the mirror assembly is reached by its own key or signs.)"""
     import math
+    from itertools import pairwise
 
     from linkage.kinematics.sweep import sweep
     from linkage.problems.closed_form import fourbar_positions
@@ -336,10 +340,27 @@ def test_rocker_driven_fourbar_keeps_both_assemblies_and_labels_each_position():
     assert all(math.sin(s["theta4"] - s["theta3"]) < 0 for s in sols.values())
     assert math.sin(sols["crossed"]["theta3"] - sols["crossed"]["theta2"]) < 0
     m = load_mechanism(SAMPLES / "fourbar_me581_theta4.toml").with_values({"r2": 20.0}, {})
-    for branch in ("open", "crossed"):
+    followed = {}
+    for branch in ("open", "crossed", "open (mirror)"):
         result = sweep(m, [float(v) for v in range(0, 360, 3)], branch=branch)
         solved = [p for p in result.positions if p.solution]
-        assert solved and all(p.branch == branch for p in solved)
+        assert solved
         for p in solved:
             side = math.sin(math.radians(p.input - p.solution["theta3"]))
-            assert (side > 0) == (branch == "open"), p
+            assert p.branch == ("open" if side > 0 else "crossed"), p
+        # one assembly: constant signs, reported as the sweep's branch, and no jump
+        signs = {m.derivation.signs_of([math.radians(p.solution[u.name]) for u in m.unknowns],
+                                       math.radians(p.input)) for p in solved}
+        assert len(signs) == 1 and result.branch == "+-"[signs.pop()[0] < 0], (branch, signs)
+        assert max(abs(math.remainder(b.solution["theta2"] - a.solution["theta2"], 360.0))
+                   for a, b in pairwise(solved)) < 15.0
+        # where the name first appears (the closed form above, r2 = 20), the sweep carries it
+        first = next(p for p in solved if branch.removesuffix(" (mirror)") in
+                     {k.removesuffix(" (mirror)") for k in
+                      fourbar_positions(90.0, 20.0, 60.0, 45.0, 0.0, theta4=math.radians(p.input))})
+        if not branch.endswith("(mirror)"):
+            assert first.branch == branch
+        followed[branch] = (result.branch, {p.branch for p in solved})
+    # both assemblies reached, and each passes through both names
+    assert {b for b, _ in followed.values()} == {"+", "-"}
+    assert all(names == {"open", "crossed"} for _, names in followed.values())

@@ -204,10 +204,14 @@ def test_json_rates_carry_their_units_not_only_the_positions_deg(cli, command):
     assert "rate_units" not in json.loads(cli(*args[:2], "--format", "json").out)
 
 
-def test_a_rocker_driven_plot_breaks_its_line_at_a_re_entry(monkeypatch, tmp_path):
+def test_a_rocker_driven_plot_draws_one_assembly_as_one_line(monkeypatch, tmp_path):
     """The plot drew the re-entry on the mirror assembly (theta2 112 -> 268 deg between
-    theta4 164 and 165) as a vertical stroke, as if the linkage moved there."""
+    theta4 164 and 165) as a vertical stroke, as if the linkage moved there; then as a
+    break in its line. The sweep now follows one assembly by its signs (issue 19), so
+    there is no jump to draw: from 105 to 255 deg theta2 is one unbroken line, through
+    the change of its name from open to crossed."""
     import math as _math
+    from itertools import pairwise
 
     import linkage
     from linkage.kinematics.continuation import REENTERED
@@ -215,12 +219,16 @@ def test_a_rocker_driven_plot_breaks_its_line_at_a_re_entry(monkeypatch, tmp_pat
 
     result = linkage.sweep(linkage.load_mechanism(SAMPLES / "fourbar_me581_theta4.toml"),
                            [float(v) for v in range(360)])
-    jumps = [p.input for p in result.positions if p.note == REENTERED]
-    assert jumps
+    assert not [p.input for p in result.positions if p.note == REENTERED]
+    solved = [p for p in result.positions if p.solution]
+    assert [p.input for p in solved] == [float(v) for v in range(105, 256)]
+    assert {p.branch for p in solved} == {"open", "crossed"}
     seen = {}
     monkeypatch.setattr(plots, "_save", lambda fig, path: seen.setdefault("fig", fig))
     plots.sweep_plot(result, tmp_path / "p.png")
     xs, ys = seen["fig"].axes[0].lines[0].get_data()
-    for x in jumps:
-        k = list(xs).index(x)
-        assert _math.isnan(ys[k]) and not _math.isnan(ys[k + 1])
+    assert result.branch == "+" and "+ branch" in seen["fig"]._suptitle.get_text()
+    drawn = [(x, y) for x, y in zip(xs, ys) if 105 <= x <= 255]
+    assert [x for x, _ in drawn] == [p.input for p in solved]
+    assert not any(_math.isnan(y) for _, y in drawn)
+    assert max(abs(b - a) for (_, a), (_, b) in pairwise(drawn)) < 15.0

@@ -111,11 +111,15 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
         return None
     shown = _display(m, solver, vals, cols, kinds, closes)
     label = "/".join(words)
-    from .stepwise import classification_of
+    from ..problems.derive import sign_text
+    from .stepwise import classification_of, names_follow_signs
 
+    # the followed branch as the one-at-a-time engine reports it: its name where each name
+    # is one sign branch, else its signs (each position still carries its name)
+    followed = label if names_follow_signs(m) else sign_text(signs)
     meta = SweepResult(m.name, m.driver.name, m.driver.unit, tuple(u.name for u in m.unknowns),
                        tuple("deg" if k == "angle" else m.length_unit for k in kinds), (),
-                       ((float(vals[0]), float(vals[-1])),), (), label, classification_of(m),
+                       ((float(vals[0]), float(vals[-1])),), (), followed, classification_of(m),
                        "newton (closed form)", length_unit=m.length_unit)
     rates = (speed, accel) if speed is not None or joints else None
     return BatchResult(vals, np.full(n_pos, STATUS_CODES["converged"], dtype=np.int8),

@@ -11,7 +11,7 @@ from typing import Any
 from ..problems.closed_form import fourbar_class
 from ..problems.loops import Mechanism
 from .angles import anchor_index, closes_circle, continuous, driver_turn, turn_shift, unwrap_turns
-from .continuation import Solver, classify_gap, follow, q_of, solve_position
+from .continuation import Solver, classify_gap, follow, q_of, solve_position, solver_q
 from .limits import closed_form_limits, solved_ranges, toggles
 from .positions import Position, SweepResult, check_driver_values
 
@@ -44,7 +44,7 @@ def sweep(
         for i, v in enumerate(values):
             pos, q = solve_position(solver, v, None, None, guess0, target, True)
             if pos.status == "converged" and q is not None:
-                seed, target = (v, q), target if target is not None else pos.branch
+                seed, target = (v, q), target if target is not None else seed_target(solver, q, v)
                 done[i] = pos
                 break
             done[i] = pos
@@ -74,8 +74,8 @@ def sweep(
             tries = [g for g in (other, anchor_q, guess0) if g is not None]
             pos, found = classify_gap(solver, v, tries)
             other = found or other
-        if target is None and pos.status == "converged":
-            target = pos.branch
+        if target is None and pos.status == "converged" and pos.solution is not None:
+            target = seed_target(solver, solver_q(solver, pos), v) if have_closed else pos.branch
         done[j] = pos
         if progress is not None:
             progress(len(done))
@@ -91,12 +91,11 @@ def sweep(
 
 
 def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -> str | None:
-    """What the sweep follows for a ``branch`` text: a name as it is (followed by the
-    configurations' names); a sign string as the name of that sign branch where each name
-    is one (:func:`names_follow_signs`), else as it is (followed by the configurations'
-    signs); and a name only one assembly can carry at a driver value (``open (mirror)``)
-    as the signs of that assembly at the first value where the linkage assembles."""
-    from ..errors import InputError
+    """What the sweep follows for a ``branch`` text. A sweep follows signs: where each
+    name is one sign branch (:func:`names_follow_signs`) a name and its signs are the
+    same thing, and the branch is followed and reported by its name; otherwise a name
+    (``open`` of a rocker-driven four-bar, ``open (mirror)``) is the signs of its assembly
+    at the first driver value where the name appears."""
     from ..problems.derive import MIRROR, Indeterminate, parse_signs, sign_text
 
     d = solver.derivation
@@ -113,19 +112,33 @@ def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -
                 if sign_text(signs) == branch:
                     return name
         return branch
-    if not branch.endswith(MIRROR):
+    if parse_signs(branch, solver.count) is not None or (
+            not branch.endswith(MIRROR) and names_follow_signs(solver.m)):
         return branch
+    # a name that cuts across the signs (a four-bar driven by its rocker or coupler, or a
+    # mirror key): the signs of its assembly where the name first appears, followed as
+    # signs (the positions carry their own names); a name that appears nowhere is left as
+    # it is, and every position is then off that branch
     for v in values:
         try:
             named = d.named_solutions(v * solver.scale)
         except Indeterminate:
             continue
-        if named:
-            try:
-                return sign_text(d.branch_signs(branch, v * solver.scale))
-            except ValueError as exc:
-                raise InputError(f"branch: {exc} at {solver.m.driver.name} = {v:g}") from None
+        if branch in named:
+            return sign_text(named[branch][0])
     return branch
+
+
+def seed_target(solver: Solver, q: Sequence[float], v: float) -> str:
+    """The branch a sweep follows from its seed: the seed's name where each name is one
+    sign branch, else its signs (a sweep follows signs; its positions carry their names)."""
+    from ..problems.derive import sign_text
+
+    d = solver.derivation
+    assert d is not None
+    if names_follow_signs(solver.m):
+        return d.name_of(q, v * solver.scale)
+    return sign_text(d.signs_of(q, v * solver.scale))
 
 
 def names_follow_signs(m: Mechanism) -> bool:

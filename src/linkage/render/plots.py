@@ -103,8 +103,11 @@ def sweep_plot(result: Any, path: Path) -> None:
         legend.append("dashed: limit/toggle positions")
     if jumps:
         legend.append("a break in a line: re-entered on the other assembly")
+    # a sign string is the followed assembly (a rocker-driven four-bar's, whose positions'
+    # names change along it), named or not by --branch
+    signs = bool(result.branch) and set(result.branch) <= {"+", "-"}
     title = f"{result.mechanism}: " + (f"{result.branch} branch" if result.branch in ("open", "crossed")
-                                       else "the branch of the file's guess")
+                                       or signs else "the branch of the file's guess")
     if result.motion is not None:
         per = "rad" if result.driver_unit == "deg" else result.driver_unit
         title += f"; driver at {result.motion[0]:g} {per}/s, {result.motion[1]:g} {per}/s^2"
