@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 import tomllib
 
+from linkage.errors import InputError
 from linkage.kinematics.stepwise import sweep as one_at_a_time
 from linkage.kinematics.sweep import sweep_mechanism
 from linkage.problems.loops import load
@@ -200,14 +201,17 @@ def test_a_limit_inside_falls_back_to_the_one_at_a_time_engine():
     assert fast.summary == ref.summary
 
 
-def test_a_branch_name_with_no_assembly_falls_back():
+def test_a_branch_name_with_no_assembly_is_refused_by_both_engines():
     """Driven by its rocker, both assemblies of the four-bar at 106..129 deg are named open
-    (open and open (mirror)): there is no crossed one to follow, the one-at-a-time engine
-    reports every position off_branch, and this engine leaves it to that engine."""
+    (open and open (mirror)): there is no crossed one to follow anywhere in the range, and
+    both engines say so (InputError naming branch and what assembles there)."""
     m = load(sample_path("fourbar_me581_theta4.toml"))
     values = [float(k) for k in range(106, 130)]
-    fast = sweep_mechanism(m, values, branch="crossed")
-    assert fast.method == "newton" and fast.summary == one_at_a_time(m, values, branch="crossed").summary
+    for run in (lambda: sweep_mechanism(m, values, branch="crossed"),
+                lambda: one_at_a_time(m, values, branch="crossed")):
+        with pytest.raises(InputError, match=r"branch: no 'crossed' assembly anywhere in theta4 = "
+                                             r"106\.\.129 deg; at 106: open, open \(mirror\)"):
+            run()
 
 
 @pytest.mark.parametrize("kw", [{"method": "lm"}, {"method": "newton-fd"}, {"batch": False}])

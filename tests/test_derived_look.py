@@ -140,8 +140,8 @@ def test_sweep_refusal_of_a_name_absent_at_the_start_says_what_a_sign_is(cli):
     """It said 'or give the signs of the 1 two-way step, e.g. +'."""
     run_ = cli("sweep", str(SAMPLES / "crank_rocker.toml"), "--step", "60", "--branch", "open (mirror)")
     assert run_.code == 2 and len(run_.err.splitlines()) == 1
-    assert "assemblies: open, crossed; or their signs, one + or - per closed-form step with two roots" \
-        in run_.err and "two-way" not in run_.err
+    assert "no 'open (mirror)' assembly anywhere in theta2 = 0..360 deg; at 0: open, crossed" in run_.err
+    assert "one + or - per closed-form step with two roots" in run_.err and "two-way" not in run_.err
 
 
 def test_a_six_bar_sweep_names_its_one_four_bar_loop(cli):

@@ -95,7 +95,8 @@ def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -
     name is one sign branch (:func:`names_follow_signs`) a name and its signs are the
     same thing, and the branch is followed and reported by its name; otherwise a name
     (``open`` of a rocker-driven four-bar, ``open (mirror)``) is the signs of its assembly
-    at the first driver value where the name appears."""
+    at the first driver value where the name appears (InputError where it appears nowhere)."""
+    from ..errors import InputError
     from ..problems.derive import MIRROR, Indeterminate, parse_signs, sign_text
 
     d = solver.derivation
@@ -119,6 +120,7 @@ def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -
     # mirror key): the signs of its assembly where the name first appears, followed as
     # signs (the positions carry their own names); a name that appears nowhere is left as
     # it is, and every position is then off that branch
+    first: tuple[float, list[str]] | None = None
     for v in values:
         try:
             named = d.named_solutions(v * solver.scale)
@@ -126,7 +128,12 @@ def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -
             continue
         if branch in named:
             return sign_text(named[branch][0])
-    return branch
+        if first is None and named:
+            first = (v, list(named))
+    where = f"{solver.m.driver.name} = {min(values):g}..{max(values):g} {solver.m.driver.unit}"
+    there = f"; at {first[0]:g}: {', '.join(first[1])}" if first else ": it assembles nowhere there"
+    raise InputError(f"branch: no {branch!r} assembly anywhere in {where}{there} (or give the "
+                     f"signs: one + or - per closed-form step with two roots, e.g. {'+' * solver.count})")
 
 
 def seed_target(solver: Solver, q: Sequence[float], v: float) -> str:
