@@ -466,3 +466,25 @@ def test_a_sign_string_on_the_batch_engine_is_the_branch_of_that_name():
     assert r.branch == "crossed" and r.summary == {"converged": 2001}
     for p in r.positions[::97]:
         assert p.branch == "crossed" and not is_open(p.solution["theta3"], p.solution["theta4"])
+
+
+@pytest.mark.parametrize("name", ["crank_rocker.toml", "watt_sixbar.toml", "fourbar_me581.toml",
+                                  "fourbar_me581_theta4.toml"])
+def test_a_command_line_sweep_of_a_derived_closed_form_does_not_import_numpy(name):
+    """The limits and followed branches of a command-line sweep come from the scalar rules:
+    numpy's import cost a fresh `linkage sweep FILE` more than the sweep (cold start 4.4x
+    of `import rich.table` against the 2.0x target, linkage bench)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, runpy, io, contextlib\n"
+            f"sys.argv = ['linkage', 'sweep', {str(SAMPLES / name)!r}]\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    try:\n"
+            "        runpy.run_module('linkage', run_name='__main__')\n"
+            "    except SystemExit as e:\n"
+            "        assert e.code == 0, e.code\n"
+            "print('HEAVY', [m for m in ('numpy', 'scipy', 'matplotlib') if m in sys.modules])\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "HEAVY []" in proc.stdout

@@ -70,19 +70,23 @@ def followed_branches(solver: Solver, positions: Sequence[Position], target: str
     """The sign tuples of the assemblies a sweep solved (one for a branch followed by its
     signs, or by a name that is one sign branch; both mirror assemblies of a rocker-driven
     four-bar followed by name); with none solved, the target's signs or every branch."""
-    import numpy as np
-
     d = solver.derivation
     assert d is not None
     solved = [p for p in positions if p.solution is not None]
     out: list[Signs] = []
-    if solved:
+    if len(solved) > SCALAR_GRID:
+        import numpy as np
+
         # every position at once, by the numpy twin of signs_of
         q = [np.radians([p.solution[n] for p in solved]) if k == "angle" else  # type: ignore[index]
              np.array([p.solution[n] for p in solved]) for n, k in zip(solver.names, solver.kinds)]  # type: ignore[index]
         signs = np.stack(d.signs_of_np(q, np.array([p.input for p in solved]) * solver.scale), axis=-1)
         for row in np.unique(signs[(signs != 0.0).all(axis=-1)], axis=0)[::-1]:  # "+" first
             out.append(tuple(float(s) for s in row))
+    elif solved:
+        # a command-line sweep: the scalar rule (no numpy import)
+        seen = {d.signs_of(solver_q(solver, p), p.input * solver.scale) for p in solved}
+        out = sorted((s for s in seen if 0.0 not in s), reverse=True)  # "+" first
     if out:
         return out
     if target is not None:
@@ -102,6 +106,11 @@ LIMIT_CANDIDATE = 0.1
 grid points only where it is below this (a tenth of the loop's size)."""
 
 
+SCALAR_GRID = 4096
+"""Grids up to this many driver values are scanned for limits by the scalar rule, larger
+ones by its numpy twin (the two agree: tests/test_derived_sweep.py)."""
+
+
 def closed_form_limits(solver: Solver, positions: Sequence[Position], lo: float, hi: float,
                        target: str | None) -> tuple[list[float], tuple[tuple[float, float], ...]]:
     """The limit positions in [lo, hi] and the feasible ranges of the followed branches,
@@ -110,8 +119,6 @@ def closed_form_limits(solver: Solver, positions: Sequence[Position], lo: float,
     driver values (across the grid's end where it closes the circle) is bisected to
     adjacent doubles, and a dip below zero between two that assemble is found by its
     minimum."""
-    import numpy as np
-
     d = solver.derivation
     assert d is not None
     branches = followed_branches(solver, positions, target)
@@ -123,14 +130,27 @@ def closed_form_limits(solver: Solver, positions: Sequence[Position], lo: float,
     ring = list(grid)
     if turn and len(grid) > 2 and closes_circle(grid, turn):
         ring.append(grid[0] + turn)
-    x = np.array(ring)
-    g = assembles_np(d, x, branches, scale)
-    ok = g >= 0.0
-    change = np.flatnonzero(ok[:-1] != ok[1:])
-    if len(change) > FEW_BRACKETS:  # all at once; a few are quicker one by one (no array overhead)
-        found = [float(t) for t in limits_between_np(d, x[change], x[change + 1], branches, scale)]
+    if len(ring) > SCALAR_GRID:
+        import numpy as np
+
+        x = np.array(ring)
+        g = assembles_np(d, x, branches, scale)
+        ok = g >= 0.0
+        change = np.flatnonzero(ok[:-1] != ok[1:])
     else:
-        found = [limit_between(d, float(x[i]), float(x[i + 1]), branches, scale) for i in change]
+        # a command-line sweep's grid: the scalar rule, so the sweep does not import numpy
+        # (its import costs a fresh process more than the whole sweep)
+        g = [assembles(d, v, branches, scale) for v in ring]
+        ok = [v >= 0.0 for v in g]
+        change = [i for i in range(len(ring) - 1) if ok[i] != ok[i + 1]]
+    if len(change) > FEW_BRACKETS:  # all at once; a few are quicker one by one (no array overhead)
+        import numpy as np
+
+        x = np.array(ring)
+        at = np.asarray(change)
+        found = [float(t) for t in limits_between_np(d, x[at], x[at + 1], branches, scale)]
+    else:
+        found = [limit_between(d, float(ring[i]), float(ring[i + 1]), branches, scale) for i in change]
     for i in range(1, len(ring) - 1):
         if ok[i - 1] and ok[i + 1] and g[i] <= g[i - 1] and g[i] <= g[i + 1] and g[i] < LIMIT_CANDIDATE:
             for a, c in ((ring[i - 1], ring[i]), (ring[i], ring[i + 1])):
