@@ -1,0 +1,56 @@
+"""Issue 19, a second reading: regressions for the defects it found, each named after
+the defect. References are written here independently: a linear closed form solved by
+hand (s E + t F = r e^(i theta), Cramer), and the refusals solve already gives.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+# s along x, t along y, closing on r e^(i theta): linear, one assembly,
+# s = r cos(theta), t = r sin(theta)
+XY = """name = "xy"
+length_unit = "mm"
+[parameters]
+r = { value = 50, unit = "mm" }
+[driver]
+name = "theta"
+value = 30
+unit = "deg"
+[unknowns]
+s = { guess = 10, unit = "mm" }
+t = { guess = 10, unit = "mm" }
+[[loops]]
+name = "L"
+vectors = [{ length = "s", angle = 0 }, { length = "t", angle = 90 },
+           { length = "r", angle = "theta", sign = -1 }]
+"""
+
+
+@pytest.fixture
+def xy(tmp_path):
+    path = tmp_path / "xy.toml"
+    path.write_text(XY)
+    return path
+
+
+@pytest.mark.parametrize("engine", ["--batch", "--no-batch"])
+def test_sweep_of_a_linear_closed_form_labels_its_one_assembly_as_solve_does(cli, xy, engine):
+    """Defect: the sweep labelled every position of a linear closed form 'det+' (the sign of
+    det J, the label of a mechanism with no closed form) where solve calls its one assembly
+    'only'."""
+    doc = json.loads(cli("solve", str(xy), "--format", "json").out)
+    assert doc["branch"] == "only"
+    run = cli("sweep", str(xy), "--step", "90", "--format", "json", engine)
+    assert run.code == 0, run.err
+    sweep = json.loads(run.out)
+    assert sweep["branch"] == "only"
+    for p in sweep["positions"]:
+        assert p["status"] == "converged" and p["branch"] == "only"
+        th = math.radians(p["input"])
+        assert p["solution"]["s"] == pytest.approx(50 * math.cos(th), abs=1e-12)
+        assert p["solution"]["t"] == pytest.approx(50 * math.sin(th), abs=1e-12)
+
