@@ -54,3 +54,14 @@ def test_sweep_of_a_linear_closed_form_labels_its_one_assembly_as_solve_does(cli
         assert p["solution"]["s"] == pytest.approx(50 * math.cos(th), abs=1e-12)
         assert p["solution"]["t"] == pytest.approx(50 * math.sin(th), abs=1e-12)
 
+
+@pytest.mark.parametrize("text", ["garbage", "+", "open"])
+def test_scan_refuses_a_branch_of_a_linear_closed_form_as_solve_does(cli, xy, text):
+    """Defect: the scan took any --branch text for a closed form with no two-way step
+    (read_branch has nothing to check against) and printed 'branch: garbage' over the
+    designs; solve and sweep refuse it: there is nothing to choose."""
+    run = cli("scan", str(xy), "--vary", "r=20:60:2", "--step", "90", "--branch", text)
+    assert run.code == 2 and run.out == ""
+    assert run.err == f"error: --branch has nothing to choose: {xy} has one assembly (its closed form is linear)\n"
+    solve = cli("solve", str(xy), "--branch", text)
+    assert solve.code == 2 and solve.err == run.err
