@@ -62,6 +62,7 @@ def test_scan_refuses_a_branch_of_a_linear_closed_form_as_solve_does(cli, xy, te
     designs; solve and sweep refuse it: there is nothing to choose."""
     run = cli("scan", str(xy), "--vary", "r=20:60:2", "--step", "90", "--branch", text)
     assert run.code == 2 and run.out == ""
-    assert run.err == f"error: --branch has nothing to choose: {xy} has one assembly (its closed form is linear)\n"
+    assert run.err == (f"error: --branch has nothing to choose: {xy} has one assembly "
+                       "(its closed form is linear)\n")
     solve = cli("solve", str(xy), "--branch", text)
     assert solve.code == 2 and solve.err == run.err
