@@ -66,3 +66,20 @@ def test_scan_refuses_a_branch_of_a_linear_closed_form_as_solve_does(cli, xy, te
                        "(its closed form is linear)\n")
     solve = cli("solve", str(xy), "--branch", text)
     assert solve.code == 2 and solve.err == run.err
+
+
+def test_old_closed_form_module_names_only_what_it_has_and_keeps_no_branch_rule():
+    """Defect: closed_form kept branch_rule (a second home of the open/crossed rule, keyed
+    on the old closed_form key, that no engine calls any more) and its docstring sent the
+    reader to feasible_arcs, which is gone. Every :func: it names must exist, and the
+    branch names come from the derivation alone."""
+    import re
+
+    from linkage.problems import closed_form
+
+    named = re.findall(r":func:`~?\.?([A-Za-z_][A-Za-z_0-9.]*)`", closed_form.__doc__ or "")
+    for name in named:
+        if "." not in name:
+            assert hasattr(closed_form, name), name
+    assert not hasattr(closed_form, "branch_rule")
+    assert not hasattr(closed_form, "feasible_arcs")
