@@ -83,3 +83,22 @@ def test_old_closed_form_module_names_only_what_it_has_and_keeps_no_branch_rule(
             assert hasattr(closed_form, name), name
     assert not hasattr(closed_form, "branch_rule")
     assert not hasattr(closed_form, "feasible_arcs")
+
+
+@pytest.mark.parametrize("text", ["", "+-+", "\u00e9", "sideways", "open/open"])
+def test_solve_does_not_call_a_text_that_is_no_branch_an_assembly_missing_here(cli, text):
+    """Defect: solve answered any text it could not read (an empty --branch, '+-+' on a
+    one-step four-bar, a unicode word) with "no such assembly at theta2 = 30 deg", as if
+    it might assemble elsewhere; the crank-rocker has exactly the branches open and
+    crossed (+ and -) and assembles at every crank angle (Grashof: 40 + 120 <= 100 + 80)."""
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "sample_inputs" / "crank_rocker.toml"
+    run = cli("solve", str(path), "--branch", text)
+    assert run.code == 2 and run.out == "" and len(run.err.splitlines()) == 1
+    assert run.err.startswith(f"error: --branch {text!r} is not a branch of this mechanism")
+    assert "no such assembly" not in run.err
+    for word in ("open", "crossed", "+", "-"):
+        assert word in run.err
+    for ok in ("open", "crossed", "+", "-"):
+        assert cli("solve", str(path), "--branch", ok).code == 0
