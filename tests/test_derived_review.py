@@ -102,3 +102,32 @@ def test_solve_does_not_call_a_text_that_is_no_branch_an_assembly_missing_here(c
         assert word in run.err
     for ok in ("open", "crossed", "+", "-"):
         assert cli("solve", str(path), "--branch", ok).code == 0
+
+
+# two slides along x (s, and t at angle alpha) closing on r e^(i theta): with alpha = 0
+# they are parallel, and at theta = 0 every s with t = r - s closes the loop
+SLIDES = XY.replace('{ length = "t", angle = 90 }', '{ length = "t", angle = "alpha" }').replace(
+    'r = { value = 50, unit = "mm" }', 'r = { value = 50, unit = "mm" }\nalpha = { value = 0, unit = "deg" }')
+
+
+def test_parallel_slides_along_the_known_vectors_are_a_change_point_not_unassemblable(cli, tmp_path):
+    """Defect: two_lengths returned None ("cannot be assembled") for parallel slides even
+    where the known vectors lie along them and every s (with t = r - s) closes the loop;
+    solve's JSON reference was {} beside a converged Newton answer. It is a change point:
+    Indeterminate, reference None; off the line there is still no solution."""
+    from linkage.problems.derive import Indeterminate
+    from linkage.problems.loops import load
+
+    path = tmp_path / "slides.toml"
+    path.write_text(SLIDES)
+    m = load(path)
+    assert m.derivation.complete and not m.derivation.two_way
+    with pytest.raises(Indeterminate):
+        m.derivation.solve(0.0, ())
+    assert m.derivation.solve(math.radians(30), ()) is None  # r sin(30) = 25 off the line
+    doc = json.loads(cli("solve", str(path), "--set", "theta=0", "--format", "json").out)
+    assert doc["reference"] is None
+    s, t = doc["solution"]["s"], doc["solution"]["t"]
+    assert s + t == pytest.approx(50.0, abs=1e-6)  # Newton's answer is one of them
+    doc = json.loads(cli("solve", str(path), "--set", "theta=30", "--format", "json").out)
+    assert doc["reference"] == {}
