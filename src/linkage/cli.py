@@ -462,7 +462,7 @@ def _start_on_branch(mechanism: Any, branch: str, guessed: bool) -> Any:
     a name at the driver's value (open, crossed, open/crossed, a rocker-driven four-bar's
     second assembly of one name 'open (mirror)') or the signs of the two-way steps (+-),
     as :meth:`~linkage.problems.derive.Derivation.branch_signs` reads them."""
-    from .problems.derive import Indeterminate, sign_text
+    from .problems.derive import Indeterminate, read_branch, sign_text
     from .problems.loops import ANGLE_UNITS
 
     if guessed:
@@ -493,6 +493,12 @@ def _start_on_branch(mechanism: Any, branch: str, guessed: bool) -> Any:
         there = (f"assemblies: {', '.join(named)}; or their signs, one per closed-form step with two roots: "
                  f"{', '.join(sign_text(s) for s, _ in named.values())}" if named else
                  "assemblies: none: it cannot be assembled there")
+        try:
+            read_branch(derivation, branch)
+        except ValueError:
+            # not a name or sign string of this mechanism at all: not "no such assembly here"
+            raise InputError(f"--branch {what} is not a branch of this mechanism "
+                             f"(at {at}, {there})") from None
         raise InputError(f"--branch {what}: no such assembly at {at} ({there})")
     return mechanism.with_values({}, {u.name: v / ANGLE_UNITS[u.unit] if u.kind == "angle" else v
                                       for u, v in zip(mechanism.unknowns, q)})

@@ -508,9 +508,9 @@ def default_branch(m: Mechanism, branch: str | None, tol: float) -> str | None:
 
     der = m.derivation
     if branch is not None:
-        if not der.complete:
-            raise InputError(f"--branch needs a mechanism whose loops have a closed form; "
-                             f"{m.source}: {der.summary}")
+        refusal = der.branch_refusal(m.source)  # solve's and sweep's refusal, one home
+        if refusal is not None:
+            raise InputError(refusal)
         try:
             read_branch(der, branch)
         except ValueError as exc:

@@ -151,6 +151,11 @@ class Solver:
         d = self.derivation
         if d is not None:
             return d.name_of(q, self.m.driver.value if value is None else value * self.scale)
+        if self.m.derivation.complete:
+            # a linear closed form has one assembly: solve's name for it, not det J's sign
+            from ..problems.loops import ONLY
+
+            return ONLY
         return "det+" if det > 0 else "det-"
 
     def on_target(self, q: Sequence[float], det: float, value: float, target: str | None,

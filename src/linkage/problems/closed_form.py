@@ -5,8 +5,8 @@ What solve shows (the reference, branch names, --branch) now comes from the clos
 derived from the loops (:mod:`.derive`, :attr:`~.loops.Mechanism.derivation`), whatever
 the names and the driver: :func:`fourbar_facts` reads every four-bar loop from it. A file's
 ``closed_form`` key is still read and checked (:func:`verify`, REQUIRED_NAMES) as a claim
-about its loops. The formulas below serve the sweeps and scans still keyed on it
-(:func:`branch_rule`, :func:`feasible_arcs`, DRIVERS) and the tests.
+about its loops (DRIVERS: the driver each claim can take). The formulas below serve that
+check, the stress checks and the tests; no engine labels or follows a branch by them.
 
 Four-bar (names r1..r4, theta1..theta4; loop r2 e^(i t2) + r3 e^(i t3) = r1 e^(i t1) +
 r4 e^(i t4)): with theta2 or theta4 given, the free joint lies on one circle at a
@@ -27,7 +27,7 @@ coupler's turn), crossed otherwise.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 from .assembly import (
@@ -35,9 +35,7 @@ from .assembly import (
     fourbar_by_rocker,
     is_open,
     label,
-    rocker_angle,
     slider_crank,
-    slider_is_open,
     triangle,
 )
 
@@ -213,31 +211,6 @@ def verify(m: Any) -> str | None:
         return (f"its loop differs from the file's by {worst:.3g} {m.length_unit} at scattered positions "
                 f"(e.g. {where}): the loops are not that mechanism")
     return None
-
-
-def branch_rule(m: Any) -> Callable[[dict[str, float]], str]:
-    """The branch label of a solution given in display units (degrees): the configuration
-    rule (:func:`~.assembly.is_open`, :func:`~.assembly.slider_is_open`) whatever the
-    driver. A rocker-driven file's solution is labelled by its own theta3 and theta4."""
-    values = {k: q.value for k, q in m.parameters.items()}
-
-    if m.closed_form == "fourbar" and m.driver.name == "theta4":
-        def rocker_driven(sol: dict[str, float]) -> str:
-            t2, t3 = math.radians(sol["theta2"]), math.radians(sol["theta3"])
-            t4 = rocker_angle(values["r1"], values["r2"], values["r3"], values["theta1"], t2, t3)
-            return label(is_open(t3, t4))
-        return rocker_driven
-
-    if m.closed_form == "fourbar":
-        def fourbar(sol: dict[str, float]) -> str:
-            t3 = math.radians(sol["theta3"]) if "theta3" in sol else values["theta3"]
-            t4 = math.radians(sol["theta4"]) if "theta4" in sol else values["theta4"]
-            return label(is_open(t3, t4))
-        return fourbar
-
-    def slider(sol: dict[str, float]) -> str:
-        return label(slider_is_open(math.radians(sol["theta3"])))
-    return slider
 
 
 # --- assembly: classification ------------------------------------------------------------

@@ -241,8 +241,13 @@ def line_side_np(z: tuple[Any, Any], s: Any) -> Any:
 # --- two lengths -----------------------------------------------------------------------------
 
 def two_lengths(e: Pair, f: Pair, k: Pair) -> tuple[float, float] | None:
-    """(s, t) with s E + t F + K = 0; None when E and F are parallel."""
+    """(s, t) with s E + t F + K = 0; None when E and F are parallel and K leaves their
+    line (no solution). Raises ZeroDivisionError when they are parallel and K lies along
+    it (every s with its t is a solution: a change point, not "cannot be assembled")."""
     det = e[0] * f[1] - e[1] * f[0]
+    if det == 0.0 and (e != (0.0, 0.0) or f != (0.0, 0.0)) and \
+            e[0] * k[1] - e[1] * k[0] == 0.0 and f[0] * k[1] - f[1] * k[0] == 0.0:
+        raise ZeroDivisionError("parallel slides along the known vectors")
     if det == 0.0 or not math.isfinite(det):
         return None
     return -(k[0] * f[1] - k[1] * f[0]) / det, -(e[0] * k[1] - e[1] * k[0]) / det
