@@ -336,7 +336,8 @@ def test_branch_without_a_closed_form_says_why(cli):
     run = cli("solve", str(path), "--branch", "open")
     assert run.code == 2 and run.out == ""
     assert run.err == (f"error: --branch needs a closed form; {path} has none: "
-                       "loop 1 has 3 unknowns, loop 2 has 3 unknowns (coupled)\n")
+                       "loop 1 has 3 unknowns, loop 2 has 3 unknowns (coupled); choose its assembly "
+                       "with --guess\n")
 
 
 def test_unknown_branch_lists_the_assemblies_and_the_sign_form(cli):

@@ -470,7 +470,8 @@ def _start_on_branch(mechanism: Any, branch: str, guessed: bool) -> Any:
     derivation = mechanism.derivation
     refusal = derivation.branch_refusal(mechanism.source)
     if refusal:
-        raise InputError(refusal)
+        hint = "" if derivation.complete else "; choose its assembly with --guess"
+        raise InputError(refusal + hint)
     driver = mechanism.driver.value
     at = f"{mechanism.driver.name} = {mechanism.problem().meta['driver_value']:g} {mechanism.driver.unit}"
     try:
