@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ..problems.derive import is_open_np, sign_text
+from ..problems.derive import sign_text
 from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..rules import residual_gate, step_scales, step_size_array, system_converged_array
 from .angles import (
@@ -111,7 +111,6 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
         return None
     shown = _display(m, solver, vals, cols, kinds, closes)
     label = "/".join(words)
-    from ..problems.derive import sign_text
     from .stepwise import classification_of, names_follow_signs
 
     # the followed branch as the one-at-a-time engine reports it: its name where each name
@@ -222,25 +221,17 @@ def _column_lengths(jac: list[list[Any]], k: int) -> np.ndarray:
 
 
 def _words(m: Mechanism, drv: np.ndarray, q: list[np.ndarray], signs: tuple[float, ...]) -> list[str] | None:
-    """Each two-way step's name for the block (:meth:`Derivation.words_of` over arrays), or
-    None where one changes within it."""
+    """Each two-way step's name for the block, by the derivation's own rule
+    (:meth:`~linkage.problems.derive.Derivation.words_of_np`), or None where one changes
+    within it."""
     d = m.derivation
-    params = d.params
-    assert params is not None
     out = []
-    it = iter(signs)
-    for step in d.steps:
-        if not step.two_way:
-            continue
-        sigma = next(it)
-        if not step.word_rule:
-            out.append(sign_text((sigma,)))
-            continue
-        is_open = is_open_np(step, params, drv, q)
-        if is_open.all():
-            out.append("open")
-        elif not is_open.any():
-            out.append("crossed")
+    for i, word in zip(d.two_way, d.words_of_np(q, drv)):
+        named = bool(d.steps[i].word_rule)
+        if word.all():
+            out.append("open" if named else "+")
+        elif not word.any():
+            out.append("crossed" if named else "-")
         else:
             return None
     return out
