@@ -180,3 +180,19 @@ def test_solve_help_says_what_the_closed_form_header_means(cli):
     text = _words(cli("solve", "--help").out)
     assert '("loops 1, 2 (stepwise)": loop 1 solved first, then loop 2 with its answers)' in text
     assert "which are coupled (Newton only)" in text
+
+
+def test_a_sweep_plots_cannot_be_assembled_band_ends_at_the_limit_positions():
+    """The red band ran from the last unassembled grid value to the first solved one
+    (100..106 deg of the rocker-driven ME581 at step 2), so it said "cannot be assembled"
+    over 104.48..106 deg, where it can. It now ends at the limits, which the law of
+    cosines gives here: |B - O2| = r2 + r3 = 90 with B 45 from O4 and O4 90 from O2."""
+    import linkage
+    from linkage.render.plots import bands
+
+    r = linkage.sweep(SAMPLES / "fourbar_me581_theta4.toml", [float(v) for v in range(100, 262, 2)],
+                      branch="open")
+    # 90^2 = 90^2 + 45^2 - 2 * 90 * 45 cos(180 - theta4)  =>  cos(theta4) = -45 / 180
+    limit = math.degrees(math.acos(-0.25))
+    red = [(a, b) for a, b, status in bands(r) if status == "no_solution"]
+    assert red == [(100.0, pytest.approx(limit, abs=1e-9)), (pytest.approx(360.0 - limit, abs=1e-9), 260.0)]

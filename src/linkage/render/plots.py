@@ -78,7 +78,7 @@ def sweep_plot(result: Any, path: Path) -> None:
     fig, axes = plt.subplots(len(series), 1, sharex=True, figsize=(8, 1.9 * len(series) + 1.2),
                              squeeze=False)
     xs = [p.input for p in result.positions]
-    gaps = _runs([p.status for p in result.positions], xs)
+    gaps = bands(result)
     # a re-entry on the other assembly that carries the branch's label is a jump, not a
     # motion: the line breaks before it
     from ..kinematics.continuation import REENTERED
@@ -152,6 +152,25 @@ def _broken(xs: Sequence[float], ys: Sequence[float], before: set[int]) -> tuple
         bx.append(x)
         by.append(y)
     return bx, by
+
+
+def bands(result: Any) -> list[tuple[float, float, str]]:
+    """The shaded intervals of a sweep plot: runs of positions off the branch, a run that
+    cannot be assembled cut back to the feasible ranges' ends."""
+    xs = [p.input for p in result.positions]
+    return [(a, b, status) for lo, hi, status in _runs([p.status for p in result.positions], xs)
+            for a, b in (_outside(lo, hi, result.feasible_ranges) if status == "no_solution"
+                         else [(lo, hi)])]
+
+
+def _outside(lo: float, hi: float, ranges: Sequence[tuple[float, float]]) -> list[tuple[float, float]]:
+    """The parts of [lo, hi] outside the feasible ranges: a run of unassembled grid
+    positions reaches to its solved neighbours, but the linkage assembles up to the limit
+    positions inside that interval (exact where a closed form locates them)."""
+    out = [(lo, hi)]
+    for a, b in ranges:
+        out = [piece for x, y in out for piece in ((x, min(y, a)), (max(x, b), y)) if piece[1] > piece[0]]
+    return out
 
 
 def _runs(statuses: Sequence[str], xs: Sequence[float]) -> list[tuple[float, float, str]]:
