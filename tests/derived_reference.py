@@ -22,6 +22,25 @@ from linkage.problems.loops import Mechanism, from_text
 
 DPS = 50
 
+# A closed form with only a linear step: s along x, t along y, closing on r e^(i theta)
+# (s = r cos(theta), t = r sin(theta)): one assembly, nothing for --branch to choose.
+XY = """name = "xy"
+length_unit = "mm"
+[parameters]
+r = { value = 50, unit = "mm" }
+[driver]
+name = "theta"
+value = 30
+unit = "deg"
+[unknowns]
+s = { guess = 10, unit = "mm" }
+t = { guess = 10, unit = "mm" }
+[[loops]]
+name = "L"
+vectors = [{ length = "s", angle = 0 }, { length = "t", angle = 90 },
+           { length = "r", angle = "theta", sign = -1 }]
+"""
+
 
 # --- random mechanisms as TOML ---------------------------------------------------------------
 

@@ -10,24 +10,10 @@ import math
 
 import pytest
 
+from derived_reference import XY
+
 # s along x, t along y, closing on r e^(i theta): linear, one assembly,
 # s = r cos(theta), t = r sin(theta)
-XY = """name = "xy"
-length_unit = "mm"
-[parameters]
-r = { value = 50, unit = "mm" }
-[driver]
-name = "theta"
-value = 30
-unit = "deg"
-[unknowns]
-s = { guess = 10, unit = "mm" }
-t = { guess = 10, unit = "mm" }
-[[loops]]
-name = "L"
-vectors = [{ length = "s", angle = 0 }, { length = "t", angle = 90 },
-           { length = "r", angle = "theta", sign = -1 }]
-"""
 
 
 @pytest.fixture

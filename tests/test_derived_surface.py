@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 
+from derived_reference import XY
 from linkage.errors import ParseError
 from linkage.problems.loops import load, parse_mechanism
 from pty_run import run as pty
@@ -262,22 +263,7 @@ def test_a_closed_form_with_no_choice_names_its_one_assembly(cli, tmp_path):
     s = r cos(theta), t = r sin(theta); it is called 'only', and --branch says there is
     nothing to choose."""
     path = tmp_path / "xy.toml"
-    path.write_text("""name = "xy"
-length_unit = "mm"
-[parameters]
-r = { value = 50, unit = "mm" }
-[driver]
-name = "theta"
-value = 30
-unit = "deg"
-[unknowns]
-s = { guess = 10, unit = "mm" }
-t = { guess = 10, unit = "mm" }
-[[loops]]
-name = "L"
-vectors = [{ length = "s", angle = 0 }, { length = "t", angle = 90 },
-           { length = "r", angle = "theta", sign = -1 }]
-""")
+    path.write_text(XY)
     doc = solve_json(cli, path)
     assert doc["branch"] == "only" and set(doc["reference"]) == {"only"}
     assert doc["reference"]["only"]["s"] == pytest.approx(50 * math.cos(math.radians(30)), abs=1e-12)
