@@ -42,6 +42,39 @@ vectors = [{ length = "s", angle = 0 }, { length = "t", angle = 90 },
 """
 
 
+def abcd_text(links: tuple[float, float, float, float], driver: str, value: float,
+              guesses: dict[str, float], *, unit: str = "mm", name: str = "abcd four-bar",
+              key: str = "") -> str:
+    """A four-bar with the textbook's names (a crank, b coupler, c rocker, d ground), no
+    closed_form key unless ``key`` gives one, driven by ``driver`` (theta2, theta3 or
+    theta4); ``guesses`` for the other two angles."""
+    a, b, c, d = links
+    unknowns = "\n".join(f'{k} = {{ guess = {v!r}, unit = "deg" }}' for k, v in guesses.items())
+    return f"""name = "{name}"
+length_unit = "{unit}"
+{key}
+[parameters]
+a = {{ value = {a!r}, unit = "{unit}" }}
+b = {{ value = {b!r}, unit = "{unit}" }}
+c = {{ value = {c!r}, unit = "{unit}" }}
+d = {{ value = {d!r}, unit = "{unit}" }}
+[driver]
+name = "{driver}"
+value = {value!r}
+unit = "deg"
+[unknowns]
+{unknowns}
+[[loops]]
+name = "O2-A-B-O4"
+vectors = [
+  {{ length = "a", angle = "theta2" }},
+  {{ length = "b", angle = "theta3" }},
+  {{ length = "c", angle = "theta4", sign = -1 }},
+  {{ length = "d", angle = 0, sign = -1 }},
+]
+"""
+
+
 # --- random mechanisms as TOML ---------------------------------------------------------------
 
 @dataclass

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from derived_reference import XY
+from derived_reference import XY, abcd_text
 from linkage.errors import ParseError
 from linkage.problems.loops import load, parse_mechanism
 from pty_run import run as pty
@@ -80,34 +80,7 @@ def abcd_file(tmp_path: Path, driver: str, value: float, guesses: dict[str, floa
               links: tuple[float, float, float, float] = P3, key: str = "") -> Path:
     """A four-bar written with textbook names a (input), b (coupler), c (output), d
     (ground), no closed_form key, driven by any of theta2, theta3, theta4."""
-    a, b, c, d = links
-    unknowns = "\n".join(f"{k} = {{ guess = {v!r}, unit = \"deg\" }}" for k, v in guesses.items())
-    text = f"""name = "Norton four-bar"
-length_unit = "cm"
-{key}
-[parameters]
-a = {{ value = {a!r}, unit = "cm" }}
-b = {{ value = {b!r}, unit = "cm" }}
-c = {{ value = {c!r}, unit = "cm" }}
-d = {{ value = {d!r}, unit = "cm" }}
-
-[driver]
-name = "{driver}"
-value = {value!r}
-unit = "deg"
-
-[unknowns]
-{unknowns}
-
-[[loops]]
-name = "O2-A-B-O4"
-vectors = [
-  {{ length = "a", angle = "theta2" }},
-  {{ length = "b", angle = "theta3" }},
-  {{ length = "c", angle = "theta4", sign = -1 }},
-  {{ length = "d", angle = 0, sign = -1 }},
-]
-"""
+    text = abcd_text(links, driver, value, guesses, unit="cm", name="Norton four-bar", key=key)
     path = tmp_path / f"abcd_{driver}.toml"
     path.write_text(text)
     return path

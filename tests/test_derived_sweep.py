@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import linkage
+from derived_reference import abcd_text
 from linkage.errors import InputError
 from linkage.problems.loops import load
 
@@ -20,39 +21,10 @@ SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 mp.mp.dps = 50
 
 
-def abcd_text(a: float, b: float, c: float, d: float, driver: str, value: float) -> str:
-    """A four-bar with the textbook's names (a crank, b coupler, c rocker, d ground) and no
-    closed_form key, driven by ``driver``; the other two angles unknown."""
-    unknowns = "\n".join(f'{n} = {{ guess = {g}, unit = "deg" }}'
-                         for n, g in (("theta2", 30), ("theta3", 20), ("theta4", 60)) if n != driver)
-    return f"""
-name = "abcd four-bar"
-length_unit = "mm"
-[parameters]
-a = {{ value = {a}, unit = "mm" }}
-b = {{ value = {b}, unit = "mm" }}
-c = {{ value = {c}, unit = "mm" }}
-d = {{ value = {d}, unit = "mm" }}
-[driver]
-name = "{driver}"
-value = {value}
-unit = "deg"
-[unknowns]
-{unknowns}
-[[loops]]
-name = "O2-A-B-O4"
-vectors = [
-  {{ length = "a", angle = "theta2" }},
-  {{ length = "b", angle = "theta3" }},
-  {{ length = "c", angle = "theta4", sign = -1 }},
-  {{ length = "d", angle = 0, sign = -1 }},
-]
-"""
-
-
 def abcd(tmp_path: Path, links: tuple[float, float, float, float], driver: str, value: float = 30.0):
     path = tmp_path / f"abcd_{driver}.toml"
-    path.write_text(abcd_text(*links, driver, value))
+    guesses = {n: g for n, g in (("theta2", 30.0), ("theta3", 20.0), ("theta4", 60.0)) if n != driver}
+    path.write_text(abcd_text(links, driver, value, guesses))
     return load(path)
 
 
