@@ -111,11 +111,11 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
         return None
     shown = _display(m, solver, vals, cols, kinds, closes)
     label = "/".join(words)
-    from .stepwise import classification_of, names_follow_signs
+    from .stepwise import classification_of
 
     # the followed branch as the one-at-a-time engine reports it: its name where each name
     # is one sign branch, else its signs (each position still carries its name)
-    followed = label if names_follow_signs(m) else sign_text(signs)
+    followed = label if m.derivation.names_are_signs else sign_text(signs)
     meta = SweepResult(m.name, m.driver.name, m.driver.unit, tuple(u.name for u in m.unknowns),
                        tuple("deg" if k == "angle" else m.length_unit for k in kinds), (),
                        ((float(vals[0]), float(vals[-1])),), (), followed, classification_of(m),

@@ -92,9 +92,10 @@ def sweep(
 
 def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -> str | None:
     """What the sweep follows for a ``branch`` text. A sweep follows signs: where each
-    name is one sign branch (:func:`names_follow_signs`) a name and its signs are the
-    same thing, and the branch is followed and reported by its name; otherwise a name
-    (``open`` of a rocker-driven four-bar, ``open (mirror)``) is the signs of its assembly
+    name is one sign branch (:attr:`~linkage.problems.derive.Derivation.names_are_signs`)
+    a name and its signs are the same thing, and the branch is followed and reported by
+    its name; otherwise a name (``open`` of a rocker-driven four-bar, ``open (mirror)``)
+    is the signs of its assembly
     at the first driver value where the name appears (InputError where it appears nowhere)."""
     from ..errors import InputError
     from ..problems.derive import MIRROR, Indeterminate, parse_signs, sign_text
@@ -102,7 +103,7 @@ def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -
     d = solver.derivation
     if branch is None or d is None:
         return branch
-    if parse_signs(branch, solver.count) is not None and names_follow_signs(solver.m):
+    if parse_signs(branch, solver.count) is not None and d.names_are_signs:
         # each name is one sign branch: follow (and report) it by its name
         for v in values:
             try:
@@ -114,7 +115,7 @@ def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -
                     return name
         return branch
     if parse_signs(branch, solver.count) is not None or (
-            not branch.endswith(MIRROR) and names_follow_signs(solver.m)):
+            not branch.endswith(MIRROR) and d.names_are_signs):
         return branch
     # a name that cuts across the signs (a four-bar driven by its rocker or coupler, or a
     # mirror key): the signs of its assembly where the name first appears, followed as
@@ -143,15 +144,9 @@ def seed_target(solver: Solver, q: Sequence[float], v: float) -> str:
 
     d = solver.derivation
     assert d is not None
-    if names_follow_signs(solver.m):
+    if d.names_are_signs:
         return d.name_of(q, v * solver.scale)
     return sign_text(d.signs_of(q, v * solver.scale))
-
-
-def names_follow_signs(m: Mechanism) -> bool:
-    """Whether each branch name of ``m``'s derivation is one sign branch
-    (:attr:`~linkage.problems.derive.Derivation.names_are_signs`)."""
-    return m.derivation.names_are_signs
 
 
 def classification_of(m: Mechanism) -> dict[str, Any]:
