@@ -1,0 +1,54 @@
+"""A report's blocks as a person reads them: rich on a terminal, plain text, or any
+tabulate format. LaTeX is a complete ``table`` environment with its caption; the text
+lines around a table become LaTeX comments."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .data import Report
+from .report import Table, Text, print_rich, render_text
+
+LATEX = ("latex", "latex_raw", "latex_booktabs", "latex_longtable")
+_LATEX_SPECIAL = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#",
+                  "_": r"\_", "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}", "^": r"\^{}"}
+
+
+def latex_escape(text: str) -> str:
+    return "".join(_LATEX_SPECIAL.get(c, c) for c in text)
+
+
+def print_table(report: Report, file: Any = None) -> None:
+    print_rich(report.blocks(), file)
+
+
+def display_text(report: Report, fmt: str) -> str:
+    blocks = report.blocks()
+    if fmt not in LATEX:
+        return render_text(blocks, fmt)
+    return latex_text(report.title, blocks, fmt)
+
+
+def latex_text(title: str, blocks: Any, fmt: str) -> str:
+    """Each table in a ``table`` float (``longtable`` carries its own caption), captioned by
+    its title or the report's, labelled ``tab:linkage-K``; every other line a comment, so
+    the text compiles as it is in a document."""
+    out: list[str] = []
+    k = 0
+    for b in blocks:
+        if isinstance(b, Text):
+            out.extend(f"% {line}" if line else "%" for line in b.text.splitlines() or [""])
+            continue
+        assert isinstance(b, Table)
+        k += 1
+        caption = latex_escape(b.title or title)
+        body = render_text([Table("", b.headers, b.rows)], fmt).rstrip("\n")
+        if fmt == "latex_longtable":
+            head = f"\\caption{{{caption}}}\\label{{tab:linkage-{k}}}\\\\\n\\hline"
+            body = body.replace("\\hline", head, 1)
+            out.append(body)
+        else:
+            out += ["\\begin{table}[htbp]", "\\centering", f"\\caption{{{caption}}}",
+                    f"\\label{{tab:linkage-{k}}}", body, "\\end{table}"]
+        out.extend(f"% {n}" for n in b.notes)
+    return "\n".join(out) + "\n"

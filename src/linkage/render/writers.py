@@ -1,0 +1,455 @@
+"""One registry of output formats; each writes a :class:`~.data.Report`.
+
+Display formats (table, plain and tabulate's) show the report's blocks. Data formats
+(csv, json, parquet, xlsx) write its tables, every column with its unit, streamed a block
+of rows at a time (never one Python object per cell of a large table):
+
+- csv: a header row of ``name (unit)``, numbers as the shortest text that reads back to
+  the same double, an empty cell where there is none. A report of several tables writes
+  them one after another, each under a ``# name`` line, a blank line between.
+- json: the command's document, with the tables under ``tables``: for each, its name,
+  column names, units and rows.
+- parquet: one file per table (the first at the path given, the others beside it as
+  ``stem.name.parquet``), each field's unit in its metadata.
+- xlsx: one sheet per table, ``name (unit)`` in the header row, numbers as numbers.
+
+A file is written to a temporary name beside it and renamed when complete
+(:func:`~linkage.files.atomic_target`): a failed or interrupted run leaves no
+half-written file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import sys
+from collections.abc import Callable, Iterator, Sequence
+from pathlib import Path
+from typing import IO, Any, NamedTuple
+
+from ..errors import InputError, OutputError
+from .data import Column, DataTable, Report
+
+
+class Format(NamedTuple):
+    name: str
+    suffixes: tuple[str, ...]
+    data: bool  # writes the tables (else the display blocks)
+    binary: bool = False
+    help: str = ""
+
+
+OWN_FORMATS = {f.name: f for f in (
+    Format("table", (), False, help="rich, on a terminal"),
+    Format("plain", (".txt", ""), False, help="headers over a rule"),
+    Format("csv", (".csv",), True),
+    Format("json", (".json",), True),
+    Format("parquet", (".parquet",), True, binary=True, help="needs pyarrow"),
+    Format("xlsx", (".xlsx",), True, binary=True, help="needs openpyxl"),
+)}
+TABULATE_SUFFIXES = {".md": "github", ".tex": "latex", ".html": "html", ".rst": "rst"}
+EXTRAS = {"parquet": ("pyarrow.parquet", "pip install 'linkage-kinematics[scan]'"),
+          "xlsx": ("openpyxl", "pip install 'linkage-kinematics[xlsx]'")}
+SLICE = 8192
+"""Rows formatted at a time."""
+FAST_CELLS = 200_000
+"""From this many cells, CSV numbers are formatted by pyarrow when it is installed."""
+
+
+def tabulate_formats() -> list[str]:
+    from tabulate import tabulate_formats as names
+
+    return [n for n in names if n not in OWN_FORMATS]
+
+
+def suffix_map() -> dict[str, str]:
+    out = {s: f.name for f in OWN_FORMATS.values() for s in f.suffixes}
+    return {**out, **TABULATE_SUFFIXES}
+
+
+def known_suffixes() -> str:
+    return ", ".join(f"{s} ({n})" for s, n in suffix_map().items() if s)
+
+
+def choose_format(fmt: str | None, output: Path | None, *, terminal: bool | None = None) -> str:
+    """The format of this run: --format if given (checked), else -o's suffix, else table on
+    a terminal and plain when piped. An unknown format or suffix, or a binary format for
+    standard output, is an InputError naming what works."""
+    to_stdout = output is None or str(output) == "-"
+    if fmt is None:
+        if not to_stdout:
+            suffix = output.suffix.lower()  # type: ignore[union-attr]
+            chosen = suffix_map().get(suffix)
+            if chosen is None:
+                raise InputError(f"-o {output}: unknown suffix {suffix}; use {known_suffixes()}, "
+                                 "or --format NAME (any format to any file name)")
+            fmt = chosen
+        else:
+            tty = sys.stdout.isatty() if terminal is None else terminal
+            fmt = "table" if tty else "plain"
+    elif fmt not in OWN_FORMATS and fmt not in tabulate_formats():
+        raise InputError(f"unknown format {fmt!r}; use {', '.join(OWN_FORMATS)} or a tabulate format "
+                         f"({', '.join(tabulate_formats()[:8])}, ...)")
+    if to_stdout and fmt in OWN_FORMATS and OWN_FORMATS[fmt].binary:
+        raise InputError(f"{fmt} is a binary format: give -o FILE.{fmt}")
+    if fmt in EXTRAS:
+        module, how = EXTRAS[fmt]
+        try:
+            __import__(module)
+        except ImportError:
+            raise InputError(f"{fmt} output needs {module.split('.')[0]}: {how}") from None
+    return fmt
+
+
+def is_data(fmt: str) -> bool:
+    return fmt in OWN_FORMATS and OWN_FORMATS[fmt].data
+
+
+# --- cells ----------------------------------------------------------------------------------
+
+def number_texts(values: Any) -> list[str]:
+    """Each number as the shortest text that reads back to the same double (Python's repr,
+    or pyarrow's shortest form for a large block when pyarrow is installed: ``100`` where
+    repr says ``100.0``; both read back bit for bit); "" for NaN, infinities and None."""
+    if _is_array(values) and values.dtype.kind == "f" and len(values) >= 1024 and _pyarrow():
+        import numpy as np
+        import pyarrow as pa
+        import pyarrow.compute as pc
+
+        finite = np.isfinite(values)
+        arr = pa.array(values, mask=~finite)
+        return pc.fill_null(pc.cast(arr, pa.string()), "").to_pylist()  # type: ignore[no-any-return]
+    seq = values.tolist() if _is_array(values) else values
+    return ["" if v is None or (isinstance(v, float) and not math.isfinite(v)) else
+            repr(v) if isinstance(v, float) else str(v) for v in seq]
+
+
+def _is_array(values: Any) -> bool:
+    return hasattr(values, "dtype") and hasattr(values, "tolist")
+
+
+_HAS_PYARROW: list[bool] = []
+
+
+def _pyarrow() -> bool:
+    if not _HAS_PYARROW:
+        try:
+            import pyarrow.compute  # noqa: F401
+            _HAS_PYARROW.append(True)
+        except ImportError:
+            _HAS_PYARROW.append(False)
+    return _HAS_PYARROW[0]
+
+
+def _quote(text: str) -> str:
+    if any(c in text for c in ',"\n\r'):
+        return '"' + text.replace('"', '""') + '"'
+    return text
+
+
+def cell_texts(col: Column, values: Any) -> list[str]:
+    """One column's cells as CSV text."""
+    if col.kind == "number":
+        return number_texts(values)
+    seq = values.tolist() if _is_array(values) else list(values)
+    if col.kind == "bool":
+        return ["" if v is None else "true" if v else "false" for v in seq]
+    if col.kind == "int":
+        return ["" if v is None else str(int(v)) for v in seq]
+    return ["" if v is None else _quote(str(v)) for v in seq]
+
+
+def json_values(col: Column, values: Any) -> list[Any]:
+    seq = values.tolist() if _is_array(values) else list(values)
+    if col.kind == "number":
+        return [v if v is None or isinstance(v, int) or math.isfinite(v) else None for v in seq]
+    if col.kind == "bool":
+        return [None if v is None else bool(v) for v in seq]
+    return seq
+
+
+# --- sinks: a table at a time, a block of rows at a time --------------------------------------
+
+class Sink:
+    """Writes tables to one output: ``begin(name, columns)``, ``rows(values)`` (one
+    sequence per column, any number of times), ``end()``; ``close()`` finishes the output."""
+
+    def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
+        self.out, self.path, self.meta = out, path, meta or {}
+        self.count = 0  # rows written in the current table
+        self.tables = 0
+        self.columns: tuple[Column, ...] = ()
+
+    def begin(self, name: str, columns: Sequence[Column]) -> None:
+        self.name, self.columns, self.count = name, tuple(columns), 0
+        self.tables += 1
+
+    def rows(self, values: Sequence[Any]) -> None:
+        raise NotImplementedError
+
+    def end(self) -> None:
+        return None
+
+    def close(self) -> None:
+        return None
+
+
+class CsvSink(Sink):
+    def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None,
+                 several: bool = False) -> None:
+        super().__init__(out, path, meta)
+        self.several = several
+
+    def begin(self, name: str, columns: Sequence[Column]) -> None:
+        super().begin(name, columns)
+        head = ("\n" if self.tables > 1 else "") + (f"# {name}\n" if self.several else "")
+        self.out.write(head + ",".join(_quote(c.header) for c in self.columns) + "\n")  # type: ignore[union-attr]
+
+    def rows(self, values: Sequence[Any]) -> None:
+        n = len(values[0]) if values else 0
+        for a in range(0, n, SLICE):
+            b = min(n, a + SLICE)
+            cells = [cell_texts(c, v[a:b]) for c, v in zip(self.columns, values)]
+            self.out.write("\n".join(map(",".join, zip(*cells))) + "\n")  # type: ignore[union-attr]
+        self.count += n
+
+
+class JsonSink(Sink):
+    """The document's keys, then ``"tables": [{"name", "columns", "units", "rows"}, ...]``."""
+
+    def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
+        super().__init__(out, path, meta)
+        from .export import clean
+
+        head = json.dumps(clean(self.meta), indent=2, allow_nan=False)
+        self.out.write(head[:-1].rstrip() + (",\n" if self.meta else "") + '  "tables": [')  # type: ignore[union-attr]
+
+    def begin(self, name: str, columns: Sequence[Column]) -> None:
+        super().begin(name, columns)
+        spec = {"name": name, "columns": [c.name for c in self.columns],
+                "units": [c.unit for c in self.columns]}
+        text = json.dumps(spec, allow_nan=False)[:-1] + ', "rows": ['
+        self.out.write(("," if self.tables > 1 else "") + "\n    " + text)  # type: ignore[union-attr]
+
+    def rows(self, values: Sequence[Any]) -> None:
+        n = len(values[0]) if values else 0
+        for a in range(0, n, SLICE):
+            b = min(n, a + SLICE)
+            cols = [json_values(c, v[a:b]) for c, v in zip(self.columns, values)]
+            text = ",".join("\n      " + json.dumps(r, allow_nan=False) for r in map(list, zip(*cols)))
+            self.out.write(("," if self.count or a else "") + text)  # type: ignore[union-attr]
+        self.count += n
+
+    def end(self) -> None:
+        self.out.write("\n    ]}" if self.count else "]}")  # type: ignore[union-attr]
+
+    def close(self) -> None:
+        self.out.write("\n  ]\n}\n")  # type: ignore[union-attr]
+
+
+class ParquetSink(Sink):
+    """One parquet file per table: the first at the path, the others beside it."""
+
+    def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None,
+                 paths: Callable[[str], str] | None = None) -> None:
+        super().__init__(out, path, meta)
+        self.paths = paths
+        self.writer: Any = None
+
+    def begin(self, name: str, columns: Sequence[Column]) -> None:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        super().begin(name, columns)
+        types = {"number": pa.float64(), "int": pa.int64(), "bool": pa.bool_(), "text": pa.string()}
+        fields = [pa.field(c.name, types[c.kind], metadata={"unit": c.unit} if c.unit else None)
+                  for c in self.columns]
+        from .export import clean
+
+        self.schema = pa.schema(fields, metadata={"linkage": json.dumps(clean({**self.meta, "table": name}))})
+        target = self.path if self.tables == 1 or self.paths is None else self.paths(name)
+        self.writer = pq.ParquetWriter(target, self.schema)
+
+    def rows(self, values: Sequence[Any]) -> None:
+        import pyarrow as pa
+
+        arrays = []
+        for c, f, v in zip(self.columns, self.schema, values):
+            if c.kind == "number":  # NaN and infinities are no value, as in CSV and JSON
+                import numpy as np
+
+                x = np.asarray(v if _is_array(v) else [math.nan if x is None else x for x in v], dtype=float)
+                arrays.append(pa.array(x, type=f.type, mask=~np.isfinite(x)))
+            else:
+                arrays.append(pa.array(v.tolist() if _is_array(v) else list(v), type=f.type))
+        self.writer.write_table(pa.Table.from_arrays(arrays, schema=self.schema))
+        self.count += len(values[0]) if values else 0
+
+    def end(self) -> None:
+        self.writer.close()
+        self.writer = None
+
+    def close(self) -> None:
+        if self.writer is not None:
+            with contextlib.suppress(Exception):
+                self.writer.close()
+
+
+XLSX_ROWS = 1_048_575
+"""Rows a sheet holds below its header row (Excel's limit)."""
+
+
+class XlsxSink(Sink):
+    def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
+        super().__init__(out, path, meta)
+        from openpyxl import Workbook
+
+        self.book = Workbook(write_only=True)
+        self.sheet: Any = None
+
+    def begin(self, name: str, columns: Sequence[Column]) -> None:
+        super().begin(name, columns)
+        self.sheet = self.book.create_sheet(title=name[:31] or f"table {self.tables}")
+        self.sheet.append([c.header for c in self.columns])
+
+    def rows(self, values: Sequence[Any]) -> None:
+        n = len(values[0]) if values else 0
+        if self.count + n > XLSX_ROWS:
+            raise InputError(f"{self.count + n:,} rows is more than an xlsx sheet holds ({XLSX_ROWS:,}); "
+                             "use csv or parquet")
+        for a in range(0, n, SLICE):
+            b = min(n, a + SLICE)
+            cols = [json_values(c, v[a:b]) for c, v in zip(self.columns, values)]
+            for r in zip(*cols):
+                self.sheet.append(r)
+        self.count += n
+
+    def close(self) -> None:
+        if self.sheet is None:
+            self.book.create_sheet(title="empty")
+        self.book.save(self.path)
+
+
+def _sidecar(path: str) -> Callable[[str], str]:
+    def name(table: str) -> str:
+        p = Path(path)
+        return str(p.with_name(f"{p.stem}.{table}{p.suffix}"))
+    return name
+
+
+@contextlib.contextmanager
+def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None,
+              several: bool = False) -> Iterator[Sink]:
+    """A sink for a data format, to ``output`` (None or "-": standard output), finished and
+    renamed into place only if the block completes."""
+    to_stdout = output is None or str(output) == "-"
+    kinds = {"csv": CsvSink, "json": JsonSink, "parquet": ParquetSink, "xlsx": XlsxSink}
+    try:
+        with contextlib.ExitStack() as stack:
+            if to_stdout:
+                sink: Sink = _make(kinds[fmt], sys.stdout, None, meta, several)
+                yield sink
+                sink.close()
+                sys.stdout.flush()
+                return
+            from ..files import atomic_target
+
+            tmp = stack.enter_context(atomic_target(output))  # type: ignore[arg-type]
+            extra: list[str] = []
+            if fmt in ("parquet", "xlsx"):
+                sink = _make(kinds[fmt], None, tmp, meta, several)
+                if isinstance(sink, ParquetSink):
+                    sink.paths = lambda t: _extra_target(stack, output, t, extra)  # type: ignore[arg-type]
+                try:
+                    yield sink
+                finally:
+                    sink.close()
+            else:
+                fh = stack.enter_context(open(tmp, "w", encoding="utf-8", newline=""))
+                sink = _make(kinds[fmt], fh, tmp, meta, several)
+                yield sink
+                sink.close()
+    except OSError as exc:
+        where = "standard output" if to_stdout else str(output)
+        raise OutputError(f"cannot write to {where}: {exc.strerror or exc}") from None
+
+
+def _extra_target(stack: contextlib.ExitStack, output: Path, table: str, made: list[str]) -> str:
+    from ..files import atomic_target
+
+    final = Path(_sidecar(str(output))(table))
+    made.append(str(final))
+    return stack.enter_context(atomic_target(final))
+
+
+def _make(kind: type[Sink], out: Any, path: str | None, meta: Any, several: bool) -> Sink:
+    if kind is CsvSink:
+        return CsvSink(out, path, meta, several)
+    return kind(out, path, meta)
+
+
+def side_paths(output: Path, report: Report) -> list[Path]:
+    """The files a parquet report of several tables writes beside ``output``."""
+    return [Path(_sidecar(str(output))(t.name)) for t in [t for t in report.tables if t.columns][1:]]
+
+
+PROGRESS_ROWS = 16 * SLICE
+"""Rows handed to a sink at a time when a progress bar is shown."""
+
+
+def write_tables(sink: Sink, tables: Sequence[DataTable],
+                 progress: Callable[[int], None] | None = None) -> None:
+    """Every table into ``sink``; ``progress(rows written so far)`` after each block."""
+    done = 0
+    for t in tables:
+        sink.begin(t.name, t.columns)
+        n = len(t)
+        step = PROGRESS_ROWS if progress is not None else max(n, 1)
+        for a in range(0, n, step):
+            whole = step >= n
+            sink.rows([c.values if whole else c.values[a:a + step] for c in t.columns])
+            done += min(step, n - a)
+            if progress is not None:
+                progress(done)
+        sink.end()
+
+
+# --- the one entry point --------------------------------------------------------------------
+
+def write(report: Report, fmt: str, output: Path | None, *,
+          progress: Callable[[int], None] | None = None) -> None:
+    """Write ``report`` in ``fmt`` to ``output`` (None or "-": standard output);
+    ``progress(rows written)`` as a data format's rows go out."""
+    to_stdout = output is None or str(output) == "-"
+    if is_data(fmt):
+        tables = [t for t in report.tables if t.columns]
+        meta = report.document() if (fmt == "json" and report.document is not None) else \
+            {"title": report.title} if fmt in ("json", "parquet") else {}
+        with open_sink(fmt, output, meta, several=len(tables) > 1) as sink:
+            write_tables(sink, tables, progress)
+    else:
+        from .display import display_text, print_table
+
+        if fmt == "table" and to_stdout:
+            try:
+                print_table(report)
+            except OSError as exc:
+                raise OutputError(f"cannot write to standard output: {exc.strerror or exc}") from None
+            return
+        text = display_text(report, "plain" if fmt == "table" else fmt)
+        if to_stdout:
+            try:
+                sys.stdout.write(text)
+                sys.stdout.flush()
+            except OSError as exc:
+                raise OutputError(f"cannot write to standard output: {exc.strerror or exc}") from None
+            return
+        from ..files import write_atomic
+
+        write_atomic(output, text)  # type: ignore[arg-type]
+    if not to_stdout:
+        made = [str(output)]
+        if fmt == "parquet":
+            made += [str(p) for p in side_paths(output, report)]  # type: ignore[arg-type]
+        print(f"wrote {', '.join(made)}", file=sys.stderr)

@@ -1,0 +1,179 @@
+"""The writer registry (render.writers) on a report made here: every data format read back
+gives the same numbers (CSV and JSON bit for bit) and the same units; refusals name what
+works."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from linkage.errors import InputError
+from linkage.render import writers
+from linkage.render.data import Column, DataTable, Report, split_header
+from linkage.render.report import Text, table
+
+
+def awkward_numbers(n: int = 3000) -> np.ndarray:
+    rng = np.random.default_rng(7)
+    head = [0.1, 1 / 3, -0.0, 5e-324, 2.2250738585072014e-308, 1.7976931348623157e308, math.nan,
+            math.inf, -math.inf, 123456789.0, 1e22, 1e16, 9007199254740993.0, 0.0]
+    tail = rng.standard_normal(n) * 10.0 ** rng.integers(-300, 300, n)
+    return np.concatenate([head, tail])
+
+
+def report(x: np.ndarray | list[float]) -> Report:
+    positions = DataTable("positions", (
+        Column("theta2", "deg", x),
+        Column("status", "", ["converged", "no_solution"] * (len(x) // 2) + ["converged"] * (len(x) % 2),
+               "text"),
+        Column("iterations", "", list(range(len(x))), "int"),
+        Column("open", "", [k % 3 == 0 for k in range(len(x))], "bool"),
+    ))
+    joints = DataTable("joints", (Column("joint", "", ["A", 'B, "c"'], "text"),
+                                  Column("x", "mm", [1.5, None])))
+    return Report("a test, with 50% & an_underscore", (positions, joints),
+                  lambda: [Text("a line"), table("", ["theta2 (deg)", "n"], [[1.0, 2]], 6)],
+                  lambda: {"mechanism": "test"})
+
+
+def bits(values: list[float]) -> list[int]:
+    return [struct.unpack("<q", struct.pack("<d", v))[0] for v in values]
+
+
+def finite(x: np.ndarray) -> list[float | None]:
+    return [float(v) if math.isfinite(v) else None for v in x.tolist()]
+
+
+def read_csv_sections(text: str) -> dict[str, list[list[str]]]:
+    out: dict[str, list[list[str]]] = {}
+    for part in text.split("\n\n"):
+        lines = part.strip("\n").split("\n")
+        name = lines[0][2:] if lines[0].startswith("# ") else "only"
+        out[name] = list(csv.reader(io.StringIO("\n".join(lines[1:] if name != "only" else lines))))
+    return out
+
+
+@pytest.mark.parametrize("n", [20, 3000])  # below and above the pyarrow fast path's block
+def test_csv_and_json_read_back_bit_for_bit(tmp_path: Path, n: int) -> None:
+    x = awkward_numbers(n)
+    rep = report(x)
+    writers.write(rep, "csv", tmp_path / "a.csv")
+    sections = read_csv_sections((tmp_path / "a.csv").read_text())
+    head, *rows = sections["positions"]
+    assert [split_header(h) for h in head] == [("theta2", "deg"), ("status", ""), ("iterations", ""),
+                                               ("open", "")]
+    got = [float(r[0]) if r[0] else None for r in rows]
+    want = finite(x)
+    assert [g is None for g in got] == [w is None for w in want]
+    assert bits([g for g in got if g is not None]) == bits([w for w in want if w is not None])
+    assert [r[1] for r in rows] == list(rep.tables[0].columns[1].values)
+    assert [int(r[2]) for r in rows] == list(range(len(x)))
+    assert [r[3] for r in rows] == ["true" if k % 3 == 0 else "false" for k in range(len(x))]
+    assert sections["joints"] == [["joint", "x (mm)"], ["A", "1.5"], ['B, "c"', ""]]
+
+    writers.write(rep, "json", tmp_path / "a.json")
+    doc = json.loads((tmp_path / "a.json").read_text())
+    assert doc["mechanism"] == "test"
+    t = doc["tables"][0]
+    assert t["name"] == "positions" and t["columns"][0] == "theta2" and t["units"][0] == "deg"
+    got = [r[0] for r in t["rows"]]
+    assert [g is None for g in got] == [w is None for w in want]
+    assert bits([g for g in got if g is not None]) == bits([w for w in want if w is not None])
+    assert doc["tables"][1] == {"name": "joints", "columns": ["joint", "x"], "units": ["", "mm"],
+                                "rows": [["A", 1.5], ['B, "c"', None]]}
+
+
+def test_parquet_and_xlsx_read_back(tmp_path: Path) -> None:
+    pq = pytest.importorskip("pyarrow.parquet")
+    openpyxl = pytest.importorskip("openpyxl")
+    x = awkward_numbers(500)
+    rep = report(x)
+    writers.write(rep, "parquet", tmp_path / "a.parquet")
+    t = pq.read_table(tmp_path / "a.parquet")
+    assert t.schema.field("theta2").metadata == {b"unit": b"deg"}
+    got = t.column("theta2").to_pylist()
+    want = finite(x)
+    assert [g is None or (isinstance(g, float) and math.isnan(g)) for g in got] == [w is None for w in want]
+    assert bits([g for g, w in zip(got, want) if w is not None]) == bits([w for w in want if w is not None])
+    side = pq.read_table(tmp_path / "a.joints.parquet")
+    assert side.schema.field("x").metadata == {b"unit": b"mm"}
+    assert side.to_pydict() == {"joint": ["A", 'B, "c"'], "x": [1.5, None]}
+
+    writers.write(rep, "xlsx", tmp_path / "a.xlsx")
+    book = openpyxl.load_workbook(tmp_path / "a.xlsx")
+    assert book.sheetnames == ["positions", "joints"]
+    rows = list(book["positions"].iter_rows(values_only=True))
+    assert rows[0] == ("theta2 (deg)", "status", "iterations", "open")
+    cells = [r[0] for r in rows[1:]]
+    assert [c is None for c in cells] == [w is None for w in want]
+    assert all(isinstance(c, (int, float)) for c in cells if c is not None)  # numbers, not text
+    # xlsx is not bit for bit: openpyxl writes 16 significant digits ("%.16g"), so 1/3
+    # comes back one ulp off, and the largest doubles (beyond Excel's 9.99e307) overflow;
+    # Excel has no -0. To 16 significant digits (Excel shows 15), within Excel's range.
+    for c, w in zip(cells, want):
+        if w is not None and abs(w) < 9.99e307:
+            assert abs(float(c) - w) <= 6e-16 * abs(w), (c, w)
+    assert list(book["joints"].iter_rows(values_only=True)) == [("joint", "x (mm)"), ("A", 1.5),
+                                                                 ('B, "c"', None)]
+
+
+@pytest.mark.parametrize("name", ["x.mat", "x.xls", "x.CSVX", "x.parquet.bak"])
+def test_unknown_suffix_is_refused_naming_the_ones_that_work(name: str) -> None:
+    with pytest.raises(InputError) as e:
+        writers.choose_format(None, Path(name))
+    assert ".csv (csv)" in str(e.value) and ".xlsx (xlsx)" in str(e.value)
+
+
+def test_suffixes_and_formats() -> None:
+    assert writers.choose_format(None, Path("a.CSV")) == "csv"
+    assert writers.choose_format(None, Path("a.tex")) == "latex"
+    assert writers.choose_format(None, Path("noext")) == "plain"
+    assert writers.choose_format("grid", Path("a.csv")) == "grid"  # --format wins
+    with pytest.raises(InputError, match="binary"):
+        writers.choose_format("parquet", None)
+    with pytest.raises(InputError, match="unknown format"):
+        writers.choose_format("mat", None)
+
+
+def test_latex_is_a_captioned_table(tmp_path: Path) -> None:
+    rep = report([1.0, 2.0])
+    writers.write(rep, "latex", tmp_path / "a.tex")
+    text = (tmp_path / "a.tex").read_text()
+    lines = text.splitlines()
+    assert lines[0] == "% a line"
+    assert lines.index("\\begin{table}[htbp]") < lines.index("\\begin{tabular}{rr}") < \
+        lines.index("\\end{table}")
+    assert "\\caption{a test, with 50\\% \\& an\\_underscore}" in lines
+    # every line is a comment or LaTeX: no bare text outside the float
+    inside = False
+    for line in lines:
+        inside = inside or line.startswith("\\begin{table}")
+        assert inside or line.startswith("%"), line
+        if line == "\\end{table}":
+            inside = False
+
+
+def test_a_failed_write_leaves_no_file(tmp_path: Path) -> None:
+    rep = report([1.0, 2.0])._replace(tables=(DataTable("t", (Column("x", "", _Exploding()),)),))
+    with pytest.raises(_ExplodingError):
+        writers.write(rep, "csv", tmp_path / "a.csv")
+    assert list(tmp_path.iterdir()) == []
+
+
+class _Exploding(list):  # a column whose values fail half-way through the write
+    def __len__(self) -> int:
+        return 10
+
+    def __getitem__(self, i: object) -> object:
+        raise _ExplodingError
+
+
+class _ExplodingError(Exception):
+    pass
