@@ -37,7 +37,8 @@ class DataTable(NamedTuple):
     """What a row is: iterations, positions, designs, joints, rates, ..."""
     columns: tuple[Column, ...]
 
-    def __len__(self) -> int:  # type: ignore[override]
+    @property
+    def row_count(self) -> int:  # not __len__: a NamedTuple's own length is its fields'
         return len(self.columns[0].values) if self.columns else 0
 
 

@@ -404,7 +404,7 @@ def write_tables(sink: Sink, tables: Sequence[DataTable],
     done = 0
     for t in tables:
         sink.begin(t.name, t.columns)
-        n = len(t)
+        n = t.row_count
         step = PROGRESS_ROWS if progress is not None else max(n, 1)
         for a in range(0, n, step):
             whole = step >= n
@@ -453,3 +453,35 @@ def write(report: Report, fmt: str, output: Path | None, *,
         if fmt == "parquet":
             made += [str(p) for p in side_paths(output, report)]  # type: ignore[arg-type]
         print(f"wrote {', '.join(made)}", file=sys.stderr)
+
+
+def pick_columns(report: Report, names: str) -> Report:
+    """``--columns``: keep each table's first column and the columns whose name (or
+    header) begins with one of ``names`` (comma-separated, case-insensitive), in the tables
+    and in the display; a display table says which columns it left out. None matching is
+    an InputError naming the columns there are."""
+    from .report import pick_columns as pick_blocks
+
+    wanted = [w.strip().lower() for w in names.split(",") if w.strip()]
+
+    def keep(c: Column) -> bool:
+        return any(c.name.lower().startswith(w) or c.header.lower().startswith(w) for w in wanted)
+
+    tables = []
+    matched = False
+    for t in report.tables:
+        cols = t.columns[:1] + tuple(c for c in t.columns[1:] if keep(c))
+        matched = matched or len(cols) > 1
+        tables.append(t._replace(columns=cols) if len(cols) > 1 else t)
+    if not matched:
+        there = sorted({c.name for t in report.tables for c in t.columns[1:]})
+        raise InputError(f"--columns {names!r} matches no column; the columns are {', '.join(there)}")
+    blocks = report.blocks
+
+    def picked() -> Any:
+        try:
+            return pick_blocks(blocks(), ((), ()), names)[0]
+        except InputError:
+            return blocks()  # the display shows fewer columns than the tables: keep it whole
+
+    return report._replace(tables=tuple(tables), blocks=picked)
