@@ -490,6 +490,51 @@ def _place(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd
     return placed
 
 
+def place_np(model: LoopModel, q: Any, d: Any) -> dict[str, tuple[Any, Any]]:
+    """:func:`place`'s positions over arrays: every named joint and point, name -> (x, y)
+    arrays, for ``q`` (one array per unknown, internal units) and driver values ``d``.
+    The same sums in the same order as :func:`_place` (each vector ``sign r e^(i theta)``,
+    a joint reached along the side of its loop with fewer moving vectors), so it agrees
+    with the scalar definition to the last bits of numpy's cos and sin (tests check it)."""
+    import numpy as np
+
+    d = np.asarray(d, dtype=float)
+    zero = np.zeros(d.shape)
+
+    def part(t: Any) -> tuple[Any, Any]:
+        sign, lc, li, ac, ai, off = t
+        r = q[li] if li >= 0 else (d if li == DRIVER else lc)
+        th = (q[ai] if ai >= 0 else (d if ai == DRIVER else ac)) + off
+        sr = sign * r  # as _term: (sign r) e^(i theta), e^(i theta) = cos + i sin
+        return sr * np.cos(th), sr * np.sin(th)
+
+    def add(start: tuple[Any, Any], parts: Any, sign: float) -> tuple[Any, Any]:
+        x, y = start
+        for dx, dy in parts:
+            x, y = x + sign * dx, y + sign * dy
+        return x, y
+
+    placed: dict[str, tuple[Any, Any]] = {}
+    origin0 = (zero, zero)
+    for loop, terms in zip(model.mechanism.loops, model.terms):
+        names = loop.joints
+        start = placed.get(names[0]) if names and names[0] else None
+        origin = start if start is not None else origin0
+        parts = [part(t) for t in terms]
+        moving = [t[2] != FIXED or t[4] != FIXED for t in terms]
+        for k in range(len(terms)):
+            if not names or not names[k] or names[k] in placed:
+                continue
+            forward, backward = range(k), range(k, len(terms))
+            ahead = sum(moving[j] for j in forward) <= sum(moving[j] for j in backward)
+            placed[names[k]] = add(origin, [parts[j] for j in (forward if ahead else backward)],
+                                   1.0 if ahead else -1.0)
+    for name, (origin_name, terms) in model.point_terms.items():
+        placed[name] = add(placed.get(origin_name, origin0), [part(t) for t in terms], 1.0)
+    # a constant joint (a ground pivot) as a full column, as every position has it
+    return {k: (x + zero, y + zero) for k, (x, y) in placed.items()}
+
+
 def _xy(c: complex) -> XY:
     return (c.real, c.imag)
 

@@ -1,11 +1,15 @@
-"""Report blocks, CSV and JSON for sweeps."""
+"""A sweep's report: its table of positions (columns read from the engine's arrays), the
+display blocks and the JSON document (built only when shown or written)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 from ..kinematics.angles import angle_extent, closes_circle, driver_turn
+from ..kinematics.columns import SweepColumns, sweep_columns
 from ..kinematics.sweep import SweepResult
+from .data import DataTable, Report, column, from_rows, split_header
 from .rates import rate_cells, rate_headers, rate_units_dict, rates_dict
 from .report import Block, Text, fmt, table
 
@@ -35,6 +39,8 @@ def joint_names(s: SweepResult) -> list[str]:
 
 
 def sweep_headers(s: SweepResult, kinematics: bool = True) -> list[str]:
+    """Today's CSV headers of :func:`sweep_rows`, ``name (unit)`` (the report's columns'
+    headers, :func:`sweep_table`)."""
     u = s.driver_unit
     headers = [f"{s.driver} ({u})", "status"]
     headers += [f"{n} ({unit})" for n, unit in zip(s.names, s.units)]
@@ -61,27 +67,101 @@ def sweep_rows(s: SweepResult, kinematics: bool = True) -> list[tuple[Any, ...]]
     return rows
 
 
-def ranges_of(s: SweepResult) -> dict[str, dict[str, float]]:
-    """Per unknown: min and max over solved positions, where they occur, and the stroke
-    (an angle's by the range rule of kinematics.angles: a full turn at most, 360 for one
-    that turns fully)."""
+def sweep_table(s: SweepResult, cols: SweepColumns | None = None) -> DataTable:
+    """The sweep's one table, ``positions``: the driver, status, each unknown, branch,
+    iterations, det J, the transmission angle (a four-bar), with a driver speed the rates
+    (each with its bound) and the joints' coordinates (and rates) where computed. Each
+    column named as today's CSV header without its unit (``theta3``, ``det J``,
+    ``A.x``), the unit beside it."""
+    c = sweep_columns(s) if cols is None else cols
+    out = [column(s.driver, s.driver_unit, c.inputs), column("status", "", c.status, "text")]
+    out += [column(n, unit, c.solution[n]) for n, unit in zip(s.names, s.units)]
+    out += [column("branch", "", c.branch, "text"), column("iterations", "", c.iterations, "int"),
+            column("det J", det_unit_of(s), c.det)]
+    if s.classification:
+        out.append(column("transmission angle", "deg", c.transmission))
+    joints = list(c.joints)
+    if c.rates is not None:  # the scalar rates, a row at a time (the one definition)
+        heads = rate_headers(s.names, _kinds(s), s.length_unit, joints, True)
+        cells = [rate_cells(r, s.names, joints, True) for r in c.rates]
+        by_column = list(zip(*cells)) if cells else [() for _ in heads]
+        for h, values in zip(heads, by_column):
+            name, unit = split_header(h)
+            out.append(column(name, unit, list(values), "text" if name == "rates status" else "number"))
+    else:
+        for j in joints:
+            x, y = c.joints[j]
+            out += [column(f"{j}.x", s.length_unit, x), column(f"{j}.y", s.length_unit, y)]
+    return DataTable("positions", tuple(out))
+
+
+def sweep_report(s: SweepResult, digits: int, max_rows: int = 400, joints_note: str = "") -> Report:
+    """The sweep as a :class:`~.data.Report`: one table (:func:`sweep_table`), the display
+    blocks and the JSON document built only when a format asks for them. ``joints_note``:
+    a line the display adds (where the joints are written, say)."""
+    cols = sweep_columns(s)
+    title = f"{s.mechanism}: sweep of {s.driver} over {len(cols)} positions"
+
+    def blocks() -> list[Block]:
+        out = sweep_blocks(s, digits, max_rows, cols)
+        return [*out, Text(joints_note)] if joints_note else out
+
+    return Report(title, (sweep_table(s, cols),), blocks, lambda: sweep_dict(s, cols))
+
+
+def _cell(v: Any) -> Any:
+    """A display cell: NaN (an array's no value) as None."""
+    return None if isinstance(v, float) and v != v else v
+
+
+def _extreme(values: Any, inputs: Any, low: bool) -> tuple[float, float]:
+    """(min or max of the solved values, where it occurs: as min and max of (value, driver)
+    pairs pick it, the smallest driver value of equal minima, the largest of maxima)."""
+    if hasattr(values, "dtype"):
+        import numpy as np
+
+        best = float(np.nanmin(values) if low else np.nanmax(values))
+        at = np.asarray(inputs)[values == best]
+        return best, float(at.min() if low else at.max())
+    pts = [(v, x) for v, x in zip(values, inputs) if v is not None]
+    return min(pts) if low else max(pts)
+
+
+def ranges_of(s: SweepResult, cols: SweepColumns | None = None) -> dict[str, dict[str, float]]:
+    """Per unknown: min and max over solved positions, where they occur (the first
+    driver value of equals), and the stroke (an angle's by the range rule of
+    kinematics.angles: a full turn at most, 360 for one that turns fully)."""
+    c = sweep_columns(s) if cols is None else cols
     out = {}
-    inputs = [p.input for p in s.positions]
-    closes = s.driver_unit in ("deg", "rad") and closes_circle(inputs, driver_turn(s.driver_unit))
+    inputs = c.inputs
+    angle = s.driver_unit in ("deg", "rad")
     for name, unit in zip(s.names, s.units):
-        pts = [(p.solution[name], p.input) for p in s.positions if p.solution]
-        if not pts:
-            continue
-        lo, hi = min(pts), max(pts)
-        stroke = hi[0] - lo[0]
-        if unit == "deg":
-            stroke = angle_extent([p.solution[name] if p.solution else None for p in s.positions],
-                                  closes)[2]
+        values = c.solution[name]
+        if c.arrays:
+            import numpy as np
+
+            from ..kinematics.angles import angle_extent_array, closes_circle_array
+
+            if not np.isfinite(values).any():
+                continue
+            lo, hi = _extreme(values, inputs, True), _extreme(values, inputs, False)
+            stroke = hi[0] - lo[0]
+            if unit == "deg":
+                closes = angle and closes_circle_array(inputs, driver_turn(s.driver_unit))
+                stroke = float(angle_extent_array(values[None, :], closes)[2][0])
+        else:
+            if all(v is None for v in values):
+                continue
+            lo, hi = _extreme(values, inputs, True), _extreme(values, inputs, False)
+            stroke = hi[0] - lo[0]
+            if unit == "deg":
+                closes = angle and closes_circle(inputs, driver_turn(s.driver_unit))
+                stroke = angle_extent(values, closes)[2]
         out[name] = {"min": lo[0], "at_min": lo[1], "max": hi[0], "at_max": hi[1], "stroke": stroke}
     return out
 
 
-def sweep_dict(s: SweepResult) -> dict[str, Any]:
+def sweep_dict(s: SweepResult, cols: SweepColumns | None = None) -> dict[str, Any]:
     return {
         "mechanism": s.mechanism,
         "driver": {"name": s.driver, "unit": s.driver_unit},
@@ -102,44 +182,78 @@ def sweep_dict(s: SweepResult) -> dict[str, Any]:
         ],
         "feasible_ranges": [list(r) for r in s.feasible_ranges],
         "toggles": list(s.toggles),
-        "ranges": ranges_of(s),
+        "ranges": ranges_of(s, cols),
         "summary": s.summary,
     }
 
 
-def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400) -> list[Block]:
+def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400,
+                 cols: SweepColumns | None = None) -> list[Block]:
+    c = sweep_columns(s) if cols is None else cols
     u = s.driver_unit
-    blocks: list[Block] = [Text(f"{s.mechanism}: sweep of {s.driver} over {len(s.positions)} positions "
+    n = len(c)
+    blocks: list[Block] = [Text(f"{s.mechanism}: sweep of {s.driver} over {n} positions "
                                 f"({s.method}, continuation)", "bold")]
     if s.classification:
-        for c in s.classification.get("loops", [s.classification]):
-            where = f" loop {c['loop']}" if "loop" in c else ""
-            blocks.append(Text(f"four-bar{where}: {c['type']} (s + l = {fmt(c['s_plus_l'], 6)}, "
-                               f"p + q = {fmt(c['p_plus_q'], 6)})"))
+        for cl in s.classification.get("loops", [s.classification]):
+            where = f" loop {cl['loop']}" if "loop" in cl else ""
+            blocks.append(Text(f"four-bar{where}: {cl['type']} (s + l = {fmt(cl['s_plus_l'], 6)}, "
+                               f"p + q = {fmt(cl['p_plus_q'], 6)})"))
         if len(s.classification.get("loops", ())) > 1:  # one column for several loops
             blocks.append(Text("transmission angle: at each position, of the four-bar loop "
                                "farthest from 90 deg"))
-    rows = sweep_rows(s, kinematics=False)
     headers = sweep_headers(s, kinematics=False)
-    if s.motion is not None:  # the unknowns' rates beside their values (joints: csv, json)
+    every = -(-n // max_rows)  # ceil: the fewest rows skipped that fit max_rows
+    shown = range(n) if every <= 1 else range(0, n, every)
+    # only the rows shown are read from the columns (a batch sweep builds no position)
+    data = [c.inputs, c.status, *[c.solution[name] for name in s.names], c.branch, c.iterations, c.det]
+    if s.classification:
+        data.append(c.transmission)
+    picked = [v[shown.start:shown.stop:shown.step] for v in data]
+    picked = [p.tolist() if hasattr(p, "tolist") else list(p) for p in picked]
+    rows = [tuple(_cell(v) for v in r) for r in zip(*picked)]
+    if s.motion is not None and c.rates is not None:  # the unknowns' rates beside their values
         headers += rate_headers(s.names, _kinds(s), s.length_unit, [], True, bounds=False)
-        rows = [(*r, *rate_cells(p.rates, s.names, [], True, bounds=False))
-                for r, p in zip(rows, s.positions)]
-    every = -(-len(rows) // max_rows)  # ceil: the fewest rows skipped that fit max_rows
-    shown = rows if every <= 1 else rows[::every]
-    note = [] if shown is rows else [f"(one row in {every} of {len(rows)} shown; "
-                                     "--format csv or json gives all)"]
+        rows = [(*r, *rate_cells(c.rates[i], s.names, [], True, bounds=False)) for r, i in zip(rows, shown)]
+    note = [] if every <= 1 else [f"(one row in {every} of {n} shown; "
+                                  "--format csv or json gives all)"]
     blocks.append(Text(""))
-    blocks.append(table("", headers, shown, digits, notes=note))
+    blocks.append(table("", headers, rows, digits, notes=note))
     counts = ", ".join(f"{k}: {v}" for k, v in sorted(s.summary.items()))
     blocks.append(Text(f"positions: {counts}; branch: {s.branch}", "bold"))
     blocks.append(Text("feasible ranges: " + (", ".join(f"[{fmt(a, 12)}, {fmt(b, 12)}] {u}"
                                                         for a, b in s.feasible_ranges) or "none")))
     blocks.append(Text("limit and toggle positions: " + (", ".join(f"{fmt(t, 13)} {u}" for t in s.toggles)
                                                          or "none")))
-    for name, r in ranges_of(s).items():
+    for name, r in ranges_of(s, c).items():
         unit = dict(zip(s.names, s.units))[name]
         blocks.append(Text(f"{name}: min {fmt(r['min'], 10)} {unit} at {s.driver} = {fmt(r['at_min'], 8)}, "
                            f"max {fmt(r['max'], 10)} {unit} at {fmt(r['at_max'], 8)}, "
                            f"range {fmt(r['stroke'], 10)} {unit}"))
     return blocks
+
+
+EQUATION = "f(phi) = R1 cos(alpha) - R2 cos(phi) + R3 - cos(alpha - phi)"
+EQUATION_COLUMNS = (("alpha", "deg", "number"), ("status", "", "text"), ("phi", "deg", "number"),
+                    ("iterations", "", "int"), ("f(phi)", "", "number"))
+"""The equation sweep's columns: f(phi) is Freudenstein's dimensionless residual."""
+
+
+def equation_report(rows: Sequence[Sequence[Any]], method: str, tol: float, heading: str,
+                    digits: int) -> Report:
+    """The four-bar input-output equation swept over alpha (rows of alpha, status, phi,
+    iterations, f(phi); None where there is no value) as a Report: one table,
+    ``positions``; ``heading`` names the coefficients."""
+    headers = tuple(f"{n} ({u})" if u else n for n, u, _ in EQUATION_COLUMNS)
+
+    def blocks() -> list[Block]:
+        return [Text(f"four-bar input-output equation over alpha ({method}, each from the previous "
+                     f"root): {heading}", "bold"), Text(""), table("", headers, list(rows), digits)]
+
+    def document() -> dict[str, Any]:
+        return {"equation": EQUATION, "method": method, "tol": tol,
+                "positions": [dict(zip(("alpha", "status", "phi", "iterations", "residual"), r))
+                              for r in rows]}
+
+    return Report(f"four-bar input-output equation over alpha: {heading}",
+                  (from_rows("positions", EQUATION_COLUMNS, rows),), blocks, document)
