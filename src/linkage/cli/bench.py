@@ -6,9 +6,9 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import InputError
-from .app import app
 from .options import PICTURES, FormatOpt, OutputOpt, check_paths, choose_format, emit
 from .progress import progress_bar
+from .root import app
 
 
 @app.command(

@@ -6,9 +6,9 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .app import app
 from .options import PICTURES, MechanismFile, SetOpt, check_paths, note_closed_form, parse_assignments
 from .progress import progress_bar
+from .root import app
 
 
 @app.command(

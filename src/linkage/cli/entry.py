@@ -8,32 +8,23 @@ from typing import Any
 import typer
 
 from ..errors import LinkageError
-from .app import app
 from .options import NOTED
-
-
-def reflow(doc: str) -> str:
-    """A docstring as help text: each paragraph one line (rich keeps single line breaks,
-    so hard-wrapped source lines would break mid-sentence at any width), and square
-    brackets escaped (rich would read "[points]" as a style)."""
-    import inspect
-
-    paragraphs = inspect.cleandoc(doc).split("\n\n")
-    return "\n\n".join(" ".join(line.strip() for line in p.splitlines()).replace("[", "\\[")
-                       for p in paragraphs)
+from .root import app
 
 
 def app_for(args: list[str]) -> typer.Typer:
-    """The app with only the command this run names: typer builds the parser of every
-    registered command (signature, type hints, options) before it dispatches, and a run
-    uses one. Anything else (no command, an option first, a misspelt name) gets the
-    whole app, whose help and "No such command" list them all."""
-    if not args or args[0].startswith("-"):
+    """The app with only the command this run names, whose module alone is imported:
+    typer builds the parser of every registered command (signature, type hints, options)
+    before it dispatches, and a run uses one. Anything else (no command, an option first,
+    a misspelt name) gets the whole app, whose help and "No such command" list them all."""
+    from .registry import COMMANDS, load
+
+    if not args or args[0].startswith("-") or args[0] not in COMMANDS:
+        load()
         return app
+    load((args[0],))
     chosen = [c for c in app.registered_commands if c.callback is not None and
               (c.name or c.callback.__name__) == args[0]]
-    if not chosen:
-        return app
     lean = copy.copy(app)
     lean.registered_commands = chosen
     return lean

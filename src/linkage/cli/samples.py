@@ -7,8 +7,8 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .app import app
 from .options import check_paths, emit, stdout_errors
+from .root import app
 
 
 @app.command(

@@ -8,7 +8,6 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .app import app
 from .options import (
     ColumnsOpt,
     DigitsOpt,
@@ -21,6 +20,7 @@ from .options import (
     parse_assignments,
 )
 from .progress import progress_bar
+from .root import app
 
 
 @app.command(

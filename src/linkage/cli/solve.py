@@ -6,7 +6,6 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import InputError
-from .app import app
 from .options import (
     PICTURES,
     AccelOpt,
@@ -20,6 +19,7 @@ from .options import (
     choose_format,
     emit,
 )
+from .root import app
 from .solve_file import convergence_plot, solve_file
 
 

@@ -5,8 +5,8 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import InputError
-from .app import app
 from .options import FormatOpt, OutputOpt, check_paths, choose_format, emit
+from .root import app
 
 
 @app.command(

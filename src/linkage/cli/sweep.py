@@ -6,7 +6,6 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import InputError
-from .app import app
 from .options import (
     PICTURES,
     AccelOpt,
@@ -23,6 +22,7 @@ from .options import (
     parse_assignments,
 )
 from .progress import progress_bar
+from .root import app
 
 
 @app.command(
