@@ -1,12 +1,12 @@
 """linkage bench."""
 
 from pathlib import Path
-from typing import Annotated, Any, Optional
+from typing import Annotated, Optional
 
 import typer
 
 from ..errors import InputError
-from .options import PICTURES, FormatOpt, OutputOpt, check_paths, choose_format, emit
+from .options import PICTURES, FormatOpt, OutputOpt, check_paths, choose_format, emit_report
 from .progress import progress_bar
 from .root import app
 
@@ -36,7 +36,6 @@ def bench(
     """
     from ..bench import (
         FULL_TOLERANCES,
-        MEASUREMENT_HEADERS,
         PROBLEMS,
         QUICK_TOLERANCES,
         cold_start,
@@ -47,7 +46,6 @@ def bench(
         sweep_times,
         targets,
     )
-    from ..render.report import Text, table
 
     out_fmt = choose_format(fmt, output)
     check_paths([], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})
@@ -79,30 +77,16 @@ def bench(
     cold_times = cold_start(3 if quick else 5) if cold else {}
     sweeps = sweep_times(n_repeats, 100_000 if quick else 1_000_000)
     target_rows = targets(results, cold_times, sweeps)
-    headers = MEASUREMENT_HEADERS
-    rows = measurement_rows(results)
-    blocks: list[Any] = [Text(f"work-precision benchmark: {len(results)} measurements, {n_repeats} timed "
-                              "batches each (median; spread = fastest-slowest batch)", "bold")]
+    from ..render.tools import bench_report
+
+    notes = []
     if not has_scipy():
-        blocks.append(Text("scipy is not installed: its rows are skipped "
-                           "(pip install 'linkage-kinematics[bench]')"))
+        notes.append("scipy is not installed: its rows are skipped (pip install 'linkage-kinematics[bench]')")
     if not has_pylinkage():
-        blocks.append(Text("pylinkage is not installed: the sweep comparison is skipped "
-                           "(pip install 'pylinkage==1.3.0')"))
-    blocks += [Text(""), table("", headers, rows, 4)]
-    blocks.append(table("Sweeps (median seconds)", ("sweep", "seconds"), list(sweeps.items()), 4))
-    if cold_times:
-        blocks.append(table("Cold start (fresh interpreter, median wall time)", ("command", "seconds"),
-                            list(cold_times.items()), 4))
-    blocks.append(table("Targets (ratios measured in this run)", ("target", "ratio", "measured", "met"),
-                        [(t, c, r, "n/a" if r is None or r != r or ok is None else ("yes" if ok else "no"))
-                         for t, c, r, ok in target_rows], 3))
-    json_obj = {"measurements": [dict(zip(headers, r)) for r in rows], "cold_start": cold_times,
-                "sweeps": sweeps,
-                "targets": [{"target": t, "ratio": c, "measured": r, "met": ok}
-                            for t, c, r, ok in target_rows],
-                "scipy": has_scipy()}
-    emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=(headers, rows))
+        notes.append("pylinkage is not installed: the sweep comparison is skipped "
+                     "(pip install 'pylinkage==1.3.0')")
+    emit_report(bench_report(measurement_rows(results), sweeps, cold_times, target_rows, n_repeats, notes,
+                             has_scipy()), out_fmt, output)
     if plot is not None:
         from ..render.plots import work_precision_plot
 

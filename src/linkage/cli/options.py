@@ -13,12 +13,14 @@ from ..numbers import parse_number
 FormatOpt = Annotated[
     Optional[str],
     typer.Option("--format", "-f", help="table (rich, default on a terminal), plain (default "
-                 "when piped), csv, json, or any tabulate format (github, grid, latex, ...)."),
+                 "when piped), csv, json, parquet, xlsx, or any tabulate format (github, grid, "
+                 "latex, ...)."),
 ]
 OutputOpt = Annotated[
     Optional[Path],
     typer.Option("--output", "-o", help="Write to this file instead of standard output; "
-                 "the format follows the suffix (.csv, .json) unless --format is given."),
+                 "the format follows the suffix (.csv, .json, .parquet, .xlsx, .txt, .md, .tex, "
+                 ".html, .rst) unless --format is given."),
 ]
 MechanismFile = Annotated[
     Path, typer.Argument(metavar="FILE", help="A mechanism file (TOML, see `linkage samples`).",
@@ -65,18 +67,22 @@ AccelOpt = Annotated[
 ]
 
 def choose_format(fmt: str | None, output: Path | None) -> str:
-    from ..render.report import FORMATS_OWN, tabulate_formats
+    """The run's format, by the one registry (render.writers): --format, else -o's suffix
+    (an unknown suffix refused, naming those that work), else table or plain."""
+    from ..render.writers import choose_format as choose
 
-    if output is not None and str(output) == "-":
-        output = None  # -o - is standard output
-    if fmt is None:
-        if output is not None:
-            return {".csv": "csv", ".json": "json"}.get(output.suffix.lower(), "plain")
-        return "table" if sys.stdout.isatty() else "plain"
-    if fmt in FORMATS_OWN or fmt in tabulate_formats():
-        return fmt
-    raise InputError(f"unknown format {fmt!r}; use table, plain, csv, json or a tabulate format "
-                     f"({', '.join(tabulate_formats()[:8])}, ...)")
+    return choose(fmt, output)
+
+
+def emit_report(report: Any, fmt: str, output: Path | None, *, columns: str | None = None,
+                progress: Any = None) -> None:
+    """Write a command's report (render.data.Report) through the one writer registry;
+    ``columns`` (--columns) keeps only those columns."""
+    from ..render.writers import pick_columns, write
+
+    if columns:
+        report = pick_columns(report, columns)
+    write(report, fmt, output, progress=progress)
 
 
 def emit(fmt: str, output: Path | None, *, blocks: Any, json_obj: Any,

@@ -7,7 +7,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import check_paths, emit, stdout_errors
+from .options import FormatOpt, check_paths, choose_format, emit_report, stdout_errors
 from .root import app
 
 
@@ -20,7 +20,8 @@ def samples(
                     "with -o), e.g. crank_rocker.", show_default=False)] = None,
     *,
     output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Write the sample to this "
-                      "new file (an existing file is never replaced).")] = None,
+                      "new .toml file (an existing file is never replaced).")] = None,
+    fmt: FormatOpt = None,
 ) -> None:
     """List the mechanism files shipped with linkage, or copy one out to start your own.
 
@@ -32,16 +33,14 @@ def samples(
     if name is None:
         if output is not None:
             raise InputError("give the NAME of the sample to write with -o")
-        from ..render.report import Text
+        from ..render.tools import samples_report
 
-        listing = shipped()
-        width = max((len(k) for k in listing), default=0)
-        emit("table" if sys.stdout.isatty() else "plain", None,
-             blocks=[*(Text(f"{k.ljust(width)}  {v}") for k, v in listing.items()), Text(""),
-                     Text("print one with `linkage samples NAME`, or copy it with "
-                          "`linkage samples NAME -o FILE`")],
-             json_obj=listing, csv_table=(("sample", "what it is"), list(listing.items())))
+        emit_report(samples_report(shipped()), choose_format(fmt, None), None)
         return
+    if fmt is not None:
+        raise InputError("--format applies to the list of samples; a sample is printed as its TOML text")
+    if output is not None and str(output) != "-" and output.suffix.lower() != ".toml":
+        raise InputError(f"-o {output}: a sample is a mechanism file: name it with .toml")
     text = find_sample(name).read_text(encoding="utf-8")
     if output is None or str(output) == "-":
         with stdout_errors():
