@@ -10,13 +10,13 @@ from .report import Block, Text, table
 
 
 def samples_report(listing: Mapping[str, str]) -> Report:
+    rows = list(listing.items())
     width = max((len(k) for k in listing), default=0)
 
-    def blocks() -> list[Block]:
-        return [*(Text(f"{k.ljust(width)}  {v}") for k, v in listing.items()), Text(""),
+    def blocks() -> list[Block]:  # lines, not a table: a table right-aligns the descriptions
+        return [*(Text(f"{k.ljust(width)}  {v}") for k, v in rows), Text(""),
                 Text("print one with `linkage samples NAME`, or copy it with `linkage samples NAME -o FILE`")]
 
-    rows = list(listing.items())
     return Report("the mechanism files shipped with linkage",
                   (from_rows("samples", [("sample", "", "text"), ("what it is", "", "text")], rows),),
                   blocks, lambda: {"samples": dict(listing)})
