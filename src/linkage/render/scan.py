@@ -34,6 +34,12 @@ from .data import Column as DataColumn
 from .data import DataTable, Report
 from .report import Block, Text, table
 
+BLOCK = 1000
+"""Records handed to a text sink (csv, json, xlsx) at a time: its Python objects for a block
+(about 2 MB) are what such a format holds. Below writers' pyarrow threshold (1,024) on
+purpose: a number reads the same (Python's repr) whatever --chunk cut the scan into.
+Parquet takes a chunk at a time (a row group per chunk)."""
+
 TABLE = "designs"
 """The name of the scan's one table (what a row is)."""
 
@@ -101,7 +107,9 @@ class RecordSink:
         n = len(cols["design"])
         if not n:
             return
-        self._sink.rows([cols[name] for name, _, _ in self.spec])
+        step = n if self.fmt == "parquet" else BLOCK
+        for a in range(0, n, step):
+            self._sink.rows([cols[name][a:a + step] for name, _, _ in self.spec])
         self.count += n
         if self.to_stdout:  # a pipe sees each chunk as it is computed
             self._flush()
