@@ -156,3 +156,38 @@ def scan_report(cols: Mapping[str, np.ndarray], spec: Sequence[Column], summary:
     doc = dict(meta or {})
     return Report(summary[0], (DataTable(TABLE, scan_columns(spec, held)),),
                   lambda: scan_blocks(cols, spec, summary, digits), lambda: doc)
+
+
+def scan_meta(m: Any, source: str, setup: Any, driver: tuple[float, float, float], where: str | None,
+              sort: str | None, descending: bool) -> dict[str, Any]:
+    """The scan's settings: the JSON document (the records go under its ``tables``) and
+    parquet's ``linkage`` metadata."""
+    start, stop, step = driver
+    return {"mechanism": m.name, "source": source, "branch": setup.branch,
+            "driver": {"name": m.driver.name, "unit": m.driver.unit, "from": start, "to": stop,
+                       "step": step, "positions": len(setup.values)},
+            "where": where, "sort": sort, "descending": descending, "designs": setup.plan.total}
+
+
+def scan_summary(m: Any, setup: Any, driver: tuple[float, float, float], scanned: int, keeper: Any,
+                 held: Mapping[str, np.ndarray], elapsed: float, shown: bool) -> list[str]:
+    """The lines over the display (the first also ends a file's "wrote" line): designs
+    scanned and kept, the driver range, branch and engine, and (``shown``) how many rows
+    the display holds."""
+    from ..kinematics.designs import ENGINES, engine_for
+
+    start, stop, step = driver
+    total, top, sort = setup.plan.total, keeper.top, keeper.sort
+    engine = ENGINES[engine_for(m, setup.branch)]
+    where_note = f"; {keeper.kept:,} pass --where" if setup.where is not None else ""
+    stopped = f" (stopped early: the first {top} are final)" if scanned < total else ""
+    branch = setup.branch or "the one the file's guess is on"
+    lines = [f"{m.name}: {scanned:,} of {total:,} designs scanned{stopped}{where_note}; {elapsed:.2f} s",
+             f"{len(setup.values)} positions each ({m.driver.name} {start:g}..{stop:g} "
+             f"{m.driver.unit}, step {step:g}); branch: {branch}; engine: {engine}"]
+    n_held = len(held["design"]) if held else 0
+    if shown and n_held < keeper.kept:
+        lines.append(f"showing {n_held} of {keeper.kept:,}"
+                     + (f" by {sort}{' (largest first)' if keeper.descending else ''}" if sort else "")
+                     + "; --top K or --format csv/json/parquet/xlsx for more")
+    return lines
