@@ -1,7 +1,6 @@
 """linkage scan."""
 
 import contextlib
-import sys
 import time
 from typing import Annotated, Optional
 
@@ -15,7 +14,6 @@ from .options import (
     OutputOpt,
     SetOpt,
     check_paths,
-    emit,
     note_closed_form,
     parse_assignments,
 )
@@ -66,7 +64,8 @@ def scan(
     chunk: Annotated[Optional[int], typer.Option(help="Designs per task (default: about "
                      "200,000 positions per task).")] = None,
     fmt: Annotated[Optional[str], typer.Option("--format", "-f", help="table (default on a "
-                   "terminal), plain, csv, json or parquet; -o FILE picks by suffix.")] = None,
+                   "terminal), plain, csv, json, parquet, xlsx or a tabulate format (github, "
+                   "latex, ...); -o FILE picks by suffix.")] = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 6,
     columns: ColumnsOpt = None,
@@ -84,27 +83,14 @@ def scan(
     from ..files import read_input
     from ..kinematics.sweep import driver_values
     from ..problems.loops import from_text
-    from ..render.scan import RecordSink, scan_blocks
-    from ..scan import (
-        MAX_DESIGNS,
-        Keeper,
-        ScanJob,
-        check_held,
-        feed,
-        parse_vary,
-        pick_chunk,
-        prepare,
-    )
+    from ..render import writers
+    from ..render.scan import RecordSink, pick_spec, scan_meta, scan_report, scan_summary
+    from ..scan import MAX_DESIGNS, Keeper, ScanJob, check_held, feed, parse_vary, pick_chunk, prepare
     from ..solve import check_criteria
 
     if output is not None and str(output) == "-":
         output = None
-    if fmt is None:
-        suffix = output.suffix.lower() if output is not None else ""
-        fmt = {".csv": "csv", ".json": "json", ".parquet": "parquet"}.get(suffix) or (
-            "table" if output is None and sys.stdout.isatty() else "plain")
-    if fmt not in ("table", "plain", "csv", "json", "parquet"):
-        raise InputError(f"unknown format {fmt!r} for scan; use table, plain, csv, json or parquet")
+    fmt = writers.choose_format(fmt, output)
     check_paths([file], [("--output", output)])
     check_criteria(tol, 0.0, None, 50)
     check_scan_options(seed=seed, samples=samples, top=top, chunk=chunk, workers=workers,
@@ -120,67 +106,39 @@ def scan(
                          "values from --vary only")
     mechanism = from_text(text, str(file)).with_values(fixed, {})
     note_closed_form(mechanism)
-    angle = mechanism.driver.kind == "angle"
-    if not angle and (start is None or stop is None):
+    if mechanism.driver.kind != "angle" and (start is None or stop is None):
         raise InputError(f"{mechanism.driver.name} is a length: give --from and --to")
     a = 0.0 if start is None else start
     b = 359.0 if stop is None else stop
     if b < a:
         raise InputError(f"--to ({b:g}) must not be below --from ({a:g})")
-    setup = prepare(mechanism, varies, samples=samples, seed=seed, sampling=sampling,
-                    values=driver_values(a, b, step, None), branch=branch, tol=tol, where=where, sort=sort)
-    plan, spec, test, chosen, values = setup.plan, setup.spec, setup.where, setup.branch, setup.values
-    if columns:
-        wanted = [w.strip().lower() for w in columns.split(",") if w.strip()]
-        picked = [c for c in spec[1:] if any(c[0].lower().startswith(w) for w in wanted)]
-        if not picked:
-            raise InputError(f"--columns {columns!r} matches no column; the columns are "
-                             f"{', '.join(c[0] for c in spec)}")
-        spec = [spec[0], *picked]
     if desc and sort is None:
         raise InputError("--desc orders by --sort: give --sort COLUMN")
-    if sort is not None and fmt not in ("table", "plain"):
-        check_held(plan.total, len(setup.spec), top, f"--sort {sort} with --format {fmt}")
-    overrides = tuple((k, float(v)) for k, v in fixed.items())
-    job = ScanJob(text, str(file), overrides, plan.names, tuple(values), chosen, tol)
-    size = pick_chunk(mechanism, len(values), chosen, chunk, plan.total)
-    as_table = fmt in ("table", "plain")
-    meta = {"mechanism": mechanism.name, "source": str(file), "branch": chosen,
-            "driver": {"name": mechanism.driver.name, "unit": mechanism.driver.unit, "from": a,
-                       "to": b, "step": step, "positions": len(values)},
-            "where": where, "sort": sort, "descending": desc, "designs": plan.total}
-    sink = None if as_table else RecordSink(fmt, output, spec, meta)
+    setup = prepare(mechanism, varies, samples=samples, seed=seed, sampling=sampling,
+                    values=driver_values(a, b, step, None), branch=branch, tol=tol, where=where, sort=sort)
+    spec = pick_spec(setup.spec, columns) if columns else setup.spec
+    streamed = writers.is_data(fmt)
+    if sort is not None and streamed:
+        check_held(setup.plan.total, len(setup.spec), top, f"--sort {sort} with --format {fmt}")
+    job = ScanJob(text, str(file), tuple((k, float(v)) for k, v in fixed.items()), setup.plan.names,
+                  tuple(setup.values), setup.branch, tol)
+    size = pick_chunk(mechanism, len(setup.values), setup.branch, chunk, setup.plan.total)
+    meta = scan_meta(mechanism, str(file), setup, (a, b, step), where, sort, desc)
     started = time.perf_counter()
     with contextlib.ExitStack() as stack:
-        if sink is not None:
-            stack.enter_context(sink)
-        keeper = Keeper(sort, desc, top, sink if (sink is not None and sort is None) else None,
-                        show=20 if as_table else None)
-        advance = stack.enter_context(progress_bar(plan.total, minimum=2 * size))
+        # a data format streams every record through the registry's sink (sorted: once, at
+        # the end); a display holds the rows it shows
+        sink = stack.enter_context(RecordSink(fmt, output, spec, meta)) if streamed else None
+        keeper = Keeper(sort, desc, top, sink if sort is None else None, show=None if streamed else 20)
+        advance = stack.enter_context(progress_bar(setup.plan.total, minimum=2 * size))
         scanned = feed(keeper, job, setup, size, scheduler=scheduler, workers=workers, progress=advance)
         held = keeper.result()
         if sink is not None and sort is not None:
             sink(held)
-    elapsed = time.perf_counter() - started
-    from ..kinematics.designs import ENGINES, engine_for
-
-    engine = ENGINES[engine_for(mechanism, chosen)]
-    where_note = f"; {keeper.kept:,} pass --where" if test is not None else ""
-    branch_shown = chosen or "the one the file's guess is on"
-    stopped = f" (stopped early: the first {top} are final)" if scanned < plan.total else ""
-    summary = [f"{mechanism.name}: {scanned:,} of {plan.total:,} designs scanned{stopped}"
-               f"{where_note}; {elapsed:.2f} s",
-               f"{len(values)} positions each ({mechanism.driver.name} {a:g}..{b:g} "
-               f"{mechanism.driver.unit}, step {step:g}); branch: {branch_shown}; "
-               f"engine: {engine}"]
-    if as_table:
-        n_held = len(held["design"]) if held else 0
-        if n_held < keeper.kept:
-            summary.append(f"showing {n_held} of {keeper.kept:,}"
-                           + (f" by {sort}{' (largest first)' if desc else ''}" if sort else "")
-                           + "; --top K or --format csv/json/parquet for more")
-        emit(fmt, output, blocks=scan_blocks(held, spec, summary, digits), json_obj=None,
-             csv_table=([], []))
+    summary = scan_summary(mechanism, setup, (a, b, step), scanned, keeper, held,
+                           time.perf_counter() - started, shown=not streamed)
+    if sink is None:
+        writers.write(scan_report(held, spec, summary, digits, meta), fmt, output)
     else:
-        typer.echo(f"{summary[0]}; wrote {sink.count:,} records" +  # type: ignore[union-attr]
+        typer.echo(f"{summary[0]}; wrote {sink.count:,} records" +
                    (f" to {output}" if output is not None else ""), err=True)
