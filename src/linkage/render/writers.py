@@ -54,7 +54,8 @@ EXTRAS = {"parquet": ("pyarrow.parquet", "pip install 'linkage-kinematics[scan]'
 SLICE = 8192
 """Rows formatted at a time."""
 FAST_CELLS = 200_000
-"""From this many cells, CSV numbers are formatted by pyarrow when it is installed."""
+"""From this many cells in a table, CSV numbers are formatted by pyarrow when it is
+installed; the choice is made once per table, so a column's numbers read alike throughout."""
 
 
 def tabulate_formats() -> list[str]:
@@ -108,11 +109,12 @@ def is_data(fmt: str) -> bool:
 
 # --- cells ----------------------------------------------------------------------------------
 
-def number_texts(values: Any) -> list[str]:
-    """Each number as the shortest text that reads back to the same double (Python's repr,
-    or pyarrow's shortest form for a large block when pyarrow is installed: ``100`` where
-    repr says ``100.0``; both read back bit for bit); "" for NaN, infinities and None."""
-    if _is_array(values) and values.dtype.kind == "f" and len(values) >= 1024 and _pyarrow():
+def number_texts(values: Any, fast: bool = False) -> list[str]:
+    """Each number as the shortest text that reads back to the same double: Python's repr,
+    or with ``fast`` (a large table, pyarrow installed) pyarrow's shortest form (``100``
+    where repr says ``100.0``, ``0.000012345`` for ``1.2345e-05``); both read back bit for
+    bit. "" for NaN, infinities and None."""
+    if fast and _is_array(values) and values.dtype.kind == "f" and _pyarrow():
         import numpy as np
         import pyarrow as pa
         import pyarrow.compute as pc
@@ -148,10 +150,10 @@ def _quote(text: str) -> str:
     return text
 
 
-def cell_texts(col: Column, values: Any) -> list[str]:
+def cell_texts(col: Column, values: Any, fast: bool = False) -> list[str]:
     """One column's cells as CSV text."""
     if col.kind == "number":
-        return number_texts(values)
+        return number_texts(values, fast)
     seq = values.tolist() if _is_array(values) else list(values)
     if col.kind == "bool":
         return ["" if v is None else "true" if v else "false" for v in seq]
@@ -181,7 +183,8 @@ class Sink:
         self.tables = 0
         self.columns: tuple[Column, ...] = ()
 
-    def begin(self, name: str, columns: Sequence[Column]) -> None:
+    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
+        """A new table; ``rows``, when known, its number of rows."""
         self.name, self.columns, self.count = name, tuple(columns), 0
         self.tables += 1
 
@@ -201,8 +204,9 @@ class CsvSink(Sink):
         super().__init__(out, path, meta)
         self.several = several
 
-    def begin(self, name: str, columns: Sequence[Column]) -> None:
-        super().begin(name, columns)
+    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
+        super().begin(name, columns, rows)
+        self.fast = rows is not None and rows * len(self.columns) >= FAST_CELLS and _pyarrow()
         head = ("\n" if self.tables > 1 else "") + (f"# {name}\n" if self.several else "")
         self.out.write(head + ",".join(_quote(c.header) for c in self.columns) + "\n")  # type: ignore[union-attr]
 
@@ -210,7 +214,7 @@ class CsvSink(Sink):
         n = len(values[0]) if values else 0
         for a in range(0, n, SLICE):
             b = min(n, a + SLICE)
-            cells = [cell_texts(c, v[a:b]) for c, v in zip(self.columns, values)]
+            cells = [cell_texts(c, v[a:b], self.fast) for c, v in zip(self.columns, values)]
             self.out.write("\n".join(map(",".join, zip(*cells))) + "\n")  # type: ignore[union-attr]
         self.count += n
 
@@ -225,8 +229,8 @@ class JsonSink(Sink):
         head = json.dumps(clean(self.meta), indent=2, allow_nan=False)
         self.out.write(head[:-1].rstrip() + (",\n" if self.meta else "") + '  "tables": [')  # type: ignore[union-attr]
 
-    def begin(self, name: str, columns: Sequence[Column]) -> None:
-        super().begin(name, columns)
+    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
+        super().begin(name, columns, rows)
         spec = {"name": name, "columns": [c.name for c in self.columns],
                 "units": [c.unit for c in self.columns]}
         text = json.dumps(spec, allow_nan=False)[:-1] + ', "rows": ['
@@ -257,11 +261,11 @@ class ParquetSink(Sink):
         self.paths = paths
         self.writer: Any = None
 
-    def begin(self, name: str, columns: Sequence[Column]) -> None:
+    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        super().begin(name, columns)
+        super().begin(name, columns, rows)
         types = {"number": pa.float64(), "int": pa.int64(), "bool": pa.bool_(), "text": pa.string()}
         fields = [pa.field(c.name, types[c.kind], metadata={"unit": c.unit} if c.unit else None)
                   for c in self.columns]
@@ -308,8 +312,8 @@ class XlsxSink(Sink):
         self.book = Workbook(write_only=True)
         self.sheet: Any = None
 
-    def begin(self, name: str, columns: Sequence[Column]) -> None:
-        super().begin(name, columns)
+    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
+        super().begin(name, columns, rows)
         self.sheet = self.book.create_sheet(title=name[:31] or f"table {self.tables}")
         self.sheet.append([c.header for c in self.columns])
 
@@ -403,8 +407,8 @@ def write_tables(sink: Sink, tables: Sequence[DataTable],
     """Every table into ``sink``; ``progress(rows written so far)`` after each block."""
     done = 0
     for t in tables:
-        sink.begin(t.name, t.columns)
         n = t.row_count
+        sink.begin(t.name, t.columns, n)
         step = PROGRESS_ROWS if progress is not None else max(n, 1)
         for a in range(0, n, step):
             whole = step >= n
