@@ -104,6 +104,15 @@ def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: b
     return v
 
 
+def check_fps(name: str, value: Any) -> float:
+    """An animation's frames per second: 0.01 to 100, since a GIF stores each frame's delay
+    as a whole number of hundredths of a second (at most 655.35 s)."""
+    fps = check_number(name, value, positive=True, allow_zero=False)
+    if not 0.01 <= fps <= 100:
+        raise InputError(f"{name} {fps:g} is out of range (0.01 to 100 frames per second)")
+    return fps
+
+
 def check_whole(name: str, value: Any, lo: int = 1, hi: int | None = None, why: str = "") -> int:
     """An int in [lo, hi] (no bools, no floats), or InputError: "NAME must be a whole
     number from LO to HI, got V" (``why`` says where HI comes from)."""
