@@ -306,16 +306,17 @@ def animate_sweep(mechanism: Any, frames: Sequence[tuple[float, Sequence[float]]
     plt = _pyplot()
     from matplotlib.animation import FuncAnimation, PillowWriter
 
-    fig, ax = plt.subplots(figsize=(6, 5.1))
-    fig.subplots_adjust(bottom=0.16)  # room for a note under the x label
+    scale = 180.0 / math.pi if mechanism.driver.kind == "angle" else 1.0
+    values = [d * scale for d, _ in frames]
+    notes = frame_notes(values, gaps, mechanism.driver.unit)
+    fig, ax = plt.subplots(figsize=(6, 5.1 if any(notes) else 4.8))
+    if any(notes):
+        fig.subplots_adjust(bottom=0.16)  # room for a note under the x label
     allpts = [p for d, q in frames for pts, _ in _geometry(mechanism, q, d) for p in pts]
     xs, ys = [p.real for p in allpts], [p.imag for p in allpts]
     pad = 0.08 * max(max(xs) - min(xs), max(ys) - min(ys), 1e-9)
-    scale = 180.0 / math.pi if mechanism.driver.kind == "angle" else 1.0
 
     traces = [_named_points(mechanism, q, d) for d, q in frames]
-    values = [d * scale for d, _ in frames]
-    notes = frame_notes(values, gaps, mechanism.driver.unit)
     # the traced path breaks across a gap: a straight stroke there is no motion
     cuts = {i for i in range(1, len(values)) for a, b in gaps if values[i - 1] <= a and values[i] >= b}
     for t in traces:
