@@ -105,3 +105,22 @@ def summary_blocks(problem: ScalarProblem, runs: Sequence[tuple[Result, Converge
                              fmt(row[8], 4)) for row in rows], digits),
     ]
     return blocks, (tuple(headers), rows)
+
+
+def fourbar_blocks(info: dict[str, Any], digits: int) -> list[Any]:
+    d = max(digits, 12)
+    out: list[Any] = [Text("")]
+    roots = info["roots"]
+    out.append(Text("both roots (closed form): " + (", ".join(f"phi = {fmt(r, d)} deg" for r in roots)
+                                                     or "none: the linkage cannot be assembled here")))
+    fc = info.get("file_convention")
+    if fc:
+        other = info.get("other_assembly")
+        out.append(Text(f"in the mechanism-file convention (ground O2 -> O4 along +x, angles from +x): "
+                        f"theta2 = {fmt(fc['theta2'], d)}, theta3 = {fmt(fc['theta3'], d)}, "
+                        f"theta4 = {fmt(fc['theta4'], d)} deg ({fc['branch']} branch)"
+                        + (f"; other assembly theta3 = {fmt(other['theta3'], d)}, theta4 = "
+                           f"{fmt(other['theta4'], d)} deg ({other['branch']})" if other else "")))
+        out.append(Text("(alpha and phi are measured from the line O4 -> O2, so theta2 = alpha + 180 "
+                        "and theta4 = phi + 180: see the README's angle conventions)"))
+    return out
