@@ -114,9 +114,7 @@ def test_an_animation_notes_the_gap_on_the_frames_either_side(monkeypatch, tmp_p
     grabbed = _frame_texts(monkeypatch)
     mechanism = linkage.load_mechanism(CRANK_ROCKER).with_values({"r3": 50.0}, {})
     s = linkage.sweep(mechanism, [float(v) for v in range(0, 361, 30)])
-    frames = plots.sweep_frames(mechanism, s) if hasattr(plots, "sweep_frames") else [
-        (math.radians(p.input), [math.radians(p.solution[u.name]) for u in mechanism.unknowns])
-        for p in s.positions if p.solution]
+    frames = plots.sweep_frames(mechanism, s)
     gif = tmp_path / "a.gif"
     plots.animate_sweep(mechanism, frames, gif, fps=5, gaps=plots.assembly_gaps(s))
     limit = _no_solution_limit(50.0)
@@ -135,3 +133,104 @@ def test_an_animation_refuses_a_bad_fps(tmp_path, fps):
     mechanism = linkage.load_mechanism(CRANK_ROCKER)
     with pytest.raises(InputError, match="fps"):
         plots.animate_sweep(mechanism, [(0.5, [0.4, 1.0])], tmp_path / "a.gif", fps=fps)
+
+
+def test_linkage_sweep_plot_says_600_rpm(cli, monkeypatch, tmp_path):
+    seen = _capture(monkeypatch)
+    run = cli("sweep", str(CRANK_ROCKER), "--speed", "600rpm", "--step", "30",
+              "--plot", str(tmp_path / "s.png"))
+    assert run.code == 0, run.err
+    title = seen["fig"]._suptitle.get_text()
+    assert "driver at 600 rpm, 0 rpm/s" in title and "62.8" not in title
+    assert len(seen["fig"].axes) == 6
+
+
+SLIDE = """name = "slide"
+length_unit = "mm"
+[parameters]
+r = { value = 50, unit = "mm" }
+[driver]
+name = "s"
+value = 30
+unit = "mm"
+[unknowns]
+theta = { guess = 50, unit = "deg" }
+t = { guess = 40, unit = "mm" }
+[[loops]]
+name = "L"
+vectors = [{ length = "s", angle = 0 }, { length = "t", angle = 90 },
+           { length = "r", angle = "theta", sign = -1 }]
+"""
+
+
+@pytest.mark.parametrize("speed,accel,text,internal", [
+    ("600rpm", None, "600 rpm, 0 rpm/s", (600 * 2 * math.pi / 60, 0.0)),
+    ("90 deg/s", "-45deg/s^2", "90 deg/s, -45 deg/s^2", (math.pi / 2, -math.pi / 4)),
+    ("2.5", None, "2.5 rad/s, 0 rad/s^2", (2.5, 0.0)),
+    ("3 rad/s", "1", "3 rad/s, 1 rad/s^2", (3.0, 1.0)),
+])
+def test_motion_text_is_the_speed_as_given(speed, accel, text, internal):
+    """The text states what parse_motion reads: 600 rpm is 600 turns of 2 pi a minute."""
+    from linkage.arguments import motion_text, parse_motion
+
+    mechanism = linkage.load_mechanism(CRANK_ROCKER)
+    assert motion_text(speed, accel, mechanism) == text
+    assert parse_motion(speed, accel, mechanism) == pytest.approx(internal, rel=1e-15)
+
+
+def test_a_sliding_driver_speed_is_in_its_length_unit_per_second(cli, monkeypatch, tmp_path):
+    from linkage.arguments import motion_text
+
+    path = tmp_path / "slide.toml"
+    path.write_text(SLIDE)
+    assert motion_text("2", None, linkage.load_mechanism(path)) == "2 mm/s, 0 mm/s^2"
+    assert motion_text("2mm/s", "0.5 mm/s^2", linkage.load_mechanism(path)) == "2 mm/s, 0.5 mm/s^2"
+    seen = _capture(monkeypatch)
+    run = cli("sweep", str(path), "--from", "0", "--to", "40", "--step", "10", "--speed", "2",
+              "--plot", str(tmp_path / "s.png"))
+    assert run.code == 0, run.err
+    assert "driver at 2 mm/s, 0 mm/s^2" in seen["fig"]._suptitle.get_text()
+
+
+def test_linkage_draw_notes_the_gap_on_the_frames_either_side(cli, monkeypatch, tmp_path):
+    grabbed = _frame_texts(monkeypatch)
+    run = cli("draw", str(CRANK_ROCKER), "--set", "r3=50", "--animate", str(tmp_path / "a.gif"),
+              "--step", "30")
+    assert run.code == 0, run.err
+    limit = _no_solution_limit(50.0)
+    note = f"cannot be assembled from {limit:.4g} to {360 - limit:.4g} deg"
+    shown = [[t for t in texts if "assembled" in t] for texts in grabbed]
+    assert shown == [[]] * 4 + [[note], [note]] + [[]] * 4  # 0 to 120 and 240 to 360 deg
+
+
+@pytest.mark.parametrize("fps,duration", [(None, 80), ("5", 200), ("20", 50), ("0.5", 2000)])
+def test_fps_sets_the_frame_duration(cli, tmp_path, fps, duration):
+    """A GIF stores a frame's delay in hundredths of a second: 1000 / fps ms, the default
+    12 fps's 83.3 ms stored as 80 (truncated, as it always was)."""
+    from PIL import Image
+
+    gif = tmp_path / "a.gif"
+    args = ["draw", str(CRANK_ROCKER), "--animate", str(gif), "--step", "90"]
+    run = cli(*args, *(["--fps", fps] if fps else []))
+    assert run.code == 0, run.err
+    with Image.open(gif) as im:
+        durations = []
+        for i in range(im.n_frames):
+            im.seek(i)
+            durations.append(im.info["duration"])
+    assert durations == [duration] * 5
+
+
+@pytest.mark.parametrize("fps", ["0", "nan", "-2", "inf", "101", "fast"])
+def test_linkage_draw_refuses_a_bad_fps(cli, tmp_path, fps):
+    gif = tmp_path / "a.gif"
+    run = cli("draw", str(CRANK_ROCKER), "--animate", str(gif), "--fps", fps)
+    assert run.code == 2
+    lines = run.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and "--fps" in lines[0]
+    assert not gif.exists()
+
+
+def test_fps_without_an_animation_is_refused(cli, tmp_path):
+    run = cli("draw", str(CRANK_ROCKER), "-o", str(tmp_path / "d.png"), "--fps", "5")
+    assert run.code == 2 and run.err.startswith("error: ") and "--animate" in run.err
