@@ -26,11 +26,14 @@ def draw(
     start: Annotated[float, typer.Option("--from", help="Animation: first driver value.")] = 0.0,
     stop: Annotated[float, typer.Option("--to", help="Animation: last driver value.")] = 360.0,
     step: Annotated[float, typer.Option(help="Animation: driver increment per frame.")] = 5.0,
+    fps: Annotated[Optional[float], typer.Option(help="Animation: frames per second (0.01 to 100; "
+                   "default 12).")] = None,
 ) -> None:
     """Draw a mechanism from its joint coordinates, links and joints labelled.
 
     Example: linkage draw sample_inputs/fourbar_me581.toml --set theta2=80 -o fourbar.png
     """
+    from ..arguments import check_fps
     from ..kinematics.sweep import driver_values
     from ..kinematics.sweep import sweep as run_sweep
     from ..problems.loops import load
@@ -40,6 +43,9 @@ def draw(
         raise InputError("give -o PATH for a drawing, --animate PATH.gif for an animation, or both")
     check_paths([file], [("--output", output), ("--animate", animate)],
                 {"--output": (output, PICTURES), "--animate": (animate, (".gif",))})
+    if fps is not None and animate is None:
+        raise InputError("--fps sets the speed of the --animate GIF: give --animate PATH.gif as well")
+    rate = check_fps("--fps", 12.0 if fps is None else fps)
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
     note_closed_form(mechanism)
     if output is not None:
@@ -53,7 +59,7 @@ def draw(
         draw_mechanism(mechanism, result.x, output, problem.title)
         typer.echo(f"wrote {output}", err=True)
     if animate is not None:
-        from ..render.plots import animate_sweep, sweep_frames
+        from ..render.plots import animate_sweep, assembly_gaps, sweep_frames
 
         a, b = check_number("--from", start), check_number("--to", stop)
         if not check_number("--step", step) > 0 or b < a:
@@ -67,5 +73,5 @@ def draw(
             typer.echo(f"error: no position of {file} between {a:g} and {b:g} could be solved", err=True)
             raise typer.Exit(1)
         with progress_bar(len(frames), minimum=1) as advance:
-            animate_sweep(mechanism, frames, animate, progress=advance)
+            animate_sweep(mechanism, frames, animate, fps=rate, progress=advance, gaps=assembly_gaps(s))
         typer.echo(f"wrote {animate} ({len(frames)} frames)", err=True)

@@ -135,12 +135,13 @@ def sweep(
          columns=columns,
          csv_table=(sweep_headers(result), sweep_rows(result)))
     if plot is not None:
+        from ..arguments import motion_text
         from ..render.plots import path_plot, sweep_plot
 
         if path:
             path_plot(result, mechanism, path, plot)
         else:
-            sweep_plot(result, plot)
+            sweep_plot(result, plot, motion_text(speed, accel, mechanism))
         typer.echo(f"wrote {plot}", err=True)
     if result.summary.get("failed"):
         raise typer.Exit(1)
