@@ -150,6 +150,8 @@ def test_every_solve_report_reads_back_in_every_format(cli, tmp_path, case):
             csv_col = [_number(r[j]) for r in rows]
             assert [v is None for v in csv_col] == [v is None for v in json_col] == \
                 [v is None for v in columns[col]]
+            if col == "time per solve":
+                continue  # measured again by each run
             # CSV, JSON and parquet bit for bit; xlsx to its 16 significant digits
             expected = bits([v for v in json_col if v is not None])
             assert bits([v for v in csv_col if v is not None]) == expected

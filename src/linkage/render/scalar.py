@@ -125,8 +125,27 @@ def iterations_table(result: Result) -> DataTable:
     """The recorded history as a table: each column named and with its unit (``phi_i (deg)``
     -> name ``phi_i``, unit ``deg``), full precision."""
     h = result.history
-    return from_history("iterations", h.columns, h.rows) if h is not None and h.rows else \
-        DataTable("iterations", ())
+    if h is None or not h.rows:
+        return DataTable("iterations", ())
+    t = from_history("iterations", h.columns, h.rows)
+    seen: set[str] = set()
+    cols = []
+    for c, label in zip(t.columns, h.columns):
+        name, unit = history_name(label)
+        if name in seen:  # a step in rad and again in deg: dtheta3 (rad), dtheta3_deg (deg)
+            name = f"{name}_{unit}"
+        seen.add(name)
+        cols.append(c._replace(name=name, unit=unit))
+    return t._replace(columns=tuple(cols))
+
+
+def history_name(label: str) -> tuple[str, str]:
+    """A history column's (name, unit): ``phi_i (deg)`` -> (phi_i, deg); a unit inside the
+    label, ``true error (deg) vs open`` -> (true error vs open, deg); ``f(phi_i)`` has none."""
+    import re
+
+    m = re.fullmatch(r"(.*?) \(([^()]*)\)(.*)", label)
+    return (m.group(1) + m.group(3), m.group(2)) if m else (label, "")
 
 
 def scalar_report(problem: ScalarProblem, result: Result, conv: Convergence | None, digits: int,
