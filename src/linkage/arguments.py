@@ -370,3 +370,36 @@ def guarded(call: Callable[[], Any], diagnose: Callable[[], None]) -> Any:
     except (TypeError, IndexError):
         diagnose()
         raise
+
+
+def parse_motion(speed: str | None, accel: str | None, mechanism: Any) -> tuple[float | None, float]:
+    """--speed and --accel in internal units (rad/s, rad/s^2, or length/s, length/s^2)."""
+    import re
+
+    from .numbers import parse_number
+
+    if speed is None:
+        if accel is not None:
+            raise InputError("--accel needs --speed (the driver's velocity)")
+        return None, 0.0
+    angle = mechanism.driver.kind == "angle"
+    unit = mechanism.length_unit
+    tables = (
+        {"": 1.0, "rad/s": 1.0, "deg/s": math.pi / 180.0, "rpm": math.pi / 30.0} if angle
+        else {"": 1.0, f"{unit}/s": 1.0},
+        {"": 1.0, "rad/s^2": 1.0, "rad/s2": 1.0, "deg/s^2": math.pi / 180.0, "deg/s2": math.pi / 180.0,
+         "rpm/s": math.pi / 30.0} if angle else {"": 1.0, f"{unit}/s^2": 1.0, f"{unit}/s2": 1.0},
+    )
+    out = []
+    accel = "0" if accel is None else accel  # an empty --accel '' is refused, not taken as 0
+    for option, text, units in (("--speed", speed, tables[0]), ("--accel", accel, tables[1])):
+        m = re.fullmatch(r"\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*", text)
+        if m is None or m.group(2) not in units:
+            known = ", ".join(u for u in units if u) or "none"
+            raise InputError(f"{option} {text!r}: give a number, optionally with one of these units: {known}")
+        value = parse_number(option, m.group(1)) * units[m.group(2)]
+        if not rate_in_range(value):
+            raise InputError(f"{option} {text!r} is out of range "
+                             f"(0, or {MIN_RATE:g} to {MAX_RATE:g} in size)")
+        out.append(value)
+    return out[0], out[1]

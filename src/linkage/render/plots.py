@@ -264,6 +264,15 @@ def draw_mechanism(mechanism: Any, q: Sequence[float], path: Path, title: str) -
     _save(fig, path)
 
 
+def sweep_frames(mechanism: Any, sweep: Any) -> list[tuple[float, list[float]]]:
+    """The solved positions of a sweep as animation frames: (driver, unknowns), angles in
+    radians (the file's degrees converted), lengths as they are."""
+    scale = math.pi / 180.0 if mechanism.driver.kind == "angle" else 1.0
+    return [(p.input * scale,
+             [math.radians(p.solution[u.name]) if u.kind == "angle" else p.solution[u.name]
+              for u in mechanism.unknowns]) for p in sweep.positions if p.solution]
+
+
 def animate_sweep(mechanism: Any, frames: Sequence[tuple[float, Sequence[float]]], path: Path,
                   fps: int = 12, progress: Any = None) -> None:
     """frames: (driver value in internal units, q) per frame."""
@@ -304,6 +313,16 @@ def animate_sweep(mechanism: Any, frames: Sequence[tuple[float, Sequence[float]]
                       progress_callback=(lambda i, n: progress(i + 1)) if progress else None)
     finally:
         plt.close(fig)
+
+
+def error_series(results: Sequence[Any]) -> list[tuple[str, list[float | None]]]:
+    """Each run's label and its iterates' error sizes (None where an iterate has none)."""
+    series = []
+    for r in results:
+        errors = [abs(e) if isinstance(e, (int, float)) else None for e in r.history.errors()] \
+            if r.history is not None else []
+        series.append((f"{r.method} ({r.status.value})", errors))
+    return series
 
 
 def convergence_plot(runs: Sequence[tuple[str, Sequence[float]]], path: Path, title: str,

@@ -194,25 +194,9 @@ def summary_report(problem: ScalarProblem, runs: Sequence[tuple[Result, Converge
                   lambda: shown, document)
 
 
-def fourbar_info(alpha: float, rs: Sequence[float], lengths: Sequence[float] | None,
-                 result: Result) -> dict[str, Any]:
-    """The four-bar equation's both roots in closed form, and the answer in the
-    mechanism-file convention (with the link lengths, when it converged)."""
-    from ..problems.freudenstein import equation_roots, file_convention
-
-    roots = equation_roots(alpha, *rs)
-    info: dict[str, Any] = {"alpha": alpha, "R": list(rs), "roots": roots,
-                            "links": list(lengths) if lengths else None, "file_convention": None}
-    if lengths and result.converged:
-        info["file_convention"] = file_convention(alpha, result.x, lengths)
-        others = [r for r in roots if abs(((r - result.x) + 180.0) % 360.0 - 180.0) > 1e-6]
-        info["other_assembly"] = file_convention(alpha, others[0], lengths) if others else None
-    return info
-
-
-def fourbar_blocks(info: dict[str, Any], digits: int) -> list[Block]:
+def fourbar_blocks(info: dict[str, Any], digits: int) -> list[Any]:
     d = max(digits, 12)
-    out: list[Block] = [Text("")]
+    out: list[Any] = [Text("")]
     roots = info["roots"]
     out.append(Text("both roots (closed form): " + (", ".join(f"phi = {fmt(r, d)} deg" for r in roots)
                                                      or "none: the linkage cannot be assembled here")))
