@@ -164,6 +164,6 @@ def solve(
         summary_report(problem, runs, digits, fourbar)
     emit_report(report, out_fmt, output, columns=columns)
     if plot is not None:
-        convergence_plot([r for r, _, _ in runs], plot, problem.title, problem.unit)
+        convergence_plot([r for r, _, _ in runs], plot, report.title, problem.unit)
     if not all(r.converged for r, _, _ in runs):
         raise typer.Exit(1)

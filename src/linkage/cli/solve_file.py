@@ -50,7 +50,7 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
                            (speed, accel) if speed is not None else None, mechanism.driver.kind)
     emit_report(report, out_fmt, output, columns=columns)
     if plot is not None:
-        convergence_plot([result], plot, problem.title,
+        convergence_plot([result], plot, report.title,
                           ", ".join(sorted({problem.step_unit(i) for i in range(problem.n)} - {""})))
     if not result.converged:
         raise typer.Exit(1)
