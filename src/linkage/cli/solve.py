@@ -17,7 +17,7 @@ from .options import (
     SpeedOpt,
     check_paths,
     choose_format,
-    emit,
+    emit_report,
 )
 from .root import app
 from .solve_file import convergence_plot, solve_file
@@ -97,8 +97,7 @@ def solve(
     """
     from ..analysis.convergence import analyze
     from ..methods import BRACKETING, SCALAR_METHODS
-    from ..problems.seed_equation import applicable, fourbar_info, scalar_problem
-    from ..render.export import result_dict
+    from ..problems.seed_equation import applicable, fourbar_coefficients, fourbar_info, scalar_problem
     from ..solve import check_criteria, check_number, solve_scalar
 
     out_fmt = choose_format(fmt, output)
@@ -153,28 +152,18 @@ def solve(
         seconds = time_per_solve(problem, kwargs) if method == "all" else None
         runs.append((result, conv, seconds))
 
-    from ..render.scalar import fourbar_blocks, scalar_blocks, summary_blocks
+    from ..render.scalar import scalar_report, summary_report
 
-    var = problem.var
-    if method != "all":
-        result, conv, _ = runs[0]
-        blocks = scalar_blocks(problem, result, conv, digits)
-        extra: dict[str, Any] = {"problem": problem.title, "units": {var: problem.unit}}
-        if equation is None:
-            info = fourbar_info(alpha, r1, r2, r3, links, result)
-            extra["fourbar"] = info
-            blocks += fourbar_blocks(info, digits)
-        json_obj: Any = result_dict(result, {var: result.x}, conv.as_dict() if conv else None, extra)
-        h = result.history
-        csv_table = (h.columns, h.rows) if h is not None else ((), ())
-    else:
-        blocks, csv_table = summary_blocks(problem, runs, digits)
-        json_obj = [result_dict(r, {var: r.x}, c.as_dict() if c else None,
-                                {"problem": problem.title, "units": {var: problem.unit},
-                                 "seconds_per_solve": s})
-                    for r, c, s in runs]
-    emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=csv_table, columns=columns)
+    fourbar = None
+    if equation is None and method != "all":
+        fourbar = fourbar_info(alpha, r1, r2, r3, links, runs[0][0])
+    elif equation is None:  # the summary's title: alpha and R1, R2, R3
+        fourbar = {"alpha": 70.0 if alpha is None else alpha,
+                   "R": list(fourbar_coefficients(r1, r2, r3, links)[0])}
+    report = scalar_report(problem, *runs[0][:2], digits, fourbar) if method != "all" else \
+        summary_report(problem, runs, digits, fourbar)
+    emit_report(report, out_fmt, output, columns=columns)
     if plot is not None:
-        convergence_plot([r for r, _, _ in runs], plot, problem.title, problem.unit)
+        convergence_plot([r for r, _, _ in runs], plot, report.title, problem.unit)
     if not all(r.converged for r, _, _ in runs):
         raise typer.Exit(1)

@@ -6,7 +6,7 @@ from typing import Any
 import typer
 
 from ..errors import InputError
-from .options import emit, note_closed_form, parse_assignments
+from .options import emit_report, note_closed_form, parse_assignments
 
 
 def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: float, rtol: float,
@@ -21,8 +21,7 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
     from ..problems.closed_form import fourbar_facts
     from ..problems.loops import load
     from ..problems.start import start_on_branch
-    from ..render.export import result_dict
-    from ..render.system import branch_label, system_blocks, system_extra, system_solution
+    from ..render.system import branch_label, system_report
     from ..solve import SYSTEM_METHODS, solve_system
 
     if method not in SYSTEM_METHODS:
@@ -42,37 +41,16 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
     conv = analyze(result)
     branch = branch_label(problem, result) if result.converged else None
     fourbars = fourbar_facts(mechanism, result.x if result.converged else None)
-    blocks = system_blocks(problem, result, conv, digits, branch, fourbars)
-    extra = system_extra(problem, result, branch)
-    extra["fourbars"] = fourbars
+    rates = None
     if result.converged:
         from ..kinematics.rates import position_rates
-        from ..render.rates import rates_blocks, rates_dict
 
         rates = position_rates(mechanism.model, result.x, mechanism.driver.value, speed, accel)
-        extra.update(rates_dict(rates))
-        if speed is not None:
-            from ..render.rates import rate_units_dict
-
-            extra["driver"].update(speed=speed, accel=accel)
-            extra["rate_units"] = rate_units_dict(problem.names, problem.kinds, mechanism.length_unit,
-                                                  mechanism.driver.kind)
-        blocks += rates_blocks(rates, problem.names, problem.kinds, mechanism.length_unit, digits)
-        if rates.status != "ok":
-            from ..render.report import Text
-
-            why = ("velocities and accelerations are undefined here: the Jacobian is singular "
-                   "(a toggle or dead-centre position)" if rates.status == "undefined" else
-                   f"ill-conditioned here (near a toggle or limit): {', '.join(rates.ill_conditioned)} "
-                   "shown with the digits their error bounds leave")
-            blocks.append(Text(why, "red"))
-    json_obj = result_dict(result, system_solution(problem, result), conv.as_dict() if conv else None,
-                           extra)
-    h = result.history
-    emit(out_fmt, output, blocks=blocks, json_obj=json_obj,
-         csv_table=(h.columns, h.rows) if h is not None else ((), ()), columns=columns)
+    report = system_report(problem, result, conv, digits, branch, fourbars, rates,
+                           (speed, accel) if speed is not None else None, mechanism.driver.kind)
+    emit_report(report, out_fmt, output, columns=columns)
     if plot is not None:
-        convergence_plot([result], plot, problem.title,
+        convergence_plot([result], plot, report.title,
                           ", ".join(sorted({problem.step_unit(i) for i in range(problem.n)} - {""})))
     if not result.converged:
         raise typer.Exit(1)

@@ -382,6 +382,9 @@ def convergence_plot(runs: Sequence[tuple[str, Sequence[float]]], path: Path, ti
         if pts:
             ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=4, label=label)
     ax.set_xlabel("iteration")
+    from matplotlib.ticker import MaxNLocator
+
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))  # iteration 2.5 does not exist
     ax.set_ylabel(f"log10 of the error ({unit})" if unit else "log10 of the error")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)

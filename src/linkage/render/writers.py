@@ -369,14 +369,31 @@ def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None,
                     yield sink
                 finally:
                     sink.close()
+                _sync(tmp)
             else:
                 fh = stack.enter_context(open(tmp, "w", encoding="utf-8", newline=""))
                 sink = _make(kinds[fmt], fh, tmp, meta, several)
                 yield sink
                 sink.close()
+                fh.flush()
+                _sync(tmp)
     except OSError as exc:
         where = "standard output" if to_stdout else str(output)
         raise OutputError(f"cannot write to {where}: {exc.strerror or exc}") from None
+
+
+def _sync(path: str) -> None:
+    """On disk before the rename, as files.write_atomic does: a full disk is an error here,
+    not a truncated file after "wrote"."""
+    import os
+    import stat
+
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        if stat.S_ISREG(os.fstat(fd).st_mode):
+            os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def _extra_target(stack: contextlib.ExitStack, output: Path, table: str, made: list[str]) -> str:
