@@ -21,7 +21,6 @@ half-written file.
 from __future__ import annotations
 
 import contextlib
-import json
 import math
 import sys
 from collections.abc import Callable, Iterator, Sequence
@@ -224,6 +223,8 @@ class JsonSink(Sink):
 
     def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
         super().__init__(out, path, meta)
+        import json
+
         from .export import clean
 
         head = json.dumps(clean(self.meta), indent=2, allow_nan=False)
@@ -233,6 +234,8 @@ class JsonSink(Sink):
         super().begin(name, columns, rows)
         spec = {"name": name, "columns": [c.name for c in self.columns],
                 "units": [c.unit for c in self.columns]}
+        import json
+
         text = json.dumps(spec, allow_nan=False)[:-1] + ', "rows": ['
         self.out.write(("," if self.tables > 1 else "") + "\n    " + text)  # type: ignore[union-attr]
 
@@ -241,6 +244,8 @@ class JsonSink(Sink):
         for a in range(0, n, SLICE):
             b = min(n, a + SLICE)
             cols = [json_values(c, v[a:b]) for c, v in zip(self.columns, values)]
+            import json
+
             text = ",".join("\n      " + json.dumps(r, allow_nan=False) for r in map(list, zip(*cols)))
             self.out.write(("," if self.count or a else "") + text)  # type: ignore[union-attr]
         self.count += n
@@ -269,6 +274,8 @@ class ParquetSink(Sink):
         types = {"number": pa.float64(), "int": pa.int64(), "bool": pa.bool_(), "text": pa.string()}
         fields = [pa.field(c.name, types[c.kind], metadata={"unit": c.unit} if c.unit else None)
                   for c in self.columns]
+        import json
+
         from .export import clean
 
         self.schema = pa.schema(fields, metadata={"linkage": json.dumps(clean({**self.meta, "table": name}))})
