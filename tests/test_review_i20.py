@@ -100,3 +100,26 @@ def test_xlsx_to_a_full_disk_is_one_error_line() -> None:
                          capture_output=True, text=True, env=env, timeout=60)
     assert run.returncode == 2
     assert run.stderr.splitlines() == [run.stderr.splitlines()[0]] and run.stderr.startswith("error: ")
+
+
+def test_html_escapes_the_lines_around_its_tables() -> None:
+    # the title line carries the mechanism file's name: raw in the HTML, a name such as
+    # "<script>...</script>" ran in the browser that opened `-o x.html`
+    from linkage.render.display import display_text
+    from linkage.render.report import Table, Text
+
+    hostile = "<script>alert(1)</script> & co"
+    blocks = [Text(hostile, "bold"), Table(hostile, ("joint",), (("<b>B</b>",),), (hostile,))]
+    out = display_text(Report(hostile, (), lambda: blocks), "html")
+    assert "<script>" not in out and "<b>B" not in out
+    assert out.count("&lt;script&gt;alert(1)&lt;/script&gt; &amp; co") == 3
+    assert "<table>" in out
+
+
+def test_latex_note_of_several_lines_stays_a_comment() -> None:
+    from linkage.render.display import display_text
+    from linkage.render.report import Table
+
+    blocks = [Table("t", ("a",), (("1",),), ("first\n\\input{/etc/passwd}",))]
+    out = display_text(Report("t", (), lambda: blocks), "latex")
+    assert all(line.startswith("%") for line in out.splitlines() if "passwd" in line or "first" in line)
