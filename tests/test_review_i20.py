@@ -123,3 +123,13 @@ def test_latex_note_of_several_lines_stays_a_comment() -> None:
     blocks = [Table("t", ("a",), (("1",),), ("first\n\\input{/etc/passwd}",))]
     out = display_text(Report("t", (), lambda: blocks), "latex")
     assert all(line.startswith("%") for line in out.splitlines() if "passwd" in line or "first" in line)
+
+
+def test_json_document_that_is_not_an_object_still_gives_valid_json(tmp_path: Path) -> None:
+    # the writer adds "tables" by cutting the document's closing brace: a list document
+    # (a sweep's points, say) came out as broken JSON
+    t = DataTable("t", (Column("x", "mm", [0.1]),))
+    rep = Report("r", (t,), lambda: [], lambda: [{"x": 0.1}, {"x": 0.2}])
+    writers.write(rep, "json", tmp_path / "l.json")
+    doc = json.loads((tmp_path / "l.json").read_text())
+    assert doc["document"] == [{"x": 0.1}, {"x": 0.2}] and doc["tables"][0]["rows"] == [[0.1]]

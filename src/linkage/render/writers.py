@@ -526,6 +526,8 @@ def write(report: Report, fmt: str, output: Path | None, *,
         tables = [t for t in report.tables if t.columns]
         meta = report.document() if (fmt == "json" and report.document is not None) else \
             {"title": report.title} if fmt in ("json", "parquet") else {}
+        if not isinstance(meta, dict):  # the tables go under a key: the document must be an object
+            meta = {"title": report.title, "document": meta}
         with open_sink(fmt, output, meta, several=len(tables) > 1) as sink:
             write_tables(sink, tables, progress)
     else:
