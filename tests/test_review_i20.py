@@ -133,3 +133,18 @@ def test_json_document_that_is_not_an_object_still_gives_valid_json(tmp_path: Pa
     writers.write(rep, "json", tmp_path / "l.json")
     doc = json.loads((tmp_path / "l.json").read_text())
     assert doc["document"] == [{"x": 0.1}, {"x": 0.2}] and doc["tables"][0]["rows"] == [[0.1]]
+
+
+def test_parquet_names_the_files_of_its_report(tmp_path: Path) -> None:
+    # a rerun with fewer tables leaves the last run's sidecars beside the new file (the
+    # writer does not delete files by pattern); the metadata says which files belong
+    pq = pytest.importorskip("pyarrow.parquet")
+    one = (Column("x", "mm", [1.0]),)
+    rep = _report(DataTable("iterations", one), DataTable("joints", one))
+    writers.write(rep, "parquet", tmp_path / "r.parquet")
+    for f in ("r.parquet", "r.joints.parquet"):
+        meta = json.loads(pq.read_table(tmp_path / f).schema.metadata[b"linkage"])
+        assert meta["files"] == {"iterations": "r.parquet", "joints": "r.joints.parquet"}
+    writers.write(_report(DataTable("iterations", one)), "parquet", tmp_path / "r.parquet")
+    meta = json.loads(pq.read_table(tmp_path / "r.parquet").schema.metadata[b"linkage"])
+    assert meta["files"] == {"iterations": "r.parquet"}

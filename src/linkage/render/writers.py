@@ -528,6 +528,11 @@ def write(report: Report, fmt: str, output: Path | None, *,
             {"title": report.title} if fmt in ("json", "parquet") else {}
         if not isinstance(meta, dict):  # the tables go under a key: the document must be an object
             meta = {"title": report.title, "document": meta}
+        if fmt == "parquet" and not to_stdout:
+            # which files are this report's: a rerun with fewer tables leaves the last
+            # run's sidecars beside it (nothing is deleted by pattern)
+            files = [Path(str(output)).name] + [p.name for p in side_paths(output, report)]  # type: ignore[arg-type]
+            meta = {**meta, "files": dict(zip([t.name for t in tables], files))}
         with open_sink(fmt, output, meta, several=len(tables) > 1) as sink:
             write_tables(sink, tables, progress)
     else:
