@@ -148,3 +148,14 @@ def test_parquet_names_the_files_of_its_report(tmp_path: Path) -> None:
     writers.write(_report(DataTable("iterations", one)), "parquet", tmp_path / "r.parquet")
     meta = json.loads(pq.read_table(tmp_path / "r.parquet").schema.metadata[b"linkage"])
     assert meta["files"] == {"iterations": "r.parquet"}
+
+
+def test_solve_file_honours_an_explicit_max_iter_of_100(cli: object, tmp_path: Path) -> None:
+    # a file's default cap is 50; "--max-iter 100" given on purpose was read as "not given"
+    # and became 50 (the plain Newton from this far start needs more than 50 steps)
+    sample = ROOT / "sample_inputs" / "rapier_drive.toml"
+    args = ["solve", str(sample), "--plain", "--set", "a2=3000", "-f", "json"]
+    given = json.loads(cli(*args, "--max-iter", "100").out)  # type: ignore[operator]
+    assert 50 < given["iteration_count"] <= 100
+    default = json.loads(cli(*args).out)  # type: ignore[operator]
+    assert default["status"] == "max_iter" and default["iteration_count"] == 50
