@@ -54,6 +54,8 @@ def quick_bench(monkeypatch: pytest.MonkeyPatch) -> None:
              m("seed002", "scipy brentq", 1e-12, 1e-4, (0.9e-4, 1.1e-4), 0.0, None, 9)]
     monkeypatch.setattr(bench_module, "measure", lambda *a, **k: fixed)
     monkeypatch.setattr(bench_module, "sweep_times", lambda *a, **k: {"a sweep": 0.25, "another": 0.5})
+    # solve --method all times each method: its "time per solve" column, too
+    monkeypatch.setattr(bench_module, "time_per_solve", lambda *a, **k: 2.5e-5)
 
 
 def run(cli: Any, tmp_path: Path, name: str, fmt: str) -> Path:

@@ -55,7 +55,8 @@ def solve(
     rtol: Annotated[float, typer.Option(help="Relative step tolerance.")] = 0.0,
     ftol: Annotated[Optional[float], typer.Option(help="Residual tolerance epsilon_e "
                     "(off unless given).")] = None,
-    max_iter: Annotated[int, typer.Option("--max-iter", help="Iteration cap.")] = 100,
+    max_iter: Annotated[Optional[int], typer.Option("--max-iter", help="Iteration cap (default 100; "
+                        "50 with FILE).")] = None,
     set_: SetOpt = None,
     guess: Annotated[Optional[list[str]], typer.Option(metavar="NAME=VALUE", help="With FILE: initial guess "
                      "name=value in the file's units (repeatable).")] = None,
@@ -102,6 +103,8 @@ def solve(
 
     out_fmt = choose_format(fmt, output)
     check_paths([file], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})
+    # the cap's default depends on FILE: None until here, so "--max-iter 100" given is kept
+    file_cap, max_iter = (50, 100) if max_iter is None else (max_iter, max_iter)
     check_criteria(tol, rtol, ftol, max_iter)
     scalar_only = {"--alpha": alpha, "--r1": r1, "--r2": r2, "--r3": r3, "--links": links,
                    "--equation": equation, "--g": g, "--x0": x0, "--x1": x1, "--bracket": bracket}
@@ -113,7 +116,7 @@ def solve(
         if given:
             raise InputError(f"{', '.join(given)} apply to a single equation, not to a mechanism file")
         solve_file(file, method, set_ or [], guess or [], tol, rtol, ftol,
-                    max_iter if max_iter != 100 else 50, fd_step, damped, show_jacobian,
+                    file_cap, fd_step, damped, show_jacobian,
                     out_fmt, output, digits, plot, (speed, accel), branch, columns)
         return
     given = [k for k, v in system_only.items() if v is not None]

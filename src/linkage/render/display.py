@@ -24,9 +24,32 @@ def print_table(report: Report, file: Any = None) -> None:
 
 def display_text(report: Report, fmt: str) -> str:
     blocks = report.blocks()
+    if fmt == "html":
+        return html_text(blocks)
     if fmt not in LATEX:
         return render_text(blocks, fmt)
     return latex_text(report.title, blocks, fmt)
+
+
+def html_text(blocks: Any) -> str:
+    """Each table as tabulate's (escaped) HTML table; every line around it (the title,
+    which carries the mechanism file's name, the notes) escaped in a paragraph of its own:
+    raw, a name such as ``<script>...`` would run in the browser that opens the file."""
+    import html
+
+    def para(text: str) -> list[str]:
+        return [f"<p>{html.escape(line)}</p>" for line in text.splitlines() if line]
+
+    out: list[str] = []
+    for b in blocks:
+        if isinstance(b, Text):
+            out += para(b.text)
+            continue
+        out += para(b.title)
+        out.append(render_text([Table("", b.headers, b.rows)], "html").rstrip("\n"))
+        for n in b.notes:
+            out += para(n)
+    return "\n".join(out) + "\n"
 
 
 def latex_text(title: str, blocks: Any, fmt: str) -> str:
@@ -50,5 +73,5 @@ def latex_text(title: str, blocks: Any, fmt: str) -> str:
         else:
             out += ["\\begin{table}[htbp]", "\\centering", f"\\caption{{{caption}}}",
                     f"\\label{{tab:linkage-{k}}}", body, "\\end{table}"]
-        out.extend(f"% {n}" for n in b.notes)
+        out.extend(f"% {line}" for n in b.notes for line in n.splitlines() or [""])
     return "\n".join(out) + "\n"

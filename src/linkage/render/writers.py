@@ -121,13 +121,22 @@ def number_texts(values: Any, fast: bool = False) -> list[str]:
         finite = np.isfinite(values)
         arr = pa.array(values, mask=~finite)
         return pc.fill_null(pc.cast(arr, pa.string()), "").to_pylist()  # type: ignore[no-any-return]
-    seq = values.tolist() if _is_array(values) else values
+    seq = _plain(values)
     return ["" if v is None or (isinstance(v, float) and not math.isfinite(v)) else
             repr(v) if isinstance(v, float) else str(v) for v in seq]
 
 
 def _is_array(values: Any) -> bool:
     return hasattr(values, "dtype") and hasattr(values, "tolist")
+
+
+def _plain(values: Any) -> list[Any]:
+    """The values as Python objects: an array's ``tolist``; in a list, numpy scalars (a
+    median, a ratio) as Python numbers (numpy 2's repr of one is ``np.float64(0.1)``, and
+    json cannot encode ``np.int64``)."""
+    if _is_array(values):
+        return values.tolist()  # type: ignore[no-any-return]
+    return [v.item() if _is_array(v) else v for v in values]
 
 
 _HAS_PYARROW: list[bool] = []
@@ -153,7 +162,7 @@ def cell_texts(col: Column, values: Any, fast: bool = False) -> list[str]:
     """One column's cells as CSV text."""
     if col.kind == "number":
         return number_texts(values, fast)
-    seq = values.tolist() if _is_array(values) else list(values)
+    seq = _plain(values)
     if col.kind == "bool":
         return ["" if v is None else "true" if v else "false" for v in seq]
     if col.kind == "int":
@@ -162,7 +171,7 @@ def cell_texts(col: Column, values: Any, fast: bool = False) -> list[str]:
 
 
 def json_values(col: Column, values: Any) -> list[Any]:
-    seq = values.tolist() if _is_array(values) else list(values)
+    seq = _plain(values)
     if col.kind == "number":
         return [v if v is None or isinstance(v, int) or math.isfinite(v) else None for v in seq]
     if col.kind == "bool":
@@ -194,6 +203,11 @@ class Sink:
         return None
 
     def close(self) -> None:
+        return None
+
+    def abandon(self) -> None:
+        """Stop after a failure or an interrupt: release what is open, finish nothing (the
+        temporary file is removed)."""
         return None
 
 
@@ -279,7 +293,7 @@ class ParquetSink(Sink):
         from .export import clean
 
         self.schema = pa.schema(fields, metadata={"linkage": json.dumps(clean({**self.meta, "table": name}))})
-        target = self.path if self.tables == 1 or self.paths is None else self.paths(name)
+        target = self.path if self.tables == 1 or self.paths is None else self.paths(safe_name(name))
         self.writer = pq.ParquetWriter(target, self.schema)
 
     def rows(self, values: Sequence[Any]) -> None:
@@ -302,6 +316,19 @@ class ParquetSink(Sink):
         self.writer = None
 
     def close(self) -> None:
+        if self.tables == 0 and self.path is not None:  # no table: still a parquet file
+            import json
+
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+
+            from .export import clean
+
+            schema = pa.schema([], metadata={"linkage": json.dumps(clean(self.meta))})
+            pq.ParquetWriter(self.path, schema).close()
+        self.abandon()
+
+    def abandon(self) -> None:
         if self.writer is not None:
             with contextlib.suppress(Exception):
                 self.writer.close()
@@ -321,8 +348,25 @@ class XlsxSink(Sink):
 
     def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
         super().begin(name, columns, rows)
-        self.sheet = self.book.create_sheet(title=name[:31] or f"table {self.tables}")
-        self.sheet.append([c.header for c in self.columns])
+        title = safe_name(name)[:31] or f"table {self.tables}"
+        used = {s.title for s in self.book.worksheets}
+        k = 1
+        while title in used:  # two names alike in their first 31 characters
+            k += 1
+            title = f"{safe_name(name)[:31 - len(str(k)) - 1]} {k}"
+        self.sheet = self.book.create_sheet(title=title)
+        self.sheet.append([self._cell(c.header) for c in self.columns])
+
+    def _cell(self, v: Any) -> Any:
+        """Text as text: openpyxl makes a string beginning with "=" a formula (a joint
+        named "=HYPERLINK(...)" in a mechanism file would be live in the workbook)."""
+        if not (isinstance(v, str) and v.startswith("=")):
+            return v
+        from openpyxl.cell import WriteOnlyCell
+
+        cell = WriteOnlyCell(self.sheet, value=v)
+        cell.data_type = "s"
+        return cell
 
     def rows(self, values: Sequence[Any]) -> None:
         n = len(values[0]) if values else 0
@@ -332,20 +376,46 @@ class XlsxSink(Sink):
         for a in range(0, n, SLICE):
             b = min(n, a + SLICE)
             cols = [json_values(c, v[a:b]) for c, v in zip(self.columns, values)]
+            text = [j for j, c in enumerate(self.columns) if c.kind == "text"]
             for r in zip(*cols):
+                if text:
+                    r = tuple(self._cell(v) if j in text else v for j, v in enumerate(r))
                 self.sheet.append(r)
         self.count += n
+
+    def abandon(self) -> None:
+        # each sheet's row stream closed here, not left to the garbage collector (which
+        # printed "Exception ignored" tracebacks after an interrupt)
+        for ws in self.book.worksheets:
+            with contextlib.suppress(Exception):
+                ws.close()
 
     def close(self) -> None:
         if self.sheet is None:
             self.book.create_sheet(title="empty")
-        self.book.save(self.path)
+        # saved in memory, then written: openpyxl saving straight to a full disk left its
+        # half-closed zip to the garbage collector, which printed tracebacks after the error
+        import io
+
+        buf = io.BytesIO()
+        self.book.save(buf)
+        with open(self.path, "wb") as fh:  # type: ignore[arg-type]
+            fh.write(buf.getbuffer())
+
+
+UNSAFE = frozenset('[]:*?/\\\0')
+"""Characters an xlsx sheet name or a file name cannot hold."""
+
+
+def safe_name(table: str) -> str:
+    """A table's name as a sheet and a sidecar file name: ``_`` for each unsafe character."""
+    return "".join("_" if c in UNSAFE else c for c in table)
 
 
 def _sidecar(path: str) -> Callable[[str], str]:
     def name(table: str) -> str:
         p = Path(path)
-        return str(p.with_name(f"{p.stem}.{table}{p.suffix}"))
+        return str(p.with_name(f"{p.stem}.{safe_name(table)}{p.suffix}"))
     return name
 
 
@@ -374,8 +444,10 @@ def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None,
                     sink.paths = lambda t: _extra_target(stack, output, t, extra)  # type: ignore[arg-type]
                 try:
                     yield sink
-                finally:
-                    sink.close()
+                except BaseException:
+                    sink.abandon()  # an interrupt stays an interrupt, and nothing is saved
+                    raise
+                sink.close()
                 _sync(tmp)
             else:
                 fh = stack.enter_context(open(tmp, "w", encoding="utf-8", newline=""))
@@ -454,6 +526,13 @@ def write(report: Report, fmt: str, output: Path | None, *,
         tables = [t for t in report.tables if t.columns]
         meta = report.document() if (fmt == "json" and report.document is not None) else \
             {"title": report.title} if fmt in ("json", "parquet") else {}
+        if not isinstance(meta, dict):  # the tables go under a key: the document must be an object
+            meta = {"title": report.title, "document": meta}
+        if fmt == "parquet" and not to_stdout:
+            # which files are this report's: a rerun with fewer tables leaves the last
+            # run's sidecars beside it (nothing is deleted by pattern)
+            files = [Path(str(output)).name] + [p.name for p in side_paths(output, report)]  # type: ignore[arg-type]
+            meta = {**meta, "files": dict(zip([t.name for t in tables], files))}
         with open_sink(fmt, output, meta, several=len(tables) > 1) as sink:
             write_tables(sink, tables, progress)
     else:
