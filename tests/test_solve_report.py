@@ -53,7 +53,7 @@ def test_speed_csv_carries_the_rates_bit_for_bit_with_the_json(cli, tmp_path):
     assert cli(*args, "-o", str(tmp_path / "f.json")).code == 0
     doc = json.loads((tmp_path / "f.json").read_text())
     csvs = sections((tmp_path / "f.csv").read_text())
-    assert set(csvs) == {"iterations", "unknowns", "joints"}
+    assert set(csvs) == {"iterations", "unknowns", "joints", "outcome"}
 
     unknowns = by_name(csvs["unknowns"])
     assert set(unknowns) == {"theta3", "theta4"}
@@ -102,8 +102,9 @@ CASES = {
     "file": ("solve", ME581),
     "file-speed": ("solve", ME581, "--speed", "25", "--accel", "15"),
 }
-TABLES = {"scalar": ["iterations"], "all": ["summary"], "file": ["iterations", "unknowns", "joints"],
-          "file-speed": ["iterations", "unknowns", "joints"]}
+TABLES = {"scalar": ["iterations"], "all": ["summary"],
+          "file": ["iterations", "unknowns", "joints", "outcome"],
+          "file-speed": ["iterations", "unknowns", "joints", "outcome"]}
 
 
 def _number(cell: str) -> float | None:
@@ -274,3 +275,16 @@ def test_convergence_plot_has_integer_iteration_ticks(tmp_path, monkeypatch):
     ticks = seen[0]
     assert ticks and all(t == int(t) for t in ticks), ticks
     assert (tmp_path / "c.png").stat().st_size > 0
+
+
+def test_a_failed_file_solve_says_so_in_every_file(cli, tmp_path) -> None:
+    """A run that did not converge: its outcome table (status, message) is in the CSV too,
+    not only in the JSON and on the screen."""
+    r = cli("solve", str(SAMPLES / "fourbar_me581.toml"), "--max-iter", "1", "-o", str(tmp_path / "f.csv"))
+    assert r.code == 1
+    parts = sections((tmp_path / "f.csv").read_text())
+    assert set(parts) == {"iterations", "outcome"}
+    head, row = parts["outcome"][0], parts["outcome"][1]
+    outcome = dict(zip(head, row))
+    assert outcome["converged"] == "false" and outcome["status"] == "max_iter"
+    assert outcome["iterations"] == "1"

@@ -167,7 +167,29 @@ def scalar_report(problem: ScalarProblem, result: Result, conv: Convergence | No
             extra["fourbar"] = fourbar
         return result_dict(result, {problem.var: result.x}, conv.as_dict() if conv else None, extra)
 
+    # the seed's table alone: a spreadsheet or a script reads the CSV as it is (the
+    # outcome is the exit code; the convergence analysis is in the display and JSON)
     return Report(scalar_title(problem, digits, fourbar), (iterations_table(result),), blocks, document)
+
+
+def outcome_table(result: Result, conv: Convergence | None, error_unit: str) -> DataTable:
+    """One row: how the run ended (method, status, converged, message), its counts, the
+    last step and residual, and the estimated order of convergence with its rate and
+    constant: what the display's lines say, for the files (a run that did not converge
+    says so in every format)."""
+    c = conv.as_dict() if conv is not None else {}
+    spec = [("method", "", "text"), ("status", "", "text"), ("converged", "", "bool"),
+            ("message", "", "text"), ("iterations", "", "int"), ("evaluations", "", "int"),
+            ("jacobians", "", "int"), ("last step", error_unit, "number"), ("residual", "", "number"),
+            ("order", "", "number"), ("rate", "", "number"), ("constant", "", "number")]
+
+    def number(v: Any) -> float | None:
+        return float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else None
+
+    row = (result.method, result.status.value, result.converged, result.message, result.iterations,
+           result.nfev, result.njev, number(result.error), number(result.residual),
+           number(c.get("order")), number(c.get("rate")), number(c.get("constant")))
+    return from_rows("outcome", spec, [row])
 
 
 SUMMARY_KINDS = ("text", "text", "int", "int", "number", "number", "number", "number", "number")

@@ -11,7 +11,7 @@ from ..problems.system import SystemProblem
 from ..result import Result
 from .data import DataTable, Report, column
 from .report import Block, Text, fmt, history_blocks
-from .scalar import convergence_blocks, iterations_table
+from .scalar import convergence_blocks, iterations_table, outcome_table
 
 
 def system_solution(problem: SystemProblem, result: Result) -> dict[str, float]:
@@ -139,11 +139,13 @@ def system_report(problem: SystemProblem, result: Result, conv: Convergence | No
     from .rates import rate_units_dict, rates_blocks, rates_dict
 
     L = problem.length_unit
+    units = sorted({problem.step_unit(i) for i in range(problem.n)} - {""})
     tables = [iterations_table(result)]
     if result.converged:
         tables.append(unknowns_table(problem, result, branch, rates, motion is not None))
         if rates is not None:
             tables.append(joints_table(rates, L, motion is not None))
+    tables.append(outcome_table(result, conv, units[0] if len(units) == 1 else ""))
 
     def blocks() -> list[Block]:
         out = system_blocks(problem, result, conv, digits, branch, fourbars)
