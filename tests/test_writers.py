@@ -141,6 +141,7 @@ def test_suffixes_and_formats() -> None:
     assert writers.choose_format(None, Path("a.tex")) == "latex"
     assert writers.choose_format(None, Path("noext")) == "plain"
     assert writers.choose_format("grid", Path("a.csv")) == "grid"  # --format wins
+    assert writers.choose_format("CSV", None) == "csv"
     with pytest.raises(InputError, match="binary"):
         writers.choose_format("parquet", None)
     with pytest.raises(InputError, match="unknown format"):

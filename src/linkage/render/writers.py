@@ -77,6 +77,8 @@ def choose_format(fmt: str | None, output: Path | None, *, terminal: bool | None
     a terminal and plain when piped. An unknown format or suffix, or a binary format for
     standard output, is an InputError naming what works."""
     to_stdout = output is None or str(output) == "-"
+    if fmt is not None:
+        fmt = fmt.strip().lower()  # --format CSV as --format csv, as a suffix .CSV is .csv
     if fmt is None:
         if not to_stdout:
             suffix = output.suffix.lower()  # type: ignore[union-attr]
