@@ -58,3 +58,15 @@ def test_columns_part_label_is_never_broken_across_lines():
     parts = re.findall(r"\(columns part[^)]*\)", seen)
     assert parts and all(re.fullmatch(r"\(columns part \d+ of \d+\)", p) for p in parts), parts
     assert all(len(line.rstrip()) <= 80 for line in seen.splitlines())
+
+
+def test_latex_tables_escape_the_bar_of_max_phi(cli):
+    """tabulate escapes & % _ ^ but not |: "max|Phi| (cm)" compiled as "max—Phi— (cm)" in
+    LaTeX's default font. latex_raw is the format that escapes nothing, and stays so."""
+    r = cli("solve", ME581, "--format", "latex")
+    assert r.code == 0, r.err
+    tables = [line for line in r.out.splitlines() if not line.startswith("%")]
+    assert any(r"max\textbar{}Phi\textbar{} (cm)" in line for line in tables)
+    assert not any("|" in line for line in tables)
+    raw = cli("solve", ME581, "--format", "latex_raw")
+    assert any("max|Phi| (cm)" in line for line in raw.out.splitlines() if not line.startswith("%"))
