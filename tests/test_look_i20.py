@@ -70,3 +70,19 @@ def test_latex_tables_escape_the_bar_of_max_phi(cli):
     assert not any("|" in line for line in tables)
     raw = cli("solve", ME581, "--format", "latex_raw")
     assert any("max|Phi| (cm)" in line for line in raw.out.splitlines() if not line.startswith("%"))
+
+
+def test_unknown_format_names_the_tabulate_formats_people_use(cli):
+    """The refusal listed the first eight tabulate formats by name (asciidoc, colon_grid,
+    double_grid, ...), not github or latex, which the suffixes .md and .tex stand for."""
+    r = cli("solve", "-f", "nosuch")
+    assert r.code == 2 and r.err.startswith("error: ") and r.err.count("\n") == 1, r.err
+    for name in ("github", "latex", "html", "rst"):
+        assert name in r.err, r.err
+    assert "colon_grid" not in r.err
+
+
+def test_format_help_says_which_formats_need_a_file(cli):
+    r = cli("solve", "--help")
+    text = " ".join(r.out.replace("│", " ").split())
+    assert "parquet or xlsx (these two to -o FILE)" in text, text
