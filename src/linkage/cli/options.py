@@ -13,8 +13,8 @@ from ..numbers import parse_number
 FormatOpt = Annotated[
     Optional[str],
     typer.Option("--format", "-f", help="table (rich, default on a terminal), plain (default "
-                 "when piped), csv, json, parquet, xlsx, or any tabulate format (github, grid, "
-                 "latex, ...)."),
+                 "when piped), csv, json, parquet or xlsx (these two to -o FILE), or any tabulate "
+                 "format (github, grid, latex, ...)."),
 ]
 OutputOpt = Annotated[
     Optional[Path],
@@ -33,8 +33,8 @@ SetOpt = Annotated[
 ]
 ColumnsOpt = Annotated[
     Optional[str],
-    typer.Option("--columns", metavar="NAMES", help="Show only these columns of the tables and "
-                 "the CSV: comma-separated names or their beginnings, e.g. theta3,theta4,det "
+    typer.Option("--columns", metavar="NAMES", help="Show only these columns, on screen and in "
+                 "every file: comma-separated names or their beginnings, e.g. theta3,theta4,det "
                  "(the first column always stays)."),
 ]
 def _digits(value: int) -> int:

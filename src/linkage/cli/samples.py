@@ -7,7 +7,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import FormatOpt, check_paths, choose_format, emit_report, stdout_errors
+from .options import check_paths, choose_format, emit_report, stdout_errors
 from .root import app
 
 
@@ -21,7 +21,9 @@ def samples(
     *,
     output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Write the sample to this "
                       "new .toml file (an existing file is never replaced).")] = None,
-    fmt: FormatOpt = None,
+    fmt: Annotated[Optional[str], typer.Option("--format", "-f", help="The list's format, to "
+                   "standard output: table (rich, default on a terminal), plain (default when "
+                   "piped), csv, json or any tabulate format (github, grid, latex, ...).")] = None,
 ) -> None:
     """List the mechanism files shipped with linkage, or copy one out to start your own.
 
@@ -34,7 +36,11 @@ def samples(
         if output is not None:
             raise InputError("give the NAME of the sample to write with -o")
         from ..render.tools import samples_report
+        from ..render.writers import OWN_FORMATS
 
+        if fmt in OWN_FORMATS and OWN_FORMATS[fmt].binary:  # the registry would ask for -o FILE
+            raise InputError(f"--format {fmt}: the list of samples goes to standard output; "
+                             "use table, plain, csv, json or a tabulate format")
         emit_report(samples_report(shipped()), choose_format(fmt, None), None)
         return
     if fmt is not None:

@@ -11,7 +11,9 @@ from .report import Table, Text, print_rich, render_text
 
 LATEX = ("latex", "latex_raw", "latex_booktabs", "latex_longtable")
 _LATEX_SPECIAL = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#",
-                  "_": r"\_", "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}", "^": r"\^{}"}
+                  "_": r"\_", "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}", "^": r"\^{}",
+                  # in LaTeX's default (OT1) text font | < > print as an em dash and inverted marks
+                  "|": r"\textbar{}", "<": r"\textless{}", ">": r"\textgreater{}"}
 
 
 def latex_escape(text: str) -> str:
@@ -66,6 +68,8 @@ def latex_text(title: str, blocks: Any, fmt: str) -> str:
         k += 1
         caption = latex_escape(b.title or title)
         body = render_text([Table("", b.headers, b.rows)], fmt).rstrip("\n")
+        if fmt != "latex_raw":  # tabulate escapes & % _ ^ but not |: "max|Phi|" read "max—Phi—"
+            body = body.replace("|", r"\textbar{}")
         if fmt == "latex_longtable":
             head = f"\\caption{{{caption}}}\\label{{tab:linkage-{k}}}\\\\\n\\hline"
             body = body.replace("\\hline", head, 1)

@@ -255,7 +255,10 @@ def print_rich(blocks: Sequence[Block], file: Any = None) -> None:
         for k, cols in enumerate(groups):
             title = b.title or None
             if len(groups) > 1:
-                title = f"{b.title + ' ' if b.title else ''}(columns part {k + 1} of {len(groups)})"
+                part = f"(columns part {k + 1} of {len(groups)})"
+                # a title that cannot take the part on its line gets it on the next, whole
+                sep = "\n" if b.title and len(b.title) + 1 + len(part) > console.width else " "
+                title = f"{b.title + sep if b.title else ''}{part}"
             widths = column_widths(b.headers, b.rows, console.width)
             shown = widen_headers(b.headers, cols, widths, console.width)
             if title and len(title) > 1 + sum(w + 3 for w in shown):

@@ -150,7 +150,10 @@ def system_report(problem: SystemProblem, result: Result, conv: Convergence | No
     def blocks() -> list[Block]:
         out = system_blocks(problem, result, conv, digits, branch, fourbars)
         if rates is not None:
-            out += rates_blocks(rates, problem.names, problem.kinds, L, digits)
+            more = rates_blocks(rates, problem.names, problem.kinds, L, digits)
+            if more:  # a blank line after the convergence summary, as between the other blocks
+                out.append(Text(""))
+            out += more
             if rates.status != "ok":
                 why = ("velocities and accelerations are undefined here: the Jacobian is singular "
                        "(a toggle or dead-centre position)" if rates.status == "undefined" else

@@ -90,7 +90,8 @@ def bench_report(rows: Sequence[Sequence[Any]], sweeps: Mapping[str, float], col
         from_rows("targets", [("target", "", "text"), ("ratio", "", "text"), ("measured", "", "number"),
                               ("met", "", "bool")], met),
     ]
-    title = (f"work-precision benchmark: {len(rows)} measurements, {n_repeats} timed batches each "
+    title = (f"work-precision benchmark: {len(rows)} measurements, {n_repeats} timed "
+             f"batch{'' if n_repeats == 1 else 'es'} each "
              "(median; spread = fastest-slowest batch)")
     shown = [f"{n} ({u})" if u else n for n, u, _ in headers]
 

@@ -50,6 +50,9 @@ OWN_FORMATS = {f.name: f for f in (
 TABULATE_SUFFIXES = {".md": "github", ".tex": "latex", ".html": "html", ".rst": "rst"}
 EXTRAS = {"parquet": ("pyarrow.parquet", "pip install 'linkage-kinematics[scan]'"),
           "xlsx": ("openpyxl", "pip install 'linkage-kinematics[xlsx]'")}
+COMMON_TABULATE = ("github", "grid", "latex", "latex_booktabs", "html", "rst", "tsv")
+"""The tabulate formats an unknown --format names (the first eight by name were asciidoc,
+colon_grid, double_grid, ...)."""
 SLICE = 8192
 """Rows formatted at a time."""
 FAST_CELLS = 200_000
@@ -92,7 +95,7 @@ def choose_format(fmt: str | None, output: Path | None, *, terminal: bool | None
             fmt = "table" if tty else "plain"
     elif fmt not in OWN_FORMATS and fmt not in tabulate_formats():
         raise InputError(f"unknown format {fmt!r}; use {', '.join(OWN_FORMATS)} or a tabulate format "
-                         f"({', '.join(tabulate_formats()[:8])}, ...)")
+                         f"({', '.join(f for f in COMMON_TABULATE if f in tabulate_formats())}, ...)")
     if to_stdout and fmt in OWN_FORMATS and OWN_FORMATS[fmt].binary:
         raise InputError(f"{fmt} is a binary format: give -o FILE.{fmt}")
     if fmt in EXTRAS:
