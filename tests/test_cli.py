@@ -119,7 +119,7 @@ def test_json_contract_and_round_trip_with_csv(cli):
 def test_method_all_lists_every_method(cli):
     run = cli("solve", "--method", "all", "--format", "json")
     assert run.code == 0
-    docs = json.loads(run.out)
+    docs = json.loads(run.out)["runs"]  # one document (an object), its runs under "runs"
     assert [d["method"] for d in docs] == ["bisection", "regula-falsi", "hybrid", "secant", "newton",
                                            "fixed-point"]
     for d in docs:
@@ -131,7 +131,7 @@ def test_method_all_lists_every_method(cli):
 
 def test_method_all_on_an_equation_runs_only_what_applies(cli):
     run = cli("solve", "--equation", "x**2 - 2", "--x0", "1", "--method", "all", "--format", "json")
-    assert [d["method"] for d in json.loads(run.out)] == ["newton"]
+    assert [d["method"] for d in json.loads(run.out)["runs"]] == ["newton"]
 
 
 @pytest.mark.parametrize("fmt", ["table", "plain", "github", "grid", "latex"])

@@ -182,8 +182,9 @@ def test_rocker_driven_sweep_and_scan_agree_on_the_transmission_extremes(cli):
     doc = json.loads(cli("sweep", str(SAMPLES / "fourbar_me581_theta4.toml"), *args, "--format", "json").out)
     folded = [min(t, 180.0 - t) for t in (p["transmission"] for p in doc["positions"]
                                           if p["status"] == "converged")]
-    scan = json.loads(cli("scan", str(SAMPLES / "fourbar_me581_theta4.toml"), "--vary", "r2=30:30:1", *args,
-                          "-f", "json").out)[0]
+    table = json.loads(cli("scan", str(SAMPLES / "fourbar_me581_theta4.toml"), "--vary", "r2=30:30:1", *args,
+                           "-f", "json").out)["tables"][0]
+    scan = dict(zip(table["columns"], table["rows"][0]))
     assert min(folded) == pytest.approx(scan["min_transmission_deg"], abs=1e-9)
     assert max(folded) == pytest.approx(scan["max_transmission_deg"], abs=1e-9)
 

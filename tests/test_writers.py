@@ -22,7 +22,7 @@ from linkage.render.report import Text, table
 
 def awkward_numbers(n: int = 3000) -> np.ndarray:
     rng = np.random.default_rng(7)
-    head = [0.1, 1 / 3, -0.0, 5e-324, 2.2250738585072014e-308, 1.7976931348623157e308, math.nan,
+    head = [0.1, 1 / 3, -0.0, 100.0, 5e-324, 2.2250738585072014e-308, 1.7976931348623157e308, math.nan,
             math.inf, -math.inf, 123456789.0, 1e22, 1e16, 9007199254740993.0, 0.0]
     tail = rng.standard_normal(n) * 10.0 ** rng.integers(-300, 300, n)
     return np.concatenate([head, tail])
@@ -60,9 +60,13 @@ def read_csv_sections(text: str) -> dict[str, list[list[str]]]:
     return out
 
 
-@pytest.mark.parametrize("n", [20, 3000])  # below and above the pyarrow fast path's block
-def test_csv_and_json_read_back_bit_for_bit(tmp_path: Path, n: int) -> None:
-    x = awkward_numbers(n)
+@pytest.mark.parametrize("fast", [False, True])  # Python's repr, and pyarrow's for a big table
+def test_csv_and_json_read_back_bit_for_bit(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                            fast: bool) -> None:
+    if fast:
+        pytest.importorskip("pyarrow")
+        monkeypatch.setattr(writers, "FAST_CELLS", 1000)
+    x = awkward_numbers(3000)
     rep = report(x)
     writers.write(rep, "csv", tmp_path / "a.csv")
     sections = read_csv_sections((tmp_path / "a.csv").read_text())
@@ -70,6 +74,7 @@ def test_csv_and_json_read_back_bit_for_bit(tmp_path: Path, n: int) -> None:
     assert [split_header(h) for h in head] == [("theta2", "deg"), ("status", ""), ("iterations", ""),
                                                ("open", "")]
     got = [float(r[0]) if r[0] else None for r in rows]
+    assert ("100" in [r[0] for r in rows]) == fast and ("100.0" in [r[0] for r in rows]) != fast
     want = finite(x)
     assert [g is None for g in got] == [w is None for w in want]
     assert bits([g for g in got if g is not None]) == bits([w for w in want if w is not None])
@@ -136,6 +141,7 @@ def test_suffixes_and_formats() -> None:
     assert writers.choose_format(None, Path("a.tex")) == "latex"
     assert writers.choose_format(None, Path("noext")) == "plain"
     assert writers.choose_format("grid", Path("a.csv")) == "grid"  # --format wins
+    assert writers.choose_format("CSV", None) == "csv"
     with pytest.raises(InputError, match="binary"):
         writers.choose_format("parquet", None)
     with pytest.raises(InputError, match="unknown format"):

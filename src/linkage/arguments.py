@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any
 
@@ -102,6 +103,15 @@ def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: b
     if positive and (v < 0.0 or (v == 0.0 and not allow_zero)):
         raise InputError(f"{name} must be {'>' if not allow_zero else '>='} 0, got {v!r}")
     return v
+
+
+def check_fps(name: str, value: Any) -> float:
+    """An animation's frames per second: 0.01 to 100, since a GIF stores each frame's delay
+    as a whole number of hundredths of a second (at most 655.35 s)."""
+    fps = check_number(name, value, positive=True, allow_zero=False)
+    if not 0.01 <= fps <= 100:
+        raise InputError(f"{name} {fps:g} is out of range (0.01 to 100 frames per second)")
+    return fps
 
 
 def check_whole(name: str, value: Any, lo: int = 1, hi: int | None = None, why: str = "") -> int:
@@ -370,3 +380,59 @@ def guarded(call: Callable[[], Any], diagnose: Callable[[], None]) -> Any:
     except (TypeError, IndexError):
         diagnose()
         raise
+
+
+def parse_motion(speed: str | None, accel: str | None, mechanism: Any) -> tuple[float | None, float]:
+    """--speed and --accel in internal units (rad/s, rad/s^2, or length/s, length/s^2)."""
+    from .numbers import parse_number
+
+    if speed is None:
+        if accel is not None:
+            raise InputError("--accel needs --speed (the driver's velocity)")
+        return None, 0.0
+    tables = _rate_units(mechanism)
+    out = []
+    accel = "0" if accel is None else accel  # an empty --accel '' is refused, not taken as 0
+    for option, text, units in (("--speed", speed, tables[0]), ("--accel", accel, tables[1])):
+        m = _RATE.fullmatch(text)
+        if m is None or m.group(2) not in units:
+            known = ", ".join(u for u in units if u) or "none"
+            raise InputError(f"{option} {text!r}: give a number, optionally with one of these units: {known}")
+        value = parse_number(option, m.group(1)) * units[m.group(2)]
+        if not rate_in_range(value):
+            raise InputError(f"{option} {text!r} is out of range "
+                             f"(0, or {MIN_RATE:g} to {MAX_RATE:g} in size)")
+        out.append(value)
+    return out[0], out[1]
+
+
+_RATE = re.compile(r"\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*")  # a number, then its unit
+
+
+def _rate_units(mechanism: Any) -> tuple[dict[str, float], dict[str, float]]:
+    """--speed's and --accel's units, each with its factor to the internal unit ("": none
+    given, internal)."""
+    unit = mechanism.length_unit
+    if mechanism.driver.kind == "angle":
+        deg, rpm = math.pi / 180.0, math.pi / 30.0
+        return ({"": 1.0, "rad/s": 1.0, "deg/s": deg, "rpm": rpm},
+                {"": 1.0, "rad/s^2": 1.0, "rad/s2": 1.0, "deg/s^2": deg, "deg/s2": deg, "rpm/s": rpm})
+    return {"": 1.0, f"{unit}/s": 1.0}, {"": 1.0, f"{unit}/s^2": 1.0, f"{unit}/s2": 1.0}
+
+
+def motion_text(speed: str | None, accel: str | None, mechanism: Any) -> str | None:
+    """--speed and --accel as given, for a plot's title: "600 rpm, 0 rpm/s". A bare number
+    is in the internal unit (rad/s, or the length unit per second); no --accel is 0 in the
+    speed's unit per second. Checked as :func:`parse_motion` checks them."""
+    parse_motion(speed, accel, mechanism)
+    if speed is None:
+        return None
+    per = "rad" if mechanism.driver.kind == "angle" else mechanism.length_unit
+    number, unit = _RATE.fullmatch(speed).groups()  # type: ignore[union-attr]
+    unit = unit or f"{per}/s"
+    if accel is None:
+        a_number, a_unit = "0", "rpm/s" if unit == "rpm" else f"{unit}^2"
+    else:
+        a_number, a_unit = _RATE.fullmatch(accel).groups()  # type: ignore[union-attr]
+        a_unit = a_unit or f"{per}/s^2"
+    return f"{float(number):g} {unit}, {float(a_number):g} {a_unit}"

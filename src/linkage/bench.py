@@ -567,3 +567,34 @@ def has_scipy() -> bool:
     except ImportError:
         return False
     return True
+
+
+def time_per_solve(problem: Any, kwargs: dict[str, Any]) -> float:
+    """Seconds per solve with recording off, the median of short timed batches."""
+    from .solve import solve_scalar
+
+    kw = dict(kwargs, record=False)
+    times = []
+    for _ in range(5):
+        n = 0
+        t0 = time.perf_counter()
+        while True:
+            solve_scalar(problem, **kw)
+            n += 1
+            dt = time.perf_counter() - t0
+            if dt > 0.002:
+                break
+        times.append(dt / n)
+    times.sort()
+    return times[len(times) // 2]
+
+
+MEASUREMENT_HEADERS = ("problem", "contender", "tol", "time per solve (us)", "fastest batch (us)",
+                       "slowest batch (us)", "error", "iterations", "evaluations")
+
+
+def measurement_rows(results: Sequence[Any]) -> list[tuple[Any, ...]]:
+    """The measurements as the table's rows, times in microseconds."""
+    return [(m.problem, m.contender, m.tol, m.seconds * 1e6,
+             m.spread[0] * 1e6, m.spread[1] * 1e6, m.error, m.iterations, m.nfev)
+            for m in results]

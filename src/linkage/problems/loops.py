@@ -670,7 +670,7 @@ class LoopModel:
             reference=reference,
             branch_of=branch_of,
             meta={"driver": m.driver.name, "driver_value": shown, "driver_unit": m.driver.unit,
-                  "source": m.source},
+                  "source": m.source, "mechanism": m.name},
             length_scale=m.length_scale,
         )
 

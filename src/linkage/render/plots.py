@@ -71,12 +71,16 @@ def _series(result: Any) -> list[tuple[str, list[float]]]:
     return out
 
 
-def sweep_plot(result: Any, path: Path) -> None:
+def sweep_plot(result: Any, path: Path, motion_text: str | None = None) -> None:
+    """``motion_text``: the driver's speed (and acceleration) as the user gave them, e.g.
+    "600 rpm"; without it the title says the internal rad/s (or length/s)."""
     _check_suffix(path, SUFFIXES)
     plt = _pyplot()
     series = _series(result)
+    # constrained layout places the panels under the title: the default subplot margins
+    # left a band of empty figure above a tall stack (12 % of its height)
     fig, axes = plt.subplots(len(series), 1, sharex=True, figsize=(8, 1.9 * len(series) + 1.2),
-                             squeeze=False)
+                             squeeze=False, layout="constrained")
     xs = [p.input for p in result.positions]
     gaps = bands(result)
     # a re-entry on the other assembly that carries the branch's label is a jump, not a
@@ -108,7 +112,9 @@ def sweep_plot(result: Any, path: Path) -> None:
     signs = bool(result.branch) and set(result.branch) <= {"+", "-"}
     title = f"{result.mechanism}: " + (f"{result.branch} branch" if result.branch in ("open", "crossed")
                                        or signs else "the branch of the file's guess")
-    if result.motion is not None:
+    if result.motion is not None and motion_text:
+        title += f"; driver at {motion_text}"
+    elif result.motion is not None:
         per = "rad" if result.driver_unit == "deg" else result.driver_unit
         title += f"; driver at {result.motion[0]:g} {per}/s, {result.motion[1]:g} {per}/s^2"
     import textwrap
@@ -129,9 +135,12 @@ def path_plot(result: Any, mechanism: Any, names: Sequence[str], path: Path) -> 
         scale = math.pi / 180.0 if mechanism.driver.kind == "angle" else 1.0
         q = [math.radians(first.solution[u.name]) if u.kind == "angle" else first.solution[u.name]
              for u in mechanism.unknowns]
+        # the second line says where the faint linkage stands: without it a reader takes
+        # it for any position of the curve
         _draw(ax, mechanism, q, first.input * scale,
               f"{result.mechanism}: path of {', '.join(names)} over {result.driver} "
-              f"{result.positions[0].input:g} to {result.positions[-1].input:g} {result.driver_unit}")
+              f"{result.positions[0].input:g} to {result.positions[-1].input:g} {result.driver_unit}\n"
+              f"linkage drawn at {result.driver} = {first.input:g} {result.driver_unit}")
     for k, name in enumerate(names):
         pts = [p.rates.joints[name] if p.rates is not None else (math.nan, math.nan)
                for p in result.positions]
@@ -264,20 +273,61 @@ def draw_mechanism(mechanism: Any, q: Sequence[float], path: Path, title: str) -
     _save(fig, path)
 
 
+def assembly_gaps(result: Any) -> list[tuple[float, float]]:
+    """The driver intervals of a sweep where the linkage cannot be assembled (the red
+    bands of its plot), in the driver's unit."""
+    return [(a, b) for a, b, status in bands(result) if status == "no_solution"]
+
+
+def frame_notes(values: Sequence[float], gaps: Sequence[tuple[float, float]], unit: str) -> list[str]:
+    """A note per animation frame: the last frame before a gap and the first after it say
+    where the linkage cannot be assembled (the animation jumps over that interval).
+    ``values``: each frame's driver value, increasing, in ``unit`` like ``gaps``."""
+    notes = [""] * len(values)
+    for a, b in gaps:
+        text = f"cannot be assembled from {a:.4g} to {b:.4g} {unit}"
+        before = [i for i, v in enumerate(values) if v <= a]
+        after = [i for i, v in enumerate(values) if v >= b]
+        for i in ([before[-1]] if before else []) + ([after[0]] if after else []):
+            notes[i] = "; ".join(filter(None, (notes[i], text)))
+    return notes
+
+
+def sweep_frames(mechanism: Any, sweep: Any) -> list[tuple[float, list[float]]]:
+    """The solved positions of a sweep as animation frames: (driver, unknowns), angles in
+    radians (the file's degrees converted), lengths as they are."""
+    scale = math.pi / 180.0 if mechanism.driver.kind == "angle" else 1.0
+    return [(p.input * scale,
+             [math.radians(p.solution[u.name]) if u.kind == "angle" else p.solution[u.name]
+              for u in mechanism.unknowns]) for p in sweep.positions if p.solution]
+
+
 def animate_sweep(mechanism: Any, frames: Sequence[tuple[float, Sequence[float]]], path: Path,
-                  fps: int = 12, progress: Any = None) -> None:
-    """frames: (driver value in internal units, q) per frame."""
+                  fps: float = 12, progress: Any = None, gaps: Sequence[tuple[float, float]] = ()) -> None:
+    """frames: (driver value in internal units, q) per frame; ``fps``: frames per second
+    (0.01 to 100: a GIF counts a frame's delay in hundredths of a second); ``gaps``: the
+    driver intervals (the driver's unit) that cannot be assembled, noted on the frames
+    either side (see :func:`assembly_gaps`)."""
+    from ..arguments import check_fps
+
+    fps = check_fps("fps", fps)
     _check_suffix(path, (".gif",))
     plt = _pyplot()
     from matplotlib.animation import FuncAnimation, PillowWriter
 
-    fig, ax = plt.subplots(figsize=(6, 4.8))
+    scale = 180.0 / math.pi if mechanism.driver.kind == "angle" else 1.0
+    values = [d * scale for d, _ in frames]
+    notes = frame_notes(values, gaps, mechanism.driver.unit)
+    fig, ax = plt.subplots(figsize=(6, 5.1 if any(notes) else 4.8))
+    if any(notes):
+        fig.subplots_adjust(bottom=0.16)  # room for a note under the x label
     allpts = [p for d, q in frames for pts, _ in _geometry(mechanism, q, d) for p in pts]
     xs, ys = [p.real for p in allpts], [p.imag for p in allpts]
     pad = 0.08 * max(max(xs) - min(xs), max(ys) - min(ys), 1e-9)
-    scale = 180.0 / math.pi if mechanism.driver.kind == "angle" else 1.0
 
     traces = [_named_points(mechanism, q, d) for d, q in frames]
+    # the traced path breaks across a gap: a straight stroke there is no motion
+    cuts = {i for i in range(1, len(values)) for a, b in gaps if values[i - 1] <= a and values[i] >= b}
     for t in traces:
         for _, pos in t.values():
             xs.append(pos.real)
@@ -288,10 +338,14 @@ def animate_sweep(mechanism: Any, frames: Sequence[tuple[float, Sequence[float]]
         d, q = frames[i]
         for name in mechanism.points:  # the path each named point has traced so far
             path_pts = [t[name][1] for t in traces[: i + 1]]
-            ax.plot([p.real for p in path_pts], [p.imag for p in path_pts], color="tab:green", lw=1.0,
-                    alpha=0.7)
+            ax.plot(*_broken([p.real for p in path_pts], [p.imag for p in path_pts], cuts),
+                    color="tab:green", lw=1.0, alpha=0.7)
         _draw(ax, mechanism, q, d, f"{mechanism.name}: {mechanism.driver.name} = {d * scale:.1f} "
                                    f"{mechanism.driver.unit}", adjustable="box")
+        if notes[i]:
+            # under the axes, where it hides no link (ax.clear() removes it for the next frame)
+            ax.text(0.5, 0.015, notes[i], transform=fig.transFigure, ha="center", va="bottom", fontsize=9,
+                    color="tab:red", bbox=dict(boxstyle="round", fc="white", ec="tab:red"))
         ax.set_xlim(min(xs) - pad, max(xs) + pad)
         ax.set_ylim(min(ys) - pad, max(ys) + pad)
 
@@ -306,6 +360,16 @@ def animate_sweep(mechanism: Any, frames: Sequence[tuple[float, Sequence[float]]
         plt.close(fig)
 
 
+def error_series(results: Sequence[Any]) -> list[tuple[str, list[float | None]]]:
+    """Each run's label and its iterates' error sizes (None where an iterate has none)."""
+    series = []
+    for r in results:
+        errors = [abs(e) if isinstance(e, (int, float)) else None for e in r.history.errors()] \
+            if r.history is not None else []
+        series.append((f"{r.method} ({r.status.value})", errors))
+    return series
+
+
 def convergence_plot(runs: Sequence[tuple[str, Sequence[float]]], path: Path, title: str,
                      unit: str = "") -> None:
     """runs: (label, errors per iteration); ``unit``: the errors' unit."""
@@ -318,6 +382,9 @@ def convergence_plot(runs: Sequence[tuple[str, Sequence[float]]], path: Path, ti
         if pts:
             ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=4, label=label)
     ax.set_xlabel("iteration")
+    from matplotlib.ticker import MaxNLocator
+
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))  # iteration 2.5 does not exist
     ax.set_ylabel(f"log10 of the error ({unit})" if unit else "log10 of the error")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)

@@ -6,7 +6,7 @@ import math
 from typing import Any
 
 from ..kinematics.labels import rate_label
-from .report import Block, table
+from .report import Block, denoise, table
 
 
 def rate_units(kind: str, length_unit: str) -> tuple[str, str]:
@@ -131,18 +131,21 @@ def rates_blocks(rates: Any, names: Any, kinds: Any, length_unit: str, digits: i
                 label = rate_label(n, order)
                 value = rates.velocities[n] if order == 1 else rates.accelerations[n]
                 bound = (rates.velocity_bounds if order == 1 else rates.acceleration_bounds).get(n)
-                rows.append((f"{label} ({unit})", _shown(rates, label, value, bound), _bound(bound)))
+                shown = value if rates.flagged(label) else denoise(value, 0.0, bound)
+                rows.append((f"{label} ({unit})", _shown(rates, label, shown, bound), _bound(bound)))
         blocks.append(table("Velocities and accelerations", ("rate", "value", "± bound"), rows, digits))
     L = length_unit
+    size = _largest(rates.joints.values())  # the mechanism's size: the scale of a coordinate's noise
     if rates.velocities:
         headers = ("joint", f"x ({L})", f"y ({L})", f"vx ({L}/s)", f"vy ({L}/s)", f"± v ({L}/s)",
                    f"ax ({L}/s^2)", f"ay ({L}/s^2)", f"± a ({L}/s^2)")
-        rows = [(j, *xy, *_joint_cells(rates, j, 1), _bound(rates.joint_velocity_bounds.get(j)),
+        rows = [(j, *(denoise(c, size) for c in xy), *_joint_cells(rates, j, 1),
+                 _bound(rates.joint_velocity_bounds.get(j)),
                  *_joint_cells(rates, j, 2), _bound(rates.joint_acceleration_bounds.get(j)))
                 for j, xy in rates.joints.items()]
     else:
         headers = ("joint", f"x ({L})", f"y ({L})")
-        rows = [(j, *xy) for j, xy in rates.joints.items()]
+        rows = [(j, *(denoise(c, size) for c in xy)) for j, xy in rates.joints.items()]
     if rows:
         blocks.append(table("Joints (the first loop's first joint at the origin, x along 0 deg)", headers,
                             rows, digits))
@@ -158,8 +161,18 @@ def _shown(rates: Any, label: str, value: float, bound: float | None) -> Any:
     return uncertain(value, bound, with_bound=False) if bound is not None and rates.flagged(label) else value
 
 
+def _largest(pairs: Any) -> float:
+    """The largest finite magnitude among (x, y) pairs (0 for none)."""
+    return max((abs(c) for xy in pairs if xy for c in xy if c is not None and math.isfinite(c)), default=0.0)
+
+
 def _joint_cells(rates: Any, j: str, order: int) -> tuple[Any, Any]:
-    xy = rates.joint_velocities[j] if order == 1 else rates.joint_accelerations[j]
+    table = rates.joint_velocities if order == 1 else rates.joint_accelerations
+    xy = table[j]
     bound = rates.joint_velocity_bounds.get(j) if order == 1 else rates.joint_acceleration_bounds.get(j)
     label = rate_label(j, order, joint=True)
-    return _shown(rates, label, xy[0], bound), _shown(rates, label, xy[1], bound)
+    if rates.flagged(label):
+        return _shown(rates, label, xy[0], bound), _shown(rates, label, xy[1], bound)
+    # a still joint's rate computed as 1e-13 cm/s beside joints moving at 600 cm/s: 0
+    size = _largest(table.values())
+    return denoise(xy[0], size, bound), denoise(xy[1], size, bound)

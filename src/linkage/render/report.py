@@ -50,6 +50,31 @@ def fmt(v: Any, digits: int = 12) -> str:
     return str(v)
 
 
+NOISE_ULPS = 16
+"""How many rounding errors of its scale a displayed value may be and still be zero."""
+
+
+def is_noise(v: Any, scale: float, bound: float | None = None) -> bool:
+    """Whether ``v`` is rounding noise around zero: within ``NOISE_ULPS`` rounding errors
+    of ``scale`` (the size of the quantities it was computed from: a mechanism's largest
+    coordinate for a joint's x and y, its fastest joint for a velocity), or within its own
+    error bound where it has one. Display tables print such a value as 0 (a joint at the
+    origin computed as 9.18e-15 cm); CSV, JSON, parquet and xlsx keep every bit. Never for
+    a number that is small on its own (an iteration's error or residual): those have no
+    larger scale beside them and are passed through untouched."""
+    if not isinstance(v, float) or not math.isfinite(v):
+        return False
+    limit = NOISE_ULPS * 2.220446049250313e-16 * abs(scale) if math.isfinite(scale) else 0.0
+    if bound is not None and math.isfinite(bound):
+        limit = max(limit, bound)
+    return abs(v) <= limit
+
+
+def denoise(v: Any, scale: float, bound: float | None = None) -> Any:
+    """``v``, or 0.0 where it is rounding noise (:func:`is_noise`): for display only."""
+    return 0.0 if is_noise(v, scale, bound) else v
+
+
 def table(title: str, headers: Sequence[str], rows: Sequence[Sequence[Any]], digits: int,
           notes: Sequence[str] = ()) -> Table:
     return Table(title, tuple(headers), tuple(tuple(fmt(v, digits) for v in r) for r in rows),
@@ -230,7 +255,10 @@ def print_rich(blocks: Sequence[Block], file: Any = None) -> None:
         for k, cols in enumerate(groups):
             title = b.title or None
             if len(groups) > 1:
-                title = f"{b.title + ' ' if b.title else ''}(columns part {k + 1} of {len(groups)})"
+                part = f"(columns part {k + 1} of {len(groups)})"
+                # a title that cannot take the part on its line gets it on the next, whole
+                sep = "\n" if b.title and len(b.title) + 1 + len(part) > console.width else " "
+                title = f"{b.title + sep if b.title else ''}{part}"
             widths = column_widths(b.headers, b.rows, console.width)
             shown = widen_headers(b.headers, cols, widths, console.width)
             if title and len(title) > 1 + sum(w + 3 for w in shown):

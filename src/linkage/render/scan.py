@@ -1,165 +1,136 @@
-"""Scan records out: CSV, JSON (a list of records) and Parquet written chunk by chunk, and
-the table of the top rows.
+"""Scan records out, through the one writer registry (:mod:`.writers`).
+
+A scan's records are one table, ``designs``, written by :func:`.writers.open_sink` for
+every data format (csv, json, parquet, xlsx) a chunk at a time as the scan computes them
+(:class:`RecordSink`), and shown by any display format (table, plain, github, latex, ...)
+from :func:`scan_report`, whose blocks hold the kept rows under the scan's summary.
+
+Every column has a name, a unit and a kind (:func:`scan_columns`). The name is the bare
+one ``--where``, ``--sort`` and ``--columns`` use (``min_transmission_deg``), the key in
+JSON and parquet; the unit goes beside it: CSV, xlsx and the display write the header
+``min_transmission_deg (deg)``, JSON lists ``units`` beside ``columns``, parquet puts it
+in each field's metadata. A dimensionless column (a fraction, a count, a boolean, a word)
+has the unit "" and its header is its bare name (``feasible_fraction``, no ``()``): an
+empty pair of brackets would read as a unit someone forgot.
 
 A file is written to a temporary name beside it and renamed only when the scan is
 complete, so a failed or interrupted scan never leaves a half-written file; standard
-output receives each chunk as it is computed. CSV headers carry units (``r2 (mm)``);
-JSON keys and Parquet columns are the bare names that ``--where`` and ``--sort`` use,
-Parquet with each unit in its field's metadata.
+output receives each chunk as it is computed. Memory stays bounded: a chunk's arrays go
+to the sink as arrays, which formats a slice of rows at a time.
 """
 
 from __future__ import annotations
 
 import contextlib
-import csv
-import json
 import math
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 import numpy as np
 
-from ..errors import InputError, OutputError
+from .data import Column as DataColumn
+from .data import DataTable, Report
 from .report import Block, Text, table
 
-SLICE = 2048
-"""Records formatted at a time."""
+BLOCK = 1000
+"""Records handed to a text sink (csv, json, xlsx) at a time: its Python objects for a block
+(about 2 MB) are what such a format holds. Below writers' pyarrow threshold (1,024) on
+purpose: a number reads the same (Python's repr) whatever --chunk cut the scan into.
+Parquet takes a chunk at a time (a row group per chunk)."""
 
-Column = tuple[str, str, str]  # name, type (number, int, bool, text), unit
+TABLE = "designs"
+"""The name of the scan's one table (what a row is)."""
+
+Column = tuple[str, str, str]  # a scan spec entry: name, kind (number, int, bool, text), unit
+
+
+def scan_columns(spec: Sequence[Column],
+                 cols: Mapping[str, np.ndarray] | None = None) -> tuple[DataColumn, ...]:
+    """The spec as the registry's columns (name, unit, kind), holding ``cols``' values
+    (none if not given)."""
+    return tuple(DataColumn(name, unit, cols[name] if cols else (), kind) for name, kind, unit in spec)
 
 
 def header(col: Column) -> str:
+    """A column's header: ``name (unit)``, the bare name where it has no unit."""
     name, _, unit = col
-    return f"{name} ({unit})" if unit and not name.endswith(f"_{unit}") else name
+    return DataColumn(name, unit).header
 
 
-def _cells(cols: Mapping[str, np.ndarray], spec: Sequence[Column]) -> list[list[Any]]:
-    """Each column as Python values: floats at full precision, None for NaN."""
-    out = []
-    for name, kind, _ in spec:
-        v = cols[name]
-        if kind == "number":
-            out.append([x if math.isfinite(x) else None for x in v.tolist()])
-        else:
-            out.append(v.tolist())
-    return out
+def pick_spec(spec: Sequence[Column], names: str) -> list[Column]:
+    """``--columns``: the registry's rule (:func:`.writers.pick_columns`: ``design`` and
+    the columns whose name or header begins with one of ``names``), on the scan's spec, so
+    the stream writes only the picked columns. None matching: an InputError."""
+    from .writers import pick_columns
+
+    probe = Report("", (DataTable(TABLE, scan_columns(spec)),), lambda: ())
+    kept = {c.name for c in pick_columns(probe, names).tables[0].columns}
+    return [c for c in spec if c[0] in kept]
 
 
 class RecordSink:
-    """Writes records in ``fmt`` (csv, json or parquet) to ``path`` (None: standard output)."""
+    """The scan's records in a data format (csv, json, parquet or xlsx) to ``path`` (None
+    or "-": standard output): :func:`.writers.open_sink` with one table, ``designs``,
+    whose JSON document (and parquet ``linkage`` metadata) is ``meta``. Use as a context
+    manager; call with a chunk's columns (name -> array) as often as there are chunks;
+    ``count`` is the records written."""
 
     def __init__(self, fmt_: str, path: Path | None, spec: Sequence[Column],
                  meta: Mapping[str, Any]) -> None:
-        if fmt_ == "parquet" and path is None:
-            raise InputError("parquet is a binary format: give -o FILE.parquet")
+        from ..errors import InputError
+        from .writers import OWN_FORMATS, choose_format, is_data
+
+        if not is_data(fmt_):
+            data = ", ".join(f for f in OWN_FORMATS if is_data(f))
+            raise InputError(f"{fmt_} is not a data format; use {data}")
+        choose_format(fmt_, path)  # the registry's refusals: binary to standard output, a missing extra
         self.fmt, self.path, self.spec, self.meta = fmt_, path, list(spec), dict(meta)
+        self.to_stdout = path is None or str(path) == "-"
         self.count = 0
         self._stack = contextlib.ExitStack()
-        self._fh: IO[str] | None = None
-        self._parquet: Any = None
 
     def __enter__(self) -> RecordSink:
-        if self.fmt == "parquet":
-            try:
-                import pyarrow.parquet  # noqa: F401
-            except ImportError:
-                raise InputError("parquet output needs pyarrow: pip install "
-                                 "'linkage-kinematics[scan]'") from None
-        if self.path is not None:
-            from ..files import atomic_target
+        from .writers import open_sink
 
-            self._tmp = self._stack.enter_context(atomic_target(self.path))
-            if self.fmt != "parquet":
-                self._fh = self._stack.enter_context(open(self._tmp, "w", encoding="utf-8", newline=""))
-        else:
-            self._fh = sys.stdout
-        if self.fmt == "csv":
-            self._csv = csv.writer(self._fh, lineterminator="\n")
-            self._write(lambda: self._csv.writerow([header(c) for c in self.spec]))
-        elif self.fmt == "json":
-            self._write(lambda: self._fh.write("["))  # type: ignore[union-attr]
-        return self
-
-    def _write(self, action: Any) -> None:
+        self._sink = self._stack.enter_context(open_sink(self.fmt, None if self.to_stdout else self.path,
+                                                         self.meta))
         try:
-            action()
-        except OSError as exc:
-            where = self.path if self.path is not None else "standard output"
-            raise OutputError(f"cannot write to {where}: {exc.strerror or exc}") from None
+            self._sink.begin(TABLE, scan_columns(self.spec))
+        except BaseException:
+            self._stack.__exit__(*sys.exc_info())
+            raise
+        return self
 
     def __call__(self, cols: Mapping[str, np.ndarray]) -> None:
         n = len(cols["design"])
-        for a in range(0, n, SLICE):  # Python objects for a slice at a time, never a chunk
-            self._slice({k: v[a:a + SLICE] for k, v in cols.items()})
-
-    def _slice(self, cols: Mapping[str, np.ndarray]) -> None:
-        n = len(cols["design"])
-        if self.fmt == "parquet":
-            self._write(lambda: self._write_parquet(cols))
-        else:
-            columns = _cells(cols, self.spec)
-            rows = list(zip(*columns))
-            if self.fmt == "csv":
-                fix = [i for i, c in enumerate(self.spec) if c[1] == "bool"]
-                if fix:
-                    rows = [tuple(("true" if v else "false") if i in fix else v for i, v in enumerate(r))
-                            for r in rows]
-                self._write(lambda: self._csv.writerows(
-                    [["" if v is None else repr(v) if isinstance(v, float) else v for v in r] for r in rows]))
-            else:
-                names = [c[0] for c in self.spec]
-                text = ("," if self.count else "") + ",".join(
-                    "\n  " + json.dumps(dict(zip(names, r)), allow_nan=False) for r in rows)
-                self._write(lambda: self._fh.write(text))  # type: ignore[union-attr]
-            if self.path is None:
-                self._write(sys.stdout.flush)
+        if not n:
+            return
+        step = n if self.fmt == "parquet" else BLOCK
+        for a in range(0, n, step):
+            self._sink.rows([cols[name][a:a + step] for name, _, _ in self.spec])
         self.count += n
+        if self.to_stdout:  # a pipe sees each chunk as it is computed
+            self._flush()
 
-    def _write_parquet(self, cols: Mapping[str, np.ndarray]) -> None:
-        import pyarrow as pa
+    def _flush(self) -> None:
+        from ..errors import OutputError
 
-        if self._parquet is None:
-            self._open_parquet()
-        arrays = []
-        for (name, kind, _), f in zip(self.spec, self._schema):
-            v = cols[name]
-            arrays.append(pa.array(v.tolist() if kind == "text" else v, type=f.type,
-                                   from_pandas=kind == "number"))
-        self._parquet.write_table(pa.Table.from_arrays(arrays, schema=self._schema))
+        try:
+            sys.stdout.flush()
+        except OSError as exc:
+            raise OutputError(f"cannot write to standard output: {exc.strerror or exc}") from None
 
     def __exit__(self, kind: Any, exc: Any, tb: Any) -> Any:
         if kind is None:
             try:
-                self._finish()
+                self._sink.end()
             except BaseException:
                 # the temporary file goes; the old file, if any, stays as it was
                 self._stack.__exit__(*sys.exc_info())
                 raise
-        elif self._parquet is not None:
-            with contextlib.suppress(Exception):
-                self._parquet.close()
         return self._stack.__exit__(kind, exc, tb)
-
-    def _finish(self) -> None:
-        if self.fmt == "json":
-            self._write(lambda: self._fh.write("\n]\n" if self.count else "]\n"))  # type: ignore[union-attr]
-        elif self.fmt == "parquet":
-            if self._parquet is None:  # no record: a valid file with the columns
-                self._write(self._open_parquet)
-            self._write(self._parquet.close)
-        if self.path is None:
-            self._write(sys.stdout.flush)
-
-    def _open_parquet(self) -> None:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-
-        types = {"number": pa.float64(), "int": pa.int64(), "bool": pa.bool_(), "text": pa.string()}
-        fields = [pa.field(n, types[k], metadata={"unit": u} if u else None) for n, k, u in self.spec]
-        self._schema = pa.schema(fields, metadata={"linkage": json.dumps(self.meta)})
-        self._parquet = pq.ParquetWriter(self._tmp, self._schema)
 
 
 def scan_blocks(cols: Mapping[str, np.ndarray], spec: Sequence[Column], summary: Sequence[str],
@@ -167,9 +138,56 @@ def scan_blocks(cols: Mapping[str, np.ndarray], spec: Sequence[Column], summary:
     """The kept rows as a table, under the scan's summary lines."""
     blocks: list[Block] = [Text(summary[0], "bold"), *(Text(s) for s in summary[1:])]
     if cols and len(cols["design"]):
-        cells = _cells(cols, spec)
-        rows = [tuple(("yes" if v else "no") if k == "bool" else v for v, (_, k, _u) in zip(r, spec))
-                for r in zip(*cells)]
+        cells = []
+        for name, kind, _ in spec:
+            v = cols[name].tolist()
+            cells.append(["yes" if x else "no" for x in v] if kind == "bool" else
+                         [None if isinstance(x, float) and not math.isfinite(x) else x for x in v])
         blocks.append(Text(""))
-        blocks.append(table("", [header(c) for c in spec], rows, digits))
+        blocks.append(table("", [header(c) for c in spec], list(zip(*cells)), digits))
     return blocks
+
+
+def scan_report(cols: Mapping[str, np.ndarray], spec: Sequence[Column], summary: Sequence[str],
+                digits: int, meta: Mapping[str, Any] | None = None) -> Report:
+    """The kept rows (a table's worth, or every sorted row) as a Report: one table,
+    ``designs``, and the display of :func:`scan_blocks`; ``meta`` is the JSON document."""
+    held = cols if cols and len(cols.get("design", ())) else {name: np.array([]) for name, _, _ in spec}
+    doc = dict(meta or {})
+    return Report(summary[0], (DataTable(TABLE, scan_columns(spec, held)),),
+                  lambda: scan_blocks(cols, spec, summary, digits), lambda: doc)
+
+
+def scan_meta(m: Any, source: str, setup: Any, driver: tuple[float, float, float], where: str | None,
+              sort: str | None, descending: bool) -> dict[str, Any]:
+    """The scan's settings: the JSON document (the records go under its ``tables``) and
+    parquet's ``linkage`` metadata."""
+    start, stop, step = driver
+    return {"mechanism": m.name, "source": source, "branch": setup.branch,
+            "driver": {"name": m.driver.name, "unit": m.driver.unit, "from": start, "to": stop,
+                       "step": step, "positions": len(setup.values)},
+            "where": where, "sort": sort, "descending": descending, "designs": setup.plan.total}
+
+
+def scan_summary(m: Any, setup: Any, driver: tuple[float, float, float], scanned: int, keeper: Any,
+                 held: Mapping[str, np.ndarray], elapsed: float, shown: bool) -> list[str]:
+    """The lines over the display (the first also ends a file's "wrote" line): designs
+    scanned and kept, the driver range, branch and engine, and (``shown``) how many rows
+    the display holds."""
+    from ..kinematics.designs import ENGINES, engine_for
+
+    start, stop, step = driver
+    total, top, sort = setup.plan.total, keeper.top, keeper.sort
+    engine = ENGINES[engine_for(m, setup.branch)]
+    where_note = f"; {keeper.kept:,} pass --where" if setup.where is not None else ""
+    stopped = f" (stopped early: the first {top} are final)" if scanned < total else ""
+    branch = setup.branch or "the one the file's guess is on"
+    lines = [f"{m.name}: {scanned:,} of {total:,} designs scanned{stopped}{where_note}; {elapsed:.2f} s",
+             f"{len(setup.values)} positions each ({m.driver.name} {start:g}..{stop:g} "
+             f"{m.driver.unit}, step {step:g}); branch: {branch}; engine: {engine}"]
+    n_held = len(held["design"]) if held else 0
+    if shown and n_held < keeper.kept:
+        lines.append(f"showing {n_held} of {keeper.kept:,}"
+                     + (f" by {sort}{' (largest first)' if keeper.descending else ''}" if sort else "")
+                     + "; --top K or --format csv/json/parquet/xlsx for more")
+    return lines

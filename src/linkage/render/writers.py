@@ -21,7 +21,6 @@ half-written file.
 from __future__ import annotations
 
 import contextlib
-import json
 import math
 import sys
 from collections.abc import Callable, Iterator, Sequence
@@ -51,10 +50,14 @@ OWN_FORMATS = {f.name: f for f in (
 TABULATE_SUFFIXES = {".md": "github", ".tex": "latex", ".html": "html", ".rst": "rst"}
 EXTRAS = {"parquet": ("pyarrow.parquet", "pip install 'linkage-kinematics[scan]'"),
           "xlsx": ("openpyxl", "pip install 'linkage-kinematics[xlsx]'")}
+COMMON_TABULATE = ("github", "grid", "latex", "latex_booktabs", "html", "rst", "tsv")
+"""The tabulate formats an unknown --format names (the first eight by name were asciidoc,
+colon_grid, double_grid, ...)."""
 SLICE = 8192
 """Rows formatted at a time."""
 FAST_CELLS = 200_000
-"""From this many cells, CSV numbers are formatted by pyarrow when it is installed."""
+"""From this many cells in a table, CSV numbers are formatted by pyarrow when it is
+installed; the choice is made once per table, so a column's numbers read alike throughout."""
 
 
 def tabulate_formats() -> list[str]:
@@ -77,6 +80,8 @@ def choose_format(fmt: str | None, output: Path | None, *, terminal: bool | None
     a terminal and plain when piped. An unknown format or suffix, or a binary format for
     standard output, is an InputError naming what works."""
     to_stdout = output is None or str(output) == "-"
+    if fmt is not None:
+        fmt = fmt.strip().lower()  # --format CSV as --format csv, as a suffix .CSV is .csv
     if fmt is None:
         if not to_stdout:
             suffix = output.suffix.lower()  # type: ignore[union-attr]
@@ -90,7 +95,7 @@ def choose_format(fmt: str | None, output: Path | None, *, terminal: bool | None
             fmt = "table" if tty else "plain"
     elif fmt not in OWN_FORMATS and fmt not in tabulate_formats():
         raise InputError(f"unknown format {fmt!r}; use {', '.join(OWN_FORMATS)} or a tabulate format "
-                         f"({', '.join(tabulate_formats()[:8])}, ...)")
+                         f"({', '.join(f for f in COMMON_TABULATE if f in tabulate_formats())}, ...)")
     if to_stdout and fmt in OWN_FORMATS and OWN_FORMATS[fmt].binary:
         raise InputError(f"{fmt} is a binary format: give -o FILE.{fmt}")
     if fmt in EXTRAS:
@@ -108,11 +113,12 @@ def is_data(fmt: str) -> bool:
 
 # --- cells ----------------------------------------------------------------------------------
 
-def number_texts(values: Any) -> list[str]:
-    """Each number as the shortest text that reads back to the same double (Python's repr,
-    or pyarrow's shortest form for a large block when pyarrow is installed: ``100`` where
-    repr says ``100.0``; both read back bit for bit); "" for NaN, infinities and None."""
-    if _is_array(values) and values.dtype.kind == "f" and len(values) >= 1024 and _pyarrow():
+def number_texts(values: Any, fast: bool = False) -> list[str]:
+    """Each number as the shortest text that reads back to the same double: Python's repr,
+    or with ``fast`` (a large table, pyarrow installed) pyarrow's shortest form (``100``
+    where repr says ``100.0``, ``0.000012345`` for ``1.2345e-05``); both read back bit for
+    bit. "" for NaN, infinities and None."""
+    if fast and _is_array(values) and values.dtype.kind == "f" and _pyarrow():
         import numpy as np
         import pyarrow as pa
         import pyarrow.compute as pc
@@ -120,13 +126,22 @@ def number_texts(values: Any) -> list[str]:
         finite = np.isfinite(values)
         arr = pa.array(values, mask=~finite)
         return pc.fill_null(pc.cast(arr, pa.string()), "").to_pylist()  # type: ignore[no-any-return]
-    seq = values.tolist() if _is_array(values) else values
+    seq = _plain(values)
     return ["" if v is None or (isinstance(v, float) and not math.isfinite(v)) else
             repr(v) if isinstance(v, float) else str(v) for v in seq]
 
 
 def _is_array(values: Any) -> bool:
     return hasattr(values, "dtype") and hasattr(values, "tolist")
+
+
+def _plain(values: Any) -> list[Any]:
+    """The values as Python objects: an array's ``tolist``; in a list, numpy scalars (a
+    median, a ratio) as Python numbers (numpy 2's repr of one is ``np.float64(0.1)``, and
+    json cannot encode ``np.int64``)."""
+    if _is_array(values):
+        return values.tolist()  # type: ignore[no-any-return]
+    return [v.item() if _is_array(v) else v for v in values]
 
 
 _HAS_PYARROW: list[bool] = []
@@ -148,11 +163,11 @@ def _quote(text: str) -> str:
     return text
 
 
-def cell_texts(col: Column, values: Any) -> list[str]:
+def cell_texts(col: Column, values: Any, fast: bool = False) -> list[str]:
     """One column's cells as CSV text."""
     if col.kind == "number":
-        return number_texts(values)
-    seq = values.tolist() if _is_array(values) else list(values)
+        return number_texts(values, fast)
+    seq = _plain(values)
     if col.kind == "bool":
         return ["" if v is None else "true" if v else "false" for v in seq]
     if col.kind == "int":
@@ -161,7 +176,7 @@ def cell_texts(col: Column, values: Any) -> list[str]:
 
 
 def json_values(col: Column, values: Any) -> list[Any]:
-    seq = values.tolist() if _is_array(values) else list(values)
+    seq = _plain(values)
     if col.kind == "number":
         return [v if v is None or isinstance(v, int) or math.isfinite(v) else None for v in seq]
     if col.kind == "bool":
@@ -181,7 +196,8 @@ class Sink:
         self.tables = 0
         self.columns: tuple[Column, ...] = ()
 
-    def begin(self, name: str, columns: Sequence[Column]) -> None:
+    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
+        """A new table; ``rows``, when known, its number of rows."""
         self.name, self.columns, self.count = name, tuple(columns), 0
         self.tables += 1
 
@@ -194,6 +210,11 @@ class Sink:
     def close(self) -> None:
         return None
 
+    def abandon(self) -> None:
+        """Stop after a failure or an interrupt: release what is open, finish nothing (the
+        temporary file is removed)."""
+        return None
+
 
 class CsvSink(Sink):
     def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None,
@@ -201,8 +222,9 @@ class CsvSink(Sink):
         super().__init__(out, path, meta)
         self.several = several
 
-    def begin(self, name: str, columns: Sequence[Column]) -> None:
-        super().begin(name, columns)
+    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
+        super().begin(name, columns, rows)
+        self.fast = rows is not None and rows * len(self.columns) >= FAST_CELLS and _pyarrow()
         head = ("\n" if self.tables > 1 else "") + (f"# {name}\n" if self.several else "")
         self.out.write(head + ",".join(_quote(c.header) for c in self.columns) + "\n")  # type: ignore[union-attr]
 
@@ -210,7 +232,7 @@ class CsvSink(Sink):
         n = len(values[0]) if values else 0
         for a in range(0, n, SLICE):
             b = min(n, a + SLICE)
-            cells = [cell_texts(c, v[a:b]) for c, v in zip(self.columns, values)]
+            cells = [cell_texts(c, v[a:b], self.fast) for c, v in zip(self.columns, values)]
             self.out.write("\n".join(map(",".join, zip(*cells))) + "\n")  # type: ignore[union-attr]
         self.count += n
 
@@ -220,15 +242,19 @@ class JsonSink(Sink):
 
     def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
         super().__init__(out, path, meta)
+        import json
+
         from .export import clean
 
         head = json.dumps(clean(self.meta), indent=2, allow_nan=False)
         self.out.write(head[:-1].rstrip() + (",\n" if self.meta else "") + '  "tables": [')  # type: ignore[union-attr]
 
-    def begin(self, name: str, columns: Sequence[Column]) -> None:
-        super().begin(name, columns)
+    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
+        super().begin(name, columns, rows)
         spec = {"name": name, "columns": [c.name for c in self.columns],
                 "units": [c.unit for c in self.columns]}
+        import json
+
         text = json.dumps(spec, allow_nan=False)[:-1] + ', "rows": ['
         self.out.write(("," if self.tables > 1 else "") + "\n    " + text)  # type: ignore[union-attr]
 
@@ -237,6 +263,8 @@ class JsonSink(Sink):
         for a in range(0, n, SLICE):
             b = min(n, a + SLICE)
             cols = [json_values(c, v[a:b]) for c, v in zip(self.columns, values)]
+            import json
+
             text = ",".join("\n      " + json.dumps(r, allow_nan=False) for r in map(list, zip(*cols)))
             self.out.write(("," if self.count or a else "") + text)  # type: ignore[union-attr]
         self.count += n
@@ -257,18 +285,20 @@ class ParquetSink(Sink):
         self.paths = paths
         self.writer: Any = None
 
-    def begin(self, name: str, columns: Sequence[Column]) -> None:
+    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        super().begin(name, columns)
+        super().begin(name, columns, rows)
         types = {"number": pa.float64(), "int": pa.int64(), "bool": pa.bool_(), "text": pa.string()}
         fields = [pa.field(c.name, types[c.kind], metadata={"unit": c.unit} if c.unit else None)
                   for c in self.columns]
+        import json
+
         from .export import clean
 
         self.schema = pa.schema(fields, metadata={"linkage": json.dumps(clean({**self.meta, "table": name}))})
-        target = self.path if self.tables == 1 or self.paths is None else self.paths(name)
+        target = self.path if self.tables == 1 or self.paths is None else self.paths(safe_name(name))
         self.writer = pq.ParquetWriter(target, self.schema)
 
     def rows(self, values: Sequence[Any]) -> None:
@@ -291,6 +321,19 @@ class ParquetSink(Sink):
         self.writer = None
 
     def close(self) -> None:
+        if self.tables == 0 and self.path is not None:  # no table: still a parquet file
+            import json
+
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+
+            from .export import clean
+
+            schema = pa.schema([], metadata={"linkage": json.dumps(clean(self.meta))})
+            pq.ParquetWriter(self.path, schema).close()
+        self.abandon()
+
+    def abandon(self) -> None:
         if self.writer is not None:
             with contextlib.suppress(Exception):
                 self.writer.close()
@@ -308,10 +351,27 @@ class XlsxSink(Sink):
         self.book = Workbook(write_only=True)
         self.sheet: Any = None
 
-    def begin(self, name: str, columns: Sequence[Column]) -> None:
-        super().begin(name, columns)
-        self.sheet = self.book.create_sheet(title=name[:31] or f"table {self.tables}")
-        self.sheet.append([c.header for c in self.columns])
+    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
+        super().begin(name, columns, rows)
+        title = safe_name(name)[:31] or f"table {self.tables}"
+        used = {s.title for s in self.book.worksheets}
+        k = 1
+        while title in used:  # two names alike in their first 31 characters
+            k += 1
+            title = f"{safe_name(name)[:31 - len(str(k)) - 1]} {k}"
+        self.sheet = self.book.create_sheet(title=title)
+        self.sheet.append([self._cell(c.header) for c in self.columns])
+
+    def _cell(self, v: Any) -> Any:
+        """Text as text: openpyxl makes a string beginning with "=" a formula (a joint
+        named "=HYPERLINK(...)" in a mechanism file would be live in the workbook)."""
+        if not (isinstance(v, str) and v.startswith("=")):
+            return v
+        from openpyxl.cell import WriteOnlyCell
+
+        cell = WriteOnlyCell(self.sheet, value=v)
+        cell.data_type = "s"
+        return cell
 
     def rows(self, values: Sequence[Any]) -> None:
         n = len(values[0]) if values else 0
@@ -321,20 +381,46 @@ class XlsxSink(Sink):
         for a in range(0, n, SLICE):
             b = min(n, a + SLICE)
             cols = [json_values(c, v[a:b]) for c, v in zip(self.columns, values)]
+            text = [j for j, c in enumerate(self.columns) if c.kind == "text"]
             for r in zip(*cols):
+                if text:
+                    r = tuple(self._cell(v) if j in text else v for j, v in enumerate(r))
                 self.sheet.append(r)
         self.count += n
+
+    def abandon(self) -> None:
+        # each sheet's row stream closed here, not left to the garbage collector (which
+        # printed "Exception ignored" tracebacks after an interrupt)
+        for ws in self.book.worksheets:
+            with contextlib.suppress(Exception):
+                ws.close()
 
     def close(self) -> None:
         if self.sheet is None:
             self.book.create_sheet(title="empty")
-        self.book.save(self.path)
+        # saved in memory, then written: openpyxl saving straight to a full disk left its
+        # half-closed zip to the garbage collector, which printed tracebacks after the error
+        import io
+
+        buf = io.BytesIO()
+        self.book.save(buf)
+        with open(self.path, "wb") as fh:  # type: ignore[arg-type]
+            fh.write(buf.getbuffer())
+
+
+UNSAFE = frozenset('[]:*?/\\\0')
+"""Characters an xlsx sheet name or a file name cannot hold."""
+
+
+def safe_name(table: str) -> str:
+    """A table's name as a sheet and a sidecar file name: ``_`` for each unsafe character."""
+    return "".join("_" if c in UNSAFE else c for c in table)
 
 
 def _sidecar(path: str) -> Callable[[str], str]:
     def name(table: str) -> str:
         p = Path(path)
-        return str(p.with_name(f"{p.stem}.{table}{p.suffix}"))
+        return str(p.with_name(f"{p.stem}.{safe_name(table)}{p.suffix}"))
     return name
 
 
@@ -363,16 +449,35 @@ def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None,
                     sink.paths = lambda t: _extra_target(stack, output, t, extra)  # type: ignore[arg-type]
                 try:
                     yield sink
-                finally:
-                    sink.close()
+                except BaseException:
+                    sink.abandon()  # an interrupt stays an interrupt, and nothing is saved
+                    raise
+                sink.close()
+                _sync(tmp)
             else:
                 fh = stack.enter_context(open(tmp, "w", encoding="utf-8", newline=""))
                 sink = _make(kinds[fmt], fh, tmp, meta, several)
                 yield sink
                 sink.close()
+                fh.flush()
+                _sync(tmp)
     except OSError as exc:
         where = "standard output" if to_stdout else str(output)
         raise OutputError(f"cannot write to {where}: {exc.strerror or exc}") from None
+
+
+def _sync(path: str) -> None:
+    """On disk before the rename, as files.write_atomic does: a full disk is an error here,
+    not a truncated file after "wrote"."""
+    import os
+    import stat
+
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        if stat.S_ISREG(os.fstat(fd).st_mode):
+            os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def _extra_target(stack: contextlib.ExitStack, output: Path, table: str, made: list[str]) -> str:
@@ -403,8 +508,8 @@ def write_tables(sink: Sink, tables: Sequence[DataTable],
     """Every table into ``sink``; ``progress(rows written so far)`` after each block."""
     done = 0
     for t in tables:
-        sink.begin(t.name, t.columns)
         n = t.row_count
+        sink.begin(t.name, t.columns, n)
         step = PROGRESS_ROWS if progress is not None else max(n, 1)
         for a in range(0, n, step):
             whole = step >= n
@@ -426,6 +531,13 @@ def write(report: Report, fmt: str, output: Path | None, *,
         tables = [t for t in report.tables if t.columns]
         meta = report.document() if (fmt == "json" and report.document is not None) else \
             {"title": report.title} if fmt in ("json", "parquet") else {}
+        if not isinstance(meta, dict):  # the tables go under a key: the document must be an object
+            meta = {"title": report.title, "document": meta}
+        if fmt == "parquet" and not to_stdout:
+            # which files are this report's: a rerun with fewer tables leaves the last
+            # run's sidecars beside it (nothing is deleted by pattern)
+            files = [Path(str(output)).name] + [p.name for p in side_paths(output, report)]  # type: ignore[arg-type]
+            meta = {**meta, "files": dict(zip([t.name for t in tables], files))}
         with open_sink(fmt, output, meta, several=len(tables) > 1) as sink:
             write_tables(sink, tables, progress)
     else:

@@ -1,0 +1,77 @@
+"""linkage draw."""
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ..errors import InputError
+from .options import PICTURES, MechanismFile, SetOpt, check_paths, note_closed_form, parse_assignments
+from .progress import progress_bar
+from .root import app
+
+
+@app.command(
+    epilog="Examples:  linkage draw sample_inputs/rapier_drive.toml -o rapier.svg  |  "
+    "linkage draw sample_inputs/crank_rocker.toml --animate crank.gif --step 10",
+)
+def draw(
+    file: MechanismFile,
+    *,
+    output: Annotated[Optional[Path], typer.Option("--output", "-o", help="The drawing at the "
+                      "file's driver value (.png, .svg or .pdf).")] = None,
+    animate: Annotated[Optional[Path], typer.Option(help="A GIF of the mechanism over a sweep of "
+                       "its driver (--from, --to, --step).")] = None,
+    set_: SetOpt = None,
+    start: Annotated[float, typer.Option("--from", help="Animation: first driver value.")] = 0.0,
+    stop: Annotated[float, typer.Option("--to", help="Animation: last driver value.")] = 360.0,
+    step: Annotated[float, typer.Option(help="Animation: driver increment per frame.")] = 5.0,
+    fps: Annotated[Optional[float], typer.Option(help="Animation: frames per second (0.01 to 100; "
+                   "default 12).")] = None,
+) -> None:
+    """Draw a mechanism from its joint coordinates, links and joints labelled.
+
+    Example: linkage draw sample_inputs/fourbar_me581.toml --set theta2=80 -o fourbar.png
+    """
+    from ..arguments import check_fps
+    from ..kinematics.sweep import driver_values
+    from ..kinematics.sweep import sweep as run_sweep
+    from ..problems.loops import load
+    from ..solve import check_number, solve_system
+
+    if output is None and animate is None:
+        raise InputError("give -o PATH for a drawing, --animate PATH.gif for an animation, or both")
+    check_paths([file], [("--output", output), ("--animate", animate)],
+                {"--output": (output, PICTURES), "--animate": (animate, (".gif",))})
+    if fps is not None and animate is None:
+        raise InputError("--fps sets the speed of the --animate GIF: give --animate PATH.gif as well")
+    rate = check_fps("--fps", 12.0 if fps is None else fps)
+    mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
+    note_closed_form(mechanism)
+    if output is not None:
+        from ..render.plots import draw_mechanism
+
+        problem = mechanism.problem()
+        result = solve_system(problem, tol=1e-12, record=False)
+        if not result.converged:
+            typer.echo(f"error: cannot draw {file} at {problem.title}: {result.message}", err=True)
+            raise typer.Exit(1)
+        draw_mechanism(mechanism, result.x, output, problem.title)
+        typer.echo(f"wrote {output}", err=True)
+    if animate is not None:
+        from ..render.plots import animate_sweep, assembly_gaps, sweep_frames
+
+        a, b = check_number("--from", start), check_number("--to", stop)
+        if not check_number("--step", step) > 0 or b < a:
+            raise InputError("--step must be > 0 and --to must not be below --from")
+        values = driver_values(a, b, step, None)
+        if len(values) > 2000:
+            raise InputError(f"{len(values)} frames is too many for a GIF; use a larger --step")
+        s = run_sweep(mechanism, values)
+        frames = sweep_frames(mechanism, s)
+        if not frames:
+            typer.echo(f"error: no position of {file} between {a:g} and {b:g} could be solved", err=True)
+            raise typer.Exit(1)
+        with progress_bar(len(frames), minimum=1) as advance:
+            animate_sweep(mechanism, frames, animate, fps=rate, progress=advance, gaps=assembly_gaps(s))
+        typer.echo(f"wrote {animate} ({len(frames)} frames)", err=True)

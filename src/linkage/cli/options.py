@@ -1,0 +1,171 @@
+"""What every command shares: the options, the output format and writer, path checks,
+--set/--guess parsing and the closed-form notes."""
+
+import sys
+from pathlib import Path
+from typing import Annotated, Any, Optional
+
+import typer
+
+from ..errors import InputError
+from ..numbers import parse_number
+
+FormatOpt = Annotated[
+    Optional[str],
+    typer.Option("--format", "-f", help="table (rich, default on a terminal), plain (default "
+                 "when piped), csv, json, parquet or xlsx (these two to -o FILE), or any tabulate "
+                 "format (github, grid, latex, ...)."),
+]
+OutputOpt = Annotated[
+    Optional[Path],
+    typer.Option("--output", "-o", help="Write to this file instead of standard output; "
+                 "the format follows the suffix (.csv, .json, .parquet, .xlsx, .txt, .md, .tex, "
+                 ".html, .rst) unless --format is given."),
+]
+MechanismFile = Annotated[
+    Path, typer.Argument(metavar="FILE", help="A mechanism file (TOML, see `linkage samples`).",
+                         show_default=False)
+]
+SetOpt = Annotated[
+    Optional[list[str]],
+    typer.Option("--set", metavar="NAME=VALUE", help="Override a parameter or the driver, in "
+                 "the file's units (repeatable)."),
+]
+ColumnsOpt = Annotated[
+    Optional[str],
+    typer.Option("--columns", metavar="NAMES", help="Show only these columns, on screen and in "
+                 "every file: comma-separated names or their beginnings, e.g. theta3,theta4,det "
+                 "(the first column always stays)."),
+]
+def _digits(value: int) -> int:
+    """--digits: checked here, not by a click range, whose "<int range> [3<=x<=17]" label
+    widened every help page's type column until the help text wrapped at 23 characters."""
+    if not 3 <= value <= 17:
+        raise typer.BadParameter(f"{value} is not from 3 to 17")
+    return value
+
+
+DigitsOpt = Annotated[
+    int, typer.Option("--digits", metavar="N", callback=_digits,
+                      help="Significant digits printed in tables (3 to 17).")
+]
+
+
+SpeedOpt = Annotated[
+    Optional[str],
+    typer.Option("--speed", metavar="SPEED", help="Driver speed, for velocities and "
+                 "accelerations of every unknown, joint and point: a number in rad/s (or the "
+                 "file's length unit per second for a sliding driver), or with a unit: 600rpm, "
+                 "10rad/s, 90deg/s, 250mm/s. Every rate has an error bound: near a toggle or "
+                 "limit a rate is ill_conditioned (printed to the digits its bound leaves), at "
+                 "one undefined (no number)."),
+]
+AccelOpt = Annotated[
+    Optional[str],
+    typer.Option("--accel", metavar="ACCEL", help="Driver acceleration (with --speed; "
+                 "default 0): rad/s^2, or 5rad/s^2, 90deg/s^2, 100rpm/s, 20mm/s^2."),
+]
+
+def choose_format(fmt: str | None, output: Path | None) -> str:
+    """The run's format, by the one registry (render.writers): --format, else -o's suffix
+    (an unknown suffix refused, naming those that work), else table or plain."""
+    from ..render.writers import choose_format as choose
+
+    return choose(fmt, output)
+
+
+def emit_report(report: Any, fmt: str, output: Path | None, *, columns: str | None = None,
+                progress: Any = None) -> None:
+    """Write a command's report (render.data.Report) through the one writer registry;
+    ``columns`` (--columns) keeps only those columns."""
+    from ..render.writers import pick_columns, write
+
+    if columns:
+        report = pick_columns(report, columns)
+    write(report, fmt, output, progress=progress)
+
+
+def emit(fmt: str, output: Path | None, *, blocks: Any, json_obj: Any,
+         csv_table: tuple[Any, Any], columns: str | None = None) -> None:
+    """Write one command's output in the chosen format, to stdout or ``output``;
+    ``columns`` (comma-separated name prefixes) keeps only those table and CSV columns."""
+    from ..render.export import to_csv, to_json
+    from ..render.report import pick_columns, print_rich, render_text
+
+    if columns:
+        blocks, csv_table = pick_columns(blocks, csv_table, columns)
+
+    if fmt == "json":
+        text = to_json(json_obj)
+    elif fmt == "csv":
+        text = to_csv(*csv_table)
+    elif fmt == "table":
+        if output is None or str(output) == "-":
+            with stdout_errors():
+                print_rich(blocks)
+            return
+        text = render_text(blocks, "simple")
+    else:
+        text = render_text(blocks, fmt)
+    if output is None or str(output) == "-":
+        with stdout_errors():
+            sys.stdout.write(text)
+            sys.stdout.flush()
+        return
+    from ..files import write_atomic
+
+    write_atomic(output, text)
+    typer.echo(f"wrote {output}", err=True)
+
+
+class stdout_errors:
+    """A failed write to standard output (full disk, closed pipe) becomes one error line."""
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, kind: Any, exc: Any, tb: Any) -> bool:
+        if isinstance(exc, OSError):
+            from ..errors import OutputError
+
+            raise OutputError(f"cannot write to standard output: {exc.strerror or exc}") from None
+        return False
+
+
+PICTURES = (".png", ".svg", ".pdf")
+
+
+def check_paths(inputs: list[Path | None], outputs: list[tuple[str, Path | None]],
+                pictures: dict[str, tuple[Path | None, tuple[str, ...]]] | None = None) -> None:
+    """Every output path checked before any work: not an input, not shared, its folder
+    exists; pictures have a suffix the plotter can write."""
+    from ..files import check_outputs
+
+    for opt, (path, suffixes) in (pictures or {}).items():
+        if path is not None and path.suffix.lower() not in suffixes:
+            raise InputError(f"{opt} {path}: use one of {', '.join(suffixes)} for the picture")
+    check_outputs(inputs, outputs)
+
+
+def parse_assignments(option: str, items: list[str]) -> dict[str, float]:
+    out = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            raise InputError(f"{option} expects name=value, got {item!r}")
+        out[name.strip()] = parse_number(f"{option} {name.strip()}", value)
+    return out
+
+
+def note_closed_form(mechanism: Any) -> None:
+    """Once per command, a one-line note on standard error for a file that still says
+    ``closed_form = ...`` (read and checked, but derived from the loops now): kept here,
+    printed by :func:`run_cli` when the command ends."""
+    note = mechanism.closed_form_note
+    if note is not None and note not in NOTED:
+        NOTED.append(note)
+
+
+NOTED: list[str] = []
+"""The notes of this command, printed by :func:`run_cli` after its output (emptied as each
+command starts: tests run many commands in one process)."""

@@ -1,0 +1,144 @@
+"""linkage scan."""
+
+import contextlib
+import time
+from typing import Annotated, Optional
+
+import typer
+
+from ..errors import InputError
+from .options import (
+    ColumnsOpt,
+    DigitsOpt,
+    MechanismFile,
+    OutputOpt,
+    SetOpt,
+    check_paths,
+    note_closed_form,
+    parse_assignments,
+)
+from .progress import progress_bar
+from .root import app
+
+
+@app.command(
+    epilog="Examples:  linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60:9 --vary r3=80:160:9 "
+    "--where 'full_cycle and min_transmission_deg >= 40' --sort theta4_range --desc --top 10  |  "
+    "linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60 --vary r4=50:120 --samples 100000 "
+    "-o designs.parquet",
+)
+def scan(
+    file: MechanismFile,
+    *,
+    vary: Annotated[Optional[list[str]], typer.Option(
+        "--vary", metavar="NAME=LO:HI[:N]", help="A parameter to vary, in the file's units "
+        "(repeatable): N points from LO to HI (a grid of every combination), or LO:HI with "
+        "--samples.")] = None,
+    samples: Annotated[Optional[int], typer.Option(help="Draw this many random designs in the "
+                       "--vary ranges instead of a grid.")] = None,
+    sampling: Annotated[str, typer.Option(help="With --samples: lhs (Latin hypercube, default) "
+                        "or random.")] = "lhs",
+    seed: Annotated[int, typer.Option(help="With --samples: the random seed (same seed, same "
+                    "designs).")] = 0,
+    start: Annotated[Optional[float], typer.Option("--from", help="First driver value (default 0).")] = None,
+    stop: Annotated[Optional[float], typer.Option("--to", help="Last driver value (default 359).")] = None,
+    step: Annotated[float, typer.Option(help="Driver increment (default 1).", show_default=False)] = 1.0,
+    branch: Annotated[Optional[str], typer.Option(help="Assembly branch every design follows: "
+                      "open or crossed (mechanisms with a closed form); default: the branch of "
+                      "the file's guess.")] = None,
+    set_: SetOpt = None,
+    tol: Annotated[float, typer.Option(help="Step and residual tolerance per position.")] = 1e-12,
+    where: Annotated[Optional[str], typer.Option(metavar="TEST", help="Keep designs passing this "
+                     "test of their columns, e.g. \"full_cycle and min_transmission_deg >= 40\" "
+                     "(numbers, + - * / **, functions, comparisons, and, or, not).")] = None,
+    sort: Annotated[Optional[str], typer.Option(metavar="COLUMN", help="Order the kept designs "
+                    "by this column (ascending; NaN last).")] = None,
+    desc: Annotated[bool, typer.Option("--desc", help="With --sort: largest first.")] = False,
+    top: Annotated[Optional[int], typer.Option(metavar="K", help="Keep only the first K designs (after "
+                   "--where and --sort). A table shows 20 unless given.")] = None,
+    scheduler: Annotated[Optional[str], typer.Option(help="Where the chunks run: threads "
+                         "(default), processes, synchronous, or tcp://HOST:PORT (a "
+                         "dask.distributed scheduler).")] = None,
+    workers: Annotated[Optional[int], typer.Option(help="Local workers (default: one per "
+                       "core).")] = None,
+    chunk: Annotated[Optional[int], typer.Option(help="Designs per task (default: about "
+                     "200,000 positions per task).")] = None,
+    fmt: Annotated[Optional[str], typer.Option("--format", "-f", help="table (default on a "
+                   "terminal), plain, csv, json, parquet, xlsx or a tabulate format (github, "
+                   "latex, ...); -o FILE picks by suffix.")] = None,
+    output: OutputOpt = None,
+    digits: DigitsOpt = 6,
+    columns: ColumnsOpt = None,
+) -> None:
+    """Scan a range of designs: each over its whole cycle, one record per design.
+
+    Each record: the varied parameters, feasible_fraction (positions where an assembly
+    exists), solved_fraction (positions solved on the followed branch), full_cycle, every
+    unknown's _min, _max and _range, for four-bars grashof and min/max_transmission_deg
+    (folded into 0..90), and the x/y extents of each [points] path.
+
+    Example: linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60:5 --vary r4=60:120:7
+    """
+    from ..arguments import check_scan_options
+    from ..files import read_input
+    from ..kinematics.sweep import driver_values
+    from ..problems.loops import from_text
+    from ..render import writers
+    from ..render.scan import RecordSink, pick_spec, scan_meta, scan_report, scan_summary
+    from ..scan import MAX_DESIGNS, Keeper, ScanJob, check_held, feed, parse_vary, pick_chunk, prepare
+    from ..solve import check_criteria
+
+    if output is not None and str(output) == "-":
+        output = None
+    fmt = writers.choose_format(fmt, output)
+    check_paths([file], [("--output", output)])
+    check_criteria(tol, 0.0, None, 50)
+    check_scan_options(seed=seed, samples=samples, top=top, chunk=chunk, workers=workers,
+                       scheduler=scheduler, max_designs=MAX_DESIGNS, prefix="--")
+    if not vary:
+        raise InputError("give at least one --vary NAME=LO:HI[:N]")
+    varies = [parse_vary(v) for v in vary]
+    text = read_input(file)
+    fixed = parse_assignments("--set", set_ or [])
+    both = sorted({v.name for v in varies} & set(fixed))
+    if both:
+        raise InputError(f"{both[0]} is given by --set and by --vary; a scanned parameter takes its "
+                         "values from --vary only")
+    mechanism = from_text(text, str(file)).with_values(fixed, {})
+    note_closed_form(mechanism)
+    if mechanism.driver.kind != "angle" and (start is None or stop is None):
+        raise InputError(f"{mechanism.driver.name} is a length: give --from and --to")
+    a = 0.0 if start is None else start
+    b = 359.0 if stop is None else stop
+    if b < a:
+        raise InputError(f"--to ({b:g}) must not be below --from ({a:g})")
+    if desc and sort is None:
+        raise InputError("--desc orders by --sort: give --sort COLUMN")
+    setup = prepare(mechanism, varies, samples=samples, seed=seed, sampling=sampling,
+                    values=driver_values(a, b, step, None), branch=branch, tol=tol, where=where, sort=sort)
+    spec = pick_spec(setup.spec, columns) if columns else setup.spec
+    streamed = writers.is_data(fmt)
+    if sort is not None and streamed:
+        check_held(setup.plan.total, len(setup.spec), top, f"--sort {sort} with --format {fmt}")
+    job = ScanJob(text, str(file), tuple((k, float(v)) for k, v in fixed.items()), setup.plan.names,
+                  tuple(setup.values), setup.branch, tol)
+    size = pick_chunk(mechanism, len(setup.values), setup.branch, chunk, setup.plan.total)
+    meta = scan_meta(mechanism, str(file), setup, (a, b, step), where, sort, desc)
+    started = time.perf_counter()
+    with contextlib.ExitStack() as stack:
+        # a data format streams every record through the registry's sink (sorted: once, at
+        # the end); a display holds the rows it shows
+        sink = stack.enter_context(RecordSink(fmt, output, spec, meta)) if streamed else None
+        keeper = Keeper(sort, desc, top, sink if sort is None else None, show=None if streamed else 20)
+        advance = stack.enter_context(progress_bar(setup.plan.total, minimum=2 * size))
+        scanned = feed(keeper, job, setup, size, scheduler=scheduler, workers=workers, progress=advance)
+        held = keeper.result()
+        if sink is not None and sort is not None:
+            sink(held)
+    summary = scan_summary(mechanism, setup, (a, b, step), scanned, keeper, held,
+                           time.perf_counter() - started, shown=not streamed)
+    if sink is None:
+        writers.write(scan_report(held, spec, summary, digits, meta), fmt, output)
+    else:
+        typer.echo(f"{summary[0]}; wrote {sink.count:,} records" +
+                   (f" to {output}" if output is not None else ""), err=True)

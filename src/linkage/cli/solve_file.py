@@ -1,0 +1,64 @@
+"""linkage solve FILE: a mechanism's loop equations."""
+
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from ..errors import InputError
+from .options import emit_report, note_closed_form, parse_assignments
+
+
+def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: float, rtol: float,
+                ftol: float | None, max_iter: int, fd_step: float | None, damped: bool,
+                show_jacobian: bool, out_fmt: str, output: Path | None, digits: int,
+                plot: Path | None = None, motion: tuple[str | None, str | None] = (None, None),
+                branch_wanted: str | None = None, columns: str | None = None) -> None:
+    import dataclasses
+
+    from ..analysis.convergence import analyze
+    from ..arguments import parse_motion
+    from ..problems.closed_form import fourbar_facts
+    from ..problems.loops import load
+    from ..problems.start import start_on_branch
+    from ..render.system import branch_label, system_report
+    from ..solve import SYSTEM_METHODS, solve_system
+
+    if method not in SYSTEM_METHODS:
+        raise InputError(f"unknown method {method!r} for a mechanism file; choose from "
+                         f"{', '.join(SYSTEM_METHODS)}")
+    mechanism = load(file).with_values(parse_assignments("--set", set_),
+                                       parse_assignments("--guess", guess))
+    note_closed_form(mechanism)
+    if branch_wanted is not None:
+        mechanism = start_on_branch(mechanism, branch_wanted, bool(guess))
+    speed, accel = parse_motion(*motion, mechanism)
+    problem = mechanism.problem()
+    # the header says which loops are closed-form and which coupled (solve_system copies meta)
+    problem = dataclasses.replace(problem, meta={**problem.meta, "closed_form": mechanism.derivation.summary})
+    result = solve_system(problem, method=method, tol=tol, rtol=rtol, ftol=ftol, max_iter=max_iter,
+                          fd_step=fd_step, damped=damped, show_jacobian=show_jacobian)
+    conv = analyze(result)
+    branch = branch_label(problem, result) if result.converged else None
+    fourbars = fourbar_facts(mechanism, result.x if result.converged else None)
+    rates = None
+    if result.converged:
+        from ..kinematics.rates import position_rates
+
+        rates = position_rates(mechanism.model, result.x, mechanism.driver.value, speed, accel)
+    report = system_report(problem, result, conv, digits, branch, fourbars, rates,
+                           (speed, accel) if speed is not None else None, mechanism.driver.kind)
+    emit_report(report, out_fmt, output, columns=columns)
+    if plot is not None:
+        convergence_plot([result], plot, report.title,
+                          ", ".join(sorted({problem.step_unit(i) for i in range(problem.n)} - {""})))
+    if not result.converged:
+        raise typer.Exit(1)
+
+
+def convergence_plot(results: list[Any], path: Path, title: str, unit: str = "") -> None:
+    from ..render.plots import convergence_plot as plot
+    from ..render.plots import error_series
+
+    plot(error_series(results), path, title, unit)
+    typer.echo(f"wrote {path}", err=True)

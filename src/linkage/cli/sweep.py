@@ -1,0 +1,188 @@
+"""linkage sweep."""
+
+from pathlib import Path
+from typing import Annotated, Any, Optional
+
+import typer
+
+from ..errors import InputError
+from .options import (
+    PICTURES,
+    AccelOpt,
+    ColumnsOpt,
+    DigitsOpt,
+    FormatOpt,
+    OutputOpt,
+    SetOpt,
+    SpeedOpt,
+    check_paths,
+    choose_format,
+    emit,
+    note_closed_form,
+    parse_assignments,
+)
+from .progress import progress_bar
+from .root import app
+
+
+@app.command(
+    epilog="Examples:  linkage sweep sample_inputs/fourbar_me581.toml --from 0 --to 359 --step 1  |  "
+    "linkage sweep sample_inputs/crank_rocker.toml --branch crossed --format csv -o cycle.csv",
+)
+def sweep(
+    file: Annotated[Optional[Path], typer.Argument(
+        metavar="[FILE]", help="A mechanism file (TOML, see sample_inputs/; - reads standard input); "
+        "without it, the four-bar input-output equation over alpha.", show_default=False)] = None,
+    *,
+    start: Annotated[Optional[float], typer.Option("--from", help="First driver value (driver's "
+                     "unit; default 0).")] = None,
+    stop: Annotated[Optional[float], typer.Option("--to", help="Last driver value (default 360).")] = None,
+    r1: Annotated[Optional[str], typer.Option("--r1", help="Without FILE: R1 (default 5/3).")] = None,
+    r2: Annotated[Optional[str], typer.Option("--r2", help="Without FILE: R2 (default 5/2).")] = None,
+    r3: Annotated[Optional[str], typer.Option("--r3", help="Without FILE: R3 (default 11/6).")] = None,
+    links: Annotated[Optional[tuple[str, str, str, str]], typer.Option(
+        metavar="A B C D", help="Without FILE: link lengths input, coupler, output, ground.")] = None,
+    step: Annotated[Optional[float], typer.Option(help="Driver increment (default 1).")] = None,
+    points: Annotated[Optional[int], typer.Option(help="Number of evenly spaced positions "
+                      "instead of --step.")] = None,
+    method: Annotated[str, typer.Option("--method", "-m", help="newton, newton-fd or lm.")] = "newton",
+    branch: Annotated[Optional[str], typer.Option(help="Assembly branch to follow (mechanisms "
+                      "whose loops have a closed form), by name or signs as in solve --branch: open, "
+                      "crossed, open/crossed for a six-bar, 'open (mirror)', +-; default: the "
+                      "branch of the file's guess.")] = None,
+    set_: SetOpt = None,
+    tol: Annotated[float, typer.Option(help="Step and residual tolerance per position.")] = 1e-12,
+    batch: Annotated[Optional[bool], typer.Option("--batch/--no-batch", help="Use the numpy "
+                     "batch engine (default: above 20,000 positions; newton only).")] = None,
+    plot: Annotated[Optional[Path], typer.Option(help="Also plot the outputs against the driver "
+                    "(.png, .svg or .pdf; needs matplotlib).")] = None,
+    path: Annotated[Optional[list[str]], typer.Option(
+        "--path", metavar="JOINT", help="With --plot: draw the path of this joint or named "
+        "point over the sweep instead (a coupler curve; repeatable).")] = None,
+    speed: SpeedOpt = None,
+    accel: AccelOpt = None,
+    fmt: FormatOpt = None,
+    output: OutputOpt = None,
+    digits: DigitsOpt = 10,
+    columns: ColumnsOpt = None,
+) -> None:
+    """Solve a mechanism over a range of its driver, each position from the previous one.
+
+    Reports every position (converged; no_solution where the linkage cannot be assembled;
+    off_branch where it can, but not on the followed branch), the branch, det J, a
+    four-bar's transmission angle, the feasible ranges and the limit/toggle positions
+    (with --speed, each unknown's rates too). Without FILE:
+    the four-bar input-output equation (solve's --r1/--r2/--r3/--links and --method) at
+    each alpha from --from to --to, each from the previous root.
+
+    Example: linkage sweep sample_inputs/rapier_drive.toml --step 5
+
+    Example: linkage sweep --from 10 --to 160 --step 30
+    """
+    from ..arguments import parse_motion
+    from ..kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
+    from ..problems.loops import load
+    from ..render.sweep import sweep_blocks, sweep_dict, sweep_headers, sweep_rows
+    from ..solve import SYSTEM_METHODS, check_criteria, check_number
+
+    out_fmt = choose_format(fmt, output)
+    check_paths([file], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})
+    check_criteria(tol, 0.0, None, 50)
+    a = check_number("--from", 0.0 if start is None else start)
+    b = check_number("--to", 360.0 if stop is None else stop)
+    equation_only = {"--r1": r1, "--r2": r2, "--r3": r3, "--links": links}
+    if file is None:
+        given = [k for k, v in {"--branch": branch, "--set": set_, "--batch": batch, "--path": path,
+                                "--speed": speed, "--accel": accel}.items() if v or v == ""]
+        if given:
+            raise InputError(f"{', '.join(given)} apply to a mechanism FILE")
+        sweep_equation(a, b, step, points, method, r1, r2, r3, links, tol, out_fmt, output, digits, plot)
+        return
+    given = [k for k, v in equation_only.items() if v is not None]
+    if given:
+        raise InputError(f"{', '.join(given)} belong to the four-bar equation (sweep without FILE)")
+    if step is not None and points is not None:
+        raise InputError("give --step or --points, not both")
+    if step is not None:
+        check_number("--step", step)
+    if b < a:
+        raise InputError(f"--to ({b:g}) must not be below --from ({a:g})")
+    if points is None and step is None:
+        step = 1.0
+    values = driver_values(a, b, step, points)
+    if method not in SYSTEM_METHODS:
+        raise InputError(f"unknown method {method!r}; choose from {', '.join(SYSTEM_METHODS)}")
+    mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
+    note_closed_form(mechanism)
+    w, a_ = parse_motion(speed, accel, mechanism)
+    if path:
+        if plot is None:
+            raise InputError("--path draws into the --plot file: give --plot PATH.png as well")
+        named = [j for loop in mechanism.loops for j in loop.joints if j] + list(mechanism.points)
+        for name in path:
+            if name not in named:
+                raise InputError(f"--path {name}: no joint or point of that name in {file} "
+                                 f"(named: {', '.join(dict.fromkeys(named)) or 'none'})")
+    if batch is None and len(values) <= BATCH_ABOVE:
+        # the numpy engines (closed form, batch) cost a fresh process numpy's import, more
+        # than the one-at-a-time sweep of this many positions (the cold-start target)
+        batch = False
+    with progress_bar(len(values)) as advance:
+        result = sweep_mechanism(mechanism, values, method=method, branch=branch, tol=tol, batch=batch,
+                                 progress=advance, speed=w, accel=a_,
+                                 joints=out_fmt in ("csv", "json") or bool(path))
+    emit(out_fmt, output, blocks=sweep_blocks(result, digits), json_obj=sweep_dict(result),
+         columns=columns,
+         csv_table=(sweep_headers(result), sweep_rows(result)))
+    if plot is not None:
+        from ..arguments import motion_text
+        from ..render.plots import path_plot, sweep_plot
+
+        if path:
+            path_plot(result, mechanism, path, plot)
+        else:
+            sweep_plot(result, plot, motion_text(speed, accel, mechanism))
+        typer.echo(f"wrote {plot}", err=True)
+    if result.summary.get("failed"):
+        raise typer.Exit(1)
+
+
+def sweep_equation(a: float, b: float, step: float | None, points: int | None, method: str,
+                   r1: str | None, r2: str | None, r3: str | None, links: Any, tol: float, out_fmt: str,
+                   output: Path | None, digits: int, plot: Path | None) -> None:
+    """The four-bar input-output equation over alpha (seed 002's table): the options
+    checked here, the walk in :func:`linkage.kinematics.equation_sweep.equation_sweep`."""
+    from ..kinematics.equation_sweep import equation_sweep
+    from ..kinematics.sweep import driver_values
+    from ..methods import SCALAR_METHODS
+    from ..problems.seed_equation import fourbar_coefficients, scalar_problem
+    from ..render.report import Text, table
+
+    if method not in SCALAR_METHODS:
+        raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")
+    if plot is not None:
+        raise InputError("--plot draws mechanism sweeps; without FILE use --format csv")
+    if step is not None and points is not None:
+        raise InputError("give --step or --points, not both")
+    if b < a:
+        raise InputError(f"--to ({b:g}) must not be below --from ({a:g})")
+    values = driver_values(a, b, step if step is not None or points is not None else 1.0, points)
+    if len(values) > 100_000:
+        raise InputError(f"{len(values):,} values of alpha is more than 100,000; use a larger --step")
+    first = scalar_problem(None, None, values[0], r1, r2, r3, links)
+    coeffs = first.title  # "..., R1 = ..., R2 = ..., R3 = ..." for the table's heading
+    rs, _ = fourbar_coefficients(r1, r2, r3, links)
+    rows = equation_sweep(values, rs, method, tol)
+    headers = ("alpha (deg)", "status", "phi (deg)", "iterations", "f(phi)")
+    blocks: list[Any] = [
+        Text(f"four-bar input-output equation over alpha ({method}, each from the previous root): "
+             f"{coeffs.split(', ', 2)[2] if coeffs.count(', ') >= 2 else coeffs}", "bold"),
+        Text(""), table("", headers, rows, digits)]
+    json_obj = {"equation": "f(phi) = R1 cos(alpha) - R2 cos(phi) + R3 - cos(alpha - phi)",
+                "method": method, "tol": tol,
+                "positions": [dict(zip(("alpha", "status", "phi", "iterations", "residual"), r))
+                              for r in rows]}
+    emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=(headers, rows))
+    # as a mechanism sweep: where the linkage cannot be assembled is an answer, not a failure
+    if any(r[2] is None and r[1] != "no_solution" for r in rows):
+        raise typer.Exit(1)

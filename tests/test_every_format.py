@@ -1,0 +1,206 @@
+"""Every command's report in every format (issue 20, done-when 1 and 3).
+
+Each command runs once per data format (csv, json, parquet, xlsx) and the four files are
+read back against each other: the same tables, the same column names and units, the
+same numbers (CSV and JSON bit for bit, parquet bit for bit, xlsx to the 16 significant
+digits openpyxl writes). Display formats (plain, github, latex, rst) write a file that is
+not empty; LaTeX is a captioned table. An unknown suffix is refused by every command with
+one line and exit 2. Whether the numbers are right is other tests' business (they compare
+with closed forms, mpmath and PROBLEMS.md); here they must be the same everywhere.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import struct
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from linkage import bench as bench_module
+
+pq = pytest.importorskip("pyarrow.parquet")
+openpyxl = pytest.importorskip("openpyxl")
+
+SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
+
+COMMANDS: dict[str, list[str]] = {
+    "solve": ["solve"],
+    "solve-all": ["solve", "--method", "all"],
+    "solve-equation": ["solve", "--equation", "x**2 - 4*x + 1", "--x0", "5"],
+    "solve-file": ["solve", str(SAMPLES / "fourbar_me581.toml")],
+    "solve-file-rates": ["solve", str(SAMPLES / "fourbar_me581.toml"), "--speed", "600rpm", "--accel", "15"],
+    "sweep": ["sweep", str(SAMPLES / "crank_rocker.toml"), "--step", "30"],
+    "sweep-rates": ["sweep", str(SAMPLES / "rapier_drive.toml"), "--step", "45", "--speed", "10"],
+    "sweep-equation": ["sweep", "--step", "30"],
+    "scan": ["scan", str(SAMPLES / "crank_rocker.toml"), "--vary", "r2=30:40:3", "--step", "30"],
+    "samples": ["samples"],
+    "stress": ["stress", "--quick", "--method", "newton"],
+    "bench": ["bench", "--quick", "--no-cold", "--problem", "seed002", "--repeats", "1"],
+}
+OUTPUT_OPTION = {"samples": "--format"}  # the listing goes to standard output only
+
+
+@pytest.fixture
+def quick_bench(monkeypatch: pytest.MonkeyPatch) -> None:
+    """bench's measurements stubbed with fixed figures: the writers are under test, and a
+    timing differs from run to run."""
+    m = bench_module.Measurement
+    fixed = [m("seed002", "linkage newton", 1e-12, 2.5e-5, (2.25e-5, 3e-5), 1e-16, 5, 6),
+             m("seed002", "scipy brentq", 1e-12, 1e-4, (0.9e-4, 1.1e-4), 0.0, None, 9)]
+    monkeypatch.setattr(bench_module, "measure", lambda *a, **k: fixed)
+    monkeypatch.setattr(bench_module, "sweep_times", lambda *a, **k: {"a sweep": 0.25, "another": 0.5})
+    # solve --method all times each method: its "time per solve" column, too
+    monkeypatch.setattr(bench_module, "time_per_solve", lambda *a, **k: 2.5e-5)
+
+
+def run(cli: Any, tmp_path: Path, name: str, fmt: str) -> Path:
+    path = tmp_path / f"{name}.{fmt}"
+    if name in OUTPUT_OPTION:
+        if fmt in ("parquet", "xlsx"):
+            r = cli(*COMMANDS[name], "--format", fmt)
+            assert r.code == 2 and "binary" in r.err, r.err
+            pytest.skip("a listing to standard output: no binary format")
+        r = cli(*COMMANDS[name], "--format", fmt)
+        assert r.code == 0, r.err
+        path.write_text(r.out)
+        return path
+    r = cli(*COMMANDS[name], "-o", str(path))
+    assert r.code in (0, 1), r.err
+    assert path.exists()
+    return path
+
+
+def bits(v: float) -> int:
+    return struct.unpack("<q", struct.pack("<d", v))[0]
+
+
+def same_number(a: Any, b: Any) -> bool:
+    if a is None or b is None:
+        return a is None and b is None
+    return bits(float(a)) == bits(float(b))
+
+
+def csv_tables(text: str) -> list[tuple[str | None, list[list[str]]]]:
+    out = []
+    for part in text.split("\n\n"):
+        lines = part.strip("\n").split("\n")
+        name = lines[0][2:] if lines[0].startswith("# ") else None
+        body = lines[1:] if name is not None else lines
+        out.append((name, list(csv.reader(io.StringIO("\n".join(body))))))
+    return out
+
+
+def header(name: str, unit: str) -> str:
+    return f"{name} ({unit})" if unit else name
+
+
+@pytest.mark.usefixtures("quick_bench")
+@pytest.mark.parametrize("name", list(COMMANDS))
+def test_every_data_format_reads_back_the_same(cli: Any, tmp_path: Path, name: str) -> None:
+    doc = json.loads(run(cli, tmp_path, name, "json").read_text())
+    tables = doc["tables"]
+    assert tables, "a report without tables"
+    for t in tables:
+        assert len(t["columns"]) == len(t["units"]) and all(isinstance(u, str) for u in t["units"])
+
+    # CSV: the same tables, headers "name (unit)", numbers bit for bit
+    found = csv_tables(run(cli, tmp_path, name, "csv").read_text())
+    assert len(found) == len(tables)
+    for (title, rows), t in zip(found, tables):
+        assert title == (t["name"] if len(tables) > 1 else None)
+        assert rows[0] == [header(c, u) for c, u in zip(t["columns"], t["units"])]
+        assert len(rows) - 1 == len(t["rows"])
+        for got, want in zip(rows[1:], t["rows"]):
+            for g, w in zip(got, want):
+                if isinstance(w, bool):
+                    assert g == ("true" if w else "false")
+                elif isinstance(w, (int, float)):
+                    assert same_number(float(g), w), (g, w)
+                elif w is None:
+                    assert g == ""
+                else:
+                    assert g == w
+
+    if name in OUTPUT_OPTION:
+        return
+    # parquet: one file per table, units in the fields' metadata, numbers bit for bit
+    path = run(cli, tmp_path, name, "parquet")
+    for k, t in enumerate(tables):
+        p = path if k == 0 else path.with_name(f"{path.stem}.{t['name']}.parquet")
+        table = pq.read_table(p)
+        assert table.column_names == t["columns"]
+        for c, u in zip(t["columns"], t["units"]):
+            meta = table.schema.field(c).metadata
+            assert (meta or {}).get(b"unit", b"").decode() == u
+        for j, c in enumerate(t["columns"]):
+            got = table.column(c).to_pylist()
+            want = [r[j] for r in t["rows"]]
+            for g, w in zip(got, want):
+                if isinstance(w, float) or (isinstance(g, float) and isinstance(w, int)):
+                    assert same_number(g, w), (c, g, w)
+                else:
+                    assert g == w, (c, g, w)
+
+    # xlsx: a sheet per table, units in the header row, numbers as numbers
+    book = openpyxl.load_workbook(run(cli, tmp_path, name, "xlsx"))
+    assert book.sheetnames == [t["name"][:31] for t in tables]
+    for sheet, t in zip(book.worksheets, tables):
+        rows = list(sheet.iter_rows(values_only=True))
+        assert list(rows[0]) == [header(c, u) for c, u in zip(t["columns"], t["units"])]
+        for got, want in zip(rows[1:], t["rows"]):
+            for g, w in zip(got, want):
+                if isinstance(w, float) and not isinstance(w, bool):
+                    assert isinstance(g, (int, float)) and abs(g - w) <= 6e-16 * abs(w), (g, w)
+                elif w is None or w == "":
+                    assert g in (None, "")
+                else:
+                    assert g == w, (g, w)
+
+
+@pytest.mark.usefixtures("quick_bench")
+@pytest.mark.parametrize("name", ["solve", "solve-file-rates", "sweep", "scan", "samples", "stress"])
+@pytest.mark.parametrize("fmt", ["plain", "github", "latex", "rst"])
+def test_every_display_format_writes(cli: Any, tmp_path: Path, name: str, fmt: str) -> None:
+    if name in OUTPUT_OPTION:
+        r = cli(*COMMANDS[name], "--format", fmt)
+        text = r.out
+    else:
+        path = tmp_path / "out.txt"
+        r = cli(*COMMANDS[name], "--format", fmt, "-o", str(path))
+        text = path.read_text()
+    assert r.code in (0, 1), r.err
+    assert text.strip()
+    if fmt == "latex" and name != "samples":  # the listing is lines: LaTeX comments
+        assert "\\begin{table}" in text and "\\caption{" in text and "\\end{table}" in text
+
+
+@pytest.mark.parametrize("name", [*COMMANDS, "draw"])
+def test_an_unknown_suffix_is_refused(cli: Any, tmp_path: Path, name: str) -> None:
+    args = ["draw", str(SAMPLES / "crank_rocker.toml")] if name == "draw" else COMMANDS[name]
+    if name == "samples":
+        args = ["samples", "crank_rocker"]
+    r = cli(*args, "-o", str(tmp_path / "x.mat"))
+    assert r.code == 2
+    assert r.err.count("\n") == 1 and r.err.startswith("error: ") and ".mat" in r.err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_solve_csv_carries_the_rates(cli: Any, tmp_path: Path) -> None:
+    """solve FILE --speed -o f.csv: the velocities and accelerations JSON has, bit for bit."""
+    doc = json.loads(run(cli, tmp_path, "solve-file-rates", "json").read_text())
+    text = run(cli, tmp_path, "solve-file-rates", "csv").read_text()
+    cells = {c for _, rows in csv_tables(text) for r in rows[1:] for c in r}
+    for value in [*doc["velocities"].values(), *doc["accelerations"].values()]:
+        assert any(c and same_number(float(c), value) for c in cells if _is_number(c)), value
+
+
+def _is_number(text: str) -> bool:
+    try:
+        return math.isfinite(float(text))
+    except ValueError:
+        return False
