@@ -15,11 +15,12 @@ class progress_bar:
     def __enter__(self) -> Any:
         if self.total < self.minimum or not sys.stderr.isatty():
             return None
-        from rich.progress import Progress
+        from rich.progress import Progress, TimeRemainingColumn
 
-        self.bar = Progress(transient=True)
+        # transient: gone when the run ends (a sweep ends it once its file is complete)
+        self.bar = Progress(*Progress.get_default_columns()[:-1], TimeRemainingColumn(), transient=True)
         self.bar.start()
-        task = self.bar.add_task("solving", total=self.total)
+        task = self.bar.add_task("working", total=self.total)
         return lambda done: self.bar.update(task, completed=done)
 
     def __exit__(self, *exc: object) -> None:

@@ -17,7 +17,7 @@ from .options import (
     SpeedOpt,
     check_paths,
     choose_format,
-    emit,
+    emit_report,
     note_closed_form,
     parse_assignments,
 )
@@ -82,7 +82,8 @@ def sweep(
     from ..arguments import parse_motion
     from ..kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
     from ..problems.loops import load
-    from ..render.sweep import sweep_blocks, sweep_dict, sweep_headers, sweep_rows
+    from ..render.sweep import sweep_report
+    from ..render.writers import is_data
     from ..solve import SYSTEM_METHODS, check_criteria, check_number
 
     out_fmt = choose_format(fmt, output)
@@ -127,13 +128,18 @@ def sweep(
         # the numpy engines (closed form, batch) cost a fresh process numpy's import, more
         # than the one-at-a-time sweep of this many positions (the cold-start target)
         batch = False
-    with progress_bar(len(values)) as advance:
+    n = len(values)
+    data = is_data(out_fmt)
+    # one bar for solving and writing (n positions each), on screen until the file is complete
+    with progress_bar(2 * n if data else n, minimum=4000 if data else 2000) as advance:
         result = sweep_mechanism(mechanism, values, method=method, branch=branch, tol=tol, batch=batch,
-                                 progress=advance, speed=w, accel=a_,
-                                 joints=out_fmt in ("csv", "json") or bool(path))
-    emit(out_fmt, output, blocks=sweep_blocks(result, digits), json_obj=sweep_dict(result),
-         columns=columns,
-         csv_table=(sweep_headers(result), sweep_rows(result)))
+                                 progress=advance, speed=w, accel=a_, joints=data or bool(path))
+        named = any(j for loop in mechanism.loops for j in loop.joints) or bool(mechanism.points)
+        note = "" if data or not named else \
+            "joints and points (x, y): with --format csv, json, parquet or xlsx"
+        report = sweep_report(result, digits, joints_note=note)
+        emit_report(report, out_fmt, output, columns=columns,
+                    progress=None if advance is None else (lambda rows: advance(n + rows)))
     if plot is not None:
         from ..arguments import motion_text
         from ..render.plots import path_plot, sweep_plot
@@ -156,7 +162,7 @@ def sweep_equation(a: float, b: float, step: float | None, points: int | None, m
     from ..kinematics.sweep import driver_values
     from ..methods import SCALAR_METHODS
     from ..problems.seed_equation import fourbar_coefficients, scalar_problem
-    from ..render.report import Text, table
+    from ..render.sweep import equation_report
 
     if method not in SCALAR_METHODS:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")
@@ -173,16 +179,8 @@ def sweep_equation(a: float, b: float, step: float | None, points: int | None, m
     coeffs = first.title  # "..., R1 = ..., R2 = ..., R3 = ..." for the table's heading
     rs, _ = fourbar_coefficients(r1, r2, r3, links)
     rows = equation_sweep(values, rs, method, tol)
-    headers = ("alpha (deg)", "status", "phi (deg)", "iterations", "f(phi)")
-    blocks: list[Any] = [
-        Text(f"four-bar input-output equation over alpha ({method}, each from the previous root): "
-             f"{coeffs.split(', ', 2)[2] if coeffs.count(', ') >= 2 else coeffs}", "bold"),
-        Text(""), table("", headers, rows, digits)]
-    json_obj = {"equation": "f(phi) = R1 cos(alpha) - R2 cos(phi) + R3 - cos(alpha - phi)",
-                "method": method, "tol": tol,
-                "positions": [dict(zip(("alpha", "status", "phi", "iterations", "residual"), r))
-                              for r in rows]}
-    emit(out_fmt, output, blocks=blocks, json_obj=json_obj, csv_table=(headers, rows))
+    heading = coeffs.split(', ', 2)[2] if coeffs.count(', ') >= 2 else coeffs
+    emit_report(equation_report(rows, method, tol, heading, digits), out_fmt, output)
     # as a mechanism sweep: where the linkage cannot be assembled is an answer, not a failure
     if any(r[2] is None and r[1] != "no_solution" for r in rows):
         raise typer.Exit(1)
