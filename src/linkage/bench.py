@@ -598,3 +598,55 @@ def measurement_rows(results: Sequence[Any]) -> list[tuple[Any, ...]]:
     return [(m.problem, m.contender, m.tol, m.seconds * 1e6,
              m.spread[0] * 1e6, m.spread[1] * 1e6, m.error, m.iterations, m.nfev)
             for m in results]
+
+
+SWEEP_OUTPUT_POSITIONS = 360_001
+"""Issue 20's output targets: crank_rocker.toml over 0..360 step 0.001."""
+
+
+def sweep_output_targets(repeats: int = 3) -> list[tuple[str, str, float | None, bool | None]]:
+    """Issue 20's targets, measured in this run: ``linkage sweep crank_rocker.toml --step
+    0.001 --to 360 -o FILE`` in a fresh process (best of ``repeats``) against
+    ``linkage.sweep`` of the same 360,001 positions in this process plus an interpreter's
+    start (``python -c pass``): CSV within 2x, parquet within 1.5x (parquet: n/a without
+    pyarrow)."""
+    import os
+    import tempfile
+
+    from .kinematics.sweep import sweep_mechanism
+    from .problems.loops import load
+    from .samples import sample_path
+
+    path = str(sample_path("crank_rocker.toml"))
+    m = load(path)
+    values = [k * 0.001 for k in range(SWEEP_OUTPUT_POSITIONS)]
+
+    def best(run: Callable[[], Any]) -> float:
+        times = []
+        for _ in range(max(repeats, 1)):
+            t0 = time.perf_counter()
+            run()
+            times.append(time.perf_counter() - t0)
+        return min(times)
+
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    api = best(lambda: sweep_mechanism(m, values))
+    start = best(lambda: subprocess.run([sys.executable, "-c", "pass"], check=False, env=env))
+    rows: list[tuple[str, str, float | None, bool | None]] = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for suffix, bound in (("csv", 2.0), ("parquet", 1.5)):
+            if suffix == "parquet":
+                try:
+                    import pyarrow.parquet  # noqa: F401
+                except ImportError:
+                    rows.append((f"issue 20: sweep of 360,001 positions to {suffix} within {bound}x of "
+                                 "linkage.sweep + python start", "cli / api", None, None))
+                    continue
+            out = os.path.join(tmp, f"sweep.{suffix}")
+            cmd = [sys.executable, "-m", "linkage", "sweep", path, "--step", "0.001", "--to", "360",
+                   "-o", out]
+            cli = best(lambda c=cmd: subprocess.run(c, check=False, capture_output=True, env=env))
+            r = cli / (api + start)
+            rows.append((f"issue 20: sweep of 360,001 positions to {suffix} within {bound}x of "
+                         "linkage.sweep + python start", "cli / api", r, r <= bound))
+    return rows

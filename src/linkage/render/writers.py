@@ -230,11 +230,54 @@ class CsvSink(Sink):
 
     def rows(self, values: Sequence[Any]) -> None:
         n = len(values[0]) if values else 0
+        if self.fast and n >= SLICE:
+            for a in range(0, n, FAST_BLOCK):
+                text = _arrow_block(self.columns, [v[a:a + FAST_BLOCK] for v in values])
+                if text is None:
+                    break
+                self.out.write(text)  # type: ignore[union-attr]
+            else:
+                self.count += n
+                return
+            values = [v[a:] for v in values]  # the rest cell by cell
+            self.count += a
+            n -= a
         for a in range(0, n, SLICE):
             b = min(n, a + SLICE)
             cells = [cell_texts(c, v[a:b], self.fast) for c, v in zip(self.columns, values)]
             self.out.write("\n".join(map(",".join, zip(*cells))) + "\n")  # type: ignore[union-attr]
         self.count += n
+
+
+FAST_BLOCK = 16 * SLICE
+"""Rows a CSV block formats and joins in pyarrow at a time (:func:`_arrow_block`)."""
+
+
+def _arrow_block(columns: Sequence[Column], values: Sequence[Any]) -> str | None:
+    """A block of CSV rows formatted and joined by pyarrow: the same cells as
+    :func:`cell_texts` with pyarrow's numbers (tests check it), without a Python string
+    per cell; None (the caller goes cell by cell) for a column that is not a numpy
+    number or integer array or text that needs no quoting."""
+    import numpy as np
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    texts = []
+    for c, v in zip(columns, values):
+        if c.kind == "number" and _is_array(v) and v.dtype.kind == "f":
+            arr = pc.cast(pa.array(v, mask=~np.isfinite(v)), pa.string())
+        elif c.kind == "int" and _is_array(v) and v.dtype.kind in "iu":
+            arr = pc.cast(pa.array(v), pa.string())
+        elif c.kind == "text":
+            arr = pa.array(_plain(v), type=pa.string())
+            if pc.any(pc.match_substring_regex(arr, '[,"\n\r]')).as_py():
+                return None
+        else:
+            return None
+        texts.append(pc.fill_null(arr, ""))
+    lines = pc.binary_join_element_wise(*texts, ",")
+    body = pc.binary_join(pa.array([lines], type=pa.list_(pa.string())), "\n")[0].as_py()
+    return body + "\n" if len(lines) else ""
 
 
 class JsonSink(Sink):
