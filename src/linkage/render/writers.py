@@ -232,10 +232,15 @@ class CsvSink(Sink):
         n = len(values[0]) if values else 0
         if self.fast and n >= SLICE:
             for a in range(0, n, FAST_BLOCK):
-                text = _arrow_block(self.columns, [v[a:a + FAST_BLOCK] for v in values])
-                if text is None:
+                body = _arrow_block(self.columns, [v[a:a + FAST_BLOCK] for v in values])
+                if body is None:
                     break
-                self.out.write(text)  # type: ignore[union-attr]
+                if hasattr(self.out, "buffer"):  # a file: its bytes, no str of the block
+                    self.out.flush()  # type: ignore[union-attr]
+                    self.out.buffer.write(body)  # type: ignore[union-attr]
+                    self.out.buffer.write(b"\n")  # type: ignore[union-attr]
+                else:
+                    self.out.write(bytes(body).decode("utf-8") + "\n")  # type: ignore[union-attr]
             else:
                 self.count += n
                 return
@@ -253,31 +258,35 @@ FAST_BLOCK = 16 * SLICE
 """Rows a CSV block formats and joins in pyarrow at a time (:func:`_arrow_block`)."""
 
 
-def _arrow_block(columns: Sequence[Column], values: Sequence[Any]) -> str | None:
+def _arrow_block(columns: Sequence[Column], values: Sequence[Any]) -> Any:
     """A block of CSV rows formatted and joined by pyarrow: the same cells as
     :func:`cell_texts` with pyarrow's numbers (tests check it), without a Python string
-    per cell; None (the caller goes cell by cell) for a column that is not a numpy
-    number or integer array or text that needs no quoting."""
+    per cell, as a buffer of UTF-8 bytes; None (the caller goes cell by cell) for a column
+    that is not a numpy number or integer array or text that needs no quoting. The
+    columns' numbers are formatted on every core (pyarrow releases the GIL)."""
     import numpy as np
     import pyarrow as pa
     import pyarrow.compute as pc
 
-    texts = []
-    for c, v in zip(columns, values):
+    def text(c: Column, v: Any) -> Any:
         if c.kind == "number" and _is_array(v) and v.dtype.kind == "f":
-            arr = pc.cast(pa.array(v, mask=~np.isfinite(v)), pa.string())
-        elif c.kind == "int" and _is_array(v) and v.dtype.kind in "iu":
-            arr = pc.cast(pa.array(v), pa.string())
-        elif c.kind == "text":
-            arr = pa.array(_plain(v), type=pa.string())
-            if pc.any(pc.match_substring_regex(arr, '[,"\n\r]')).as_py():
-                return None
-        else:
-            return None
-        texts.append(pc.fill_null(arr, ""))
-    lines = pc.binary_join_element_wise(*texts, ",")
-    body = pc.binary_join(pa.array([lines], type=pa.list_(pa.string())), "\n")[0].as_py()
-    return body + "\n" if len(lines) else ""
+            return pc.cast(pa.array(v, mask=~np.isfinite(v)), pa.string())
+        if c.kind == "int" and _is_array(v) and v.dtype.kind in "iu":
+            return pc.cast(pa.array(v), pa.string())
+        if c.kind == "text":
+            arr = pa.array(v if _is_array(v) and v.dtype.kind == "O" else _plain(v), type=pa.string())
+            return None if pc.any(pc.match_substring_regex(arr, '[,"\n\r]')).as_py() else arr
+        return None
+
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor() as pool:
+        texts = list(pool.map(text, columns, values))
+    if any(t is None for t in texts):
+        return None
+    lines = pc.binary_join_element_wise(*[pc.fill_null(t, "") for t in texts], ",")
+    body = pc.binary_join(pa.array([lines], type=pa.list_(pa.string())), "\n")[0]
+    return memoryview(body.as_buffer()) if len(lines) else None
 
 
 class JsonSink(Sink):
