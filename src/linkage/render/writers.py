@@ -351,7 +351,11 @@ class ParquetSink(Sink):
 
         self.schema = pa.schema(fields, metadata={"linkage": json.dumps(clean({**self.meta, "table": name}))})
         target = self.path if self.tables == 1 or self.paths is None else self.paths(safe_name(name))
-        self.writer = pq.ParquetWriter(target, self.schema)
+        # a dictionary only for text (a status, a branch: few distinct words); tried on
+        # every column of doubles it costs 3x the write (0.40 s against 0.13 s for a
+        # 360,001-position sweep) and saves nothing, as the doubles rarely repeat
+        words = [c.name for c in self.columns if c.kind == "text"]
+        self.writer = pq.ParquetWriter(target, self.schema, use_dictionary=words or False)
 
     def rows(self, values: Sequence[Any]) -> None:
         import pyarrow as pa
