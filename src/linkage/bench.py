@@ -606,7 +606,7 @@ SWEEP_OUTPUT_POSITIONS = 360_001
 
 def sweep_output_targets(repeats: int = 3) -> list[tuple[str, str, float | None, bool | None]]:
     """Issue 20's targets, measured in this run: ``linkage sweep crank_rocker.toml --step
-    0.001 --to 360 -o FILE`` in a fresh process (best of ``repeats``) against
+    0.001 --to 360 -o FILE`` in a fresh process (the median of ``repeats``) against
     ``linkage.sweep`` of the same 360,001 positions in this process plus an interpreter's
     start (``python -c pass``): CSV within 2x, parquet within 1.5x (parquet: n/a without
     pyarrow)."""
@@ -621,13 +621,13 @@ def sweep_output_targets(repeats: int = 3) -> list[tuple[str, str, float | None,
     m = load(path)
     values = [k * 0.001 for k in range(SWEEP_OUTPUT_POSITIONS)]
 
-    def best(run: Callable[[], Any]) -> float:
+    def best(run: Callable[[], Any]) -> float:  # the median of the repeats, as every timing here
         times = []
         for _ in range(max(repeats, 1)):
             t0 = time.perf_counter()
             run()
             times.append(time.perf_counter() - t0)
-        return min(times)
+        return statistics.median(times)
 
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     api = best(lambda: sweep_mechanism(m, values))
