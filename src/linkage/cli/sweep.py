@@ -134,6 +134,8 @@ def sweep(
     with progress_bar(2 * n if data else n, minimum=4000 if data else 2000) as advance:
         result = sweep_mechanism(mechanism, values, method=method, branch=branch, tol=tol, batch=batch,
                                  progress=advance, speed=w, accel=a_, joints=data or bool(path))
+        if advance is not None and data:
+            advance(n, f"writing {out_fmt}")
         named = any(j for loop in mechanism.loops for j in loop.joints) or bool(mechanism.points)
         note = "" if data or not named else \
             "joints and points (x, y): with --format csv, json, parquet or xlsx"
