@@ -5,8 +5,6 @@ and the same units; the header keeps --digits; rounding noise prints as 0 on scr
 from __future__ import annotations
 
 import cmath
-import csv
-import io
 import json
 import math
 import struct
@@ -18,6 +16,7 @@ import pytest
 
 from linkage.render.data import split_header
 from linkage.render.report import NOISE_ULPS, denoise, is_noise
+from report_reading import csv_sections as sections
 
 SAMPLES = Path(__file__).resolve().parent.parent / "sample_inputs"
 ME581 = str(SAMPLES / "fourbar_me581.toml")
@@ -27,16 +26,6 @@ EPS = 2.220446049250313e-16
 
 def bits(values: list[float]) -> list[bytes]:
     return [struct.pack("<d", v) for v in values]
-
-
-def sections(text: str) -> dict[str, list[list[str]]]:
-    """A CSV of one table (no "# name" line) or of several (each under "# name")."""
-    out: dict[str, list[list[str]]] = {}
-    for part in text.split("\n\n"):
-        lines = part.strip("\n").split("\n")
-        name = lines[0][2:] if lines[0].startswith("# ") else "only"
-        out[name] = list(csv.reader(io.StringIO("\n".join(lines[1:] if name != "only" else lines))))
-    return out
 
 
 def by_name(rows: list[list[str]]) -> dict[str, dict[str, str]]:

@@ -4,8 +4,6 @@ works."""
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 import struct
@@ -18,6 +16,7 @@ from linkage.errors import InputError
 from linkage.render import writers
 from linkage.render.data import Column, DataTable, Report, split_header
 from linkage.render.report import Text, table
+from report_reading import csv_sections as read_csv_sections
 
 
 def awkward_numbers(n: int = 3000) -> np.ndarray:
@@ -49,15 +48,6 @@ def bits(values: list[float]) -> list[int]:
 
 def finite(x: np.ndarray) -> list[float | None]:
     return [float(v) if math.isfinite(v) else None for v in x.tolist()]
-
-
-def read_csv_sections(text: str) -> dict[str, list[list[str]]]:
-    out: dict[str, list[list[str]]] = {}
-    for part in text.split("\n\n"):
-        lines = part.strip("\n").split("\n")
-        name = lines[0][2:] if lines[0].startswith("# ") else "only"
-        out[name] = list(csv.reader(io.StringIO("\n".join(lines[1:] if name != "only" else lines))))
-    return out
 
 
 @pytest.mark.parametrize("fast", [False, True])  # Python's repr, and pyarrow's for a big table
