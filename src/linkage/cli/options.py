@@ -1,7 +1,6 @@
 """What every command shares: the options, the output format and writer, path checks,
 --set/--guess parsing and the closed-form notes."""
 
-import sys
 from pathlib import Path
 from typing import Annotated, Any, Optional
 
@@ -83,39 +82,6 @@ def emit_report(report: Any, fmt: str, output: Path | None, *, columns: str | No
     if columns:
         report = pick_columns(report, columns)
     write(report, fmt, output, progress=progress)
-
-
-def emit(fmt: str, output: Path | None, *, blocks: Any, json_obj: Any,
-         csv_table: tuple[Any, Any], columns: str | None = None) -> None:
-    """Write one command's output in the chosen format, to stdout or ``output``;
-    ``columns`` (comma-separated name prefixes) keeps only those table and CSV columns."""
-    from ..render.export import to_csv, to_json
-    from ..render.report import pick_columns, print_rich, render_text
-
-    if columns:
-        blocks, csv_table = pick_columns(blocks, csv_table, columns)
-
-    if fmt == "json":
-        text = to_json(json_obj)
-    elif fmt == "csv":
-        text = to_csv(*csv_table)
-    elif fmt == "table":
-        if output is None or str(output) == "-":
-            with stdout_errors():
-                print_rich(blocks)
-            return
-        text = render_text(blocks, "simple")
-    else:
-        text = render_text(blocks, fmt)
-    if output is None or str(output) == "-":
-        with stdout_errors():
-            sys.stdout.write(text)
-            sys.stdout.flush()
-        return
-    from ..files import write_atomic
-
-    write_atomic(output, text)
-    typer.echo(f"wrote {output}", err=True)
 
 
 class stdout_errors:

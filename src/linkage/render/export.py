@@ -1,10 +1,7 @@
-"""CSV and JSON writers. Full double precision: scripts and spreadsheets do their own rounding."""
+"""The JSON contract of a solve (result_dict) and JSON-safe values; files are written by render.writers."""
 
 from __future__ import annotations
 
-import io
-import math
-from collections.abc import Sequence
 from typing import Any
 
 from ..result import Result, finite_or_none
@@ -48,16 +45,3 @@ def to_json(obj: Any) -> str:
     import json
 
     return json.dumps(clean(obj), indent=2, allow_nan=False) + "\n"
-
-
-def to_csv(headers: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:
-    """A header row, then one row per record; empty cells for missing or non-finite values."""
-    import csv
-
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(headers)
-    for r in rows:
-        w.writerow(["" if v is None or (isinstance(v, float) and not math.isfinite(v))
-                    else repr(v) if isinstance(v, float) else v for v in r])
-    return buf.getvalue()
