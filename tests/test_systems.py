@@ -258,7 +258,8 @@ MALFORMED = {
 def malformed_text(case: str) -> str:
     text = Path(ME581).read_text()
     if case == "unknown unit":
-        return text.replace('r1 = { value = 90, unit = "cm" }', 'r1 = { value = 90, unit = "in" }')
+        # not "in": an inch is converted on read now
+        return text.replace('r1 = { value = 90, unit = "cm" }', 'r1 = { value = 90, unit = "furlong" }')
     if case == "unknown name in a loop":
         return text.replace('{ length = "r1", angle = "theta1", sign = -1 }',
                             '{ length = "r9", angle = "theta1", sign = -1 }')

@@ -50,6 +50,42 @@ ANGLE_UNITS = {"deg": math.pi / 180.0, "rad": 1.0}
 LENGTH_RANGE = (1e-100, 1e100)
 """Magnitudes a nonzero length may have: squares and products of two stay normal doubles."""
 
+LENGTH_UNITS = {"mm": 10, "cm": 100, "m": 10_000, "in": 254, "ft": 3048}
+"""Lengths a file may give in another of these units than its length_unit, converted on
+read: each in tenths of a millimetre, exactly (an inch is 25.4 mm by definition)."""
+
+
+def length_factor(unit: str, length_unit: str) -> float:
+    """The double nearest the exact ratio of two LENGTH_UNITS (in to mm: 25.4): a true
+    division of integers is correctly rounded."""
+    return LENGTH_UNITS[unit] / LENGTH_UNITS[length_unit]
+
+
+def accepted_units(length_unit: str) -> str:
+    lengths = [length_unit] + [u for u in LENGTH_UNITS if u != length_unit and length_unit in LENGTH_UNITS]
+    return ", ".join(["deg", "rad", *lengths])
+
+
+def kinds_by_use(doc: Mapping[str, Any]) -> dict[str, set[str]]:
+    """Each name a loop or point vector uses, with how: "length" or "angle" (a bare number
+    or a table without a unit takes the file's unit for its use)."""
+    out: dict[str, set[str]] = {}
+    vectors: list[Any] = []
+    for loop in doc.get("loops", []) if isinstance(doc.get("loops"), list) else []:
+        if isinstance(loop, Mapping) and isinstance(loop.get("vectors"), list):
+            vectors += loop["vectors"]
+    points = doc.get("points", {})
+    for p in points.values() if isinstance(points, Mapping) else []:
+        if isinstance(p, Mapping) and isinstance(p.get("vectors"), list):
+            vectors += p["vectors"]
+    for v in vectors:
+        if isinstance(v, Mapping):
+            for kind in ("length", "angle"):
+                if isinstance(v.get(kind), str):
+                    out.setdefault(v[kind], set()).add(kind)
+    return out
+
+
 ANGLE_LIMIT_DEG = 1e6
 """Largest |angle| in degrees: beyond it a degree has too few bits to follow a sweep."""
 
@@ -268,9 +304,13 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
     if closed_form is not None and closed_form not in ("fourbar", "slider_crank"):
         raise fail("closed_form", f"unknown closed form {closed_form!r} (fourbar or slider_crank)")
 
+    use = kinds_by_use(doc)
+
     def quantity(key: str, qname: str, spec: Any, field_name: str) -> Quantity:
+        if isinstance(spec, (int, float)) and not isinstance(spec, bool):
+            spec = {field_name: spec}  # a bare number: the file's unit for its kind (below)
         if not isinstance(spec, Mapping):
-            raise fail(key, f"expected a table like {{ {field_name} = 1.0, unit = \"deg\" }}")
+            raise fail(key, f"expected a number or a table like {{ {field_name} = 1.0, unit = \"deg\" }}")
         for k in spec:
             if k not in (field_name, "unit", "note", "signed"):
                 raise fail(f"{key}.{k}", f"unknown key (expected {field_name}, unit, signed)")
@@ -283,9 +323,19 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         if value is None:
             raise fail(f"{key}.{field_name}", f"must be a finite number, got {_short(spec[field_name])}")
         unit = spec.get("unit")
+        accepted = accepted_units(length_unit)
+        if unit is None:
+            kinds = use.get(qname, set())
+            if len(kinds) != 1:
+                how = ("is used as " + " and as ".join(sorted(kinds)) if kinds else "is in no loop")
+                raise fail(key, f"{qname} {how}, so its unit cannot be read from its use: give "
+                                f"unit = one of {accepted}")
+            unit = "deg" if kinds == {"angle"} else length_unit  # the file's unit for its kind
         if not isinstance(unit, str):
-            raise fail(f"{key}.unit", f"must be a unit name such as \"deg\" or {length_unit!r}, "
-                                      f"got {_short(unit)}")
+            raise fail(f"{key}.unit", f"must be one of {accepted}, got {_short(unit)}")
+        if unit != length_unit and unit in LENGTH_UNITS and length_unit in LENGTH_UNITS:
+            value *= length_factor(unit, length_unit)  # converted on read: the file's unit inside
+            unit = length_unit
         if unit in ANGLE_UNITS or unit == length_unit:
             kind = "angle" if unit in ANGLE_UNITS else "length"
             internal = value * ANGLE_UNITS[unit] if kind == "angle" else value
@@ -293,8 +343,7 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
             if why:
                 raise fail(f"{key}.{field_name}", why)
             return Quantity(qname, kind, internal, unit, signed if kind == "length" else False)
-        raise fail(f"{key}.unit", f"unit {unit!r} is neither an angle unit (deg, rad) nor the "
-                                  f"file's length_unit {length_unit!r}")
+        raise fail(f"{key}.unit", f"unknown unit {unit!r}: use one of {accepted}")
 
     params_doc = doc.get("parameters", {})
     if not isinstance(params_doc, Mapping):
