@@ -288,6 +288,11 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
     def fail(key: str, msg: str) -> ParseError:
         return ParseError(f"{source}: {key}: {msg}")
 
+    if "joints" in doc and "links" in doc and "loops" not in doc:
+        from .joints import loops_doc  # a drawing: its loops derived (problems/joints.py)
+
+        doc = loops_doc(doc, source)
+
     allowed = {"name", "description", "length_unit", "closed_form", "parameters", "driver",
                "unknowns", "loops", "notes", "points"}
     _check_printable(doc, fail)
