@@ -284,3 +284,44 @@ def _cycles(edges: list[tuple[str, str, str]], root: str) -> list[list[tuple[tup
             node = nxt
         cycles.append([(edges[k], True), *walk, *reversed(down)])
     return cycles
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(float(v)) if isinstance(v, float) else str(v)
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, Mapping):
+        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
+    raise TypeError(type(v).__name__)
+
+
+def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>") -> str:
+    """The derived loops-form file of a drawing, as TOML text: each loop under a comment
+    naming its joints, so the loop-closure equations the drawing implies can be read."""
+    d = loops_doc(doc, source)
+    out = [f"# the vector loops of {source}, derived from its joints and links (linkage convert)",
+           f"name = {_toml_value(d['name'])}"]
+    if d.get("description"):
+        out.append(f"description = {_toml_value(d['description'])}")
+    out += [f"length_unit = {_toml_value(d['length_unit'])}", "", "[parameters]  # the drawn lengths"]
+    out += [f"{k} = {_toml_value(v)}" for k, v in d["parameters"].items()]
+    out += ["", "[driver]"] + [f"{k} = {_toml_value(v)}" for k, v in d["driver"].items()]
+    out += ["", "[unknowns]  # each moving link's angle, guessed from the drawing"]
+    out += [f"{k} = {_toml_value(v)}" for k, v in d["unknowns"].items()]
+    for loop in d["loops"]:
+        names = loop["joints"]
+        out += ["", f"# {' -> '.join([*names, names[0]])}: the sum of these vectors is zero",
+                "[[loops]]", f"name = {_toml_value(loop['name'])}", f"joints = {_toml_value(names)}",
+                "vectors = ["]
+        out += [f"  {_toml_value(v)},  # {a} -> {b}"
+                for v, a, b in zip(loop["vectors"], names, [*names[1:], names[0]])]
+        out.append("]")
+    for name, p in d.get("points", {}).items():
+        out += ["", f"[points.{name}]  # on a link, nothing else attached",
+                f"from = {_toml_value(p['from'])}", f"vectors = {_toml_value(p['vectors'])}"]
+    return "\n".join(out) + "\n"
