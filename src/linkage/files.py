@@ -220,6 +220,7 @@ def atomic_target(path: Path) -> Iterator[str]:
         raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
     try:
         yield tmp
+        _sync(tmp)  # on disk before the rename: a full disk is an error here, not a truncated file
         mask = os.umask(0)
         os.umask(mask)
         os.chmod(tmp, 0o666 & ~mask)
@@ -232,6 +233,15 @@ def atomic_target(path: Path) -> Iterator[str]:
         raise
 
 
+def _sync(path: str) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        if stat.S_ISREG(os.fstat(fd).st_mode):
+            os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
 def _remove(path: str) -> None:
     with contextlib.suppress(OSError):
         os.unlink(path)
@@ -241,6 +251,3 @@ def write_atomic(path: Path, text: str) -> None:
     """Write ``text`` (UTF-8) to ``path`` completely or not at all."""
     with atomic_target(path) as tmp, open(tmp, "w", encoding="utf-8") as fh:
         fh.write(text)
-        fh.flush()
-        if stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
-            os.fsync(fh.fileno())

@@ -116,10 +116,10 @@ def sweep(
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
     note_closed_form(mechanism)
     w, a_ = parse_motion(speed, accel, mechanism)
+    named = [j for loop in mechanism.loops for j in loop.joints if j] + list(mechanism.points)
     if path:
         if plot is None:
             raise InputError("--path draws into the --plot file: give --plot PATH.png as well")
-        named = [j for loop in mechanism.loops for j in loop.joints if j] + list(mechanism.points)
         for name in path:
             if name not in named:
                 raise InputError(f"--path {name}: no joint or point of that name in {file} "
@@ -136,7 +136,6 @@ def sweep(
                                  progress=advance, speed=w, accel=a_, joints=data or bool(path))
         if advance is not None and data:
             advance(n, f"writing {out_fmt}")
-        named = any(j for loop in mechanism.loops for j in loop.joints) or bool(mechanism.points)
         note = "" if data or not named else \
             "joints and points (x, y): with --format csv, json, parquet or xlsx"
         report = sweep_report(result, digits, joints_note=note)

@@ -4,8 +4,8 @@ fixed angles inside it, the mobility (Gruebler-Kutzbach) and the independent loo
 cycle basis of the joint-link graph), and hands :func:`~.loops.parse_mechanism` the
 equivalent loops-form document, so everything downstream works unchanged.
 
-This is the core of issue 21, revolute joints only (sliders, ``convert`` and ``linkage
-new`` are to come). The shape of the file::
+This is the core of issue 21, revolute joints only (sliders, converting a loops file back
+to joints and ``linkage new`` are to come); :func:`loops_text` is ``linkage convert``. The shape of the file::
 
     name = "Norton four-bar"
     length_unit = "mm"
@@ -35,6 +35,7 @@ from collections.abc import Mapping
 from typing import Any, NamedTuple
 
 from ..errors import ParseError
+from .closed_form import wrap_degrees
 
 GROUND = "ground"
 DRIVER_TOLERANCE_DEG = 1e-6
@@ -47,10 +48,6 @@ def is_joints_doc(doc: Mapping[str, Any]) -> bool:
 
 def _angle_deg(p: tuple[float, float], q: tuple[float, float]) -> float:
     return math.degrees(math.atan2(q[1] - p[1], q[0] - p[0]))
-
-
-def _wrap(deg: float) -> float:
-    return (deg + 180.0) % 360.0 - 180.0
 
 
 def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, Any]:
@@ -71,7 +68,7 @@ def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, 
     value = drv.get("value", drawn)
     if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
         raise fail("driver.value", "must be a finite number of degrees")
-    if abs(_wrap(value - drawn)) > DRIVER_TOLERANCE_DEG:
+    if abs(wrap_degrees(value - drawn)) > DRIVER_TOLERANCE_DEG:
         raise fail("driver.value", f"{value:g} deg, but {dlink} is drawn at {drawn:.9g} deg "
                                    f"({links[dlink][0]} -> {links[dlink][1]})")
 
@@ -102,7 +99,7 @@ def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, 
                        f"joints {p} and {q} are drawn at one place")
         pname = b if q == bodies[b][1] else f"{b}_{p}_{q}"
         params[pname] = {"value": length, "unit": unit}
-        offset = _wrap(_angle_deg(xy[p], xy[q]) - base[b])
+        offset = wrap_degrees(_angle_deg(xy[p], xy[q]) - base[b])
         out: dict[str, Any] = {"length": pname, "sign": sign}
         if angle_of[b] is None:
             out["angle"] = _angle_deg(xy[p], xy[q])

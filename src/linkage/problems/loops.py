@@ -288,9 +288,9 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
     def fail(key: str, msg: str) -> ParseError:
         return ParseError(f"{source}: {key}: {msg}")
 
-    if "joints" in doc and "links" in doc and "loops" not in doc:
-        from .joints import loops_doc  # a drawing: its loops derived (problems/joints.py)
+    from .joints import is_joints_doc, loops_doc
 
+    if is_joints_doc(doc):  # a drawing: its loops derived (problems/joints.py)
         doc = loops_doc(doc, source)
 
     allowed = {"name", "description", "length_unit", "closed_form", "parameters", "driver",
@@ -310,6 +310,7 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         raise fail("closed_form", f"unknown closed form {closed_form!r} (fourbar or slider_crank)")
 
     use = kinds_by_use(doc)
+    accepted = accepted_units(length_unit)  # for the messages
 
     def quantity(key: str, qname: str, spec: Any, field_name: str) -> Quantity:
         if isinstance(spec, (int, float)) and not isinstance(spec, bool):
@@ -328,7 +329,6 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         if value is None:
             raise fail(f"{key}.{field_name}", f"must be a finite number, got {_short(spec[field_name])}")
         unit = spec.get("unit")
-        accepted = accepted_units(length_unit)
         if unit is None:
             kinds = use.get(qname, set())
             if len(kinds) != 1:

@@ -36,9 +36,10 @@ from .report import Block, Text, table
 
 BLOCK = 1000
 """Records handed to a text sink (csv, json, xlsx) at a time: its Python objects for a block
-(about 2 MB) are what such a format holds. Below writers' pyarrow threshold (1,024) on
-purpose: a number reads the same (Python's repr) whatever --chunk cut the scan into.
-Parquet takes a chunk at a time (a row group per chunk)."""
+(about 2 MB) are what such a format holds. A scan's CSV numbers are Python's repr
+throughout (a streamed table's size is not known when it begins, so the writers' pyarrow
+path, chosen per table by its size, is never taken). Parquet takes a chunk at a time (a row
+group per chunk)."""
 
 TABLE = "designs"
 """The name of the scan's one table (what a row is)."""

@@ -28,43 +28,16 @@ def det_unit_of(s: SweepResult) -> str:
     return f"{top}/rad" if n_angle == 1 else f"{top}/rad^{n_angle}"
 
 
-def joint_names(s: SweepResult) -> list[str]:
-    """Every joint and point named at any solved position, in the order first met."""
-    seen: dict[str, None] = {}
-    for p in s.positions:
-        if p.rates is not None:
-            seen.update(dict.fromkeys(p.rates.joints))
-            break
-    return list(seen)
-
-
-def sweep_headers(s: SweepResult, kinematics: bool = True) -> list[str]:
-    """Today's CSV headers of :func:`sweep_rows`, ``name (unit)`` (the report's columns'
-    headers, :func:`sweep_table`)."""
+def sweep_headers(s: SweepResult) -> list[str]:
+    """The display table's headers, ``name (unit)``: the driver, status, the unknowns,
+    branch, iterations, det J and the transmission angle (the rates are added beside)."""
     u = s.driver_unit
     headers = [f"{s.driver} ({u})", "status"]
     headers += [f"{n} ({unit})" for n, unit in zip(s.names, s.units)]
     headers += ["branch", "iterations", f"det J ({det_unit_of(s)})"]
     if s.classification:
         headers.append("transmission angle (deg)")
-    if kinematics:
-        headers += rate_headers(s.names, _kinds(s), s.length_unit, joint_names(s), s.motion is not None)
     return headers
-
-
-def sweep_rows(s: SweepResult, kinematics: bool = True) -> list[tuple[Any, ...]]:
-    rows = []
-    joints = joint_names(s) if kinematics else []
-    motion = s.motion is not None
-    for p in s.positions:
-        sol = p.solution or {}
-        row: list[Any] = [p.input, p.status, *[sol.get(n) for n in s.names], p.branch, p.iterations, p.det]
-        if s.classification:
-            row.append(p.transmission)
-        if kinematics:
-            row += rate_cells(p.rates, s.names, joints, motion)
-        rows.append(tuple(row))
-    return rows
 
 
 def sweep_table(s: SweepResult, cols: SweepColumns | None = None) -> DataTable:
@@ -128,9 +101,10 @@ def _extreme(values: Any, inputs: Any, low: bool) -> tuple[float, float]:
 
 
 def ranges_of(s: SweepResult, cols: SweepColumns | None = None) -> dict[str, dict[str, float]]:
-    """Per unknown: min and max over solved positions, where they occur (the first
-    driver value of equals), and the stroke (an angle's by the range rule of
-    kinematics.angles: a full turn at most, 360 for one that turns fully)."""
+    """Per unknown: min and max over solved positions, where they occur (the smallest
+    driver value of equal minima, the largest of equal maxima), and the stroke (an angle's
+    by the range rule of kinematics.angles: a full turn at most, 360 for one that turns
+    fully)."""
     c = sweep_columns(s) if cols is None else cols
     out = {}
     inputs = c.inputs
@@ -202,7 +176,7 @@ def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400,
         if len(s.classification.get("loops", ())) > 1:  # one column for several loops
             blocks.append(Text("transmission angle: at each position, of the four-bar loop "
                                "farthest from 90 deg"))
-    headers = sweep_headers(s, kinematics=False)
+    headers = sweep_headers(s)
     every = -(-n // max_rows)  # ceil: the fewest rows skipped that fit max_rows
     shown = range(n) if every <= 1 else range(0, n, every)
     # only the rows shown are read from the columns (a batch sweep builds no position)

@@ -498,49 +498,32 @@ def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None,
             from ..files import atomic_target
 
             tmp = stack.enter_context(atomic_target(output))  # type: ignore[arg-type]
-            extra: list[str] = []
             if fmt in ("parquet", "xlsx"):
                 sink = _make(kinds[fmt], None, tmp, meta, several)
                 if isinstance(sink, ParquetSink):
-                    sink.paths = lambda t: _extra_target(stack, output, t, extra)  # type: ignore[arg-type]
+                    sink.paths = lambda t: _extra_target(stack, output, t)  # type: ignore[arg-type]
                 try:
                     yield sink
                 except BaseException:
                     sink.abandon()  # an interrupt stays an interrupt, and nothing is saved
                     raise
                 sink.close()
-                _sync(tmp)
             else:
                 fh = stack.enter_context(open(tmp, "w", encoding="utf-8", newline=""))
                 sink = _make(kinds[fmt], fh, tmp, meta, several)
                 yield sink
                 sink.close()
                 fh.flush()
-                _sync(tmp)
     except OSError as exc:
         where = "standard output" if to_stdout else str(output)
         raise OutputError(f"cannot write to {where}: {exc.strerror or exc}") from None
 
 
-def _sync(path: str) -> None:
-    """On disk before the rename, as files.write_atomic does: a full disk is an error here,
-    not a truncated file after "wrote"."""
-    import os
-    import stat
-
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        if stat.S_ISREG(os.fstat(fd).st_mode):
-            os.fsync(fd)
-    finally:
-        os.close(fd)
-
-
-def _extra_target(stack: contextlib.ExitStack, output: Path, table: str, made: list[str]) -> str:
+def _extra_target(stack: contextlib.ExitStack, output: Path, table: str) -> str:
+    """A sidecar file's temporary path, renamed into place (synced) with the main file."""
     from ..files import atomic_target
 
     final = Path(_sidecar(str(output))(table))
-    made.append(str(final))
     return stack.enter_context(atomic_target(final))
 
 
@@ -583,16 +566,19 @@ def write(report: Report, fmt: str, output: Path | None, *,
     """Write ``report`` in ``fmt`` to ``output`` (None or "-": standard output);
     ``progress(rows written)`` as a data format's rows go out."""
     to_stdout = output is None or str(output) == "-"
+    sides: list[Path] = []  # a parquet report's sidecar files
     if is_data(fmt):
         tables = [t for t in report.tables if t.columns]
         meta = report.document() if (fmt == "json" and report.document is not None) else \
             {"title": report.title} if fmt in ("json", "parquet") else {}
         if not isinstance(meta, dict):  # the tables go under a key: the document must be an object
             meta = {"title": report.title, "document": meta}
-        if fmt == "parquet" and not to_stdout:
+        to_parquet_file = fmt == "parquet" and not to_stdout
+        sides = side_paths(output, report) if to_parquet_file else []  # type: ignore[arg-type]
+        if to_parquet_file:
             # which files are this report's: a rerun with fewer tables leaves the last
             # run's sidecars beside it (nothing is deleted by pattern)
-            files = [Path(str(output)).name] + [p.name for p in side_paths(output, report)]  # type: ignore[arg-type]
+            files = [Path(str(output)).name] + [p.name for p in sides]
             meta = {**meta, "files": dict(zip([t.name for t in tables], files))}
         with open_sink(fmt, output, meta, several=len(tables) > 1) as sink:
             write_tables(sink, tables, progress)
@@ -617,9 +603,7 @@ def write(report: Report, fmt: str, output: Path | None, *,
 
         write_atomic(output, text)  # type: ignore[arg-type]
     if not to_stdout:
-        made = [str(output)]
-        if fmt == "parquet":
-            made += [str(p) for p in side_paths(output, report)]  # type: ignore[arg-type]
+        made = [str(output)] + [str(p) for p in sides]
         print(f"wrote {', '.join(made)}", file=sys.stderr)
 
 
