@@ -33,7 +33,7 @@ def test_each_loop_is_under_a_comment_naming_its_joints(cli, tmp_path) -> None:
     path.write_text(me581_drawing())
     out = cli("convert", str(path)).out
     assert "# O2 -> A -> B -> O4 -> O2: the sum of these vectors is zero" in out
-    assert '{ length = "crank", sign = 1, angle = "theta_crank" },  # O2 -> A' in out
+    assert '{ length = "crank", angle = "theta_crank", sign = 1 },  # O2 -> A' in out
 
 
 def test_convert_refuses_what_it_cannot_do(cli, tmp_path) -> None:

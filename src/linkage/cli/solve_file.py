@@ -47,7 +47,8 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
 
         rates = position_rates(mechanism.model, result.x, mechanism.driver.value, speed, accel)
     report = system_report(problem, result, conv, digits, branch, fourbars, rates,
-                           (speed, accel) if speed is not None else None, mechanism.driver.kind)
+                           (speed, accel) if speed is not None else None, mechanism.driver.kind,
+                           origin=mechanism.origin)
     emit_report(report, out_fmt, output, columns=columns)
     if plot is not None:
         convergence_plot([result], plot, report.title,

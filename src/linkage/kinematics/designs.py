@@ -640,7 +640,8 @@ def _paths(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, q: 
     placed: dict[str, Any] = {}
     for loop in m.loops:
         names = loop.joints
-        p: Any = placed.get(names[0], 0j) if names and names[0] else 0j
+        start = complex(*m.origin)
+        p: Any = placed.get(names[0], start) if names and names[0] else start
         for name, t in zip(names or [""] * len(loop.vectors), loop.vectors):
             if name:
                 placed.setdefault(name, p)

@@ -16,7 +16,8 @@ vector whose length and angle both move (a slider on a rotating link). Where J i
 singular (a toggle or dead centre) the rates are undefined and the status says so.
 
 Joints are the start points of the loops' vectors that the file names (``joints``):
-the first loop starts at the origin, with x along the 0-degree direction; a later loop
+the first loop starts at the file's ``origin`` ((0, 0) unless it says; a drawing's is
+where its first ground joint is drawn), with x along the 0-degree direction; a later loop
 starts at its first joint if an earlier loop placed it (a six-bar's second loop at the
 rocker pivot), else at the origin too. A named point (``[points.P]``) starts at a joint
 and adds its own vectors. Their velocities and accelerations are the same sums,
@@ -467,7 +468,7 @@ def _place(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd
             ba += ca + EPS * abs(a) if unc is not None else 0.0
         return p, v, a, bv, ba
 
-    origin0 = (0j, 0j, 0j, 0.0, 0.0)
+    origin0 = (complex(*m.origin), 0j, 0j, 0.0, 0.0)
     for i, (loop, terms) in enumerate(zip(m.loops, model.terms)):
         names = loop.joints
         start = placed.get(names[0]) if names and names[0] else None
@@ -515,7 +516,7 @@ def place_np(model: LoopModel, q: Any, d: Any) -> dict[str, tuple[Any, Any]]:
         return x, y
 
     placed: dict[str, tuple[Any, Any]] = {}
-    origin0 = (zero, zero)
+    origin0 = (zero + model.mechanism.origin[0], zero + model.mechanism.origin[1])
     for loop, terms in zip(model.mechanism.loops, model.terms):
         names = loop.joints
         start = placed.get(names[0]) if names and names[0] else None

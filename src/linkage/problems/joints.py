@@ -1,31 +1,36 @@
-"""A mechanism from its drawing: joints with coordinates, links as lists of joints, a
-driver link. Derives what the loops form states by hand: each link's lengths and the
+"""A mechanism from its drawing: joints with coordinates, links as lists of joints,
+sliders, a driver. Derives what the loops form states by hand: each link's lengths and the
 fixed angles inside it, the mobility (Gruebler-Kutzbach) and the independent loops (a
 cycle basis of the joint-link graph), and hands :func:`~.loops.parse_mechanism` the
-equivalent loops-form document, so everything downstream works unchanged.
+equivalent loops-form document, so everything downstream works unchanged;
+:func:`loops_text` is ``linkage convert``. The shape of the file::
 
-This is the core of issue 21, revolute joints only (sliders, converting a loops file back
-to joints and ``linkage new`` are to come); :func:`loops_text` is ``linkage convert``. The shape of the file::
-
-    name = "Norton four-bar"
+    name = "Offset slider-crank"
     length_unit = "mm"
-    ground = ["O2", "O4"]          # fixed joints
+    ground = ["O2"]                # fixed joints
     [joints]                       # one pose, in length_unit
     O2 = [0, 0]
-    A  = [30.642, 25.712]
-    B  = [...]
-    O4 = [100, 0]
+    A  = [28.2842712474619, 28.2842712474619]
+    B  = [146.883113674145, 10]
+    P  = [...]                     # on the coupler, nothing else attached: a coupler point
     [links]
     crank   = ["O2", "A"]
-    coupler = ["A", "B", "P"]      # a ternary link; P, on nothing else, is a coupler point
-    rocker  = ["B", "O4"]
+    coupler = ["A", "B", "P"]      # a ternary link
+    block   = ["B"]                # a slider: a link that slides, carrying B
+    [sliders]                      # along a line fixed to `on`, through its first joint as
+    block = { on = "ground", angle = 0 }   # drawn, at `angle` (or line = [P, Q] of `on`)
     [driver]
-    link = "crank"                 # its angle at its first joint, degrees
-    value = 40                     # the drawn pose is at this value
+    link = "crank"                 # its angle at its first joint, degrees (or slider = NAME:
+    value = 45                     # its travel); the drawn pose is at this value
 
 Each link's angle is the angle of the line from its first joint to its second, as drawn
-and as it moves; its other joints are fixed in it by their drawn offsets. The driver
-value must be the driver link's drawn angle.
+and as it moves; its other joints are fixed in it by their drawn offsets. A slider turns
+with the body its line is on; its travel is measured along the line from the foot of the
+perpendicular from that body's first joint. The driver value must be the drawn one.
+Derived names (stable: scans and scripts use them): unknowns ``theta_<link>`` and
+``s_<slider>``; lengths ``<link>`` (first to second joint), ``<link>_<P>_<Q>``, ``ground``
+with its angle ``theta_ground`` (``ground_<P>_<Q>``, ``theta_ground_<P>_<Q>``), and each
+slider line's signed offset ``e_<slider>``.
 """
 
 from __future__ import annotations
@@ -40,6 +45,11 @@ from .closed_form import wrap_degrees
 GROUND = "ground"
 DRIVER_TOLERANCE_DEG = 1e-6
 """How far the drawn driver angle may be from [driver] value (the drawing's rounding)."""
+DRIVER_TOLERANCE_LENGTH = 1e-6
+"""The same for a slider's travel, relative to the drawing's size."""
+MAX_JOINTS = 1000
+"""Joints (and links) a drawing may have: far above any real mechanism, and small enough
+that the checks and the cycle basis stay instant on a hostile file."""
 
 
 def is_joints_doc(doc: Mapping[str, Any]) -> bool:
@@ -50,90 +60,12 @@ def _angle_deg(p: tuple[float, float], q: tuple[float, float]) -> float:
     return math.degrees(math.atan2(q[1] - p[1], q[0] - p[0]))
 
 
-def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, Any]:
-    """The loops-form document equivalent to a joints-form one (see the module)."""
-    def fail(key: str, msg: str) -> ParseError:
-        return ParseError(f"{source}: {key}: {msg}")
+class Slide(NamedTuple):
+    """A prismatic pair: a link sliding along a line fixed to ``on`` (the ground or a
+    link), through the slider's first joint as drawn, at ``angle_deg`` in the drawing."""
 
-    xy, ground, links, bodies, points = _read(doc, fail)
-
-    drv = doc.get("driver")
-    if not isinstance(drv, Mapping) or not isinstance(drv.get("link"), str) or drv["link"] not in links:
-        raise fail("driver", f"must name a link: [driver] link = one of {', '.join(links)}")
-    dlink = drv["link"]
-    if links[dlink][0] not in ground:
-        fixed = ", ".join(j for j in links[dlink] if j in ground) or "none of its joints is"
-        raise fail("driver.link", f"{dlink} must turn about a ground joint: list it first ({fixed} fixed)")
-    drawn = _angle_deg(xy[links[dlink][0]], xy[links[dlink][1]])
-    value = drv.get("value", drawn)
-    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
-        raise fail("driver.value", "must be a finite number of degrees")
-    if abs(wrap_degrees(value - drawn)) > DRIVER_TOLERANCE_DEG:
-        raise fail("driver.value", f"{value:g} deg, but {dlink} is drawn at {drawn:.9g} deg "
-                                   f"({links[dlink][0]} -> {links[dlink][1]})")
-
-    unit = doc.get("length_unit")
-    params: dict[str, Any] = {}
-    unknowns: dict[str, Any] = {}
-    angle_of: dict[str, Any] = {GROUND: None, dlink: f"theta_{dlink}"}
-    base = {b: _angle_deg(xy[js[0]], xy[js[1]]) for b, js in bodies.items()}
-    for b in links:
-        if b != dlink:
-            angle_of[b] = f"theta_{b}"
-            unknowns[f"theta_{b}"] = {"guess": base[b], "unit": "deg"}
-    if 2 * _loop_count(bodies, points) != len(unknowns):
-        raise fail("links", f"{_loop_count(bodies, points)} independent loop(s) give "
-                            f"{2 * _loop_count(bodies, points)} equations for {len(unknowns)} link angles")
-
-    # each body a star from its first joint: the edge to each other joint (points aside)
-    edges: list[tuple[str, str, str]] = []  # (body, from joint, to joint)
-    for b, js in bodies.items():
-        for j in js[1:]:
-            if j not in points:
-                edges.append((b, js[0], j))
-
-    def vector(b: str, p: str, q: str, sign: int) -> dict[str, Any]:
-        length = math.dist(xy[p], xy[q])
-        if not length > 0.0:
-            raise fail(f"links.{b}" if b != GROUND else "ground",
-                       f"joints {p} and {q} are drawn at one place")
-        pname = b if q == bodies[b][1] else f"{b}_{p}_{q}"
-        params[pname] = {"value": length, "unit": unit}
-        offset = wrap_degrees(_angle_deg(xy[p], xy[q]) - base[b])
-        out: dict[str, Any] = {"length": pname, "sign": sign}
-        if angle_of[b] is None:
-            out["angle"] = _angle_deg(xy[p], xy[q])
-        else:
-            out["angle"] = angle_of[b]
-            if offset:
-                out["offset"] = offset
-        return out
-
-    loops = []
-    for cycle in _cycles(edges, ground[0]):
-        # start at a fixed joint (the root if the loop has it): the joints are then placed
-        # as drawn, the first loop's first joint at the origin of the drawing's frame
-        starts = [p if fwd else q for (_, p, q), fwd in cycle]
-        first = next((k for k, j in enumerate(starts) if j == ground[0]),
-                     next((k for k, j in enumerate(starts) if j in ground), 0))
-        cycle = cycle[first:] + cycle[:first]
-        names, vecs = [], []
-        for (b, p, q), forward in cycle:
-            start = p if forward else q
-            names.append(start)
-            vecs.append(vector(b, p, q, 1 if forward else -1))
-        loops.append({"name": "-".join(names), "joints": names, "vectors": vecs})
-    pts = {}
-    for j, b in points.items():
-        pts[j] = {"from": bodies[b][0], "vectors": [vector(b, bodies[b][0], j, 1)]}
-    out = {"name": doc.get("name", "mechanism"), "length_unit": unit,
-           "description": doc.get("description", ""),
-           "parameters": params,
-           "driver": {"name": f"theta_{dlink}", "value": float(value), "unit": "deg"},
-           "unknowns": unknowns, "loops": loops}
-    if pts:
-        out["points"] = pts
-    return out
+    on: str
+    angle_deg: float
 
 
 class Drawing(NamedTuple):
@@ -144,18 +76,183 @@ class Drawing(NamedTuple):
     """The links and the ground (a body of its fixed joints)."""
     points: dict[str, str]
     """A joint on one moving link and nothing else (a point on it) -> that link."""
+    sliders: dict[str, Slide]
+    """Each sliding link and its line."""
+
+    def center(self, body: str) -> str:
+        """The joint a body's vectors start from: its first joint that is not a point."""
+        return next(j for j in self.bodies[body] if j not in self.points)
+
+
+def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, Any]:
+    """The loops-form document equivalent to a joints-form one (see the module)."""
+    def fail(key: str, msg: str) -> ParseError:
+        return ParseError(f"{source}: {key}: {msg}")
+
+    drawing = _read(doc, fail)
+    xy, ground, links, bodies, points, sliders = drawing
+    unit = doc.get("length_unit")
+    scale = max(math.dist(xy[ground[0]], p) for p in xy.values()) or 1.0
+    dname, value = _driver(doc, drawing, scale, fail)
+
+    # each body's frame: the angle its vectors turn with (an unknown, the driver, or None
+    # for the ground) and the drawn angle of that reference (a link's first two joints)
+    base = {b: _angle_deg(xy[js[0]], xy[js[1]]) for b, js in links.items() if len(js) > 1}
+    frame: dict[str, tuple[str | None, float]] = {GROUND: (None, 0.0)}
+    unknowns: dict[str, Any] = {}
+    for b in links:
+        if b not in sliders:
+            frame[b] = (f"theta_{b}", base[b])
+            if frame[b][0] != dname:
+                unknowns[f"theta_{b}"] = {"guess": base[b], "unit": "deg"}
+    for b, slide in sliders.items():
+        frame[b] = frame[slide.on]
+    slid: dict[str, tuple[float, float]] = {}  # a slider's drawn travel and offset
+    for b, slide in sliders.items():
+        (jx, jy), (px, py) = xy[drawing.center(slide.on)], xy[drawing.center(b)]
+        ux, uy = math.cos(math.radians(slide.angle_deg)), math.sin(math.radians(slide.angle_deg))
+        along, across = (px - jx) * ux + (py - jy) * uy, (py - jy) * ux - (px - jx) * uy
+        if abs(across) <= 4 * EPS * math.hypot(px - jx, py - jy):
+            across = 0.0  # the projection's rounding: the line passes through J0
+        slid[b] = (along, across)
+        if f"s_{b}" != dname:
+            unknowns[f"s_{b}"] = {"guess": along, "unit": unit}
+    loops_needed = _loop_count(drawing)
+    if 2 * loops_needed != len(unknowns):
+        raise fail("links", f"{loops_needed} independent loop(s) give {2 * loops_needed} equations "
+                            f"for {len(unknowns)} unknowns ({', '.join(unknowns)})")
+
+    params: dict[str, Any] = {}
+
+    def angle(b: str, drawn_deg: float) -> dict[str, Any]:
+        ref, b0 = frame[b]
+        if ref is None:
+            return {"angle": drawn_deg}
+        offset = wrap_degrees(drawn_deg - b0)
+        return {"angle": ref, "offset": offset} if offset else {"angle": ref}
+
+    def vector(b: str, p: str, q: str, sign: int) -> dict[str, Any]:
+        length = math.dist(xy[p], xy[q])
+        if not length > 0.0:
+            raise fail(f"links.{b}" if b != GROUND else "ground",
+                       f"joints {p} and {q} are drawn at one place")
+        first_two = len(bodies[b]) > 1 and (p, q) == (bodies[b][0], bodies[b][1])
+        pname = b if first_two else f"{b}_{p}_{q}"
+        params[pname] = {"value": length, "unit": unit}
+        if b == GROUND:  # a length and an angle parameter: a scan may move a ground joint
+            params[f"theta_{pname}"] = {"value": _angle_deg(xy[p], xy[q]), "unit": "deg"}
+            return {"length": pname, "angle": f"theta_{pname}", "sign": sign}
+        return {"length": pname, **angle(b, _angle_deg(xy[p], xy[q])), "sign": sign}
+
+    def slide_vectors(b: str, forward: bool) -> tuple[list[str], list[dict[str, Any]]]:
+        """A slider's edge J0 -> P: its offset across the line, then its travel along it."""
+        start, end = drawing.center(sliders[b].on), drawing.center(b)
+        line = sliders[b].angle_deg
+        params[f"e_{b}"] = {"value": slid[b][1], "unit": unit, "signed": True}
+        e = {"length": f"e_{b}", **angle(sliders[b].on, wrap_degrees(line + 90.0))}
+        s = {"length": f"s_{b}", **angle(sliders[b].on, line)}
+        if forward:
+            return [start, ""], [{**e, "sign": 1}, {**s, "sign": 1}]
+        return [end, ""], [{**s, "sign": -1}, {**e, "sign": -1}]
+
+    edges: list[tuple[str, str, str]] = []  # (body, from joint, to joint)
+    for b, js in bodies.items():
+        c = drawing.center(b)
+        edges += [(b, c, j) for j in js if j != c and j not in points]
+    edges += [(b, drawing.center(slide.on), drawing.center(b)) for b, slide in sliders.items()]
+
+    loops = []
+    for cycle in _placed_in_order(_cycles(edges, ground[0]), ground):
+        names, vecs = [], []
+        for (b, p, q), forward in cycle:
+            if b in sliders and (p, q) == (drawing.center(sliders[b].on), drawing.center(b)):
+                n, v = slide_vectors(b, forward)
+            else:
+                n, v = [p if forward else q], [vector(b, p, q, 1 if forward else -1)]
+            names += n
+            vecs += v
+        loops.append({"name": "-".join(n for n in names if n), "joints": names, "vectors": vecs})
+    pts = {}
+    for j, b in points.items():
+        pts[j] = {"from": drawing.center(b), "vectors": [vector(b, drawing.center(b), j, 1)]}
+    if dname.startswith("s_"):
+        drv = {"name": dname, "value": float(value), "unit": unit}
+    else:
+        drv = {"name": dname, "value": float(value), "unit": "deg"}
+    out = {"name": doc.get("name", "mechanism"), "length_unit": unit,
+           "description": doc.get("description", ""),
+           "origin": list(xy[ground[0]]),
+           "parameters": params, "driver": drv, "unknowns": unknowns, "loops": loops}
+    if pts:
+        out["points"] = pts
+    return out
+
+
+EPS = 2.220446049250313e-16
+
+
+def _driver(doc: Mapping[str, Any], d: Drawing, scale: float, fail: Any) -> tuple[str, float]:
+    """The driver's derived name and its value, checked against the drawing."""
+    drv = doc.get("driver")
+    if not isinstance(drv, Mapping):
+        raise fail("driver", "missing: [driver] link = NAME (an angle) or slider = NAME (a travel)")
+    for key in drv:
+        if key not in ("link", "slider", "value"):
+            raise fail(f"driver.{key}", "unknown key (expected link or slider, and value)")
+    if ("link" in drv) == ("slider" in drv):
+        raise fail("driver", "name one: link = NAME (its angle) or slider = NAME (its travel)")
+    value = drv.get("value")
+    if value is not None and (not isinstance(value, (int, float)) or isinstance(value, bool)
+                              or not math.isfinite(value)):
+        raise fail("driver.value", "must be a finite number (degrees for a link, the length "
+                                   "unit for a slider)")
+    if "slider" in drv:
+        s = drv["slider"]
+        if not isinstance(s, str) or s not in d.sliders:
+            raise fail("driver.slider", f"must name a slider (sliders: {', '.join(d.sliders) or 'none'})")
+        if d.sliders[s].on != GROUND:
+            raise fail("driver.slider", f"{s} slides on {d.sliders[s].on}: a driving slider runs on "
+                                        "the ground")
+        (jx, jy), (px, py) = d.xy[d.center(GROUND)], d.xy[d.center(s)]
+        t = math.radians(d.sliders[s].angle_deg)
+        drawn = (px - jx) * math.cos(t) + (py - jy) * math.sin(t)
+        value = drawn if value is None else float(value)
+        if abs(value - drawn) > DRIVER_TOLERANCE_LENGTH * scale:
+            raise fail("driver.value", f"{value:g}, but {s} is drawn at travel {drawn:.9g} (from "
+                                       f"the foot of {d.center(GROUND)} on its line)")
+        return f"s_{s}", value
+    link = drv["link"]
+    if not isinstance(link, str) or link not in d.links:
+        raise fail("driver.link", f"must name a link (links: {', '.join(d.links)})")
+    if link in d.sliders:
+        raise fail("driver.link", f"{link} slides: drive it by its travel, [driver] slider = \"{link}\"")
+    js = d.links[link]
+    if js[0] not in d.ground:
+        fixed = ", ".join(j for j in js if j in d.ground) or "none of its joints is"
+        raise fail("driver.link", f"{link} must turn about a ground joint: list it first ({fixed} fixed)")
+    drawn = _angle_deg(d.xy[js[0]], d.xy[js[1]])
+    value = drawn if value is None else float(value)
+    if abs(wrap_degrees(value - drawn)) > DRIVER_TOLERANCE_DEG:
+        raise fail("driver.value", f"{value:g} deg, but {link} is drawn at {drawn:.9g} deg "
+                                   f"({js[0]} -> {js[1]})")
+    return f"theta_{link}", value
 
 
 def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
-    """The drawing's joints, ground, links and points, checked: every name known and
-    used, the bodies connected, and the mobility 1."""
-    allowed = {"name", "description", "length_unit", "ground", "joints", "links", "driver", "notes"}
+    """The drawing's joints, ground, links, sliders and points, checked: every name known
+    and used, the bodies connected, and the mobility 1."""
+    allowed = {"name", "description", "length_unit", "ground", "joints", "links", "sliders",
+               "driver", "notes"}
     for key in doc:
         if key not in allowed:
             raise fail(key, f"unknown key in a joints file (expected one of {', '.join(sorted(allowed))})")
     joints_doc, links_doc = doc["joints"], doc["links"]
     if not isinstance(joints_doc, Mapping) or not joints_doc:
         raise fail("joints", "must be a table of joint = [x, y]")
+    for key, table in (("joints", joints_doc), ("links", links_doc)):
+        if isinstance(table, Mapping) and len(table) > MAX_JOINTS:
+            raise fail(key, f"{len(table):,} entries; at most {MAX_JOINTS:,} are accepted, far above "
+                            "any real mechanism")
     xy: dict[str, tuple[float, float]] = {}
     for name, p in joints_doc.items():
         if (not isinstance(p, list) or len(p) != 2 or
@@ -164,8 +261,8 @@ def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
             raise fail(f"joints.{name}", "must be [x, y]: two finite numbers in the file's length_unit")
         xy[str(name)] = (float(p[0]), float(p[1]))
     ground = doc.get("ground")
-    if not isinstance(ground, list) or len(ground) < 2 or not all(isinstance(g, str) for g in ground):
-        raise fail("ground", "must list at least two fixed joints, e.g. [\"O2\", \"O4\"]")
+    if not isinstance(ground, list) or not ground or not all(isinstance(g, str) for g in ground):
+        raise fail("ground", "must list the fixed joints, e.g. [\"O2\", \"O4\"]")
     for g in ground:
         if g not in xy:
             raise fail("ground", f"{g!r} is not a joint (joints: {', '.join(xy)})")
@@ -173,13 +270,19 @@ def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
         raise fail("ground", "names a joint twice")
     if not isinstance(links_doc, Mapping) or not links_doc:
         raise fail("links", "must be a table of link = [joints]")
+    sliders_doc = doc.get("sliders", {})
+    if not isinstance(sliders_doc, Mapping):
+        raise fail("sliders", "must be a table of link = { on = BODY, angle = DEG } or { on, line = [P, Q] }")
     links: dict[str, list[str]] = {}
     for name, js in links_doc.items():
         key = f"links.{name}"
         if name == GROUND:
             raise fail(key, "the ground is listed under ground = [...], not as a link")
-        if not isinstance(js, list) or len(js) < 2 or not all(isinstance(j, str) for j in js):
-            raise fail(key, "must list at least two joints, e.g. [\"O2\", \"A\"]")
+        least = 1 if name in sliders_doc else 2
+        if not isinstance(js, list) or len(js) < least or not all(isinstance(j, str) for j in js):
+            raise fail(key, "must list at least two joints, e.g. [\"O2\", \"A\"] (a slider, one)")
+        if len(js) > MAX_JOINTS:
+            raise fail(key, f"{len(js):,} joints; at most {MAX_JOINTS:,} are accepted")
         for j in js:
             if j not in xy:
                 raise fail(key, f"{j!r} is not a joint (joints: {', '.join(xy)})")
@@ -189,48 +292,129 @@ def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
             raise fail(key, "every joint of it is fixed: it is part of the ground")
         links[str(name)] = list(js)
     bodies = {GROUND: list(ground), **links}
-    at: dict[str, list[str]] = {j: [b for b, js in bodies.items() if j in js] for j in xy}
+    sliders = _sliders(sliders_doc, bodies, xy, fail)
+    at: dict[str, list[str]] = {j: [] for j in xy}
+    for b, js in bodies.items():
+        for j in js:
+            at[j].append(b)
     loose = [j for j, bs in at.items() if not bs]
     if loose:
         raise fail(f"joints.{loose[0]}", "is on no link")
 
-    # coupler points: a joint on one moving link and nothing else, drawn on it
-    points = {j: bs[0] for j, bs in at.items() if len(bs) == 1 and bs[0] != GROUND}
-    # mobility (Gruebler-Kutzbach): 3 (n - 1) - 2 j1, a joint shared by k bodies being k - 1 pairs
+    # coupler points: a joint on one moving link and nothing else, drawn on it (a slider's
+    # first joint is its pin on the line, never a point)
+    points = {j: bs[0] for j, bs in at.items()
+              if len(bs) == 1 and bs[0] != GROUND and not (bs[0] in sliders and bodies[bs[0]][0] == j)}
+    # mobility (Gruebler-Kutzbach): 3 (n - 1) - 2 j1, a joint shared by k bodies being k - 1
+    # revolute pairs, and each slider one prismatic pair
     n = len(bodies)
-    pairs = sum(len(bs) - 1 for bs in at.values())
+    revolute = sum(len(bs) - 1 for bs in at.values())
+    pairs = revolute + len(sliders)
     mobility = 3 * (n - 1) - 2 * pairs
     if mobility != 1:
         what = ("this is a structure" if mobility == 0 else "it is overconstrained" if mobility < 0
                 else f"name {mobility - 1} more driver{'s' if mobility > 2 else ''}")
-        raise fail("links", f"mobility {mobility} ({n} bodies with the ground, {pairs} revolute pairs: "
+        kinds = f"{revolute} revolute" + (f" and {len(sliders)} sliding" if sliders else "")
+        raise fail("links", f"mobility {mobility} ({n} bodies with the ground, {kinds} pairs: "
                             f"3 x {n - 1} - 2 x {pairs}): {what}; a joints file needs mobility 1")
-    _connected(bodies, at, fail)
-    return Drawing(xy, list(ground), links, bodies, points)
+    _connected(bodies, at, sliders, fail)
+    return Drawing(xy, list(ground), links, bodies, points, sliders)
 
 
-def _loop_count(bodies: Mapping[str, list[str]], points: Mapping[str, str]) -> int:
-    joints = {j for js in bodies.values() for j in js if j not in points}
-    edges = sum(len([j for j in js[1:] if j not in points]) for js in bodies.values())
-    return edges - len(joints) + 1
+def _sliders(spec: Mapping[str, Any], bodies: Mapping[str, list[str]],
+             xy: Mapping[str, tuple[float, float]], fail: Any) -> dict[str, Slide]:
+    """``[sliders]``: each a link that slides along a line fixed to the ground or a link."""
+    out: dict[str, Slide] = {}
+    for name, s in spec.items():
+        key = f"sliders.{name}"
+        if name not in bodies or name == GROUND:
+            raise fail(key, f"must be a link (links: {', '.join(b for b in bodies if b != GROUND)})")
+        if not isinstance(s, Mapping):
+            raise fail(key, "must be { on = BODY, angle = DEG } or { on = BODY, line = [P, Q] }")
+        for k in s:
+            if k not in ("on", "angle", "line"):
+                raise fail(f"{key}.{k}", "unknown key (expected on, and angle or line)")
+        on = s.get("on")
+        if not isinstance(on, str) or on not in bodies or on == name:
+            others = ", ".join(b for b in bodies if b not in (GROUND, name))
+            raise fail(f"{key}.on", f"must name the body its line is fixed to: \"ground\" or another "
+                                    f"link (links: {others})")
+        if on in spec:
+            raise fail(f"{key}.on", f"{on} slides itself: a line must be fixed to the ground or a "
+                                    "turning link")
+        if bodies[name][0] in bodies[on]:
+            raise fail(key, f"its first joint {bodies[name][0]} is on {on} too: it cannot both turn on "
+                            "and slide along it")
+        if ("angle" in s) == ("line" in s):
+            raise fail(key, "a slider needs its line: angle = DEG (its direction as drawn) or "
+                            f"line = [P, Q] (parallel to two joints of {on})")
+        if "angle" in s:
+            a = s["angle"]
+            if not isinstance(a, (int, float)) or isinstance(a, bool) or not math.isfinite(a) or abs(a) > 1e6:
+                raise fail(f"{key}.angle", "must be a finite number of degrees (the line's direction "
+                                           "as drawn)")
+            angle = float(a)
+        else:
+            line = s["line"]
+            if (not isinstance(line, list) or len(line) != 2 or not all(isinstance(j, str) for j in line)
+                    or not all(j in bodies[on] for j in line)):
+                raise fail(f"{key}.line", f"must be two joints of {on} ({', '.join(bodies[on])}): "
+                                          "the line runs parallel to them")
+            if xy[line[0]] == xy[line[1]]:
+                raise fail(f"{key}.line", f"{line[0]} and {line[1]} are drawn at one place: no direction")
+            angle = _angle_deg(xy[line[0]], xy[line[1]])
+        out[str(name)] = Slide(on, angle)
+    return out
 
 
-def _connected(bodies: Mapping[str, list[str]], at: Mapping[str, list[str]], fail: Any) -> None:
+def _loop_count(d: Drawing) -> int:
+    joints = {j for js in d.bodies.values() for j in js if j not in d.points}
+    edges = sum(len([j for j in js if j not in d.points]) - 1 for js in d.bodies.values())
+    return edges + len(d.sliders) - len(joints) + 1
+
+
+def _connected(bodies: Mapping[str, list[str]], at: Mapping[str, list[str]],
+               sliders: Mapping[str, Slide], fail: Any) -> None:
     seen = {GROUND}
     todo = [GROUND]
     while todo:
         b = todo.pop()
-        for j in bodies[b]:
-            for other in at[j]:
-                if other not in seen:
-                    seen.add(other)
-                    todo.append(other)
+        near = [other for j in bodies[b] for other in at[j]]
+        near += [s for s, slide in sliders.items() if slide.on == b]
+        near += [sliders[b].on] if b in sliders else []
+        for other in near:
+            if other not in seen:
+                seen.add(other)
+                todo.append(other)
     apart = [b for b in bodies if b not in seen]
     if apart:
         raise fail(f"links.{apart[0]}", "is not connected to the ground through the other links")
 
 
-def _cycles(edges: list[tuple[str, str, str]], root: str) -> list[list[tuple[tuple[str, str, str], bool]]]:
+Cycle = list[tuple[tuple[str, str, str], bool]]
+
+
+def _placed_in_order(cycles: list[Cycle], ground: list[str]) -> list[Cycle]:
+    """The loops ordered and each turned to start at a joint an earlier loop placed (the
+    first at the ground's first joint, a fixed joint wherever one is placed), so that the
+    loops place every joint from the drawing's origin onwards."""
+    placed = {ground[0]}
+    out: list[Cycle] = []
+    todo = list(cycles)
+    while todo:
+        k = next((i for i, c in enumerate(todo)
+                  if any((p if fwd else q) in placed for (_, p, q), fwd in c)), 0)
+        cycle = todo.pop(k)
+        starts = [p if fwd else q for (_, p, q), fwd in cycle]
+        first = next((i for i, j in enumerate(starts) if j == ground[0]),
+                     next((i for i, j in enumerate(starts) if j in ground and j in placed),
+                          next((i for i, j in enumerate(starts) if j in placed), 0)))
+        out.append(cycle[first:] + cycle[:first])
+        placed.update(starts)
+    return out
+
+
+def _cycles(edges: list[tuple[str, str, str]], root: str) -> list[Cycle]:
     """A fundamental cycle basis: a spanning tree by breadth-first search from ``root``, and
     for each edge not in it, the edge followed by the tree path back to its start. Each
     cycle is a list of (edge, forward) in order around the loop."""
@@ -305,18 +489,22 @@ def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>") -> str:
            f"name = {_toml_value(d['name'])}"]
     if d.get("description"):
         out.append(f"description = {_toml_value(d['description'])}")
-    out += [f"length_unit = {_toml_value(d['length_unit'])}", "", "[parameters]  # the drawn lengths"]
+    first = d["loops"][0]["joints"][0] if d["loops"] else "the first joint"
+    out += [f"length_unit = {_toml_value(d['length_unit'])}",
+            f"origin = {_toml_value(d['origin'])}  # where {first} is drawn",
+            "", "[parameters]  # the drawn lengths (and the ground's angles; e_: a slider line's offset)"]
     out += [f"{k} = {_toml_value(v)}" for k, v in d["parameters"].items()]
     out += ["", "[driver]"] + [f"{k} = {_toml_value(v)}" for k, v in d["driver"].items()]
-    out += ["", "[unknowns]  # each moving link's angle, guessed from the drawing"]
+    out += ["", "[unknowns]  # each moving link's angle (s_: a slider's travel), guessed from the drawing"]
     out += [f"{k} = {_toml_value(v)}" for k, v in d["unknowns"].items()]
     for loop in d["loops"]:
         names = loop["joints"]
-        out += ["", f"# {' -> '.join([*names, names[0]])}: the sum of these vectors is zero",
+        shown = [n or "(foot)" for n in names]
+        out += ["", f"# {' -> '.join([*shown, shown[0]])}: the sum of these vectors is zero",
                 "[[loops]]", f"name = {_toml_value(loop['name'])}", f"joints = {_toml_value(names)}",
                 "vectors = ["]
         out += [f"  {_toml_value(v)},  # {a} -> {b}"
-                for v, a, b in zip(loop["vectors"], names, [*names[1:], names[0]])]
+                for v, a, b in zip(loop["vectors"], shown, [*shown[1:], shown[0]])]
         out.append("]")
     for name, p in d.get("points", {}).items():
         out += ["", f"[points.{name}]  # on a link, nothing else attached",

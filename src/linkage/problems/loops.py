@@ -166,6 +166,9 @@ class Mechanism:
     extra: dict[str, Any] = field(default_factory=dict)
     points: dict[str, tuple[str, tuple[VectorTerm, ...]]] = field(default_factory=dict)
     """Named points on links: name -> (the joint it starts from, its vectors)."""
+    origin: tuple[float, float] = (0.0, 0.0)
+    """Where the first loop's first joint is (length unit): a drawing's joints are placed
+    where they were drawn."""
 
     def value_of(self, name: str) -> Quantity:
         if name == self.driver.name:
@@ -196,7 +199,8 @@ class Mechanism:
                                  f"(unknowns: {', '.join(u.name for u in unknowns)})")
             unknowns[idx] = _requantify(unknowns[idx], v)
         return Mechanism(self.name, self.source, self.length_unit, params, driver, tuple(unknowns),
-                         self.loops, self.closed_form, self.description, self.extra, self.points)
+                         self.loops, self.closed_form, self.description, self.extra, self.points,
+                         self.origin)
 
     def problem(self) -> SystemProblem:
         return build_problem(self)
@@ -294,7 +298,7 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         doc = loops_doc(doc, source)
 
     allowed = {"name", "description", "length_unit", "closed_form", "parameters", "driver",
-               "unknowns", "loops", "notes", "points"}
+               "unknowns", "loops", "notes", "points", "origin"}
     _check_printable(doc, fail)
     for key in doc:
         if key not in allowed:
@@ -445,7 +449,7 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
     points = _points(doc.get("points", {}), loops, vector, fail)
     mechanism = Mechanism(name, source, length_unit, parameters, driver, unknowns, tuple(loops),
                           closed_form, str(doc.get("description", "")),
-                          {"notes": doc.get("notes", "")}, points)
+                          {"notes": doc.get("notes", "")}, points, _origin(doc.get("origin"), fail))
     clash = column_clash(mechanism)
     if clash:
         raise fail(*clash)
@@ -463,6 +467,17 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
 
 KEY_HINT = "; the key is no longer needed: delete it and the closed form is derived from the loops"
 """What a refused ``closed_form = ...`` claim adds: the way out (the claim is the old way)."""
+
+
+def _origin(spec: Any, fail: Any) -> tuple[float, float]:
+    """``origin = [x, y]``: where the first loop's first joint is, in the length unit."""
+    if spec is None:
+        return (0.0, 0.0)
+    xy = [as_float(v) for v in spec] if isinstance(spec, list) and len(spec) == 2 else None
+    if xy is None or any(v is None or magnitude_problem(v, "length", "", signed=True) for v in xy):
+        raise fail("origin", "must be [x, y]: where the first loop's first joint is, two finite "
+                             "numbers in the file's length_unit")
+    return (xy[0], xy[1])  # type: ignore[return-value]
 
 
 def _points(spec: Any, loops: list[Loop], vector: Any,
@@ -681,13 +696,14 @@ class LoopModel:
 
     def points(self, q: Any, driver: float) -> list[list[complex]]:
         """Cumulative vector sums along each loop, the joints to draw: the first loop from
-        the origin, a later loop from its first joint where an earlier loop placed it (a
+        the file's origin, a later loop from its first joint where an earlier loop placed it (a
         six-bar's second loop at the rocker pivot), else from the origin too."""
         out = []
         placed: dict[str, complex] = {}
         for loop, terms in zip(self.mechanism.loops, self.terms):
             names = loop.joints
-            p = placed.get(names[0], 0j) if names and names[0] else 0j
+            start = complex(*self.mechanism.origin)
+            p = placed.get(names[0], start) if names and names[0] else start
             pts = [p]
             for sign, lc, li, ac, ai, off in terms:
                 r = q[li] if li >= 0 else (driver if li == DRIVER else lc)

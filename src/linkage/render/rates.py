@@ -113,7 +113,8 @@ def rate_cells(rates: Any, names: Any, joints: Any, motion: bool, bounds: bool =
     return cells
 
 
-def rates_blocks(rates: Any, names: Any, kinds: Any, length_unit: str, digits: int) -> list[Block]:
+def rates_blocks(rates: Any, names: Any, kinds: Any, length_unit: str, digits: int,
+                 origin: tuple[float, float] = (0.0, 0.0)) -> list[Block]:
     """Tables of one position's kinematics: the unknowns' rates with their error bounds,
     then the joints; an ill-conditioned rate shows only the digits its bound leaves."""
     blocks: list[Block] = []
@@ -147,7 +148,9 @@ def rates_blocks(rates: Any, names: Any, kinds: Any, length_unit: str, digits: i
         headers = ("joint", f"x ({L})", f"y ({L})")
         rows = [(j, *(denoise(c, size) for c in xy)) for j, xy in rates.joints.items()]
     if rows:
-        blocks.append(table("Joints (the first loop's first joint at the origin, x along 0 deg)", headers,
+        where = ("the origin" if origin == (0.0, 0.0) else
+                 f"({origin[0]:.{digits}g}, {origin[1]:.{digits}g}) {length_unit}")
+        blocks.append(table(f"Joints (the first loop's first joint at {where}, x along 0 deg)", headers,
                             rows, digits))
     return blocks
 

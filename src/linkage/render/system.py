@@ -127,7 +127,8 @@ def system_extra(problem: SystemProblem, result: Result, branch: str | None) -> 
 
 def system_report(problem: SystemProblem, result: Result, conv: Convergence | None, digits: int,
                   branch: str | None, fourbars: Sequence[dict[str, Any]] = (), rates: Any = None,
-                  motion: tuple[float, float] | None = None, driver_kind: str = "angle") -> Report:
+                  motion: tuple[float, float] | None = None, driver_kind: str = "angle",
+                  origin: tuple[float, float] = (0.0, 0.0)) -> Report:
     """``solve FILE``: the tables ``iterations`` (the history, each column with its unit)
     and, when it converged, ``unknowns`` (each unknown's value with its unit; with a driver
     speed, ``motion`` = (speed, accel) in internal units, its velocity and acceleration
@@ -150,7 +151,7 @@ def system_report(problem: SystemProblem, result: Result, conv: Convergence | No
     def blocks() -> list[Block]:
         out = system_blocks(problem, result, conv, digits, branch, fourbars)
         if rates is not None:
-            more = rates_blocks(rates, problem.names, problem.kinds, L, digits)
+            more = rates_blocks(rates, problem.names, problem.kinds, L, digits, origin)
             if more:  # a blank line after the convergence summary, as between the other blocks
                 out.append(Text(""))
             out += more
