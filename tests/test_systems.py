@@ -209,6 +209,26 @@ def test_lm_never_claims_success_above_tolerance(r1, r2, r3, r4, theta2):
         return
     if sols == {}:
         assert not result.converged and result.status is Status.NO_SOLUTION
+    elif result.status is Status.CONVERGED_STEP:
+        # a step-converged claim is a forward one: within tol of a root the closed form gives
+        gap = min(max(abs(math.remainder(x - t, 2 * math.pi)) for x, t in zip(result.x, (sol["theta3"], sol["theta4"])))
+                  for sol in sols.values())
+        assert gap <= 1e-9 * 10
+
+
+def test_lm_at_a_change_point_claims_the_residual_not_a_step():
+    """Regression (found by Hypothesis): r1..r4 = 2 at theta2 = 1e-7 deg. LM stopped at
+    theta3 = theta4 = 45 deg, a point of the family of roots at theta2 = 0, 45 deg from
+    any root at 1e-7 deg (theta3 near 0 or 180), and called it step-converged with
+    "error 2.87e-13", its damped step. The error is now the undamped step: the claim made
+    is the residual's (max|Phi| 1.75e-9 within tol x scale), named as such."""
+    problem = parse_mechanism(fourbar_doc(2.0, 2.0, 2.0, 2.0, 1e-7, 10.0, 80.0)).problem()
+    result = solve_system(problem, method="lm", tol=1e-9, max_iter=200)
+    assert result.status is Status.CONVERGED_RESIDUAL
+    sols = fourbar_positions(2.0, 2.0, 2.0, 2.0, 0.0, theta2=math.radians(1e-7))
+    gap = min(max(abs(math.remainder(x - t, 2 * math.pi)) for x, t in zip(result.x, (sol["theta3"], sol["theta4"])))
+              for sol in sols.values())
+    assert gap > 0.1  # far from every root: what the residual claim, not a step claim, allows
 
 
 def test_a_change_point_is_indeterminate_not_unassemblable():

@@ -81,8 +81,11 @@ class LevenbergMarquardt:
         try:
             fj = lu(jac)
             det, cond = det_from_lu(fj), (cond1(jac, fj) if self.diagnostics else math.nan)
+            # the error estimate is the undamped (Gauss-Newton) step, as Newton's: a damped
+            # step is small wherever mu is large, at a local minimum too, and bounds nothing
+            newton = step_measure(lu_solve(fj, [-v for v in phi]), problem.step_scales)
         except SingularMatrix:
-            det, cond = 0.0, math.inf
+            det, cond, newton = 0.0, math.inf, math.inf
         mu = s.mu
         while True:
             a = [row[:] for row in jtj]
@@ -99,7 +102,8 @@ class LevenbergMarquardt:
                 cost_t = sum(v * v for v in phi_t)
                 if cost_t < s.cost:
                     return new_state(LMState, (
-                        tuple(trial), max_abs(phi_t), step_measure(dq, problem.step_scales), None,
+                        tuple(trial), max_abs(phi_t), max(step_measure(dq, problem.step_scales), newton),
+                        None,
                         tuple(q), tuple(phi),
                         tuple(map(tuple, jac)), tuple(dq), det, cond, max(mu / 3.0, 1e-12), cost_t,
                         tuple(phi_t), nfev, njev))
@@ -107,7 +111,10 @@ class LevenbergMarquardt:
             if mu > MU_MAX:
                 # No step lowers the residual: a local minimum of |Phi|^2.
                 return new_state(LMState, (
-                    tuple(q), max_abs(phi), 0.0, None, tuple(q), tuple(phi), tuple(map(tuple, jac)),
+                    tuple(q), max_abs(phi), newton,
+                    (Status.LOCAL_MINIMUM, f"no step lowers |Phi|^2 below {s.cost:.3g} from here "
+                                           f"(mu above {MU_MAX:g})"),
+                    tuple(q), tuple(phi), tuple(map(tuple, jac)),
                     tuple(0.0 for _ in q), det, cond, mu, s.cost, tuple(phi), nfev, njev))
 
     def initial_row(self, problem: SystemProblem, s: LMState) -> None:
