@@ -183,3 +183,49 @@ def test_a_loops_file_has_no_coordinates_and_a_lone_ground_joint_cannot_move(cli
     slider = write(tmp_path, "slider.toml", SLIDER_CRANK)
     r = cli("scan", str(slider), "--vary", "O2.y=-1:1:3")
     assert r.code == 2 and "O2 is this drawing's only fixed joint" in r.err, r.err
+
+
+def watt_moved(o6: tuple[float, float] | None = None) -> str:
+    """test_joints_form's Watt drawing with its third fixed joint O6 at ``o6``: D redrawn
+    where circles about C (|CD|) and O6 (|O6 D|) meet, on the side of C -> O6 it was drawn
+    (derived here), every other joint where it was."""
+    import tomllib
+
+    from test_joints_form import watt_drawing
+
+    text = watt_drawing()
+    xy = {k: tuple(v) for k, v in tomllib.loads(text)["joints"].items()}
+    if o6 is None:
+        return text
+    (cx, cy), (dx0, dy0), (ox, oy) = xy["C"], xy["D"], xy["O6"]
+    r1, r2 = math.dist(xy["C"], xy["D"]), math.dist(xy["O6"], xy["D"])
+    side = math.copysign(1.0, (ox - cx) * (dy0 - cy) - (oy - cy) * (dx0 - cx))
+    ux, uy = o6[0] - cx, o6[1] - cy
+    d = math.hypot(ux, uy)
+    a = (r1 * r1 - r2 * r2 + d * d) / (2 * d)
+    h = side * math.sqrt(r1 * r1 - a * a)
+    d_new = (cx + a * ux / d - h * uy / d, cy + a * uy / d + h * ux / d)
+    for name, (x, y) in (("O6", o6), ("D", d_new)):
+        old = f"{name} = [{xy[name][0]!r}, {xy[name][1]!r}]"
+        assert old in text
+        text = text.replace(old, f"{name} = [{x!r}, {y!r}]")
+    return text
+
+
+def test_a_six_bars_third_fixed_joint_scans_as_drawings_with_it_moved_by_hand(tmp_path) -> None:
+    """The Watt's O6 is ground_O2_O6 and theta_ground_O2_O6 from O2 (O4 stays)."""
+    import tomllib
+
+    values = [float(v) for v in range(0, 360, 30)]
+    o6 = tomllib.loads(watt_moved())["joints"]["O6"]
+    drawn = write(tmp_path, "watt.toml", watt_moved())
+    got = scan(drawn, {"O6.x": (o6[0] - 4, o6[0] + 4, 2), "O6.y": (o6[1] - 3, o6[1] + 3, 2)}, values=values)
+    crank = from_text(watt_moved(), "<watt>").parameters["crank"].value
+    metrics = [k for k in got if k not in ("design", "O6_x", "O6_y")]
+    assert "theta_link7_range" in metrics
+    for i in range(len(got["design"])):
+        moved = write(tmp_path, f"watt_{i}.toml", watt_moved((float(got["O6_x"][i]), float(got["O6_y"][i]))))
+        want = scan(moved, {"crank": (crank, crank, 1)}, values=values)
+        assert want["solved_fraction"][0] > 0.5
+        for k in metrics:
+            assert same(got[k][i:i + 1], want[k], 1e-12), (i, k, got[k][i], want[k][0])
