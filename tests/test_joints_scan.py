@@ -165,6 +165,11 @@ link = "crank"
     (["--vary", "O4.x=80:90:2", "--vary", "O4.x=80:90:2"], "--vary O4.x is given twice"),
     (["--vary", "O4.x=80:90:2", "--samples", "3"], "--samples draws random designs"),
     (["--vary", "O4.x=80:90"], "--vary O4_x: give :N points for a grid"),
+    (["--vary", "O4.x=1e200:1e200:1"], "--vary O4.x: ground: a length must be 0 or between 1e-100 "
+                                       "and 1e+100 cm in magnitude, got 1e+200"),
+    (["--vary", "O4.x=-5:5:3", "--vary", "O4.y=-1:1:2"], "--vary O4.x and O4.y: the range puts O4 on "
+                                                         "O2, the ground's first joint"),
+    (["--vary", "O4.x=0:0:1", "--vary", "O4.y=0:1:2"], "the range puts O4 on O2"),
 ])
 def test_a_coordinate_that_cannot_vary_is_one_line(cli, tmp_path, args, message) -> None:
     drawn = write(tmp_path, "drawn.toml", drawing())

@@ -247,8 +247,29 @@ def joint_moves(m: Mechanism, doc: Mapping[str, Any] | None, varies: Sequence[Va
                                  f"it); vary {joint}.x/{joint}.y or {other}, not both")
         out[k] = Vary(col, v.lo, v.hi, v.n)
         moved.setdefault(joint, [-1, -1])[0 if axis == "x" else 1] = k
-    moves = tuple(GroundMove(j, xy[j], (c[0], c[1]), *where[j]) for j, c in moved.items())
-    return out, JointMoves(xy[root], moves)
+    moves = JointMoves(xy[root], tuple(GroundMove(j, xy[j], (c[0], c[1]), *where[j])
+                                       for j, c in moved.items()))
+    _check_moves(m, moves, out, root)
+    return out, moves
+
+
+def _check_moves(m: Mechanism, moves: JointMoves, varies: Sequence[Vary], root: str) -> None:
+    """Every design's ground valid, found at the corners of each joint's box (its farthest
+    places); a box holding ``root`` would put a joint on it (a ground vector of no length)."""
+    for g in moves.moves:
+        ranges = [(varies[c].lo, varies[c].hi) if c >= 0 else (v, v) for c, v in zip(g.columns, g.drawn)]
+        named = " and ".join(f"{g.joint}.{a}" for a, c in zip("xy", g.columns) if c >= 0)
+        if all(lo <= r <= hi for (lo, hi), r in zip(ranges, moves.root)):
+            raise InputError(f"--vary {named}: the range puts {g.joint} on {root}, the ground's first "
+                             "joint (no ground length); keep it off")
+        corners = np.array([(x, y) for x in ranges[0] for y in ranges[1]])
+        one = JointMoves(moves.root, (GroundMove(g.joint, g.drawn, (0, 1), g.length, g.angle),))
+        for row in range(len(corners)):
+            values = {k: float(v[row]) for k, v in one.parameters(("x", "y"), corners).items()}
+            try:
+                m.with_values(values, {})
+            except ParseError as exc:
+                raise InputError(f"--vary {named}: {str(exc).removeprefix('--set ')}") from None
 
 
 def _ground_vectors(m: Mechanism, root: str) -> dict[str, tuple[str, str]]:
