@@ -54,9 +54,18 @@ REFUSALS = {
                                                      'block = { on = "ground" }'),
                                 "sliders.block: a slider needs its line: angle = DEG"),
     "a duplicate joint name": (me581_drawing(extra="A = [5, 5]\n"),
-                               "not valid TOML: Cannot overwrite a value (at line 10"),
+                               "not valid TOML: Cannot overwrite a value (at line 10, column 11): "
+                               "A is given twice"),
     "a duplicate link name": (me581_drawing(links=FOURBAR_LINKS + '\ncrank = ["O2", "A"]'),
-                              "not valid TOML: Cannot overwrite a value (at line 14"),
+                              "not valid TOML: Cannot overwrite a value (at line 14, column 20): "
+                              "crank is given twice"),
+    "no links": (me581_drawing().split("[links]")[0] + '[driver]\nlink = "crank"\n',
+                 "links: must be a table of link = [joints]"),
+    "no joints": (me581_drawing().split("[joints]")[0] + "[links]" + me581_drawing().split("[links]")[1],
+                  "joints: must be a table of joint = [x, y]"),
+    "both forms": (me581_drawing() + "[[loops]]\nname = 'x'\nvectors = []\n",
+                   "loops: unknown key in a joints file (expected one of description, driver, ground, "
+                   "joints, length_unit, links, name, notes, sliders)"),
     "a link naming an unknown joint": (me581_drawing(links=FOURBAR_LINKS.replace('"A", "B", "P"',
                                                                                  '"A", "Q", "P"')),
                                        "links.coupler: 'Q' is not a joint (joints: O2, A, B, O4, P)"),

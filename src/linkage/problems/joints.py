@@ -55,7 +55,9 @@ that the checks and the cycle basis stay instant on a hostile file."""
 
 
 def is_joints_doc(doc: Mapping[str, Any]) -> bool:
-    return "joints" in doc and "links" in doc and "loops" not in doc
+    """Any key of the joints form: a drawing missing [links] (or holding [[loops]] too) is
+    then told what it lacks, not read as a loops file."""
+    return any(k in doc for k in ("joints", "links", "ground", "sliders"))
 
 
 def _number(v: Any) -> bool:
@@ -268,7 +270,7 @@ def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
     for key in doc:
         if key not in allowed:
             raise fail(key, f"unknown key in a joints file (expected one of {', '.join(sorted(allowed))})")
-    joints_doc, links_doc = doc["joints"], doc["links"]
+    joints_doc, links_doc = doc.get("joints"), doc.get("links")
     if not isinstance(joints_doc, Mapping) or not joints_doc:
         raise fail("joints", "must be a table of joint = [x, y]")
     for key, table in (("joints", joints_doc), ("links", links_doc)):
