@@ -61,6 +61,19 @@ def test_a_derived_length_scans_as_the_derived_loops_file(tmp_path) -> None:
         assert np.array_equal(got[k], want[k], equal_nan=got[k].dtype.kind == "f"), k
 
 
+@pytest.mark.parametrize(("driver", "values"), [('link = "crank"', VALUES),
+                                                ('slider = "block"', [60.0 + 5 * k for k in range(19)])])
+def test_a_slider_cranks_derived_lengths_scan_as_its_loops_file(tmp_path, driver, values) -> None:
+    text = SLIDER_CRANK.replace('link = "crank"', driver)
+    drawn = write(tmp_path, "drawn.toml", text)
+    loops = write(tmp_path, "loops.toml", loops_text(from_toml(text), "drawn.toml"))
+    vary = {"coupler": (100.0, 140.0, 3), "e_block": (-10.0, 10.0, 3)}
+    got, want = scan(drawn, vary, values=values), scan(loops, vary, values=values)
+    assert list(got) == list(want) and got["solved_fraction"].min() > 0.5
+    for k in got:
+        assert np.array_equal(got[k], want[k], equal_nan=got[k].dtype.kind == "f"), k
+
+
 def from_toml(text: str) -> dict:
     import tomllib
 
