@@ -247,3 +247,13 @@ def test_a_six_bars_third_fixed_joint_scans_as_drawings_with_it_moved_by_hand(tm
         assert want["solved_fraction"][0] > 0.5
         for k in metrics:
             assert same(got[k][i:i + 1], want[k], 1e-12), (i, k, got[k][i], want[k][0])
+
+
+def test_the_python_api_reads_coordinates_from_a_path_not_a_mechanism(tmp_path) -> None:
+    from linkage.errors import InputError
+    from linkage.problems.loops import load
+
+    drawn = write(tmp_path, "drawn.toml", drawing())
+    with pytest.raises(InputError, match="a joint's coordinate is read from a joints file: give its path"):
+        scan(load(drawn), {"O4.x": (80.0, 90.0, 2)}, values=VALUES)
+    assert scan(str(drawn), {"O4.x": (80.0, 90.0, 2)}, values=VALUES)["O4_x"].tolist() == [80.0, 90.0]

@@ -205,7 +205,10 @@ def joint_moves(m: Mechanism, doc: Mapping[str, Any] | None, varies: Sequence[Va
     from .problems.joints import is_joints_doc
 
     first = coords[0][1].name
-    if doc is None or not is_joints_doc(doc):
+    if doc is None:  # the Python API given a Mechanism: its drawing is gone
+        raise InputError(f"vary {first!r}: a joint's coordinate is read from a joints file: give "
+                         "its path, not a Mechanism")
+    if not is_joints_doc(doc):
         raise InputError(f"--vary {first}: a joint's coordinate is varied in a joints file; "
                          f"{m.source} is in the loops form: vary its parameters "
                          f"({', '.join(m.parameters)})")
@@ -726,13 +729,15 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
     ``linkage.scan_designs`` (``linkage.scan`` is this module).
 
     ``vary`` maps parameter names to ``(lo, hi, n)`` (a grid) or ``(lo, hi)`` (with
-    ``samples``), in the file's units; ``values`` are the driver values (default 0..359
-    deg). Returns the kept records as columns (name -> numpy array), in design order or
-    sorted by ``sort``: the columns ``linkage scan`` writes, with the same ``where``,
-    ``sort``, ``top``, ``scheduler`` and ``workers``. Every argument is checked first
-    (:mod:`linkage.arguments`): a misuse raises InputError naming it; n, samples, seed,
-    top, chunk and workers are whole numbers (workers at most MAX_THREADS threads or
-    MAX_PROCESSES processes), the driver values finite reals.
+    ``samples``), in the file's units (of a joints file given by path, also a fixed
+    joint's coordinate, ``"O4.x"`` or ``"O4.y"``: columns ``O4_x``, ``O4_y``); ``values``
+    are the driver values (default 0..359 deg). Returns the kept records as columns (name
+    -> numpy array), in design order or sorted by ``sort``: the columns ``linkage scan``
+    writes, with the same ``where``, ``sort``, ``top``, ``scheduler`` and ``workers``.
+    Every argument is checked first (:mod:`linkage.arguments`): a misuse raises
+    InputError naming it; n, samples, seed, top, chunk and workers are whole numbers
+    (workers at most MAX_THREADS threads or MAX_PROCESSES processes), the driver values
+    finite reals.
     """
     from .arguments import (
         check_flag,

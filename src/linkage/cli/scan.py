@@ -33,7 +33,8 @@ def scan(
     vary: Annotated[Optional[list[str]], typer.Option(
         "--vary", metavar="NAME=LO:HI[:N]", help="A parameter to vary, in the file's units "
         "(repeatable): N points from LO to HI (a grid of every combination), or LO:HI with "
-        "--samples.")] = None,
+        "--samples. In a joints file also a fixed joint's coordinate, e.g. O4.x (column "
+        "O4_x).")] = None,
     samples: Annotated[Optional[int], typer.Option(help="Draw this many random designs in the "
                        "--vary ranges instead of a grid.")] = None,
     sampling: Annotated[str, typer.Option(help="With --samples: lhs (Latin hypercube, default) "
