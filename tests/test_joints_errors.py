@@ -249,6 +249,16 @@ def test_two_joints_at_one_place(cli, tmp_path) -> None:
     assert run(cli, tmp_path, "solve", text).code == 0
 
 
+def test_two_fixed_joints_at_one_place_and_empty_names(cli, tmp_path) -> None:
+    refused(run(cli, tmp_path, "scan", me581_drawing().replace(O4, "O4 = [0, 0]")),
+            "ground: joints O2 and O4 are drawn at one place")
+    # "" marks a loop's unnamed point (a slider's foot): no joint or link may take it
+    text = me581_drawing().replace("P = [", '"" = [').replace('"P"]', '""]')
+    refused(run(cli, tmp_path, "convert", text), 'joints: "" is no name: give each a name')
+    text = me581_drawing().replace("crank = [", '"" = [').replace('link = "crank"', 'link = ""')
+    refused(run(cli, tmp_path, "solve", text), 'links: "" is no name: give each a name')
+
+
 @pytest.mark.parametrize(("value", "ok"), [("425.0", True), ("-295", True), ("70", False),
                                            ("1e300", False), ("1e20", False)])
 def test_a_driver_value_far_from_the_drawing(cli, tmp_path, value, ok) -> None:

@@ -273,6 +273,9 @@ def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
         if isinstance(table, Mapping) and len(table) > MAX_JOINTS:
             raise fail(key, f"{len(table):,} entries; at most {MAX_JOINTS:,} are accepted, far above "
                             "any real mechanism")
+    for key, table in (("joints", joints_doc), ("links", links_doc)):
+        if isinstance(table, Mapping) and "" in table:  # "" is a loop's unnamed point (a foot)
+            raise fail(key, '"" is no name: give each a name')
     xy: dict[str, tuple[float, float]] = {}
     for name, p in joints_doc.items():
         if (not isinstance(p, list) or len(p) != 2 or
