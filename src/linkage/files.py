@@ -88,12 +88,23 @@ def parse_toml(text: str, where: str) -> dict[str, Any]:
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ParseError(f"{where}: not valid TOML: {exc}") from None
+        raise ParseError(f"{where}: not valid TOML: {exc}{_given_twice(text, str(exc))}") from None
     except RecursionError:
         raise ParseError(f"{where}: not valid TOML: nested too deeply") from None
     except (ValueError, OverflowError, MemoryError) as exc:
         # e.g. an integer of more digits than Python converts (ValueError)
         raise ParseError(f"{where}: not valid TOML: {exc}") from None
+
+
+def _given_twice(text: str, message: str) -> str:
+    """The key a "Cannot overwrite a value" names by its line (a joint or link listed twice),
+    when it reads plainly; else nothing."""
+    found = re.match(r"Cannot overwrite a value \(at line (\d+)", message)
+    lines = text.splitlines()
+    if not found or not 0 < int(found.group(1)) <= len(lines):
+        return ""
+    key = lines[int(found.group(1)) - 1].partition("=")[0].strip()
+    return f": {key} is given twice" if re.fullmatch(r"[A-Za-z0-9_\-]{1,60}", key) else ""
 
 
 def read_input(path: Path, what: str = "mechanism file") -> str:

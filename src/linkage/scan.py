@@ -146,6 +146,150 @@ class DesignPlan:
         return np.stack([a[i] for a, i in zip(self.axes, idx)], axis=1)
 
 
+# --- a joints file's ground joints, moved ----------------------------------------------------
+
+def coordinate_column(joint: str, axis: str) -> str:
+    """The record column of a varied coordinate (``--vary O4.x`` -> ``O4_x``): a name
+    --where and --sort read (a dot would be an attribute there)."""
+    return f"{joint}_{axis}"
+
+
+@dataclass(frozen=True)
+class GroundMove:
+    """A ground joint a scan moves: where it is drawn, the plan's columns giving its x and
+    y (-1: as drawn) and the derived parameters that place it from the ground's first
+    joint (its distance and its angle, deg)."""
+
+    joint: str
+    drawn: tuple[float, float]
+    columns: tuple[int, int]
+    length: str
+    angle: str
+
+
+@dataclass(frozen=True)
+class JointMoves:
+    """The coordinates of a joints file's ground joints that a scan varies, and how each
+    design's coordinates become the derived loops' parameters: the ground is a star from
+    its first joint ``root``, so a ground joint at (x, y) is a vector of length
+    hypot(x - x0, y - y0) at atan2(y - y0, x - x0) from it. The one home of that rule."""
+
+    root: tuple[float, float]
+    moves: tuple[GroundMove, ...]
+
+    @property
+    def columns(self) -> frozenset[int]:
+        return frozenset(c for g in self.moves for c in g.columns if c >= 0)
+
+    def parameters(self, names: Sequence[str], designs: np.ndarray) -> dict[str, np.ndarray]:
+        """The parameter columns (file units) of a chunk of designs (rows of ``names``)."""
+        out = {n: designs[:, j] for j, n in enumerate(names) if j not in self.columns}
+        rows = designs.shape[0]
+        for g in self.moves:
+            x, y = (designs[:, c] if c >= 0 else np.full(rows, v) for c, v in zip(g.columns, g.drawn))
+            dx, dy = x - self.root[0], y - self.root[1]
+            out[g.length] = np.hypot(dx, dy)
+            out[g.angle] = np.degrees(np.arctan2(dy, dx))
+        return out
+
+
+def joint_moves(m: Mechanism, doc: Mapping[str, Any] | None, varies: Sequence[Vary],
+                fixed: Sequence[str] = ()) -> tuple[list[Vary], JointMoves | None]:
+    """``varies`` with each ``JOINT.x``/``JOINT.y`` (a ground joint's coordinate in the
+    joints file ``doc``) renamed to its column, and how they move the joints; None when no
+    coordinate is varied. ``fixed``: the names given by --set. InputError, one line, for a
+    coordinate that cannot be varied."""
+    coords = [(k, v) for k, v in enumerate(varies) if v.name not in m.parameters and "." in v.name]
+    if not coords:
+        return list(varies), None
+    from .problems.joints import is_joints_doc
+
+    first = coords[0][1].name
+    if doc is None:  # the Python API given a Mechanism: its drawing is gone
+        raise InputError(f"vary {first!r}: a joint's coordinate is read from a joints file: give "
+                         "its path, not a Mechanism")
+    if not is_joints_doc(doc):
+        raise InputError(f"--vary {first}: a joint's coordinate is varied in a joints file; "
+                         f"{m.source} is in the loops form: vary its parameters "
+                         f"({', '.join(m.parameters)})")
+    xy = {str(k): (float(p[0]), float(p[1])) for k, p in doc["joints"].items()}
+    ground = [str(g) for g in doc["ground"]]
+    root, movable = ground[0], ground[1:]
+    can = (f"the fixed joints after {root} can move: " + ", ".join(f"{g}.x, {g}.y" for g in movable)
+           if movable else f"{root} is this drawing's only fixed joint")
+    where = _ground_vectors(m, root)
+    names = [v.name for v in varies]
+    moved: dict[str, list[int]] = {}
+    out = list(varies)
+    for k, v in coords:
+        if names.index(v.name) != k:
+            raise InputError(f"--vary {v.name} is given twice")
+        joint, _, axis = v.name.rpartition(".")
+        if joint not in xy:
+            raise InputError(f"--vary {v.name}: no joint {joint!r} in {m.source}; {can}")
+        if axis not in ("x", "y"):
+            raise InputError(f"--vary {v.name}: a joint's coordinates are x and y, not {axis!r}")
+        if joint == root:
+            raise InputError(f"--vary {v.name}: {root} is where the drawing is placed (the ground's "
+                             f"first joint): moving it moves the whole drawing; {can}")
+        if joint not in ground:
+            links = [str(k) for k, js in doc["links"].items() if joint in js]
+            lengths = [p for p in m.parameters if p in links or any(p.startswith(f"{k}_") for k in links)]
+            raise InputError(f"--vary {v.name}: {joint} moves with {', '.join(links)}: where it is "
+                             f"follows from the link lengths; vary those instead ({', '.join(lengths)})")
+        if joint not in where:
+            raise InputError(f"--vary {v.name}: {joint} is on no loop of {m.source}: moving it "
+                             "changes nothing")
+        col = coordinate_column(joint, axis)
+        if col in m.parameters:
+            raise InputError(f"--vary {v.name}: its column {col} is also a parameter of "
+                             f"{m.source}; rename that link")
+        for other in where[joint]:
+            if other in names or other in fixed:
+                raise InputError(f"--vary {v.name}: {other} is {joint}'s place too (derived from "
+                                 f"it); vary {joint}.x/{joint}.y or {other}, not both")
+        out[k] = Vary(col, v.lo, v.hi, v.n)
+        moved.setdefault(joint, [-1, -1])[0 if axis == "x" else 1] = k
+    moves = JointMoves(xy[root], tuple(GroundMove(j, xy[j], (c[0], c[1]), *where[j])
+                                       for j, c in moved.items()))
+    _check_moves(m, moves, out, root)
+    return out, moves
+
+
+def _check_moves(m: Mechanism, moves: JointMoves, varies: Sequence[Vary], root: str) -> None:
+    """Every design's ground valid, found at the corners of each joint's box (its farthest
+    places); a box holding ``root`` would put a joint on it (a ground vector of no length)."""
+    for g in moves.moves:
+        ranges = [(varies[c].lo, varies[c].hi) if c >= 0 else (v, v) for c, v in zip(g.columns, g.drawn)]
+        named = " and ".join(f"{g.joint}.{a}" for a, c in zip("xy", g.columns) if c >= 0)
+        if all(lo <= r <= hi for (lo, hi), r in zip(ranges, moves.root)):
+            raise InputError(f"--vary {named}: the range puts {g.joint} on {root}, the ground's first "
+                             "joint (no ground length); keep it off")
+        corners = np.array([(x, y) for x in ranges[0] for y in ranges[1]])
+        one = JointMoves(moves.root, (GroundMove(g.joint, g.drawn, (0, 1), g.length, g.angle),))
+        for row in range(len(corners)):
+            values = {k: float(v[row]) for k, v in one.parameters(("x", "y"), corners).items()}
+            try:
+                m.with_values(values, {})
+            except ParseError as exc:
+                raise InputError(f"--vary {named}: {str(exc).removeprefix('--set ')}") from None
+
+
+def _ground_vectors(m: Mechanism, root: str) -> dict[str, tuple[str, str]]:
+    """Each ground joint's (length, angle) parameters, read from the derived loops: the
+    vector between ``root`` and it whose angle is a parameter."""
+    out: dict[str, tuple[str, str]] = {}
+    for loop in m.loops:
+        js = loop.joints
+        for i, t in enumerate(loop.vectors):
+            if not js or not isinstance(t.length, str) or not isinstance(t.angle, str):
+                continue
+            a, b = js[i], js[(i + 1) % len(js)]
+            if t.angle in m.parameters and root in (a, b):
+                out[b if a == root else a] = (t.length, t.angle)
+    return out
+
+
 def _draw(varies: Sequence[Vary], n: int, seed: int, method: str) -> np.ndarray:
     rng = np.random.default_rng(seed)
     p = len(varies)
@@ -178,6 +322,8 @@ class ScanJob:
     tol: float
     mechanism: Mechanism | None = None
     """A mechanism object given directly (the Python API); it travels pickled."""
+    moves: JointMoves | None = None
+    """The ground joints a scan of a joints file moves (their coordinates among names)."""
 
 
 @functools.lru_cache(maxsize=8)
@@ -190,10 +336,11 @@ def job_mechanism(text: str, source: str, overrides: tuple[tuple[str, float], ..
 def run_chunk(job: ScanJob, start: int, designs: np.ndarray) -> dict[str, np.ndarray]:
     """One task: the records of designs ``start, start + 1, ...`` as columns."""
     m = job.mechanism or job_mechanism(job.text, job.source, job.overrides)
-    params = {name: designs[:, j] for j, name in enumerate(job.names)}
+    params = (job.moves.parameters(job.names, designs) if job.moves is not None else
+              {name: designs[:, j] for j, name in enumerate(job.names)})
     sol = solve_designs(m, params, np.array(job.values), branch=job.branch, tol=job.tol,
                         paths=bool(m.points))
-    return design_metrics(m, job.names, designs, sol, start)
+    return design_metrics(m, job.names, designs, sol, start, params)
 
 
 def chunk_size(m: Mechanism, positions: int, branch: str | None) -> int:
@@ -237,7 +384,9 @@ def pick_chunk(m: Mechanism, positions: int, branch: str | None, chunk: int | No
 # --- metrics ---------------------------------------------------------------------------------
 
 def design_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray, sol: DesignSolutions,
-                   start: int) -> dict[str, np.ndarray]:
+                   start: int, params: Mapping[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
+    """The records of a chunk: ``names`` the varied columns (``designs``' columns),
+    ``params`` the parameter columns solved (default: the same)."""
     n_designs, n_pos = sol.status.shape
     solved = sol.status == CONVERGED
     out: dict[str, np.ndarray] = {"design": np.arange(start, start + n_designs, dtype=np.int64)}
@@ -259,7 +408,7 @@ def design_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray, sol:
                 span = hi - lo
             for key, col in zip(extent_columns(u.name), (lo, hi, span)):
                 out[key] = col
-        out.update(fourbar_metrics(m, names, designs, sol))
+        out.update(fourbar_metrics(m, names, designs, sol, params))
         for p in m.points:
             z = sol.paths[p]
             for axis, part in (("x", z.real), ("y", z.imag)):
@@ -277,7 +426,8 @@ def _extent(values: np.ndarray, solved: np.ndarray) -> tuple[np.ndarray, np.ndar
 
 
 def fourbar_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray,
-                    sol: DesignSolutions) -> dict[str, np.ndarray]:
+                    sol: DesignSolutions, given: Mapping[str, np.ndarray] | None = None,
+                    ) -> dict[str, np.ndarray]:
     """For every four-bar loop of the derivation (columns named by
     :func:`~linkage.problems.columns.fourbar_loops`): its Grashof class, from the lengths
     of its ground, input, coupler and output as each design has them, and the extremes of
@@ -290,7 +440,8 @@ def fourbar_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray,
         return {}
     n_designs, n_pos = sol.status.shape
     solved = sol.status == CONVERGED
-    varied = {n: np.asarray(designs[:, j], dtype=float) for j, n in enumerate(names)}
+    varied = ({n: np.asarray(c, dtype=float) for n, c in given.items()} if given is not None else
+              {n: np.asarray(designs[:, j], dtype=float) for j, n in enumerate(names)})
     # the derivation's parameters (internal units): a varied one a column per design
     params: dict[str, Any] = {k: q.value for k, q in m.parameters.items()}
     for k, col in varied.items():
@@ -540,16 +691,21 @@ class ScanSetup:
     where: Any
     branch: str | None
     values: list[float]
+    moves: JointMoves | None = None
 
 
 def prepare(m: Mechanism, varies: Sequence[Vary], *, samples: int | None, seed: int, sampling: str,
             values: Sequence[float], branch: str | None, tol: float, where: str | None,
-            sort: str | None) -> ScanSetup:
-    """Everything checked before any design is solved (one InputError or ParseError)."""
+            sort: str | None, doc: Mapping[str, Any] | None = None,
+            fixed: Sequence[str] = ()) -> ScanSetup:
+    """Everything checked before any design is solved (one InputError or ParseError).
+    ``doc``: the file's document, for a joints file's coordinates (:func:`joint_moves`);
+    ``fixed``: the names --set gives."""
     from .kinematics.sweep import check_driver_values
     from .problems.where import parse_where
 
-    check_varies(m, varies)
+    varies, moves = joint_moves(m, doc, varies, fixed)
+    check_varies(m, [v for k, v in enumerate(varies) if moves is None or k not in moves.columns])
     plan = DesignPlan(varies, samples, seed, sampling)
     if len(values) > MAX_SCAN_POSITIONS:
         raise InputError(f"{len(values):,} driver positions per design is more than "
@@ -560,7 +716,7 @@ def prepare(m: Mechanism, varies: Sequence[Vary], *, samples: int | None, seed: 
     test = parse_where(where, known) if where is not None else None
     if sort is not None and sort not in known:
         raise InputError(f"--sort {sort}: no such column; the columns are {', '.join(known)}")
-    return ScanSetup(plan, spec, test, default_branch(m, branch, tol), listed)
+    return ScanSetup(plan, spec, test, default_branch(m, branch, tol), listed, moves)
 
 
 def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, samples: int | None = None,
@@ -573,13 +729,15 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
     ``linkage.scan_designs`` (``linkage.scan`` is this module).
 
     ``vary`` maps parameter names to ``(lo, hi, n)`` (a grid) or ``(lo, hi)`` (with
-    ``samples``), in the file's units; ``values`` are the driver values (default 0..359
-    deg). Returns the kept records as columns (name -> numpy array), in design order or
-    sorted by ``sort``: the columns ``linkage scan`` writes, with the same ``where``,
-    ``sort``, ``top``, ``scheduler`` and ``workers``. Every argument is checked first
-    (:mod:`linkage.arguments`): a misuse raises InputError naming it; n, samples, seed,
-    top, chunk and workers are whole numbers (workers at most MAX_THREADS threads or
-    MAX_PROCESSES processes), the driver values finite reals.
+    ``samples``), in the file's units (of a joints file given by path, also a fixed
+    joint's coordinate, ``"O4.x"`` or ``"O4.y"``: columns ``O4_x``, ``O4_y``); ``values``
+    are the driver values (default 0..359 deg). Returns the kept records as columns (name
+    -> numpy array), in design order or sorted by ``sort``: the columns ``linkage scan``
+    writes, with the same ``where``, ``sort``, ``top``, ``scheduler`` and ``workers``.
+    Every argument is checked first (:mod:`linkage.arguments`): a misuse raises
+    InputError naming it; n, samples, seed, top, chunk and workers are whole numbers
+    (workers at most MAX_THREADS threads or MAX_PROCESSES processes), the driver values
+    finite reals.
     """
     from .arguments import (
         check_flag,
@@ -593,6 +751,13 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
 
     m = mechanism_of("mechanism", mechanism)
     specs = check_vary(vary, MAX_DESIGNS)
+    doc = None
+    if not isinstance(mechanism, Mechanism) and any("." in s[0] for s in specs):
+        from pathlib import Path
+
+        from .files import parse_toml, read_input
+
+        doc = parse_toml(read_input(Path(mechanism)), str(mechanism))  # a joint's coordinates
     check_scan_options(seed=seed, samples=samples, top=top, chunk=chunk, workers=workers,
                        scheduler=scheduler, max_designs=MAX_DESIGNS)
     check_criteria(tol, 0.0, None, 50)
@@ -611,9 +776,10 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
         # a fraction of no positions is no fraction: feasible_fraction would read 0
         raise InputError("values must hold at least one driver value")
     setup = prepare(m, varies, samples=samples, seed=seed, sampling=sampling, values=list(values),
-                    branch=branch, tol=tol, where=where, sort=sort)
+                    branch=branch, tol=tol, where=where, sort=sort, doc=doc)
     check_held(setup.plan.total, len(setup.spec), top, "a scan returned as columns", "top")
-    job = ScanJob("", m.source, (), setup.plan.names, tuple(setup.values), setup.branch, tol, m)
+    job = ScanJob("", m.source, (), setup.plan.names, tuple(setup.values), setup.branch, tol, m,
+                  setup.moves)
     keeper = Keeper(sort, descending, top, None)
     feed(keeper, job, setup, pick_chunk(m, len(setup.values), setup.branch, chunk,
                                         setup.plan.total),

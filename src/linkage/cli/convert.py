@@ -28,6 +28,7 @@ def convert(
 
     from ..files import parse_toml, read_input, write_atomic
     from ..problems.joints import is_joints_doc, loops_text
+    from ..problems.loops import parse_mechanism
 
     if output is not None and str(output) != "-" and output.suffix.lower() != ".toml":
         raise InputError(f"-o {output}: a mechanism file: name it with .toml")
@@ -35,6 +36,7 @@ def convert(
     doc = parse_toml(read_input(file), str(file))
     if not is_joints_doc(doc):
         raise InputError(f"{file} is already in the loops form (the joints form from loops is to come)")
+    parse_mechanism(doc, str(file))  # refuse here what solve refuses: the printed file solves
     text = loops_text(doc, str(file))
     if output is None or str(output) == "-":
         with stdout_errors():

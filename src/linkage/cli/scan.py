@@ -33,7 +33,8 @@ def scan(
     vary: Annotated[Optional[list[str]], typer.Option(
         "--vary", metavar="NAME=LO:HI[:N]", help="A parameter to vary, in the file's units "
         "(repeatable): N points from LO to HI (a grid of every combination), or LO:HI with "
-        "--samples.")] = None,
+        "--samples. In a joints file also a fixed joint's coordinate, e.g. O4.x (column "
+        "O4_x).")] = None,
     samples: Annotated[Optional[int], typer.Option(help="Draw this many random designs in the "
                        "--vary ranges instead of a grid.")] = None,
     sampling: Annotated[str, typer.Option(help="With --samples: lhs (Latin hypercube, default) "
@@ -80,7 +81,7 @@ def scan(
     Example: linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60:5 --vary r4=60:120:7
     """
     from ..arguments import check_scan_options
-    from ..files import read_input
+    from ..files import parse_toml, read_input
     from ..kinematics.sweep import driver_values
     from ..problems.loops import from_text
     from ..render import writers
@@ -115,13 +116,15 @@ def scan(
     if desc and sort is None:
         raise InputError("--desc orders by --sort: give --sort COLUMN")
     setup = prepare(mechanism, varies, samples=samples, seed=seed, sampling=sampling,
-                    values=driver_values(a, b, step, None), branch=branch, tol=tol, where=where, sort=sort)
+                    values=driver_values(a, b, step, None), branch=branch, tol=tol, where=where, sort=sort,
+                    doc=parse_toml(text, str(file)) if any("." in v.name for v in varies) else None,
+                    fixed=tuple(fixed))
     spec = pick_spec(setup.spec, columns) if columns else setup.spec
     streamed = writers.is_data(fmt)
     if sort is not None and streamed:
         check_held(setup.plan.total, len(setup.spec), top, f"--sort {sort} with --format {fmt}")
     job = ScanJob(text, str(file), tuple((k, float(v)) for k, v in fixed.items()), setup.plan.names,
-                  tuple(setup.values), setup.branch, tol)
+                  tuple(setup.values), setup.branch, tol, moves=setup.moves)
     size = pick_chunk(mechanism, len(setup.values), setup.branch, chunk, setup.plan.total)
     meta = scan_meta(mechanism, str(file), setup, (a, b, step), where, sort, desc)
     started = time.perf_counter()

@@ -54,7 +54,8 @@ def sourced_columns(m: Any, names: Sequence[str]) -> list[tuple[str, str, str, s
     unit = {k: (q.unit if q.kind == "angle" else m.length_unit) for k, q in m.parameters.items()}
     own = "a column every scan writes"
     cols = [(DESIGN, "int", "", own, "")]
-    cols += [(n, "number", unit[n], f"parameter {n}", f"parameters.{n}") for n in names]
+    # a varied name that is no parameter is a joint's coordinate (scan.coordinate_column)
+    cols += [(n, "number", unit.get(n, m.length_unit), f"parameter {n}", f"parameters.{n}") for n in names]
     cols += [(c, t, u, own, "") for c, t, u in SUMMARY]
     for q in m.unknowns:
         uu = "deg" if q.kind == "angle" else m.length_unit

@@ -36,6 +36,7 @@ slider line's signed offset ``e_<slider>``.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Mapping
 from typing import Any, NamedTuple
 
@@ -53,7 +54,15 @@ that the checks and the cycle basis stay instant on a hostile file."""
 
 
 def is_joints_doc(doc: Mapping[str, Any]) -> bool:
-    return "joints" in doc and "links" in doc and "loops" not in doc
+    """Any key of the joints form: a drawing missing [links] (or holding [[loops]] too) is
+    then told what it lacks, not read as a loops file."""
+    return any(k in doc for k in ("joints", "links", "ground", "sliders"))
+
+
+def _number(v: Any) -> bool:
+    """A finite real number (a TOML integer beyond a double's range is not: never
+    converted, so never an OverflowError)."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and abs(v) <= sys.float_info.max
 
 
 def _angle_deg(p: tuple[float, float], q: tuple[float, float]) -> float:
@@ -123,6 +132,15 @@ def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, 
                             f"for {len(unknowns)} unknowns ({', '.join(unknowns)})")
 
     params: dict[str, Any] = {}
+    owner = {(f"s_{b}" if b in sliders else f"theta_{b}"): f"{b}'s {'travel' if b in sliders else 'angle'}"
+             for b in links}
+
+    def own(name: str, what: str) -> None:
+        """Each derived name one thing: a link named like another's derived name would
+        silently share its number."""
+        if owner.setdefault(name, what) != what:
+            raise fail("links", f"the derived name {name} is {owner[name]} and {what}: rename a "
+                                "link (names: <link>, <link>_<P>_<Q>, theta_<link>, s_ and e_<slider>)")
 
     def angle(b: str, drawn_deg: float) -> dict[str, Any]:
         ref, b0 = frame[b]
@@ -138,8 +156,10 @@ def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, 
                        f"joints {p} and {q} are drawn at one place")
         first_two = len(bodies[b]) > 1 and (p, q) == (bodies[b][0], bodies[b][1])
         pname = b if first_two else f"{b}_{p}_{q}"
+        own(pname, f"the length {p} -> {q} of {b}")
         params[pname] = {"value": length, "unit": unit}
         if b == GROUND:  # a length and an angle parameter: a scan may move a ground joint
+            own(f"theta_{pname}", f"the ground's angle {p} -> {q}")
             params[f"theta_{pname}"] = {"value": _angle_deg(xy[p], xy[q]), "unit": "deg"}
             return {"length": pname, "angle": f"theta_{pname}", "sign": sign}
         return {"length": pname, **angle(b, _angle_deg(xy[p], xy[q])), "sign": sign}
@@ -148,6 +168,7 @@ def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, 
         """A slider's edge J0 -> P: its offset across the line, then its travel along it."""
         start, end = drawing.center(sliders[b].on), drawing.center(b)
         line = sliders[b].angle_deg
+        own(f"e_{b}", f"slider {b}'s offset")
         params[f"e_{b}"] = {"value": slid[b][1], "unit": unit, "signed": True}
         e = {"length": f"e_{b}", **angle(sliders[b].on, wrap_degrees(line + 90.0))}
         s = {"length": f"s_{b}", **angle(sliders[b].on, line)}
@@ -202,8 +223,7 @@ def _driver(doc: Mapping[str, Any], d: Drawing, scale: float, fail: Any) -> tupl
     if ("link" in drv) == ("slider" in drv):
         raise fail("driver", "name one: link = NAME (its angle) or slider = NAME (its travel)")
     value = drv.get("value")
-    if value is not None and (not isinstance(value, (int, float)) or isinstance(value, bool)
-                              or not math.isfinite(value)):
+    if value is not None and not _number(value):
         raise fail("driver.value", "must be a finite number (degrees for a link, the length "
                                    "unit for a slider)")
     if "slider" in drv:
@@ -246,18 +266,20 @@ def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
     for key in doc:
         if key not in allowed:
             raise fail(key, f"unknown key in a joints file (expected one of {', '.join(sorted(allowed))})")
-    joints_doc, links_doc = doc["joints"], doc["links"]
+    joints_doc, links_doc = doc.get("joints"), doc.get("links")
     if not isinstance(joints_doc, Mapping) or not joints_doc:
         raise fail("joints", "must be a table of joint = [x, y]")
     for key, table in (("joints", joints_doc), ("links", links_doc)):
         if isinstance(table, Mapping) and len(table) > MAX_JOINTS:
             raise fail(key, f"{len(table):,} entries; at most {MAX_JOINTS:,} are accepted, far above "
                             "any real mechanism")
+    for key, table in (("joints", joints_doc), ("links", links_doc)):
+        if isinstance(table, Mapping) and "" in table:  # "" is a loop's unnamed point (a foot)
+            raise fail(key, '"" is no name: give each a name')
     xy: dict[str, tuple[float, float]] = {}
     for name, p in joints_doc.items():
         if (not isinstance(p, list) or len(p) != 2 or
-                not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-                        for v in p)):
+                not all(_number(v) for v in p)):
             raise fail(f"joints.{name}", "must be [x, y]: two finite numbers in the file's length_unit")
         xy[str(name)] = (float(p[0]), float(p[1]))
     ground = doc.get("ground")
@@ -297,9 +319,14 @@ def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
     for b, js in bodies.items():
         for j in js:
             at[j].append(b)
-    loose = [j for j, bs in at.items() if not bs]
+    # a fixed joint on no link is a slip, unless it marks a slider's line
+    lines = {j for v in sliders_doc.values() if isinstance(v, Mapping) for j in v.get("line", [])}
+    loose = [j for j, bs in at.items() if not [b for b in bs if b != GROUND] and j not in lines]
     if loose:
-        raise fail(f"joints.{loose[0]}", "is on no link")
+        raise fail(f"joints.{loose[0]}", "is on no link" + (" (a fixed joint carries a link)"
+                                                           if at[loose[0]] else ""))
+    # before the mobility: a part apart from the ground has its own, which would mislead
+    _connected(bodies, at, sliders, fail)
 
     # coupler points: a joint on one moving link and nothing else, drawn on it (a slider's
     # first joint is its pin on the line, never a point)
@@ -317,7 +344,6 @@ def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
         kinds = f"{revolute} revolute" + (f" and {len(sliders)} sliding" if sliders else "")
         raise fail("links", f"mobility {mobility} ({n} bodies with the ground, {kinds} pairs: "
                             f"3 x {n - 1} - 2 x {pairs}): {what}; a joints file needs mobility 1")
-    _connected(bodies, at, sliders, fail)
     return Drawing(xy, list(ground), links, bodies, points, sliders)
 
 
@@ -350,7 +376,7 @@ def _sliders(spec: Mapping[str, Any], bodies: Mapping[str, list[str]],
                             f"line = [P, Q] (parallel to two joints of {on})")
         if "angle" in s:
             a = s["angle"]
-            if not isinstance(a, (int, float)) or isinstance(a, bool) or not math.isfinite(a) or abs(a) > 1e6:
+            if not _number(a) or abs(a) > 1e6:
                 raise fail(f"{key}.angle", "must be a finite number of degrees (the line's direction "
                                            "as drawn)")
             angle = float(a)
@@ -481,6 +507,12 @@ def _toml_value(v: Any) -> str:
     raise TypeError(type(v).__name__)
 
 
+def _toml_key(k: str) -> str:
+    """A key as TOML reads it back: bare when it can be, else quoted (a joint may be named
+    "B'" or "joint 1")."""
+    return k if k and all(c.isascii() and (c.isalnum() or c in "_-") for c in k) else _toml_value(k)
+
+
 def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>") -> str:
     """The derived loops-form file of a drawing, as TOML text: each loop under a comment
     naming its joints, so the loop-closure equations the drawing implies can be read."""
@@ -493,10 +525,10 @@ def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>") -> str:
     out += [f"length_unit = {_toml_value(d['length_unit'])}",
             f"origin = {_toml_value(d['origin'])}  # where {first} is drawn",
             "", "[parameters]  # the drawn lengths (and the ground's angles; e_: a slider line's offset)"]
-    out += [f"{k} = {_toml_value(v)}" for k, v in d["parameters"].items()]
+    out += [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in d["parameters"].items()]
     out += ["", "[driver]"] + [f"{k} = {_toml_value(v)}" for k, v in d["driver"].items()]
     out += ["", "[unknowns]  # each moving link's angle (s_: a slider's travel), guessed from the drawing"]
-    out += [f"{k} = {_toml_value(v)}" for k, v in d["unknowns"].items()]
+    out += [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in d["unknowns"].items()]
     for loop in d["loops"]:
         names = loop["joints"]
         shown = [n or "(foot)" for n in names]
@@ -507,6 +539,6 @@ def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>") -> str:
                 for v, a, b in zip(loop["vectors"], shown, [*shown[1:], shown[0]])]
         out.append("]")
     for name, p in d.get("points", {}).items():
-        out += ["", f"[points.{name}]  # on a link, nothing else attached",
+        out += ["", f"[points.{_toml_key(name)}]  # on a link, nothing else attached",
                 f"from = {_toml_value(p['from'])}", f"vectors = {_toml_value(p['vectors'])}"]
     return "\n".join(out) + "\n"

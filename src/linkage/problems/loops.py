@@ -294,12 +294,12 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
 
     from .joints import is_joints_doc, loops_doc
 
+    _check_printable(doc, fail)  # a drawing's too, before its names are in a message
     if is_joints_doc(doc):  # a drawing: its loops derived (problems/joints.py)
         doc = loops_doc(doc, source)
 
     allowed = {"name", "description", "length_unit", "closed_form", "parameters", "driver",
                "unknowns", "loops", "notes", "points", "origin"}
-    _check_printable(doc, fail)
     for key in doc:
         if key not in allowed:
             raise fail(key, f"unknown key (expected one of {', '.join(sorted(allowed))})")
