@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from ..problems.templates import links_order
+from ..problems.templates import angles, links_order
 from .root import app
 
 OPTIONS = {"links": "--links", "angle_deg": "--angle", "branch": "--branch", "unit": "--unit",
@@ -30,12 +30,12 @@ def new(
                      f"{links_order()} (offset: a slider line's, any sign). Default: the sample's "
                      "(linkage samples).")] = False,
     angle: Annotated[Optional[float], typer.Option("--angle", metavar="DEG", help="The crank's angle "
-                     "in the drawing, degrees (default: the sample's, 30 or 45 or 60).",
+                     f"in the drawing, degrees (default: the sample's: {angles()}).",
                      show_default=False)] = None,
     branch: Annotated[str, typer.Option("--branch", help="The assembly drawn: open (a four-bar's rocker "
                       "turns anticlockwise from its coupler; a slider-crank's coupler points the way "
-                      "the slide grows) or crossed; a six-bar takes one word per dyad, e.g. "
-                      "open/crossed.")] = "open",
+                      "the slide grows; an inverted slider's rocker points towards the block) or "
+                      "crossed; a six-bar takes one word per dyad, e.g. open/crossed.")] = "open",
     unit: Annotated[str, typer.Option("--unit", help="The file's length_unit: mm, cm, m, in or ft.")] = "mm",
     name: Annotated[Optional[str], typer.Option("--name", help="The mechanism's name "
                     "(default: its kind's).", show_default=False)] = None,
@@ -45,9 +45,12 @@ def new(
                       "instead of standard output; an existing file is kept unless --force.")] = None,
     force: Annotated[bool, typer.Option("--force", help="With -o: replace an existing file.")] = False,
 ) -> None:
-    """Start a mechanism file in one command: a four-bar, slider-crank, inverted slider-crank,
-    Watt or Stephenson six-bar from its link lengths, drawn at the crank angle you give as a
-    commented joints-and-links file that solves and sweeps as written.
+    """Start a mechanism file from its link lengths: a four-bar, slider-crank, inverted
+    slider-crank, Watt or Stephenson six-bar, drawn as a commented joints file.
+
+    The file solves and sweeps as written: the crank at --angle, each dyad closed on
+    --branch. Move its joints to change the design; --form loops writes the vector loops
+    the drawing implies instead.
 
     Example: linkage new fourbar --links 40 120 80 100 -o my_fourbar.toml
     """

@@ -28,6 +28,8 @@ from . import dyads
 
 Point = tuple[float, float]
 BRANCHES = ("open", "crossed")
+COMMENT_WIDTH = 92
+"""The file's comments are wrapped to this width."""
 MAX_ANGLE_DEG = 1e6
 """The largest drawn angle accepted: beyond it a degree is below a double's resolution."""
 
@@ -226,6 +228,17 @@ def links_order(kind: str | None = None) -> str:
     return "; ".join(f"{key}: {' '.join(k.links)}" for key, k in KINDS.items() if kind in (None, key))
 
 
+def angles() -> str:
+    """Each kind's default crank angle (its sample's), for --help."""
+    return ", ".join(f"{key} {_num(k.angle_deg)}" for key, k in KINDS.items())
+
+
+def _num(v: float) -> str:
+    """The shortest text that reads back as ``v`` (40, not 40.0)."""
+    text = repr(float(v))
+    return text[:-2] if text.endswith(".0") else text
+
+
 def _kind(kind: str) -> Kind:
     if kind not in KINDS:
         raise InputError(f"KIND: {kind!r} is not a kind linkage new draws (kinds: {', '.join(KINDS)})")
@@ -289,12 +302,12 @@ def template(kind: str, links: Sequence[float] | None = None, angle_deg: float |
     try:
         joints = k.draw(lengths, t, sides)
     except _Cannot as exc:
-        raise InputError(f"links {' '.join(f'{v:g}' for v in lengths)}: the {kind} cannot be assembled "
-                         f"at {angle:g} deg ({branch}): {exc}") from None
-    shown = ", ".join(f"{n} {v:g}" for n, v in zip(k.links, lengths))
+        raise InputError(f"links {' '.join(map(_num, lengths))}: the {kind} cannot be assembled "
+                         f"at {_num(angle)} deg ({branch}): {exc}") from None
+    shown = ", ".join(f"{n} {_num(v)}" for n, v in zip(k.links, lengths))
     doc: dict[str, Any] = {
         "name": name if name is not None else k.title,
-        "description": f"{k.title}: {shown} {unit}, drawn with the crank at {angle:g} deg ({branch})",
+        "description": f"{k.title}: {shown} {unit}, drawn with the crank at {_num(angle)} deg ({branch})",
         "length_unit": unit,
         "ground": list(k.ground),
         "joints": {j: [float(x), float(y)] for j, (x, y) in joints.items()},
@@ -313,8 +326,8 @@ def command(kind: str, links: Sequence[float] | None = None, angle_deg: float | 
 
     k = _kind(kind)
     lengths = _lengths(k, kind, links)
-    words = ["linkage", "new", kind, "--links", *(f"{v:.17g}" for v in lengths),
-             "--angle", f"{k.angle_deg if angle_deg is None else angle_deg:.17g}", "--branch", branch,
+    words = ["linkage", "new", kind, "--links", *map(_num, lengths),
+             "--angle", _num(k.angle_deg if angle_deg is None else angle_deg), "--branch", branch,
              "--unit", unit]
     if name is not None:
         words += ["--name", name]
@@ -344,14 +357,19 @@ def joints_text(doc: Mapping[str, Any], kind: str, made_by: str) -> str:
     values, what each joint and link is, the branch drawn, and the commands to try."""
     k = _kind(kind)
     unit = doc["length_unit"]
-    out = [f"# {k.title}, drawn by: {made_by}",
-           f"# --links order for {kind}: " + ", ".join(f"{n} ({m})" for n, m in zip(k.links, k.meaning)),
-           f"# Defaults: the lengths and crank angle of sample_inputs/{k.sample}.",
-           f"# --branch open: {k.open_means}; crossed: the other assembly.",
-           *([f"# Fixed in the drawing: {k.fixed}."] if k.fixed else []),
-           "# Every length and angle comes from the joints below: move them to change the design.",
-           "# Try: linkage solve FILE; linkage sweep FILE; linkage draw FILE; linkage convert FILE",
-           "",
+    import textwrap
+
+    said = [f"--links order for {kind}: " + ", ".join(f"{n} ({m})" for n, m in zip(k.links, k.meaning)),
+            f"Defaults: the lengths and crank angle of sample_inputs/{k.sample}.",
+            f"--branch open: {k.open_means}; crossed: the other assembly.",
+            *([f"Fixed in the drawing: {k.fixed}."] if k.fixed else []),
+            "Every length and angle comes from the joints below: move them to change the design.",
+            "Try: linkage solve FILE; linkage sweep FILE; linkage draw FILE; linkage convert FILE"]
+    out = [f"# {k.title}, drawn by: {made_by}"]  # one line, to copy
+    out += [line for s in said for line in textwrap.wrap(s, COMMENT_WIDTH, initial_indent="# ",
+                                                        subsequent_indent="#   ", break_long_words=False,
+                                                        break_on_hyphens=False)]
+    out += ["",
            f"name = {_toml(doc['name'])}",
            f"description = {_toml(doc['description'])}",
            f"length_unit = {_toml(unit)}",
