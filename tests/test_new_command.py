@@ -165,9 +165,25 @@ def test_the_loops_form_solves_to_the_same_answers(cli, tmp_path, kind: str) -> 
     assert r.code == 0, r.err
     assert "[[loops]]" in r.out and "[joints]" not in r.out
     assert r.out.startswith(f"# drawn by: linkage new {kind} --links ")
+    (path,) = tmp_path.iterdir()
+    converted = cli("convert", str(path)).out
+    assert converted.splitlines()[1:] == r.out.splitlines()[2:]  # one derivation, from one drawing
     for value in (None, 10.0, 95.0, 275.0):
         a, b = solved(joints, value)[1], solved(r.out, value)[1]
         assert list(a.x) == pytest.approx(list(b.x), abs=1e-12)
+
+
+def test_the_command_in_the_file_makes_the_file_again(cli, tmp_path) -> None:
+    import shlex
+
+    text = made(cli, tmp_path, "stephenson", "--links", "1/3", "120", "80.5", "100", "60", "100", "90", "160",
+                "--angle", "-33.25", "--branch", "open/crossed", "--unit", "cm", "--name", "it's mine")
+    first = text.splitlines()[0]
+    assert first.startswith("# Stephenson III six-bar, drawn by: linkage new stephenson "
+                            "--links 0.3333333333333333 120 80.5 ")
+    words = shlex.split(first.split("drawn by: ", 1)[1])
+    again = cli(*words[1:])
+    assert again.code == 0 and again.out == text
 
 
 def test_the_defaults_are_the_samples_and_the_file_says_how_it_was_made(cli, tmp_path) -> None:
