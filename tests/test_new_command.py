@@ -257,6 +257,8 @@ def test_an_existing_file_is_kept_unless_forced(cli, tmp_path) -> None:
     (["fourbar", "--name", "two\nlines"], "--name: must be one line of printable text"),
     (["fourbar", "--form", "loop"], "--form: 'loop': give joints or loops"),
     (["fourbar", "--angel", "30"], "no such option: --angel"),
+    (["--links", "40", "120", "80", "100", "fourbar"], "give KIND first: linkage new fourbar --links"),
+    ([], "Missing argument 'KIND'"),
 ])
 def test_what_cannot_be_drawn_is_refused_in_one_line(cli, tmp_path, args: list[str], message: str) -> None:
     out = tmp_path / "out.toml"

@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from ..problems.templates import angles, links_order
+from ..problems.templates import KINDS, angles, links_order
 from .root import app
 
 OPTIONS = {"links": "--links", "angle_deg": "--angle", "branch": "--branch", "unit": "--unit",
@@ -61,6 +61,9 @@ def new(
     from .options import check_paths, stdout_errors
 
     given = list(lengths or [])
+    kinds = [item for item in given if item in KINDS]
+    if kinds:
+        raise InputError(f"give KIND first: linkage new {kinds[0]} --links ...")
     for item in given:
         if item.startswith("-") and not item[1:2].isdigit() and item[1:2] != ".":
             raise InputError(f"no such option: {item} (see linkage new --help)")

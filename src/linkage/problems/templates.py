@@ -31,7 +31,8 @@ BRANCHES = ("open", "crossed")
 COMMENT_WIDTH = 92
 """The file's comments are wrapped to this width."""
 MAX_ANGLE_DEG = 1e6
-"""The largest drawn angle accepted: beyond it a degree is below a double's resolution."""
+"""The largest drawn angle accepted (degrees): the drawing's check of the driver value
+(joints.DRIVER_TOLERANCE_DEG, 1e-6) needs the angle's rounding well below it (here 1e-10)."""
 
 
 Joints = dict[str, Point]
