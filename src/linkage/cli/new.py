@@ -1,0 +1,94 @@
+"""linkage new."""
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ..errors import InputError
+from ..problems.templates import KINDS, angles, links_order
+from .root import app
+
+OPTIONS = {"links": "--links", "angle_deg": "--angle", "branch": "--branch", "unit": "--unit",
+           "name": "--name", "form": "--form"}
+"""templates' argument names, as this command's options."""
+
+
+@app.command(
+    epilog="Examples:  linkage new fourbar --links 40 120 80 100 -o my_fourbar.toml  |  "
+    "linkage new slider-crank --links 40 120 -5 --angle 90 --branch crossed  |  "
+    "linkage new watt --form loops",
+    context_settings={"ignore_unknown_options": True},  # a negative offset in --links
+)
+def new(
+    kind: Annotated[str, typer.Argument(metavar="KIND", help="fourbar, slider-crank, inverted-slider, "
+                    "watt or stephenson.", show_default=False)],
+    lengths: Annotated[Optional[list[str]], typer.Argument(metavar="[--links LENGTH...]", help="The "
+                       "lengths, in the file's unit.", show_default=False, hidden=True)] = None,
+    *,
+    links: Annotated[bool, typer.Option("--links", help="The lengths follow, in this order: "
+                     f"{links_order()} (offset: a slider line's, any sign). Default: the sample's "
+                     "(linkage samples).")] = False,
+    angle: Annotated[Optional[float], typer.Option("--angle", metavar="DEG", help="The crank's angle "
+                     f"in the drawing, degrees (default: the sample's: {angles()}).",
+                     show_default=False)] = None,
+    branch: Annotated[str, typer.Option("--branch", help="The assembly drawn: open (a four-bar's rocker "
+                      "turns anticlockwise from its coupler; a slider-crank's coupler points the way "
+                      "the slide grows; an inverted slider's rocker points towards the block) or "
+                      "crossed; a six-bar takes one word per dyad, e.g. open/crossed.")] = "open",
+    unit: Annotated[str, typer.Option("--unit", help="The file's length_unit: mm, cm, m, in or ft.")] = "mm",
+    name: Annotated[Optional[str], typer.Option("--name", help="The mechanism's name "
+                    "(default: its kind's).", show_default=False)] = None,
+    form: Annotated[str, typer.Option("--form", help="joints (the drawing) or loops (the vector loops "
+                    "it implies, as linkage convert prints them).")] = "joints",
+    output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Write the file here (.toml) "
+                      "instead of standard output; an existing file is kept unless --force.")] = None,
+    force: Annotated[bool, typer.Option("--force", help="With -o: replace an existing file.")] = False,
+) -> None:
+    """Start a mechanism file from its link lengths: a four-bar, slider-crank, inverted
+    slider-crank, Watt or Stephenson six-bar, drawn as a commented joints file.
+
+    The file solves and sweeps as written: the crank at --angle, each dyad closed on
+    --branch. Move its joints to change the design; --form loops writes the vector loops
+    the drawing implies instead.
+
+    Example: linkage new fourbar --links 40 120 80 100 -o my_fourbar.toml
+    """
+    import sys
+
+    from ..numbers import parse_number
+    from ..problems.templates import text
+    from .options import check_paths, stdout_errors
+
+    given = list(lengths or [])
+    kinds = [item for item in given if item in KINDS]
+    if kinds:
+        raise InputError(f"give KIND first: linkage new {kinds[0]} --links ...")
+    for item in given:
+        if item.startswith("-") and not item[1:2].isdigit() and item[1:2] != ".":
+            raise InputError(f"no such option: {item} (see linkage new --help)")
+    if given and not links:
+        raise InputError(f"{given[0]!r}: give the lengths after --links, e.g. linkage new {kind} "
+                         f"--links {' '.join(given)}")
+    if links and not given:
+        raise InputError(f"--links: give the lengths after it ({links_order(kind) or links_order()})")
+    values = [parse_number(f"--links {item}", item) for item in given]
+    if output is not None and str(output) != "-" and output.suffix.lower() != ".toml":
+        raise InputError(f"-o {output}: a mechanism file: name it with .toml")
+    try:
+        content = text(kind, values or None, angle, branch, unit, name, form)
+    except InputError as exc:  # the library names its arguments; say them as options
+        word, sep, rest = str(exc).partition(" " if str(exc).startswith("links ") else ":")
+        raise InputError(f"{OPTIONS.get(word, word)}{sep}{rest}") from None
+    if output is None or str(output) == "-":
+        with stdout_errors():
+            sys.stdout.write(content)
+            sys.stdout.flush()
+        return
+    if (output.exists() or output.is_symlink()) and not force:
+        raise InputError(f"-o {output} exists; choose a new name, or --force to replace it")
+    check_paths([], [("--output", output)])
+    from ..files import write_atomic
+
+    write_atomic(output, content)
+    typer.echo(f"wrote {output}", err=True)
