@@ -211,9 +211,13 @@ def test_lm_never_claims_success_above_tolerance(r1, r2, r3, r4, theta2):
         assert not result.converged and result.status is Status.NO_SOLUTION
     elif result.status is Status.CONVERGED_STEP:
         # a step-converged claim is a forward one: within tol of a root the closed form gives
-        gap = min(max(abs(math.remainder(x - t, 2 * math.pi)) for x, t in zip(result.x, (sol["theta3"], sol["theta4"])))
-                  for sol in sols.values())
-        assert gap <= 1e-9 * 10
+        assert gap_to_roots(result.x, sols) <= 1e-9 * 10
+
+
+def gap_to_roots(x, sols):
+    """The largest angle (rad) by which x misses the nearest closed-form assembly."""
+    return min(max(abs(math.remainder(v - sol[k], 2 * math.pi)) for v, k in zip(x, ("theta3", "theta4")))
+               for sol in sols.values())
 
 
 def test_lm_at_a_change_point_claims_the_residual_not_a_step():
@@ -226,9 +230,7 @@ def test_lm_at_a_change_point_claims_the_residual_not_a_step():
     result = solve_system(problem, method="lm", tol=1e-9, max_iter=200)
     assert result.status is Status.CONVERGED_RESIDUAL
     sols = fourbar_positions(2.0, 2.0, 2.0, 2.0, 0.0, theta2=math.radians(1e-7))
-    gap = min(max(abs(math.remainder(x - t, 2 * math.pi)) for x, t in zip(result.x, (sol["theta3"], sol["theta4"])))
-              for sol in sols.values())
-    assert gap > 0.1  # far from every root: what the residual claim, not a step claim, allows
+    assert gap_to_roots(result.x, sols) > 0.1  # far from every root: a residual claim, not a step one
 
 
 def test_a_change_point_is_indeterminate_not_unassemblable():
