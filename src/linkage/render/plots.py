@@ -38,11 +38,24 @@ def _check_suffix(path: Path, allowed: Sequence[str]) -> None:
 
 
 def _save(fig: Any, path: Path) -> None:
+    import warnings
+
     from ..files import atomic_target
 
     try:
-        with atomic_target(path) as tmp:
+        with atomic_target(path) as tmp, warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
             fig.savefig(tmp, dpi=120, bbox_inches="tight", format=path.suffix.lower()[1:])
+        # matplotlib's two-line warning per missing glyph (a name in a script the font
+        # lacks) becomes one line saying what the reader will see
+        if any("missing from font" in str(w.message) for w in seen):
+            import sys
+
+            print(f"note: {path}: the font has no glyph for some characters of the names; "
+                  "they show as boxes", file=sys.stderr)
+        for w in seen:
+            if "missing from font" not in str(w.message):
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     finally:
         import matplotlib.pyplot as plt
 
