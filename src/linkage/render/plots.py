@@ -241,9 +241,12 @@ def _draw(ax: Any, mechanism: Any, q: Sequence[float], driver: float, title: str
             ax.plot([a.real, b.real], [a.imag, b.imag], solid_capstyle="round", **style)
             if not fixed and isinstance(term.length, str) and b != a:
                 mid = (a + b) / 2
-                normal = 1j * (b - a) / abs(b - a)  # label beside the link, never on it
+                normal = 1j * (b - a) / abs(b - a)  # label beside the link, never on it:
+                # the text's near corner on the normal, so a steep link's label clears it
+                ha = "center" if abs(normal.real) < 0.3 else ("left" if normal.real > 0 else "right")
+                va = "center" if abs(normal.imag) < 0.3 else ("bottom" if normal.imag > 0 else "top")
                 ax.annotate(term.length, (mid.real, mid.imag), textcoords="offset points",
-                            xytext=(9 * normal.real, 9 * normal.imag), ha="center", va="center",
+                            xytext=(5 * normal.real, 5 * normal.imag), ha=ha, va=va,
                             fontsize=8, color=style["color"])
         labels = loop.joints or ("",) * len(loop.vectors)
         for k, label in enumerate(labels):
