@@ -11,16 +11,22 @@ from .root import app
 
 
 @app.command(
-    epilog="Example:  linkage convert my_fourbar.toml -o my_fourbar_loops.toml",
+    epilog="Examples:  linkage convert my_fourbar.toml -o my_fourbar_loops.toml  |  "
+           "linkage convert sample_inputs/watt_sixbar.toml --form joints",
 )
 def convert(
     file: MechanismFile,
     *,
-    output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Write the loops-form file "
+    form: Annotated[Optional[str], typer.Option("--form", metavar="FORM", help="The form to write: "
+                    "loops (the vector loops a drawing implies) or joints (a loops file drawn as "
+                    "joints and links). Default: the form the file is not in.")] = None,
+    output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Write the converted file "
                       "here (.toml) instead of standard output.")] = None,
 ) -> None:
-    """Print the vector loops a drawing implies: a joints-and-links file as the loops form,
-    each loop under a comment naming its joints.
+    """Convert a mechanism file between its two forms: a joints-and-links file to the
+    vector loops it implies (each loop under a comment naming its joints), or a loops file
+    to joints and links (its loops solved at the driver value, each joint where they place
+    it).
 
     Example: linkage convert my_fourbar.toml
     """
@@ -30,14 +36,24 @@ def convert(
     from ..problems.joints import is_joints_doc, loops_text
     from ..problems.loops import parse_mechanism
 
+    if form is not None and form.lower() not in ("joints", "loops"):
+        raise InputError(f"--form {form!r}: write joints or loops")
     if output is not None and str(output) != "-" and output.suffix.lower() != ".toml":
         raise InputError(f"-o {output}: a mechanism file: name it with .toml")
     check_paths([file], [("--output", output)])
     doc = parse_toml(read_input(file), str(file))
-    if not is_joints_doc(doc):
-        raise InputError(f"{file} is already in the loops form (the joints form from loops is to come)")
-    parse_mechanism(doc, str(file))  # refuse here what solve refuses: the printed file solves
-    text = loops_text(doc, str(file))
+    now = "joints" if is_joints_doc(doc) else "loops"
+    wanted = (form or ("loops" if now == "joints" else "joints")).lower()
+    if wanted == now:
+        raise InputError(f"{file} is already in the {now} form: --form "
+                         f"{'loops' if now == 'joints' else 'joints'} converts it")
+    mechanism = parse_mechanism(doc, str(file))  # refuse what solve refuses: the printed file solves
+    if wanted == "loops":
+        text = loops_text(doc, str(file))
+    else:
+        from ..problems.to_joints import joints_text
+
+        text = joints_text(mechanism, str(file))
     if output is None or str(output) == "-":
         with stdout_errors():
             sys.stdout.write(text)
