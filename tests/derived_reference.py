@@ -102,7 +102,7 @@ class Case:
         for vectors in self.loops:
             out += ["", "[[loops]]", "vectors = ["]
             for v in vectors:
-                body = ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items())
+                body = ", ".join(f"{k} = {toml_value(x)}" for k, x in v.items())
                 out.append(f"  {{ {body} }},")
             out.append("]")
         return "\n".join(out) + "\n"
@@ -118,7 +118,7 @@ class Case:
         return Case(self.family, dict(self.params), (name, value), unknowns, self.loops, roles, self.signed)
 
 
-def _toml_value(x: Any) -> str:
+def toml_value(x: Any) -> str:
     return f'"{x}"' if isinstance(x, str) else repr(x)
 
 

@@ -43,7 +43,7 @@ def test_convert_refuses_what_it_cannot_do(cli, tmp_path) -> None:
     assert r.code == 2 and "name it with .toml" in r.err and r.err.count("\n") == 1
     loops = tmp_path / "loops.toml"
     loops.write_text(cli("convert", str(path)).out)
-    r = cli("convert", str(loops))
+    r = cli("convert", str(loops), "--form", "loops")
     assert r.code == 2 and "already in the loops form" in r.err
     r = cli("convert", str(path), "-o", str(tmp_path / "out.toml"))
     assert r.code == 0 and (tmp_path / "out.toml").read_text() == loops.read_text()

@@ -337,7 +337,7 @@ EXTREMES = [0, -1, 1e-320, 3e-320, 1e-300, 1e308, 1.7e308, 10**58, 10**400, -(10
             float("nan"), float("inf"), "text", True, [1, 2], {"value": 1}, ""]
 
 
-def _toml_value(v: object) -> str:
+def toml_value(v: object) -> str:
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, float):
@@ -345,9 +345,9 @@ def _toml_value(v: object) -> str:
     if isinstance(v, int):
         return str(v)
     if isinstance(v, list):
-        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
     if isinstance(v, dict):
-        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
+        return "{ " + ", ".join(f"{k} = {toml_value(x)}" for k, x in v.items()) + " }"
     return json.dumps(v)
 
 
@@ -363,7 +363,7 @@ def mutate(text: str, rng: random.Random) -> str:
         lines = text.splitlines()
         if kind == 0 and numbers:
             m = rng.choice(numbers)
-            text = text[:m.start()] + _toml_value(rng.choice(EXTREMES)) + text[m.end():]
+            text = text[:m.start()] + toml_value(rng.choice(EXTREMES)) + text[m.end():]
         elif kind == 1 and names:
             m = rng.choice(names)
             new = rng.choice(['"nosuch"', '"theta2"', '"r1"', '""', '"' + "x" * 300 + '"', "7"])
@@ -388,7 +388,7 @@ def mutate(text: str, rng: random.Random) -> str:
         else:
             for key in ("unit", "sign", "offset", "closed_form", "length_unit", "guess", "value"):
                 if key in text and rng.random() < 0.3:
-                    junk = _toml_value(rng.choice(EXTREMES))
+                    junk = toml_value(rng.choice(EXTREMES))
                     text = text.replace(f"{key} = ", f"{key} = {junk}, x{key} = ", 1)
     return text
 
@@ -427,7 +427,7 @@ def test_cli_fuzz_mechanism_mutations_and_extremes(cli, tmp_path, monkeypatch):
         codes[well_behaved(cli(*args), args, text[:2000])] += 1
         count += 1
     for _ in range(700):
-        value = _toml_value(rng.choice(EXTREMES))
+        value = toml_value(rng.choice(EXTREMES))
         args = rng.choice([
             ["solve", str(SAMPLES / "fourbar_me581.toml"), "--set", f"r{rng.randint(1, 4)}={value}"],
             ["solve", str(SAMPLES / "fourbar_me581.toml"), "--guess", f"theta3={value}"],
@@ -515,9 +515,9 @@ def scan_invocation(rng: random.Random) -> list[str]:
 def with_points(text: str, rng: random.Random) -> str:
     """A [points] table added to a mechanism, valid or not."""
     start = rng.choice(['"A"', '"B"', '"O2"', '"nosuch"', '""', "7"])
-    length = _toml_value(rng.choice([60, 0, -5, 1e308, float("nan"), "theta3", "r2", "nosuch", 1e-320]))
-    angle = _toml_value(rng.choice(["theta3", "theta4", "theta2", 30, float("inf"), "nosuch", "s"]))
-    offset = _toml_value(rng.choice([30, 0, -720, 1e308, float("nan"), "x"]))
+    length = toml_value(rng.choice([60, 0, -5, 1e308, float("nan"), "theta3", "r2", "nosuch", 1e-320]))
+    angle = toml_value(rng.choice(["theta3", "theta4", "theta2", 30, float("inf"), "nosuch", "s"]))
+    offset = toml_value(rng.choice([30, 0, -720, 1e308, float("nan"), "x"]))
     name = rng.choice(["Q", "P", "A", "theta3", "Q_x", "design", "x" * 100])
     return text + f'\n[points.{name}]\nfrom = {start}\nvectors = [ {{ length = {length}, angle = {angle}, ' \
                   f'offset = {offset} }} ]\n'

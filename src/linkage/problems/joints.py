@@ -493,7 +493,7 @@ def _cycles(edges: list[tuple[str, str, str]], root: str) -> list[Cycle]:
     return cycles
 
 
-def _toml_value(v: Any) -> str:
+def toml_value(v: Any) -> str:
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, (int, float)):
@@ -501,16 +501,16 @@ def _toml_value(v: Any) -> str:
     if isinstance(v, str):
         return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
     if isinstance(v, list):
-        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
     if isinstance(v, Mapping):
-        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
+        return "{ " + ", ".join(f"{k} = {toml_value(x)}" for k, x in v.items()) + " }"
     raise TypeError(type(v).__name__)
 
 
-def _toml_key(k: str) -> str:
+def toml_key(k: str) -> str:
     """A key as TOML reads it back: bare when it can be, else quoted (a joint may be named
     "B'" or "joint 1")."""
-    return k if k and all(c.isascii() and (c.isalnum() or c in "_-") for c in k) else _toml_value(k)
+    return k if k and all(c.isascii() and (c.isalnum() or c in "_-") for c in k) else toml_value(k)
 
 
 def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>") -> str:
@@ -518,27 +518,27 @@ def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>") -> str:
     naming its joints, so the loop-closure equations the drawing implies can be read."""
     d = loops_doc(doc, source)
     out = [f"# the vector loops of {source}, derived from its joints and links (linkage convert)",
-           f"name = {_toml_value(d['name'])}"]
+           f"name = {toml_value(d['name'])}"]
     if d.get("description"):
-        out.append(f"description = {_toml_value(d['description'])}")
+        out.append(f"description = {toml_value(d['description'])}")
     first = d["loops"][0]["joints"][0] if d["loops"] else "the first joint"
-    out += [f"length_unit = {_toml_value(d['length_unit'])}",
-            f"origin = {_toml_value(d['origin'])}  # where {first} is drawn",
+    out += [f"length_unit = {toml_value(d['length_unit'])}",
+            f"origin = {toml_value(d['origin'])}  # where {first} is drawn",
             "", "[parameters]  # the drawn lengths (and the ground's angles; e_: a slider line's offset)"]
-    out += [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in d["parameters"].items()]
-    out += ["", "[driver]"] + [f"{k} = {_toml_value(v)}" for k, v in d["driver"].items()]
+    out += [f"{toml_key(k)} = {toml_value(v)}" for k, v in d["parameters"].items()]
+    out += ["", "[driver]"] + [f"{k} = {toml_value(v)}" for k, v in d["driver"].items()]
     out += ["", "[unknowns]  # each moving link's angle (s_: a slider's travel), guessed from the drawing"]
-    out += [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in d["unknowns"].items()]
+    out += [f"{toml_key(k)} = {toml_value(v)}" for k, v in d["unknowns"].items()]
     for loop in d["loops"]:
         names = loop["joints"]
         shown = [n or "(foot)" for n in names]
         out += ["", f"# {' -> '.join([*shown, shown[0]])}: the sum of these vectors is zero",
-                "[[loops]]", f"name = {_toml_value(loop['name'])}", f"joints = {_toml_value(names)}",
+                "[[loops]]", f"name = {toml_value(loop['name'])}", f"joints = {toml_value(names)}",
                 "vectors = ["]
-        out += [f"  {_toml_value(v)},  # {a} -> {b}"
+        out += [f"  {toml_value(v)},  # {a} -> {b}"
                 for v, a, b in zip(loop["vectors"], shown, [*shown[1:], shown[0]])]
         out.append("]")
     for name, p in d.get("points", {}).items():
-        out += ["", f"[points.{_toml_key(name)}]  # on a link, nothing else attached",
-                f"from = {_toml_value(p['from'])}", f"vectors = {_toml_value(p['vectors'])}"]
+        out += ["", f"[points.{toml_key(name)}]  # on a link, nothing else attached",
+                f"from = {toml_value(p['from'])}", f"vectors = {toml_value(p['vectors'])}"]
     return "\n".join(out) + "\n"

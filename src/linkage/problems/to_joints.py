@@ -24,7 +24,7 @@ import re
 from typing import Any, NamedTuple
 
 from ..errors import InputError
-from .joints import GROUND, _toml_key, _toml_value
+from .joints import GROUND, toml_key, toml_value
 
 CHECK_TOLERANCE = 1e-9
 """How closely the drawing's own solve must reproduce the placed joints (of the size)."""
@@ -277,21 +277,21 @@ def joints_text(m: Any, source: str) -> str:
                 names.setdefault(t.angle, set()).add(t.length)
     out = [f"# {source} drawn as joints and links (linkage convert --form joints): its loops",
            f"# solved at {m.driver.name} = {_shown_driver(m)}, each joint where they place it",
-           f"name = {_toml_value(doc['name'])}"]
+           f"name = {toml_value(doc['name'])}"]
     if doc["description"]:
-        out.append(f"description = {_toml_value(doc['description'])}")
-    out += [f"length_unit = {_toml_value(unit)}", f"ground = {_toml_value(doc['ground'])}  # fixed joints",
+        out.append(f"description = {toml_value(doc['description'])}")
+    out += [f"length_unit = {toml_value(unit)}", f"ground = {toml_value(doc['ground'])}  # fixed joints",
             "", f"[joints]  # one pose, in {unit}"]
-    out += [f"{_toml_key(j)} = {_toml_value(xy)}" for j, xy in doc["joints"].items()]
+    out += [f"{toml_key(j)} = {toml_value(xy)}" for j, xy in doc["joints"].items()]
     out += ["", "[links]  # the joints each rigid link carries; its angle: first joint -> second"]
     for link, js in doc["links"].items():
         was = next((a for a in names if _link_name(a) == link), None)
         note = f"  # {was}: {', '.join(sorted(names[was]))}" if was else ""
-        out.append(f"{_toml_key(link)} = {_toml_value(js)}{note}")
+        out.append(f"{toml_key(link)} = {toml_value(js)}{note}")
     if "sliders" in doc:
         out += ["", "[sliders]  # a link sliding along a line fixed to `on`, through its first joint"]
-        out += [f"{_toml_key(s)} = {_toml_value(spec)}" for s, spec in doc["sliders"].items()]
-    out += ["", "[driver]"] + [f"{k} = {_toml_value(v)}" for k, v in doc["driver"].items()]
+        out += [f"{toml_key(s)} = {toml_value(spec)}" for s, spec in doc["sliders"].items()]
+    out += ["", "[driver]"] + [f"{k} = {toml_value(v)}" for k, v in doc["driver"].items()]
     if "slider" in doc["driver"]:
         out[-1] += "  # its travel is the drawn one"
     return "\n".join(out) + "\n"
