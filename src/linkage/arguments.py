@@ -436,3 +436,20 @@ def motion_text(speed: str | None, accel: str | None, mechanism: Any) -> str | N
         a_number, a_unit = _RATE.fullmatch(accel).groups()  # type: ignore[union-attr]
         a_unit = a_unit or f"{per}/s^2"
     return f"{float(number):g} {unit}, {float(a_number):g} {a_unit}"
+
+
+def driver_span(mechanism: Any, start: float | None, stop: float | None,
+                turn_end: float = 360.0) -> tuple[float, float]:
+    """The driver values a sweep, scan or animation runs between: --from and --to where
+    given, else the file's ``[driver] range``, else a turn (0 to ``turn_end``) for an
+    angle; a length driver has no natural range and asks for one."""
+    given = getattr(mechanism, "driver_range", None)
+    lo, hi = given if given is not None else (0.0, turn_end)
+    if given is None and mechanism.driver.kind != "angle" and (start is None or stop is None):
+        raise InputError(f"{mechanism.driver.name} is a length: give --from and --to "
+                         "(or range = [LO, HI] under [driver] in the file)")
+    a = check_number("--from", lo if start is None else start)
+    b = check_number("--to", hi if stop is None else stop)
+    if b < a:
+        raise InputError(f"--to ({b:g}) must not be below --from ({a:g})")
+    return a, b

@@ -23,8 +23,10 @@ def draw(
     animate: Annotated[Optional[Path], typer.Option(help="A GIF of the mechanism over a sweep of "
                        "its driver (--from, --to, --step).")] = None,
     set_: SetOpt = None,
-    start: Annotated[float, typer.Option("--from", help="Animation: first driver value.")] = 0.0,
-    stop: Annotated[float, typer.Option("--to", help="Animation: last driver value.")] = 360.0,
+    start: Annotated[Optional[float], typer.Option("--from", help="Animation: first driver value "
+                     "(default 0, or the file's [driver] range).")] = None,
+    stop: Annotated[Optional[float], typer.Option("--to", help="Animation: last driver value "
+                    "(default 360, or the file's [driver] range).")] = None,
     step: Annotated[float, typer.Option(help="Animation: driver increment per frame.")] = 5.0,
     fps: Annotated[Optional[float], typer.Option(help="Animation: frames per second (0.01 to 100; "
                    "default 12).")] = None,
@@ -33,7 +35,7 @@ def draw(
 
     Example: linkage draw sample_inputs/fourbar_me581.toml --set theta2=80 -o fourbar.png
     """
-    from ..arguments import check_fps
+    from ..arguments import check_fps, driver_span
     from ..kinematics.sweep import driver_values
     from ..kinematics.sweep import sweep as run_sweep
     from ..problems.loops import load
@@ -61,8 +63,8 @@ def draw(
     if animate is not None:
         from ..render.plots import animate_sweep, assembly_gaps, sweep_frames
 
-        a, b = check_number("--from", start), check_number("--to", stop)
-        if not check_number("--step", step) > 0 or b < a:
+        a, b = driver_span(mechanism, start, stop)
+        if not check_number("--step", step) > 0:
             raise InputError("--step must be > 0 and --to must not be below --from")
         values = driver_values(a, b, step, None)
         if len(values) > 2000:

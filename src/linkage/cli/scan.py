@@ -41,8 +41,10 @@ def scan(
                         "or random.")] = "lhs",
     seed: Annotated[int, typer.Option(help="With --samples: the random seed (same seed, same "
                     "designs).")] = 0,
-    start: Annotated[Optional[float], typer.Option("--from", help="First driver value (default 0).")] = None,
-    stop: Annotated[Optional[float], typer.Option("--to", help="Last driver value (default 359).")] = None,
+    start: Annotated[Optional[float], typer.Option("--from", help="First driver value (default 0, or "
+                     "the file's [driver] range).")] = None,
+    stop: Annotated[Optional[float], typer.Option("--to", help="Last driver value (default 359, or "
+                    "the file's [driver] range).")] = None,
     step: Annotated[float, typer.Option(help="Driver increment (default 1).", show_default=False)] = 1.0,
     branch: Annotated[Optional[str], typer.Option(help="Assembly branch every design follows: "
                       "open or crossed (mechanisms with a closed form); default: the branch of "
@@ -80,7 +82,7 @@ def scan(
 
     Example: linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60:5 --vary r4=60:120:7
     """
-    from ..arguments import check_scan_options
+    from ..arguments import check_scan_options, driver_span
     from ..files import parse_toml, read_input
     from ..kinematics.sweep import driver_values
     from ..problems.loops import from_text
@@ -107,12 +109,7 @@ def scan(
                          "values from --vary only")
     mechanism = from_text(text, str(file)).with_values(fixed, {})
     note_closed_form(mechanism)
-    if mechanism.driver.kind != "angle" and (start is None or stop is None):
-        raise InputError(f"{mechanism.driver.name} is a length: give --from and --to")
-    a = 0.0 if start is None else start
-    b = 359.0 if stop is None else stop
-    if b < a:
-        raise InputError(f"--to ({b:g}) must not be below --from ({a:g})")
+    a, b = driver_span(mechanism, start, stop, turn_end=359.0)
     if desc and sort is None:
         raise InputError("--desc orders by --sort: give --sort COLUMN")
     setup = prepare(mechanism, varies, samples=samples, seed=seed, sampling=sampling,

@@ -36,7 +36,8 @@ def sweep(
     *,
     start: Annotated[Optional[float], typer.Option("--from", help="First driver value (driver's "
                      "unit; default 0).")] = None,
-    stop: Annotated[Optional[float], typer.Option("--to", help="Last driver value (default 360).")] = None,
+    stop: Annotated[Optional[float], typer.Option("--to", help="Last driver value (default 360, or "
+                    "the file's [driver] range).")] = None,
     r1: Annotated[Optional[str], typer.Option("--r1", help="Without FILE: R1 (default 5/3).")] = None,
     r2: Annotated[Optional[str], typer.Option("--r2", help="Without FILE: R2 (default 5/2).")] = None,
     r3: Annotated[Optional[str], typer.Option("--r3", help="Without FILE: R3 (default 11/6).")] = None,
@@ -49,7 +50,8 @@ def sweep(
     branch: Annotated[Optional[str], typer.Option(help="Assembly branch to follow (mechanisms "
                       "whose loops have a closed form), by name or signs as in solve --branch: open, "
                       "crossed, open/crossed for a six-bar, 'open (mirror)', +-; default: the "
-                      "branch of the file's guess.")] = None,
+                      "assembly of the file's pose (its guesses solved at its driver value: a "
+                      "drawing's drawn pose).")] = None,
     set_: SetOpt = None,
     tol: Annotated[float, typer.Option(help="Step and residual tolerance per position.")] = 1e-12,
     batch: Annotated[Optional[bool], typer.Option("--batch/--no-batch", help="Use the numpy "
@@ -79,7 +81,7 @@ def sweep(
 
     Example: linkage sweep --from 10 --to 160 --step 30
     """
-    from ..arguments import parse_motion
+    from ..arguments import driver_span, parse_motion
     from ..kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
     from ..problems.loops import load
     from ..render.sweep import sweep_report
@@ -89,14 +91,14 @@ def sweep(
     out_fmt = choose_format(fmt, output)
     check_paths([file], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})
     check_criteria(tol, 0.0, None, 50)
-    a = check_number("--from", 0.0 if start is None else start)
-    b = check_number("--to", 360.0 if stop is None else stop)
     equation_only = {"--r1": r1, "--r2": r2, "--r3": r3, "--links": links}
     if file is None:
         given = [k for k, v in {"--branch": branch, "--set": set_, "--batch": batch, "--path": path,
                                 "--speed": speed, "--accel": accel}.items() if v or v == ""]
         if given:
             raise InputError(f"{', '.join(given)} apply to a mechanism FILE")
+        a = check_number("--from", 0.0 if start is None else start)
+        b = check_number("--to", 360.0 if stop is None else stop)
         sweep_equation(a, b, step, points, method, r1, r2, r3, links, tol, out_fmt, output, digits, plot)
         return
     given = [k for k, v in equation_only.items() if v is not None]
@@ -106,14 +108,13 @@ def sweep(
         raise InputError("give --step or --points, not both")
     if step is not None:
         check_number("--step", step)
-    if b < a:
-        raise InputError(f"--to ({b:g}) must not be below --from ({a:g})")
-    if points is None and step is None:
-        step = 1.0
-    values = driver_values(a, b, step, points)
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SYSTEM_METHODS)}")
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
+    a, b = driver_span(mechanism, start, stop)
+    if points is None and step is None:
+        step = 1.0
+    values = driver_values(a, b, step, points)
     note_closed_form(mechanism)
     w, a_ = parse_motion(speed, accel, mechanism)
     named = [j for loop in mechanism.loops for j in loop.joints if j] + list(mechanism.points)

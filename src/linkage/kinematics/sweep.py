@@ -42,7 +42,9 @@ def sweep_mechanism(
     ``values``: a list or a numpy array. ``branch``: for a mechanism whose loops have a
     derived closed form, a branch name (``open``, ``crossed``; ``open/crossed`` for two
     four-bar loops; ``open (mirror)``) or its signs (``+-``: one per two-way step); else
-    the branch of the file's guess. More than ``BATCH_ABOVE`` values with Newton go
+    the assembly of the file's pose (its guesses solved at its driver value: a drawing's
+    drawn pose, :func:`file_branch`), wherever the values start. More than
+    ``BATCH_ABOVE`` values with Newton go
     through the numpy batch engine; fewer, of a mechanism whose loops solve stepwise in
     closed form, on one branch with no limit position inside, through the closed-form
     engine (:mod:`.closed`). Both results keep columns and build a position only when one
@@ -81,6 +83,8 @@ def sweep_mechanism(
         raise InputError(f"unknown method {method!r}; choose from newton, newton-fd, lm")
     if branch is not None:
         check_branch(m, branch)
+    else:
+        branch = file_branch(m)
     n = len(values)
     use_batch = batch if batch is not None else (n > BATCH_ABOVE and method == "newton")
     if use_batch:
@@ -110,6 +114,24 @@ def sweep_mechanism(
     from .rates import with_rates  # here: a sweep without rates does not load them
 
     return with_rates(m, result, speed, accel)
+
+
+def file_branch(m: Mechanism) -> str | None:
+    """The branch a sweep follows unless told: the assembly of the file's own pose (its
+    guesses solved at its driver value: a drawing's drawn pose), as signs, wherever the
+    sweep starts; None where the loops have no derived closed form with two-way steps or
+    the pose does not solve (the sweep then starts from the guesses at its first value)."""
+    d = m.derivation
+    if not d.complete or not d.two_way:
+        return None
+    from ..problems.derive import sign_text
+    from ..solve import solve_system
+
+    r = solve_system(m.problem(), tol=1e-12)
+    if not r.converged:
+        return None
+    signs = d.signs_of(r.x, m.driver.value)
+    return sign_text(signs) if all(signs) else None
 
 
 def branch_choices(m: Mechanism) -> list[str]:

@@ -200,6 +200,8 @@ def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, 
         drv = {"name": dname, "value": float(value), "unit": unit}
     else:
         drv = {"name": dname, "value": float(value), "unit": "deg"}
+    if isinstance(doc.get("driver"), Mapping) and "range" in doc["driver"]:
+        drv["range"] = doc["driver"]["range"]  # checked as the loops form's (one rule)
     out = {"name": doc.get("name", "mechanism"), "length_unit": unit,
            "description": doc.get("description", ""),
            "origin": list(xy[ground[0]]),
@@ -218,8 +220,8 @@ def _driver(doc: Mapping[str, Any], d: Drawing, scale: float, fail: Any) -> tupl
     if not isinstance(drv, Mapping):
         raise fail("driver", "missing: [driver] link = NAME (an angle) or slider = NAME (a travel)")
     for key in drv:
-        if key not in ("link", "slider", "value"):
-            raise fail(f"driver.{key}", "unknown key (expected link or slider, and value)")
+        if key not in ("link", "slider", "value", "range"):
+            raise fail(f"driver.{key}", "unknown key (expected link or slider, value and range)")
     if ("link" in drv) == ("slider" in drv):
         raise fail("driver", "name one: link = NAME (its angle) or slider = NAME (its travel)")
     value = drv.get("value")

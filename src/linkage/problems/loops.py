@@ -169,6 +169,9 @@ class Mechanism:
     origin: tuple[float, float] = (0.0, 0.0)
     """Where the first loop's first joint is (length unit): a drawing's joints are placed
     where they were drawn."""
+    driver_range: tuple[float, float] | None = None
+    """``[driver] range = [LO, HI]``, in the driver's unit: what a sweep, a scan and an
+    animation run over unless told otherwise."""
 
     def value_of(self, name: str) -> Quantity:
         if name == self.driver.name:
@@ -200,7 +203,7 @@ class Mechanism:
             unknowns[idx] = _requantify(unknowns[idx], v)
         return Mechanism(self.name, self.source, self.length_unit, params, driver, tuple(unknowns),
                          self.loops, self.closed_form, self.description, self.extra, self.points,
-                         self.origin)
+                         self.origin, self.driver_range)
 
     def problem(self) -> SystemProblem:
         return build_problem(self)
@@ -369,7 +372,9 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
     drv_name = drv["name"]
     if not isinstance(drv_name, str):
         raise fail("driver.name", "must be a string")
-    driver = quantity("driver", drv_name, {k: v for k, v in drv.items() if k != "name"}, "value")
+    driver = quantity("driver", drv_name, {k: v for k, v in drv.items() if k not in ("name", "range")},
+                      "value")
+    driver_range = _driver_range(drv.get("range"), driver, fail)
     if drv_name in parameters:
         raise fail("driver.name", f"{drv_name!r} is also listed under [parameters]")
 
@@ -449,7 +454,8 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
     points = _points(doc.get("points", {}), loops, vector, fail)
     mechanism = Mechanism(name, source, length_unit, parameters, driver, unknowns, tuple(loops),
                           closed_form, str(doc.get("description", "")),
-                          {"notes": doc.get("notes", "")}, points, _origin(doc.get("origin"), fail))
+                          {"notes": doc.get("notes", "")}, points, _origin(doc.get("origin"), fail),
+                          driver_range)
     clash = column_clash(mechanism)
     if clash:
         raise fail(*clash)
@@ -467,6 +473,22 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
 
 KEY_HINT = "; the key is no longer needed: delete it and the closed form is derived from the loops"
 """What a refused ``closed_form = ...`` claim adds: the way out (the claim is the old way)."""
+
+
+def _driver_range(spec: Any, driver: Quantity, fail: Any) -> tuple[float, float] | None:
+    """``range = [LO, HI]`` under [driver]: two finite numbers in the driver's unit."""
+    if spec is None:
+        return None
+    lo, hi = ([as_float(v) for v in spec] if isinstance(spec, list) and len(spec) == 2
+              else (None, None))
+    if lo is None or hi is None or not lo < hi:
+        raise fail("driver.range", f"must be [LO, HI] with LO < HI, in the driver's unit ({driver.unit})")
+    for v in (lo, hi):
+        internal = math.radians(v) if driver.kind == "angle" else v
+        why = magnitude_problem(internal, driver.kind, driver.unit, signed=True)
+        if why:
+            raise fail("driver.range", why)
+    return (lo, hi)
 
 
 def _origin(spec: Any, fail: Any) -> tuple[float, float]:

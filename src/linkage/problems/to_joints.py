@@ -199,6 +199,8 @@ def joints_doc(m: Any) -> dict[str, Any]:
         if slider is None:
             raise refuse(f"the driver {m.driver.name} is a length but no slider's travel")
         driver = {"slider": slider}
+    if m.driver_range is not None:
+        driver["range"] = list(m.driver_range)
     used = {j for js in [ground, *links.values()] for j in js}
     doc = {"name": m.name, "description": m.description, "length_unit": m.length_unit,
            "ground": ground, "joints": {j: list(xy) for j, xy in coords.items() if j in used},
