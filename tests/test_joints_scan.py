@@ -13,6 +13,7 @@ import pytest
 from linkage.problems.joints import loops_text
 from linkage.problems.loops import from_text
 from linkage.scan import scan
+from test_joints_errors import SLIDER_CRANK
 
 VALUES = [float(v) for v in range(0, 360, 6)]
 CRANK, COUPLER, ROCKER, POINT, POINT_DEG, THETA2 = 30.0, 60.0, 45.0, 30.0, 40.0, 65.0
@@ -145,22 +146,6 @@ def test_the_cli_reads_the_column_in_where_and_sort(cli, tmp_path) -> None:
         (100.0, 0.0), (100.0, 5.0), (95.0, 0.0), (95.0, 5.0), (90.0, 0.0), (90.0, 5.0)]
 
 
-SLIDER_CRANK = """name = "slider-crank"
-length_unit = "mm"
-ground = ["O2"]
-[joints]
-O2 = [0, 0]
-A = [30, 40]
-B = [140, 10]
-[links]
-crank = ["O2", "A"]
-coupler = ["A", "B"]
-block = ["B"]
-[sliders]
-block = { on = "ground", angle = 0 }
-[driver]
-link = "crank"
-"""
 
 
 @pytest.mark.parametrize(("args", "message"), [

@@ -25,6 +25,7 @@ from typing import Any
 
 from ..errors import InputError
 from . import dyads
+from .joints import toml_value
 
 Point = tuple[float, float]
 BRANCHES = ("open", "crossed")
@@ -337,22 +338,6 @@ def command(kind: str, links: Sequence[float] | None = None, angle_deg: float | 
     return " ".join(shlex.quote(w) for w in words)
 
 
-def _toml(v: Any) -> str:
-    """A TOML value of the kinds a template holds (JSON's strings are TOML's basic strings
-    for printable text, which :func:`template` ensures)."""
-    if isinstance(v, str):
-        import json
-
-        return json.dumps(v, ensure_ascii=False)
-    if isinstance(v, float):
-        return repr(v)
-    if isinstance(v, list):
-        return "[" + ", ".join(_toml(x) for x in v) + "]"
-    if isinstance(v, Mapping):
-        return "{ " + ", ".join(f"{key} = {_toml(x)}" for key, x in v.items()) + " }"
-    return str(v)
-
-
 def joints_text(doc: Mapping[str, Any], kind: str, made_by: str) -> str:
     """A template's joints document as a commented TOML file: the --links order and
     values, what each joint and link is, the branch drawn, and the commands to try."""
@@ -371,21 +356,21 @@ def joints_text(doc: Mapping[str, Any], kind: str, made_by: str) -> str:
                                                         subsequent_indent="#   ", break_long_words=False,
                                                         break_on_hyphens=False)]
     out += ["",
-           f"name = {_toml(doc['name'])}",
-           f"description = {_toml(doc['description'])}",
-           f"length_unit = {_toml(unit)}",
-           f"ground = {_toml(doc['ground'])}  # fixed joints",
+           f"name = {toml_value(doc['name'])}",
+           f"description = {toml_value(doc['description'])}",
+           f"length_unit = {toml_value(unit)}",
+           f"ground = {toml_value(doc['ground'])}  # fixed joints",
            "",
            f"[joints]  # one pose, in {unit}"]
-    out += [f"{j} = {_toml(p)}  # {k.notes[j]}" for j, p in doc["joints"].items()]
+    out += [f"{j} = {toml_value(p)}  # {k.notes[j]}" for j, p in doc["joints"].items()]
     out += ["", "[links]  # the joints each rigid link carries; its angle: first joint -> second"]
-    out += [f"{b} = {_toml(js)}" + (f"  # {k.link_notes[b]}" if k.link_notes[b] else "")
+    out += [f"{b} = {toml_value(js)}" + (f"  # {k.link_notes[b]}" if k.link_notes[b] else "")
             for b, js in doc["links"].items()]
     if "sliders" in doc:
         out += ["", "[sliders]  # a link sliding along a line fixed to `on`, through its joint as drawn"]
-        out += [f"{b} = {_toml(s)}" for b, s in doc["sliders"].items()]
+        out += [f"{b} = {toml_value(s)}" for b, s in doc["sliders"].items()]
     out += ["", "[driver]", 'link = "crank"  # its angle O2 -> A, degrees',
-            f"value = {_toml(doc['driver']['value'])}  # the drawn pose is at this value"]
+            f"value = {toml_value(doc['driver']['value'])}  # the drawn pose is at this value"]
     return "\n".join(out) + "\n"
 
 
