@@ -101,3 +101,18 @@ def test_the_range_survives_convert_both_ways(cli, tmp_path) -> None:
     back = cli("convert", str(tmp_path / "l.toml"))
     assert back.code == 0, back.err
     assert from_text(back.out, "<back>").driver_range == (80.0, 159.0)
+
+
+def test_a_range_in_radians_is_drawn_in_degrees() -> None:
+    from pathlib import Path
+
+    from linkage.problems.to_joints import joints_doc
+
+    text = (Path(__file__).resolve().parents[1] / "sample_inputs" / "fourbar_me581.toml").read_text()
+    text = text.replace("value = 65\n", "value = 1.1344640137963142\nrange = [0, 1.5]\n", 1).replace(
+        'unit = "deg"\n\n[unknowns]', 'unit = "rad"\n\n[unknowns]', 1)
+    m = from_text(text, "<rad>")
+    assert m.driver.unit == "rad" and m.driver_range == (0.0, 1.5)
+    doc = joints_doc(m)
+    assert doc["driver"]["value"] == pytest.approx(65.0, abs=1e-12)
+    assert doc["driver"]["range"] == pytest.approx([0.0, math.degrees(1.5)], rel=1e-15)

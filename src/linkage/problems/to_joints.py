@@ -199,8 +199,8 @@ def joints_doc(m: Any) -> dict[str, Any]:
         if slider is None:
             raise refuse(f"the driver {m.driver.name} is a length but no slider's travel")
         driver = {"slider": slider}
-    if m.driver_range is not None:
-        driver["range"] = list(m.driver_range)
+    if m.driver_range is not None:  # in the driver's unit; a drawing's is deg or its length unit
+        driver["range"] = [v * _to_drawing_unit(m) for v in m.driver_range]
     used = {j for js in [ground, *links.values()] for j in js}
     doc = {"name": m.name, "description": m.description, "length_unit": m.length_unit,
            "ground": ground, "joints": {j: list(xy) for j, xy in coords.items() if j in used},
@@ -210,6 +210,14 @@ def joints_doc(m: Any) -> dict[str, Any]:
     doc["driver"] = driver
     _check(doc, coords, m, refuse)
     return doc
+
+
+def _to_drawing_unit(m: Any) -> float:
+    from .loops import ANGLE_UNITS, length_factor
+
+    if m.driver.kind == "angle":
+        return ANGLE_UNITS[m.driver.unit] * 180.0 / math.pi if m.driver.unit != "deg" else 1.0
+    return 1.0 if m.driver.unit == m.length_unit else length_factor(m.driver.unit, m.length_unit)
 
 
 def _at(vectors: list[_Vector], loop: int, index: int) -> int:
