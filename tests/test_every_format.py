@@ -39,6 +39,8 @@ COMMANDS: dict[str, list[str]] = {
     "sweep-equation": ["sweep", "--step", "30"],
     "scan": ["scan", str(SAMPLES / "crank_rocker.toml"), "--vary", "r2=30:40:3", "--step", "30"],
     "samples": ["samples"],
+    "synthesize": ["synthesize", "--function", "log10(x)", "--x", "1:2", "--alpha", "90:150",
+                   "--phi", "0:90"],
     "stress": ["stress", "--quick", "--method", "newton"],
     "bench": ["bench", "--quick", "--no-cold", "--problem", "seed002", "--repeats", "1"],
 }

@@ -19,9 +19,10 @@ class EquationRow(NamedTuple):
 
 
 def equation_sweep(values: Sequence[float], rs: tuple[float, float, float], method: str,
-                   tol: float) -> list[EquationRow]:
+                   tol: float, seed: tuple[float, float] | None = None) -> list[EquationRow]:
     """The four-bar input-output equation over alpha: seed 002's table, each alpha solved
-    from the previous alpha's root (the first from the equation's own default start).
+    from the previous alpha's root (the first from the equation's own default start, or
+    walked from ``seed``, an (alpha, phi) root on the branch to follow).
 
     Where the closed form (freudenstein.equation_roots) has no real root the position is
     no_solution and continuation restarts after it. A run from the tangent prediction
@@ -37,7 +38,7 @@ def equation_sweep(values: Sequence[float], rs: tuple[float, float, float], meth
     from ..solve import certify_root, solve_scalar
 
     rows: list[EquationRow] = []
-    previous: tuple[float, float] | None = None  # (alpha, phi) of the last root on the branch
+    previous: tuple[float, float] | None = seed  # (alpha, phi) of the last root on the branch
 
     def solve_at(alpha: float, guess: float | None) -> Any:
         problem = fourbar_equation(alpha, *rs)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Callable
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from ..errors import InputError
 from .assembly import is_open, label
@@ -160,6 +160,42 @@ def equation_roots(alpha_deg: float, r1: float, r2: float, r3: float) -> list[fl
     base, spread = math.atan2(q, p), math.acos(max(-1.0, min(1.0, k / size)))
     roots = {(math.degrees(base + s * spread) + 180.0) % 360.0 - 180.0 for s in (1.0, -1.0)}
     return sorted(roots)
+
+
+def branch_root(alpha_deg: float, r1: float, r2: float, r3: float, sign: float) -> float:
+    """The root phi (deg, unwrapped) on one branch of the input-output equation:
+    atan2(sin a, R2 + cos a) + sign * acos(K / |(R2 + cos a, sin a)|), the two roots of
+    :func:`equation_roots` told apart by ``sign`` (+1 or -1). A branch keeps its sign
+    between limit positions, where the two roots meet (acos at 0 or pi); NaN where the
+    linkage cannot be assembled."""
+    a = alpha_deg * DEG
+    p, q = r2 + math.cos(a), math.sin(a)
+    size = math.hypot(p, q)
+    k = r1 * math.cos(a) + r3
+    if size == 0.0 or abs(k) > size:
+        return math.nan
+    return math.degrees(math.atan2(q, p) + sign * math.acos(k / size))
+
+
+def branch_root_np(alpha_deg: Any, r1: Any, r2: Any, r3: Any, sign: Any) -> Any:
+    """:func:`branch_root` over arrays (broadcast): NaN where there is no assembly."""
+    import numpy as np
+
+    a = np.asarray(alpha_deg, float) * DEG
+    p, q = r2 + np.cos(a), np.sin(a)
+    size = np.hypot(p, q)
+    ratio = (r1 * np.cos(a) + r3) / np.where(size == 0.0, np.nan, size)
+    with np.errstate(invalid="ignore"):
+        spread = np.where(np.abs(ratio) <= 1.0, np.arccos(np.clip(ratio, -1.0, 1.0)), np.nan)
+    return np.degrees(np.arctan2(q, p) + sign * spread)
+
+
+def branch_sign(alpha_deg: float, phi_deg: float, r1: float, r2: float, r3: float) -> float:
+    """The sign (+1 or -1) of :func:`branch_root` whose root is ``phi_deg``: the side of
+    atan2(sin a, R2 + cos a) the root lies on (+1 for a root at a limit position)."""
+    a = alpha_deg * DEG
+    base = math.degrees(math.atan2(math.sin(a), r2 + math.cos(a)))
+    return 1.0 if math.remainder(phi_deg - base, 360.0) >= 0.0 else -1.0
 
 
 def links_of(r1: float, r2: float, r3: float,

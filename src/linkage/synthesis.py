@@ -1,0 +1,1101 @@
+"""Function generation: seed 002's equation run backwards (Freudenstein's synthesis).
+
+The seed solves R1 cos(alpha) - R2 cos(phi) + R3 - cos(alpha - phi) = 0 for phi given the
+constants. Here the constants are the unknowns: a function y = f(x) over LO..HI is mapped
+linearly onto the input angle alpha (LO -> A0, HI -> A1) and the output angle phi
+(f(LO) -> P0, f(HI) -> P1), both in the seed's convention (alpha at O2, phi at O4, from
+the line O4 -> O2), and at each precision point the equation is linear in (R1, R2, R3).
+Three points give a 3x3 system; more a least-squares fit by orthogonal factorisation.
+
+The linkage found is then analysed as a user's would be: the input-output equation is
+followed with continuation (kinematics.equation_sweep, the seed's own solver) over the
+whole x range on the branch through the first precision point, and its output compared
+with the function asked for (the structural error). Defects are named, never hidden.
+
+The rules live here once, each with its numpy twin where the search (many candidates at
+a time) needs one: the precision points (:func:`precision_xs`), the linear system
+(:func:`solve_coefficients`, :func:`solve_coefficients_np`), the linkage of a solution
+(:func:`linkage_of`), and the branch's closed form (freudenstein.branch_root and its twin).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+from .errors import InputError
+
+SPACINGS = ("chebyshev", "uniform", "optimal")
+DEFECTS = ("no_linkage", "branch", "grashof", "order", "transmission")
+"""Every defect's name, as JSON and exit 1 report them."""
+MIN_TRANSMISSION_DEG = 30.0
+MAX_POINTS = 100
+GRID = 2001
+"""Dense x grid on which the structural error's extrema are located (then refined)."""
+TABLE_POINTS = 21
+SOLVER_TOL = 1e-11
+"""The continuation's step tolerance on phi (deg)."""
+BRANCH_TOL_DEG = 1e-6
+"""A precision point further than this from the followed branch is on another assembly."""
+EQUIOSCILLATION = 0.01
+"""--spacing optimal's promise: the extrema equal within 1% of the largest."""
+
+
+@dataclass(frozen=True)
+class PrecisionPoint:
+    x: float
+    y: float
+    alpha_deg: float
+    phi_deg: float
+    residual: float
+    """The equation's value there with the R found (zero to rounding for an exact fit)."""
+
+
+@dataclass(frozen=True)
+class Defect:
+    name: str
+    message: str
+
+
+@dataclass(frozen=True)
+class Linkage:
+    """The real linkage of a solution: positive lengths (input a, coupler b, output c,
+    ground d) and whether the input or output link is drawn the other way (a negative R2
+    or R1 is a link turned by 180 deg: its angle is alpha + 180 or phi + 180)."""
+
+    a: float
+    b: float
+    c: float
+    d: float
+    input_turned: bool
+    output_turned: bool
+
+    @property
+    def coefficients(self) -> tuple[float, float, float]:
+        """R1, R2, R3 of the real linkage (its own angles: alpha', phi')."""
+        a, b, c, d = self.a, self.b, self.c, self.d
+        return d / c, d / a, (a * a - b * b + c * c + d * d) / (2.0 * a * c)
+
+    def alpha_shift(self) -> float:
+        return 180.0 if self.input_turned else 0.0
+
+    def phi_shift(self) -> float:
+        return 180.0 if self.output_turned else 0.0
+
+
+@dataclass(frozen=True)
+class CurvePoint:
+    x: float
+    y: float
+    alpha_deg: float
+    phi_desired_deg: float
+    phi_generated_deg: float | None
+    error_deg: float | None
+    error_y: float | None
+    transmission_deg: float | None
+    status: str
+
+
+@dataclass(frozen=True)
+class FunctionSynthesis:
+    """Everything ``linkage synthesize`` reports, as a value."""
+
+    function: str
+    x_range: tuple[float, float]
+    alpha_range: tuple[float, float]
+    phi_range: tuple[float, float]
+    spacing: str
+    R: tuple[float, float, float]
+    fit_residual: float
+    """The least-squares residual norm |A R - b| (rounding only, for three points)."""
+    precision_points: tuple[PrecisionPoint, ...]
+    linkage: Linkage | None
+    grashof: str | None
+    branch: str | None
+    """The followed assembly at the first precision point: open or crossed."""
+    curve: tuple[CurvePoint, ...]
+    max_error_deg: float | None
+    at_x: float | None
+    max_error_y: float | None
+    extrema: tuple[tuple[float, float], ...]
+    """(x, error_deg) of each local extremum of the structural error, refined."""
+    transmission: tuple[float, float] | None
+    """(min, max) of the transmission angle, folded into 0..90 deg, over the range."""
+    transmission_at_x: float | None
+    defects: tuple[Defect, ...]
+    notes: tuple[str, ...] = ()
+    chebyshev_max_error_deg: float | None = None
+    """With optimal spacing: the Chebyshev spacing's max error, for comparison."""
+    equioscillation: float | None = None
+    """(largest - smallest extremum) / largest: 0 for perfect equioscillation."""
+    min_transmission_deg: float = MIN_TRANSMISSION_DEG
+    request: Request | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def defect_names(self) -> list[str]:
+        return [d.name for d in self.defects]
+
+    @property
+    def links(self) -> dict[str, float] | None:
+        k = self.linkage
+        return None if k is None else {"input": k.a, "coupler": k.b, "output": k.c, "ground": k.d}
+
+
+# --- the request -----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Request:
+    """A synthesis asked for, checked."""
+
+    f: Callable[[float], float]
+    text: str
+    x_range: tuple[float, float]
+    alpha_range: tuple[float, float]
+    phi_range: tuple[float, float]
+    points: int = 3
+    spacing: str = "chebyshev"
+    at: tuple[float, ...] | None = None
+    ground: float = 1.0
+    min_transmission: float = MIN_TRANSMISSION_DEG
+    table_points: int = TABLE_POINTS
+    y_ends: tuple[float, float] = field(default=(0.0, 1.0))
+
+    def alpha(self, x: float) -> float:
+        lo, hi = self.x_range
+        a0, a1 = self.alpha_range
+        return a0 + (x - lo) / (hi - lo) * (a1 - a0)
+
+    def phi(self, y: float) -> float:
+        y0, y1 = self.y_ends
+        p0, p1 = self.phi_range
+        return p0 + (y - y0) / (y1 - y0) * (p1 - p0)
+
+    @property
+    def y_per_deg(self) -> float:
+        """Units of y per degree of phi (the output scale)."""
+        (y0, y1), (p0, p1) = self.y_ends, self.phi_range
+        return (y1 - y0) / (p1 - p0)
+
+
+def function_of(f: str | Callable[[float], float]) -> tuple[Callable[[float], float], str]:
+    """f as a callable and as text: a string is parsed by the same safe parser as
+    ``--equation`` (problems.expression)."""
+    if isinstance(f, str):
+        from .problems.expression import Expression
+
+        if not f.strip():
+            raise InputError("--function: give an expression in x, e.g. log10(x)")
+        return Expression.parse(f, what="function").function(), f
+    if callable(f):
+        return f, getattr(f, "__name__", "f")
+    raise InputError(f"function: give an expression in x or a callable, got {type(f).__name__}")
+
+
+def _range(name: str, value: Any) -> tuple[float, float]:
+    from .arguments import check_number
+
+    if isinstance(value, str):
+        parts = value.split(":")
+        if len(parts) != 2:
+            raise InputError(f"{name} {value!r}: write LO:HI")
+        from .numbers import parse_number
+
+        lo, hi = (parse_number(name, p) for p in parts)
+    else:
+        try:
+            lo, hi = value
+        except (TypeError, ValueError):
+            raise InputError(f"{name}: give two numbers (LO, HI), got {value!r}") from None
+        lo, hi = check_number(name, lo), check_number(name, hi)
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        raise InputError(f"{name}: the ends must be finite, got {lo!r}:{hi!r}")
+    if lo == hi:
+        raise InputError(f"{name} {lo:g}:{hi:g}: the two ends must differ")
+    if max(abs(lo), abs(hi)) > 1e6:
+        raise InputError(f"{name} {lo:g}:{hi:g}: ends beyond 1e6 are not supported")
+    return float(lo), float(hi)
+
+
+def make_request(
+    f: str | Callable[[float], float],
+    x_range: Any,
+    alpha_range: Any,
+    phi_range: Any,
+    *,
+    points: int = 3,
+    spacing: str = "chebyshev",
+    at: Sequence[float] | str | None = None,
+    ground: float = 1.0,
+    min_transmission: float = MIN_TRANSMISSION_DEG,
+    table_points: int = TABLE_POINTS,
+) -> Request:
+    """The request checked: each bad value one InputError naming its option."""
+    from .arguments import check_number
+
+    fn, text = function_of(f)
+    xr = _range("--x", x_range)
+    if xr[1] < xr[0]:
+        raise InputError(
+            f"--x {xr[0]:g}:{xr[1]:g}: LO must be below HI (the angle ranges may run either way)"
+        )
+    ar, pr = _range("--alpha", alpha_range), _range("--phi", phi_range)
+    for name, (lo, hi) in (("--alpha", ar), ("--phi", pr)):
+        if abs(hi - lo) >= 360.0:
+            raise InputError(
+                f"{name} {lo:g}:{hi:g}: a span of a full turn or more maps two x to one "
+                "position; give less than 360 deg"
+            )
+    if isinstance(points, bool) or not isinstance(points, int) or not 3 <= points <= MAX_POINTS:
+        raise InputError(f"--points must be a whole number from 3 to {MAX_POINTS}, got {points!r}")
+    if spacing not in SPACINGS:
+        raise InputError(f"--spacing {spacing!r}: give one of {', '.join(SPACINGS)}")
+    xs_at: tuple[float, ...] | None = None
+    if at is not None:
+        from .numbers import parse_number
+
+        items = at.split(",") if isinstance(at, str) else list(at)
+        xs_at = tuple(
+            parse_number("--at", v) if isinstance(v, str) else check_number("--at", v) for v in items
+        )
+        if len(xs_at) < 3:
+            raise InputError(f"--at: give at least 3 precision points, got {len(xs_at)}")
+        if len(xs_at) > MAX_POINTS:
+            raise InputError(f"--at: at most {MAX_POINTS} precision points, got {len(xs_at)}")
+        if any(not xr[0] <= v <= xr[1] for v in xs_at):
+            bad = next(v for v in xs_at if not xr[0] <= v <= xr[1])
+            raise InputError(f"--at {bad:g} is outside --x {xr[0]:g}:{xr[1]:g}")
+        if len(set(xs_at)) != len(xs_at):
+            raise InputError("--at: the precision points must differ")
+        xs_at = tuple(sorted(xs_at))
+        points = len(xs_at)
+    if spacing == "optimal" and (points != 3 or xs_at is not None):
+        raise InputError(
+            "--spacing optimal places 3 precision points (R1, R2, R3 are three "
+            "unknowns: with more points the fit is least squares and has no zeros to "
+            "move); drop --points/--at"
+        )
+    ground = check_number("--ground", ground)
+    if not 1e-9 <= ground <= 1e9:
+        raise InputError(f"--ground must be a length from 1e-9 to 1e9, got {ground:g}")
+    min_transmission = check_number("--min-transmission", min_transmission)
+    if not 0.0 <= min_transmission <= 90.0:
+        raise InputError(f"--min-transmission must be from 0 to 90 deg, got {min_transmission:g}")
+    if (
+        isinstance(table_points, bool)
+        or not isinstance(table_points, int)
+        or not 2 <= table_points <= 100_001
+    ):
+        raise InputError(f"--samples must be a whole number from 2 to 100001, got {table_points!r}")
+    y_ends = (_value(fn, xr[0]), _value(fn, xr[1]))
+    if y_ends[0] == y_ends[1]:
+        raise InputError(
+            f"f({xr[0]:g}) = f({xr[1]:g}) = {y_ends[0]:g}: the ends of y must differ to map onto --phi"
+        )
+    return Request(
+        fn,
+        text,
+        xr,
+        ar,
+        pr,
+        points,
+        spacing,
+        xs_at,
+        float(ground),
+        float(min_transmission),
+        table_points,
+        y_ends,
+    )
+
+
+def _value(f: Callable[[float], float], x: float) -> float:
+    try:
+        y = float(f(x))
+    except (ValueError, ZeroDivisionError, OverflowError, TypeError) as exc:
+        raise InputError(f"f({x:.12g}) cannot be evaluated: {exc}") from None
+    if not math.isfinite(y):
+        raise InputError(f"f({x:.12g}) = {y!r}: the function must be finite over --x")
+    return y
+
+
+# --- the rules ---------------------------------------------------------------------------------
+
+
+def chebyshev_xs(n: int, lo: float, hi: float) -> list[float]:
+    """Chebyshev spacing: x_j = (lo + hi)/2 - (hi - lo)/2 cos((2j - 1) pi / (2n)), ascending."""
+    mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    return [mid - half * math.cos((2 * j - 1) * math.pi / (2 * n)) for j in range(1, n + 1)]
+
+
+def uniform_xs(n: int, lo: float, hi: float) -> list[float]:
+    """Equal steps with both ends included."""
+    return [lo + (hi - lo) * j / (n - 1) for j in range(n)]
+
+
+def precision_xs(req: Request) -> list[float]:
+    if req.at is not None:
+        return list(req.at)
+    lo, hi = req.x_range
+    return uniform_xs(req.points, lo, hi) if req.spacing == "uniform" else chebyshev_xs(req.points, lo, hi)
+
+
+def system(alphas_deg: Sequence[float], phis_deg: Sequence[float]) -> tuple[list[list[float]], list[float]]:
+    """Freudenstein's equation at each point as a row of A R = b:
+    [cos alpha, -cos phi, 1] . (R1, R2, R3) = cos(alpha - phi)."""
+    rows, rhs = [], []
+    for al, ph in zip(alphas_deg, phis_deg):
+        a, p = math.radians(al), math.radians(ph)
+        rows.append([math.cos(a), -math.cos(p), 1.0])
+        rhs.append(math.cos(a - p))
+    return rows, rhs
+
+
+COND_LIMIT = 1e12
+
+
+def solve_coefficients(
+    alphas_deg: Sequence[float], phis_deg: Sequence[float]
+) -> tuple[tuple[float, float, float], float]:
+    """(R1, R2, R3) and the residual norm: three points solved exactly, more by least squares
+    through a QR factorisation (never the normal equations, which square the condition)."""
+    import numpy as np
+
+    rows, rhs = system(alphas_deg, phis_deg)
+    a, b = np.array(rows), np.array(rhs)
+    cond = np.linalg.cond(a)
+    if not np.isfinite(cond) or cond > COND_LIMIT:
+        raise InputError(
+            f"the precision points give a singular system for R1, R2, R3 (condition "
+            f"number {cond:.3g}): move them apart or change the angle ranges"
+        )
+    if len(rows) == 3:
+        r = np.linalg.solve(a, b)
+    else:
+        q, tri = np.linalg.qr(a)
+        r = np.linalg.solve(tri, q.T @ b)
+    residual = float(np.linalg.norm(a @ r - b))
+    return (float(r[0]), float(r[1]), float(r[2])), residual
+
+
+def solve_coefficients_np(alphas_deg: Any, phis_deg: Any) -> Any:
+    """:func:`solve_coefficients` for many candidates at once (three points each): arrays
+    of shape (n, 3) in, (n, 3) of R out; NaN rows where the system is singular."""
+    import numpy as np
+
+    a, p = np.radians(alphas_deg), np.radians(phis_deg)
+    mat = np.stack([np.cos(a), -np.cos(p), np.ones_like(a)], axis=-1)
+    rhs = np.cos(a - p)
+    cond = np.linalg.cond(mat)
+    good = np.isfinite(cond) & (cond <= COND_LIMIT)
+    out = np.full(a.shape, np.nan)
+    if good.any():
+        out[good] = np.linalg.solve(mat[good], rhs[good][..., None])[..., 0]
+    return out
+
+
+ZERO_R = 1e-12
+"""R1 or R2 within this (relative to the largest R, or 1) of zero is zero: a link 1e12
+grounds long is no link."""
+
+
+def linkage_of(r: Sequence[float], ground: float) -> tuple[Linkage | None, str | None]:
+    """The real linkage of (R1, R2, R3) for a ground ``ground``, or None and why not.
+    R1 = d/c, R2 = d/a, R3 = (a^2 - b^2 + c^2 + d^2) / (2ac) with a, c signed: a negative
+    one is the link drawn the other way (length |a|, angle + 180 deg)."""
+    r1, r2, r3 = r
+    if not all(math.isfinite(v) for v in r):
+        return None, "R1, R2, R3 are not finite"
+    tiny = ZERO_R * max(1.0, abs(r1), abs(r2), abs(r3))
+    if abs(r1) <= tiny or abs(r2) <= tiny:
+        which = f"output link (R1 = {r1:.3g})" if abs(r1) <= tiny else f"input link (R2 = {r2:.3g})"
+        return None, f"the {which} would be infinitely long: R = d / length is zero to rounding"
+    d = ground
+    a, c = d / r2, d / r1
+    b2 = a * a + c * c + d * d - 2.0 * a * c * r3
+    if not b2 > 0.0:
+        return None, (
+            f"the coupler's squared length b^2 = a^2 + c^2 + d^2 - 2 a c R3 = {b2:.6g} is "
+            "not positive: no real linkage fits these precision points"
+        )
+    return Linkage(abs(a), math.sqrt(b2), abs(c), d, a < 0.0, c < 0.0), None
+
+
+def linkage_of_np(r: Any, ground: float) -> tuple[Any, Any, Any, Any, Any, Any]:
+    """:func:`linkage_of` over rows of R: (a, b, c, d, input_turned, output_turned), NaN
+    lengths where there is no real linkage."""
+    import numpy as np
+
+    r1, r2, r3 = r[..., 0], r[..., 1], r[..., 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a, c = ground / r2, ground / r1
+        b2 = a * a + c * c + ground * ground - 2.0 * a * c * r3
+        tiny = ZERO_R * np.maximum(1.0, np.maximum(np.abs(r1), np.maximum(np.abs(r2), np.abs(r3))))
+        ok = np.isfinite(a) & np.isfinite(c) & (np.abs(r1) > tiny) & (np.abs(r2) > tiny) & (b2 > 0.0)
+        b = np.where(ok, np.sqrt(np.where(ok, b2, 1.0)), np.nan)
+    return (
+        np.where(ok, np.abs(a), np.nan),
+        b,
+        np.where(ok, np.abs(c), np.nan),
+        np.full(a.shape, float(ground)),
+        a < 0.0,
+        c < 0.0,
+    )
+
+
+def folded(mu_deg: float) -> float:
+    """A transmission angle folded into 0..90 deg (its distance from the toggle's 0 or 180)."""
+    return min(mu_deg, 180.0 - mu_deg)
+
+
+def transmission_deg(k: Linkage, alpha_real_deg: float, phi_real_deg: float) -> float:
+    """The transmission angle (deg, 0..180) of the real linkage at its own angles: between
+    the coupler A -> B and the output link O4 -> B (closed_form.transmission), with O4 at
+    the origin, O2 at (d, 0), A = O2 + a e^(i alpha'), B = c e^(i phi')."""
+    from .problems.closed_form import transmission
+
+    a_pt = complex(k.d, 0.0) + k.a * complex(
+        math.cos(math.radians(alpha_real_deg)), math.sin(math.radians(alpha_real_deg))
+    )
+    b_pt = k.c * complex(math.cos(math.radians(phi_real_deg)), math.sin(math.radians(phi_real_deg)))
+    t3 = math.degrees(math.atan2((b_pt - a_pt).imag, (b_pt - a_pt).real))
+    return transmission(t3, phi_real_deg)
+
+
+def transmission_deg_np(a: Any, c: Any, d: Any, alpha_real_deg: Any, phi_real_deg: Any) -> Any:
+    """:func:`transmission_deg` over arrays."""
+    import numpy as np
+
+    from .problems.closed_form import transmission_np
+
+    al, ph = np.radians(alpha_real_deg), np.radians(phi_real_deg)
+    ax, ay = d + a * np.cos(al), a * np.sin(al)
+    bx, by = c * np.cos(ph), c * np.sin(ph)
+    t3 = np.degrees(np.arctan2(by - ay, bx - ax))
+    return transmission_np(t3, phi_real_deg)
+
+
+def branch_label(k: Linkage, alpha_real_deg: float, phi_real_deg: float) -> str:
+    """open or crossed (the project's words, problems.assembly) of a real position."""
+    from .problems.freudenstein import file_convention
+
+    return str(file_convention(alpha_real_deg, phi_real_deg, (k.a, k.b, k.c, k.d))["branch"])
+
+
+def grashof_of(k: Linkage) -> str:
+    from .problems.closed_form import grashof
+
+    return grashof(k.d, k.a, k.b, k.c)
+
+
+INPUT_CRANKS = ("crank-rocker", "double crank")
+OUTPUT_CRANKS = ("rocker-crank", "double crank")
+
+
+# --- the structural error --------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Design:
+    """One synthesised linkage with what its error needs: the real R, the branch sign at
+    the first precision point, and the shifts between the equation's angles and its own."""
+
+    req: Request
+    R: tuple[float, float, float]
+    linkage: Linkage
+    real_R: tuple[float, float, float]
+    sign: float
+
+    def real_alpha(self, x: float) -> float:
+        return self.req.alpha(x) + self.linkage.alpha_shift()
+
+    def closed_error(self, x: float, y: float) -> float:
+        """phi generated - phi desired (deg) by the branch's closed form; NaN where the
+        linkage cannot be assembled."""
+        from .problems.freudenstein import branch_root
+
+        phi = branch_root(self.real_alpha(x), *self.real_R, self.sign) - self.linkage.phi_shift()
+        return math.remainder(phi - self.req.phi(y), 360.0)
+
+
+def design_of(
+    req: Request, r: tuple[float, float, float], first: PrecisionPoint
+) -> tuple[Design | None, str | None]:
+    from .problems.freudenstein import branch_sign
+
+    k, why = linkage_of(r, req.ground)
+    if k is None:
+        return None, why
+    real_r = k.coefficients
+    sign = branch_sign(first.alpha_deg + k.alpha_shift(), first.phi_deg + k.phi_shift(), *real_r)
+    return Design(req, r, k, real_r, sign), None
+
+
+def golden_max(g: Callable[[float], float], lo: float, hi: float, iters: int = 80) -> tuple[float, float]:
+    """The x in [lo, hi] where g is largest (g unimodal there) and g there."""
+    inv = (math.sqrt(5.0) - 1.0) / 2.0
+    a, b = lo, hi
+    c, d = b - inv * (b - a), a + inv * (b - a)
+    gc, gd = g(c), g(d)
+    for _ in range(iters):
+        if b - a <= 1e-15 * max(1.0, abs(a), abs(b)):
+            break
+        if gc >= gd:
+            b, d, gd = d, c, gc
+            c = b - inv * (b - a)
+            gc = g(c)
+        else:
+            a, c, gc = c, d, gd
+            d = a + inv * (b - a)
+            gd = g(d)
+    best = max(((a, g(a)), (c, gc), (d, gd), (b, g(b))), key=lambda t: t[1] if math.isfinite(t[1]) else -1.0)
+    return best
+
+
+def extrema(design: Design, grid: int = GRID) -> tuple[list[tuple[float, float]], list[float], list[float]]:
+    """The structural error's local extrema (x, error_deg), refined by golden section from
+    a dense grid (ends included), and the grid's x and errors (NaN: no assembly)."""
+    req = design.req
+    lo, hi = req.x_range
+    xs = [lo + (hi - lo) * i / (grid - 1) for i in range(grid)]
+    errs = [design.closed_error(x, _value(req.f, x)) for x in xs]
+    out: list[tuple[float, float]] = []
+    if any(not math.isfinite(e) for e in errs):
+        return out, xs, errs
+    mag = [abs(e) for e in errs]
+    for i in range(grid):
+        left = mag[i - 1] if i > 0 else -1.0
+        right = mag[i + 1] if i < grid - 1 else -1.0
+        if (mag[i] >= left and mag[i] > right) or (mag[i] > left and mag[i] >= right):
+            if 0 < i < grid - 1:
+                x, _ = golden_max(
+                    lambda t: abs(design.closed_error(t, _value(req.f, t))), xs[i - 1], xs[i + 1]
+                )
+            else:
+                x = xs[i]
+            out.append((x, design.closed_error(x, _value(req.f, x))))
+    # neighbours of one sign with a zero between them belong to different lobes; keep the
+    # largest of each run of one sign (plateaus of rounding give several)
+    lobes: list[tuple[float, float]] = []
+    for x, e in out:
+        if lobes and (lobes[-1][1] > 0.0) == (e > 0.0) and not _zero_between(errs, xs, lobes[-1][0], x):
+            if abs(e) > abs(lobes[-1][1]):
+                lobes[-1] = (x, e)
+            continue
+        lobes.append((x, e))
+    return lobes, xs, errs
+
+
+def _zero_between(errs: Sequence[float], xs: Sequence[float], x0: float, x1: float) -> bool:
+    inside = [e for x, e in zip(xs, errs) if x0 < x < x1]
+    return any((e > 0.0) != (inside[0] > 0.0) for e in inside) if inside else False
+
+
+def follow(design: Design, xs: Sequence[float], first: PrecisionPoint) -> list[float | None]:
+    """The generated phi (deg, the equation's convention) at each x, by the seed's solver
+    (Newton with continuation, kinematics.equation_sweep) from the first precision point,
+    both ways; None from the first position it cannot reach on that branch onwards (a
+    limit position in between)."""
+    from .kinematics.equation_sweep import equation_sweep
+
+    k = design.linkage
+    seed = (first.alpha_deg + k.alpha_shift(), first.phi_deg + k.phi_shift())
+    order = sorted(range(len(xs)), key=lambda i: xs[i])
+    ahead = [i for i in order if xs[i] >= first.x]
+    behind = [i for i in reversed(order) if xs[i] < first.x]
+    out: list[float | None] = [None] * len(xs)
+    for part in (ahead, behind):
+        if not part:
+            continue
+        rows = equation_sweep(
+            [design.real_alpha(xs[i]) for i in part], design.real_R, "newton", SOLVER_TOL, seed=seed
+        )
+        for i, row in zip(part, rows):
+            if row.phi is None:
+                break  # beyond a limit: the rest of this side is not on the followed branch
+            out[i] = row.phi - k.phi_shift()
+    return out
+
+
+def structural_error(design: Design, xs: Sequence[float], first: PrecisionPoint) -> list[CurvePoint]:
+    req, k = design.req, design.linkage
+    phis = follow(design, xs, first)
+    out = []
+    for x, phi in zip(xs, phis):
+        y = _value(req.f, x)
+        want = req.phi(y)
+        al = req.alpha(x)
+        if phi is None:
+            out.append(CurvePoint(x, y, al, want, None, None, None, None, "not_reached"))
+            continue
+        err = math.remainder(phi - want, 360.0)
+        mu = transmission_deg(k, al + k.alpha_shift(), phi + k.phi_shift())
+        out.append(CurvePoint(x, y, al, want, phi, err, err * req.y_per_deg, folded(mu), "converged"))
+    return out
+
+
+# --- synthesis -------------------------------------------------------------------------------------
+
+
+def precision_points(
+    req: Request, xs: Sequence[float]
+) -> tuple[list[PrecisionPoint], tuple[float, float, float], float]:
+    ys = [_value(req.f, x) for x in xs]
+    als = [req.alpha(x) for x in xs]
+    phs = [req.phi(y) for y in ys]
+    r, res = solve_coefficients(als, phs)
+    pts = []
+    for x, y, al, ph in zip(xs, ys, als, phs):
+        a, p = math.radians(al), math.radians(ph)
+        pts.append(
+            PrecisionPoint(x, y, al, ph, r[0] * math.cos(a) - r[1] * math.cos(p) + r[2] - math.cos(a - p))
+        )
+    return pts, r, res
+
+
+def synthesize(req: Request) -> FunctionSynthesis:
+    """Synthesise, analyse and judge one function generator."""
+    if req.spacing == "optimal":
+        return _optimal(req)
+    return _synthesize(req, precision_xs(req))
+
+
+def _synthesize(req: Request, xs: Sequence[float]) -> FunctionSynthesis:
+    pts, r, res = precision_points(req, xs)
+    base = FunctionSynthesis(
+        function=req.text,
+        x_range=req.x_range,
+        alpha_range=req.alpha_range,
+        phi_range=req.phi_range,
+        spacing="at" if req.at is not None else req.spacing,
+        R=r,
+        fit_residual=res,
+        precision_points=tuple(pts),
+        linkage=None,
+        grashof=None,
+        branch=None,
+        curve=(),
+        max_error_deg=None,
+        at_x=None,
+        max_error_y=None,
+        extrema=(),
+        transmission=None,
+        transmission_at_x=None,
+        defects=(),
+        min_transmission_deg=req.min_transmission,
+        request=req,
+    )
+    design, why = design_of(req, r, pts[0])
+    if design is None:
+        return replace(base, defects=(Defect("no_linkage", f"no real linkage: {why}"),))
+    k = design.linkage
+    notes = []
+    if k.input_turned:
+        notes.append(
+            f"R2 = {r[1]:.6g} < 0: the input link is drawn the other way (length {k.a:.6g}, "
+            "its angle alpha + 180 deg)"
+        )
+    if k.output_turned:
+        notes.append(
+            f"R1 = {r[0]:.6g} < 0: the output link is drawn the other way (length {k.c:.6g}, "
+            "its angle phi + 180 deg)"
+        )
+    lobes, grid_xs, grid_errs = extrema(design)
+    lo, hi = req.x_range
+    table = [lo + (hi - lo) * i / (req.table_points - 1) for i in range(req.table_points)]
+    extra = [x for x, _ in lobes] + [p.x for p in pts]
+    curve_xs = sorted(set(table) | set(extra))
+    curve = structural_error(design, curve_xs, pts[0])
+    defects = judge(design, pts, curve, grid_xs, grid_errs)
+    solved = [c for c in curve if c.error_deg is not None]
+    worst = max(solved, key=lambda c: abs(c.error_deg or 0.0)) if solved else None
+    mus = [(c.transmission_deg, c.x) for c in solved if c.transmission_deg is not None]
+    # the transmission's extremes between samples: the dense grid by the closed form
+    dense = _dense_transmission(design, grid_xs, grid_errs)
+    if dense is not None:
+        mus += dense
+    first_real = (pts[0].alpha_deg + k.alpha_shift(), pts[0].phi_deg + k.phi_shift())
+    mu_min = min(mus) if mus else None
+    result = replace(
+        base,
+        linkage=k,
+        grashof=grashof_of(k),
+        branch=branch_label(k, *first_real),
+        curve=tuple(curve),
+        max_error_deg=abs(worst.error_deg) if worst and worst.error_deg is not None else None,
+        at_x=worst.x if worst else None,
+        max_error_y=abs(worst.error_y) if worst and worst.error_y is not None else None,
+        extrema=tuple((x, _solved_error(curve, x, e)) for x, e in lobes),
+        transmission=(mu_min[0], max(mus)[0]) if mus and mu_min else None,
+        transmission_at_x=mu_min[1] if mu_min else None,
+        defects=tuple(defects),
+        notes=tuple(notes),
+    )
+    return result
+
+
+def dense_curve(s: FunctionSynthesis, n: int = 401) -> list[CurvePoint]:
+    """The structural error at ``n`` even steps of x (with the table's points, extrema and
+    precision points), by the same solver as the table: for a plot."""
+    req = s.request
+    if req is None or s.linkage is None:
+        return list(s.curve)
+    design, _ = design_of(req, s.R, s.precision_points[0])
+    if design is None:
+        return list(s.curve)
+    lo, hi = req.x_range
+    xs = sorted({lo + (hi - lo) * i / (n - 1) for i in range(n)} | {c.x for c in s.curve})
+    return structural_error(design, xs, s.precision_points[0])
+
+
+def _solved_error(curve: Sequence[CurvePoint], x: float, fallback: float) -> float:
+    for c in curve:
+        if c.x == x and c.error_deg is not None:
+            return c.error_deg
+    return fallback
+
+
+def _dense_transmission(
+    design: Design, xs: Sequence[float], errs: Sequence[float]
+) -> list[tuple[float, float]] | None:
+    import numpy as np
+
+    from .problems.freudenstein import branch_root_np
+
+    k = design.linkage
+    good = np.isfinite(np.asarray(errs))
+    if not good.any():
+        return None
+    x = np.asarray(xs)[good]
+    al = np.array([design.real_alpha(v) for v in x])
+    ph = branch_root_np(al, *design.real_R, design.sign)
+    mu = transmission_deg_np(k.a, k.c, k.d, al, ph)
+    fold = np.minimum(mu, 180.0 - mu)
+    i, j = int(np.nanargmin(fold)), int(np.nanargmax(fold))
+    return [(float(fold[i]), float(x[i])), (float(fold[j]), float(x[j]))]
+
+
+def judge(
+    design: Design,
+    pts: Sequence[PrecisionPoint],
+    curve: Sequence[CurvePoint],
+    grid_xs: Sequence[float],
+    grid_errs: Sequence[float],
+) -> list[Defect]:
+    """The defects of a synthesised linkage, each named with what shows it."""
+    req, k = design.req, design.linkage
+    out: list[Defect] = []
+    kind = grashof_of(k)
+    # branch: a precision point the followed assembly does not pass through
+    first_label = branch_label(k, pts[0].alpha_deg + k.alpha_shift(), pts[0].phi_deg + k.phi_shift())
+    off = []
+    for j, p in enumerate(pts):
+        c = next((c for c in curve if c.x == p.x), None)
+        if (
+            c is not None
+            and c.phi_generated_deg is not None
+            and abs(math.remainder(c.phi_generated_deg - p.phi_deg, 360.0)) <= BRANCH_TOL_DEG
+        ):
+            continue
+        if c is not None and c.phi_generated_deg is None:
+            continue  # beyond a limit: named below
+        off.append((j, p))
+    if off:
+        said = ", ".join(
+            f"{j + 1} (x = {p.x:.6g}, "
+            f"{branch_label(k, p.alpha_deg + k.alpha_shift(), p.phi_deg + k.phi_shift())})"
+            for j, p in off
+        )
+        out.append(
+            Defect(
+                "branch",
+                f"branch: precision point {said} is not on the {first_label} assembly "
+                "through point 1: the linkage must be taken apart to reach every point",
+            )
+        )
+    # grashof: the motion asked for against what this linkage's type allows
+    gap = next((c for c in curve if c.phi_generated_deg is None), None)
+    runs = _nan_runs(grid_xs, grid_errs)
+    if runs:
+        said = ", ".join(f"{a:.6g} to {b:.6g}" if a != b else f"{a:.6g}" for a, b in runs[:3])
+        out.append(
+            Defect(
+                "grashof",
+                f"grashof: this {kind} linkage cannot move its input through the "
+                f"range: it cannot be assembled for x from {said} (alpha "
+                f"{req.alpha(runs[0][0]):.6g} to {req.alpha(runs[0][1]):.6g} deg)",
+            )
+        )
+    elif gap is not None:
+        out.append(
+            Defect(
+                "grashof",
+                f"grashof: this {kind} linkage cannot move its input through the "
+                f"range on one branch: the branch through point 1 ends at a limit "
+                f"position before x = {gap.x:.6g} (alpha = {req.alpha(gap.x):.6g} deg)",
+            )
+        )
+    # order: the output turns back where the function does not
+    if all(math.isfinite(e) for e in grid_errs):
+        gen = [req.phi(_value(req.f, x)) + e for x, e in zip(grid_xs, grid_errs)]
+        want = [req.phi(_value(req.f, x)) for x in grid_xs]
+        extra = _turns_diff(_turns(gen), _turns(want))
+        if extra:
+            x_turn = grid_xs[extra[0]]
+            out.append(
+                Defect(
+                    "order",
+                    f"order: the output turns back at x = {x_turn:.6g} where the "
+                    "function does not, so it passes the output positions out of "
+                    "order",
+                )
+            )
+    # transmission
+    solved = [c for c in curve if c.transmission_deg is not None]
+    dense = _dense_transmission(design, grid_xs, grid_errs)
+    mus = [(c.transmission_deg, c.x) for c in solved] + (dense or [])
+    if mus:
+        mu, x_mu = min(mus)
+        if mu < req.min_transmission:
+            out.append(
+                Defect(
+                    "transmission",
+                    f"transmission: the transmission angle falls to "
+                    f"{mu:.4g} deg (at x = {x_mu:.6g}), below "
+                    f"{req.min_transmission:g} deg",
+                )
+            )
+    return out
+
+
+def _nan_runs(xs: Sequence[float], errs: Sequence[float]) -> list[tuple[float, float]]:
+    """The runs of grid x where the linkage cannot be assembled (first and last x of each)."""
+    runs: list[tuple[float, float]] = []
+    start = None
+    for i, e in enumerate(errs):
+        if not math.isfinite(e):
+            start = xs[i] if start is None else start
+            last = xs[i]
+        elif start is not None:
+            runs.append((start, last))
+            start = None
+    if start is not None:
+        runs.append((start, last))
+    return runs
+
+
+def _turns(values: Sequence[float]) -> set[int]:
+    """Indices where a sampled curve changes direction (steps below rounding ignored)."""
+    scale = max((abs(v) for v in values), default=1.0)
+    floor = 1e-9 * max(scale, 1.0)
+    out, last = set(), 0
+    for i in range(1, len(values)):
+        step = values[i] - values[i - 1]
+        if abs(step) <= floor:
+            continue
+        s = 1 if step > 0 else -1
+        if last and s != last:
+            out.add(i - 1)
+        last = s
+    return out
+
+
+def _turns_diff(gen: set[int], want: set[int], width: int = 3) -> list[int]:
+    return sorted(i for i in gen if not any(abs(i - j) <= width for j in want))
+
+
+# --- optimal spacing ---------------------------------------------------------------------------
+
+
+def _optimal(req: Request) -> FunctionSynthesis:
+    """Optimal (equal-ripple) spacing by a Remez exchange, from Chebyshev's design: on a
+    reference of four alternating extrema, Newton's method finds the constants R and a
+    level E with error(x_k) = +-E alternately; the reference then moves to the new
+    extrema, until they are equal. The precision points are the error's zeros between
+    them, and the design is synthesised from those again (so every figure reported is
+    the one rule's, from its precision points)."""
+    cheb = _synthesize(replace(req, spacing="chebyshev"), chebyshev_xs(3, *req.x_range))
+    if cheb.defects or cheb.max_error_deg is None:
+        names = ", ".join(cheb.defect_names) or "no error curve"
+        return replace(
+            cheb,
+            notes=(
+                *cheb.notes,
+                f"optimal spacing starts from Chebyshev's design, which has defects ({names}): kept "
+                "Chebyshev's spacing",
+            ),
+        )
+    xs = remez(req, cheb)
+    best = _synthesize(replace(req, spacing="optimal"), xs) if xs is not None else None
+    spread = _spread(best) if best is not None else None
+    if (
+        best is None
+        or best.defects
+        or best.max_error_deg is None
+        or spread is None
+        or spread > EQUIOSCILLATION
+        or best.max_error_deg > cheb.max_error_deg
+    ):
+        why = (
+            "did not reach equal extrema"
+            if best is None or spread is None or spread > EQUIOSCILLATION
+            else "has defects"
+            if best.defects
+            else "came out no better"
+        )
+        return replace(
+            cheb,
+            chebyshev_max_error_deg=cheb.max_error_deg,
+            equioscillation=_spread(cheb),
+            notes=(*cheb.notes, f"optimal spacing {why}: kept Chebyshev's spacing"),
+        )
+    return replace(best, chebyshev_max_error_deg=cheb.max_error_deg, equioscillation=spread)
+
+
+def remez(req: Request, start: FunctionSynthesis) -> list[float] | None:
+    """The three precision points of the equal-ripple design (None if the exchange fails)."""
+    import numpy as np
+
+    k0 = start.linkage
+    pts, r, _ = precision_points(req, [p.x for p in start.precision_points])
+    design, _ = design_of(req, r, pts[0])
+    if design is None or k0 is None:
+        return None
+    sign = design.sign
+
+    def design_at(rv: Sequence[float]) -> Design | None:
+        k, _ = linkage_of(rv, req.ground)
+        if k is None or (k.input_turned, k.output_turned) != (k0.input_turned, k0.output_turned):
+            return None
+        return Design(req, (float(rv[0]), float(rv[1]), float(rv[2])), k, k.coefficients, sign)
+
+    def reference(d: Design) -> tuple[list[float], float] | None:
+        lobes, _, errs = extrema(d, grid=801)
+        if len(lobes) < 4 or any(not math.isfinite(e) for e in errs):
+            return None
+        sizes = [abs(e) for _, e in lobes]
+        window = alternation_set(sizes)
+        i = next(i for i in range(len(sizes) - 3) if sizes[i : i + 4] == window)
+        ref = lobes[i : i + 4]
+        return [x for x, _ in ref], (1.0 if ref[0][1] > 0 else -1.0)
+
+    rv = np.array(r)
+    for _ in range(30):
+        ref = reference(design)
+        if ref is None:
+            return None
+        xk, s0 = ref
+        yk = [_value(req.f, x) for x in xk]
+        signs = np.array([s0 * (-1.0) ** j for j in range(4)])
+        errs = np.array([design.closed_error(x, y) for x, y in zip(xk, yk)])
+        level = float(np.mean(np.abs(errs)))
+        spread = (np.max(np.abs(errs)) - np.min(np.abs(errs))) / np.max(np.abs(errs))
+        if spread < 1e-9:
+            break
+        unknowns = np.array([*rv, level])
+        for _newton in range(20):
+            d = design_at(unknowns[:3])
+            if d is None:
+                return None
+            e = np.array([d.closed_error(x, y) for x, y in zip(xk, yk)])
+            fval = e - signs * unknowns[3]
+            if not np.all(np.isfinite(fval)):
+                return None
+            jac = np.empty((4, 4))
+            for j in range(3):
+                h = 1e-7 * max(abs(unknowns[j]), 1e-3)
+                up = unknowns[:3].copy()
+                up[j] += h
+                dj = design_at(up)
+                if dj is None:
+                    return None
+                jac[:, j] = (np.array([dj.closed_error(x, y) for x, y in zip(xk, yk)]) - e) / h
+            jac[:, 3] = -signs
+            try:
+                step = np.linalg.solve(jac, -fval)
+            except np.linalg.LinAlgError:
+                return None
+            unknowns = unknowns + step
+            if np.max(np.abs(step[:3]) / np.maximum(np.abs(unknowns[:3]), 1e-12)) < 1e-13:
+                break
+        rv = unknowns[:3]
+        nd = design_at(rv)
+        if nd is None:
+            return None
+        design = nd
+    # the precision points: a zero of the error between each neighbouring pair of the
+    # reference (bisection on the closed form)
+    ref = reference(design)
+    if ref is None:
+        return None
+    xk, _ = ref
+    zeros = []
+    for x0, x1 in itertools.pairwise(xk):
+        g = lambda t: design.closed_error(t, _value(req.f, t))  # noqa: E731
+        a, b, ga = x0, x1, g(x0)
+        if not (ga > 0.0) != (g(x1) > 0.0):
+            return None
+        for _ in range(200):
+            m = 0.5 * (a + b)
+            if m in (a, b):
+                break
+            gm = g(m)
+            if (gm > 0.0) == (ga > 0.0):
+                a, ga = m, gm
+            else:
+                b = m
+        zeros.append(0.5 * (a + b))
+    return zeros
+
+
+def alternation_set(sizes: Sequence[float]) -> list[float]:
+    """The four neighbouring lobes the exchange equalises: of every run of four, the one
+    holding the largest lobe whose smallest member is largest (an error with extra zeros
+    besides the precision points has more than four lobes)."""
+    top = max(range(len(sizes)), key=lambda i: sizes[i])
+    windows = [list(sizes[i : i + 4]) for i in range(len(sizes) - 3) if i <= top < i + 4]
+    return max(windows, key=min)
+
+
+def _spread(s: FunctionSynthesis) -> float | None:
+    """(largest - smallest) / largest over the alternation set (:func:`alternation_set`)."""
+    if len(s.extrema) < 4:
+        return None
+    sizes = alternation_set([abs(e) for _, e in s.extrema])
+    return (max(sizes) - min(sizes)) / max(sizes) if max(sizes) > 0 else None
+
+
+def synthesize_function(
+    f: str | Callable[[float], float],
+    x_range: Any,
+    alpha_range: Any,
+    phi_range: Any,
+    points: int = 3,
+    spacing: str = "chebyshev",
+    *,
+    at: Sequence[float] | None = None,
+    ground: float = 1.0,
+    min_transmission: float = MIN_TRANSMISSION_DEG,
+    samples: int = TABLE_POINTS,
+) -> FunctionSynthesis:
+    """A four-bar function generator for y = f(x) over ``x_range``, x mapped onto the input
+    angle ``alpha_range`` and y onto the output angle ``phi_range`` (degrees, seed 002's
+    convention), by Freudenstein's equation at ``points`` precision points spaced by
+    ``spacing`` (chebyshev, uniform or optimal) or placed ``at``; analysed over the range
+    with the seed's solver. ``f``: an expression in x (as ``--function``) or a callable."""
+    return synthesize(
+        make_request(
+            f,
+            x_range,
+            alpha_range,
+            phi_range,
+            points=points,
+            spacing=spacing,
+            at=at,
+            ground=ground,
+            min_transmission=min_transmission,
+            table_points=samples,
+        )
+    )
