@@ -219,8 +219,8 @@ def test_batch_path_plot_draws_the_curve(cli, monkeypatch, tmp_path):
         ax.plot.side_effect = plot
         return mock.MagicMock(subplots=mock.MagicMock(return_value=(fig, ax)))
 
-    monkeypatch.setattr(plots, "_pyplot", fake_pyplot)
-    monkeypatch.setattr(plots, "_save", lambda fig, path: None)
+    monkeypatch.setattr(plots, "pyplot", fake_pyplot)
+    monkeypatch.setattr(plots, "save_figure", lambda fig, path: None)
     curves = {}
     for engine in ("--batch", "--no-batch"):
         drawn.clear()

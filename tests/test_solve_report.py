@@ -252,14 +252,14 @@ def test_convergence_plot_has_integer_iteration_ticks(tmp_path, monkeypatch):
     from linkage.render import plots
 
     seen = []
-    real_save = plots._save
+    real_save = plots.save_figure
 
     def keep(fig, path):
         fig.canvas.draw()
         seen.append([t for t in fig.axes[0].get_xticks()])
         real_save(fig, path)
 
-    monkeypatch.setattr(plots, "_save", keep)
+    monkeypatch.setattr(plots, "save_figure", keep)
     plots.convergence_plot([("newton", [1.0, 0.1, 1e-3, 1e-7])], tmp_path / "c.png", "four iterations")
     ticks = seen[0]
     assert ticks and all(t == int(t) for t in ticks), ticks

@@ -457,3 +457,108 @@ def test_numpy_twins_match_the_one_definition() -> None:
                         float(transmission_deg_np(k.a, k.c, k.d, np.array([alpha]), np.array([one]))[0]),
                         abs=1e-9,
                     )
+
+
+def test_readme_section_shows_what_the_command_prints(capsys) -> None:
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    section = readme.split("## Function generation: `linkage synthesize`", 1)[1].split("\n## ", 1)[0]
+    code = run_cli(["synthesize", "--function", "log10(x)", "--x", "1:2", "--alpha", "90:150",
+                    "--phi", "0:90", "--ground", "100", "--rows", "11", "-f", "plain"])
+    out = capsys.readouterr().out
+    assert code == 0
+    for line in ("max |error| = 0.125242 deg = 0.000418907 in y, at x = 2",
+                 "R1 = -1.19401126284, R2 = -0.535907283253, R3 = -0.537109747629",
+                 "transmission angle (folded into 0..90): min 45.39 deg (at x = 1), max 89.99 deg"):
+        assert line in out and line in section
+    optimal = synthesize_function(*GOOD, spacing="optimal")
+    assert f"{optimal.max_error_deg:.6g}" == "0.0914769" and "0.0914769" in section
+    assert (Path(__file__).resolve().parents[1] / "docs" / "synthesize_log10.png").exists()
+    assert (Path(__file__).resolve().parents[1] / "docs" / "synthesize_log10_optimal.png").exists()
+
+
+# --- the search --------------------------------------------------------------------------------
+
+SEARCH_ARGS = ["--function", "log10(x)", "--x", "1:2", "--vary", "alpha0=0:330:12", "--vary",
+               "alpha_span=60:90:2", "--vary", "phi0=0:330:12", "--vary", "phi_span=60:90:2"]
+
+
+def test_search_keeps_exactly_the_defect_free_candidates_ranked_by_synthesize() -> None:
+    import numpy as np
+
+    from linkage.synthesis import search
+
+    r = search("log10(x)", (1, 2), None, None,
+               ["alpha0=0:330:12", "alpha_span=60:90:2", "phi0=0:330:12", "phi_span=60:90:2"],
+               top=100000, workers=1)
+    assert r.scanned == 12 * 2 * 12 * 2
+    kept = {int(d) for d in r.rows["design"]}
+    assert len(kept) == r.without_defects > 0
+    assert list(r.rows["max_error_deg"]) == sorted(r.rows["max_error_deg"])
+    # every candidate against the one-at-a-time rules
+    a0s, p0s = np.linspace(0, 330, 12), np.linspace(0, 330, 12)
+    das = dps = np.array([60.0, 90.0])
+    design = 0
+    for a0 in a0s:
+        for da in das:
+            for p0 in p0s:
+                for dp in dps:
+                    s = synthesize_function("log10(x)", (1, 2), (a0, a0 + da), (p0, p0 + dp))
+                    assert (not s.defects) == (design in kept), (design, s.defect_names)
+                    if design in kept:
+                        i = list(r.rows["design"]).index(design)
+                        assert r.rows["max_error_deg"][i] == pytest.approx(s.max_error_deg, rel=1e-6)
+                        assert r.rows["min_transmission_deg"][i] == pytest.approx(s.transmission[0], abs=1e-3)
+                        assert r.rows["input"][i] == pytest.approx(s.linkage.a, rel=1e-9)
+                    design += 1
+
+
+def test_search_command_best_line_reproduces_its_row(capsys) -> None:
+    code = run_cli(["synthesize", "--search", *SEARCH_ARGS, "--min-transmission", "40", "--top", "3",
+                    "-f", "json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 0
+    table = doc["tables"][0]
+    assert table["name"] == "candidates" and len(table["rows"]) == 3
+    first = dict(zip(table["columns"], table["rows"][0]))
+    best = doc["best"]
+    assert best.startswith("linkage synthesize --function")
+    code = run_cli([*__import__("shlex").split(best)[1:], "-f", "json"])
+    one = json.loads(capsys.readouterr().out)
+    assert code == 0 and one["defects"] == []
+    assert one["structural_error"]["max_deg"] == pytest.approx(first["max_error_deg"], rel=1e-6)
+    assert one["transmission"]["min"] >= 40.0
+
+
+def test_search_on_a_dask_cluster_gives_the_local_answer(capsys) -> None:
+    distributed = pytest.importorskip("distributed")
+    args = ["synthesize", "--search", *SEARCH_ARGS, "--top", "5", "-f", "json"]
+    assert run_cli(args) == 0
+    local = json.loads(capsys.readouterr().out)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        assert run_cli([*args, "--scheduler", cluster.scheduler_address]) == 0
+        remote = json.loads(capsys.readouterr().out)
+    assert remote["tables"] == local["tables"] and remote["best"] == local["best"]
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--vary", "beta=1:2:2"], "a search varies"),
+    (["--vary", "alpha_span=-30:30:3"], "one side of 0"),
+    (["--spacing", "optimal"], "optimal"),
+    ([], "give at least one --vary"),
+    (["--vary", "alpha0=0:10:2", "--top", "0"], "--top"),
+])
+def test_search_bad_input_is_one_line_and_exit_2(extra, words, capsys) -> None:
+    code = run_cli(["synthesize", "--search", "--function", "x**2", "--x", "0:1", "--alpha", "90:150",
+                    "--phi", "0:90", *extra])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and err.startswith("error:") and "\n" not in err and words in err
+
+
+def test_search_without_a_defect_free_candidate_exits_1(capsys) -> None:
+    code = run_cli(["synthesize", "--search", "--function", "x**2", "--x", "1:2", "--alpha", "150:210",
+                    "--phi", "345:405", "--vary", "alpha0=150:151:2", "-f", "plain"])
+    out = capsys.readouterr().out
+    assert code == 1 and "no candidate without defects" in out

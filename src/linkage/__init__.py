@@ -10,6 +10,7 @@ The public API, in the order a reader meets it:
 - :func:`sweep` solves a mechanism over a range of its driver (a :class:`SweepResult`);
   :func:`position_rates` gives joints, velocities and accelerations at one solution.
 - :func:`scan_designs` runs many designs of a mechanism over their cycles: one record each.
+- :func:`synthesize_function` designs a four-bar function generator (Freudenstein).
 - :func:`analyze` estimates convergence order and rate from a recorded history.
 """
 
@@ -30,6 +31,7 @@ _EXPORTS = {
     "sweep": ".kinematics.sweep", "SweepResult": ".kinematics.sweep", "Position": ".kinematics.sweep",
     "position_rates": ".kinematics.rates", "Rates": ".kinematics.rates",
     "scan_designs": ".scan",
+    "synthesize_function": ".synthesis", "FunctionSynthesis": ".synthesis",
 }
 _RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",
             "scan_designs": "scan"}
@@ -54,6 +56,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Convergence",
+    "FunctionSynthesis",
     "History",
     "InputError",
     "IterationRecord",
@@ -78,4 +81,5 @@ __all__ = [
     "solve_scalar",
     "solve_system",
     "sweep",
+    "synthesize_function",
 ]

@@ -480,28 +480,33 @@ def chunk_bounds(total: int, size: int) -> list[tuple[int, int]]:
     return [(a, min(a + size, total)) for a in range(0, total, size)]
 
 
-def run_chunks(job: ScanJob, plan: DesignPlan, size: int, *, scheduler: str | None = None,
-               workers: int | None = None) -> Iterator[dict[str, np.ndarray]]:
+def run_chunks(job: Any, plan: DesignPlan, size: int, *, scheduler: str | None = None,
+               workers: int | None = None, task: Callable[..., dict[str, np.ndarray]] | None = None
+               ) -> Iterator[dict[str, np.ndarray]]:
     """Every chunk's records, in design order. ``scheduler``: None or "threads" (dask's
     local threads), "processes", "synchronous", or the address of a dask.distributed
     scheduler (tcp://host:port). A scan of one chunk, not sent to a cluster, runs here
-    without importing dask."""
+    without importing dask. ``task(job, start, designs)`` makes a chunk's records
+    (default :func:`run_chunk`; a synthesis search passes its own, a module-level
+    function, so it pickles)."""
+    task = task or run_chunk
     bounds = chunk_bounds(plan.total, size)
     remote = scheduler is not None and "://" in scheduler
     if remote:
         check_scheduler(scheduler)  # type: ignore[arg-type]
     if not remote and (len(bounds) == 1 or scheduler == "synchronous" or workers == 1):
         for a, b in bounds:
-            yield run_chunk(job, a, plan.chunk(a, b))
+            yield task(job, a, plan.chunk(a, b))
         return
     if remote:
-        yield from _distributed(job, plan, bounds, scheduler)  # type: ignore[arg-type]
+        yield from _distributed(job, plan, bounds, scheduler, task)  # type: ignore[arg-type]
         return
-    yield from _local(job, plan, bounds, scheduler or "threads", workers)
+    yield from _local(job, plan, bounds, scheduler or "threads", workers, task)
 
 
-def _local(job: ScanJob, plan: DesignPlan, bounds: list[tuple[int, int]], kind: str,
-           workers: int | None) -> Iterator[dict[str, np.ndarray]]:
+def _local(job: Any, plan: DesignPlan, bounds: list[tuple[int, int]], kind: str,
+           workers: int | None, task: Callable[..., dict[str, np.ndarray]] = run_chunk
+           ) -> Iterator[dict[str, np.ndarray]]:
     import os
 
     if kind not in ("threads", "processes"):
@@ -516,13 +521,13 @@ def _local(job: ScanJob, plan: DesignPlan, bounds: list[tuple[int, int]], kind: 
         print("note: dask is not installed, so the chunks run one after another here "
               "(pip install 'linkage-kinematics[scan]' to run them in parallel)", file=sys.stderr)
         for a, b in bounds:
-            yield run_chunk(job, a, plan.chunk(a, b))
+            yield task(job, a, plan.chunk(a, b))
         return
     n = workers or os.cpu_count() or 1
     window = 2 * n  # chunks in flight: memory stays bounded however many designs there are
     for w in range(0, len(bounds), window):
         part = bounds[w:w + window]
-        graph = {("chunk", i): (run_chunk, job, a, plan.chunk(a, b)) for i, (a, b) in enumerate(part)}
+        graph = {("chunk", i): (task, job, a, plan.chunk(a, b)) for i, (a, b) in enumerate(part)}
         yield from get(graph, [("chunk", i) for i in range(len(part))], num_workers=n)
 
 
@@ -549,8 +554,8 @@ def check_scheduler(address: str) -> tuple[str, int]:
     return host, port
 
 
-def _distributed(job: ScanJob, plan: DesignPlan, bounds: list[tuple[int, int]],
-                 address: str) -> Iterator[dict[str, np.ndarray]]:
+def _distributed(job: Any, plan: DesignPlan, bounds: list[tuple[int, int]], address: str,
+                 task: Callable[..., dict[str, np.ndarray]] = run_chunk) -> Iterator[dict[str, np.ndarray]]:
     from collections import deque
 
     try:
@@ -568,14 +573,14 @@ def _distributed(job: ScanJob, plan: DesignPlan, bounds: list[tuple[int, int]],
         pending: deque[Any] = deque()
         queue = iter(bounds)
         for a, b in queue:
-            pending.append(client.submit(run_chunk, job, a, plan.chunk(a, b), pure=False))
+            pending.append(client.submit(task, job, a, plan.chunk(a, b), pure=False))
             if len(pending) >= window:
                 break
         while pending:
             result = pending.popleft().result()
             nxt = next(queue, None)
             if nxt is not None:
-                pending.append(client.submit(run_chunk, job, nxt[0], plan.chunk(*nxt), pure=False))
+                pending.append(client.submit(task, job, nxt[0], plan.chunk(*nxt), pure=False))
             yield result
     finally:
         client.close()

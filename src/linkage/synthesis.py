@@ -841,8 +841,9 @@ def judge(
     if all(math.isfinite(e) for e in grid_errs):
         gen = [req.phi(_value(req.f, x)) + e for x, e in zip(grid_xs, grid_errs)]
         want = [req.phi(_value(req.f, x)) for x in grid_xs]
-        extra = _turns_diff(_turns(gen), _turns(want))
-        if extra:
+        turns_gen, turns_want = _turns(gen), _turns(want)
+        if len(turns_gen) > len(turns_want):
+            extra = _turns_diff(turns_gen, turns_want) or sorted(turns_gen)
             x_turn = grid_xs[extra[0]]
             out.append(
                 Defect(
@@ -900,6 +901,22 @@ def _turns(values: Sequence[float]) -> set[int]:
             out.add(i - 1)
         last = s
     return out
+
+
+def turns_np(values: Any) -> Any:
+    """:func:`_turns` over the rows of an array: how many times each row changes direction."""
+    import numpy as np
+
+    scale = np.maximum(np.max(np.abs(values), axis=-1, keepdims=True), 1.0)
+    step = np.diff(values, axis=-1)
+    sign = np.where(np.abs(step) <= 1e-9 * scale, 0.0, np.sign(step))
+    # carry the last non-zero direction over steps below rounding (as _turns skips them)
+    idx = np.where(sign != 0.0, np.arange(sign.shape[-1]), 0)
+    np.maximum.accumulate(idx, axis=-1, out=idx)
+    carried = np.take_along_axis(sign, idx, axis=-1)
+    moving = carried != 0.0
+    changes = (carried[..., 1:] != carried[..., :-1]) & moving[..., 1:] & moving[..., :-1]
+    return changes.sum(axis=-1)
 
 
 def _turns_diff(gen: set[int], want: set[int], width: int = 3) -> list[int]:
@@ -1099,3 +1116,301 @@ def synthesize_function(
             table_points=samples,
         )
     )
+
+
+# --- the search: many candidates at a time ------------------------------------------------------
+
+SEARCH_NAMES = ("alpha0", "alpha_span", "phi0", "phi_span")
+"""The free choices a search varies (deg): each angle range's start and span."""
+SEARCH_CHUNK = 200
+"""Candidates per task: each holds a few arrays of GRID values per candidate."""
+
+
+def branch_sign_np(alpha_deg: Any, phi_deg: Any, r1: Any, r2: Any, r3: Any) -> Any:
+    """:func:`freudenstein.branch_sign` over arrays."""
+    import numpy as np
+
+    a = np.radians(alpha_deg)
+    base = np.degrees(np.arctan2(np.sin(a), r2 + np.cos(a)))
+    return np.where(np.remainder(phi_deg - base + 180.0, 360.0) - 180.0 >= 0.0, 1.0, -1.0)
+
+
+def real_coefficients_np(a: Any, b: Any, c: Any, d: Any) -> tuple[Any, Any, Any]:
+    """:attr:`Linkage.coefficients` over arrays."""
+    return d / c, d / a, (a * a - b * b + c * c + d * d) / (2.0 * a * c)
+
+
+@dataclass(frozen=True)
+class SearchJob:
+    """What a search task needs (picklable: the function travels as its text)."""
+
+    text: str
+    x_range: tuple[float, float]
+    alpha_range: tuple[float, float]
+    phi_range: tuple[float, float]
+    names: tuple[str, ...]
+    points: int
+    spacing: str
+    at: tuple[float, ...] | None
+    ground: float
+    min_transmission: float
+
+
+def search_request(job: SearchJob) -> Request:
+    return make_request(
+        job.text,
+        job.x_range,
+        job.alpha_range,
+        job.phi_range,
+        points=job.points,
+        spacing=job.spacing,
+        at=job.at,
+        ground=job.ground,
+        min_transmission=job.min_transmission,
+    )
+
+
+def evaluate_candidates(req: Request, a0: Any, da: Any, p0: Any, dp: Any, grid: int = GRID) -> dict[str, Any]:
+    """Every candidate (alpha range A0..A0+dA, phi range P0..P0+dP) synthesised and judged
+    at once: the numpy twins of :func:`_synthesize`'s rules on the dense grid (the closed
+    form on the branch through point 1, no continuation), with the largest error refined
+    by a parabola through its grid neighbours. Columns, one entry per candidate."""
+    import numpy as np
+
+    a0, da, p0, dp = (np.asarray(v, float) for v in (a0, da, p0, dp))
+    lo, hi = req.x_range
+    y0, y1 = req.y_ends
+    xs = np.array(precision_xs(req))
+    ys = np.array([_value(req.f, x) for x in xs])
+    t = (xs - lo) / (hi - lo)
+    u = (ys - y0) / (y1 - y0)
+    alphas = a0[:, None] + t[None, :] * da[:, None]
+    phis = p0[:, None] + u[None, :] * dp[:, None]
+    if len(xs) == 3:
+        r = solve_coefficients_np(alphas, phis)
+    else:
+        r = np.array([solve_coefficients(list(al), list(ph))[0] for al, ph in zip(alphas, phis)])
+    a, b, c, d, turned_in, turned_out = linkage_of_np(r, req.ground)
+    real = np.stack(real_coefficients_np(a, b, c, d), axis=-1)
+    shift_a, shift_p = np.where(turned_in, 180.0, 0.0), np.where(turned_out, 180.0, 0.0)
+    sign = branch_sign_np(alphas[:, 0] + shift_a, phis[:, 0] + shift_p, real[:, 0], real[:, 1], real[:, 2])
+    gx = np.linspace(lo, hi, grid)
+    gy = np.array([_value(req.f, x) for x in gx])
+    gt, gu = (gx - lo) / (hi - lo), (gy - y0) / (y1 - y0)
+    from .problems.freudenstein import branch_root_np
+
+    def generated(tt: Any) -> Any:
+        al = a0[:, None] + tt[None, :] * da[:, None] + shift_a[:, None]
+        return al, branch_root_np(al, real[:, 0:1], real[:, 1:2], real[:, 2:3], sign[:, None]) - shift_p[
+            :, None
+        ]
+
+    al_g, phi_g = generated(gt)
+    want = p0[:, None] + gu[None, :] * dp[:, None]
+    err = np.remainder(phi_g - want + 180.0, 360.0) - 180.0
+    linkage_ok = np.isfinite(a)
+    assembles = linkage_ok & np.all(np.isfinite(err), axis=-1)
+    # branch: the precision points' own signs against point 1's
+    signs = branch_sign_np(
+        alphas + shift_a[:, None], phis + shift_p[:, None], real[:, 0:1], real[:, 1:2], real[:, 2:3]
+    )
+    branch = linkage_ok & np.any(signs != sign[:, None], axis=-1)
+    mag = np.where(np.isfinite(err), np.abs(err), -1.0)
+    k = np.argmax(mag, axis=-1)
+    rows = np.arange(len(a0))
+    best = mag[rows, k]
+    # parabola through the grid neighbours of an interior maximum
+    inner = (k > 0) & (k < grid - 1)
+    km, kp = np.clip(k - 1, 0, grid - 1), np.clip(k + 1, 0, grid - 1)
+    fm, f0, fp = mag[rows, km], best, mag[rows, kp]
+    curv = fm - 2.0 * f0 + fp
+    with np.errstate(invalid="ignore", divide="ignore"):
+        offset = np.where(inner & (curv < 0.0), 0.5 * (fm - fp) / curv, 0.0)
+    offset = np.clip(offset, -0.5, 0.5)
+    peak = f0 - 0.25 * (fm - fp) * offset
+    h = (hi - lo) / (grid - 1)
+    at_x = gx[k] + offset * h
+    max_err = np.where(assembles, peak, np.nan)
+    mu = transmission_deg_np(a[:, None], c[:, None], d[:, None], al_g, phi_g + shift_p[:, None])
+    fold = np.minimum(mu, 180.0 - mu)
+    lowest = np.min(np.where(np.isfinite(fold), fold, np.inf), axis=-1)
+    min_mu = np.where(linkage_ok & np.isfinite(lowest), lowest, np.nan)
+    with np.errstate(invalid="ignore"):
+        # the generated output unwrapped as the scalar rule reads it: desired + error
+        gen = want + np.where(np.isfinite(err), err, 0.0)
+        order = assembles & (turns_np(gen) > turns_np(want))
+        low_mu = linkage_ok & (min_mu < req.min_transmission)
+    from .problems.closed_form import grashof_np
+
+    kinds = np.where(
+        linkage_ok,
+        grashof_np(
+            np.where(linkage_ok, d, 1.0),
+            np.where(linkage_ok, a, 1.0),
+            np.where(linkage_ok, b, 1.0),
+            np.where(linkage_ok, c, 1.0),
+        ),
+        "",
+    )
+    names = [
+        ("no_linkage", ~linkage_ok),
+        ("branch", branch),
+        ("grashof", linkage_ok & ~assembles),
+        ("order", order),
+        ("transmission", low_mu),
+    ]
+    defects = np.array([" ".join(n for n, m in names if m[i]) for i in range(len(a0))], dtype=object)
+    return {
+        "R1": r[:, 0],
+        "R2": r[:, 1],
+        "R3": r[:, 2],
+        "input": a,
+        "coupler": b,
+        "output": c,
+        "ground": np.where(linkage_ok, d, np.nan),
+        "grashof": kinds.astype(object),
+        "max_error_deg": max_err,
+        "at_x": np.where(assembles, at_x, np.nan),
+        "max_error_y": max_err * abs(req.y_per_deg),
+        "min_transmission_deg": min_mu,
+        "defects": defects,
+        "ok": defects == "",
+    }
+
+
+def search_chunk(job: SearchJob, start: int, designs: Any) -> dict[str, Any]:
+    """One task of a search: the candidates ``start, start + 1, ...`` as columns."""
+    import numpy as np
+
+    req = search_request(job)
+    given = {
+        "alpha0": job.alpha_range[0],
+        "alpha_span": job.alpha_range[1] - job.alpha_range[0],
+        "phi0": job.phi_range[0],
+        "phi_span": job.phi_range[1] - job.phi_range[0],
+    }
+    n = designs.shape[0]
+    cols = {
+        name: (designs[:, job.names.index(name)] if name in job.names else np.full(n, given[name]))
+        for name in SEARCH_NAMES
+    }
+    out = {"design": np.arange(start, start + n)}
+    out.update(cols)
+    out.update(evaluate_candidates(req, cols["alpha0"], cols["alpha_span"], cols["phi0"], cols["phi_span"]))
+    return out
+
+
+@dataclass(frozen=True)
+class SearchResult:
+    rows: dict[str, Any]
+    """The kept candidates (no defects), best first: columns."""
+    scanned: int
+    without_defects: int
+    job: SearchJob
+
+
+def search(
+    f: str,
+    x_range: Any,
+    alpha_range: Any,
+    phi_range: Any,
+    vary: Sequence[str],
+    *,
+    points: int = 3,
+    spacing: str = "chebyshev",
+    at: Sequence[float] | str | None = None,
+    ground: float = 1.0,
+    min_transmission: float = MIN_TRANSMISSION_DEG,
+    samples: int | None = None,
+    seed: int = 0,
+    sampling: str = "lhs",
+    top: int = 10,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> SearchResult:
+    """Synthesise every candidate of a grid (or ``samples`` random draws) over the free
+    choices (``vary``: alpha0, alpha_span, phi0, phi_span as NAME=LO:HI[:N], degrees),
+    keep those without defects, best (smallest max structural error) first: on the scan's
+    chunked runner, so ``scheduler`` may be a dask cluster's address. ``alpha_range`` and
+    ``phi_range`` give what is not varied (None where both of its names are)."""
+    from .scan import MAX_DESIGNS, DesignPlan, Keeper, concat, parse_vary, run_chunks, take
+
+    if not isinstance(f, str):
+        raise InputError("a search takes the function as text (it travels to the workers)")
+    if spacing == "optimal":
+        raise InputError(
+            "--search keeps the spacing fixed (chebyshev, uniform or --at): optimal "
+            "spacing is for one design; run it on the best candidate"
+        )
+    varies = [parse_vary(v) for v in vary]
+    if not varies:
+        raise InputError(
+            "--search: give at least one --vary NAME=LO:HI[:N] (alpha0, alpha_span, phi0, phi_span)"
+        )
+    seen: set[str] = set()
+    for v in varies:
+        if v.name not in SEARCH_NAMES:
+            raise InputError(f"--vary {v.name}: a search varies {', '.join(SEARCH_NAMES)} (degrees)")
+        if v.name in seen:
+            raise InputError(f"--vary {v.name} is given twice")
+        seen.add(v.name)
+        if v.name.endswith("_span") and (v.lo <= 0.0 <= v.hi or max(abs(v.lo), abs(v.hi)) >= 360.0):
+            raise InputError(
+                f"--vary {v.name}={v.lo:g}:{v.hi:g}: a span must stay on one side of 0 and within +-360 deg"
+            )
+        if max(abs(v.lo), abs(v.hi)) > 1e6:
+            raise InputError(f"--vary {v.name}: bounds beyond 1e6 deg are not supported")
+    if isinstance(top, bool) or not isinstance(top, int) or not 1 <= top <= 100_000:
+        raise InputError(f"--top must be a whole number from 1 to 100000, got {top!r}")
+
+    def base(name: str, given: Any) -> tuple[float, float]:
+        if given is not None:
+            return _range(f"--{name}", given)
+        start = next((v for v in varies if v.name == f"{name}0"), None)
+        span = next((v for v in varies if v.name == f"{name}_span"), None)
+        if start is None or span is None:
+            raise InputError(f"--{name}: give the range, or vary both {name}0 and {name}_span")
+        return start.lo, start.lo + span.lo
+
+    ar, pr = base("alpha", alpha_range), base("phi", phi_range)
+    req = make_request(
+        f,
+        x_range,
+        ar,
+        pr,
+        points=points,
+        spacing=spacing,
+        at=at,
+        ground=ground,
+        min_transmission=min_transmission,
+    )
+    plan = DesignPlan(varies, samples, seed, sampling)
+    if plan.total > MAX_DESIGNS:
+        raise InputError(f"{plan.total:,} candidates: at most {MAX_DESIGNS:,}")
+    job = SearchJob(
+        req.text,
+        req.x_range,
+        req.alpha_range,
+        req.phi_range,
+        plan.names,
+        req.points,
+        req.spacing,
+        req.at,
+        req.ground,
+        req.min_transmission,
+    )
+    keeper = Keeper("max_error_deg", False, top, None)
+    scanned = good = 0
+    for cols in run_chunks(job, plan, SEARCH_CHUNK, scheduler=scheduler, workers=workers, task=search_chunk):
+        scanned += len(cols["design"])
+        import numpy as np
+
+        ok = np.flatnonzero(cols["ok"])
+        good += len(ok)
+        if len(ok):
+            keeper.add(take(cols, ok))
+        if progress is not None:
+            progress(scanned)
+    rows = keeper.result() or concat([])
+    return SearchResult(rows, scanned, good, job)

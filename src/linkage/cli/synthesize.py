@@ -30,7 +30,7 @@ def synthesize(
     ],
     x: Annotated[str, typer.Option("--x", metavar="LO:HI", help="The range of x.", show_default=False)],
     alpha: Annotated[
-        str,
+        Optional[str],
         typer.Option(
             "--alpha",
             metavar="A0:A1",
@@ -38,16 +38,16 @@ def synthesize(
             "at O2 from the line O4 -> O2, seed 002's convention): x = LO -> A0, HI -> A1.",
             show_default=False,
         ),
-    ],
+    ] = None,
     phi: Annotated[
-        str,
+        Optional[str],
         typer.Option(
             "--phi",
             metavar="P0:P1",
             help="The output angle range (deg, at O4 from the line O4 -> O2): y = f(LO) -> P0, f(HI) -> P1.",
             show_default=False,
         ),
-    ],
+    ] = None,
     points: Annotated[
         int, typer.Option(help="Precision points: 3 solve R1, R2, R3 exactly, more by least squares.")
     ] = 3,
@@ -68,7 +68,7 @@ def synthesize(
             help="A transmission angle (folded into 0..90) below this anywhere in the range is a defect.",
         ),
     ] = 30.0,
-    samples: Annotated[
+    rows: Annotated[
         int,
         typer.Option(
             metavar="N",
@@ -76,6 +76,38 @@ def synthesize(
             "steps of x; the extrema are located on a dense grid regardless).",
         ),
     ] = 21,
+    search: Annotated[
+        bool,
+        typer.Option(
+            "--search",
+            help="Synthesise every candidate of --vary's grid (or --samples random ones) over "
+            "alpha0, alpha_span, phi0, phi_span and list those without defects, smallest max "
+            "structural error first.",
+        ),
+    ] = False,
+    vary: Annotated[
+        Optional[list[str]],
+        typer.Option(
+            "--vary",
+            metavar="NAME=LO:HI[:N]",
+            help="With --search: alpha0, alpha_span, phi0 or phi_span (deg), N points or with "
+            "--samples a random range (repeatable).",
+        ),
+    ] = None,
+    samples: Annotated[
+        Optional[int], typer.Option(help="With --search: this many random candidates instead of a grid.")
+    ] = None,
+    sampling: Annotated[str, typer.Option(help="With --samples: lhs (default) or random.")] = "lhs",
+    seed: Annotated[int, typer.Option(help="With --samples: the random seed.")] = 0,
+    top: Annotated[int, typer.Option(metavar="K", help="With --search: keep the best K.")] = 10,
+    scheduler: Annotated[
+        Optional[str],
+        typer.Option(
+            help="With --search: threads (default), processes, synchronous or tcp://HOST:PORT "
+            "(a dask.distributed scheduler), as linkage scan."
+        ),
+    ] = None,
+    workers: Annotated[Optional[int], typer.Option(help="With --search: local workers.")] = None,
     fmt: Annotated[
         Optional[str],
         typer.Option(
@@ -125,6 +157,44 @@ def synthesize(
     check_paths([], [("--output", output)], {"--plot": (plot, (".png", ".svg", ".pdf"))})
     if unit not in LENGTH_UNITS:
         raise InputError(f"--unit {unit!r} is not a length unit (units: {', '.join(LENGTH_UNITS)})")
+    if search:
+        if design or plot is not None:
+            raise InputError(
+                "--search lists candidates: run the best one without --search for -o FILE.toml or --plot"
+            )
+        _search(
+            function,
+            x,
+            alpha,
+            phi,
+            vary or [],
+            points=points,
+            spacing=spacing,
+            at=at,
+            ground=ground,
+            min_transmission=min_transmission,
+            samples=samples,
+            seed=seed,
+            sampling=sampling,
+            top=top,
+            scheduler=scheduler,
+            workers=workers,
+            fmt=fmt,
+            output=report_out,
+            digits=digits,
+        )
+        return
+    for option, given in (
+        ("--vary", vary),
+        ("--samples", samples),
+        ("--scheduler", scheduler),
+        ("--workers", workers),
+    ):
+        if given:
+            raise InputError(f"{option} is an option of --search")
+    for option, given in (("--alpha", alpha), ("--phi", phi)):
+        if given is None:
+            raise InputError(f"give {option} (the angle range x and y map onto)")
     req = make_request(
         function,
         x,
@@ -135,13 +205,12 @@ def synthesize(
         at=at,
         ground=ground,
         min_transmission=min_transmission,
-        table_points=samples,
+        table_points=rows,
     )
     result = run(req)
     if design:
         if result.linkage is None:
-            raise_later = "no mechanism file written: there is no real linkage"
-            typer.echo(f"note: {raise_later}", err=True)
+            typer.echo(f"note: {output} not written: there is no real linkage", err=True)
         else:
             from ..files import write_atomic
 
@@ -159,4 +228,43 @@ def synthesize(
             f"wrote {output}: linkage sweep {shlex.quote(str(output))} runs it over the alpha range", err=True
         )
     if result.defects:
+        raise typer.Exit(1)
+
+
+def _search(
+    function: str,
+    x: str,
+    alpha: Optional[str],
+    phi: Optional[str],
+    vary: list[str],
+    *,
+    fmt: str,
+    output: Optional[Path],
+    digits: int,
+    **options: object,
+) -> None:
+    import time
+
+    from ..render import writers
+    from ..render.synthesis import search_report
+    from ..scan import DesignPlan, parse_vary
+    from ..synthesis import search
+    from .progress import progress_bar
+
+    # the candidates' count for the bar (search checks the same options again, naming them)
+    total = (
+        DesignPlan(
+            [parse_vary(v) for v in vary],
+            options["samples"],
+            options["seed"],  # type: ignore[arg-type]
+            options["sampling"],
+        ).total
+        if vary
+        else 1
+    )  # type: ignore[arg-type]
+    started = time.perf_counter()
+    with progress_bar(total, minimum=2000, label="synthesising") as advance:
+        result = search(function, x, alpha, phi, vary, progress=advance, **options)  # type: ignore[arg-type]
+    writers.write(search_report(result, digits, time.perf_counter() - started), fmt, output)
+    if not result.without_defects:
         raise typer.Exit(1)

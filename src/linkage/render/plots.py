@@ -21,7 +21,7 @@ from ..errors import InputError
 SUFFIXES = (".png", ".svg", ".pdf")
 
 
-def _pyplot() -> Any:
+def pyplot() -> Any:
     try:
         import matplotlib
     except ImportError:
@@ -37,7 +37,7 @@ def _check_suffix(path: Path, allowed: Sequence[str]) -> None:
         raise InputError(f"{path}: use one of {', '.join(allowed)} for the picture")
 
 
-def _save(fig: Any, path: Path) -> None:
+def save_figure(fig: Any, path: Path) -> None:
     import warnings
 
     from ..files import atomic_target
@@ -88,7 +88,7 @@ def sweep_plot(result: Any, path: Path, motion_text: str | None = None) -> None:
     """``motion_text``: the driver's speed (and acceleration) as the user gave them, e.g.
     "600 rpm"; without it the title says the internal rad/s (or length/s)."""
     _check_suffix(path, SUFFIXES)
-    plt = _pyplot()
+    plt = pyplot()
     series = _series(result)
     # constrained layout places the panels under the title: the default subplot margins
     # left a band of empty figure above a tall stack (12 % of its height)
@@ -134,14 +134,14 @@ def sweep_plot(result: Any, path: Path, motion_text: str | None = None) -> None:
 
     notes = "\n".join(textwrap.wrap("; ".join(legend), 100))
     fig.suptitle(title + ("\n" + notes if legend else ""), fontsize=10)
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def path_plot(result: Any, mechanism: Any, names: Sequence[str], path: Path) -> None:
     """The paths of named joints or points over a sweep (a coupler curve), with the
     mechanism drawn faintly at the first solved position."""
     _check_suffix(path, SUFFIXES)
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 5.5))
     first = next((p for p in result.positions if p.rates is not None), None)
     if first is not None:
@@ -160,7 +160,7 @@ def path_plot(result: Any, mechanism: Any, names: Sequence[str], path: Path) -> 
         ax.plot([x for x, _ in pts], [y for _, y in pts], lw=1.8, color=("tab:green", "tab:purple",
                                                                         "tab:brown")[k % 3], label=name)
     ax.legend(fontsize=9)
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def _broken(xs: Sequence[float], ys: Sequence[float], before: set[int]) -> tuple[list[float], list[float]]:
@@ -283,10 +283,10 @@ def _named_points(mechanism: Any, q: Sequence[float], driver: float) -> dict[str
 
 def draw_mechanism(mechanism: Any, q: Sequence[float], path: Path, title: str) -> None:
     _check_suffix(path, SUFFIXES)
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 5.5))
     _draw(ax, mechanism, q, mechanism.driver.value, title)
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def assembly_gaps(result: Any) -> list[tuple[float, float]]:
@@ -328,7 +328,7 @@ def animate_sweep(mechanism: Any, frames: Sequence[tuple[float, Sequence[float]]
 
     fps = check_fps("fps", fps)
     _check_suffix(path, (".gif",))
-    plt = _pyplot()
+    plt = pyplot()
     from matplotlib.animation import FuncAnimation, PillowWriter
 
     scale = 180.0 / math.pi if mechanism.driver.kind == "angle" else 1.0
@@ -390,7 +390,7 @@ def convergence_plot(runs: Sequence[tuple[str, Sequence[float]]], path: Path, ti
                      unit: str = "") -> None:
     """runs: (label, errors per iteration); ``unit``: the errors' unit."""
     _check_suffix(path, SUFFIXES)
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for label, errors in runs:
         pts = [(k + 1, math.log10(e)) for k, e in enumerate(errors)
@@ -405,13 +405,13 @@ def convergence_plot(runs: Sequence[tuple[str, Sequence[float]]], path: Path, ti
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title, fontsize=10)
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def work_precision_plot(measurements: Sequence[Any], path: Path) -> None:
     """log10 error against log10 time, one line per contender, one panel per problem."""
     _check_suffix(path, SUFFIXES)
-    plt = _pyplot()
+    plt = pyplot()
     problems = list(dict.fromkeys(m.problem for m in measurements))
     fig, axes = plt.subplots(1, len(problems), figsize=(6.5 * len(problems), 5.5), squeeze=False)
     for ax, problem in zip(axes[0], problems):
@@ -435,4 +435,4 @@ def work_precision_plot(measurements: Sequence[Any], path: Path) -> None:
         ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, frameon=False)
     fig.suptitle("work-precision: lower left is better (solid: linkage, dashed: scipy, dotted: hand loops)",
                  fontsize=11)
-    _save(fig, path)
+    save_figure(fig, path)

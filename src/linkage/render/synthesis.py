@@ -291,9 +291,9 @@ def _plus(name: str, shift: float) -> str:
 
 def error_plot(s: Any, path: Path) -> None:
     """The structural error against x, the precision points marked, the largest error noted."""
-    from .plots import _pyplot, _save
+    from .plots import pyplot, save_figure
 
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.5, 4.2))
     from ..synthesis import dense_curve
 
@@ -317,4 +317,130 @@ def error_plot(s: Any, path: Path) -> None:
     ax.set_title(f"y = {s.function}: {s.spacing} spacing", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
-    _save(fig, path)
+    save_figure(fig, path)
+
+
+SEARCH_COLUMNS = (
+    ("design", "", "int"),
+    ("alpha0", "deg", "number"),
+    ("alpha_span", "deg", "number"),
+    ("phi0", "deg", "number"),
+    ("phi_span", "deg", "number"),
+    ("max_error_deg", "", "number"),
+    ("at_x", "", "number"),
+    ("max_error_y", "", "number"),
+    ("min_transmission_deg", "", "number"),
+    ("grashof", "", "text"),
+    ("input", "", "number"),
+    ("coupler", "", "number"),
+    ("output", "", "number"),
+    ("ground", "", "number"),
+    ("R1", "", "number"),
+    ("R2", "", "number"),
+    ("R3", "", "number"),
+)
+
+
+def best_command(job: Any, row: dict[str, Any]) -> str:
+    """The ``linkage synthesize`` line of one candidate."""
+    import shlex
+
+    a0, da, p0, dp = (float(row[k]) for k in ("alpha0", "alpha_span", "phi0", "phi_span"))
+    words = [
+        "linkage",
+        "synthesize",
+        "--function",
+        job.text,
+        "--x",
+        f"{job.x_range[0]:.17g}:{job.x_range[1]:.17g}",
+        "--alpha",
+        f"{a0:.17g}:{a0 + da:.17g}",
+        "--phi",
+        f"{p0:.17g}:{p0 + dp:.17g}",
+    ]
+    if job.at is not None:
+        words += ["--at", ",".join(f"{v:.17g}" for v in job.at)]
+    else:
+        words += ["--points", str(job.points), "--spacing", job.spacing]
+    if job.ground != 1.0:
+        words += ["--ground", f"{job.ground:.17g}"]
+    if job.min_transmission != 30.0:
+        words += ["--min-transmission", f"{job.min_transmission:.17g}"]
+    return " ".join(shlex.quote(w) for w in words)
+
+
+def search_report(result: Any, digits: int = 6, seconds: float | None = None) -> Report:
+    from .data import DataTable, column
+
+    rows = result.rows
+    n = len(rows.get("design", ()))
+    tables = (
+        DataTable(
+            "candidates",
+            tuple(
+                column(name, unit, list(rows[name]) if n else [], kind) for name, unit, kind in SEARCH_COLUMNS
+            ),
+        ),
+    )
+    job = result.job
+    head = (
+        f"search for y = {job.text}, x {job.x_range[0]:g}..{job.x_range[1]:g}: "
+        f"{result.scanned:,} candidates, "
+        f"{result.without_defects:,} without defects (transmission >= {job.min_transmission:g} deg)"
+    )
+
+    def blocks() -> list[Block]:
+        out: list[Block] = [Text(head, "bold")]
+        if seconds is not None:
+            out.append(
+                Text(
+                    f"in {seconds:.3g} s; the best {n} by max structural error (the grid's twin of "
+                    "synthesize's rules: run a candidate's command for its full report)"
+                )
+            )
+        if n:
+            shown = [
+                ("design", ""),
+                ("alpha0", "deg"),
+                ("alpha_span", "deg"),
+                ("phi0", "deg"),
+                ("phi_span", "deg"),
+                ("max_error_deg", ""),
+                ("at_x", ""),
+                ("min_transmission_deg", ""),
+                ("grashof", ""),
+            ]
+            out.append(
+                table(
+                    "",
+                    [f"{k} ({u})" if u else k for k, u in shown],
+                    [tuple(_plain(rows[k][i]) for k, _ in shown) for i in range(n)],
+                    digits,
+                )
+            )
+            best = {k: rows[k][0] for k in rows}
+            out.append(Text(f"best: {best_command(job, best)}"))
+        else:
+            out.append(
+                Text("no candidate without defects: widen the ranges or lower --min-transmission", "red")
+            )
+        return out
+
+    def document() -> dict[str, Any]:
+        return {
+            "function": job.text,
+            "x_range": list(job.x_range),
+            "candidates": result.scanned,
+            "without_defects": result.without_defects,
+            "min_transmission": job.min_transmission,
+            "best": best_command(job, {k: rows[k][0] for k in rows}) if n else None,
+        }
+
+    return Report(head, tables, blocks, document)
+
+
+def _plain(v: Any) -> Any:
+    """A numpy scalar as the Python number or text the table formats."""
+    if hasattr(v, "item"):
+        return v.item()
+    return v
