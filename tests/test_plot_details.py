@@ -24,7 +24,7 @@ CRANK_ROCKER = SAMPLES / "crank_rocker.toml"  # r1 = 100, r2 = 40, r3 = 120, r4 
 def _capture(monkeypatch) -> dict:
     """The figure a plot function would save, kept open for reading back."""
     seen: dict = {}
-    monkeypatch.setattr(plots, "_save", lambda fig, path: seen.setdefault("fig", fig))
+    monkeypatch.setattr(plots, "save_figure", lambda fig, path: seen.setdefault("fig", fig))
     return seen
 
 

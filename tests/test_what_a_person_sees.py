@@ -225,7 +225,7 @@ def test_a_rocker_driven_plot_draws_one_assembly_as_one_line(monkeypatch, tmp_pa
     assert [p.input for p in solved] == [float(v) for v in range(105, 256)]
     assert {p.branch for p in solved} == {"open", "crossed"}
     seen = {}
-    monkeypatch.setattr(plots, "_save", lambda fig, path: seen.setdefault("fig", fig))
+    monkeypatch.setattr(plots, "save_figure", lambda fig, path: seen.setdefault("fig", fig))
     plots.sweep_plot(result, tmp_path / "p.png")
     xs, ys = seen["fig"].axes[0].lines[0].get_data()
     assert result.branch == "+" and "+ branch" in seen["fig"]._suptitle.get_text()

@@ -1102,20 +1102,19 @@ def synthesize_function(
     convention), by Freudenstein's equation at ``points`` precision points spaced by
     ``spacing`` (chebyshev, uniform or optimal) or placed ``at``; analysed over the range
     with the seed's solver. ``f``: an expression in x (as ``--function``) or a callable."""
-    return synthesize(
-        make_request(
-            f,
-            x_range,
-            alpha_range,
-            phi_range,
-            points=points,
-            spacing=spacing,
-            at=at,
-            ground=ground,
-            min_transmission=min_transmission,
-            table_points=samples,
-        )
-    )
+    try:
+        req = make_request(f, x_range, alpha_range, phi_range, points=points, spacing=spacing, at=at,
+                           ground=ground, min_transmission=min_transmission, table_points=samples)
+    except InputError as exc:  # the messages name the command's options: here the arguments
+        raise InputError(API_NAMES.sub(lambda m: API_ARGUMENTS[m.group(0)], str(exc))) from None
+    return synthesize(req)
+
+
+API_ARGUMENTS = {"--x": "x_range", "--alpha": "alpha_range", "--phi": "phi_range", "--points": "points",
+                 "--spacing": "spacing", "--at": "at", "--ground": "ground",
+                 "--min-transmission": "min_transmission", "--samples": "samples", "--function": "f"}
+API_NAMES = __import__("re").compile("|".join(sorted(map(__import__("re").escape, API_ARGUMENTS), key=len,
+                                                     reverse=True)) + r"(?![\w-])")
 
 
 # --- the search: many candidates at a time ------------------------------------------------------

@@ -158,11 +158,13 @@ def synthesize(
     if unit not in LENGTH_UNITS:
         raise InputError(f"--unit {unit!r} is not a length unit (units: {', '.join(LENGTH_UNITS)})")
     if search:
+        from .search import search_command
+
         if design or plot is not None:
             raise InputError(
                 "--search lists candidates: run the best one without --search for -o FILE.toml or --plot"
             )
-        _search(
+        search_command(
             function,
             x,
             alpha,
@@ -230,41 +232,3 @@ def synthesize(
     if result.defects:
         raise typer.Exit(1)
 
-
-def _search(
-    function: str,
-    x: str,
-    alpha: Optional[str],
-    phi: Optional[str],
-    vary: list[str],
-    *,
-    fmt: str,
-    output: Optional[Path],
-    digits: int,
-    **options: object,
-) -> None:
-    import time
-
-    from ..render import writers
-    from ..render.synthesis import search_report
-    from ..scan import DesignPlan, parse_vary
-    from ..synthesis import search
-    from .progress import progress_bar
-
-    # the candidates' count for the bar (search checks the same options again, naming them)
-    total = (
-        DesignPlan(
-            [parse_vary(v) for v in vary],
-            options["samples"],
-            options["seed"],  # type: ignore[arg-type]
-            options["sampling"],
-        ).total
-        if vary
-        else 1
-    )  # type: ignore[arg-type]
-    started = time.perf_counter()
-    with progress_bar(total, minimum=2000, label="synthesising") as advance:
-        result = search(function, x, alpha, phi, vary, progress=advance, **options)  # type: ignore[arg-type]
-    writers.write(search_report(result, digits, time.perf_counter() - started), fmt, output)
-    if not result.without_defects:
-        raise typer.Exit(1)
