@@ -65,7 +65,7 @@ REFUSALS = {
                   "joints: must be a table of joint = [x, y]"),
     "both forms": (me581_drawing() + "[[loops]]\nname = 'x'\nvectors = []\n",
                    "loops: unknown key in a joints file (expected one of description, driver, ground, "
-                   "joints, length_unit, links, name, notes, sliders)"),
+                   "joints, length_unit, links, loads, mass, name, notes, sliders)"),
     "a link naming an unknown joint": (me581_drawing(links=FOURBAR_LINKS.replace('"A", "B", "P"',
                                                                                  '"A", "Q", "P"')),
                                        "links.coupler: 'Q' is not a joint (joints: O2, A, B, O4, P)"),

@@ -78,6 +78,13 @@ def solve(
                       "for a six-bar). Its closed form is the start.")] = None,
     speed: SpeedOpt = None,
     accel: AccelOpt = None,
+    load: Annotated[Optional[list[str]], typer.Option("--load", metavar="P=FX,FY", help="With FILE "
+                    "(joints form): a force in N at a joint or point, ground frame (repeatable; adds "
+                    "to or overrides the file's [loads]).")] = None,
+    torque: Annotated[Optional[list[str]], typer.Option("--torque", metavar="LINK=T", help="With FILE: a "
+                      "torque in N m on a link, counterclockwise positive (repeatable).")] = None,
+    gravity: Annotated[Optional[str], typer.Option(metavar="G", help="With FILE: gravity on the [mass] "
+                       "links, G m/s^2 in -y (e.g. 9.81) or GX,GY.")] = None,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 12,
@@ -109,7 +116,7 @@ def solve(
     scalar_only = {"--alpha": alpha, "--r1": r1, "--r2": r2, "--r3": r3, "--links": links,
                    "--equation": equation, "--g": g, "--x0": x0, "--x1": x1, "--bracket": bracket}
     system_only = {"--set": set_, "--guess": guess, "--fd-step": fd_step, "--speed": speed, "--accel": accel,
-                   "--branch": branch,
+                   "--branch": branch, "--load": load, "--torque": torque, "--gravity": gravity,
                    "--show-jacobian": show_jacobian or None, "--plain": (not damped) or None}
     if file is not None:
         given = [k for k, v in scalar_only.items() if v is not None]
@@ -117,7 +124,8 @@ def solve(
             raise InputError(f"{', '.join(given)} apply to a single equation, not to a mechanism file")
         solve_file(file, method, set_ or [], guess or [], tol, rtol, ftol,
                     file_cap, fd_step, damped, show_jacobian,
-                    out_fmt, output, digits, plot, (speed, accel), branch, columns)
+                    out_fmt, output, digits, plot, (speed, accel), branch, columns,
+                    (load or [], torque or [], gravity))
         return
     given = [k for k, v in system_only.items() if v is not None]
     if given:

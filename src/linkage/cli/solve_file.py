@@ -13,7 +13,8 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
                 ftol: float | None, max_iter: int, fd_step: float | None, damped: bool,
                 show_jacobian: bool, out_fmt: str, output: Path | None, digits: int,
                 plot: Path | None = None, motion: tuple[str | None, str | None] = (None, None),
-                branch_wanted: str | None = None, columns: str | None = None) -> None:
+                branch_wanted: str | None = None, columns: str | None = None,
+                loads_given: tuple[list[str], list[str], str | None] = ([], [], None)) -> None:
     import dataclasses
 
     from ..analysis.convergence import analyze
@@ -33,6 +34,9 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
     if branch_wanted is not None:
         mechanism = start_on_branch(mechanism, branch_wanted, bool(guess))
     speed, accel = parse_motion(*motion, mechanism)
+    from ..kinematics.forces import command_loads
+
+    loads = command_loads(mechanism, *loads_given)
     problem = mechanism.problem()
     # the header says which loops are closed-form and which coupled (solve_system copies meta)
     problem = dataclasses.replace(problem, meta={**problem.meta, "closed_form": mechanism.derivation.summary})
@@ -49,6 +53,8 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
     report = system_report(problem, result, conv, digits, branch, fourbars, rates,
                            (speed, accel) if speed is not None else None, mechanism.driver.kind,
                            origin=mechanism.origin)
+    if result.converged and (not loads.empty or loads.gravity is not None):
+        report = _with_forces(report, mechanism, result.x, loads, speed, accel, digits)
     emit_report(report, out_fmt, output, columns=columns)
     if plot is not None:
         convergence_plot([result], plot, report.title,
@@ -63,3 +69,25 @@ def convergence_plot(results: list[Any], path: Path, title: str, unit: str = "")
 
     plot(error_series(results), path, title, unit)
     typer.echo(f"wrote {path}", err=True)
+
+
+def _with_forces(report: Any, mechanism: Any, q: Any, loads: Any, speed: float | None, accel: float | None,
+                 digits: int) -> Any:
+    """The solve's report with the loads answer added (kinematics.forces)."""
+    from ..kinematics.forces import forces_at
+    from ..render.data import Report
+    from ..render.forces import force_blocks, force_document, force_tables
+
+    f = forces_at(mechanism, q, loads, speed=speed or 0.0, accel=accel or 0.0)
+    if loads.gravity is not None and not loads.masses:
+        from .options import NOTED
+
+        NOTED.append("--gravity acts on the [mass] links, and this file gives none")
+    document = report.document
+
+    def doc() -> Any:
+        d = document() if document is not None else {}
+        return {**d, "forces": force_document(f)} if isinstance(d, dict) else d
+
+    return Report(report.title, (*report.tables, *force_tables(f)),
+                  lambda: [*report.blocks(), *force_blocks(f, digits)], doc)

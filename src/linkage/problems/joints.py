@@ -93,6 +93,15 @@ class Drawing(NamedTuple):
         return next(j for j in self.bodies[body] if j not in self.points)
 
 
+def drawing_of(doc: Mapping[str, Any], source: str = "<mechanism>") -> Drawing:
+    """The checked drawing of a joints-form document: joints, ground, links as bodies,
+    points and sliders (what the loads' matrix method needs)."""
+    def fail(key: str, msg: str) -> ParseError:
+        return ParseError(f"{source}: {key}: {msg}")
+
+    return _read(doc, fail)
+
+
 def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, Any]:
     """The loops-form document equivalent to a joints-form one (see the module)."""
     def fail(key: str, msg: str) -> ParseError:
@@ -264,7 +273,7 @@ def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
     """The drawing's joints, ground, links, sliders and points, checked: every name known
     and used, the bodies connected, and the mobility 1."""
     allowed = {"name", "description", "length_unit", "ground", "joints", "links", "sliders",
-               "driver", "notes"}
+               "driver", "notes", "loads", "mass"}
     for key in doc:
         if key not in allowed:
             raise fail(key, f"unknown key in a joints file (expected one of {', '.join(sorted(allowed))})")

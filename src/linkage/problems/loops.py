@@ -291,6 +291,22 @@ def from_text(text: str, source: str) -> Mechanism:
     return parse_mechanism(parse_toml(text, source), source)
 
 
+def _keep_drawing(mechanism: Mechanism, doc: Mapping[str, Any], source: str) -> None:
+    """A drawing's bodies, driver and loads kept with its mechanism (kinematics.forces)."""
+    from ..errors import InputError
+    from .joints import drawing_of
+    from .loads import parse_loads
+
+    drawing = drawing_of(doc, source)
+    driver = doc.get("driver", {})
+    mechanism.extra["drawing"] = drawing
+    mechanism.extra["drawing_driver"] = {k: driver[k] for k in ("link", "slider") if k in driver}
+    try:
+        mechanism.extra["loads"] = parse_loads(doc, drawing, source)
+    except InputError as exc:
+        raise ParseError(str(exc)) from None
+
+
 def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:
     def fail(key: str, msg: str) -> ParseError:
         return ParseError(f"{source}: {key}: {msg}")
@@ -298,7 +314,9 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
     from .joints import is_joints_doc, loops_doc
 
     _check_printable(doc, fail)  # a drawing's too, before its names are in a message
+    drawn: Mapping[str, Any] | None = None
     if is_joints_doc(doc):  # a drawing: its loops derived (problems/joints.py)
+        drawn = doc
         doc = loops_doc(doc, source)
 
     allowed = {"name", "description", "length_unit", "closed_form", "parameters", "driver",
@@ -459,6 +477,8 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
     clash = column_clash(mechanism)
     if clash:
         raise fail(*clash)
+    if drawn is not None:
+        _keep_drawing(mechanism, drawn, source)
     if closed_form is not None:
         from .closed_form import verify
 

@@ -1,0 +1,123 @@
+"""The loads a joints-form mechanism file gives (``[loads]`` and ``[mass]``), read and checked
+against its drawing; kinematics.forces solves for the forces they cause."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..errors import InputError
+
+
+@dataclass(frozen=True)
+class Mass:
+    mass: float
+    """kg"""
+    cg: tuple[float, float]
+    """In the drawn pose, the file's length unit."""
+    inertia: float
+    """kg m^2, about the centre of mass."""
+
+
+@dataclass(frozen=True)
+class Loads:
+    forces: dict[str, tuple[float, float]] = field(default_factory=dict)
+    """Joint or point -> (Fx, Fy) in N, fixed in the ground frame."""
+    torques: dict[str, float] = field(default_factory=dict)
+    """Link -> N m, counterclockwise positive."""
+    masses: dict[str, Mass] = field(default_factory=dict)
+    gravity: tuple[float, float] | None = None
+    """m/s^2, or None."""
+
+    def merged(self, other: Loads) -> Loads:
+        """These loads with ``other``'s added or overriding (the command line's)."""
+        return Loads(
+            {**self.forces, **other.forces},
+            {**self.torques, **other.torques},
+            {**self.masses, **other.masses},
+            other.gravity if other.gravity is not None else self.gravity,
+        )
+
+    @property
+    def empty(self) -> bool:
+        return not (self.forces or self.torques or self.masses)
+
+
+# --- the loads of a file ---------------------------------------------------------------------
+
+
+def _finite(key: str, v: Any) -> float:
+    if (
+        isinstance(v, bool)
+        or not isinstance(v, (int, float))
+        or not math.isfinite(float(v))
+        or abs(v) > 1e100
+    ):
+        raise InputError(f"{key}: must be a finite number (within 1e100), got {v!r}")
+    return float(v)
+
+
+def _pair(key: str, v: Any) -> tuple[float, float]:
+    if not isinstance(v, list) or len(v) != 2:
+        raise InputError(f"{key}: must be [x, y], two numbers")
+    return _finite(key, v[0]), _finite(key, v[1])
+
+
+def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str) -> Loads:
+    """``[loads]`` and ``[mass]`` of a joints-form document, checked against its drawing."""
+    forces: dict[str, tuple[float, float]] = {}
+    torques: dict[str, float] = {}
+    masses: dict[str, Mass] = {}
+    links = {b for b in drawing.bodies if b != "ground"}
+    loads = doc.get("loads", {})
+    if not isinstance(loads, Mapping):
+        raise InputError(
+            f"{source}: loads: must be a table of NAME = {{ force = [Fx, Fy] }} or {{ torque = T }}"
+        )
+    for name, spec in loads.items():
+        key = f"{source}: loads.{name}"
+        if (
+            not isinstance(spec, Mapping)
+            or set(spec) - {"force", "torque", "note"}
+            or len(set(spec) & {"force", "torque"}) != 1
+        ):
+            raise InputError(
+                f"{key}: give {{ force = [Fx, Fy] }} (N, at a joint or point) or "
+                "{ torque = T } (N m, on a link)"
+            )
+        if "force" in spec:
+            if name not in drawing.xy:
+                raise InputError(f"{key}: a force acts at a joint or point; joints: {', '.join(drawing.xy)}")
+            forces[str(name)] = _pair(f"{key}.force", spec["force"])
+        else:
+            if name not in links:
+                raise InputError(f"{key}: a torque acts on a moving link; links: {', '.join(sorted(links))}")
+            torques[str(name)] = _finite(f"{key}.torque", spec["torque"])
+    mass = doc.get("mass", {})
+    if not isinstance(mass, Mapping):
+        raise InputError(f"{source}: mass: must be a table of LINK = {{ mass, cg, inertia }}")
+    for name, spec in mass.items():
+        key = f"{source}: mass.{name}"
+        if name not in links:
+            raise InputError(f"{key}: not a moving link; links: {', '.join(sorted(links))}")
+        if (
+            not isinstance(spec, Mapping)
+            or set(spec) - {"mass", "cg", "inertia", "note"}
+            or "mass" not in spec
+        ):
+            raise InputError(
+                f"{key}: give {{ mass = KG, cg = [x, y], inertia = KG_M2 }} (cg in the "
+                "drawn pose, the file's length unit; inertia about the cg)"
+            )
+        m = _finite(f"{key}.mass", spec["mass"])
+        inertia = _finite(f"{key}.inertia", spec.get("inertia", 0.0))
+        if m < 0.0 or inertia < 0.0:
+            raise InputError(f"{key}: mass and inertia must be >= 0")
+        if "cg" not in spec:
+            raise InputError(f"{key}.cg: give the centre of mass [x, y] in the drawn pose")
+        masses[str(name)] = Mass(m, _pair(f"{key}.cg", spec["cg"]), inertia)
+    return Loads(forces, torques, masses)
+
+

@@ -1,0 +1,185 @@
+"""The loads answer of one position: input, pin and slider forces, the ground's force."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .data import from_rows
+from .report import Block, Text, fmt, table
+
+
+def _shown(v: float | None, f: Any, digits: int) -> Any:
+    """A force as the table shows it: undefined is no number; an ill-conditioned one is
+    given to the digits its bound leaves."""
+    if v is None or f.status == "undefined":
+        return None
+    if f.status == "ill_conditioned" and f.bound is not None and f.bound > 0:
+        keep = max(1, min(digits, int(-math.log10(f.bound))))
+        return float(f"{v:.{keep}g}")
+    return v
+
+
+def force_tables(f: Any) -> list[Any]:
+    rows = [(p.joint, p.on, p.by, p.fx, p.fy, p.magnitude) for p in f.pins] if f.status != "undefined" else []
+    out = [
+        from_rows(
+            "pin_forces",
+            [
+                ("joint", "", "text"),
+                ("on", "", "text"),
+                ("by", "", "text"),
+                ("fx", "N", "number"),
+                ("fy", "N", "number"),
+                ("magnitude", "N", "number"),
+            ],
+            rows,
+        )
+    ]
+    if f.sliders:
+        srows = [(s.slider, s.on, s.normal, s.couple) for s in f.sliders] if f.status != "undefined" else []
+        out.append(
+            from_rows(
+                "slider_forces",
+                [
+                    ("slider", "", "text"),
+                    ("on", "", "text"),
+                    ("normal", "N", "number"),
+                    ("couple", "N m", "number"),
+                ],
+                srows,
+            )
+        )
+    gf = f.ground_force or (None, None)
+    out.append(
+        from_rows(
+            "loads_summary",
+            [
+                ("input", f.input_unit, "number"),
+                ("virtual_power_input", f.input_unit, "number"),
+                ("ground_fx", "N", "number"),
+                ("ground_fy", "N", "number"),
+                ("ground_moment", "N m", "number"),
+                ("mechanical_advantage", "", "number"),
+                ("condition", "", "number"),
+                ("status", "", "text"),
+            ],
+            [
+                (
+                    f.input,
+                    f.virtual_power_input,
+                    gf[0],
+                    gf[1],
+                    f.ground_moment,
+                    f.mechanical_advantage,
+                    f.condition,
+                    f.status,
+                )
+            ],
+        )
+    )
+    return out
+
+
+def force_blocks(f: Any, digits: int) -> list[Block]:
+    out: list[Block] = [Text(""), Text("loads (matrix method; SI units)", "bold")]
+    if f.status == "undefined":
+        out.append(
+            Text(
+                "forces: undefined here (a toggle or dead centre: the force matrix is singular; "
+                "they grow without bound as it nears)",
+                "red",
+            )
+        )
+        return out
+    what = "input torque" if f.input_unit == "N m" else "input force"
+    out.append(
+        Text(
+            f"{what}: {fmt(_shown(f.input, f, digits), digits)} {f.input_unit} (virtual power: "
+            f"{fmt(_shown(f.virtual_power_input, f, digits), digits)} {f.input_unit})"
+        )
+    )
+    if f.status == "near_toggle":
+        out.append(Text(f"near_toggle: condition number {f.condition:.3g}: the forces are amplified near a "
+                        "toggle; a 0.1% change in the geometry can change them by "
+                        f"{min(100.0, 0.1 * f.condition):.3g}%", "yellow"))
+    if f.status == "ill_conditioned":
+        out.append(
+            Text(
+                f"ill_conditioned: near a toggle (condition number {f.condition:.3g}); forces are "
+                f"printed to the digits their bound ({f.bound:.1g} relative) leaves",
+                "yellow",
+            )
+        )
+    out.append(
+        table(
+            "pin forces (on the link, by the body named)",
+            ["joint", "on", "by", "fx (N)", "fy (N)", "|F| (N)"],
+            [
+                (
+                    p.joint,
+                    p.on,
+                    p.by,
+                    _shown(p.fx, f, digits),
+                    _shown(p.fy, f, digits),
+                    _shown(p.magnitude, f, digits),
+                )
+                for p in f.pins
+            ],
+            digits,
+        )
+    )
+    if f.sliders:
+        out.append(
+            table(
+                "slider forces (normal to the line, on the slider)",
+                ["slider", "on", "normal (N)", "couple (N m)"],
+                [
+                    (s.slider, s.on, _shown(s.normal, f, digits), _shown(s.couple, f, digits))
+                    for s in f.sliders
+                ],
+                digits,
+            )
+        )
+    gx, gy = f.ground_force
+    out.append(
+        Text(
+            f"on the ground (shaking force): fx = {fmt(_shown(gx, f, digits), digits)} N, fy = "
+            f"{fmt(_shown(gy, f, digits), digits)} N, moment about the origin "
+            f"{fmt(_shown(f.ground_moment, f, digits), digits)} N m"
+        )
+    )
+    if f.mechanical_advantage is not None:
+        out.append(
+            Text(
+                f"mechanical advantage |output torque / input torque| = "
+                f"{fmt(_shown(f.mechanical_advantage, f, digits), digits)}"
+            )
+        )
+    return out
+
+
+def force_document(f: Any) -> dict[str, Any]:
+    defined = f.status != "undefined"
+    return {
+        "status": f.status,
+        "input": f.input,
+        "input_unit": f.input_unit,
+        "virtual_power_input": f.virtual_power_input,
+        "condition": f.condition,
+        "bound": f.bound,
+        "pins": [
+            {"joint": p.joint, "on": p.on, "by": p.by, "fx": p.fx, "fy": p.fy, "magnitude": p.magnitude}
+            for p in f.pins
+        ]
+        if defined
+        else [],
+        "sliders": [
+            {"slider": s.slider, "on": s.on, "normal": s.normal, "couple": s.couple} for s in f.sliders
+        ]
+        if defined
+        else [],
+        "ground_force": list(f.ground_force) if f.ground_force else None,
+        "ground_moment": f.ground_moment,
+        "mechanical_advantage": f.mechanical_advantage,
+    }
