@@ -219,3 +219,30 @@ def test_solve_near_a_limit_says_near_toggle(capsys) -> None:
                     "--torque", "rocker=5", "-f", "plain"])
     out = capsys.readouterr().out
     assert code == 0 and ("near_toggle" in out or "ill_conditioned" in out)
+
+
+def test_sweep_gives_the_loads_as_columns_and_plots_the_torque(tmp_path, capsys) -> None:
+    import json
+
+    from linkage.kinematics.sweep import sweep_mechanism
+
+    crank = SAMPLES / "crank_rocker_joints.toml"
+    picture = tmp_path / "torque.png"
+    code = run_cli(["sweep", str(crank), "--step", "30", "--torque", "rocker=5", "--speed", "10",
+                    "--torque-plot", str(picture), "-f", "json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 0 and picture.stat().st_size > 5000
+    table = next(t for t in doc["tables"] if t["name"] == "loads")
+    rows = [dict(zip(table["columns"], r)) for r in table["rows"]]
+    assert len(rows) == 13
+    m = load(crank)
+    result = sweep_mechanism(m, [r["theta_crank"] for r in rows])
+    for row, pos in zip(rows, result.positions):
+        q = _internal(m, pos.solution)
+        f = forces_at(m, q, Loads(torques={"rocker": 5.0}), speed=10.0, driver=math.radians(pos.input))
+        assert row["input"] == pytest.approx(f.input, rel=1e-12)
+        assert row["input"] == pytest.approx(f.virtual_power_input, rel=1e-9)
+        assert row["forces_status"] == f.status
+    code = run_cli(["sweep", str(crank), "--step", "30", "--torque-plot", str(tmp_path / "t.png")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "--torque-plot needs loads" in err

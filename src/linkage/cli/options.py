@@ -65,6 +65,23 @@ AccelOpt = Annotated[
                  "default 0): rad/s^2, or 5rad/s^2, 90deg/s^2, 100rpm/s, 20mm/s^2."),
 ]
 
+LoadOpt = Annotated[
+    Optional[list[str]],
+    typer.Option("--load", metavar="P=FX,FY", help="With FILE (joints form): a force in N at a joint or "
+                 "point, ground frame (repeatable; adds to or overrides the file's [loads])."),
+]
+TorqueOpt = Annotated[
+    Optional[list[str]],
+    typer.Option("--torque", metavar="LINK=T", help="With FILE: a torque in N m on a link, "
+                 "counterclockwise positive (repeatable)."),
+]
+GravityOpt = Annotated[
+    Optional[str],
+    typer.Option("--gravity", metavar="G", help="With FILE: gravity on the [mass] links, G m/s^2 in -y "
+                 "(e.g. 9.81) or GX,GY."),
+]
+
+
 def choose_format(fmt: str | None, output: Path | None) -> str:
     """The run's format, by the one registry (render.writers): --format, else -o's suffix
     (an unknown suffix refused, naming those that work), else table or plain."""

@@ -12,9 +12,12 @@ from .options import (
     ColumnsOpt,
     DigitsOpt,
     FormatOpt,
+    GravityOpt,
+    LoadOpt,
     OutputOpt,
     SetOpt,
     SpeedOpt,
+    TorqueOpt,
     check_paths,
     choose_format,
     emit_report,
@@ -78,13 +81,9 @@ def solve(
                       "for a six-bar). Its closed form is the start.")] = None,
     speed: SpeedOpt = None,
     accel: AccelOpt = None,
-    load: Annotated[Optional[list[str]], typer.Option("--load", metavar="P=FX,FY", help="With FILE "
-                    "(joints form): a force in N at a joint or point, ground frame (repeatable; adds "
-                    "to or overrides the file's [loads]).")] = None,
-    torque: Annotated[Optional[list[str]], typer.Option("--torque", metavar="LINK=T", help="With FILE: a "
-                      "torque in N m on a link, counterclockwise positive (repeatable).")] = None,
-    gravity: Annotated[Optional[str], typer.Option(metavar="G", help="With FILE: gravity on the [mass] "
-                       "links, G m/s^2 in -y (e.g. 9.81) or GX,GY.")] = None,
+    load: LoadOpt = None,
+    torque: TorqueOpt = None,
+    gravity: GravityOpt = None,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 12,

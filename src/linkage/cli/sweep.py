@@ -12,9 +12,12 @@ from .options import (
     ColumnsOpt,
     DigitsOpt,
     FormatOpt,
+    GravityOpt,
+    LoadOpt,
     OutputOpt,
     SetOpt,
     SpeedOpt,
+    TorqueOpt,
     check_paths,
     choose_format,
     emit_report,
@@ -63,6 +66,11 @@ def sweep(
         "point over the sweep instead (a coupler curve; repeatable).")] = None,
     speed: SpeedOpt = None,
     accel: AccelOpt = None,
+    force: LoadOpt = None,
+    torque: TorqueOpt = None,
+    gravity: GravityOpt = None,
+    torque_plot: Annotated[Optional[Path], typer.Option("--torque-plot", help="With loads: plot the "
+                           "input torque (or force) over the sweep, its peak marked.")] = None,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 10,
@@ -94,7 +102,8 @@ def sweep(
     equation_only = {"--r1": r1, "--r2": r2, "--r3": r3, "--links": links}
     if file is None:
         given = [k for k, v in {"--branch": branch, "--set": set_, "--batch": batch, "--path": path,
-                                "--speed": speed, "--accel": accel}.items() if v or v == ""]
+                                "--speed": speed, "--accel": accel, "--load": force, "--torque": torque,
+                                "--gravity": gravity, "--torque-plot": torque_plot}.items() if v or v == ""]
         if given:
             raise InputError(f"{', '.join(given)} apply to a mechanism FILE")
         a = check_number("--from", 0.0 if start is None else start)
@@ -117,6 +126,9 @@ def sweep(
     values = driver_values(a, b, step, points)
     note_closed_form(mechanism)
     w, a_ = parse_motion(speed, accel, mechanism)
+    from ..kinematics.forces import command_loads
+
+    loads = command_loads(mechanism, force or [], torque or [], gravity)
     named = [j for loop in mechanism.loops for j in loop.joints if j] + list(mechanism.points)
     if path:
         if plot is None:
@@ -140,6 +152,12 @@ def sweep(
         note = "" if data or not named else \
             "joints and points (x, y): with --format csv, json, parquet or xlsx"
         report = sweep_report(result, digits, joints_note=note)
+        if not loads.empty or loads.gravity is not None:
+            from .loads import sweep_loads
+
+            report = sweep_loads(report, mechanism, result, loads, w, a_, digits, torque_plot)
+        elif torque_plot is not None:
+            raise InputError("--torque-plot needs loads: [loads] or [mass] in the file, or --load/--torque")
         emit_report(report, out_fmt, output, columns=columns,
                     progress=None if advance is None else (lambda rows: advance(n + rows)))
     if plot is not None:

@@ -183,3 +183,37 @@ def force_document(f: Any) -> dict[str, Any]:
         "ground_moment": f.ground_moment,
         "mechanical_advantage": f.mechanical_advantage,
     }
+
+
+def sweep_force_table(rows: list[tuple[Any, ...]], driver: str, driver_unit: str, input_unit: str) -> Any:
+    return from_rows("loads", [(driver, driver_unit, "number"), ("forces_status", "", "text"),
+                               ("input", input_unit, "number"), ("max_pin_force", "N", "number"),
+                               ("ground_fx", "N", "number"), ("ground_fy", "N", "number"),
+                               ("ground_moment", "N m", "number"), ("condition", "", "number")], rows)
+
+
+def torque_plot(rows: list[tuple[Any, ...]], driver: str, driver_unit: str, input_unit: str, path: Any,
+                title: str) -> None:
+    """The input torque (or force) over the sweep, the peak marked; flagged positions drawn
+    as hollow markers, undefined ones left out (the line breaks there)."""
+    from .plots import pyplot, save_figure
+
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(7.5, 4.2))
+    xs = [r[0] for r in rows]
+    ys = [r[2] if r[1] in ("ok", "near_toggle", "ill_conditioned") else math.nan for r in rows]
+    ax.plot(xs, ys, "-", color="C0", lw=1.6, label=f"input ({input_unit})")
+    flagged = [(x, y) for x, y, r in zip(xs, ys, rows) if r[1] in ("near_toggle", "ill_conditioned")]
+    if flagged:
+        ax.plot(*zip(*flagged), "o", mfc="none", color="C1", ms=5, label="near a toggle (flagged)")
+    shown = [(x, y) for x, y, r in zip(xs, ys, rows) if r[1] == "ok"]
+    if shown:
+        px, py = max(shown, key=lambda t: abs(t[1]))
+        ax.plot([px], [py], "s", color="C3", label=f"peak {py:.4g} {input_unit} at {px:g} {driver_unit}")
+    ax.axhline(0.0, color="0.6", lw=0.8)
+    ax.set_xlabel(f"{driver} ({driver_unit})")
+    ax.set_ylabel(f"input {'torque' if input_unit == 'N m' else 'force'} ({input_unit})")
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    save_figure(fig, path)
