@@ -41,6 +41,7 @@ def readme_solve_examples() -> list[tuple[list[str], int]]:
                          isinstance(a, list) else str(a))
 def test_every_readme_example_runs(cli, args, code, tmp_path, monkeypatch):
     (tmp_path / "sample_inputs").symlink_to(ROOT / "sample_inputs")
+    (tmp_path / "docs").symlink_to(ROOT / "docs")  # the files the README shows beside its examples
     monkeypatch.chdir(tmp_path)  # examples that write files write them here
     run = cli(*args)
     assert run.code == code, run.err
