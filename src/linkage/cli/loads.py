@@ -1,7 +1,6 @@
 """The loads over a sweep: a table beside the sweep's, and the torque curve (kinematics.forces
 at every solved position)."""
 
-import math
 from pathlib import Path
 from typing import Any, Optional
 
@@ -10,27 +9,14 @@ def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Opt
                 accel: Optional[float], digits: int, plot: Optional[Path]) -> Any:
     """The sweep's report with a ``loads`` table (and its summary lines) added; ``plot``:
     the input torque over the sweep, peak marked."""
-    from ..kinematics.forces import forces_at
+    from ..kinematics.forces import sweep_force_rows
     from ..render.data import Report
     from ..render.forces import sweep_force_table, torque_plot
     from ..render.report import Text, fmt, table
 
     angle = mechanism.driver.kind == "angle"
-    rows = []
+    rows = sweep_force_rows(mechanism, result, loads, speed or 0.0, accel or 0.0)
     unit_in = "N" if mechanism.extra.get("drawing_driver", {}).get("slider") else "N m"
-    for pos in result.positions:
-        if pos.status != "converged" or pos.solution is None:
-            rows.append((pos.input, "unsolved", None, None, None, None, None, None))
-            continue
-        q = [math.radians(pos.solution[u.name]) if u.kind == "angle" else pos.solution[u.name]
-             for u in mechanism.unknowns]
-        f = forces_at(mechanism, q, loads, speed=speed or 0.0, accel=accel or 0.0,
-                      driver=math.radians(pos.input) if angle else pos.input)
-        if f.status == "undefined":
-            rows.append((pos.input, f.status, None, None, None, None, None, f.condition))
-            continue
-        rows.append((pos.input, f.status, f.input, f.max_pin_force, f.ground_force[0], f.ground_force[1],
-                     f.ground_moment, f.condition))
     unit = "deg" if angle else mechanism.length_unit
     name = mechanism.driver.name
     loads_table = sweep_force_table(rows, name, unit, unit_in)

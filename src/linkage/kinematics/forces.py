@@ -170,16 +170,16 @@ class Frame:
         return cls(drawing, doc.get("link"), doc.get("slider"), mechanism.length_unit)
 
 
-def _body_motion(
-    frame: Frame,
-    pos: Mapping[str, tuple[float, float]],
-    vel: Mapping[str, tuple[float, float]],
-    acc: Mapping[str, tuple[float, float]],
-) -> dict[str, tuple[float, float, float]]:
-    """Each body's (rotation since the drawing, omega, alpha): from two of its joints, a
-    one-joint block from the body its line is on; the ground's all zero."""
+def _body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], acc: Mapping[str, Any]
+                 ) -> dict[str, tuple[Any, Any, Any]]:
+    """Each body's (rotation since the drawing, omega, alpha), arrays over the positions:
+    from two of its joints, a one-joint block from the body its line is on; the ground's
+    all zero."""
+    import numpy as np
+
     d = frame.drawing
-    out: dict[str, tuple[float, float, float]] = {"ground": (0.0, 0.0, 0.0)}
+    zero = np.zeros_like(next(iter(pos.values()))[0])
+    out: dict[str, tuple[Any, Any, Any]] = {"ground": (zero, zero, zero)}
     pending = []
     for body, joints in d.bodies.items():
         if body == "ground":
@@ -194,28 +194,192 @@ def _body_motion(
         dvx, dvy = vel[j1][0] - vel[j0][0], vel[j1][1] - vel[j0][1]
         dax, day = acc[j1][0] - acc[j0][0], acc[j1][1] - acc[j0][1]
         drawn = math.atan2(d.xy[j1][1] - d.xy[j0][1], d.xy[j1][0] - d.xy[j0][0])
-        out[body] = (math.atan2(ry, rx) - drawn, (rx * dvy - ry * dvx) / r2, (rx * day - ry * dax) / r2)
+        out[body] = (np.arctan2(ry, rx) - drawn, (rx * dvy - ry * dvx) / r2, (rx * day - ry * dax) / r2)
     for body in pending:
         slide = d.sliders.get(body)
-        out[body] = out.get(slide.on, (0.0, 0.0, 0.0)) if slide is not None else (0.0, 0.0, 0.0)
+        out[body] = out.get(slide.on, out["ground"]) if slide is not None else out["ground"]
     return out
 
 
 def _two_apart(d: Any, joints: Sequence[str]) -> tuple[str, str] | None:
     for i, a in enumerate(joints):
-        for b in joints[i + 1 :]:
+        for b in joints[i + 1:]:
             if d.xy[a] != d.xy[b]:
                 return a, b
     return None
 
 
-def _rotate(v: tuple[float, float], t: float) -> tuple[float, float]:
-    c, s = math.cos(t), math.sin(t)
-    return c * v[0] - s * v[1], s * v[0] + c * v[1]
-
-
-def _cross(r: tuple[float, float], f: tuple[float, float]) -> float:
+def _cross(r: tuple[Any, Any], f: tuple[Any, Any]) -> Any:
     return r[0] * f[1] - r[1] * f[0]
+
+
+@dataclass(frozen=True)
+class ForceArrays:
+    """The matrix method over N positions at once (arrays of shape (N,), NaN where the
+    force matrix is singular)."""
+
+    input: Any
+    input_unit: str
+    pins: tuple[tuple[str, str, str, Any, Any], ...]
+    """(joint, on, by, fx, fy) per pin force."""
+    sliders: tuple[tuple[str, str, Any, Any], ...]
+    ground: tuple[Any, Any, Any]
+    virtual_power_input: Any
+    condition: Any
+    applied: tuple[Any, Any, Any]
+
+
+def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[str, tuple[Any, Any]],
+                acc: Mapping[str, tuple[Any, Any]], vstar: Mapping[str, tuple[Any, Any]], loads: Loads,
+                source: str = "<mechanism>") -> ForceArrays:
+    """The one definition of the matrix method: every position's system assembled and solved
+    at once. ``pos``, ``vel``, ``acc``: each joint's (x, y) arrays in m, m/s, m/s^2;
+    ``vstar`` its velocity at a unit driver speed (m/s per rad/s, or per unit/s), for the
+    virtual-power answer."""
+    import numpy as np
+
+    d = frame.drawing
+    k = metre(frame.length_unit)
+    n_pos = len(next(iter(pos.values()))[0])
+    motion = _body_motion(frame, pos, vel, acc)
+    zeros = {j: (np.zeros(n_pos), np.zeros(n_pos)) for j in pos}
+    star = _body_motion(frame, pos, vstar, zeros)
+    moving = [b for b in d.bodies if b != "ground"]
+    row = {b: 3 * i for i, b in enumerate(moving)}
+    cols: list[tuple[str, Any]] = []  # what each unknown is
+    entries: list[tuple[int, int, Any]] = []
+
+    def add_force(body: str, at: tuple[Any, Any], cx: int, cy: int, sign: float = 1.0) -> None:
+        if body == "ground":
+            return
+        r = row[body]
+        entries.extend([(r, cx, sign), (r + 2, cx, -sign * at[1]),
+                        (r + 1, cy, sign), (r + 2, cy, sign * at[0])])
+
+    for j in d.xy:
+        on = [b for b, js in d.bodies.items() if j in js]
+        if len(on) < 2:
+            continue
+        first = "ground" if "ground" in on else on[0]
+        for b in on:
+            if b == first:
+                continue
+            cx, cy = len(cols), len(cols) + 1
+            cols += [("pin", (j, b, first)), ("pin_y", None)]
+            add_force(b, pos[j], cx, cy)
+            add_force(first, pos[j], cx, cy, sign=-1.0)
+    line_dirs: dict[str, tuple[Any, Any]] = {}
+    for s, slide in d.sliders.items():
+        at = pos[d.bodies[s][0]]
+        t = math.radians(slide.angle_deg) + motion[slide.on][0]
+        u = (np.cos(t), np.sin(t))
+        n = (-u[1], u[0])
+        line_dirs[s] = u
+        cn, cm = len(cols), len(cols) + 1
+        cols += [("slider", (s, slide.on)), ("slider_m", None)]
+        for body, sign in ((s, 1.0), (slide.on, -1.0)):
+            if body != "ground":
+                r = row[body]
+                entries.extend([(r, cn, sign * n[0]), (r + 1, cn, sign * n[1]),
+                                (r + 2, cn, sign * _cross(at, n)), (r + 2, cm, sign)])
+    ci = len(cols)
+    cols.append(("input", None))
+    if frame.driver_slider is not None:
+        s = frame.driver_slider
+        at, u = pos[d.bodies[s][0]], line_dirs[s]
+        for body, sign in ((s, 1.0), (d.sliders[s].on, -1.0)):
+            if body != "ground":
+                r = row[body]
+                entries.extend([(r, ci, sign * u[0]), (r + 1, ci, sign * u[1]),
+                                (r + 2, ci, sign * _cross(at, u))])
+        input_unit = "N"
+    else:
+        entries.append((row[frame.driver_link] + 2, ci, 1.0))
+        input_unit = "N m"
+    n_eq, n_un = 3 * len(moving), len(cols)
+    if n_eq != n_un:
+        raise InputError(f"{source}: {n_eq} equilibrium equations but {n_un} unknown forces: the matrix "
+                         "method needs a mobility-1 mechanism of pins and sliders")
+    a = np.zeros((n_pos, n_eq, n_un))
+    for r, c, v in entries:
+        a[:, r, c] += v
+    # the right-hand side: minus the known loads (external, gravity, inertia) on each body
+    rhs = np.zeros((n_pos, n_eq))
+    power = np.zeros(n_pos)  # the known loads' virtual power, for the independent answer
+    applied = [np.zeros(n_pos), np.zeros(n_pos), np.zeros(n_pos)]
+
+    def known(body: str, at: tuple[Any, Any], f: tuple[Any, Any], moment: Any, v_at: tuple[Any, Any]) -> None:
+        nonlocal power
+        power = power + f[0] * v_at[0] + f[1] * v_at[1] + moment * star[body][1]
+        m_at = _cross(at, f) + moment
+        applied[0] += f[0]
+        applied[1] += f[1]
+        applied[2] += m_at
+        if body != "ground":
+            r = row[body]
+            rhs[:, r] -= f[0]
+            rhs[:, r + 1] -= f[1]
+            rhs[:, r + 2] -= m_at
+
+    origin = (np.zeros(n_pos), np.zeros(n_pos))
+    for j, f in loads.forces.items():
+        body = next((b for b in moving if j in d.bodies[b]), "ground")
+        known(body, pos[j], f, 0.0, vstar[j])
+    for b, t in loads.torques.items():
+        known(b, origin, (0.0, 0.0), t, origin)
+    g = loads.gravity
+    for b, mass in loads.masses.items():
+        j0 = d.center(b)
+        rot, w, al = motion[b]
+        dx, dy = (mass.cg[0] - d.xy[j0][0]) * k, (mass.cg[1] - d.xy[j0][1]) * k
+        rel = (np.cos(rot) * dx - np.sin(rot) * dy, np.sin(rot) * dx + np.cos(rot) * dy)
+        cg = (pos[j0][0] + rel[0], pos[j0][1] + rel[1])
+        ag = (acc[j0][0] - al * rel[1] - w * w * rel[0], acc[j0][1] + al * rel[0] - w * w * rel[1])
+        ws = star[b][1]
+        vg = (vstar[j0][0] - ws * rel[1], vstar[j0][1] + ws * rel[0])
+        known(b, cg, (-mass.mass * ag[0], -mass.mass * ag[1]), -mass.inertia * al, vg)
+        if g is not None:
+            known(b, cg, (mass.mass * g[0], mass.mass * g[1]), 0.0, vg)
+    cond = np.linalg.cond(a)
+    good = np.isfinite(cond) & (cond * EPS < 0.5)
+    x = np.full((n_pos, n_un), np.nan)
+    if good.any():
+        x[good] = np.linalg.solve(a[good], rhs[good][..., None])[..., 0]
+    # the unit driver speed's own size: rad/s, or the length unit per second in m/s
+    vp = -power / (1.0 if frame.driver_slider is None else k)
+    pins, sliders = [], []
+    gx, gy, gm = np.zeros(n_pos), np.zeros(n_pos), np.zeros(n_pos)
+    for i, (kind, what) in enumerate(cols):
+        if kind == "pin":
+            j, on, by = what
+            fx, fy = x[:, i], x[:, i + 1]
+            pins.append((j, on, by, fx, fy))
+            if by == "ground":
+                gx, gy, gm = gx - fx, gy - fy, gm - _cross(pos[j], (fx, fy))
+        elif kind == "slider":
+            s, on = what
+            nn, mm = x[:, i], x[:, i + 1]
+            sliders.append((s, on, nn, mm))
+            if on == "ground":
+                u = line_dirs[s]
+                f = (-u[1] * nn, u[0] * nn)
+                gx, gy, gm = gx - f[0], gy - f[1], gm - _cross(pos[d.bodies[s][0]], f) - mm
+    inp = x[:, ci]
+    if frame.driver_slider is None:
+        gm = gm - inp
+    elif d.sliders[frame.driver_slider].on == "ground":
+        s = frame.driver_slider
+        u = line_dirs[s]
+        f = (u[0] * inp, u[1] * inp)
+        gx, gy, gm = gx - f[0], gy - f[1], gm - _cross(pos[d.bodies[s][0]], f)
+    return ForceArrays(inp, input_unit, tuple(pins), tuple(sliders), (gx, gy, gm), vp, cond,
+                       (applied[0], applied[1], applied[2]))
+
+
+def _arrays(points: Mapping[str, tuple[float, float]], k: float) -> dict[str, tuple[Any, Any]]:
+    import numpy as np
+
+    return {j: (np.array([p[0] * k]), np.array([p[1] * k])) for j, p in points.items()}
 
 
 def forces_at(
@@ -229,192 +393,46 @@ def forces_at(
 ) -> Forces:
     """The loads answer at one position ``q`` (internal units, as a sweep's solution) with
     the driver moving at ``speed`` and ``accel`` (rad/s and rad/s^2, or the length unit
-    per s and s^2 for a sliding driver)."""
-    import numpy as np
-
+    per s and s^2 for a sliding driver): :func:`solve_loads` for one position, judged."""
     from .rates import rates_at
 
     frame = Frame.of(mechanism)
     if loads is None:
         loads = mechanism.extra.get("loads") or Loads()
-    d = frame.drawing
-    k = metre(frame.length_unit)
     actual = rates_at(mechanism, q, speed=speed, accel=accel, driver=driver)
     unit = rates_at(mechanism, q, speed=1.0, accel=0.0, driver=driver)  # virtual velocities
+    return judged(frame, actual, unit, loads, mechanism.source)
+
+
+def judged(frame: Frame, actual: Any, unit: Any, loads: Loads, source: str) -> Forces:
+    """One position's forces from its rates (kinematics.rates.Rates at the driver's motion and
+    at a unit speed), flagged by their bounds."""
     if actual.status == "undefined" or unit.status == "undefined":
         return _undefined(frame, "the kinematics are undefined here (a toggle or dead centre)")
-    pos = {j: (p[0] * k, p[1] * k) for j, p in actual.joints.items()}
-    vel = {j: (v[0] * k, v[1] * k) for j, v in actual.joint_velocities.items()}
-    acc = {j: (a[0] * k, a[1] * k) for j, a in actual.joint_accelerations.items()}
-    vstar = {j: (v[0] * k, v[1] * k) for j, v in unit.joint_velocities.items()}
-    zero = {j: (0.0, 0.0) for j in pos}
-    motion = _body_motion(frame, pos, vel or zero, acc or zero)
-    star = _body_motion(frame, pos, vstar, zero)
-    moving = [b for b in d.bodies if b != "ground"]
-    row = {b: 3 * i for i, b in enumerate(moving)}
-    cols: list[tuple[str, Any]] = []  # what each unknown is
-    entries: list[tuple[int, int, float]] = []
+    k = metre(frame.length_unit)
+    pos = _arrays(actual.joints, k)
+    zero = {j: (0.0, 0.0) for j in actual.joints}
+    vel = _arrays(actual.joint_velocities or zero, k)
+    acc = _arrays(actual.joint_accelerations or zero, k)
+    vstar = _arrays(unit.joint_velocities, k)
+    fa = solve_loads(frame, pos, vel, acc, vstar, loads, source)
+    return position_forces(fa, 0, unit, actual.status, loads)
 
-    def add_force(
-        body: str,
-        at: tuple[float, float],
-        col_x: int | None,
-        col_y: int | None,
-        fx: float = 1.0,
-        fy: float = 1.0,
-        sign: float = 1.0,
-    ) -> None:
-        if body == "ground":
-            return
-        r = row[body]
-        if col_x is not None:
-            entries.extend([(r, col_x, sign * fx), (r + 2, col_x, sign * -at[1] * fx)])
-        if col_y is not None:
-            entries.extend([(r + 1, col_y, sign * fy), (r + 2, col_y, sign * at[0] * fy)])
 
-    owner: dict[str, str] = {}
-    for j in d.xy:
-        on = [b for b, js in d.bodies.items() if j in js]
-        if len(on) < 2:
-            continue
-        first = "ground" if "ground" in on else on[0]
-        owner[j] = first
-        for b in on:
-            if b == first:
-                continue
-            cx, cy = len(cols), len(cols) + 1
-            cols += [("pin", (j, b, first)), ("pin_y", None)]
-            add_force(b, pos[j], cx, cy)
-            add_force(first, pos[j], cx, cy, sign=-1.0)
-    line_dirs: dict[str, tuple[float, float]] = {}
-    for s, slide in d.sliders.items():
-        at = pos[d.bodies[s][0]]
-        t = math.radians(slide.angle_deg) + motion[slide.on][0]
-        u = (math.cos(t), math.sin(t))
-        n = (-u[1], u[0])
-        line_dirs[s] = u
-        cn, cm = len(cols), len(cols) + 1
-        cols += [("slider", (s, slide.on)), ("slider_m", None)]
-        for body, sign in ((s, 1.0), (slide.on, -1.0)):
-            if body == "ground":
-                continue
-            r = row[body]
-            entries.extend(
-                [
-                    (r, cn, sign * n[0]),
-                    (r + 1, cn, sign * n[1]),
-                    (r + 2, cn, sign * _cross(at, n)),
-                    (r + 2, cm, sign),
-                ]
-            )
-    ci = len(cols)
-    cols.append(("input", None))
-    if frame.driver_slider is not None:
-        s = frame.driver_slider
-        at, u = pos[d.bodies[s][0]], line_dirs[s]
-        on = d.sliders[s].on
-        for body, sign in ((s, 1.0), (on, -1.0)):
-            if body != "ground":
-                r = row[body]
-                entries.extend(
-                    [(r, ci, sign * u[0]), (r + 1, ci, sign * u[1]), (r + 2, ci, sign * _cross(at, u))]
-                )
-        input_unit = "N"
-    else:
-        entries.append((row[frame.driver_link] + 2, ci, 1.0))
-        input_unit = "N m"
-    n_eq, n_un = 3 * len(moving), len(cols)
-    if n_eq != n_un:
-        raise InputError(
-            f"{mechanism.source}: {n_eq} equilibrium equations but {n_un} unknown forces: "
-            "the matrix method needs a mobility-1 mechanism of pins and sliders"
-        )
-    a = np.zeros((n_eq, n_un))
-    for r, c, v in entries:
-        a[r, c] += v
-    # the right-hand side: minus the known loads (external and inertia) on each body
-    rhs = np.zeros(n_eq)
-    loads_power = 0.0  # their virtual power, for the check
-    external = (0.0, 0.0, 0.0)  # the known loads' total force and moment, for global equilibrium
-
-    def known(
-        body: str,
-        at: tuple[float, float],
-        f: tuple[float, float],
-        moment: float,
-        vstar_at: tuple[float, float],
-    ) -> None:
-        nonlocal loads_power, external
-        loads_power += f[0] * vstar_at[0] + f[1] * vstar_at[1] + moment * star[body][1]
-        external = (external[0] + f[0], external[1] + f[1], external[2] + _cross(at, f) + moment)
-        if body == "ground":
-            return
-        r = row[body]
-        rhs[r] -= f[0]
-        rhs[r + 1] -= f[1]
-        rhs[r + 2] -= _cross(at, f) + moment
-
-    for j, f in loads.forces.items():
-        body = next((b for b in moving if j in d.bodies[b]), "ground")
-        known(body, pos[j], f, 0.0, vstar[j])
-    for b, t in loads.torques.items():
-        known(b, (0.0, 0.0), (0.0, 0.0), t, (0.0, 0.0))
-    g = loads.gravity
-    for b, mass in loads.masses.items():
-        j0 = d.center(b) if b in d.bodies else d.bodies[b][0]
-        rot, w, al = motion[b]
-        rel = _rotate(((mass.cg[0] - d.xy[j0][0]) * k, (mass.cg[1] - d.xy[j0][1]) * k), rot)
-        cg = (pos[j0][0] + rel[0], pos[j0][1] + rel[1])
-        a0 = acc.get(j0, (0.0, 0.0)) if acc else (0.0, 0.0)
-        ag = (a0[0] - al * rel[1] - w * w * rel[0], a0[1] + al * rel[0] - w * w * rel[1])
-        ws = star[b][1]
-        v0 = vstar[j0]
-        vg = (v0[0] - ws * rel[1], v0[1] + ws * rel[0])
-        f_in = (-mass.mass * ag[0], -mass.mass * ag[1])
-        known(b, cg, f_in, -mass.inertia * al, vg)
-        if g is not None:
-            known(b, cg, (mass.mass * g[0], mass.mass * g[1]), 0.0, vg)
-    cond = float(np.linalg.cond(a))
-    if not math.isfinite(cond) or cond * EPS >= 0.5:
-        return _undefined(frame, "the force matrix is singular here (a toggle)", cond)
-    x = np.linalg.solve(a, rhs)
+def position_forces(fa: ForceArrays, i: int, unit: Any, kinematics_status: str, loads: Loads) -> Forces:
+    """Position ``i`` of :func:`solve_loads`' answer as a :class:`Forces`, flagged: its error
+    bound from the condition number and from the kinematics' own bounds (the unit-speed
+    rates, relative to the fastest joint: near a toggle they carry into the forces as into
+    the velocities they balance)."""
+    cond = float(fa.condition[i])
+    inp = float(fa.input[i])
+    if not math.isfinite(inp):
+        return Forces(None, fa.input_unit, (), (), None, None, None, cond, "undefined")
     bound = 2.0 * cond * EPS * 4.0
-    # the unit driver speed's own size: rad/s, or the length unit per second in m/s
-    unit_speed = 1.0 if frame.driver_slider is None else k
-    vp = -loads_power / unit_speed
-    pins, sliders = [], []
-    gx = gy = gm = 0.0
-    for i, (kind, what) in enumerate(cols):
-        if kind == "pin":
-            j, on, by = what
-            fx, fy = float(x[i]), float(x[i + 1])
-            pins.append(PinForce(j, on, by, fx, fy))
-            if by == "ground":
-                gx, gy, gm = gx - fx, gy - fy, gm - _cross(pos[j], (fx, fy))
-        elif kind == "slider":
-            s, on = what
-            nn, mm = float(x[i]), float(x[i + 1])
-            sliders.append(SliderForce(s, on, nn, mm))
-            if on == "ground":
-                u = line_dirs[s]
-                f = (-u[1] * nn, u[0] * nn)
-                at = pos[d.bodies[s][0]]
-                gx, gy, gm = gx - f[0], gy - f[1], gm - _cross(at, f) - mm
-    inp = float(x[ci])
-    if frame.driver_slider is None:
-        gm -= inp
-    else:
-        s = frame.driver_slider
-        if d.sliders[s].on == "ground":
-            u = line_dirs[s]
-            at = pos[d.bodies[s][0]]
-            gx, gy, gm = gx - u[0] * inp, gy - u[1] * inp, gm - _cross(at, (u[0] * inp, u[1] * inp))
-    # the kinematics' own uncertainty near a toggle (the rates' bounds, relative to the
-    # fastest joint) carries into the forces as into the velocities they balance
     vmax = max((math.hypot(*v) for v in unit.joint_velocities.values()), default=0.0)
     if vmax > 0.0 and unit.joint_velocity_bounds:
         bound = max(bound, max(unit.joint_velocity_bounds.values()) / vmax)
-    if bound > FORCE_RTOL or actual.status != "ok" or unit.status != "ok":
+    if bound > FORCE_RTOL or kinematics_status != "ok" or unit.status != "ok":
         status = "ill_conditioned"
     elif cond >= TOGGLE_COND:
         status = "near_toggle"
@@ -423,9 +441,75 @@ def forces_at(
     ma = None
     if len(loads.torques) == 1 and not loads.forces and not loads.masses and inp != 0.0:
         ma = abs(next(iter(loads.torques.values())) / inp)
-    return Forces(inp, input_unit, tuple(pins), tuple(sliders), (gx, gy), gm, vp, cond, status, bound, ma,
-                  external)
+    pins = tuple(PinForce(j, on, by, float(fx[i]), float(fy[i])) for j, on, by, fx, fy in fa.pins)
+    sliders = tuple(SliderForce(s, on, float(nn[i]), float(mm[i])) for s, on, nn, mm in fa.sliders)
+    gx, gy, gm = (float(v[i]) for v in fa.ground)
+    return Forces(inp, fa.input_unit, pins, sliders, (gx, gy), gm, float(fa.virtual_power_input[i]), cond,
+                  status, bound, ma, tuple(float(v[i]) for v in fa.applied))  # type: ignore[arg-type]
 
 
 def _undefined(frame: Frame, why: str, cond: float = math.inf) -> Forces:
     return Forces(None, "N" if frame.driver_slider else "N m", (), (), None, None, None, cond, "undefined")
+
+
+def sweep_forces(mechanism: Any, result: Any, loads: Loads, speed: float, accel: float
+                 ) -> list[Forces | None]:
+    """Every position of a sweep's forces (None where unsolved): each position's rates as the
+    sweep's own (kinematics.rates), the matrix method for all of them in one
+    :func:`solve_loads`."""
+    import numpy as np
+
+    from .rates import rates_at
+
+    frame = Frame.of(mechanism)
+    angle = mechanism.driver.kind == "angle"
+    k = metre(frame.length_unit)
+    kept: list[tuple[int, Any, Any]] = []
+    out: list[Forces | None] = [None] * len(result.positions)
+    for i, pos in enumerate(result.positions):
+        if pos.status != "converged" or pos.solution is None:
+            continue
+        q = [math.radians(pos.solution[u.name]) if u.kind == "angle" else pos.solution[u.name]
+             for u in mechanism.unknowns]
+        drv = math.radians(pos.input) if angle else pos.input
+        actual = rates_at(mechanism, q, speed=speed, accel=accel, driver=drv)
+        unit = rates_at(mechanism, q, speed=1.0, accel=0.0, driver=drv)
+        if actual.status == "undefined" or unit.status == "undefined":
+            out[i] = _undefined(frame, "the kinematics are undefined here")
+            continue
+        kept.append((i, actual, unit))
+    if not kept:
+        return out
+    names = list(kept[0][1].joints)
+
+    def stack(get: Any) -> dict[str, tuple[Any, Any]]:
+        return {j: (np.array([get(r)[j][0] * k for r in rows]),
+                    np.array([get(r)[j][1] * k for r in rows])) for j in names}
+
+    rows = [a for _, a, _ in kept]
+    zero = {j: (0.0, 0.0) for j in names}
+    pos_a = stack(lambda r: r.joints)
+    vel_a = stack(lambda r: r.joint_velocities or zero)
+    acc_a = stack(lambda r: r.joint_accelerations or zero)
+    rows = [u for _, _, u in kept]
+    vstar = stack(lambda r: r.joint_velocities)
+    fa = solve_loads(frame, pos_a, vel_a, acc_a, vstar, loads, mechanism.source)
+    for n, (i, actual, unit) in enumerate(kept):
+        out[i] = position_forces(fa, n, unit, actual.status, loads)
+    return out
+
+
+def sweep_force_rows(mechanism: Any, result: Any, loads: Loads, speed: float, accel: float
+                     ) -> list[tuple[Any, ...]]:
+    """The loads table's rows: driver value, status, input, largest pin force, the ground's
+    force and moment, the condition number (None where there is no number)."""
+    rows: list[tuple[Any, ...]] = []
+    for pos, f in zip(result.positions, sweep_forces(mechanism, result, loads, speed, accel)):
+        if f is None:
+            rows.append((pos.input, "unsolved", None, None, None, None, None, None))
+        elif f.status == "undefined":
+            rows.append((pos.input, f.status, None, None, None, None, None, f.condition))
+        else:
+            rows.append((pos.input, f.status, f.input, f.max_pin_force, f.ground_force[0], f.ground_force[1],
+                         f.ground_moment, f.condition))
+    return rows
