@@ -88,8 +88,22 @@ def synthesis_report(s: Any, digits: int = 6, unit: str = "") -> Report:
         )
         for c in s.curve
     ]
+    k = s.linkage
+    links = (
+        ()
+        if k is None
+        else (
+            # the design itself, in CSV and xlsx too (JSON also has it as "links")
+            from_rows(
+                "linkage",
+                [("link", "", "text"), ("length", unit, "number")],
+                [("input", k.a), ("coupler", k.b), ("output", k.c), ("ground", k.d)],
+            ),
+        )
+    )
     tables = (
         from_rows("precision_points", pp_headers, pp_rows),
+        *links,
         from_rows("structural_error", curve_headers, curve_rows),
     )
 
