@@ -410,7 +410,10 @@ def linkage_of(r: Sequence[float], ground: float) -> tuple[Linkage | None, str |
         return None, "R1, R2, R3 are not finite"
     tiny = ZERO_R * max(1.0, abs(r1), abs(r2), abs(r3))
     if abs(r1) <= tiny or abs(r2) <= tiny:
-        which = f"output link (R1 = {r1:.3g})" if abs(r1) <= tiny else f"input link (R2 = {r2:.3g})"
+        # + 0.0: a zero of either sign is said as 0
+        which = (
+            f"output link (R1 = {r1 + 0.0:.3g})" if abs(r1) <= tiny else f"input link (R2 = {r2 + 0.0:.3g})"
+        )
         return None, f"the {which} would be infinitely long: R = d / length is zero to rounding"
     d = ground
     a, c = d / r2, d / r1
@@ -554,22 +557,31 @@ def golden_max(g: Callable[[float], float], lo: float, hi: float, iters: int = 8
     return best
 
 
-def extrema(design: Design, grid: int = GRID) -> tuple[list[tuple[float, float]], list[float], list[float]]:
+def extrema(
+    design: Design, grid: int = GRID, reached: bool = False
+) -> tuple[list[tuple[float, float]], list[float], list[float]]:
     """The structural error's local extrema (x, error_deg), refined by golden section from
-    a dense grid (ends included), and the grid's x and errors (NaN: no assembly)."""
+    a dense grid (ends included), and the grid's x and errors (NaN: no assembly). Where
+    the linkage cannot be assembled there are none, unless ``reached``: then the assembled
+    runs' extrema, an end at a limit position being the last x that assembles (the error
+    is steepest there)."""
     req = design.req
     lo, hi = req.x_range
     xs = [lo + (hi - lo) * i / (grid - 1) for i in range(grid)]
     errs = [design.closed_error(x, _value(req.f, x)) for x in xs]
     out: list[tuple[float, float]] = []
-    if any(not math.isfinite(e) for e in errs):
+    if not reached and any(not math.isfinite(e) for e in errs):
         return out, xs, errs
-    mag = [abs(e) for e in errs]
+    mag = [abs(e) if math.isfinite(e) else -1.0 for e in errs]
     for i in range(grid):
+        if mag[i] < 0.0:
+            continue
         left = mag[i - 1] if i > 0 else -1.0
         right = mag[i + 1] if i < grid - 1 else -1.0
         if (mag[i] >= left and mag[i] > right) or (mag[i] > left and mag[i] >= right):
-            if 0 < i < grid - 1:
+            if (left < 0.0 < i) or (right < 0.0 and i < grid - 1):
+                x = _last_assembled(design, xs[i], xs[i - 1] if left < 0.0 else xs[i + 1])
+            elif 0 < i < grid - 1:
                 x, _ = golden_max(
                     lambda t: abs(design.closed_error(t, _value(req.f, t))), xs[i - 1], xs[i + 1]
                 )
@@ -586,6 +598,21 @@ def extrema(design: Design, grid: int = GRID) -> tuple[list[tuple[float, float]]
             continue
         lobes.append((x, e))
     return lobes, xs, errs
+
+
+def _last_assembled(design: Design, inside: float, outside: float) -> float:
+    """The x between an assembled ``inside`` and an unassembled ``outside`` nearest the
+    limit position that still assembles (bisection)."""
+    f = design.req.f
+    for _ in range(60):
+        mid = 0.5 * (inside + outside)
+        if mid in (inside, outside):
+            break
+        if math.isfinite(design.closed_error(mid, _value(f, mid))):
+            inside = mid
+        else:
+            outside = mid
+    return inside
 
 
 def _zero_between(errs: Sequence[float], xs: Sequence[float], x0: float, x1: float) -> bool:
@@ -702,7 +729,7 @@ def _synthesize(req: Request, xs: Sequence[float]) -> FunctionSynthesis:
             f"R1 = {r[0]:.6g} < 0: the output link is drawn the other way (length {k.c:.6g}, "
             "its angle phi + 180 deg)"
         )
-    lobes, grid_xs, grid_errs = extrema(design)
+    lobes, grid_xs, grid_errs = extrema(design, reached=True)
     lo, hi = req.x_range
     table = [lo + (hi - lo) * i / (req.table_points - 1) for i in range(req.table_points)]
     extra = [x for x, _ in lobes] + [p.x for p in pts]

@@ -224,6 +224,8 @@ def synthesize(
             write_atomic(output, design_text(result, unit, made_by))  # type: ignore[arg-type]
     if plot is not None and result.linkage is not None and result.curve:
         error_plot(result, plot)
+    elif plot is not None:
+        typer.echo(f"note: {plot} not drawn: there is no real linkage", err=True)
     writers.write(synthesis_report(result, digits, unit), fmt, report_out)
     if design and result.linkage is not None:
         typer.echo(

@@ -43,7 +43,7 @@ def check_command(s: Any, digits: int = 12) -> str | None:
     if k is None:
         return None
     p = s.precision_points[0]
-    alpha = p.alpha_deg + k.alpha_shift()
+    alpha = (p.alpha_deg + k.alpha_shift()) % 360.0  # one turn, as a person gives it
     phi = math.remainder(p.phi_deg + k.phi_shift(), 360.0)  # started on the followed branch
     return (
         f"linkage solve --links {k.a:.{digits}g} {k.b:.{digits}g} {k.c:.{digits}g} {k.d:.{digits}g} "
@@ -88,8 +88,22 @@ def synthesis_report(s: Any, digits: int = 6, unit: str = "") -> Report:
         )
         for c in s.curve
     ]
+    k = s.linkage
+    links = (
+        ()
+        if k is None
+        else (
+            # the design itself, in CSV and xlsx too (JSON also has it as "links")
+            from_rows(
+                "linkage",
+                [("link", "", "text"), ("length", unit, "number")],
+                [("input", k.a), ("coupler", k.b), ("output", k.c), ("ground", k.d)],
+            ),
+        )
+    )
     tables = (
         from_rows("precision_points", pp_headers, pp_rows),
+        *links,
         from_rows("structural_error", curve_headers, curve_rows),
     )
 
@@ -158,6 +172,11 @@ def synthesis_report(s: Any, digits: int = 6, unit: str = "") -> Report:
                 Text(
                     f"max |error| = {_r(s.max_error_deg, digits)} deg = {_r(s.max_error_y, digits)} in y, "
                     f"at x = {_r(s.at_x, digits)}"
+                    + (
+                        ", over the part of the range reached"
+                        if any(c.status != "converged" for c in s.curve)
+                        else ""
+                    )
                 )
             )
         if s.chebyshev_max_error_deg is not None:
@@ -278,8 +297,9 @@ def design_text(s: Any, unit: str, made_by: str) -> str:
         "",
         "[driver]",
         'link = "crank"  # its angle O2 -> A, degrees',
-        f"value = {toml_value(value)}  # alpha at precision point 1",
-        f"range = {toml_value([lo, hi])}  # the alpha range",
+        f"value = {toml_value(value)}  # {_plus('alpha', shift)} at precision point 1",
+        f"range = {toml_value([lo, hi])}  # the alpha range {a0:g}..{a1:g}"
+        + ("" if _plus("alpha", shift) == "alpha" else f", as {_plus('alpha', shift)}"),
     ]
     return "\n".join(lines) + "\n"
 
