@@ -246,3 +246,41 @@ def test_sweep_gives_the_loads_as_columns_and_plots_the_torque(tmp_path, capsys)
     code = run_cli(["sweep", str(crank), "--step", "30", "--torque-plot", str(tmp_path / "t.png")])
     err = capsys.readouterr().err.strip()
     assert code == 2 and "--torque-plot needs loads" in err
+
+
+@pytest.mark.parametrize("theta_deg", [10.0, 45.0, 100.0, 200.0, 300.0])
+def test_slider_crank_kinetostatics_against_its_closed_form(theta_deg: float) -> None:
+    """The offset slider-crank (crank 40 mm, coupler 120 mm, offset e = 10 mm) with a 2 kg
+    block, massless crank and coupler, the crank at a constant 100 rad/s: the block's
+    position x(theta) = r cos(theta) + sqrt(l^2 - (r sin(theta) - e)^2) in closed form, its
+    acceleration x'' = x_thetatheta omega^2, the coupler a two-force member, so the input
+    torque is m x'' x_theta (by d'Alembert on the block and the crank's moment), the rod's
+    force m x'' along the rod's horizontal, and the block's normal force its vertical share.
+    The derivatives of x are differentiated here by hand, not by the tool."""
+    r, l_, e, m, w = 0.040, 0.120, 0.010, 2.0, 100.0
+    t = math.radians(theta_deg)
+    s = r * math.sin(t) - e
+    root = math.sqrt(l_ * l_ - s * s)
+    x_t = -r * math.sin(t) - s * r * math.cos(t) / root
+    ds = r * math.cos(t)
+    x_tt = -r * math.cos(t) - (ds * ds - s * r * math.sin(t)) / root - (s * ds) ** 2 / root ** 3
+    acc = x_tt * w * w
+    torque = m * acc * x_t
+    m_ = load(SAMPLES / "slider_crank_joints.toml")
+    from linkage.kinematics.sweep import sweep_mechanism
+
+    pos = sweep_mechanism(m_, [theta_deg]).positions[0]
+    assert pos.status == "converged"
+    q = _internal(m_, pos.solution)
+    f = forces_at(m_, q, Loads(masses={"block": Mass(m, (146.88311367414514, 10.0), 0.0)}), speed=w,
+                  driver=t)
+    assert f.status == "ok"
+    assert f.input == pytest.approx(torque, rel=1e-9)
+    # the rod pushes the block with m x'' along x; its line of action is the rod's
+    rod = next(p for p in f.pins if p.joint == "B")
+    assert rod.fx == pytest.approx(m * acc, rel=1e-9, abs=1e-9)
+    ax_, ay_ = r * math.cos(t), r * math.sin(t)
+    xb = r * math.cos(t) + root
+    assert rod.fy / rod.fx == pytest.approx((e - ay_) / (xb - ax_), rel=1e-9)
+    block = f.sliders[0]
+    assert block.normal == pytest.approx(-rod.fy, rel=1e-9, abs=1e-9)
