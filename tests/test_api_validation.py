@@ -61,6 +61,9 @@ def _bisect_result():
 
 
 # (exported function, label, call, the argument the message must name)
+JM = linkage.load_mechanism(FOURBAR.parent / "fourbar_me581_joints.toml")
+JQ = [u.value for u in JM.unknowns]
+
 BATTERY = [
     # sweep: values, rates, options
     ("sweep", "2-D values", lambda: linkage.sweep(M, np.zeros((3, 2))), "values"),
@@ -115,6 +118,12 @@ BATTERY = [
     ("position_rates", "mechanism None", lambda: linkage.position_rates(None, Q), "mechanism"),
     # scan_designs: the specs and every option
     ("scan_designs", "vary None", lambda: linkage.scan_designs(M, None, values=TWO), "vary"),
+    # forces: each argument by its own name
+    ("forces", "a path for the mechanism", lambda: linkage.forces("x.toml", [0.0, 0.0]), "mechanism"),
+    ("forces", "a loops-form mechanism", lambda: linkage.forces(M, Q), "joints form"),
+    ("forces", "loads a dict", lambda: linkage.forces(JM, JQ, {"rocker": 5}), "loads"),
+    ("forces", "NaN speed", lambda: linkage.forces(JM, JQ, speed=math.nan), "speed"),
+    ("forces", "text accel", lambda: linkage.forces(JM, JQ, accel="fast"), "accel"),
     # synthesize_function: each argument by its own name
     ("synthesize_function", "no function",
      lambda: linkage.synthesize_function(None, (1, 2), (90, 150), (0, 90)), "function"),

@@ -11,6 +11,7 @@ The public API, in the order a reader meets it:
   :func:`position_rates` gives joints, velocities and accelerations at one solution.
 - :func:`scan_designs` runs many designs of a mechanism over their cycles: one record each.
 - :func:`synthesize_function` designs a four-bar function generator (Freudenstein).
+- :func:`forces` gives the input torque and joint forces of a joints-form mechanism at a position.
 - :func:`analyze` estimates convergence order and rate from a recorded history.
 """
 
@@ -32,9 +33,11 @@ _EXPORTS = {
     "position_rates": ".kinematics.rates", "Rates": ".kinematics.rates",
     "scan_designs": ".scan",
     "synthesize_function": ".synthesis", "FunctionSynthesis": ".synthesis",
+    "forces": ".kinematics.forces", "Forces": ".kinematics.forces",
+    "Loads": ".problems.loads", "Mass": ".problems.loads",
 }
 _RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",
-            "scan_designs": "scan"}
+            "scan_designs": "scan", "forces": "forces_at"}
 
 
 def __getattr__(name: str) -> Any:
@@ -56,11 +59,14 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Convergence",
+    "Forces",
     "FunctionSynthesis",
     "History",
     "InputError",
     "IterationRecord",
     "LinkageError",
+    "Loads",
+    "Mass",
     "Mechanism",
     "NotConvergedError",
     "ParseError",
@@ -74,6 +80,7 @@ __all__ = [
     "analyze",
     "coefficients_from_links",
     "equation_problem",
+    "forces",
     "fourbar_equation",
     "load_mechanism",
     "position_rates",

@@ -394,8 +394,15 @@ def forces_at(
     """The loads answer at one position ``q`` (internal units, as a sweep's solution) with
     the driver moving at ``speed`` and ``accel`` (rad/s and rad/s^2, or the length unit
     per s and s^2 for a sliding driver): :func:`solve_loads` for one position, judged."""
+    from ..arguments import check_number
     from .rates import rates_at
 
+    if not hasattr(mechanism, "extra") or not hasattr(mechanism, "unknowns"):
+        raise InputError("mechanism: give a Mechanism (linkage.load_mechanism), got "
+                         f"{type(mechanism).__name__}")
+    if loads is not None and not isinstance(loads, Loads):
+        raise InputError(f"loads: give a linkage.Loads, got {type(loads).__name__}")
+    speed, accel = check_number("speed", speed), check_number("accel", accel)
     frame = Frame.of(mechanism)
     if loads is None:
         loads = mechanism.extra.get("loads") or Loads()
