@@ -334,7 +334,9 @@ def error_plot(s: Any, path: Path) -> None:
         ax.plot([worst.x], [worst.error_deg], "s", color="C1", label=f"max |error| {s.max_error_deg:.3g} deg")
     ax.set_xlabel("x")
     ax.set_ylabel("structural error (deg)")
-    ax.set_title(f"y = {s.function}: {s.spacing} spacing", fontsize=10)
+    said = f" (defects: {', '.join(s.defect_names)})" if s.defects else ""
+    ax.set_title(f"y = {s.function}: {s.spacing} spacing{said}", fontsize=10,
+                 color="C3" if s.defects else "black")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     save_figure(fig, path)
