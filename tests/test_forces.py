@@ -284,3 +284,25 @@ def test_slider_crank_kinetostatics_against_its_closed_form(theta_deg: float) ->
     assert rod.fy / rod.fx == pytest.approx((e - ay_) / (xb - ax_), rel=1e-9)
     block = f.sliders[0]
     assert block.normal == pytest.approx(-rod.fy, rel=1e-9, abs=1e-9)
+
+
+def test_loads_in_other_units_are_converted_on_read(tmp_path) -> None:
+    base = (SAMPLES / "fourbar_me581_joints.toml").read_text()
+    si = base + ('\n[loads]\nrocker = { torque = 0.5 }\nB = { force = [0, -4.4482216152605] }\n\n[mass]\n'
+                 'coupler = { mass = 0.45359237, cg = [60, 20], inertia = 0.0004 }\n')
+    other = base + ('\n[loads]\nrocker = { torque = 500, unit = "N mm" }\n'
+                    'B = { force = [0, -1], unit = "lbf" }\n\n[mass]\ncoupler = { mass = 1, mass_unit = "lb", cg = [60, 20], inertia = 400, '
+                    'inertia_unit = "kg mm^2" }\n')
+    results = []
+    for name, text in (("si", si), ("other", other)):
+        path = tmp_path / f"{name}.toml"
+        path.write_text(text)
+        m = load(path)
+        results.append(forces_at(m, [u.value for u in m.unknowns], speed=5.0, accel=1.0))
+    assert results[0].input == pytest.approx(results[1].input, rel=1e-14)
+    bad = tmp_path / "bad.toml"
+    bad.write_text(base + '\n[loads]\nrocker = { torque = 5, unit = "ft lb" }\n')
+    from linkage.errors import LinkageError
+
+    with pytest.raises(LinkageError, match="is not one of N m, N mm"):
+        load(bad)

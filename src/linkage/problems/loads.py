@@ -65,36 +65,54 @@ def _pair(key: str, v: Any) -> tuple[float, float]:
     return _finite(key, v[0]), _finite(key, v[1])
 
 
+LBF, LB, INCH = 4.4482216152605, 0.45359237, 0.0254
+FORCE_UNITS = {"N": 1.0, "kN": 1e3, "mN": 1e-3, "lbf": LBF}
+TORQUE_UNITS = {"N m": 1.0, "N mm": 1e-3, "kN m": 1e3, "lbf in": LBF * INCH, "lbf ft": LBF * 12 * INCH}
+MASS_UNITS = {"kg": 1.0, "g": 1e-3, "lb": LB}
+INERTIA_UNITS = {"kg m^2": 1.0, "kg mm^2": 1e-6, "g cm^2": 1e-7, "lb in^2": LB * INCH * INCH}
+"""Units a load may name (``unit``, ``mass_unit``, ``inertia_unit``), each to SI, exactly as
+defined (1 lbf = 4.4482216152605 N, 1 lb = 0.45359237 kg)."""
+
+
+def _unit(key: str, spec: Mapping[str, Any], field_name: str, units: Mapping[str, float]) -> float:
+    if field_name not in spec:
+        return 1.0
+    name = spec[field_name]
+    if name not in units:
+        raise InputError(f"{key}.{field_name}: {name!r} is not one of {', '.join(units)}")
+    return units[name]
+
+
 def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str) -> Loads:
-    """``[loads]`` and ``[mass]`` of a joints-form document, checked against its drawing."""
+    """``[loads]`` and ``[mass]`` of a joints-form document, checked against its drawing, in SI:
+    a force in N and a torque in N m unless its ``unit`` says otherwise, a mass in kg and an
+    inertia in kg m^2 unless ``mass_unit`` / ``inertia_unit`` say; a cg in the file's
+    length unit (the drawing's)."""
     forces: dict[str, tuple[float, float]] = {}
     torques: dict[str, float] = {}
     masses: dict[str, Mass] = {}
     links = {b for b in drawing.bodies if b != "ground"}
     loads = doc.get("loads", {})
     if not isinstance(loads, Mapping):
-        raise InputError(
-            f"{source}: loads: must be a table of NAME = {{ force = [Fx, Fy] }} or {{ torque = T }}"
-        )
+        raise InputError(f"{source}: loads: must be a table of NAME = {{ force = [Fx, Fy] }} or "
+                         "{ torque = T }")
     for name, spec in loads.items():
         key = f"{source}: loads.{name}"
-        if (
-            not isinstance(spec, Mapping)
-            or set(spec) - {"force", "torque", "note"}
-            or len(set(spec) & {"force", "torque"}) != 1
-        ):
-            raise InputError(
-                f"{key}: give {{ force = [Fx, Fy] }} (N, at a joint or point) or "
-                "{ torque = T } (N m, on a link)"
-            )
+        if (not isinstance(spec, Mapping) or set(spec) - {"force", "torque", "unit", "note"}
+                or len(set(spec) & {"force", "torque"}) != 1):
+            raise InputError(f"{key}: give {{ force = [Fx, Fy] }} (N, at a joint or point) or "
+                             "{ torque = T } (N m, on a link), with unit = ... for another unit")
         if "force" in spec:
             if name not in drawing.xy:
                 raise InputError(f"{key}: a force acts at a joint or point; joints: {', '.join(drawing.xy)}")
-            forces[str(name)] = _pair(f"{key}.force", spec["force"])
+            scale = _unit(key, spec, "unit", FORCE_UNITS)
+            fx, fy = _pair(f"{key}.force", spec["force"])
+            forces[str(name)] = (fx * scale, fy * scale)
         else:
             if name not in links:
                 raise InputError(f"{key}: a torque acts on a moving link; links: {', '.join(sorted(links))}")
-            torques[str(name)] = _finite(f"{key}.torque", spec["torque"])
+            torques[str(name)] = _finite(f"{key}.torque", spec["torque"]) * _unit(key, spec, "unit",
+                                                                                   TORQUE_UNITS)
     mass = doc.get("mass", {})
     if not isinstance(mass, Mapping):
         raise InputError(f"{source}: mass: must be a table of LINK = {{ mass, cg, inertia }}")
@@ -102,22 +120,17 @@ def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str) -> Loads:
         key = f"{source}: mass.{name}"
         if name not in links:
             raise InputError(f"{key}: not a moving link; links: {', '.join(sorted(links))}")
-        if (
-            not isinstance(spec, Mapping)
-            or set(spec) - {"mass", "cg", "inertia", "note"}
-            or "mass" not in spec
-        ):
-            raise InputError(
-                f"{key}: give {{ mass = KG, cg = [x, y], inertia = KG_M2 }} (cg in the "
-                "drawn pose, the file's length unit; inertia about the cg)"
-            )
-        m = _finite(f"{key}.mass", spec["mass"])
-        inertia = _finite(f"{key}.inertia", spec.get("inertia", 0.0))
+        if (not isinstance(spec, Mapping) or "mass" not in spec
+                or set(spec) - {"mass", "cg", "inertia", "mass_unit", "inertia_unit", "note"}):
+            raise InputError(f"{key}: give {{ mass = KG, cg = [x, y], inertia = KG_M2 }} (cg in the "
+                             "drawn pose, the file's length unit; inertia about the cg; mass_unit and "
+                             "inertia_unit for others)")
+        m = _finite(f"{key}.mass", spec["mass"]) * _unit(key, spec, "mass_unit", MASS_UNITS)
+        inertia = _finite(f"{key}.inertia", spec.get("inertia", 0.0)) * _unit(key, spec, "inertia_unit",
+                                                                             INERTIA_UNITS)
         if m < 0.0 or inertia < 0.0:
             raise InputError(f"{key}: mass and inertia must be >= 0")
         if "cg" not in spec:
             raise InputError(f"{key}.cg: give the centre of mass [x, y] in the drawn pose")
         masses[str(name)] = Mass(m, _pair(f"{key}.cg", spec["cg"]), inertia)
     return Loads(forces, torques, masses)
-
-
