@@ -291,7 +291,8 @@ def test_loads_in_other_units_are_converted_on_read(tmp_path) -> None:
     si = base + ('\n[loads]\nrocker = { torque = 0.5 }\nB = { force = [0, -4.4482216152605] }\n\n[mass]\n'
                  'coupler = { mass = 0.45359237, cg = [60, 20], inertia = 0.0004 }\n')
     other = base + ('\n[loads]\nrocker = { torque = 500, unit = "N mm" }\n'
-                    'B = { force = [0, -1], unit = "lbf" }\n\n[mass]\ncoupler = { mass = 1, mass_unit = "lb", cg = [60, 20], inertia = 400, '
+                    'B = { force = [0, -1], unit = "lbf" }\n\n[mass]\n'
+                    'coupler = { mass = 1, mass_unit = "lb", cg = [60, 20], inertia = 400, '
                     'inertia_unit = "kg mm^2" }\n')
     results = []
     for name, text in (("si", si), ("other", other)):
