@@ -815,15 +815,21 @@ def judge(
     req, k = design.req, design.linkage
     out: list[Defect] = []
     kind = grashof_of(k)
-    # branch: a precision point the followed assembly does not pass through
+    # branch: a precision point the followed assembly does not pass through (its root on
+    # the side of the point's phi: the point itself for an exact fit, the nearer root for
+    # least squares, whose points lie off the linkage by the fit's error)
+    from .problems.freudenstein import branch_root, branch_sign
+
     first_label = branch_label(k, pts[0].alpha_deg + k.alpha_shift(), pts[0].phi_deg + k.phi_shift())
     off = []
     for j, p in enumerate(pts):
         c = next((c for c in curve if c.x == p.x), None)
+        real = (p.alpha_deg + k.alpha_shift(), p.phi_deg + k.phi_shift())
+        own = branch_root(real[0], *design.real_R, branch_sign(*real, *design.real_R)) - k.phi_shift()
         if (
             c is not None
             and c.phi_generated_deg is not None
-            and abs(math.remainder(c.phi_generated_deg - p.phi_deg, 360.0)) <= BRANCH_TOL_DEG
+            and abs(math.remainder(c.phi_generated_deg - own, 360.0)) <= BRANCH_TOL_DEG
         ):
             continue
         if c is not None and c.phi_generated_deg is None:

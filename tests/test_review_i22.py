@@ -1,0 +1,107 @@
+"""Second reading of linkage synthesize (issue 22): each test failed before its fix.
+
+The reference here is the linkage's own geometry at 40 digits (mpmath): R from the
+precision points, the links from R, the output where the coupler's circle about A meets
+the output's circle about O4 on the side of the line O4 -> A the first precision point
+is on (that side changes only at a limit position)."""
+
+from __future__ import annotations
+
+import json
+
+import mpmath as mp
+import numpy as np
+import pytest
+
+from linkage.cli import run_cli
+from linkage.synthesis import search, synthesize_function
+
+FUNCTIONS = {"log10(x)": mp.log10, "x**2": lambda x: x * x, "sin(x)": mp.sin}
+
+
+def _reference(fs, xr, ar, pr, xs, ground=1.0, n=2000):
+    """(max |structural error| deg, x of it, gaps, side changes of the precision points'
+    nearer roots): least squares by 40-digit normal equations for more than 3 points."""
+    mp.mp.dps = 40
+    f = FUNCTIONS[fs]
+    (lo, hi), (a0, a1), (p0, p1) = ([mp.mpf(v) for v in r] for r in (xr, ar, pr))
+    y0, y1 = f(lo), f(hi)
+
+    def alpha(x):
+        return a0 + (x - lo) / (hi - lo) * (a1 - a0)
+
+    def phi(x):
+        return p0 + (f(x) - y0) / (y1 - y0) * (p1 - p0)
+
+    xs = [mp.mpf(x) for x in xs]
+    mat = mp.matrix([[mp.cos(mp.radians(alpha(x))), -mp.cos(mp.radians(phi(x))), 1] for x in xs])
+    rhs = mp.matrix([mp.cos(mp.radians(alpha(x) - phi(x))) for x in xs])
+    r = mp.lu_solve(mat.T * mat, mat.T * rhs)
+    d = mp.mpf(ground)
+    a, c = d / r[1], d / r[0]  # signed: negative is a link drawn the other way
+    b = mp.sqrt(a * a + c * c + d * d - 2 * a * c * r[2])
+
+    def pin(x):
+        t = mp.radians(alpha(x))
+        return d + a * mp.cos(t), a * mp.sin(t)
+
+    def side(x, ph):
+        ax, ay = pin(x)
+        return mp.sign(ax * c * mp.sin(mp.radians(ph)) - ay * c * mp.cos(mp.radians(ph)))
+
+    s1 = side(xs[0], phi(xs[0]))
+    worst, at, gaps = mp.mpf(0), None, 0
+    for i in range(n + 1):
+        x = lo + (hi - lo) * i / n
+        ax, ay = pin(x)
+        dist = mp.sqrt(ax * ax + ay * ay)
+        along = (c * c - b * b + dist * dist) / (2 * dist)
+        if c * c < along * along:
+            gaps += 1
+            continue
+        h = mp.sqrt(c * c - along * along) * s1
+        bx, by = (along * ax - h * ay) / dist, (along * ay + h * ax) / dist  # |B| = |c|
+        ph = mp.degrees(mp.atan2(by / c, bx / c))  # B = c e^(i phi), c signed
+        e = abs(mp.fmod(ph - phi(x) + 540, 360) - 180)
+        if e > worst:
+            worst, at = e, x
+    changes = sum(side(x, phi(x)) != s1 for x in xs)
+    return float(worst), at, gaps, changes
+
+
+# --- least squares (--points > 3) is not a "branch" defect --------------------------------------
+
+
+@pytest.mark.parametrize("points, spacing", [(4, "chebyshev"), (5, "chebyshev"), (10, "uniform")])
+def test_least_squares_points_are_not_a_false_branch_defect(points, spacing) -> None:
+    s = synthesize_function("log10(x)", (1, 2), (90, 150), (0, 90), points=points, spacing=spacing)
+    worst, _, gaps, changes = _reference(
+        "log10(x)", (1, 2), (90, 150), (0, 90), [p.x for p in s.precision_points]
+    )
+    assert gaps == 0 and changes == 0  # one assembly passes (nearest to) every point
+    assert s.defect_names == []
+    assert s.max_error_deg == pytest.approx(worst, rel=1e-6)
+
+
+def test_search_with_more_points_keeps_what_synthesize_keeps() -> None:
+    r = search("log10(x)", (1, 2), None, None,
+               ["alpha0=0:300:6", "alpha_span=60:90:2", "phi0=0:300:6", "phi_span=60:90:2"],
+               points=4, top=100000, workers=1)
+    kept = {int(d) for d in r.rows["design"]}
+    design, single = 0, set()
+    for a0 in np.linspace(0, 300, 6):
+        for da in (60.0, 90.0):
+            for p0 in np.linspace(0, 300, 6):
+                for dp in (60.0, 90.0):
+                    s = synthesize_function("log10(x)", (1, 2), (a0, a0 + da), (p0, p0 + dp), points=4)
+                    if not s.defects:
+                        single.add(design)
+                    design += 1
+    assert single and kept == single
+
+
+def test_least_squares_cli_exit_0(capsys) -> None:
+    code = run_cli(["synthesize", "--function", "log10(x)", "--x", "1:2", "--alpha", "90:150",
+                    "--phi", "0:90", "--points", "5", "-f", "json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 0 and doc["defects"] == []
