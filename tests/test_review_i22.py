@@ -105,3 +105,55 @@ def test_least_squares_cli_exit_0(capsys) -> None:
                     "--phi", "0:90", "--points", "5", "-f", "json"])
     doc = json.loads(capsys.readouterr().out)
     assert code == 0 and doc["defects"] == []
+
+
+# --- a gap in assembly narrower than the grid's step -------------------------------------------
+
+# The linkage a, b, c, d = 1, 3 + 1e-8, 2, 2 (seed convention, R1, R2, R3 below) is a hair
+# past a change point: it cannot be assembled for alpha in about 179.9943..180.0057 deg,
+# narrower than the 2001-point grid's step of 0.03 deg over 150.015..210.015, which puts grid
+# points at 179.985 and 180.015, both outside it. f is that linkage's own output (acos
+# reflected past -1 so f is finite everywhere), so the design is that linkage.
+_U = "((1.0*cosd(x)+-1.4999999908837935e-08)/sqrt((2.0+cosd(x))**2+sind(x)**2))"
+GAP_F = f"atand(sind(x)/(2.0+cosd(x))) + acosd(-1 + abs(1 + {_U}))"
+GAP_X = (150.015, 210.015)
+
+
+def _gap_phi() -> tuple[float, float]:
+    from linkage.synthesis import make_request
+
+    return make_request(GAP_F, GAP_X, (0, 1), (0, 1)).y_ends
+
+
+def test_a_gap_between_grid_points_is_a_grashof_defect_in_search_too() -> None:
+    from linkage.problems.freudenstein import equation_roots
+
+    r1, r2, r3 = 1.0, 2.0, -1.4999999908837935e-08
+    assert not equation_roots(180.0, r1, r2, r3)  # the gap is real
+    assert equation_roots(179.985, r1, r2, r3) and equation_roots(180.015, r1, r2, r3)
+    p = _gap_phi()
+    s = synthesize_function(GAP_F, GAP_X, GAP_X, p, min_transmission=0)
+    assert "grashof" in s.defect_names
+    r = search(GAP_F, GAP_X, GAP_X, p, ["alpha0=150.015:150.015:1"], min_transmission=0, workers=1)
+    assert r.scanned == 1 and r.without_defects == 0
+
+
+def test_assembly_gap_against_dense_sampling() -> None:
+    import random
+
+    from linkage.problems.freudenstein import equation_roots
+    from linkage.synthesis import assembly_gap, assembly_gap_np
+
+    rng = random.Random(7)
+    seen = set()
+    for _ in range(400):
+        r = [rng.uniform(-3, 3) for _ in range(3)]
+        a0 = rng.uniform(-400, 400)
+        a1 = a0 + rng.uniform(-350, 350)
+        dense = any(not equation_roots(a0 + (a1 - a0) * i / 2000, *r) for i in range(2001))
+        got = assembly_gap(r, a0, a1)
+        if dense:
+            assert got
+        seen.add((dense, got))
+        assert bool(assembly_gap_np(*(np.array([v]) for v in (*r, a0, a1)))[0]) == got
+    assert (True, True) in seen and (False, False) in seen

@@ -493,6 +493,38 @@ def grashof_of(k: Linkage) -> str:
     return grashof(k.d, k.a, k.b, k.c)
 
 
+def assembly_gap(real_r: Sequence[float], alpha0_deg: float, alpha1_deg: float) -> bool:
+    """Whether the linkage of ``real_r`` cannot be assembled somewhere in the input range
+    (its own alpha, either order), between grid points or not: it assembles at alpha iff
+    |K| <= |(R2 + cos a, sin a)| (freudenstein.branch_root), i.e. iff
+    g(cos a) = 1 + R2^2 + 2 R2 cos a - (R1 cos a + R3)^2 >= 0, a parabola in cos a opening
+    downwards, so its least over the range is at the least or the greatest cos a there."""
+    r1, r2, r3 = real_r
+    lo, hi = sorted((alpha0_deg, alpha1_deg))
+    ends = (math.cos(math.radians(lo)), math.cos(math.radians(hi)))
+    top = 1.0 if math.floor(hi / 360.0) >= math.ceil(lo / 360.0) else max(ends)
+    bottom = -1.0 if math.floor((hi - 180.0) / 360.0) >= math.ceil((lo - 180.0) / 360.0) else min(ends)
+    return min(1.0 + r2 * r2 + 2.0 * r2 * c - (r1 * c + r3) ** 2 for c in (bottom, top)) < 0.0
+
+
+def assembly_gap_np(r1: Any, r2: Any, r3: Any, alpha0_deg: Any, alpha1_deg: Any) -> Any:
+    """:func:`assembly_gap` over arrays."""
+    import numpy as np
+
+    lo, hi = np.minimum(alpha0_deg, alpha1_deg), np.maximum(alpha0_deg, alpha1_deg)
+    c_lo, c_hi = np.cos(np.radians(lo)), np.cos(np.radians(hi))
+    top = np.where(np.floor(hi / 360.0) >= np.ceil(lo / 360.0), 1.0, np.maximum(c_lo, c_hi))
+    bottom = np.where(
+        np.floor((hi - 180.0) / 360.0) >= np.ceil((lo - 180.0) / 360.0), -1.0, np.minimum(c_lo, c_hi)
+    )
+
+    def g(c: Any) -> Any:
+        return 1.0 + r2 * r2 + 2.0 * r2 * c - (r1 * c + r3) ** 2
+
+    with np.errstate(invalid="ignore"):
+        return np.minimum(g(bottom), g(top)) < 0.0
+
+
 INPUT_CRANKS = ("crank-rocker", "double crank")
 OUTPUT_CRANKS = ("rocker-crank", "double crank")
 
@@ -870,6 +902,15 @@ def judge(
                 f"position before x = {gap.x:.6g} (alpha = {req.alpha(gap.x):.6g} deg)",
             )
         )
+    elif assembly_gap(design.real_R, design.real_alpha(req.x_range[0]), design.real_alpha(req.x_range[1])):
+        out.append(
+            Defect(
+                "grashof",
+                f"grashof: this {kind} linkage cannot move its input through the "
+                "range: it cannot be assembled in a gap narrower than the "
+                f"{GRID}-point grid's step",
+            )
+        )
     # order: the output turns back where the function does not
     if all(math.isfinite(e) for e in grid_errs):
         gen = [req.phi(_value(req.f, x)) + e for x, e in zip(grid_xs, grid_errs)]
@@ -1241,7 +1282,12 @@ def evaluate_candidates(req: Request, a0: Any, da: Any, p0: Any, dp: Any, grid: 
     want = p0[:, None] + gu[None, :] * dp[:, None]
     err = np.remainder(phi_g - want + 180.0, 360.0) - 180.0
     linkage_ok = np.isfinite(a)
-    assembles = linkage_ok & np.all(np.isfinite(err), axis=-1)
+    lo_real, hi_real = a0 + shift_a, a0 + da + shift_a
+    assembles = (
+        linkage_ok
+        & np.all(np.isfinite(err), axis=-1)
+        & ~assembly_gap_np(real[:, 0], real[:, 1], real[:, 2], lo_real, hi_real)
+    )
     # branch: the precision points' own signs against point 1's
     signs = branch_sign_np(
         alphas + shift_a[:, None], phis + shift_p[:, None], real[:, 0:1], real[:, 1:2], real[:, 2:3]
