@@ -157,3 +157,14 @@ def test_assembly_gap_against_dense_sampling() -> None:
         seen.add((dense, got))
         assert bool(assembly_gap_np(*(np.array([v]) for v in (*r, a0, a1)))[0]) == got
     assert (True, True) in seen and (False, False) in seen
+
+
+# --- refusals name the option given ------------------------------------------------------------
+
+
+@pytest.mark.parametrize("rows", ["1", "-1", "1000000000"])
+def test_bad_rows_names_rows(rows, capsys) -> None:
+    code = run_cli(["synthesize", "--function", "log10(x)", "--x", "1:2", "--alpha", "90:150",
+                    "--phi", "0:90", "--rows", rows])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and err.startswith("error: --rows") and "\n" not in err

@@ -289,7 +289,7 @@ def make_request(
         or not isinstance(table_points, int)
         or not 2 <= table_points <= 100_001
     ):
-        raise InputError(f"--samples must be a whole number from 2 to 100001, got {table_points!r}")
+        raise InputError(f"--rows must be a whole number from 2 to 100001, got {table_points!r}")
     y_ends = (_value(fn, xr[0]), _value(fn, xr[1]))
     if y_ends[0] == y_ends[1]:
         raise InputError(
