@@ -16,7 +16,7 @@ import pytest
 from linkage.cli import run_cli
 from linkage.synthesis import search, synthesize_function
 
-FUNCTIONS = {"log10(x)": mp.log10, "x**2": lambda x: x * x, "sin(x)": mp.sin}
+FUNCTIONS = {"log10(x)": mp.log10, "x**2": lambda x: x * x, "sin(x)": mp.sin, "exp(x)": mp.exp}
 
 
 def _reference(fs, xr, ar, pr, xs, ground=1.0, n=2000):
@@ -168,3 +168,23 @@ def test_bad_rows_names_rows(rows, capsys) -> None:
                     "--phi", "0:90", "--rows", rows])
     err = capsys.readouterr().err.strip()
     assert code == 2 and err.startswith("error: --rows") and "\n" not in err
+
+
+# --- the continuation must not jump to the other branch near a limit ----------------------------
+
+NEAR_LIMIT = ("exp(x)", (0, 1), (-95.42062855059999, 93.55703245593415),
+              (40.77987358806064, -46.77855364187823))
+"""Uniform spacing, ground 37.5: the branch through point 1 passes within 0.5 deg of a
+toggle (transmission) near x = 0.5 without a gap, and point 3 lies on the other branch."""
+
+
+def test_the_followed_branch_does_not_jump_near_a_limit() -> None:
+    fs, xr, ar, pr = NEAR_LIMIT
+    s = synthesize_function(fs, xr, ar, pr, spacing="uniform", ground=37.5)
+    worst, at, gaps, changes = _reference(fs, xr, ar, pr, [p.x for p in s.precision_points], 37.5, n=4000)
+    assert gaps == 0 and changes == 1  # no gap, but point 3 is on the other side
+    assert "branch" in s.defect_names and "grashof" not in s.defect_names
+    assert s.max_error_deg == pytest.approx(worst, rel=1e-5)
+    assert s.at_x == pytest.approx(float(at), abs=1e-3)
+    last = s.curve[-1]
+    assert last.x == 1.0 and abs(last.error_deg) > 10.0  # not point 3's zero on the other branch

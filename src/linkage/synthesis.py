@@ -656,25 +656,36 @@ def follow(design: Design, xs: Sequence[float], first: PrecisionPoint) -> list[f
     """The generated phi (deg, the equation's convention) at each x, by the seed's solver
     (Newton with continuation, kinematics.equation_sweep) from the first precision point,
     both ways; None from the first position it cannot reach on that branch onwards (a
-    limit position in between)."""
+    limit position in between, even one narrower than the steps). Near a limit the two
+    roots are close and a continuation step can land on the other one: a root nearer the
+    other branch's closed form (freudenstein.branch_root with -sign) than the followed
+    one's is such a jump, and the walk restarts there from the followed branch's root."""
     from .kinematics.equation_sweep import equation_sweep
+    from .problems.freudenstein import branch_root
 
-    k = design.linkage
+    k, real_r, sign = design.linkage, design.real_R, design.sign
     seed = (first.alpha_deg + k.alpha_shift(), first.phi_deg + k.phi_shift())
     order = sorted(range(len(xs)), key=lambda i: xs[i])
     ahead = [i for i in order if xs[i] >= first.x]
     behind = [i for i in reversed(order) if xs[i] < first.x]
     out: list[float | None] = [None] * len(xs)
     for part in (ahead, behind):
-        if not part:
-            continue
-        rows = equation_sweep(
-            [design.real_alpha(xs[i]) for i in part], design.real_R, "newton", SOLVER_TOL, seed=seed
-        )
-        for i, row in zip(part, rows):
-            if row.phi is None:
-                break  # beyond a limit: the rest of this side is not on the followed branch
-            out[i] = row.phi - k.phi_shift()
+        start, last, j, restarted = seed, seed[0], 0, -1
+        while j < len(part):
+            alphas = [design.real_alpha(xs[i]) for i in part[j:]]
+            rows = equation_sweep(alphas, real_r, "newton", SOLVER_TOL, seed=start)
+            jump = None
+            for m, (i, row, al) in enumerate(zip(part[j:], rows, alphas)):
+                if row.phi is None or assembly_gap(real_r, last, al):
+                    break  # beyond a limit: the rest of this side is not on the followed branch
+                on, other = branch_root(al, *real_r, sign), branch_root(al, *real_r, -sign)
+                if abs(math.remainder(row.phi - on, 360.0)) > abs(math.remainder(row.phi - other, 360.0)):
+                    jump = (j + m, (al, on))
+                    break
+                out[i], last = row.phi - k.phi_shift(), al
+            if jump is None or jump[0] == restarted:
+                break
+            (j, start), restarted = jump, jump[0]
     return out
 
 
