@@ -188,3 +188,29 @@ def test_the_followed_branch_does_not_jump_near_a_limit() -> None:
     assert s.at_x == pytest.approx(float(at), abs=1e-3)
     last = s.curve[-1]
     assert last.x == 1.0 and abs(last.error_deg) > 10.0  # not point 3's zero on the other branch
+
+
+# --- the branch sign's twin at a limit position --------------------------------------------------
+
+
+def test_branch_sign_twin_agrees_at_a_limit_position() -> None:
+    from linkage.problems.freudenstein import branch_sign
+    from linkage.synthesis import branch_sign_np
+
+    # phi - atan2(...) = +-180 exactly: the two roots meet (acos at pi); and random points
+    cases = [(0.0, 180.0, 1.0, 2.0, 0.5), (0.0, -180.0, 1.0, 2.0, 0.5), (0.0, 0.0, 1.0, -2.0, 0.5),
+             (360.0, 540.0, 0.3, 1.5, -1.0)]
+    rng = np.random.default_rng(3)
+    cases += [tuple(v) for v in rng.uniform(-400, 400, (200, 5))]
+    for c in cases:
+        assert branch_sign(*c) == branch_sign_np(*(np.array([v]) for v in c))[0], c
+    assert branch_sign(0.0, 180.0, 1.0, 2.0, 0.5) == branch_sign(0.0, -180.0, 1.0, 2.0, 0.5) == 1.0
+
+
+def test_search_keeps_what_synthesize_keeps_through_a_change_point() -> None:
+    # ground 37.5, uniform: point 1 (alpha 0, phi 180) is the change point's collinear pose
+    args = ("exp(x)", (0, 1), (0, 60), (180, 120))
+    s = synthesize_function(*args, spacing="uniform", ground=37.5, min_transmission=0)
+    assert s.grashof == "change point"
+    r = search(*args, ["alpha0=0:0:1"], spacing="uniform", ground=37.5, min_transmission=0, workers=1)
+    assert r.without_defects == (0 if s.defects else 1)

@@ -1214,9 +1214,13 @@ def branch_sign_np(alpha_deg: Any, phi_deg: Any, r1: Any, r2: Any, r3: Any) -> A
     """:func:`freudenstein.branch_sign` over arrays."""
     import numpy as np
 
-    a = np.radians(alpha_deg)
+    from .problems.freudenstein import DEG
+
+    a = np.asarray(alpha_deg, float) * DEG
     base = np.degrees(np.arctan2(np.sin(a), r2 + np.cos(a)))
-    return np.where(np.remainder(phi_deg - base + 180.0, 360.0) - 180.0 >= 0.0, 1.0, -1.0)
+    d = np.fmod(phi_deg - base, 360.0)
+    d = np.where(d > 180.0, d - 360.0, np.where(d < -180.0, d + 360.0, d))
+    return np.where((d >= 0.0) | (d == -180.0), 1.0, -1.0)
 
 
 def real_coefficients_np(a: Any, b: Any, c: Any, d: Any) -> tuple[Any, Any, Any]:

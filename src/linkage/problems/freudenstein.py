@@ -195,7 +195,12 @@ def branch_sign(alpha_deg: float, phi_deg: float, r1: float, r2: float, r3: floa
     atan2(sin a, R2 + cos a) the root lies on (+1 for a root at a limit position)."""
     a = alpha_deg * DEG
     base = math.degrees(math.atan2(math.sin(a), r2 + math.cos(a)))
-    return 1.0 if math.remainder(phi_deg - base, 360.0) >= 0.0 else -1.0
+    # phi - base wrapped exactly into [-180, 180] (fmod is exact, so are the +-360 after it),
+    # the same operations as the numpy twin (synthesis.branch_sign_np); +-180 (acos at pi,
+    # a limit position) is +1 whichever way rounding put it
+    d = math.fmod(phi_deg - base, 360.0)
+    d = d - 360.0 if d > 180.0 else d + 360.0 if d < -180.0 else d
+    return 1.0 if d >= 0.0 or d == -180.0 else -1.0
 
 
 def links_of(r1: float, r2: float, r3: float,
