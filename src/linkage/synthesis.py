@@ -257,7 +257,10 @@ def make_request(
     if at is not None:
         from .numbers import parse_number
 
-        items = at.split(",") if isinstance(at, str) else list(at)
+        try:
+            items = at.split(",") if isinstance(at, str) else list(at)
+        except TypeError:
+            raise InputError(f"--at: give the precision points' x as a list, got {at!r}") from None
         xs_at = tuple(
             parse_number("--at", v) if isinstance(v, str) else check_number("--at", v) for v in items
         )
@@ -289,7 +292,7 @@ def make_request(
         or not isinstance(table_points, int)
         or not 2 <= table_points <= 100_001
     ):
-        raise InputError(f"--rows must be a whole number from 2 to 100001, got {table_points!r}")
+        raise InputError(f"--rows (samples) must be a whole number from 2 to 100001, got {table_points!r}")
     y_ends = (_value(fn, xr[0]), _value(fn, xr[1]))
     if y_ends[0] == y_ends[1]:
         raise InputError(
