@@ -292,7 +292,7 @@ def make_request(
         or not isinstance(table_points, int)
         or not 2 <= table_points <= 100_001
     ):
-        raise InputError(f"--rows (samples) must be a whole number from 2 to 100001, got {table_points!r}")
+        raise InputError(f"--rows must be a whole number from 2 to 100001, got {table_points!r}")
     y_ends = (_value(fn, xr[0]), _value(fn, xr[1]))
     if y_ends[0] == y_ends[1]:
         raise InputError(
@@ -1200,7 +1200,8 @@ def synthesize_function(
 
 API_ARGUMENTS = {"--x": "x_range", "--alpha": "alpha_range", "--phi": "phi_range", "--points": "points",
                  "--spacing": "spacing", "--at": "at", "--ground": "ground",
-                 "--min-transmission": "min_transmission", "--samples": "samples", "--function": "f"}
+                 "--min-transmission": "min_transmission", "--samples": "samples", "--rows": "samples",
+                 "--function": "f"}
 API_NAMES = __import__("re").compile("|".join(sorted(map(__import__("re").escape, API_ARGUMENTS), key=len,
                                                      reverse=True)) + r"(?![\w-])")
 
