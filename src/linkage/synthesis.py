@@ -1046,7 +1046,7 @@ def _optimal(req: Request) -> FunctionSynthesis:
         why = (
             "did not reach equal extrema"
             if best is None or spread is None or spread > EQUIOSCILLATION
-            else "has defects"
+            else f"has defects ({', '.join(best.defect_names)})"
             if best.defects
             else "came out no better"
         )
