@@ -307,3 +307,23 @@ def test_loads_in_other_units_are_converted_on_read(tmp_path) -> None:
 
     with pytest.raises(LinkageError, match="is not one of N m, N mm"):
         load(bad)
+
+
+def test_a_sliding_driver_gets_an_input_force(tmp_path) -> None:
+    """The slider-crank driven by its block: the input is a force (N) along the line, equal
+    to the virtual-power answer with and without masses; the ground carries the loads."""
+    text = (SAMPLES / "slider_crank_joints.toml").read_text()
+    text = text.replace('link = "crank"', 'slider = "block"')
+    text = text.replace("value = 45 ", "value = 146.88311367414514 ")
+    path = tmp_path / "driven_by_block.toml"
+    path.write_text(text)
+    m = load(path)
+    assert m.driver.kind == "length"
+    rng = random.Random(3)
+    for q, drv in _positions(m, (-20.0, 15.0)):
+        for masses in (False, True):
+            loads = _loads_for(m, rng, masses)
+            for speed, accel in ((0.0, 0.0), (100.0, 0.0), (100.0, 30.0)):
+                f = forces_at(m, q, loads, speed=speed, accel=accel, driver=drv)
+                assert f.input_unit == "N" and f.status in ("ok", "near_toggle")
+                _check(m, q, loads, speed, accel, drv)
