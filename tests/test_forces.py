@@ -195,6 +195,7 @@ def test_solve_prints_the_loads_and_refuses_bad_ones(tmp_path, capsys) -> None:
         (["--load", "Z=0,1"], "a force acts at a joint"),
         (["--load", "B=0"], "FX,FY"),
         (["--torque", "ground=1"], "a torque acts on a moving link"),
+        (["--load", "O2=0,-10"], "O2 is a fixed joint"),
         (["--gravity", "1,2,3"], "--gravity"),
     ):
         code = run_cli(["solve", str(path), *argv])

@@ -105,6 +105,9 @@ def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str) -> Loads:
         if "force" in spec:
             if name not in drawing.xy:
                 raise InputError(f"{key}: a force acts at a joint or point; joints: {', '.join(drawing.xy)}")
+            if name in drawing.ground:
+                raise InputError(f"{key}: {name} is a fixed joint: a force there goes straight into the "
+                                 "ground and loads nothing; put it at a moving joint or point")
             scale = _unit(key, spec, "unit", FORCE_UNITS)
             fx, fy = _pair(f"{key}.force", spec["force"])
             forces[str(name)] = (fx * scale, fy * scale)
