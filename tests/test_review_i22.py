@@ -194,8 +194,7 @@ def test_the_followed_branch_does_not_jump_near_a_limit() -> None:
 
 
 def test_branch_sign_twin_agrees_at_a_limit_position() -> None:
-    from linkage.problems.freudenstein import branch_sign
-    from linkage.synthesis import branch_sign_np
+    from linkage.problems.freudenstein import branch_sign, branch_sign_np
 
     # phi - atan2(...) = +-180 exactly: the two roots meet (acos at pi); and random points
     cases = [(0.0, 180.0, 1.0, 2.0, 0.5), (0.0, -180.0, 1.0, 2.0, 0.5), (0.0, 0.0, 1.0, -2.0, 0.5),

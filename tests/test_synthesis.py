@@ -254,6 +254,12 @@ DEFECT_CASES = {
 }
 
 
+def test_every_defect_has_a_case() -> None:
+    from linkage.synthesis import DEFECTS
+
+    assert set(DEFECT_CASES) == set(DEFECTS)
+
+
 @pytest.mark.parametrize("name", sorted(DEFECT_CASES))
 def test_each_defect_is_named_and_exits_1(name, capsys) -> None:
     fn, x, a, p = DEFECT_CASES[name]

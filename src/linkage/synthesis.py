@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -76,14 +77,19 @@ class Linkage:
     @property
     def coefficients(self) -> tuple[float, float, float]:
         """R1, R2, R3 of the real linkage (its own angles: alpha', phi')."""
-        a, b, c, d = self.a, self.b, self.c, self.d
-        return d / c, d / a, (a * a - b * b + c * c + d * d) / (2.0 * a * c)
+        return real_coefficients(self.a, self.b, self.c, self.d)
 
     def alpha_shift(self) -> float:
         return 180.0 if self.input_turned else 0.0
 
     def phi_shift(self) -> float:
         return 180.0 if self.output_turned else 0.0
+
+
+def real_coefficients(a: Any, b: Any, c: Any, d: Any) -> tuple[Any, Any, Any]:
+    """R1 = d/c, R2 = d/a, R3 = (a^2 - b^2 + c^2 + d^2) / (2ac) of positive lengths: numbers
+    or arrays alike (the same operations either way)."""
+    return d / c, d / a, (a * a - b * b + c * c + d * d) / (2.0 * a * c)
 
 
 @dataclass(frozen=True)
@@ -528,8 +534,6 @@ def assembly_gap_np(r1: Any, r2: Any, r3: Any, alpha0_deg: Any, alpha1_deg: Any)
         return np.minimum(g(bottom), g(top)) < 0.0
 
 
-INPUT_CRANKS = ("crank-rocker", "double crank")
-OUTPUT_CRANKS = ("rocker-crank", "double crank")
 
 
 # --- the structural error --------------------------------------------------------------------
@@ -781,14 +785,12 @@ def _synthesize(req: Request, xs: Sequence[float]) -> FunctionSynthesis:
     extra = [x for x, _ in lobes] + [p.x for p in pts]
     curve_xs = sorted(set(table) | set(extra))
     curve = structural_error(design, curve_xs, pts[0])
-    defects = judge(design, pts, curve, grid_xs, grid_errs)
     solved = [c for c in curve if c.error_deg is not None]
     worst = max(solved, key=lambda c: abs(c.error_deg or 0.0)) if solved else None
     mus = [(c.transmission_deg, c.x) for c in solved if c.transmission_deg is not None]
     # the transmission's extremes between samples: the dense grid by the closed form
-    dense = _dense_transmission(design, grid_xs, grid_errs)
-    if dense is not None:
-        mus += dense
+    mus += _dense_transmission(design, grid_xs, grid_errs) or []
+    defects = judge(design, pts, curve, grid_xs, grid_errs, mus)
     first_real = (pts[0].alpha_deg + k.alpha_shift(), pts[0].phi_deg + k.phi_shift())
     mu_min = min(mus) if mus else None
     result = replace(
@@ -856,8 +858,10 @@ def judge(
     curve: Sequence[CurvePoint],
     grid_xs: Sequence[float],
     grid_errs: Sequence[float],
+    mus: Sequence[tuple[float, float]],
 ) -> list[Defect]:
-    """The defects of a synthesised linkage, each named with what shows it."""
+    """The defects of a synthesised linkage, each named with what shows it; ``mus`` its
+    transmission angles (folded, deg) with their x."""
     req, k = design.req, design.linkage
     out: list[Defect] = []
     kind = grashof_of(k)
@@ -927,8 +931,8 @@ def judge(
         )
     # order: the output turns back where the function does not
     if all(math.isfinite(e) for e in grid_errs):
-        gen = [req.phi(_value(req.f, x)) + e for x, e in zip(grid_xs, grid_errs)]
         want = [req.phi(_value(req.f, x)) for x in grid_xs]
+        gen = [w + e for w, e in zip(want, grid_errs)]
         turns_gen, turns_want = _turns(gen), _turns(want)
         if len(turns_gen) > len(turns_want):
             extra = _turns_diff(turns_gen, turns_want) or sorted(turns_gen)
@@ -942,9 +946,6 @@ def judge(
                 )
             )
     # transmission
-    solved = [c for c in curve if c.transmission_deg is not None]
-    dense = _dense_transmission(design, grid_xs, grid_errs)
-    mus = [(c.transmission_deg, c.x) for c in solved] + (dense or [])
     if mus:
         mu, x_mu = min(mus)
         if mu < req.min_transmission:
@@ -1202,8 +1203,7 @@ API_ARGUMENTS = {"--x": "x_range", "--alpha": "alpha_range", "--phi": "phi_range
                  "--spacing": "spacing", "--at": "at", "--ground": "ground",
                  "--min-transmission": "min_transmission", "--samples": "samples", "--rows": "samples",
                  "--function": "f"}
-API_NAMES = __import__("re").compile("|".join(sorted(map(__import__("re").escape, API_ARGUMENTS), key=len,
-                                                     reverse=True)) + r"(?![\w-])")
+API_NAMES = re.compile("|".join(sorted(map(re.escape, API_ARGUMENTS), key=len, reverse=True)) + r"(?![\w-])")
 
 
 # --- the search: many candidates at a time ------------------------------------------------------
@@ -1212,24 +1212,6 @@ SEARCH_NAMES = ("alpha0", "alpha_span", "phi0", "phi_span")
 """The free choices a search varies (deg): each angle range's start and span."""
 SEARCH_CHUNK = 200
 """Candidates per task: each holds a few arrays of GRID values per candidate."""
-
-
-def branch_sign_np(alpha_deg: Any, phi_deg: Any, r1: Any, r2: Any, r3: Any) -> Any:
-    """:func:`freudenstein.branch_sign` over arrays."""
-    import numpy as np
-
-    from .problems.freudenstein import DEG
-
-    a = np.asarray(alpha_deg, float) * DEG
-    base = np.degrees(np.arctan2(np.sin(a), r2 + np.cos(a)))
-    d = np.fmod(phi_deg - base, 360.0)
-    d = np.where(d > 180.0, d - 360.0, np.where(d < -180.0, d + 360.0, d))
-    return np.where((d >= 0.0) | (d == -180.0), 1.0, -1.0)
-
-
-def real_coefficients_np(a: Any, b: Any, c: Any, d: Any) -> tuple[Any, Any, Any]:
-    """:attr:`Linkage.coefficients` over arrays."""
-    return d / c, d / a, (a * a - b * b + c * c + d * d) / (2.0 * a * c)
 
 
 @dataclass(frozen=True)
@@ -1269,6 +1251,8 @@ def evaluate_candidates(req: Request, a0: Any, da: Any, p0: Any, dp: Any, grid: 
     by a parabola through its grid neighbours. Columns, one entry per candidate."""
     import numpy as np
 
+    from .problems.freudenstein import branch_root_np, branch_sign_np
+
     a0, da, p0, dp = (np.asarray(v, float) for v in (a0, da, p0, dp))
     lo, hi = req.x_range
     y0, y1 = req.y_ends
@@ -1283,14 +1267,12 @@ def evaluate_candidates(req: Request, a0: Any, da: Any, p0: Any, dp: Any, grid: 
     else:
         r = np.array([solve_coefficients(list(al), list(ph))[0] for al, ph in zip(alphas, phis)])
     a, b, c, d, turned_in, turned_out = linkage_of_np(r, req.ground)
-    real = np.stack(real_coefficients_np(a, b, c, d), axis=-1)
+    real = np.stack(real_coefficients(a, b, c, d), axis=-1)
     shift_a, shift_p = np.where(turned_in, 180.0, 0.0), np.where(turned_out, 180.0, 0.0)
     sign = branch_sign_np(alphas[:, 0] + shift_a, phis[:, 0] + shift_p, real[:, 0], real[:, 1], real[:, 2])
     gx = np.linspace(lo, hi, grid)
     gy = np.array([_value(req.f, x) for x in gx])
     gt, gu = (gx - lo) / (hi - lo), (gy - y0) / (y1 - y0)
-    from .problems.freudenstein import branch_root_np
-
     def generated(tt: Any) -> Any:
         al = a0[:, None] + tt[None, :] * da[:, None] + shift_a[:, None]
         return al, branch_root_np(al, real[:, 0:1], real[:, 1:2], real[:, 2:3], sign[:, None]) - shift_p[

@@ -38,10 +38,5 @@ def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Opt
                        shown, digits))
     if plot is not None:
         torque_plot(rows, name, unit, unit_in, plot, f"{mechanism.name}: input over the sweep")
-    document = report.document
-
-    def doc() -> Any:
-        d = document() if document is not None else {}
-        return d
-
-    return Report(report.title, (*report.tables, loads_table), lambda: [*report.blocks(), *lines], doc)
+    return Report(report.title, (*report.tables, loads_table), lambda: [*report.blocks(), *lines],
+                  report.document)

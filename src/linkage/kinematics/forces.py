@@ -36,8 +36,8 @@ FORCE_RTOL = 1e-6
 their size are flagged ill_conditioned; a singular matrix (a toggle) leaves them undefined."""
 TOGGLE_COND = 1e3
 """A force matrix this ill-conditioned is near a toggle: the forces are amplified so that a
-0.1% change in the geometry can change them by 100% (every sample, away from its limits,
-stays below 500). Such forces are flagged near_toggle, with the condition number."""
+0.1% change in the geometry can change them by 100%. Such forces are flagged near_toggle,
+with the condition number."""
 
 
 @dataclass(frozen=True)
@@ -102,10 +102,10 @@ class Forces:
 
 
 def metre(length_unit: str) -> float:
-    """Metres per unit of ``length_unit``."""
-    from ..problems.loops import LENGTH_UNITS
+    """Metres per unit of ``length_unit`` (the files' one conversion, loops.length_factor)."""
+    from ..problems.loops import length_factor
 
-    return LENGTH_UNITS[length_unit] / 10_000
+    return length_factor(length_unit, "m")
 
 
 def command_loads(mechanism: Any, load: Sequence[str], torque: Sequence[str], gravity: str | None) -> Loads:
@@ -479,7 +479,9 @@ def sweep_forces(mechanism: Any, result: Any, loads: Loads, speed: float, accel:
         q = [math.radians(pos.solution[u.name]) if u.kind == "angle" else pos.solution[u.name]
              for u in mechanism.unknowns]
         drv = math.radians(pos.input) if angle else pos.input
-        actual = rates_at(mechanism, q, speed=speed, accel=accel, driver=drv)
+        # the sweep's own rates where it computed them at this motion (--speed), else here
+        given = pos.rates if speed and pos.rates is not None and pos.rates.joint_velocities else None
+        actual = given or rates_at(mechanism, q, speed=speed, accel=accel, driver=drv)
         unit = rates_at(mechanism, q, speed=1.0, accel=0.0, driver=drv)
         if actual.status == "undefined" or unit.status == "undefined":
             out[i] = _undefined(frame, "the kinematics are undefined here")

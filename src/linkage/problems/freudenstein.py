@@ -196,11 +196,22 @@ def branch_sign(alpha_deg: float, phi_deg: float, r1: float, r2: float, r3: floa
     a = alpha_deg * DEG
     base = math.degrees(math.atan2(math.sin(a), r2 + math.cos(a)))
     # phi - base wrapped exactly into [-180, 180] (fmod is exact, so are the +-360 after it),
-    # the same operations as the numpy twin (synthesis.branch_sign_np); +-180 (acos at pi,
+    # the same operations as the numpy twin (branch_sign_np); +-180 (acos at pi,
     # a limit position) is +1 whichever way rounding put it
     d = math.fmod(phi_deg - base, 360.0)
     d = d - 360.0 if d > 180.0 else d + 360.0 if d < -180.0 else d
     return 1.0 if d >= 0.0 or d == -180.0 else -1.0
+
+
+def branch_sign_np(alpha_deg: Any, phi_deg: Any, r1: Any, r2: Any, r3: Any) -> Any:
+    """:func:`branch_sign` over arrays: the same operations."""
+    import numpy as np
+
+    a = np.asarray(alpha_deg, float) * DEG
+    base = np.degrees(np.arctan2(np.sin(a), r2 + np.cos(a)))
+    d = np.fmod(phi_deg - base, 360.0)
+    d = np.where(d > 180.0, d - 360.0, np.where(d < -180.0, d + 360.0, d))
+    return np.where((d >= 0.0) | (d == -180.0), 1.0, -1.0)
 
 
 def links_of(r1: float, r2: float, r3: float,

@@ -13,10 +13,6 @@ from .report import Block, Text, fmt, table
 EQUATION = "R1 cos(alpha) - R2 cos(phi) + R3 = cos(alpha - phi)"
 
 
-def _r(v: float | None, digits: int) -> str:
-    return fmt(v, digits)
-
-
 def title(s: Any) -> str:
     (x0, x1), (a0, a1), (p0, p1) = s.x_range, s.alpha_range, s.phi_range
     return (
@@ -138,7 +134,7 @@ def synthesis_report(s: Any, digits: int = 6, unit: str = "") -> Report:
                 "precision points", [h if not u else f"{h} ({u})" for h, u, _ in pp_headers], pp_rows, digits
             ),
         ]
-        out.append(Text(f"R1 = {_r(s.R[0], 12)}, R2 = {_r(s.R[1], 12)}, R3 = {_r(s.R[2], 12)}"))
+        out.append(Text(f"R1 = {fmt(s.R[0], 12)}, R2 = {fmt(s.R[1], 12)}, R3 = {fmt(s.R[2], 12)}"))
         k = s.linkage
         if k is not None:
             u = f" ({unit})" if unit else ""
@@ -170,8 +166,8 @@ def synthesis_report(s: Any, digits: int = 6, unit: str = "") -> Report:
         if s.max_error_deg is not None:
             out.append(
                 Text(
-                    f"max |error| = {_r(s.max_error_deg, digits)} deg = {_r(s.max_error_y, digits)} in y, "
-                    f"at x = {_r(s.at_x, digits)}"
+                    f"max |error| = {fmt(s.max_error_deg, digits)} deg = {fmt(s.max_error_y, digits)} in y, "
+                    f"at x = {fmt(s.at_x, digits)}"
                     + (
                         ", over the part of the range reached"
                         if any(c.status != "converged" for c in s.curve)
@@ -184,13 +180,14 @@ def synthesis_report(s: Any, digits: int = 6, unit: str = "") -> Report:
                 "" if s.equioscillation is None else f"; extrema equal within {100 * s.equioscillation:.2g}%"
             )
             out.append(
-                Text(f"Chebyshev spacing's max |error| = {_r(s.chebyshev_max_error_deg, digits)} deg{spread}")
+                Text(f"Chebyshev spacing's max |error| = {fmt(s.chebyshev_max_error_deg, digits)} "
+                     f"deg{spread}")
             )
         if s.transmission is not None:
             out.append(
                 Text(
-                    f"transmission angle (folded into 0..90): min {_r(s.transmission[0], 4)} deg "
-                    f"(at x = {_r(s.transmission_at_x, digits)}), max {_r(s.transmission[1], 4)} deg"
+                    f"transmission angle (folded into 0..90): min {fmt(s.transmission[0], 4)} deg "
+                    f"(at x = {fmt(s.transmission_at_x, digits)}), max {fmt(s.transmission[1], 4)} deg"
                 )
             )
         cmd = check_command(s)
