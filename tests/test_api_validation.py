@@ -100,6 +100,9 @@ BATTERY = [
     ("sweep", "joints text", lambda: linkage.sweep(M, TWO, joints="x"), "joints"),
     ("sweep", "branch a number", lambda: linkage.sweep(M, TWO, branch=3), "branch"),
     ("sweep", "mechanism None", lambda: linkage.sweep(None, TWO), "mechanism"),
+    ("sweep", "loads a dict", lambda: linkage.sweep(JM, TWO, loads={"rocker": 5}), "loads"),
+    ("sweep", "loads on a loops-form mechanism", lambda: linkage.sweep(M, TWO, loads=linkage.Loads()),
+     "joints form"),
     ("sweep", "mechanism a number", lambda: linkage.sweep(3, TWO), "mechanism"),
     # position_rates: q, rates, driver, mechanism
     ("position_rates", "q too short", lambda: linkage.position_rates(M, Q[:1], speed=1.0), "q"),
@@ -122,6 +125,14 @@ BATTERY = [
     ("position_rates", "mechanism None", lambda: linkage.position_rates(None, Q), "mechanism"),
     # scan_designs: the specs and every option
     ("scan_designs", "vary None", lambda: linkage.scan_designs(M, None, values=TWO), "vary"),
+    ("scan_designs", "loads a number",
+     lambda: linkage.scan_designs(JM, {"coupler": (100, 120, 2)}, values=TWO, loads=3), "loads"),
+    ("scan_designs", "loads on a loops-form mechanism",
+     lambda: linkage.scan_designs(M, {"r3": (100, 120, 2)}, values=TWO,
+                                  loads=linkage.Loads(torques={"r4": 1.0})),
+     "joints form"),
+    ("scan_designs", "text speed",
+     lambda: linkage.scan_designs(JM, {"coupler": (100, 120, 2)}, values=TWO, speed="10rpm"), "speed"),
     # forces: each argument by its own name
     ("forces", "a path for the mechanism", lambda: linkage.forces("x.toml", [0.0, 0.0]), "mechanism"),
     ("forces", "a loops-form mechanism", lambda: linkage.forces(M, Q), "joints form"),

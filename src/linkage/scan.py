@@ -324,6 +324,11 @@ class ScanJob:
     """A mechanism object given directly (the Python API); it travels pickled."""
     moves: JointMoves | None = None
     """The ground joints a scan of a joints file moves (their coordinates among names)."""
+    loads: Any = None
+    """A :class:`~linkage.problems.loads.Loads` whose forces each design's records carry
+    (:func:`load_metrics`), or None."""
+    motion: tuple[float, float] = (0.0, 0.0)
+    """The driver's speed and acceleration (internal units) for the loads' inertia."""
 
 
 @functools.lru_cache(maxsize=8)
@@ -340,7 +345,55 @@ def run_chunk(job: ScanJob, start: int, designs: np.ndarray) -> dict[str, np.nda
               {name: designs[:, j] for j, name in enumerate(job.names)})
     sol = solve_designs(m, params, np.array(job.values), branch=job.branch, tol=job.tol,
                         paths=bool(m.points))
-    return design_metrics(m, job.names, designs, sol, start, params)
+    out = design_metrics(m, job.names, designs, sol, start, params)
+    if job.loads is not None:
+        out.update(load_metrics(m, params, sol, job.loads, job.motion))
+    return out
+
+
+FORCE_BATCH_CELLS = 4_000_000
+"""Force-matrix numbers built at once (32 MB): a chunk's positions go through the matrix
+method in slices of this many numbers."""
+
+
+def load_metrics(m: Mechanism, params: Mapping[str, np.ndarray], sol: DesignSolutions, loads: Any,
+                 motion: tuple[float, float]) -> dict[str, np.ndarray]:
+    """Each design's :data:`~linkage.problems.columns.LOADS` columns: every solved position's
+    forces by :func:`~linkage.kinematics.forces.batch_forces` (the one matrix method), the
+    peaks by :func:`~linkage.kinematics.forces.force_peaks` (the one peak rule)."""
+    from .kinematics.designs import design_grid
+    from .kinematics.forces import batch_forces, force_peaks
+
+    n_designs, n_pos = sol.status.shape
+    grid, drv = design_grid(m, params, sol.values, n_designs)
+    varied = {k: v for k, v in grid.items() if k in params}
+    solved = (sol.status == CONVERGED).reshape(-1)
+    q = [(np.radians(sol.solution[:, :, j]) if kind == "angle" else sol.solution[:, :, j]).reshape(-1)
+         for j, kind in enumerate(sol.kinds)]
+    d = np.where(solved, drv, np.nan)
+    total = n_designs * n_pos
+    status = np.full(total, -1, dtype=np.int8)
+    inp, pin, shaking = np.full(total, np.nan), np.full(total, np.nan), np.full(total, np.nan)
+    width = 3 * sum(1 for b in m.extra["drawing"].bodies if b != "ground")
+    step = max(1, FORCE_BATCH_CELLS // (width * width + 8 * width))
+    for a in range(0, total, step):
+        b = min(a + step, total)
+        part = slice(a, b)
+        bf = batch_forces(m, [c[part] for c in q], d[part], loads, speed=motion[0], accel=motion[1],
+                          values={k: v[part] for k, v in varied.items()})
+        status[part], inp[part], pin[part], shaking[part] = bf.status, bf.input, bf.pin_max, bf.shaking
+    status[~solved] = -1  # unsolved: neither counted nor flagged
+    shape = (n_designs, n_pos)
+    status, inp, pin, shaking = (x.reshape(shape) for x in (status, inp, pin, shaking))
+    (at_in, at_pin, at_ground), flagged = force_peaks(status, inp, pin, shaking)
+    rows = np.arange(n_designs)
+    none = at_in < 0  # the same positions count for every column
+    return {
+        "peak_input": np.where(none, np.nan, np.abs(inp[rows, at_in])),
+        "max_pin_force": np.where(none, np.nan, pin[rows, at_pin]),
+        "max_shaking_force": np.where(none, np.nan, shaking[rows, at_ground]),
+        "forces_flagged": flagged.astype(np.int64),
+    }
 
 
 def chunk_size(m: Mechanism, positions: int, branch: str | None) -> int:
@@ -697,15 +750,33 @@ class ScanSetup:
     branch: str | None
     values: list[float]
     moves: JointMoves | None = None
+    loads: Any = None
+
+
+def check_loads(m: Mechanism, names: Sequence[str], loads: Any) -> None:
+    """A scan with loads needs links as bodies (the joints form), and a link with a mass
+    keeps its drawn shape: its cg and inertia are given for the lengths drawn, so a scan
+    varying them would keep a mass where the link no longer is."""
+    from .kinematics.forces import Frame
+
+    frame = Frame.of(m)
+    for b in loads.masses:
+        own = [n for n in names if n in m.parameters and (n == b or n.startswith(f"{b}_"))
+               and b in frame.drawing.bodies and b != "ground"]
+        if own:
+            raise InputError(f"--vary {own[0]} changes the shape of {b}, which has a [mass] given for its "
+                             f"drawn lengths (cg, inertia); scan {b}'s lengths without its mass, or "
+                             "vary other links")
 
 
 def prepare(m: Mechanism, varies: Sequence[Vary], *, samples: int | None, seed: int, sampling: str,
             values: Sequence[float], branch: str | None, tol: float, where: str | None,
             sort: str | None, doc: Mapping[str, Any] | None = None,
-            fixed: Sequence[str] = ()) -> ScanSetup:
+            fixed: Sequence[str] = (), loads: Any = None) -> ScanSetup:
     """Everything checked before any design is solved (one InputError or ParseError).
     ``doc``: the file's document, for a joints file's coordinates (:func:`joint_moves`);
-    ``fixed``: the names --set gives."""
+    ``fixed``: the names --set gives; ``loads``: a Loads whose columns the records carry
+    (None: none)."""
     from .kinematics.sweep import check_driver_values
     from .problems.where import parse_where
 
@@ -716,12 +787,14 @@ def prepare(m: Mechanism, varies: Sequence[Vary], *, samples: int | None, seed: 
         raise InputError(f"{len(values):,} driver positions per design is more than "
                          f"{MAX_SCAN_POSITIONS:,}; use a larger --step")
     listed = check_driver_values(m, values)
-    spec = columns_of(m, plan.names)
+    if loads is not None:
+        check_loads(m, plan.names, loads)
+    spec = columns_of(m, plan.names, loads is not None)
     known = {c[0]: ("number" if c[1] in ("int", "number") else c[1]) for c in spec}
     test = parse_where(where, known) if where is not None else None
     if sort is not None and sort not in known:
         raise InputError(f"--sort {sort}: no such column; the columns are {', '.join(known)}")
-    return ScanSetup(plan, spec, test, default_branch(m, branch, tol), listed, moves)
+    return ScanSetup(plan, spec, test, default_branch(m, branch, tol), listed, moves, loads)
 
 
 def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, samples: int | None = None,
@@ -729,7 +802,8 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
          branch: str | None = None, tol: float = 1e-12, where: str | None = None,
          sort: str | None = None, descending: bool = False, top: int | None = None,
          scheduler: str | None = None, workers: int | None = None,
-         chunk: int | None = None) -> dict[str, np.ndarray]:
+         chunk: int | None = None, loads: Any = None, speed: float | None = None,
+         accel: float = 0.0) -> dict[str, np.ndarray]:
     """Scan designs of ``mechanism`` (a Mechanism or a file path); the public
     ``linkage.scan_designs`` (``linkage.scan`` is this module).
 
@@ -743,9 +817,15 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
     InputError naming it; n, samples, seed, top, chunk and workers are whole numbers
     (workers at most MAX_THREADS threads or MAX_PROCESSES processes), the driver values
     finite reals.
+
+    ``loads``: a :class:`~linkage.Loads` (default: the file's ``[loads]`` and ``[mass]``, if
+    any) adds the columns peak_input, max_pin_force, max_shaking_force and forces_flagged
+    (:func:`load_metrics`), with the driver at ``speed`` and ``accel`` (rad/s and rad/s^2,
+    or the length unit per s and s^2) for the masses' inertia.
     """
     from .arguments import (
         check_flag,
+        check_motion,
         check_reals,
         check_scan_options,
         check_text,
@@ -780,11 +860,18 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
     if not values:
         # a fraction of no positions is no fraction: feasible_fraction would read 0
         raise InputError("values must hold at least one driver value")
+    from .problems.loads import Loads
+
+    if loads is not None and not isinstance(loads, Loads):
+        raise InputError(f"loads: give a linkage.Loads, got {type(loads).__name__}")
+    speed, accel = check_motion(speed, accel, m.driver.kind, m.length_unit)
+    own = loads if loads is not None else m.extra.get("loads")
+    used = own if own is not None and (not own.empty or own.gravity is not None) else None
     setup = prepare(m, varies, samples=samples, seed=seed, sampling=sampling, values=list(values),
-                    branch=branch, tol=tol, where=where, sort=sort, doc=doc)
+                    branch=branch, tol=tol, where=where, sort=sort, doc=doc, loads=used)
     check_held(setup.plan.total, len(setup.spec), top, "a scan returned as columns", "top")
     job = ScanJob("", m.source, (), setup.plan.names, tuple(setup.values), setup.branch, tol, m,
-                  setup.moves)
+                  setup.moves, used, (speed or 0.0, accel))
     keeper = Keeper(sort, descending, top, None)
     feed(keeper, job, setup, pick_chunk(m, len(setup.values), setup.branch, chunk,
                                         setup.plan.total),

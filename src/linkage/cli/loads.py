@@ -20,23 +20,34 @@ def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Opt
     unit = "deg" if angle else mechanism.length_unit
     name = mechanism.driver.name
     loads_table = sweep_force_table(rows, name, unit, unit_in)
-    good = [r for r in rows if r[1] == "ok"]
-    flagged = [r for r in rows if r[1] in ("near_toggle", "ill_conditioned", "undefined")]
+    (at_in, at_pin), flagged = peaks_of(rows)
     lines = [Text(""), Text("loads over the sweep (matrix method, SI units)", "bold")]
-    if good:
-        peak = max(good, key=lambda r: abs(r[2]))
-        pins = max(good, key=lambda r: r[3] or 0.0)
+    if at_in >= 0:
+        peak, pins = rows[at_in], rows[at_pin]
         lines.append(Text(f"peak input {fmt(peak[2], digits)} {unit_in} at {name} = "
                           f"{fmt(peak[0], digits)} {unit}; largest pin force {fmt(pins[3], digits)} N at "
                           f"{fmt(pins[0], digits)} {unit}"))
     if flagged:
-        lines.append(Text(f"{len(flagged)} positions near a toggle (near_toggle, ill_conditioned or "
+        lines.append(Text(f"{flagged} positions near a toggle (near_toggle, ill_conditioned or "
                           "undefined): their forces are flagged in the loads table, not counted in the peaks",
                           "yellow"))
     shown = [(r[0], r[1], r[2], r[3]) for r in rows]
     lines.append(table("", [f"{name} ({unit})", "forces status", f"input ({unit_in})", "max pin force (N)"],
                        shown, digits))
     if plot is not None:
-        torque_plot(rows, name, unit, unit_in, plot, f"{mechanism.name}: input over the sweep")
+        torque_plot(rows, name, unit, unit_in, plot, f"{mechanism.name}: input over the sweep", at_in)
     return Report(report.title, (*report.tables, loads_table), lambda: [*report.blocks(), *lines],
                   report.document)
+
+
+def peaks_of(rows: list[tuple[Any, ...]]) -> tuple[list[int], int]:
+    """The rows of the largest |input| and pin force, and the flagged count, by the one peak
+    rule (kinematics.forces.force_peaks)."""
+    import numpy as np
+
+    from ..kinematics.forces import FORCE_STATUSES, force_peaks
+
+    codes = np.array([[FORCE_STATUSES.index(r[1]) if r[1] in FORCE_STATUSES else -1 for r in rows]])
+    cols = [np.array([[np.nan if r[k] is None else r[k] for r in rows]], dtype=float) for k in (2, 3)]
+    at, flagged = force_peaks(codes, *cols)
+    return [int(a[0]) for a in at], int(flagged[0])

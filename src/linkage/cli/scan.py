@@ -8,11 +8,16 @@ import typer
 
 from ..errors import InputError
 from .options import (
+    AccelOpt,
     ColumnsOpt,
     DigitsOpt,
+    GravityOpt,
+    LoadOpt,
     MechanismFile,
     OutputOpt,
     SetOpt,
+    SpeedOpt,
+    TorqueOpt,
     check_paths,
     note_closed_form,
     parse_assignments,
@@ -72,13 +77,21 @@ def scan(
     output: OutputOpt = None,
     digits: DigitsOpt = 6,
     columns: ColumnsOpt = None,
+    force: LoadOpt = None,
+    torque: TorqueOpt = None,
+    gravity: GravityOpt = None,
+    speed: SpeedOpt = None,
+    accel: AccelOpt = None,
 ) -> None:
     """Scan a range of designs: each over its whole cycle, one record per design.
 
     Each record: the varied parameters, feasible_fraction (positions where an assembly
     exists), solved_fraction (positions solved on the followed branch), full_cycle, every
     unknown's _min, _max and _range, for four-bars grashof and min/max_transmission_deg
-    (folded into 0..90), and the x/y extents of each [points] path.
+    (folded into 0..90), and the x/y extents of each [points] path. With loads ([loads] or
+    [mass] in a joints-form file, or --load/--torque/--gravity; --speed for inertia):
+    peak_input (the largest |input torque|), max_pin_force, max_shaking_force (over the
+    positions whose forces are ok) and forces_flagged (positions near a toggle).
 
     Example: linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60:5 --vary r4=60:120:7
     """
@@ -109,19 +122,29 @@ def scan(
                          "values from --vary only")
     mechanism = from_text(text, str(file)).with_values(fixed, {})
     note_closed_form(mechanism)
+    from ..arguments import parse_motion
+    from ..kinematics.forces import command_loads
+
+    w, a_ = parse_motion(speed, accel, mechanism)
+    loads = command_loads(mechanism, force or [], torque or [], gravity)
+    used = loads if not loads.empty or loads.gravity is not None else None
+    if used is None and speed is not None:
+        raise InputError("--speed in a scan moves the loads' masses: give loads ([loads] or [mass] in "
+                         "the file, or --load/--torque)")
     a, b = driver_span(mechanism, start, stop, turn_end=359.0)
     if desc and sort is None:
         raise InputError("--desc orders by --sort: give --sort COLUMN")
     setup = prepare(mechanism, varies, samples=samples, seed=seed, sampling=sampling,
                     values=driver_values(a, b, step, None), branch=branch, tol=tol, where=where, sort=sort,
                     doc=parse_toml(text, str(file)) if any("." in v.name for v in varies) else None,
-                    fixed=tuple(fixed))
+                    fixed=tuple(fixed), loads=used)
     spec = pick_spec(setup.spec, columns) if columns else setup.spec
     streamed = writers.is_data(fmt)
     if sort is not None and streamed:
         check_held(setup.plan.total, len(setup.spec), top, f"--sort {sort} with --format {fmt}")
     job = ScanJob(text, str(file), tuple((k, float(v)) for k, v in fixed.items()), setup.plan.names,
-                  tuple(setup.values), setup.branch, tol, moves=setup.moves)
+                  tuple(setup.values), setup.branch, tol, moves=setup.moves, loads=used,
+                  motion=(w or 0.0, a_))
     size = pick_chunk(mechanism, len(setup.values), setup.branch, chunk, setup.plan.total)
     meta = scan_meta(mechanism, str(file), setup, (a, b, step), where, sort, desc)
     started = time.perf_counter()

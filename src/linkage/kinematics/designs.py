@@ -220,7 +220,7 @@ def design_signs(der: Derivation, text: str, drivers: np.ndarray, columns: Mappi
     return out, named
 
 
-def _grid(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray,
+def design_grid(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray,
           n_designs: int) -> tuple[dict[str, Any], np.ndarray]:
     """Every parameter (internal units) as a float or a flat array over designs x positions,
     and the driver (internal units) flat the same way."""
@@ -301,7 +301,7 @@ def _closed_form_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np
         ok[rows] = good
     seed = [c.reshape(-1) for c in seed]
     ok = ok.reshape(-1)
-    grid, drv = _grid(m, params, vals, n_designs)
+    grid, drv = design_grid(m, params, vals, n_designs)
     # where the followed branch does not assemble: does any other? (off_branch, not no_solution)
     feasible = ok.copy()
     miss = np.flatnonzero(~ok)
@@ -486,7 +486,7 @@ def _continuation_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: n
     v0 = m.driver.value / scale
     n, k = len(m.unknowns), len(vals)
     is_length = [u.kind == "length" for u in m.unknowns]
-    grid, _ = _grid(m, params, np.array([v0]), n_designs)  # one entry per design
+    grid, _ = design_grid(m, params, np.array([v0]), n_designs)  # one entry per design
     size = _size(m, grid, np.full(n_designs, v0 * scale))
     clean = np.ones(n_designs, dtype=bool)
     q_out = [np.full((n_designs, k), np.nan) for _ in range(n)]
@@ -631,7 +631,7 @@ def _paths(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, q: 
     """Every named joint and point at every solved position (complex, NaN elsewhere), as
     LoopModel.points places them."""
     n_designs = len(solved) // max(len(vals), 1)
-    grid, drv = _grid(m, params, vals, n_designs)
+    grid, drv = design_grid(m, params, vals, n_designs)
     _, value = _resolver(m, grid, drv, q)
 
     def vec(t: VectorTerm) -> Any:
@@ -671,7 +671,7 @@ def _turn_references(m: Mechanism, params: Mapping[str, np.ndarray], n_designs: 
 
     n = len(m.unknowns)
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-    grid, drv = _grid(m, params, np.array([m.driver.value / scale]), n_designs)
+    grid, drv = design_grid(m, params, np.array([m.driver.value / scale]), n_designs)
     loops = VectorLoops.of_terms(_terms(m, grid, drv), n, n_designs)
     size = _size(m, grid, drv)
     is_length = [u.kind == "length" for u in m.unknowns]

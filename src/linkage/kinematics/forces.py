@@ -340,11 +340,11 @@ def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[s
         known(b, cg, (-mass.mass * ag[0], -mass.mass * ag[1]), -mass.inertia * al, vg)
         if g is not None:
             known(b, cg, (mass.mass * g[0], mass.mass * g[1]), 0.0, vg)
-    cond = np.linalg.cond(a)
+    cond, inv = condition_np(a)
     good = np.isfinite(cond) & (cond * EPS < 0.5)
     x = np.full((n_pos, n_un), np.nan)
     if good.any():
-        x[good] = np.linalg.solve(a[good], rhs[good][..., None])[..., 0]
+        x[good] = np.einsum("pij,pj->pi", inv[good], rhs[good])
     # the unit driver speed's own size: rad/s, or the length unit per second in m/s
     vp = -power / (1.0 if frame.driver_slider is None else k)
     pins, sliders = [], []
@@ -374,6 +374,23 @@ def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[s
         gx, gy, gm = gx - f[0], gy - f[1], gm - _cross(pos[d.bodies[s][0]], f)
     return ForceArrays(inp, input_unit, tuple(pins), tuple(sliders), (gx, gy, gm), vp, cond,
                        (applied[0], applied[1], applied[2]))
+
+
+def condition_np(a: Any) -> tuple[Any, Any]:
+    """Each matrix's condition number in the 1-norm, ||A|| ||A^-1|| (inf where A is
+    singular), and A^-1 (NaN there): an LU inverse costs a fraction of the SVD that the
+    2-norm's needs, and bounds the same error (within a factor of the matrix's size)."""
+    import numpy as np
+
+    from .rates import inverse_np
+
+    inv, usable = inverse_np(a)
+    cond = np.full(a.shape[:-2], np.inf)
+    with np.errstate(over="ignore", invalid="ignore"):
+        cond[usable] = (np.abs(a[usable]).sum(axis=-2).max(axis=-1) *
+                        np.abs(inv[usable]).sum(axis=-2).max(axis=-1))
+    cond[~np.isfinite(cond)] = np.inf
+    return cond, inv
 
 
 def _arrays(points: Mapping[str, tuple[float, float]], k: float) -> dict[str, tuple[Any, Any]]:
@@ -426,6 +443,56 @@ def judged(frame: Frame, actual: Any, unit: Any, loads: Loads, source: str) -> F
     return position_forces(fa, 0, unit, actual.status, loads)
 
 
+FORCE_STATUSES = ("ok", "near_toggle", "ill_conditioned", "undefined")
+"""A position's forces, by :func:`force_status` (codes: their index here)."""
+
+
+def matrix_bound(cond: Any) -> Any:
+    """The forces' error bound (relative to the largest) from solving the force matrix:
+    condition number x rounding, with room for assembling the matrix, doubled."""
+    return 2.0 * cond * EPS * 4.0
+
+
+def force_status(cond: float, bound: float, kinematics_ok: bool) -> str:
+    """The one rule judging a position's forces (``bound``: their error bound, relative):
+    ill_conditioned where the bound exceeds FORCE_RTOL or the kinematics are flagged,
+    near_toggle where the matrix's condition number reaches TOGGLE_COND, else ok. (No
+    number at all is ``undefined``, decided before.) :func:`force_status_np` is its twin."""
+    if not bound <= FORCE_RTOL or not kinematics_ok:
+        return "ill_conditioned"
+    if cond >= TOGGLE_COND:
+        return "near_toggle"
+    return "ok"
+
+
+def force_status_np(inp: Any, cond: Any, bound: Any, kinematics_ok: Any) -> Any:
+    """:func:`force_status` over arrays, as codes into FORCE_STATUSES; ``undefined`` where
+    the input is not a number."""
+    import numpy as np
+
+    code = np.where(cond >= TOGGLE_COND, 1, 0)
+    code = np.where(~(bound <= FORCE_RTOL) | ~kinematics_ok, 2, code)
+    return np.where(np.isfinite(inp), code, 3).astype(np.int8)
+
+
+def force_peaks(status: Any, *columns: Any) -> tuple[list[Any], Any]:
+    """The one rule for peaks over positions (arrays of shape (rows, positions), status as
+    FORCE_STATUSES codes): per row, for each column the index of its largest absolute
+    value among the positions whose forces are ok (-1 where none is), and how many
+    positions' forces are flagged (near_toggle, ill_conditioned or undefined; a negative
+    code, an unsolved position, is neither). Flagged forces are large or unknown: counted,
+    never taken as a peak."""
+    import numpy as np
+
+    ok = status == 0
+    any_ok = ok.any(axis=1)
+    at = []
+    with np.errstate(invalid="ignore"):
+        for col in columns:
+            at.append(np.where(any_ok, np.argmax(np.where(ok, np.abs(col), -1.0), axis=1), -1))
+    return at, ((status > 0) & (status < len(FORCE_STATUSES))).sum(axis=1)
+
+
 def position_forces(fa: ForceArrays, i: int, unit: Any, kinematics_status: str, loads: Loads) -> Forces:
     """Position ``i`` of :func:`solve_loads`' answer as a :class:`Forces`, flagged: its error
     bound from the condition number and from the kinematics' own bounds (the unit-speed
@@ -435,16 +502,11 @@ def position_forces(fa: ForceArrays, i: int, unit: Any, kinematics_status: str, 
     inp = float(fa.input[i])
     if not math.isfinite(inp):
         return Forces(None, fa.input_unit, (), (), None, None, None, cond, "undefined")
-    bound = 2.0 * cond * EPS * 4.0
+    bound = matrix_bound(cond)
     vmax = max((math.hypot(*v) for v in unit.joint_velocities.values()), default=0.0)
     if vmax > 0.0 and unit.joint_velocity_bounds:
         bound = max(bound, max(unit.joint_velocity_bounds.values()) / vmax)
-    if bound > FORCE_RTOL or kinematics_status != "ok" or unit.status != "ok":
-        status = "ill_conditioned"
-    elif cond >= TOGGLE_COND:
-        status = "near_toggle"
-    else:
-        status = "ok"
+    status = force_status(cond, bound, kinematics_status == "ok" and unit.status == "ok")
     ma = None
     if len(loads.torques) == 1 and not loads.forces and not loads.masses and inp != 0.0:
         ma = abs(next(iter(loads.torques.values())) / inp)
@@ -457,6 +519,79 @@ def position_forces(fa: ForceArrays, i: int, unit: Any, kinematics_status: str, 
 
 def _undefined(frame: Frame, why: str, cond: float = math.inf) -> Forces:
     return Forces(None, "N" if frame.driver_slider else "N m", (), (), None, None, None, cond, "undefined")
+
+
+@dataclass(frozen=True)
+class BatchForces:
+    """:func:`batch_forces`' answer: the matrix method's arrays (NaN where unsolved or
+    undefined), each position's status (FORCE_STATUSES codes), its largest pin force and
+    the size of the ground's force (the shaking force), N."""
+
+    arrays: ForceArrays | None
+    status: Any
+    input: Any
+    pin_max: Any
+    shaking: Any
+    virtual_power: Any
+    """The independent answer for ``input`` at every position."""
+
+
+def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, speed: float = 0.0,
+                 accel: float = 0.0, values: Mapping[str, Any] | None = None) -> BatchForces:
+    """The forces at many positions at once (a scan's designs x positions, flat): ``q`` one
+    array per unknown and ``d`` the driver (internal units, NaN where unsolved),
+    ``values`` parameters replaced by arrays (internal units, one per position). The
+    kinematics by the numpy twins (kinematics.rates.solve_rates_np, place_motion_np), the
+    forces by the one matrix method (:func:`solve_loads`), judged by
+    :func:`force_status_np` with the matrix's bound (no kinematic bounds here: where J is
+    singular the forces are undefined)."""
+    import numpy as np
+
+    from ..problems.loops import LoopModel
+    from .rates import place_motion_np, solve_rates_np
+
+    frame = Frame.of(mechanism)
+    d = np.asarray(d, dtype=float)
+    n = d.shape[0]
+    rows = np.isfinite(d)
+    for c in q:
+        rows &= np.isfinite(c)
+    status = np.full(n, 3, dtype=np.int8)
+    inp, pin_max, shaking, vp = (np.full(n, np.nan) for _ in range(4))
+    if not rows.any():
+        return BatchForces(None, status, inp, pin_max, shaking, vp)
+    sub = {k: (v[rows] if isinstance(v, np.ndarray) and v.shape == (n,) else v)
+           for k, v in (values or {}).items()}
+    model = LoopModel.compile(mechanism, sub)
+    qs, ds = [c[rows] for c in q], d[rows]
+    qd1, _, ok = solve_rates_np(model, qs, ds, 1.0, 0.0)
+    unit = place_motion_np(model, qs, ds, qd1, 1.0, [np.zeros_like(ds)] * model.n, 0.0)
+    if speed or accel:
+        qd, qdd, ok2 = solve_rates_np(model, qs, ds, speed, accel)
+        ok &= ok2
+        moving = place_motion_np(model, qs, ds, qd, speed, qdd, accel)
+    else:
+        moving = unit
+    k = metre(frame.length_unit)
+
+    def xy(which: Mapping[str, Any], part: int, scale: float) -> dict[str, tuple[Any, Any]]:
+        return {j: (v[part].real * scale, v[part].imag * scale) for j, v in which.items()}
+
+    zero = np.zeros(len(ds))
+    pos = xy(unit, 0, k)
+    vel = xy(moving, 1, k) if (speed or accel) else {j: (zero, zero) for j in pos}
+    acc = xy(moving, 2, k) if (speed or accel) else {j: (zero, zero) for j in pos}
+    vstar = xy(unit, 1, k)
+    fa = solve_loads(frame, pos, vel, acc, vstar, loads, mechanism.source)
+    got = np.where(ok, fa.input, np.nan)
+    status[rows] = force_status_np(got, fa.condition, matrix_bound(fa.condition), ok)
+    inp[rows] = got
+    vp[rows] = np.where(ok, fa.virtual_power_input, np.nan)
+    mags = [np.hypot(fx, fy) for _, _, _, fx, fy in fa.pins]
+    if mags:
+        pin_max[rows] = np.where(ok, np.max(mags, axis=0), np.nan)
+    shaking[rows] = np.where(ok, np.hypot(fa.ground[0], fa.ground[1]), np.nan)
+    return BatchForces(fa, status, inp, pin_max, shaking, vp)
 
 
 def sweep_forces(mechanism: Any, result: Any, loads: Loads, speed: float, accel: float
@@ -506,6 +641,20 @@ def sweep_forces(mechanism: Any, result: Any, loads: Loads, speed: float, accel:
     for n, (i, actual, unit) in enumerate(kept):
         out[i] = position_forces(fa, n, unit, actual.status, loads)
     return out
+
+
+def check_loads_argument(mechanism: Any, loads: Any) -> None:
+    """The Python API's ``loads``: a Loads, on a joints-form mechanism (else InputError)."""
+    if not isinstance(loads, Loads):
+        raise InputError(f"loads: give a linkage.Loads, got {type(loads).__name__}")
+    Frame.of(mechanism)  # says why not: loads need the joints form
+
+
+def with_forces(mechanism: Any, result: Any, loads: Loads, speed: float | None, accel: float) -> Any:
+    """The sweep ``result`` carrying every position's forces (``result.forces``)."""
+    from dataclasses import replace
+
+    return replace(result, forces=tuple(sweep_forces(mechanism, result, loads, speed or 0.0, accel)))
 
 
 def sweep_force_rows(mechanism: Any, result: Any, loads: Loads, speed: float, accel: float

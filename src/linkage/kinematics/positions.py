@@ -44,6 +44,36 @@ class SweepResult:
     motion: tuple[float, float] | None = None
     """The driver's (speed, acceleration) in internal units when rates were asked for."""
     length_unit: str = ""
+    forces: tuple[Any, ...] | None = None
+    """With loads (``sweep(..., loads=...)``): each position's
+    :class:`~linkage.kinematics.forces.Forces`, None where unsolved."""
+
+    def force_columns(self) -> dict[str, list[Any]]:
+        """The loads as columns, one entry per position (SI units; None where there is no
+        number): status, input (N m, or N for a sliding driver), virtual_power_input,
+        max_pin_force, ground_fx, ground_fy, ground_moment, condition, and each pin force as
+        ``<joint>_on_<link>_fx`` and ``_fy``. A flagged position (near_toggle,
+        ill_conditioned) keeps its numbers beside its status; read the status first."""
+        if self.forces is None:
+            raise ValueError("this sweep has no loads: sweep(..., loads=...)")
+        keys = ("input", "virtual_power_input", "max_pin_force", "ground_fx", "ground_fy", "ground_moment",
+                "condition")
+        out: dict[str, list[Any]] = {"status": [], **{k: [] for k in keys}}
+        pins = dict.fromkeys(f"{p.joint}_on_{p.on}_{c}" for f in self.forces if f is not None
+                             for p in f.pins for c in ("fx", "fy"))
+        out.update({k: [] for k in pins})
+        for f in self.forces:
+            number = f is not None and f.status != "undefined"
+            out["status"].append("unsolved" if f is None else f.status)
+            vals = (f.input, f.virtual_power_input, f.max_pin_force, *f.ground_force, f.ground_moment,
+                    f.condition) if number else (None,) * len(keys)
+            for k, v in zip(keys, vals):
+                out[k].append(v)
+            have = {f"{p.joint}_on_{p.on}_{c}": v for p in f.pins for c, v in (("fx", p.fx), ("fy", p.fy))
+                    } if number else {}
+            for k in pins:
+                out[k].append(have.get(k))
+        return out
 
     @property
     def summary(self) -> dict[str, int]:

@@ -515,8 +515,17 @@ def place_np(model: LoopModel, q: Any, d: Any) -> dict[str, tuple[Any, Any]]:
             x, y = x + sign * dx, y + sign * dy
         return x, y
 
-    placed: dict[str, tuple[Any, Any]] = {}
     origin0 = (zero + model.mechanism.origin[0], zero + model.mechanism.origin[1])
+    placed = _walk(model, part, add, origin0)
+    # a constant joint (a ground pivot) as a full column, as every position has it
+    return {k: (x + zero, y + zero) for k, (x, y) in placed.items()}
+
+
+def _walk(model: LoopModel, part: Any, add: Any, origin0: Any) -> dict[str, Any]:
+    """The placing rule of :func:`_place` over any values: each loop from its first joint
+    if an earlier loop placed it (else the origin), a joint reached along the side of its
+    loop with fewer moving vectors, a point from its joint."""
+    placed: dict[str, Any] = {}
     for loop, terms in zip(model.mechanism.loops, model.terms):
         names = loop.joints
         start = placed.get(names[0]) if names and names[0] else None
@@ -532,8 +541,104 @@ def place_np(model: LoopModel, q: Any, d: Any) -> dict[str, tuple[Any, Any]]:
                                    1.0 if ahead else -1.0)
     for name, (origin_name, terms) in model.point_terms.items():
         placed[name] = add(placed.get(origin_name, origin0), [part(t) for t in terms], 1.0)
-    # a constant joint (a ground pivot) as a full column, as every position has it
-    return {k: (x + zero, y + zero) for k, (x, y) in placed.items()}
+    return placed
+
+
+def inverse_np(a: Any) -> tuple[Any, Any]:
+    """The inverse of each matrix of a stack (NaN where it is singular or not finite) and
+    where it exists: one batched LU, the singular ones found only when there are some."""
+    import numpy as np
+
+    inv = np.full(a.shape, np.nan)
+    usable = np.isfinite(a).all(axis=(-2, -1)) if a.size else np.ones(a.shape[:-2], dtype=bool)
+    if a.shape[-1] == 0 or not usable.any():
+        return inv, usable
+    try:
+        inv[usable] = np.linalg.inv(a[usable])
+    except np.linalg.LinAlgError:  # an exactly singular one: find them by their determinant
+        with np.errstate(invalid="ignore", over="ignore"):
+            usable &= np.linalg.det(a) != 0.0
+        if usable.any():
+            inv[usable] = np.linalg.inv(a[usable])
+    usable &= np.isfinite(inv).all(axis=(-2, -1))
+    return inv, usable
+
+
+def solve_rates_np(model: LoopModel, q: Any, d: Any, speed: float, accel: float
+                   ) -> tuple[list[Any], list[Any], Any]:
+    """:func:`_solve`'s twin over arrays of positions (``model`` may carry arrays of
+    parameters, :meth:`LoopModel.compile`'s ``values``): (q', q'', solved), the same two
+    linear solves, J q' = -(dPhi/dv) v' and J q'' = -(dPhi/dv) v'' - b, with J and
+    dPhi/dv from each vector's derivatives and b its centripetal and Coriolis parts. NaN
+    (and solved False) where J is singular. No polishing and no bound: a batch's positions
+    are judged by the loads' condition number (kinematics.forces)."""
+    import numpy as np
+
+    d = np.asarray(d, dtype=float)
+    n, rows = model.n, 2 * len(model.terms)
+    jac = np.zeros((*d.shape, rows, n))
+    dv = np.zeros((*d.shape, rows))
+    for k, loop in enumerate(model.terms):
+        for sign, lc, li, ac, ai, off in loop:
+            r = _value(li, lc, q, d)
+            th = _value(ai, ac, q, d) + off
+            c, s = sign * np.cos(th), sign * np.sin(th)
+            for idx, (ex, ey) in ((li, (c, s)), (ai, (-r * s, r * c))):
+                if idx >= 0:
+                    jac[..., 2 * k, idx] += ex
+                    jac[..., 2 * k + 1, idx] += ey
+                elif idx == DRIVER:
+                    dv[..., 2 * k] += ex
+                    dv[..., 2 * k + 1] += ey
+    inv, solved = inverse_np(jac)
+
+    def solve(rhs: Any) -> Any:
+        return -np.einsum("...ij,...j->...i", inv, rhs)
+
+    qd = solve(speed * dv)
+    qd_list = [qd[..., i] for i in range(n)]
+    bias = np.zeros((*d.shape, rows))
+    for k, loop in enumerate(model.terms):
+        for sign, lc, li, ac, ai, off in loop:
+            r = _value(li, lc, q, d)
+            th = _value(ai, ac, q, d) + off
+            r1, w = _rate(li, qd_list, speed), _rate(ai, qd_list, speed)
+            # sign (2 i r' w - r w^2) e^(i theta), only the parts without a second derivative
+            cen, cor = -r * w * w, 2.0 * r1 * w
+            c, s = np.cos(th), np.sin(th)
+            bias[..., 2 * k] += sign * (cen * c - cor * s)
+            bias[..., 2 * k + 1] += sign * (cen * s + cor * c)
+    qdd = solve(accel * dv + bias)
+    return qd_list, [qdd[..., i] for i in range(n)], solved
+
+
+def place_motion_np(model: LoopModel, q: Any, d: Any, qd: Any, vd: float, qdd: Any, vdd: float
+                    ) -> dict[str, tuple[Any, Any, Any]]:
+    """:func:`place`'s twin over arrays: every named joint and point, name -> (position,
+    velocity, acceleration) as complex arrays, each vector by :func:`_term`'s formulas and
+    the joints by :func:`_place`'s rule (:func:`_walk`)."""
+    import numpy as np
+
+    d = np.asarray(d, dtype=float)
+    zero = np.zeros(d.shape, dtype=complex)
+
+    def part(t: Any) -> tuple[Any, Any, Any]:
+        sign, lc, li, ac, ai, off = t
+        r, th = _value(li, lc, q, d), _value(ai, ac, q, d) + off
+        r1, w = _rate(li, qd, vd), _rate(ai, qd, vd)
+        r2, al = _rate(li, qdd, vdd), _rate(ai, qdd, vdd)
+        e = np.exp(1j * th)
+        return (sign * r * e, sign * (r1 + 1j * r * w) * e,
+                sign * (r2 + 1j * r * al + 2j * r1 * w - r * w * w) * e)
+
+    def add(start: Any, parts: Any, sign: float) -> tuple[Any, Any, Any]:
+        p, v, a = start
+        for dp, dv, da in parts:
+            p, v, a = p + sign * dp, v + sign * dv, a + sign * da
+        return p, v, a
+
+    origin0 = (zero + complex(*model.mechanism.origin), zero, zero)
+    return {k: (p + zero, v + zero, a + zero) for k, (p, v, a) in _walk(model, part, add, origin0).items()}
 
 
 def _xy(c: complex) -> XY:

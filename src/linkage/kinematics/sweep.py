@@ -34,6 +34,7 @@ def sweep_mechanism(
     speed: float | None = None,
     accel: float = 0.0,
     joints: bool = False,
+    loads: Any = None,
 ) -> SweepResult:
     """Solve a mechanism over driver values (display units: degrees for an angle), each
     position from the previous one; the public ``linkage.sweep``.
@@ -63,6 +64,11 @@ def sweep_mechanism(
     and is refused here. ``values`` must be finite reals in a sequence (not a generator).
     Every argument is checked first (:mod:`linkage.arguments`): a misuse raises
     :class:`~linkage.errors.InputError` naming the argument.
+
+    ``loads``: a :class:`~linkage.Loads` (a joints-form mechanism; its own are
+    ``mechanism.extra["loads"]``): every solved position's forces by the matrix method at
+    the driver's ``speed`` and ``accel`` (static without them), as ``result.forces`` (a
+    :class:`~linkage.Forces` or None per position) and ``result.force_columns()``.
     """
     from ..arguments import check_callable, check_flag, check_motion, check_reals, check_text
     from ..errors import InputError
@@ -81,6 +87,13 @@ def sweep_mechanism(
     speed, accel = check_motion(speed, accel, m.driver.kind, m.length_unit)
     if method not in ("newton", "newton-fd", "lm"):
         raise InputError(f"unknown method {method!r}; choose from newton, newton-fd, lm")
+    if loads is not None:  # the sweep, then its forces (kinematics.forces)
+        from .forces import check_loads_argument, with_forces
+
+        check_loads_argument(m, loads)
+        return with_forces(m, sweep_mechanism(m, values, branch=branch, method=method, tol=tol,
+                                              max_iter=max_iter, batch=batch, progress=progress,
+                                              speed=speed, accel=accel, joints=joints), loads, speed, accel)
     if branch is not None:
         check_branch(m, branch)
     else:

@@ -38,6 +38,20 @@ def fourbar_columns(suffix: str) -> tuple[tuple[str, str, str], ...]:
     return tuple((f"{c}{suffix}", t, u) for c, t, u in FOURBAR)
 
 
+LOADS = (("peak_input", "number", "N m"), ("max_pin_force", "number", "N"),
+         ("max_shaking_force", "number", "N"), ("forces_flagged", "int", ""))
+"""A scan's columns with loads (kinematics.forces.force_peaks over each design's cycle): the
+largest |input torque| (N for a sliding driver) and pin force among the positions whose
+forces are ok, the largest force on the ground, and how many positions' forces are
+flagged (near a toggle: not counted)."""
+
+
+def load_columns(m: Any) -> tuple[tuple[str, str, str], ...]:
+    """:data:`LOADS` with the input's unit: N m, or N for a sliding driver."""
+    sliding = bool(getattr(m, "extra", {}).get("drawing_driver", {}).get("slider"))
+    return tuple((c, t, "N" if c == "peak_input" and sliding else u) for c, t, u in LOADS)
+
+
 def extent_columns(name: str) -> tuple[str, str, str]:
     """An unknown's columns: its min, max and range."""
     return f"{name}_min", f"{name}_max", f"{name}_range"
@@ -48,9 +62,11 @@ def path_columns(point: str, axis: str) -> tuple[str, str]:
     return f"{point}_{axis}_min", f"{point}_{axis}_max"
 
 
-def sourced_columns(m: Any, names: Sequence[str]) -> list[tuple[str, str, str, str, str]]:
-    """Every record column of a scan varying ``names``, in order, as (name, type, unit,
-    where it comes from, the file key that named it or "")."""
+def sourced_columns(m: Any, names: Sequence[str], loads: bool = False
+                    ) -> list[tuple[str, str, str, str, str]]:
+    """Every record column of a scan varying ``names`` (with ``loads``, :func:`load_columns`
+    too), in order, as (name, type, unit, where it comes from, the file key that named it
+    or "")."""
     unit = {k: (q.unit if q.kind == "angle" else m.length_unit) for k, q in m.parameters.items()}
     own = "a column every scan writes"
     cols = [(DESIGN, "int", "", own, "")]
@@ -66,19 +82,21 @@ def sourced_columns(m: Any, names: Sequence[str]) -> list[tuple[str, str, str, s
     for p in m.points:
         cols += [(c, "number", m.length_unit, f"point {p}", f"points.{p}")
                  for axis in "xy" for c in path_columns(p, axis)]
+    if loads:
+        cols += [(c, t, u, "a column of a scan with loads", "") for c, t, u in load_columns(m)]
     return cols
 
 
-def columns_of(m: Any, names: Sequence[str]) -> list[tuple[str, str, str]]:
+def columns_of(m: Any, names: Sequence[str], loads: bool = False) -> list[tuple[str, str, str]]:
     """Every record column: (name, type: number, bool, int or text, unit or "")."""
-    return [c[:3] for c in sourced_columns(m, names)]
+    return [c[:3] for c in sourced_columns(m, names, loads)]
 
 
 def column_clash(m: Any) -> tuple[str, str] | None:
     """The first name that would give two scan columns one name, as (the file key to
     blame, the clash in one line), or None."""
     seen: dict[str, tuple[str, str]] = {}
-    for name, _type, _unit, origin, key in sourced_columns(m, tuple(m.parameters)):
+    for name, _type, _unit, origin, key in sourced_columns(m, tuple(m.parameters), loads=True):
         if name not in seen:
             seen[name] = (origin, key)
             continue

@@ -635,9 +635,13 @@ class LoopModel:
         default_factory=dict)
 
     @classmethod
-    def compile(cls, m: Mechanism) -> LoopModel:
+    def compile(cls, m: Mechanism, values: Mapping[str, Any] | None = None) -> LoopModel:
+        """``values``: parameters (internal units) to use instead of the file's, numbers or
+        numpy arrays (one per position: a scan's designs); a model with arrays is for the
+        numpy twins (kinematics.rates.place_motion_np), not for :attr:`factory`."""
         index = {u.name: i for i, u in enumerate(m.unknowns)}
         fixed = {k: q.value for k, q in m.parameters.items()}
+        fixed.update(values or {})
 
         def resolve(ref: str | float) -> tuple[float, int]:
             if isinstance(ref, str):

@@ -193,9 +193,10 @@ def sweep_force_table(rows: list[tuple[Any, ...]], driver: str, driver_unit: str
 
 
 def torque_plot(rows: list[tuple[Any, ...]], driver: str, driver_unit: str, input_unit: str, path: Any,
-                title: str) -> None:
-    """The input torque (or force) over the sweep, the peak marked; flagged positions drawn
-    as hollow markers, undefined ones left out (the line breaks there)."""
+                title: str, peak: int) -> None:
+    """The input torque (or force) over the sweep, the peak (row ``peak``, by the one peak
+    rule; -1: none) marked; flagged positions drawn as hollow markers, undefined ones left
+    out (the line breaks there)."""
     from .plots import pyplot, save_figure
 
     plt = pyplot()
@@ -206,9 +207,8 @@ def torque_plot(rows: list[tuple[Any, ...]], driver: str, driver_unit: str, inpu
     flagged = [(x, y) for x, y, r in zip(xs, ys, rows) if r[1] in ("near_toggle", "ill_conditioned")]
     if flagged:
         ax.plot(*zip(*flagged), "o", mfc="none", color="C1", ms=5, label="near a toggle (flagged)")
-    shown = [(x, y) for x, y, r in zip(xs, ys, rows) if r[1] == "ok"]
-    if shown:
-        px, py = max(shown, key=lambda t: abs(t[1]))
+    if peak >= 0:
+        px, py = xs[peak], ys[peak]
         ax.plot([px], [py], "s", color="C3", label=f"peak {py:.4g} {input_unit} at {px:g} {driver_unit}")
     ax.axhline(0.0, color="0.6", lw=0.8)
     ax.set_xlabel(f"{driver} ({driver_unit})")

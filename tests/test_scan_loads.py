@@ -1,0 +1,234 @@
+"""Loads in scans and in the Python sweep (issue 23): the batch engine's kinematics
+(rates.solve_rates_np, place_motion_np) against the one-at-a-time rates, its forces against
+the one-at-a-time forces, and a scan's load columns against each design swept on its own
+(a file written with that design's joints), by the one peak rule."""
+
+from __future__ import annotations
+
+import math
+import random
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from linkage.cli import run_cli
+from linkage.kinematics.forces import FORCE_STATUSES, batch_forces, force_peaks, sweep_forces
+from linkage.kinematics.rates import place_motion_np, rates_at, solve_rates_np
+from linkage.kinematics.sweep import sweep_mechanism
+from linkage.problems.loads import Loads, Mass
+from linkage.problems.loops import LoopModel, load
+from linkage.scan import scan
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLES = sorted((ROOT / "sample_inputs").glob("*.toml"))
+JOINT_SAMPLES = sorted((ROOT / "sample_inputs").glob("*_joints.toml"))
+LOADED = ROOT / "docs" / "crank_rocker_loads.toml"
+
+
+def _solved(m, step: int = 7):
+    angle = m.driver.kind == "angle"
+    vals = (list(range(0, 360, step)) if angle else
+            list(np.linspace(m.driver.value * 0.9, m.driver.value * 1.1, 25)))
+    r = sweep_mechanism(m, vals)
+    qs, ds = [], []
+    for p in r.positions:
+        if p.status == "converged":
+            qs.append([math.radians(p.solution[u.name]) if u.kind == "angle" else p.solution[u.name]
+                       for u in m.unknowns])
+            ds.append(math.radians(p.input) if angle else p.input)
+    return r, qs, ds
+
+
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
+def test_numpy_rates_equal_the_one_at_a_time_rates(path: Path) -> None:
+    m = load(path)
+    _, qs, ds = _solved(m)
+    q = [np.array(c) for c in zip(*qs)]
+    model = LoopModel.compile(m)
+    qd, qdd, ok = solve_rates_np(model, q, np.array(ds), 2.5, -0.7)
+    placed = place_motion_np(model, q, np.array(ds), qd, 2.5, qdd, -0.7)
+    checked = 0
+    for i, (qq, d) in enumerate(zip(qs, ds)):
+        ref = rates_at(m, qq, speed=2.5, accel=-0.7, driver=d)
+        if ref.status != "ok":
+            continue
+        assert ok[i]
+        for name, u in enumerate(m.unknowns):
+            scale = max(abs(v) for v in ref.velocities.values()) + 1e-300
+            assert qd[name][i] == pytest.approx(ref.velocities[u.name], abs=1e-9 * scale)
+            scale = max(abs(v) for v in ref.accelerations.values()) + 1e-300
+            assert qdd[name][i] == pytest.approx(ref.accelerations[u.name], abs=1e-9 * scale)
+        for j, (x, y) in ref.joints.items():
+            assert abs(placed[j][0][i] - complex(x, y)) <= 1e-9 * m.length_scale
+        checked += 1
+        if not ref.joints:  # a file whose loops name no joints: the unknowns' rates only
+            continue
+        vs = max(math.hypot(*v) for v in ref.joint_velocities.values())
+        for j, (x, y) in ref.joint_velocities.items():
+            assert abs(placed[j][1][i] - complex(x, y)) <= 1e-9 * vs
+        acc = max(math.hypot(*v) for v in ref.joint_accelerations.values())
+        for j, (x, y) in ref.joint_accelerations.items():
+            assert abs(placed[j][2][i] - complex(x, y)) <= 1e-9 * acc
+    assert checked >= 5
+
+
+def _random_loads(m, rng: random.Random, masses: bool) -> Loads:
+    d = m.extra["drawing"]
+    links = [b for b in d.bodies if b != "ground"]
+    moving = [j for j in d.xy if j not in d.ground]
+    forces = {rng.choice(moving): (rng.uniform(-100, 100), rng.uniform(-100, 100))}
+    torques = {rng.choice(links): rng.uniform(-10, 10)}
+    mass = {}
+    if masses:
+        for b in links:
+            x, y = d.xy[d.bodies[b][0]]
+            mass[b] = Mass(rng.uniform(0.1, 3.0), (x + rng.uniform(-5, 5), y + rng.uniform(-5, 5)),
+                           rng.uniform(1e-4, 1e-2))
+    return Loads(forces, torques, mass, (0.0, -9.81) if masses else None)
+
+
+@pytest.mark.parametrize("path", JOINT_SAMPLES, ids=lambda p: p.stem)
+@pytest.mark.parametrize("speed", [0.0, 12.0])
+def test_batch_forces_equal_the_one_at_a_time_forces(path: Path, speed: float) -> None:
+    m = load(path)
+    rng = random.Random(hash((path.stem, speed)) & 0xFFFF)
+    loads = _random_loads(m, rng, masses=bool(speed))
+    result, _, _ = _solved(m, step=5)
+    if speed:
+        result = sweep_mechanism(m, [p.input for p in result.positions], speed=speed, accel=1.5)
+    one = sweep_forces(m, result, loads, speed, 1.5 if speed else 0.0)
+    angle = m.driver.kind == "angle"
+    q = [np.array([(math.radians(p.solution[u.name]) if u.kind == "angle" else p.solution[u.name])
+                   if p.solution else np.nan for p in result.positions]) for u in m.unknowns]
+    d = np.array([math.radians(p.input) if angle else p.input for p in result.positions])
+    batch = batch_forces(m, q, d, loads, speed=speed, accel=1.5 if speed else 0.0)
+    compared = 0
+    for i, f in enumerate(one):
+        if f is None:
+            continue
+        assert FORCE_STATUSES[batch.status[i]] in (f.status, "undefined" if f.status == "undefined" else "")
+        if f.status != "ok":
+            continue
+        scale = max([abs(f.input)] + [p.magnitude for p in f.pins])
+        assert batch.input[i] == pytest.approx(f.input, abs=1e-9 * scale)
+        assert batch.pin_max[i] == pytest.approx(f.max_pin_force, abs=1e-9 * scale)
+        assert batch.virtual_power[i] == pytest.approx(f.input, abs=1e-9 * scale)
+        compared += 1
+    assert compared >= 5
+
+
+def test_scan_load_columns_equal_each_design_swept_on_its_own() -> None:
+    """A scan moving the rocker's pivot with masses and a speed: each record's peak input,
+    largest pin force and shaking force equal those of the design swept one position at a
+    time (kinematics.rates) and reduced by the one peak rule. Moving a ground joint keeps
+    every link's length: the design is the ground vector O2 -> O4 set to the new pivot."""
+    base = load(LOADED)
+    values = [float(v) for v in range(0, 360, 4)]
+    cols = scan(str(LOADED), {"O4.x": (90.0, 110.0, 3), "O4.y": (-8.0, 8.0, 2)}, values=values,
+                speed=10.0, accel=2.0)
+    assert len(cols["design"]) == 6
+    for k in range(6):
+        x, y = float(cols["O4_x"][k]), float(cols["O4_y"][k])
+        m = base.with_values({"ground": math.hypot(x, y), "theta_ground": math.degrees(math.atan2(y, x))}, {})
+        r = sweep_mechanism(m, values, speed=10.0, accel=2.0, loads=m.extra["loads"])
+        c = r.force_columns()
+        codes = np.array([[FORCE_STATUSES.index(s) if s in FORCE_STATUSES else -1 for s in c["status"]]])
+        arrays = [np.array([[np.nan if v is None else v for v in c[key]]], dtype=float)
+                  for key in ("input", "max_pin_force")]
+        shaking = np.hypot(np.array([[np.nan if v is None else v for v in c["ground_fx"]]], dtype=float),
+                           np.array([[np.nan if v is None else v for v in c["ground_fy"]]], dtype=float))
+        (at_in, at_pin, at_g), flagged = force_peaks(codes, *arrays, shaking)
+        assert at_in[0] >= 0
+        assert cols["peak_input"][k] == pytest.approx(abs(arrays[0][0, at_in[0]]), rel=1e-9)
+        assert cols["max_pin_force"][k] == pytest.approx(arrays[1][0, at_pin[0]], rel=1e-9)
+        assert cols["max_shaking_force"][k] == pytest.approx(shaking[0, at_g[0]], rel=1e-9)
+        assert cols["forces_flagged"][k] == flagged[0]
+
+
+def test_scan_near_a_toggle_counts_flagged_positions_and_never_peaks_them() -> None:
+    """Designs whose coupler makes the crank stop short of a full turn pass limit
+    positions: the forces there are flagged, counted, and no peak comes from them."""
+    m = load(ROOT / "sample_inputs" / "crank_rocker_joints.toml")
+    loads = Loads({}, {"rocker": -2.0}, {}, None)
+    values = [float(v) for v in np.arange(0.0, 360.0, 0.25)]
+    cols = scan(m, {"coupler": (60.0, 140.0, 9)}, values=values, loads=loads)
+    assert (cols["forces_flagged"] > 0).any() and (cols["forces_flagged"] == 0).any()
+    n = len(values)
+    for k in range(len(cols["design"])):
+        mm = m.with_values({"coupler": float(cols["coupler"][k])}, {})
+        r = sweep_mechanism(mm, values, loads=loads)
+        statuses = r.force_columns()["status"]
+        # position by position: the batch flags exactly the positions the one-at-a-time
+        # forces flag (it may name them near_toggle where the rates' own bounds make them
+        # ill_conditioned), and counts the same ones ok
+        q = [np.array([math.radians(p.solution[u.name]) if p.solution else np.nan for p in r.positions])
+             for u in mm.unknowns]
+        batch = batch_forces(mm, q, np.radians(values), loads)
+        for s_one, code in zip(statuses, batch.status):
+            if s_one != "unsolved":
+                assert (s_one == "ok") == (code == 0)
+        # the scan's records: its engine may leave a limit's last position unsolved where
+        # the sweep reaches it (and flags it); the peaks come from the same ok positions
+        flagged = sum(s in ("near_toggle", "ill_conditioned", "undefined") for s in statuses)
+        unsolved_in_scan = round((1.0 - cols["solved_fraction"][k]) * n)
+        assert flagged - unsolved_in_scan <= cols["forces_flagged"][k] <= flagged
+        ok = [abs(v) for v, s in zip(r.force_columns()["input"], statuses) if s == "ok"]
+        if ok:
+            assert cols["peak_input"][k] == pytest.approx(max(ok), rel=1e-9)
+        else:
+            assert math.isnan(cols["peak_input"][k])
+
+
+def test_scan_with_loads_on_the_command_line(tmp_path, capsys) -> None:
+    out = tmp_path / "designs.csv"
+    code = run_cli(["scan", str(ROOT / "sample_inputs" / "crank_rocker_joints.toml"), "--vary",
+                    "coupler=110:130:5", "--torque", "rocker=-2", "--where", "forces_flagged == 0",
+                    "--sort", "peak_input", "-f", "csv", "-o", str(out)])
+    assert code == 0
+    lines = out.read_text().splitlines()
+    header = lines[0].split(",")
+    for col in ("peak_input (N m)", "max_pin_force (N)", "max_shaking_force (N)", "forces_flagged"):
+        assert col in header
+    peaks = [float(line.split(",")[header.index("peak_input (N m)")]) for line in lines[1:]]
+    assert peaks == sorted(peaks) and len(peaks) == 5
+
+
+@pytest.mark.parametrize("args, says", [
+    (["--vary", "coupler=110:130:3"], "changes the shape of coupler"),
+    (["--vary", "O4.x=90:110:3", "--accel", "1"], "--accel needs --speed"),
+])
+def test_scan_loads_refusals(args, says, capsys) -> None:
+    code = run_cli(["scan", str(LOADED), *args])
+    err = capsys.readouterr().err
+    assert code == 2 and says in err and len(err.strip().splitlines()) == 1
+
+
+def test_scan_speed_without_loads_and_loads_on_a_loops_file_are_refused(capsys) -> None:
+    code = run_cli(["scan", str(ROOT / "sample_inputs" / "crank_rocker_joints.toml"), "--vary",
+                    "coupler=110:130:3", "--speed", "10"])
+    err = capsys.readouterr().err
+    assert code == 2 and "--speed in a scan" in err
+    code = run_cli(["scan", str(ROOT / "sample_inputs" / "crank_rocker.toml"), "--vary", "r3=110:130:3",
+                    "--torque", "r4=1"])
+    err = capsys.readouterr().err
+    assert code == 2 and "joints form" in err and len(err.strip().splitlines()) == 1
+
+
+def test_sweep_result_carries_the_loads_as_columns() -> None:
+    m = load(LOADED)
+    values = [0.0, 45.0, 90.0]
+    r = sweep_mechanism(m, values, speed=10.0, loads=m.extra["loads"])
+    cols = r.force_columns()
+    assert cols["status"] == ["ok"] * 3
+    for i, v in enumerate(values):
+        pos = r.positions[i]
+        q = [math.radians(pos.solution[u.name]) for u in m.unknowns]
+        from linkage.kinematics.forces import forces_at
+
+        f = forces_at(m, q, speed=10.0, driver=math.radians(v))
+        assert cols["input"][i] == pytest.approx(f.input, rel=1e-9)
+        b = next(p for p in f.pins if p.joint == "B")
+        assert cols["B_on_rocker_fx"][i] == pytest.approx(b.fx, rel=1e-9, abs=1e-9)
+    with pytest.raises(ValueError):
+        sweep_mechanism(m, values).force_columns()
