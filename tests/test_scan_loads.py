@@ -16,9 +16,10 @@ from linkage.cli import run_cli
 from linkage.kinematics.forces import FORCE_STATUSES, batch_forces, force_peaks, sweep_forces
 from linkage.kinematics.rates import place_motion_np, rates_at, solve_rates_np
 from linkage.kinematics.sweep import sweep_mechanism
-from linkage.problems.loads import Loads, Mass
+from linkage.problems.loads import Loads
 from linkage.problems.loops import LoopModel, load
 from linkage.scan import scan
+from test_forces import _loads_for  # the same random loads as the one-at-a-time tests
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLES = sorted((ROOT / "sample_inputs").glob("*.toml"))
@@ -73,27 +74,12 @@ def test_numpy_rates_equal_the_one_at_a_time_rates(path: Path) -> None:
     assert checked >= 5
 
 
-def _random_loads(m, rng: random.Random, masses: bool) -> Loads:
-    d = m.extra["drawing"]
-    links = [b for b in d.bodies if b != "ground"]
-    moving = [j for j in d.xy if j not in d.ground]
-    forces = {rng.choice(moving): (rng.uniform(-100, 100), rng.uniform(-100, 100))}
-    torques = {rng.choice(links): rng.uniform(-10, 10)}
-    mass = {}
-    if masses:
-        for b in links:
-            x, y = d.xy[d.bodies[b][0]]
-            mass[b] = Mass(rng.uniform(0.1, 3.0), (x + rng.uniform(-5, 5), y + rng.uniform(-5, 5)),
-                           rng.uniform(1e-4, 1e-2))
-    return Loads(forces, torques, mass, (0.0, -9.81) if masses else None)
-
-
 @pytest.mark.parametrize("path", JOINT_SAMPLES, ids=lambda p: p.stem)
 @pytest.mark.parametrize("speed", [0.0, 12.0])
 def test_batch_forces_equal_the_one_at_a_time_forces(path: Path, speed: float) -> None:
     m = load(path)
     rng = random.Random(hash((path.stem, speed)) & 0xFFFF)
-    loads = _random_loads(m, rng, masses=bool(speed))
+    loads = _loads_for(m, rng, masses=bool(speed))
     result, _, _ = _solved(m, step=5)
     if speed:
         result = sweep_mechanism(m, [p.input for p in result.positions], speed=speed, accel=1.5)
