@@ -220,6 +220,20 @@ def gap_to_roots(x, sols):
                for sol in sols.values())
 
 
+def test_lm_closing_in_on_a_family_of_roots_claims_no_step():
+    """Regression (found by Hypothesis): r1 = r2 = 1.5, r3 = r4 = 0.9921875 at theta2 =
+    4.4e-94 rad. At theta2 = 0 every theta3 = theta4 closes the loops; LM closed in on
+    45 deg, quadratically, with J ever more singular, and called its last small step
+    (2.3e-13) convergence, 45 deg from every root at this theta2. A step from a J that
+    Newton's own test calls singular bounds nothing: the claim is now the residual's."""
+    problem = parse_mechanism(fourbar_doc(1.5, 1.5, 0.9921875, 0.9921875, 4.4170598989597503e-94,
+                                          10.0, 80.0)).problem()
+    result = solve_system(problem, method="lm", tol=1e-9, max_iter=200)
+    assert result.status is not Status.CONVERGED_STEP
+    assert result.status is Status.CONVERGED_RESIDUAL
+    assert max(abs(v) for v in problem.F(list(result.x))) <= 1e-9 * problem.length_scale
+
+
 def test_lm_at_a_change_point_claims_the_residual_not_a_step():
     """Regression (found by Hypothesis): r1..r4 = 2 at theta2 = 1e-7 deg. LM stopped at
     theta3 = theta4 = 45 deg, a point of the family of roots at theta2 = 0, 45 deg from

@@ -20,9 +20,19 @@ from ..problems.system import SystemProblem
 from ..result import Column, Status
 from ._common import new_state
 from ._linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve
-from .newton_system import fd_jacobian, max_abs, normal_equations, step_measure, system_columns, system_row
+from .newton_system import (
+    fd_jacobian,
+    max_abs,
+    newton_direction,
+    normal_equations,
+    step_measure,
+    system_columns,
+    system_row,
+)
 
 MU_MAX = 1e16
+ROUNDING_RESIDUAL = 64 * 2.220446049250313e-16
+"""max|Phi| at or below this times the length scale is rounding in the loop sums."""
 
 
 class LMState(NamedTuple):
@@ -41,6 +51,9 @@ class LMState(NamedTuple):
     phi_new: tuple[float, ...]
     nfev: int
     njev: int
+    bounded: bool = True
+    """Whether ``err`` bounds the distance to a root: the undamped step was solved from a J
+    that Newton's own test calls nonsingular (newton_system.newton_direction)."""
 
 
 @dataclass(frozen=True)
@@ -82,10 +95,24 @@ class LevenbergMarquardt:
             fj = lu(jac)
             det, cond = det_from_lu(fj), (cond1(jac, fj) if self.diagnostics else math.nan)
             # the error estimate is the undamped (Gauss-Newton) step, as Newton's: a damped
-            # step is small wherever mu is large, at a local minimum too, and bounds nothing
-            newton = step_measure(lu_solve(fj, [-v for v in phi]), problem.step_scales)
+            # step is small wherever mu is large, at a local minimum too, and bounds nothing;
+            # nor does the undamped one where J is singular by Newton's own test (a tiny
+            # residual over a vanishing pivot: Hypothesis found r1 = r2, r3 = r4 at theta2 =
+            # 4e-94 rad stopped 45 deg from every root with "error 2.3e-13")
+            direction = newton_direction(jac, phi)[0]
+            newton = step_measure(direction if direction is not None else lu_solve(fj, [-v for v in phi]),
+                                  problem.step_scales)
         except SingularMatrix:
-            det, cond, newton = 0.0, math.inf, math.inf
+            det, cond, newton, direction = 0.0, math.inf, math.inf, None
+        if direction is None and max_abs(phi) <= ROUNDING_RESIDUAL * problem.length_scale:
+            # the loops close to rounding where J is singular: no step can certify a root
+            # here, and none can lower |Phi| further; stopped, the verdict is the residual's
+            return new_state(LMState, (
+                tuple(q), max_abs(phi), newton,
+                (Status.SINGULAR_JACOBIAN, "J is singular here and the loops close to rounding level: "
+                                           "a small step bounds no distance to a root"),
+                tuple(q), tuple(phi), tuple(map(tuple, jac)), tuple(0.0 for _ in q), det, cond, s.mu, s.cost,
+                tuple(phi), nfev, njev, False))
         mu = s.mu
         while True:
             a = [row[:] for row in jtj]
@@ -106,7 +133,7 @@ class LevenbergMarquardt:
                         None,
                         tuple(q), tuple(phi),
                         tuple(map(tuple, jac)), tuple(dq), det, cond, max(mu / 3.0, 1e-12), cost_t,
-                        tuple(phi_t), nfev, njev))
+                        tuple(phi_t), nfev, njev, direction is not None))
             mu *= 2.0
             if mu > MU_MAX:
                 # No step lowers the residual: a local minimum of |Phi|^2.
@@ -115,7 +142,15 @@ class LevenbergMarquardt:
                     (Status.LOCAL_MINIMUM, f"no step lowers |Phi|^2 below {s.cost:.3g} from here "
                                            f"(mu above {MU_MAX:g})"),
                     tuple(q), tuple(phi), tuple(map(tuple, jac)),
-                    tuple(0.0 for _ in q), det, cond, mu, s.cost, tuple(phi), nfev, njev))
+                    tuple(0.0 for _ in q), det, cond, mu, s.cost, tuple(phi), nfev, njev,
+                    direction is not None))
+
+    @staticmethod
+    def plausible(s: LMState) -> bool:
+        """A small step is convergence only where it bounds the distance to a root: with J
+        singular the iterates can close in on a family of roots of a nearby mechanism (r1 =
+        r2, r3 = r4 at theta2 = 4e-94 rad: 45 deg from every root) with ever smaller steps."""
+        return s.bounded
 
     def initial_row(self, problem: SystemProblem, s: LMState) -> None:
         return None
