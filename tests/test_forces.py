@@ -2,8 +2,9 @@
 random four-bars, slider-cranks and six-bars, with and without masses; global equilibrium;
 a static four-bar against its free bodies worked by hand; toggles flagged.
 
-Textbook examples with printed answers (done-when 1) are not here: no book could be
-reached from this machine."""
+A textbook's printed answer (done-when 1) is in test_textbook_forces.py (a slider-crank's
+kinetostatics); a four-bar static analysis with a printed answer could not be reached from
+this machine."""
 
 from __future__ import annotations
 

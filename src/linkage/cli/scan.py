@@ -126,6 +126,7 @@ def scan(
     from ..kinematics.forces import command_loads
 
     w, a_ = parse_motion(speed, accel, mechanism)
+    motion = (w or 0.0, a_)
     loads = command_loads(mechanism, force or [], torque or [], gravity)
     used = loads if not loads.empty or loads.gravity is not None else None
     if used is None and speed is not None:
@@ -144,9 +145,9 @@ def scan(
         check_held(setup.plan.total, len(setup.spec), top, f"--sort {sort} with --format {fmt}")
     job = ScanJob(text, str(file), tuple((k, float(v)) for k, v in fixed.items()), setup.plan.names,
                   tuple(setup.values), setup.branch, tol, moves=setup.moves, loads=used,
-                  motion=(w or 0.0, a_))
+                  motion=motion)
     size = pick_chunk(mechanism, len(setup.values), setup.branch, chunk, setup.plan.total)
-    meta = scan_meta(mechanism, str(file), setup, (a, b, step), where, sort, desc)
+    meta = scan_meta(mechanism, str(file), setup, (a, b, step), where, sort, desc, motion)
     started = time.perf_counter()
     with contextlib.ExitStack() as stack:
         # a data format streams every record through the registry's sink (sorted: once, at
@@ -159,7 +160,7 @@ def scan(
         if sink is not None and sort is not None:
             sink(held)
     summary = scan_summary(mechanism, setup, (a, b, step), scanned, keeper, held,
-                           time.perf_counter() - started, shown=not streamed)
+                           time.perf_counter() - started, shown=not streamed, motion=motion)
     if sink is None:
         writers.write(scan_report(held, spec, summary, digits, meta), fmt, output)
     else:

@@ -424,8 +424,23 @@ def forces_at(
     if loads is None:
         loads = mechanism.extra.get("loads") or Loads()
     actual = rates_at(mechanism, q, speed=speed, accel=accel, driver=driver)
-    unit = rates_at(mechanism, q, speed=1.0, accel=0.0, driver=driver)  # virtual velocities
+    # the virtual velocities: a unit driver speed's
+    unit = per_unit_speed(actual, speed) or rates_at(mechanism, q, speed=1.0, accel=0.0, driver=driver)
     return judged(frame, actual, unit, loads, mechanism.source)
+
+
+def per_unit_speed(actual: Any, speed: float) -> Any:
+    """The velocities of a unit driver speed from those at ``speed`` (they are linear in
+    it, and so are their bounds): ``actual`` with its velocities and velocity bounds divided
+    by the speed, or None where there is no speed to divide by (then they are computed)."""
+    from dataclasses import replace
+
+    if not 1e-100 < abs(speed) < 1e100 or actual.status == "undefined" or not actual.joint_velocities:
+        return None
+    k = 1.0 / speed
+    velocities = {j: (v[0] * k, v[1] * k) for j, v in actual.joint_velocities.items()}
+    bounds = {j: b * abs(k) for j, b in actual.joint_velocity_bounds.items()}
+    return replace(actual, joint_velocities=velocities, joint_velocity_bounds=bounds)
 
 
 def judged(frame: Frame, actual: Any, unit: Any, loads: Loads, source: str) -> Forces:
@@ -617,7 +632,7 @@ def sweep_forces(mechanism: Any, result: Any, loads: Loads, speed: float, accel:
         # the sweep's own rates where it computed them at this motion (--speed), else here
         given = pos.rates if speed and pos.rates is not None and pos.rates.joint_velocities else None
         actual = given or rates_at(mechanism, q, speed=speed, accel=accel, driver=drv)
-        unit = rates_at(mechanism, q, speed=1.0, accel=0.0, driver=drv)
+        unit = per_unit_speed(actual, speed) or rates_at(mechanism, q, speed=1.0, accel=0.0, driver=drv)
         if actual.status == "undefined" or unit.status == "undefined":
             out[i] = _undefined(frame, "the kinematics are undefined here")
             continue

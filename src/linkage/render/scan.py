@@ -160,18 +160,45 @@ def scan_report(cols: Mapping[str, np.ndarray], spec: Sequence[Column], summary:
 
 
 def scan_meta(m: Any, source: str, setup: Any, driver: tuple[float, float, float], where: str | None,
-              sort: str | None, descending: bool) -> dict[str, Any]:
+              sort: str | None, descending: bool, motion: tuple[float, float] = (0.0, 0.0)
+              ) -> dict[str, Any]:
     """The scan's settings: the JSON document (the records go under its ``tables``) and
-    parquet's ``linkage`` metadata."""
+    parquet's ``linkage`` metadata; with loads, the loads (SI) and the driver's motion
+    (internal units) the load columns are for."""
     start, stop, step = driver
-    return {"mechanism": m.name, "source": source, "branch": setup.branch,
-            "driver": {"name": m.driver.name, "unit": m.driver.unit, "from": start, "to": stop,
-                       "step": step, "positions": len(setup.values)},
-            "where": where, "sort": sort, "descending": descending, "designs": setup.plan.total}
+    out = {"mechanism": m.name, "source": source, "branch": setup.branch,
+           "driver": {"name": m.driver.name, "unit": m.driver.unit, "from": start, "to": stop,
+                      "step": step, "positions": len(setup.values)},
+           "where": where, "sort": sort, "descending": descending, "designs": setup.plan.total}
+    loads = setup.loads
+    if loads is not None:
+        per_s = "rad/s" if m.driver.kind == "angle" else f"{m.length_unit}/s"
+        out["loads"] = {
+            "forces_N": {k: list(v) for k, v in loads.forces.items()},
+            "torques_N_m": dict(loads.torques),
+            "masses": {k: {"mass_kg": v.mass, f"cg_{m.length_unit}": list(v.cg), "inertia_kg_m2": v.inertia}
+                       for k, v in loads.masses.items()},
+            "gravity_m_s2": None if loads.gravity is None else list(loads.gravity),
+            "speed": motion[0], "accel": motion[1], "speed_unit": per_s, "accel_unit": f"{per_s}^2"}
+    return out
+
+
+def loads_line(m: Any, loads: Any, motion: tuple[float, float]) -> str:
+    """One line saying which loads the load columns are for."""
+    parts = [f"{len(loads.forces)} force(s)", f"{len(loads.torques)} torque(s)",
+             f"{len(loads.masses)} mass(es)"]
+    if loads.gravity is not None:
+        parts.append(f"gravity ({loads.gravity[0]:g}, {loads.gravity[1]:g}) m/s^2")
+    per_s = "rad/s" if m.driver.kind == "angle" else f"{m.length_unit}/s"
+    moving = (f"driver at {motion[0]:.6g} {per_s}" + (f", {motion[1]:.6g} {per_s}^2" if motion[1] else "")
+              if motion[0] else "static (no --speed)")
+    return (f"loads: {', '.join(parts)}; {moving}; peaks over the positions whose forces are ok "
+            "(forces_flagged: the others)")
 
 
 def scan_summary(m: Any, setup: Any, driver: tuple[float, float, float], scanned: int, keeper: Any,
-                 held: Mapping[str, np.ndarray], elapsed: float, shown: bool) -> list[str]:
+                 held: Mapping[str, np.ndarray], elapsed: float, shown: bool,
+                 motion: tuple[float, float] = (0.0, 0.0)) -> list[str]:
     """The lines over the display (the first also ends a file's "wrote" line): designs
     scanned and kept, the driver range, branch and engine, and (``shown``) how many rows
     the display holds."""
@@ -186,6 +213,8 @@ def scan_summary(m: Any, setup: Any, driver: tuple[float, float, float], scanned
     lines = [f"{m.name}: {scanned:,} of {total:,} designs scanned{stopped}{where_note}; {elapsed:.2f} s",
              f"{len(setup.values)} positions each ({m.driver.name} {start:g}..{stop:g} "
              f"{m.driver.unit}, step {step:g}); branch: {branch}; engine: {engine}"]
+    if setup.loads is not None:
+        lines.append(loads_line(m, setup.loads, motion))
     n_held = len(held["design"]) if held else 0
     if shown and n_held < keeper.kept:
         lines.append(f"showing {n_held} of {keeper.kept:,}"
