@@ -218,3 +218,25 @@ def test_sweep_result_carries_the_loads_as_columns() -> None:
         assert cols["B_on_rocker_fx"][i] == pytest.approx(b.fx, rel=1e-9, abs=1e-9)
     with pytest.raises(ValueError):
         sweep_mechanism(m, values).force_columns()
+
+
+def test_sweep_loads_table_has_every_pin_force_in_every_format(tmp_path, capsys) -> None:
+    """The sweep's loads table (json here; csv, parquet and xlsx share its columns) gives
+    each pin's force on its link, equal to linkage.forces at that position."""
+    import json
+
+    from linkage.kinematics.forces import forces_at
+
+    code = run_cli(["sweep", str(LOADED), "--step", "60", "--speed", "10", "-f", "json"])
+    assert code == 0
+    table = next(t for t in json.loads(capsys.readouterr().out)["tables"] if t["name"] == "loads")
+    cols = table["columns"]
+    assert table["units"][cols.index("B_on_rocker_fx")] == "N"
+    m = load(LOADED)
+    r = sweep_mechanism(m, [row[0] for row in table["rows"]])
+    for row, pos in zip(table["rows"], r.positions):
+        q = [math.radians(pos.solution[u.name]) for u in m.unknowns]
+        f = forces_at(m, q, speed=10.0, driver=math.radians(pos.input))
+        for p in f.pins:
+            assert row[cols.index(f"{p.joint}_on_{p.on}_fx")] == pytest.approx(p.fx, rel=1e-9, abs=1e-9)
+            assert row[cols.index(f"{p.joint}_on_{p.on}_fy")] == pytest.approx(p.fy, rel=1e-9, abs=1e-9)

@@ -9,17 +9,22 @@ def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Opt
                 accel: Optional[float], digits: int, plot: Optional[Path]) -> Any:
     """The sweep's report with a ``loads`` table (and its summary lines) added; ``plot``:
     the input torque over the sweep, peak marked."""
-    from ..kinematics.forces import sweep_force_rows
+    from ..kinematics.forces import with_forces
     from ..render.data import Report
     from ..render.forces import sweep_force_table, torque_plot
     from ..render.report import Text, fmt, table
 
     angle = mechanism.driver.kind == "angle"
-    rows = sweep_force_rows(mechanism, result, loads, speed or 0.0, accel or 0.0)
+    cols = with_forces(mechanism, result, loads, speed, accel or 0.0).force_columns()
+    keys = list(cols)
+    pins = keys[keys.index("condition") + 1:]  # each pin force's x and y, after the summary columns
+    rows = list(zip([p.input for p in result.positions], cols["status"], cols["input"], cols["max_pin_force"],
+                    cols["ground_fx"], cols["ground_fy"], cols["ground_moment"], cols["condition"],
+                    *(cols[k] for k in pins)))
     unit_in = "N" if mechanism.extra.get("drawing_driver", {}).get("slider") else "N m"
     unit = "deg" if angle else mechanism.length_unit
     name = mechanism.driver.name
-    loads_table = sweep_force_table(rows, name, unit, unit_in)
+    loads_table = sweep_force_table(rows, name, unit, unit_in, pins)
     (at_in, at_pin), flagged = peaks_of(rows)
     lines = [Text(""), Text("loads over the sweep (matrix method, SI units)", "bold")]
     if at_in >= 0:

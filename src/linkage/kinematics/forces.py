@@ -670,19 +670,3 @@ def with_forces(mechanism: Any, result: Any, loads: Loads, speed: float | None, 
     from dataclasses import replace
 
     return replace(result, forces=tuple(sweep_forces(mechanism, result, loads, speed or 0.0, accel)))
-
-
-def sweep_force_rows(mechanism: Any, result: Any, loads: Loads, speed: float, accel: float
-                     ) -> list[tuple[Any, ...]]:
-    """The loads table's rows: driver value, status, input, largest pin force, the ground's
-    force and moment, the condition number (None where there is no number)."""
-    rows: list[tuple[Any, ...]] = []
-    for pos, f in zip(result.positions, sweep_forces(mechanism, result, loads, speed, accel)):
-        if f is None:
-            rows.append((pos.input, "unsolved", None, None, None, None, None, None))
-        elif f.status == "undefined":
-            rows.append((pos.input, f.status, None, None, None, None, None, f.condition))
-        else:
-            rows.append((pos.input, f.status, f.input, f.max_pin_force, f.ground_force[0], f.ground_force[1],
-                         f.ground_moment, f.condition))
-    return rows
