@@ -18,7 +18,7 @@ def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Opt
     cols = with_forces(mechanism, result, loads, speed, accel or 0.0).force_columns()
     keys = list(cols)
     pins = keys[keys.index("condition") + 1:]  # each pin force's x and y, after the summary columns
-    rows = list(zip([p.input for p in result.positions], cols["status"], cols["input"], cols["max_pin_force"],
+    rows = list(zip(result.inputs, cols["status"], cols["input"], cols["max_pin_force"],
                     cols["ground_fx"], cols["ground_fy"], cols["ground_moment"], cols["condition"],
                     *(cols[k] for k in pins)))
     unit_in = "N" if mechanism.extra.get("drawing_driver", {}).get("slider") else "N m"

@@ -48,6 +48,13 @@ class SweepResult:
     """With loads (``sweep(..., loads=...)``): each position's
     :class:`~linkage.kinematics.forces.Forces`, None where unsolved."""
 
+    @property
+    def inputs(self) -> list[float]:
+        """Every position's driver value, without building the positions (a batch sweep
+        builds each one read, its rates with it)."""
+        batch = getattr(self.positions, "batch", None)
+        return [float(v) for v in batch.values] if batch is not None else [p.input for p in self.positions]
+
     def force_columns(self) -> dict[str, list[Any]]:
         """The loads as columns, one entry per position (SI units; None where there is no
         number): status, input (N m, or N for a sliding driver), virtual_power_input,
