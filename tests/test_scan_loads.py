@@ -17,7 +17,7 @@ from linkage.kinematics.forces import FORCE_STATUSES, batch_forces, force_peaks,
 from linkage.kinematics.rates import place_motion_np, rates_at, solve_rates_np
 from linkage.kinematics.sweep import sweep_mechanism
 from linkage.problems.loads import Loads
-from linkage.problems.loops import LoopModel, load
+from linkage.problems.loops import LoopModel, from_text, load
 from linkage.scan import scan
 from test_forces import _loads_for  # the same random loads as the one-at-a-time tests
 
@@ -240,3 +240,80 @@ def test_sweep_loads_table_has_every_pin_force_in_every_format(tmp_path, capsys)
         for p in f.pins:
             assert row[cols.index(f"{p.joint}_on_{p.on}_fx")] == pytest.approx(p.fx, rel=1e-9, abs=1e-9)
             assert row[cols.index(f"{p.joint}_on_{p.on}_fy")] == pytest.approx(p.fy, rel=1e-9, abs=1e-9)
+
+
+@pytest.mark.parametrize("unit", ["m", "ft", "in", "cm"])
+def test_near_toggle_does_not_depend_on_the_length_unit(unit: str) -> None:
+    """The same numbers in another unit are the same mechanism at another size: a pure
+    torque load needs the same input torque, and the same positions are near a toggle
+    (the force matrix is judged in the mechanism's own size). Found by the second reading:
+    in m every position of the crank-rocker was flagged, in mm none."""
+    text = (ROOT / "sample_inputs" / "crank_rocker_joints.toml").read_text()
+    loads = Loads({}, {"rocker": -2.0}, {}, None)
+    values = [float(v) for v in np.arange(0.0, 360.0, 0.5)]
+    ref = load(ROOT / "sample_inputs" / "crank_rocker_joints.toml")
+    other = from_text(text.replace('length_unit = "mm"', f'length_unit = "{unit}"'), f"in {unit}")
+    for coupler in (120.0, 70.0):  # a full turn, and one stopped by limit positions
+        a = sweep_mechanism(ref.with_values({"coupler": coupler}, {}), values, loads=loads).force_columns()
+        b = sweep_mechanism(other.with_values({"coupler": coupler}, {}), values, loads=loads).force_columns()
+        assert a["status"] == b["status"]
+        assert "ok" in a["status"]
+        for x, y, s in zip(a["input"], b["input"], a["status"]):
+            if s == "ok":
+                assert y == pytest.approx(x, rel=1e-9)
+        m_a = scan(ref, {"coupler": (coupler, coupler + 1.0, 2)}, values=values, loads=loads)
+        m_b = scan(other, {"coupler": (coupler, coupler + 1.0, 2)}, values=values, loads=loads)
+        assert list(m_a["forces_flagged"]) == list(m_b["forces_flagged"])
+        np.testing.assert_allclose(m_b["peak_input"], m_a["peak_input"], rtol=1e-9)
+
+
+def test_python_loads_are_checked_as_a_files_are() -> None:
+    """linkage.sweep, scan_designs and forces take a Loads checked by the file's one
+    definition (problems.loads.parse_loads): one InputError naming it, never a KeyError,
+    a numpy error or a silent NaN."""
+    from linkage.errors import InputError
+    from linkage.kinematics.forces import forces_at
+    from linkage.problems.loads import Mass
+
+    m = load(ROOT / "sample_inputs" / "crank_rocker_joints.toml")
+    q = [u.value for u in m.unknowns]
+    bad = [Loads({}, {"nosuch": 1.0}), Loads({}, {"rocker": "x"}), Loads({"B": (math.nan, 0.0)}),
+           Loads({}, {}, {"rocker": Mass(-1.0, (0.0, 0.0), 0.0)}), Loads({"O2": (1.0, 0.0)}),
+           Loads(gravity=(0.0, math.nan)), Loads(masses={"rocker": 3}), Loads({"B": (1e300, 0.0)}),
+           Loads(forces=[("B", (1.0, 0.0))])]
+    for loads in bad:
+        with pytest.raises(InputError, match=r"^loads"):
+            sweep_mechanism(m, [0.0, 10.0], loads=loads)
+        with pytest.raises(InputError, match=r"^loads"):
+            scan(m, {"coupler": (110.0, 120.0, 2)}, values=[0.0], loads=loads)
+        with pytest.raises(InputError, match=r"^loads"):
+            forces_at(m, q, loads)
+
+
+def test_a_mass_keeps_its_links_drawn_shape_however_the_length_changes(capsys) -> None:
+    """--set, with_values and --vary alike: a link whose mass (cg, inertia) is given for
+    its drawn lengths cannot take other lengths; other links can."""
+    from linkage.errors import InputError
+
+    for args in (["scan", str(LOADED), "--set", "coupler=130", "--vary", "O4.x=95:105:3"],
+                 ["solve", str(LOADED), "--set", "coupler=130"],
+                 ["sweep", str(LOADED), "--set", "rocker=85", "--step", "90"],
+                 ["scan", str(LOADED), "--vary", "coupler_A_P=50:70:3"]):
+        code = run_cli(args)
+        err = capsys.readouterr().err
+        assert code == 2 and "[mass]" in err and len(err.strip().splitlines()) == 1, (args, err)
+    m = load(LOADED)
+    with pytest.raises(InputError, match="coupler = 130"):
+        sweep_mechanism(m.with_values({"coupler": 130.0}, {}), [0.0], loads=m.extra["loads"])
+    assert run_cli(["solve", str(LOADED), "--set", "crank=42"]) == 0  # the crank carries no mass
+    capsys.readouterr()
+
+
+def test_loads_need_a_known_length_unit(tmp_path, capsys) -> None:
+    path = tmp_path / "furlong.toml"
+    path.write_text(LOADED.read_text().replace('length_unit = "mm"', 'length_unit = "furlong"'))
+    for args in (["scan", str(path), "--vary", "O4.x=95:105:3"], ["solve", str(path)],
+                 ["sweep", str(path), "--step", "90"]):
+        code = run_cli(args)
+        err = capsys.readouterr().err
+        assert code == 2 and "length_unit 'furlong'" in err and len(err.strip().splitlines()) == 1

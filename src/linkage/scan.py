@@ -756,17 +756,10 @@ class ScanSetup:
 def check_loads(m: Mechanism, names: Sequence[str], loads: Any) -> None:
     """A scan with loads needs links as bodies (the joints form), and a link with a mass
     keeps its drawn shape: its cg and inertia are given for the lengths drawn, so a scan
-    varying them would keep a mass where the link no longer is."""
+    varying them (or a --set) would keep a mass where the link no longer is."""
     from .kinematics.forces import Frame
 
-    frame = Frame.of(m)
-    for b in loads.masses:
-        own = [n for n in names if n in m.parameters and (n == b or n.startswith(f"{b}_"))
-               and b in frame.drawing.bodies and b != "ground"]
-        if own:
-            raise InputError(f"--vary {own[0]} changes the shape of {b}, which has a [mass] given for its "
-                             f"drawn lengths (cg, inertia); scan {b}'s lengths without its mass, or "
-                             "vary other links")
+    Frame.of(m).check_masses(loads, names)
 
 
 def prepare(m: Mechanism, varies: Sequence[Vary], *, samples: int | None, seed: int, sampling: str,
@@ -860,13 +853,14 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
     if not values:
         # a fraction of no positions is no fraction: feasible_fraction would read 0
         raise InputError("values must hold at least one driver value")
-    from .problems.loads import Loads
+    from .kinematics.forces import checked_loads
 
-    if loads is not None and not isinstance(loads, Loads):
-        raise InputError(f"loads: give a linkage.Loads, got {type(loads).__name__}")
     speed, accel = check_motion(speed, accel, m.driver.kind, m.length_unit)
-    own = loads if loads is not None else m.extra.get("loads")
+    own = checked_loads(loads, m) if loads is not None else m.extra.get("loads")
     used = own if own is not None and (not own.empty or own.gravity is not None) else None
+    if used is None and speed is not None:
+        raise InputError("speed in a scan is for the loads' inertia: give loads (a linkage.Loads, or "
+                         "[loads] and [mass] in a joints-form file)")
     setup = prepare(m, varies, samples=samples, seed=seed, sampling=sampling, values=list(values),
                     branch=branch, tol=tol, where=where, sort=sort, doc=doc, loads=used)
     check_held(setup.plan.total, len(setup.spec), top, "a scan returned as columns", "top")

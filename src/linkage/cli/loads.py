@@ -17,7 +17,7 @@ def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Opt
     angle = mechanism.driver.kind == "angle"
     cols = with_forces(mechanism, result, loads, speed, accel or 0.0).force_columns()
     keys = list(cols)
-    pins = keys[keys.index("condition") + 1:]  # each pin force's x and y, after the summary columns
+    pins = keys[keys.index("condition") + 1:]  # each pin's and slider's forces, after the summary
     rows = list(zip(result.inputs, cols["status"], cols["input"], cols["max_pin_force"],
                     cols["ground_fx"], cols["ground_fy"], cols["ground_moment"], cols["condition"],
                     *(cols[k] for k in pins)))

@@ -130,7 +130,11 @@ def scan(
     loads = command_loads(mechanism, force or [], torque or [], gravity)
     used = loads if not loads.empty or loads.gravity is not None else None
     if used is None and speed is not None:
-        raise InputError("--speed in a scan moves the loads' masses: give loads ([loads] or [mass] in "
+        if mechanism.extra.get("drawing") is None:
+            from ..kinematics.forces import Frame
+
+            Frame.of(mechanism)  # says why: loads need the joints form
+        raise InputError("--speed in a scan is for the loads' inertia: give loads ([loads] or [mass] in "
                          "the file, or --load/--torque)")
     a, b = driver_span(mechanism, start, stop, turn_end=359.0)
     if desc and sort is None:

@@ -157,6 +157,12 @@ class Frame:
     driver_link: str | None
     driver_slider: str | None
     length_unit: str
+    size: float = 1.0
+    """The mechanism's length scale in m: the force matrix's moment rows and torque
+    columns are scaled by it, so its condition number does not depend on the unit."""
+    reshaped: tuple[tuple[str, str, float, float], ...] = ()
+    """(body, length, value, drawn value) for each moving body's length that is not the
+    drawing's (a --set or with_values): a mass given for the drawn shape cannot ride on it."""
 
     @classmethod
     def of(cls, mechanism: Any) -> Frame:
@@ -166,8 +172,104 @@ class Frame:
                 f"{mechanism.source}: loads need links as bodies: give the mechanism in the "
                 "joints form (linkage convert --form joints FILE writes it)"
             )
+        from ..problems.loops import LENGTH_UNITS
+
+        unit = mechanism.length_unit
+        if unit not in LENGTH_UNITS:
+            raise InputError(f"{mechanism.source}: length_unit {unit!r}: loads are in SI, so the lengths "
+                             f"need a known unit: {', '.join(LENGTH_UNITS)}")
         doc = mechanism.extra.get("drawing_driver", {})
-        return cls(drawing, doc.get("link"), doc.get("slider"), mechanism.length_unit)
+        reshaped = []
+        for name, (body, drawn) in drawn_lengths(drawing).items():
+            q = mechanism.parameters.get(name)
+            if q is not None and not abs(q.value - drawn) <= 1e-9 * max(abs(drawn), 1e-300):
+                reshaped.append((body, name, q.value, drawn))
+        return cls(drawing, doc.get("link"), doc.get("slider"), unit, force_size(mechanism), tuple(reshaped))
+
+    def check_masses(self, loads: Loads, varied: Sequence[str] = ()) -> None:
+        """A mass is given for its link's drawn shape (cg in the drawn pose, inertia): refuse
+        loads whose massive link has other lengths here (``varied``: lengths a scan varies)."""
+        owner = {name: body for name, (body, _) in drawn_lengths(self.drawing).items()}
+        for name in varied:
+            if owner.get(name) in loads.masses:
+                body = owner[name]
+                raise InputError(f"--vary {name} changes the shape of {body}, which has a [mass] given for "
+                                 f"its drawn lengths (cg, inertia); scan {body}'s lengths without its mass, "
+                                 "or vary other links")
+        for body, name, value, drawn in self.reshaped:
+            if body in loads.masses:
+                raise InputError(f"{name} = {value:.10g} here, {drawn:.10g} as drawn: {body} has a [mass] "
+                                 "given for its drawn lengths (cg, inertia); draw the link at its new "
+                                 "lengths, or drop its mass")
+
+
+def force_size(mechanism: Any, values: Mapping[str, Any] | None = None) -> Any:
+    """The size the force matrix is scaled by (m): the longest length parameter, from
+    ``values`` (file units, arrays over positions: a scan's designs) where they give it.
+    Not the driver's value: a sliding driver's position must not change the scale."""
+    import numpy as np
+
+    size: Any = 0.0
+    for name, q in mechanism.parameters.items():
+        if q.kind == "length":
+            size = np.maximum(size, np.abs((values or {}).get(name, q.value)))
+    size = np.where(np.isfinite(size) & (size > 0.0), size, 1.0) * metre(mechanism.length_unit)
+    return float(size) if np.ndim(size) == 0 else size
+
+
+def drawn_lengths(drawing: Any) -> dict[str, tuple[str, float]]:
+    """Each moving body's length parameter as the joints form derives it (problems.joints:
+    ``<link>`` for its first two joints, ``<link>_<P>_<Q>`` for the others, from its first
+    joint), with its body and its drawn value (the file's unit)."""
+    out: dict[str, tuple[str, float]] = {}
+    for b, js in drawing.bodies.items():
+        if b == "ground" or all(j in drawing.points for j in js):
+            continue
+        c = drawing.center(b)
+        for j in js:
+            if j != c:
+                name = b if (c, j) == tuple(js[:2]) else f"{b}_{c}_{j}"
+                out[name] = (b, math.dist(drawing.xy[c], drawing.xy[j]))
+    return out
+
+
+def checked_loads(loads: Any, mechanism: Any) -> Loads:
+    """A :class:`Loads` from Python checked as a file's are, by the file's one definition
+    (problems.loads.parse_loads: names, shapes, finite values, units) and its gravity as
+    the command line's; an InputError naming ``loads`` otherwise."""
+    from ..problems.loads import Mass
+
+    if not isinstance(loads, Loads):
+        raise InputError(f"loads: give a linkage.Loads, got {type(loads).__name__}")
+    frame = Frame.of(mechanism)
+    for field in ("forces", "torques", "masses"):
+        if not isinstance(getattr(loads, field), Mapping):
+            raise InputError(f"loads: {field} must be a dict, got {type(getattr(loads, field)).__name__}")
+    table: dict[Any, Any] = {}
+    for k, f in loads.forces.items():
+        table[k] = {"force": list(f) if isinstance(f, (tuple, list)) else f}
+    for k, t in loads.torques.items():
+        if k in table:
+            raise InputError(f"loads: {k!r} has a force and a torque: a name is a joint or a link")
+        table[k] = {"torque": t}
+    masses: dict[Any, Any] = {}
+    for k, mm in loads.masses.items():
+        if not isinstance(mm, Mass):
+            raise InputError(f"loads: masses[{k!r}]: give a linkage.Mass, got {type(mm).__name__}")
+        masses[k] = {"mass": mm.mass, "cg": list(mm.cg) if isinstance(mm.cg, (tuple, list)) else mm.cg,
+                     "inertia": mm.inertia}
+    parsed = parse_loads({"loads": table, "mass": masses}, frame.drawing, "loads")
+    g = loads.gravity
+    if g is not None:
+        ok = isinstance(g, (tuple, list)) and len(g) == 2 and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and abs(v) <= 1e6
+            for v in g)
+        if not ok:
+            raise InputError(f"loads: gravity {g!r}: give (gx, gy) in m/s^2, finite, within 1e6")
+        g = (float(g[0]), float(g[1]))
+    out = Loads(parsed.forces, parsed.torques, parsed.masses, g)
+    frame.check_masses(out)
+    return out
 
 
 def _body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], acc: Mapping[str, Any]
@@ -340,11 +442,20 @@ def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[s
         known(b, cg, (-mass.mass * ag[0], -mass.mass * ag[1]), -mass.inertia * al, vg)
         if g is not None:
             known(b, cg, (mass.mass * g[0], mass.mass * g[1]), 0.0, vg)
+    # in the mechanism's own size: moments per metre of it, torques as forces at that arm, so
+    # the condition number (the near-toggle test) is the same in mm, in m or in miles
+    size = np.broadcast_to(np.asarray(frame.size, dtype=float), (n_pos,))[:, None]
+    couples = [i for i, (kind, _) in enumerate(cols)
+               if kind == "slider_m" or (kind == "input" and frame.driver_slider is None)]
+    a[:, 2::3, :] /= size[:, :, None]
+    rhs[:, 2::3] /= size
+    a[:, :, couples] *= size[:, :, None]
     cond, inv = condition_np(a)
     good = np.isfinite(cond) & (cond * EPS < 0.5)
     x = np.full((n_pos, n_un), np.nan)
     if good.any():
         x[good] = np.einsum("pij,pj->pi", inv[good], rhs[good])
+    x[:, couples] *= size
     # the unit driver speed's own size: rad/s, or the length unit per second in m/s
     vp = -power / (1.0 if frame.driver_slider is None else k)
     pins, sliders = [], []
@@ -417,12 +528,13 @@ def forces_at(
     if not hasattr(mechanism, "extra") or not hasattr(mechanism, "unknowns"):
         raise InputError("mechanism: give a Mechanism (linkage.load_mechanism), got "
                          f"{type(mechanism).__name__}")
-    if loads is not None and not isinstance(loads, Loads):
-        raise InputError(f"loads: give a linkage.Loads, got {type(loads).__name__}")
     speed, accel = check_number("speed", speed), check_number("accel", accel)
     frame = Frame.of(mechanism)
     if loads is None:
         loads = mechanism.extra.get("loads") or Loads()
+        frame.check_masses(loads)
+    else:
+        loads = checked_loads(loads, mechanism)
     actual = rates_at(mechanism, q, speed=speed, accel=accel, driver=driver)
     # the virtual velocities: a unit driver speed's
     unit = per_unit_speed(actual, speed) or rates_at(mechanism, q, speed=1.0, accel=0.0, driver=driver)
@@ -597,6 +709,10 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
     vel = xy(moving, 1, k) if (speed or accel) else {j: (zero, zero) for j in pos}
     acc = xy(moving, 2, k) if (speed or accel) else {j: (zero, zero) for j in pos}
     vstar = xy(unit, 1, k)
+    if sub:  # each design at its own size, as it is judged on its own
+        from dataclasses import replace
+
+        frame = replace(frame, size=np.broadcast_to(force_size(mechanism, sub), ds.shape))
     fa = solve_loads(frame, pos, vel, acc, vstar, loads, mechanism.source)
     got = np.where(ok, fa.input, np.nan)
     status[rows] = force_status_np(got, fa.condition, matrix_bound(fa.condition), ok)
@@ -619,6 +735,7 @@ def sweep_forces(mechanism: Any, result: Any, loads: Loads, speed: float, accel:
     from .rates import rates_at
 
     frame = Frame.of(mechanism)
+    frame.check_masses(loads)
     angle = mechanism.driver.kind == "angle"
     k = metre(frame.length_unit)
     kept: list[tuple[int, Any, Any]] = []
@@ -656,13 +773,6 @@ def sweep_forces(mechanism: Any, result: Any, loads: Loads, speed: float, accel:
     for n, (i, actual, unit) in enumerate(kept):
         out[i] = position_forces(fa, n, unit, actual.status, loads)
     return out
-
-
-def check_loads_argument(mechanism: Any, loads: Any) -> None:
-    """The Python API's ``loads``: a Loads, on a joints-form mechanism (else InputError)."""
-    if not isinstance(loads, Loads):
-        raise InputError(f"loads: give a linkage.Loads, got {type(loads).__name__}")
-    Frame.of(mechanism)  # says why not: loads need the joints form
 
 
 def with_forces(mechanism: Any, result: Any, loads: Loads, speed: float | None, accel: float) -> Any:

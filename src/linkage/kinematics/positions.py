@@ -58,16 +58,19 @@ class SweepResult:
     def force_columns(self) -> dict[str, list[Any]]:
         """The loads as columns, one entry per position (SI units; None where there is no
         number): status, input (N m, or N for a sliding driver), virtual_power_input,
-        max_pin_force, ground_fx, ground_fy, ground_moment, condition, and each pin force as
-        ``<joint>_on_<link>_fx`` and ``_fy``. A flagged position (near_toggle,
+        max_pin_force, ground_fx, ground_fy, ground_moment, condition, each pin force as
+        ``<joint>_on_<link>_fx`` and ``_fy``, and each slider's ``<slider>_normal`` (N, on the
+        slider along its line's left normal) and ``_couple`` (N m). A flagged position (near_toggle,
         ill_conditioned) keeps its numbers beside its status; read the status first."""
         if self.forces is None:
             raise ValueError("this sweep has no loads: sweep(..., loads=...)")
         keys = ("input", "virtual_power_input", "max_pin_force", "ground_fx", "ground_fy", "ground_moment",
                 "condition")
         out: dict[str, list[Any]] = {"status": [], **{k: [] for k in keys}}
-        pins = dict.fromkeys(f"{p.joint}_on_{p.on}_{c}" for f in self.forces if f is not None
-                             for p in f.pins for c in ("fx", "fy"))
+        pins = dict.fromkeys([f"{p.joint}_on_{p.on}_{c}" for f in self.forces if f is not None
+                              for p in f.pins for c in ("fx", "fy")]
+                             + [f"{s.slider}_{c}" for f in self.forces if f is not None
+                                for s in f.sliders for c in ("normal", "couple")])
         out.update({k: [] for k in pins})
         for f in self.forces:
             number = f is not None and f.status != "undefined"
@@ -78,6 +81,9 @@ class SweepResult:
                 out[k].append(v)
             have = {f"{p.joint}_on_{p.on}_{c}": v for p in f.pins for c, v in (("fx", p.fx), ("fy", p.fy))
                     } if number else {}
+            if number:
+                have.update({f"{s.slider}_{c}": v for s in f.sliders
+                             for c, v in (("normal", s.normal), ("couple", s.couple))})
             for k in pins:
                 out[k].append(have.get(k))
         return out

@@ -66,9 +66,10 @@ def sweep_mechanism(
     :class:`~linkage.errors.InputError` naming the argument.
 
     ``loads``: a :class:`~linkage.Loads` (a joints-form mechanism; its own are
-    ``mechanism.extra["loads"]``): every solved position's forces by the matrix method at
-    the driver's ``speed`` and ``accel`` (static without them), as ``result.forces`` (a
-    :class:`~linkage.Forces` or None per position) and ``result.force_columns()``.
+    ``mechanism.extra["loads"]``, which a Loads given replaces): every solved position's
+    forces by the matrix method at the driver's ``speed`` and ``accel`` (static without
+    them), as ``result.forces`` (a :class:`~linkage.Forces` or None per position) and
+    ``result.force_columns()``.
     """
     from ..arguments import check_callable, check_flag, check_motion, check_reals, check_text
     from ..errors import InputError
@@ -88,9 +89,9 @@ def sweep_mechanism(
     if method not in ("newton", "newton-fd", "lm"):
         raise InputError(f"unknown method {method!r}; choose from newton, newton-fd, lm")
     if loads is not None:  # the sweep, then its forces (kinematics.forces)
-        from .forces import check_loads_argument, with_forces
+        from .forces import checked_loads, with_forces
 
-        check_loads_argument(m, loads)
+        loads = checked_loads(loads, m)
         return with_forces(m, sweep_mechanism(m, values, branch=branch, method=method, tol=tol,
                                               max_iter=max_iter, batch=batch, progress=progress,
                                               speed=speed, accel=accel, joints=joints), loads, speed, accel)

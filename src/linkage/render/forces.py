@@ -188,13 +188,14 @@ def force_document(f: Any) -> dict[str, Any]:
 def sweep_force_table(rows: list[tuple[Any, ...]], driver: str, driver_unit: str, input_unit: str,
                       pins: Any = ()) -> Any:
     """The sweep's ``loads`` table: per position the status, the input, the largest pin
-    force, the ground's force and moment, the condition number, and each pin force's x and
-    y (``<joint>_on_<link>_fx``: on that link, SI units)."""
+    force, the ground's force and moment, the condition number, each pin force's x and y
+    (``<joint>_on_<link>_fx``: on that link) and each slider's normal force and couple (SI)."""
     return from_rows("loads", [(driver, driver_unit, "number"), ("forces_status", "", "text"),
                                ("input", input_unit, "number"), ("max_pin_force", "N", "number"),
                                ("ground_fx", "N", "number"), ("ground_fy", "N", "number"),
                                ("ground_moment", "N m", "number"), ("condition", "", "number"),
-                               *((k, "N", "number") for k in pins)], rows)
+                               *((k, "N m" if k.endswith("_couple") else "N", "number") for k in pins)],
+                     rows)
 
 
 def torque_plot(rows: list[tuple[Any, ...]], driver: str, driver_unit: str, input_unit: str, path: Any,
