@@ -317,3 +317,33 @@ def test_loads_need_a_known_length_unit(tmp_path, capsys) -> None:
         code = run_cli(args)
         err = capsys.readouterr().err
         assert code == 2 and "length_unit 'furlong'" in err and len(err.strip().splitlines()) == 1
+
+
+def test_mechanical_advantage_is_one_number_of_one_kind(capsys) -> None:
+    """Torque over torque for a turning driver, force over force for a sliding one (the
+    force form), equal to the velocity ratio where the load acts along the motion; never a
+    ratio with a unit (a sliding driver against a torque load), never with masses."""
+    from linkage.kinematics.forces import forces_at
+    from linkage.kinematics.rates import rates_at
+    from linkage.problems.loads import Mass
+
+    text = (ROOT / "sample_inputs" / "slider_crank_joints.toml").read_text()
+    text = text.replace('link = "crank"', 'slider = "block"')
+    text = text.replace("value = 45 ", "value = 146.88311367414514 ")
+    m = from_text(text, "sliding driver")
+    assert m.extra["drawing_driver"]["slider"] == "block"
+    q = [u.value for u in m.unknowns]
+    v = rates_at(m, q, speed=1.0).joint_velocities["A"]  # mm/s per mm/s of the block
+    along = (v[0] / math.hypot(*v) * 10.0, v[1] / math.hypot(*v) * 10.0)  # 10 N along A's motion
+    f = forces_at(m, q, Loads({"A": along}))
+    assert f.input_unit == "N"
+    assert f.mechanical_advantage == pytest.approx(1.0 / math.hypot(*v), rel=1e-9)  # v_in / v_out
+    assert forces_at(m, q, Loads({}, {"coupler": 1.0})).mechanical_advantage is None
+    crank = load(ROOT / "sample_inputs" / "crank_rocker_joints.toml")
+    cq = [u.value for u in crank.unknowns]
+    assert forces_at(crank, cq, Loads({}, {"rocker": -2.0})).mechanical_advantage == pytest.approx(
+        1.0 / abs(rates_at(crank, cq, speed=1.0).velocities["theta_rocker"]), rel=1e-9)
+    with_mass = Loads({}, {"rocker": -2.0}, {"rocker": Mass(1.0, (120.0, 30.0), 1e-3)}, (0.0, -9.81))
+    assert forces_at(crank, cq, with_mass).mechanical_advantage is None
+    r = sweep_mechanism(crank, [0.0, 90.0], loads=Loads({}, {"rocker": -2.0}))
+    assert all(isinstance(x, float) for x in r.force_columns()["mechanical_advantage"])

@@ -20,7 +20,7 @@ def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Opt
     pins = keys[keys.index("condition") + 1:]  # each pin's and slider's forces, after the summary
     rows = list(zip(result.inputs, cols["status"], cols["input"], cols["max_pin_force"],
                     cols["ground_fx"], cols["ground_fy"], cols["ground_moment"], cols["condition"],
-                    *(cols[k] for k in pins)))
+                    cols["mechanical_advantage"], *(cols[k] for k in pins)))
     unit_in = "N" if mechanism.extra.get("drawing_driver", {}).get("slider") else "N m"
     unit = "deg" if angle else mechanism.length_unit
     name = mechanism.driver.name

@@ -89,7 +89,8 @@ class Forces:
     bound: float | None = None
     """An error bound on every force (relative to the largest), where defined."""
     mechanical_advantage: float | None = None
-    """|output load torque / input torque| for a single torque load, else None."""
+    """Output over input, where it is one number of one kind (:func:`mechanical_advantage`),
+    else None."""
     applied: tuple[float, float, float] | None = None
     """The known loads' total (external, gravity and inertia): force x, y (N) and moment
     about the origin (N m). In equilibrium the ground carries exactly this."""
@@ -620,6 +621,20 @@ def force_peaks(status: Any, *columns: Any) -> tuple[list[Any], Any]:
     return at, ((status > 0) & (status < len(FORCE_STATUSES))).sum(axis=1)
 
 
+def mechanical_advantage(loads: Loads, inp: float, input_unit: str) -> float | None:
+    """The one rule: |output torque / input torque| for a turning driver with a single torque
+    load, |output force| / |input force| for a sliding driver with a single force load (its
+    force form); None with masses, with loads of both kinds or of the other kind (a ratio
+    with a unit), or where the input is zero."""
+    if loads.masses or not inp:
+        return None
+    if input_unit == "N m" and len(loads.torques) == 1 and not loads.forces:
+        return abs(next(iter(loads.torques.values())) / inp)
+    if input_unit == "N" and len(loads.forces) == 1 and not loads.torques:
+        return math.hypot(*next(iter(loads.forces.values()))) / abs(inp)
+    return None
+
+
 def position_forces(fa: ForceArrays, i: int, unit: Any, kinematics_status: str, loads: Loads) -> Forces:
     """Position ``i`` of :func:`solve_loads`' answer as a :class:`Forces`, flagged: its error
     bound from the condition number and from the kinematics' own bounds (the unit-speed
@@ -634,9 +649,7 @@ def position_forces(fa: ForceArrays, i: int, unit: Any, kinematics_status: str, 
     if vmax > 0.0 and unit.joint_velocity_bounds:
         bound = max(bound, max(unit.joint_velocity_bounds.values()) / vmax)
     status = force_status(cond, bound, kinematics_status == "ok" and unit.status == "ok")
-    ma = None
-    if len(loads.torques) == 1 and not loads.forces and not loads.masses and inp != 0.0:
-        ma = abs(next(iter(loads.torques.values())) / inp)
+    ma = mechanical_advantage(loads, inp, fa.input_unit)
     pins = tuple(PinForce(j, on, by, float(fx[i]), float(fy[i])) for j, on, by, fx, fy in fa.pins)
     sliders = tuple(SliderForce(s, on, float(nn[i]), float(mm[i])) for s, on, nn, mm in fa.sliders)
     gx, gy, gm = (float(v[i]) for v in fa.ground)

@@ -58,14 +58,15 @@ class SweepResult:
     def force_columns(self) -> dict[str, list[Any]]:
         """The loads as columns, one entry per position (SI units; None where there is no
         number): status, input (N m, or N for a sliding driver), virtual_power_input,
-        max_pin_force, ground_fx, ground_fy, ground_moment, condition, each pin force as
+        max_pin_force, ground_fx, ground_fy, ground_moment, mechanical_advantage (None where
+        it is not one number: kinematics.forces.mechanical_advantage), condition, each pin force as
         ``<joint>_on_<link>_fx`` and ``_fy``, and each slider's ``<slider>_normal`` (N, on the
         slider along its line's left normal) and ``_couple`` (N m). A flagged position (near_toggle,
         ill_conditioned) keeps its numbers beside its status; read the status first."""
         if self.forces is None:
             raise ValueError("this sweep has no loads: sweep(..., loads=...)")
         keys = ("input", "virtual_power_input", "max_pin_force", "ground_fx", "ground_fy", "ground_moment",
-                "condition")
+                "mechanical_advantage", "condition")
         out: dict[str, list[Any]] = {"status": [], **{k: [] for k in keys}}
         pins = dict.fromkeys([f"{p.joint}_on_{p.on}_{c}" for f in self.forces if f is not None
                               for p in f.pins for c in ("fx", "fy")]
@@ -76,7 +77,7 @@ class SweepResult:
             number = f is not None and f.status != "undefined"
             out["status"].append("unsolved" if f is None else f.status)
             vals = (f.input, f.virtual_power_input, f.max_pin_force, *f.ground_force, f.ground_moment,
-                    f.condition) if number else (None,) * len(keys)
+                    f.mechanical_advantage, f.condition) if number else (None,) * len(keys)
             for k, v in zip(keys, vals):
                 out[k].append(v)
             have = {f"{p.joint}_on_{p.on}_{c}": v for p in f.pins for c, v in (("fx", p.fx), ("fy", p.fy))

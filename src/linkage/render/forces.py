@@ -152,8 +152,10 @@ def force_blocks(f: Any, digits: int) -> list[Block]:
     if f.mechanical_advantage is not None:
         out.append(
             Text(
-                f"mechanical advantage |output torque / input torque| = "
-                f"{fmt(_shown(f.mechanical_advantage, f, digits), digits)}"
+                "mechanical advantage "
+                + ("|output torque / input torque|" if f.input_unit == "N m"
+                   else "|output force| / |input force|")
+                + f" = {fmt(_shown(f.mechanical_advantage, f, digits), digits)}"
             )
         )
     return out
@@ -194,6 +196,7 @@ def sweep_force_table(rows: list[tuple[Any, ...]], driver: str, driver_unit: str
                                ("input", input_unit, "number"), ("max_pin_force", "N", "number"),
                                ("ground_fx", "N", "number"), ("ground_fy", "N", "number"),
                                ("ground_moment", "N m", "number"), ("condition", "", "number"),
+                               ("mechanical_advantage", "", "number"),
                                *((k, "N m" if k.endswith("_couple") else "N", "number") for k in pins)],
                      rows)
 
