@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from linkage.cli import run_cli
-from linkage.kinematics.forces import FORCE_STATUSES, batch_forces, force_peaks, sweep_forces
+from linkage.kinematics.force_sweeps import batch_forces, sweep_forces
+from linkage.kinematics.forces import FORCE_STATUSES, force_peaks
 from linkage.kinematics.rates import place_motion_np, rates_at, solve_rates_np
 from linkage.kinematics.sweep import sweep_mechanism
 from linkage.problems.loads import Loads

@@ -359,10 +359,11 @@ method in slices of this many numbers."""
 def load_metrics(m: Mechanism, params: Mapping[str, np.ndarray], sol: DesignSolutions, loads: Any,
                  motion: tuple[float, float]) -> dict[str, np.ndarray]:
     """Each design's :data:`~linkage.problems.columns.LOADS` columns: every solved position's
-    forces by :func:`~linkage.kinematics.forces.batch_forces` (the one matrix method), the
+    forces by :func:`~linkage.kinematics.force_sweeps.batch_forces` (the one matrix method), the
     peaks by :func:`~linkage.kinematics.forces.force_peaks` (the one peak rule)."""
     from .kinematics.designs import design_grid
-    from .kinematics.forces import batch_forces, force_peaks
+    from .kinematics.force_sweeps import batch_forces
+    from .kinematics.forces import force_peaks
 
     n_designs, n_pos = sol.status.shape
     grid, drv = design_grid(m, params, sol.values, n_designs)
@@ -757,7 +758,7 @@ def check_loads(m: Mechanism, names: Sequence[str], loads: Any) -> None:
     """A scan with loads needs links as bodies (the joints form), and a link with a mass
     keeps its drawn shape: its cg and inertia are given for the lengths drawn, so a scan
     varying them (or a --set) would keep a mass where the link no longer is."""
-    from .kinematics.forces import Frame
+    from .kinematics.bodies import Frame
 
     Frame.of(m).check_masses(loads, names)
 
@@ -853,7 +854,7 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
     if not values:
         # a fraction of no positions is no fraction: feasible_fraction would read 0
         raise InputError("values must hold at least one driver value")
-    from .kinematics.forces import checked_loads
+    from .kinematics.bodies import checked_loads
 
     speed, accel = check_motion(speed, accel, m.driver.kind, m.length_unit)
     own = checked_loads(loads, m) if loads is not None else m.extra.get("loads")

@@ -9,7 +9,7 @@ def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Opt
                 accel: Optional[float], digits: int, plot: Optional[Path]) -> Any:
     """The sweep's report with a ``loads`` table (and its summary lines) added; ``plot``:
     the input torque over the sweep, peak marked."""
-    from ..kinematics.forces import with_forces
+    from ..kinematics.force_sweeps import with_forces
     from ..render.data import Report
     from ..render.forces import sweep_force_table, torque_plot
     from ..render.report import Text, fmt, table

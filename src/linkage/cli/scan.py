@@ -123,7 +123,7 @@ def scan(
     mechanism = from_text(text, str(file)).with_values(fixed, {})
     note_closed_form(mechanism)
     from ..arguments import parse_motion
-    from ..kinematics.forces import command_loads
+    from ..kinematics.bodies import command_loads
 
     w, a_ = parse_motion(speed, accel, mechanism)
     motion = (w or 0.0, a_)
@@ -131,7 +131,7 @@ def scan(
     used = loads if not loads.empty or loads.gravity is not None else None
     if used is None and speed is not None:
         if mechanism.extra.get("drawing") is None:
-            from ..kinematics.forces import Frame
+            from ..kinematics.bodies import Frame
 
             Frame.of(mechanism)  # says why: loads need the joints form
         raise InputError("--speed in a scan is for the loads' inertia: give loads ([loads] or [mass] in "

@@ -34,7 +34,7 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
     if branch_wanted is not None:
         mechanism = start_on_branch(mechanism, branch_wanted, bool(guess))
     speed, accel = parse_motion(*motion, mechanism)
-    from ..kinematics.forces import command_loads
+    from ..kinematics.bodies import command_loads
 
     loads = command_loads(mechanism, *loads_given)
     problem = mechanism.problem()

@@ -126,7 +126,7 @@ def sweep(
     values = driver_values(a, b, step, points)
     note_closed_form(mechanism)
     w, a_ = parse_motion(speed, accel, mechanism)
-    from ..kinematics.forces import command_loads
+    from ..kinematics.bodies import command_loads
 
     loads = command_loads(mechanism, force or [], torque or [], gravity)
     named = [j for loop in mechanism.loops for j in loop.joints if j] + list(mechanism.points)

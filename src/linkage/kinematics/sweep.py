@@ -89,7 +89,8 @@ def sweep_mechanism(
     if method not in ("newton", "newton-fd", "lm"):
         raise InputError(f"unknown method {method!r}; choose from newton, newton-fd, lm")
     if loads is not None:  # the sweep, then its forces (kinematics.forces)
-        from .forces import checked_loads, with_forces
+        from .bodies import checked_loads
+        from .force_sweeps import with_forces
 
         loads = checked_loads(loads, m)
         return with_forces(m, sweep_mechanism(m, values, branch=branch, method=method, tol=tol,
