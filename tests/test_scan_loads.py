@@ -348,3 +348,26 @@ def test_mechanical_advantage_is_one_number_of_one_kind(capsys) -> None:
     assert forces_at(crank, cq, with_mass).mechanical_advantage is None
     r = sweep_mechanism(crank, [0.0, 90.0], loads=Loads({}, {"rocker": -2.0}))
     assert all(isinstance(x, float) for x in r.force_columns()["mechanical_advantage"])
+
+
+def test_a_loaded_scan_on_a_dask_cluster_gives_the_local_records(tmp_path) -> None:
+    """The loads travel with each task (ScanJob.loads, .motion): a scheduler and two worker
+    processes on loopback give the records of the local run."""
+    import json
+    import subprocess
+    import sys
+
+    distributed = pytest.importorskip("distributed")
+    args = [sys.executable, "-m", "linkage", "scan", str(LOADED), "--vary", "O4.x=95:105:4", "--vary",
+            "O4.y=-5:5:3", "--speed", "300rpm", "--gravity", "9.81", "--torque", "rocker=-3", "--chunk", "3",
+            "-f", "json"]
+    local = subprocess.run(args, capture_output=True, text=True, check=True).stdout
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        remote = subprocess.run([*args, "--scheduler", cluster.scheduler_address], capture_output=True,
+                                text=True, check=True).stdout
+    a, b = json.loads(local), json.loads(remote)
+    assert a == b
+    assert a["loads"]["torques_N_m"] == {"rocker": -3.0}
+    table = a["tables"][0]
+    assert "peak_input" in table["columns"] and len(table["rows"]) == 12
