@@ -371,3 +371,20 @@ def test_a_loaded_scan_on_a_dask_cluster_gives_the_local_records(tmp_path) -> No
     assert a["loads"]["torques_N_m"] == {"rocker": -3.0}
     table = a["tables"][0]
     assert "peak_input" in table["columns"] and len(table["rows"]) == 12
+
+
+@pytest.mark.parametrize("argv, says", [
+    (["--torque", "nosuch=1"], "error: --torque nosuch: a torque acts on a moving link"),
+    (["--torque", "rocker=1e300"], "error: --torque rocker: must be a finite number"),
+    (["--load", "O2=1,2"], "error: --load O2: O2 is a fixed joint"),
+    (["--torque", "rocker=1", "--gravity", "9.81"], "error: --gravity: it acts on the links' masses"),
+])
+def test_command_line_loads_are_named_by_their_option(argv, says, capsys) -> None:
+    """A bad --load or --torque is named as it was typed, and gravity without a [mass]
+    (it would load nothing: every column zero) is refused, for solve, sweep and scan."""
+    crank = str(ROOT / "sample_inputs" / "crank_rocker_joints.toml")
+    for command in (["solve", crank], ["sweep", crank, "--step", "90"],
+                    ["scan", crank, "--vary", "coupler=110:120:2"]):
+        code = run_cli([*command, *argv])
+        err = capsys.readouterr().err.strip()
+        assert code == 2 and err.startswith(says) and "\n" not in err, (command, argv, err)

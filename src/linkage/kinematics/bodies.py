@@ -27,10 +27,12 @@ def command_loads(mechanism: Any, load: Sequence[str], torque: Sequence[str], gr
 
     base: Loads = mechanism.extra.get("loads") or Loads()
     spec: dict[str, Any] = {}
+    named: dict[str, str] = {}
     for option, items in (("--load", load), ("--torque", torque)):
         for item in items:
             name, eq, value = item.partition("=")
             name = name.strip()
+            named[name] = f"{option} {name}"
             if not eq or not name:
                 raise InputError(f"{option} {item!r}: write NAME=" + ("FX,FY" if option == "--load" else "T"))
             if option == "--load":
@@ -54,8 +56,12 @@ def command_loads(mechanism: Any, load: Sequence[str], torque: Sequence[str], gr
     drawing = mechanism.extra.get("drawing")
     if (spec or g is not None) and drawing is None:
         Frame.of(mechanism)  # says why: loads need the joints form
-    extra = parse_loads({"loads": spec}, drawing, "the command line") if spec else Loads()
-    return base.merged(Loads(extra.forces, extra.torques, {}, g))
+    extra = parse_loads({"loads": spec}, drawing, "the command line", named) if spec else Loads()
+    out = base.merged(Loads(extra.forces, extra.torques, {}, g))
+    if g is not None and not out.masses:
+        raise InputError(f"--gravity: it acts on the links' masses, and {mechanism.source} gives none: add "
+                         "[mass] LINK = { mass = KG, cg = [x, y] } to the file")
+    return out
 
 
 # --- one position ------------------------------------------------------------------------------

@@ -83,11 +83,13 @@ def _unit(key: str, spec: Mapping[str, Any], field_name: str, units: Mapping[str
     return units[name]
 
 
-def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str) -> Loads:
+def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str,
+                named: Mapping[str, str] | None = None) -> Loads:
     """``[loads]`` and ``[mass]`` of a joints-form document, checked against its drawing, in SI:
     a force in N and a torque in N m unless its ``unit`` says otherwise, a mass in kg and an
     inertia in kg m^2 unless ``mass_unit`` / ``inertia_unit`` say; a cg in the file's
-    length unit (the drawing's)."""
+    length unit (the drawing's). ``named``: how a message names an entry of ``[loads]``
+    (the command line's option, ``--torque rocker``) instead of ``source: loads.NAME``."""
     forces: dict[str, tuple[float, float]] = {}
     torques: dict[str, float] = {}
     masses: dict[str, Mass] = {}
@@ -97,7 +99,8 @@ def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str) -> Loads:
         raise InputError(f"{source}: loads: must be a table of NAME = {{ force = [Fx, Fy] }} or "
                          "{ torque = T }")
     for name, spec in loads.items():
-        key = f"{source}: loads.{name}"
+        key = (named or {}).get(name) or f"{source}: loads.{name}"
+        part = "" if name in (named or {}) else "."  # an option names its value itself
         if (not isinstance(spec, Mapping) or set(spec) - {"force", "torque", "unit", "note"}
                 or len(set(spec) & {"force", "torque"}) != 1):
             raise InputError(f"{key}: give {{ force = [Fx, Fy] }} (N, at a joint or point) or "
@@ -109,13 +112,13 @@ def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str) -> Loads:
                 raise InputError(f"{key}: {name} is a fixed joint: a force there goes straight into the "
                                  "ground and loads nothing; put it at a moving joint or point")
             scale = _unit(key, spec, "unit", FORCE_UNITS)
-            fx, fy = _pair(f"{key}.force", spec["force"])
+            fx, fy = _pair(f"{key}{part and '.force'}", spec["force"])
             forces[str(name)] = (fx * scale, fy * scale)
         else:
             if name not in links:
                 raise InputError(f"{key}: a torque acts on a moving link; links: {', '.join(sorted(links))}")
-            torques[str(name)] = _finite(f"{key}.torque", spec["torque"]) * _unit(key, spec, "unit",
-                                                                                   TORQUE_UNITS)
+            torque = _finite(f"{key}{part and '.torque'}", spec["torque"])
+            torques[str(name)] = torque * _unit(key, spec, "unit", TORQUE_UNITS)
     mass = doc.get("mass", {})
     if not isinstance(mass, Mapping):
         raise InputError(f"{source}: mass: must be a table of LINK = {{ mass, cg, inertia }}")
