@@ -388,3 +388,23 @@ def test_command_line_loads_are_named_by_their_option(argv, says, capsys) -> Non
         code = run_cli([*command, *argv])
         err = capsys.readouterr().err.strip()
         assert code == 2 and err.startswith(says) and "\n" not in err, (command, argv, err)
+
+
+def test_readme_loads_section_shows_what_the_commands_print(capsys) -> None:
+    """The figures of the README's loads section come from the commands shown beside them."""
+    readme = (ROOT / "README.md").read_text()
+    section = readme.split("## Loads: input torque and joint forces", 1)[1].split("\n## ", 1)[0]
+    assert "$ linkage solve docs/crank_rocker_loads.toml --speed 300rpm --gravity 9.81 -f plain" in section
+    assert run_cli(["solve", str(LOADED), "--speed", "300rpm", "--gravity", "9.81", "-f", "plain"]) == 0
+    out = capsys.readouterr().out
+    for line in ("input torque: 1.10243212952 N m (virtual power: 1.10243212952 N m)",
+                 "     B   rocker  coupler  -73.5518178502  -48.9730331005  88.3641775841",
+                 "on the ground (shaking force): fx = 27.1398890387 N, fy = -33.5376681256 N"):
+        assert line in out and line in section
+    crank = str(ROOT / "sample_inputs" / "crank_rocker_joints.toml")
+    assert run_cli(["solve", crank, "--torque", "rocker=-2", "--speed", "1"]) == 0
+    out = capsys.readouterr().out
+    flat = " ".join(section.split())
+    assert "linkage solve sample_inputs/crank_rocker_joints.toml --torque rocker=-2 --speed 1" in flat
+    assert "= 8.2145" in out and "gives 8.2145" in flat
+    assert "0.121735843" in out and "0.121736" in flat

@@ -21,6 +21,8 @@ from linkage.synthesis import chebyshev_xs, synthesize_function
 
 GOOD = ("log10(x)", (1.0, 2.0), (90.0, 150.0), (0.0, 90.0))
 """Defect-free, both links drawn the other way (R1, R2 < 0)."""
+GOOD_COMMAND = ["synthesize", "--function", "log10(x)", "--x", "1:2", "--alpha", "90:150", "--phi", "0:90"]
+"""GOOD on the command line."""
 
 DEFECT_FREE = [
     GOOD,
@@ -306,15 +308,7 @@ def test_negative_R_is_a_link_drawn_the_other_way(capsys) -> None:
     # the check command the report prints: linkage solve --links ... --alpha ...
     code = run_cli(
         [
-            "synthesize",
-            "--function",
-            GOOD[0],
-            "--x",
-            "1:2",
-            "--alpha",
-            "90:150",
-            "--phi",
-            "0:90",
+            *GOOD_COMMAND,
             "-f",
             "json",
         ]
@@ -336,15 +330,7 @@ def test_negative_R_is_a_link_drawn_the_other_way(capsys) -> None:
 def test_json_has_the_promised_keys(capsys) -> None:
     code = run_cli(
         [
-            "synthesize",
-            "--function",
-            "log10(x)",
-            "--x",
-            "1:2",
-            "--alpha",
-            "90:150",
-            "--phi",
-            "0:90",
+            *GOOD_COMMAND,
             "-f",
             "json",
         ]
@@ -365,15 +351,7 @@ def test_design_file_and_plot_are_written(tmp_path, capsys) -> None:
     design, picture = tmp_path / "design.toml", tmp_path / "error.png"
     code = run_cli(
         [
-            "synthesize",
-            "--function",
-            "log10(x)",
-            "--x",
-            "1:2",
-            "--alpha",
-            "90:150",
-            "--phi",
-            "0:90",
+            *GOOD_COMMAND,
             "--ground",
             "100",
             "-o",
@@ -470,13 +448,14 @@ def test_readme_section_shows_what_the_command_prints(capsys) -> None:
 
     readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
     section = readme.split("## Function generation: `linkage synthesize`", 1)[1].split("\n## ", 1)[0]
-    code = run_cli(["synthesize", "--function", "log10(x)", "--x", "1:2", "--alpha", "90:150",
-                    "--phi", "0:90", "--ground", "100", "--rows", "11", "-f", "plain"])
+    code = run_cli([*GOOD_COMMAND, "--ground", "100", "--rows", "11", "-f", "plain"])
     out = capsys.readouterr().out
     assert code == 0
-    for line in ("max |error| = 0.125242 deg = 0.000418907 in y, at x = 2",
-                 "R1 = -1.19401126284, R2 = -0.535907283253, R3 = -0.537109747629",
-                 "transmission angle (folded into 0..90): min 45.39 deg (at x = 1), max 89.99 deg"):
+    for line in (
+        "max |error| = 0.125242 deg = 0.000418907 in y, at x = 2",
+        "R1 = -1.19401126284, R2 = -0.535907283253, R3 = -0.537109747629",
+        "transmission angle (folded into 0..90): min 45.39 deg (at x = 1), max 89.99 deg",
+    ):
         assert line in out and line in section
     optimal = synthesize_function(*GOOD, spacing="optimal")
     assert f"{optimal.max_error_deg:.6g}" == "0.0914769" and "0.0914769" in section
@@ -486,8 +465,20 @@ def test_readme_section_shows_what_the_command_prints(capsys) -> None:
 
 # --- the search --------------------------------------------------------------------------------
 
-SEARCH_ARGS = ["--function", "log10(x)", "--x", "1:2", "--vary", "alpha0=0:330:12", "--vary",
-               "alpha_span=60:90:2", "--vary", "phi0=0:330:12", "--vary", "phi_span=60:90:2"]
+SEARCH_ARGS = [
+    "--function",
+    "log10(x)",
+    "--x",
+    "1:2",
+    "--vary",
+    "alpha0=0:330:12",
+    "--vary",
+    "alpha_span=60:90:2",
+    "--vary",
+    "phi0=0:330:12",
+    "--vary",
+    "phi_span=60:90:2",
+]
 
 
 def test_search_keeps_exactly_the_defect_free_candidates_ranked_by_synthesize() -> None:
@@ -495,9 +486,15 @@ def test_search_keeps_exactly_the_defect_free_candidates_ranked_by_synthesize() 
 
     from linkage.synthesis import search
 
-    r = search("log10(x)", (1, 2), None, None,
-               ["alpha0=0:330:12", "alpha_span=60:90:2", "phi0=0:330:12", "phi_span=60:90:2"],
-               top=100000, workers=1)
+    r = search(
+        "log10(x)",
+        (1, 2),
+        None,
+        None,
+        ["alpha0=0:330:12", "alpha_span=60:90:2", "phi0=0:330:12", "phi_span=60:90:2"],
+        top=100000,
+        workers=1,
+    )
     assert r.scanned == 12 * 2 * 12 * 2
     kept = {int(d) for d in r.rows["design"]}
     assert len(kept) == r.without_defects > 0
@@ -521,8 +518,9 @@ def test_search_keeps_exactly_the_defect_free_candidates_ranked_by_synthesize() 
 
 
 def test_search_command_best_line_reproduces_its_row(capsys) -> None:
-    code = run_cli(["synthesize", "--search", *SEARCH_ARGS, "--min-transmission", "40", "--top", "3",
-                    "-f", "json"])
+    code = run_cli(
+        ["synthesize", "--search", *SEARCH_ARGS, "--min-transmission", "40", "--top", "3", "-f", "json"]
+    )
     doc = json.loads(capsys.readouterr().out)
     assert code == 0
     table = doc["tables"][0]
@@ -542,29 +540,62 @@ def test_search_on_a_dask_cluster_gives_the_local_answer(capsys) -> None:
     args = ["synthesize", "--search", *SEARCH_ARGS, "--top", "5", "-f", "json"]
     assert run_cli(args) == 0
     local = json.loads(capsys.readouterr().out)
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                  dashboard_address=None) as cluster:
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+    ) as cluster:
         assert run_cli([*args, "--scheduler", cluster.scheduler_address]) == 0
         remote = json.loads(capsys.readouterr().out)
     assert remote["tables"] == local["tables"] and remote["best"] == local["best"]
 
 
-@pytest.mark.parametrize("extra, words", [
-    (["--vary", "beta=1:2:2"], "a search varies"),
-    (["--vary", "alpha_span=-30:30:3"], "one side of 0"),
-    (["--spacing", "optimal"], "optimal"),
-    ([], "give at least one --vary"),
-    (["--vary", "alpha0=0:10:2", "--top", "0"], "--top"),
-])
+@pytest.mark.parametrize(
+    "extra, words",
+    [
+        (["--vary", "beta=1:2:2"], "a search varies"),
+        (["--vary", "alpha_span=-30:30:3"], "one side of 0"),
+        (["--spacing", "optimal"], "optimal"),
+        ([], "give at least one --vary"),
+        (["--vary", "alpha0=0:10:2", "--top", "0"], "--top"),
+    ],
+)
 def test_search_bad_input_is_one_line_and_exit_2(extra, words, capsys) -> None:
-    code = run_cli(["synthesize", "--search", "--function", "x**2", "--x", "0:1", "--alpha", "90:150",
-                    "--phi", "0:90", *extra])
+    code = run_cli(
+        [
+            "synthesize",
+            "--search",
+            "--function",
+            "x**2",
+            "--x",
+            "0:1",
+            "--alpha",
+            "90:150",
+            "--phi",
+            "0:90",
+            *extra,
+        ]
+    )
     err = capsys.readouterr().err.strip()
     assert code == 2 and err.startswith("error:") and "\n" not in err and words in err
 
 
 def test_search_without_a_defect_free_candidate_exits_1(capsys) -> None:
-    code = run_cli(["synthesize", "--search", "--function", "x**2", "--x", "1:2", "--alpha", "150:210",
-                    "--phi", "345:405", "--vary", "alpha0=150:151:2", "-f", "plain"])
+    code = run_cli(
+        [
+            "synthesize",
+            "--search",
+            "--function",
+            "x**2",
+            "--x",
+            "1:2",
+            "--alpha",
+            "150:210",
+            "--phi",
+            "345:405",
+            "--vary",
+            "alpha0=150:151:2",
+            "-f",
+            "plain",
+        ]
+    )
     out = capsys.readouterr().out
     assert code == 1 and "no candidate without defects" in out

@@ -20,6 +20,7 @@ here: none could be reached from this machine.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -28,30 +29,10 @@ from linkage.problems.loads import Loads
 from linkage.problems.loops import from_text as parse_mechanism
 
 R2 = math.sqrt(2.0)
-MARGHITU_R_RRT = f"""
-name = "Marghitu 2009, ch. 4, R-RRT slider-crank"
-length_unit = "m"
-ground = ["A"]
-[joints]
-A = [0.0, 0.0]
-B = [{R2 / 2!r}, {R2 / 2!r}]
-C = [{R2!r}, 0.0]
-[links]
-crank = ["A", "B"]
-rod = ["B", "C"]
-slider = ["C"]
-[sliders]
-slider = {{ on = "ground", angle = 0 }}
-[driver]
-link = "crank"
-value = 45
-[loads]
-C = {{ force = [100, 0] }}
-[mass]
-crank = {{ mass = 1, cg = [{R2 / 4!r}, {R2 / 4!r}], inertia = 0.0833417 }}
-rod = {{ mass = 1, cg = [{3 * R2 / 4!r}, {R2 / 4!r}], inertia = 0.0833417 }}
-slider = {{ mass = 1, cg = [{R2!r}, 0.0], inertia = 1.67e-5 }}
-"""
+ROOT = Path(__file__).resolve().parents[1]
+MARGHITU = ROOT / "docs" / "marghitu_slider_crank.toml"
+"""The example as a joints-form file, the README's (docs/), its numbers as the book's."""
+MARGHITU_R_RRT = MARGHITU.read_text()
 
 
 def test_marghitu_slider_crank_kinetostatics_printed_pin_force() -> None:
@@ -107,3 +88,27 @@ def test_marghitu_through_the_command_line(tmp_path, capsys) -> None:
     assert (pin["on"], pin["by"]) == ("rod", "crank")
     assert pin["fx"] == pytest.approx(-(400.0 + 7.0 * R2) / 4.0, rel=1e-12)
     assert pin["fy"] == pytest.approx(5.0 * (84.0 + R2) / 4.0, rel=1e-12)
+
+
+def test_the_file_holds_the_books_data() -> None:
+    """The docs file is the example as printed: sqrt 2 geometry, 1 kg links, the loads."""
+    m = parse_mechanism(MARGHITU_R_RRT, "marghitu.toml")
+    d = m.extra["drawing"]
+    assert d.xy["B"] == pytest.approx((R2 / 2, R2 / 2), rel=1e-15)
+    assert d.xy["C"] == pytest.approx((R2, 0.0), rel=1e-15)
+    loads = m.extra["loads"]
+    assert loads.forces == {"C": (100.0, 0.0)}
+    assert {k: v.mass for k, v in loads.masses.items()} == {"crank": 1.0, "rod": 1.0, "slider": 1.0}
+
+
+def test_readme_shows_what_the_command_prints(capsys) -> None:
+    """The README's figures for the example are the output of the command shown beside them."""
+    from linkage.cli import run_cli
+
+    readme = (ROOT / "README.md").read_text()
+    section = " ".join(readme.split("**A textbook's printed answer.**", 1)[1].split("\n\n", 1)[0].split())
+    assert "linkage solve docs/marghitu_slider_crank.toml --speed 1 --gravity 10" in section
+    assert run_cli(["solve", str(MARGHITU), "--speed", "1", "--gravity", "10", "-f", "plain"]) == 0
+    out = capsys.readouterr().out
+    for figure in ("-102.474873734", "106.767766953", "151.492424049"):
+        assert figure in out and figure in section

@@ -576,24 +576,14 @@ def design_of(
 
 
 def golden_max(g: Callable[[float], float], lo: float, hi: float, iters: int = 80) -> tuple[float, float]:
-    """The x in [lo, hi] where g is largest (g unimodal there) and g there."""
-    inv = (math.sqrt(5.0) - 1.0) / 2.0
-    a, b = lo, hi
-    c, d = b - inv * (b - a), a + inv * (b - a)
-    gc, gd = g(c), g(d)
-    for _ in range(iters):
-        if b - a <= 1e-15 * max(1.0, abs(a), abs(b)):
-            break
-        if gc >= gd:
-            b, d, gd = d, c, gc
-            c = b - inv * (b - a)
-            gc = g(c)
-        else:
-            a, c, gc = c, d, gd
-            d = a + inv * (b - a)
-            gd = g(d)
-    best = max(((a, g(a)), (c, gc), (d, gd), (b, g(b))), key=lambda t: t[1] if math.isfinite(t[1]) else -1.0)
-    return best
+    """The x in [lo, hi] where g is largest (g unimodal there) and g there: the golden-section
+    loop (methods.golden) on -g, then the best of the last bracket and its ends."""
+    from .methods.golden import golden_min
+
+    a, c, fc, d, fd, b = golden_min(lambda x: -g(x), lo, hi, iters,
+                                    lambda k: k[5] - k[0] <= 1e-15 * max(1.0, abs(k[0]), abs(k[5])))
+    ends = ((a, g(a)), (c, -fc), (d, -fd), (b, g(b)))
+    return max(ends, key=lambda t: t[1] if math.isfinite(t[1]) else -1.0)
 
 
 def extrema(

@@ -28,10 +28,10 @@ def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Opt
     (at_in, at_pin), flagged = peaks_of(rows)
     lines = [Text(""), Text("loads over the sweep (matrix method, SI units)", "bold")]
     if at_in >= 0:
-        peak, pins = rows[at_in], rows[at_pin]
+        peak, pin = rows[at_in], rows[at_pin]
         lines.append(Text(f"peak input {fmt(peak[2], digits)} {unit_in} at {name} = "
-                          f"{fmt(peak[0], digits)} {unit}; largest pin force {fmt(pins[3], digits)} N at "
-                          f"{fmt(pins[0], digits)} {unit}"))
+                          f"{fmt(peak[0], digits)} {unit}; largest pin force {fmt(pin[3], digits)} N at "
+                          f"{fmt(pin[0], digits)} {unit}"))
     if flagged:
         lines.append(Text(f"{flagged} positions near a toggle (near_toggle, ill_conditioned or "
                           "undefined): their forces are flagged in the loads table, not counted in the peaks",

@@ -436,7 +436,8 @@ def force_status_np(inp: Any, cond: Any, bound: Any, kinematics_ok: Any) -> Any:
 def force_peaks(status: Any, *columns: Any) -> tuple[list[Any], Any]:
     """The one rule for peaks over positions (arrays of shape (rows, positions), status as
     FORCE_STATUSES codes): per row, for each column the index of its largest absolute
-    value among the positions whose forces are ok (-1 where none is), and how many
+    value (the first, of values equal to rounding) among the positions whose forces are ok
+    (-1 where none is), and how many
     positions' forces are flagged (near_toggle, ill_conditioned or undefined; a negative
     code, an unsolved position, is neither). Flagged forces are large or unknown: counted,
     never taken as a peak."""
@@ -447,7 +448,11 @@ def force_peaks(status: Any, *columns: Any) -> tuple[list[Any], Any]:
     at = []
     with np.errstate(invalid="ignore"):
         for col in columns:
-            at.append(np.where(any_ok, np.argmax(np.where(ok, np.abs(col), -1.0), axis=1), -1))
+            size = np.where(ok & np.isfinite(col), np.abs(col), -1.0)
+            # the first of the largest within rounding: a closed cycle's 0 and 360 deg differ
+            # by an ulp, and the peak is at 0
+            top = size.max(axis=1, keepdims=True)
+            at.append(np.where(any_ok, np.argmax(size >= top * (1.0 - 8.0 * EPS), axis=1), -1))
     return at, ((status > 0) & (status < len(FORCE_STATUSES))).sum(axis=1)
 
 

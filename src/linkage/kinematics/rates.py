@@ -448,14 +448,12 @@ def _place(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd
     n = model.n
     qd = qd if qd is not None else [0.0] * n
     qdd = qdd if qdd is not None else [0.0] * n
-    placed: dict[str, tuple[complex, complex, complex, float, float]] = {}
 
-    def part(t: Any, st: tuple[Any, ...] | None = None
+    def part(t: Any, at: tuple[int, int] | None
              ) -> tuple[tuple[complex, complex, complex], tuple[float, float]]:
         if unc is None:
             return _term(t, q, d, qd, vd, qdd, vdd), (0.0, 0.0)
-        if st is None:
-            st = _static(t, q, d, qd, vd, qdd, vdd)
+        st = data[at[0]][at[1]] if data is not None and at is not None else _static(t, q, d, qd, vd, qdd, vdd)
         return st[5:8], (max(_bounds_of(st, unc, 1)), max(_bounds_of(st, unc, 2)))
 
     def add(start: tuple[complex, complex, complex, float, float], parts: Any, sign: float
@@ -468,41 +466,21 @@ def _place(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd
             ba += ca + EPS * abs(a) if unc is not None else 0.0
         return p, v, a, bv, ba
 
-    origin0 = (complex(*m.origin), 0j, 0j, 0.0, 0.0)
-    for i, (loop, terms) in enumerate(zip(m.loops, model.terms)):
-        names = loop.joints
-        start = placed.get(names[0]) if names and names[0] else None
-        origin = start if start is not None else origin0
-        parts = [part(t, data[i][j] if data is not None else None) for j, t in enumerate(terms)]
-        moving = [t[2] != FIXED or t[4] != FIXED for t in terms]
-        for k in range(len(terms)):
-            if not names or not names[k] or names[k] in placed:
-                continue
-            # reach joint k along the side of the loop with fewer moving vectors (a ground
-            # pivot then has exactly zero velocity, and fewer terms round)
-            forward = range(k)
-            backward = range(k, len(terms))
-            ahead = sum(moving[j] for j in forward) <= sum(moving[j] for j in backward)
-            placed[names[k]] = add(origin, [parts[j] for j in (forward if ahead else backward)],
-                                   1.0 if ahead else -1.0)
-    for name, (origin_name, terms) in model.point_terms.items():
-        start = placed.get(origin_name, origin0)
-        placed[name] = add(start, [part(t) for t in terms], 1.0)
-    return placed
+    return _walk(model, part, add, (complex(*m.origin), 0j, 0j, 0.0, 0.0))
 
 
 def place_np(model: LoopModel, q: Any, d: Any) -> dict[str, tuple[Any, Any]]:
     """:func:`place`'s positions over arrays: every named joint and point, name -> (x, y)
     arrays, for ``q`` (one array per unknown, internal units) and driver values ``d``.
     The same sums in the same order as :func:`_place` (each vector ``sign r e^(i theta)``,
-    a joint reached along the side of its loop with fewer moving vectors), so it agrees
+    the joints by the one placing rule, :func:`_walk`), so it agrees
     with the scalar definition to the last bits of numpy's cos and sin (tests check it)."""
     import numpy as np
 
     d = np.asarray(d, dtype=float)
     zero = np.zeros(d.shape)
 
-    def part(t: Any) -> tuple[Any, Any]:
+    def part(t: Any, _at: Any) -> tuple[Any, Any]:
         sign, lc, li, ac, ai, off = t
         r = q[li] if li >= 0 else (d if li == DRIVER else lc)
         th = (q[ai] if ai >= 0 else (d if ai == DRIVER else ac)) + off
@@ -522,15 +500,17 @@ def place_np(model: LoopModel, q: Any, d: Any) -> dict[str, tuple[Any, Any]]:
 
 
 def _walk(model: LoopModel, part: Any, add: Any, origin0: Any) -> dict[str, Any]:
-    """The placing rule of :func:`_place` over any values: each loop from its first joint
-    if an earlier loop placed it (else the origin), a joint reached along the side of its
-    loop with fewer moving vectors, a point from its joint."""
+    """The placing rule, over any values: each loop from its first joint if an earlier loop
+    placed it (else the origin), a joint reached along the side of its loop with fewer
+    moving vectors (a ground pivot then has exactly zero velocity, and fewer terms round),
+    a point from its joint. ``part(term, (loop, index))`` is a vector's value (``None``
+    for a point's), ``add(start, parts, sign)`` their sum."""
     placed: dict[str, Any] = {}
-    for loop, terms in zip(model.mechanism.loops, model.terms):
+    for i, (loop, terms) in enumerate(zip(model.mechanism.loops, model.terms)):
         names = loop.joints
         start = placed.get(names[0]) if names and names[0] else None
         origin = start if start is not None else origin0
-        parts = [part(t) for t in terms]
+        parts = [part(t, (i, j)) for j, t in enumerate(terms)]
         moving = [t[2] != FIXED or t[4] != FIXED for t in terms]
         for k in range(len(terms)):
             if not names or not names[k] or names[k] in placed:
@@ -540,7 +520,7 @@ def _walk(model: LoopModel, part: Any, add: Any, origin0: Any) -> dict[str, Any]
             placed[names[k]] = add(origin, [parts[j] for j in (forward if ahead else backward)],
                                    1.0 if ahead else -1.0)
     for name, (origin_name, terms) in model.point_terms.items():
-        placed[name] = add(placed.get(origin_name, origin0), [part(t) for t in terms], 1.0)
+        placed[name] = add(placed.get(origin_name, origin0), [part(t, None) for t in terms], 1.0)
     return placed
 
 
@@ -616,13 +596,13 @@ def place_motion_np(model: LoopModel, q: Any, d: Any, qd: Any, vd: float, qdd: A
                     ) -> dict[str, tuple[Any, Any, Any]]:
     """:func:`place`'s twin over arrays: every named joint and point, name -> (position,
     velocity, acceleration) as complex arrays, each vector by :func:`_term`'s formulas and
-    the joints by :func:`_place`'s rule (:func:`_walk`)."""
+    the joints by the one placing rule (:func:`_walk`)."""
     import numpy as np
 
     d = np.asarray(d, dtype=float)
     zero = np.zeros(d.shape, dtype=complex)
 
-    def part(t: Any) -> tuple[Any, Any, Any]:
+    def part(t: Any, _at: Any) -> tuple[Any, Any, Any]:
         sign, lc, li, ac, ai, off = t
         r, th = _value(li, lc, q, d), _value(ai, ac, q, d) + off
         r1, w = _rate(li, qd, vd), _rate(ai, qd, vd)

@@ -22,6 +22,7 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from ..methods.golden import golden_min
 from .derive import Derivation
 
 Signs = tuple[float, ...]
@@ -98,9 +99,6 @@ def limits_between_np(d: Derivation, a: Any, b: Any, branches: Sequence[Signs], 
     return good
 
 
-GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
-
-
 def dip_between(d: Derivation, a: float, c: float, branches: Sequence[Signs], scale: float = 1.0,
                 params: Mapping[str, float] | None = None) -> tuple[float, float] | None:
     """Where :func:`assembles` is >= 0 at both ``a`` and ``c`` but dips below zero between
@@ -109,20 +107,7 @@ def dip_between(d: Derivation, a: float, c: float, branches: Sequence[Signs], sc
     def g(x: float) -> float:
         return assembles(d, x, branches, scale, params)
 
-    lo, hi = a, c
-    x1, x2 = hi - GOLDEN * (hi - lo), lo + GOLDEN * (hi - lo)
-    g1, g2 = g(x1), g(x2)
-    for _ in range(200):
-        if g1 < 0.0 or g2 < 0.0 or not (x1 < x2):
-            break
-        if g1 <= g2:
-            hi, x2, g2 = x2, x1, g1
-            x1 = hi - GOLDEN * (hi - lo)
-            g1 = g(x1)
-        else:
-            lo, x1, g1 = x1, x2, g2
-            x2 = lo + GOLDEN * (hi - lo)
-            g2 = g(x2)
+    _, x1, g1, x2, g2, _ = golden_min(g, a, c, 200, lambda k: k[2] < 0.0 or k[4] < 0.0 or not k[1] < k[3])
     inside = x1 if g1 < 0.0 else x2 if g2 < 0.0 else None
     if inside is None:
         return None
