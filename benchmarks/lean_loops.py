@@ -74,7 +74,7 @@ def parts() -> None:
     from linkage.problems.system import LeanProblem
     from linkage.solve import certify_root
 
-    spec = scalar_problem("seed002")
+    spec = scalar_problem("freudenstein")
     p, x0 = spec["problem"], spec["x0"]
     r = solve_scalar(p, method="newton", x0=x0, tol=1e-12, record=False)
 
@@ -84,7 +84,7 @@ def parts() -> None:
     whole = best(lambda: solve_scalar(p, method="newton", x0=x0, tol=1e-12, record=False), 20000)
     loop = best(lambda: newton_lean(p, x0, 1e-12, 0.0, None, 100, certify, None), 20000)
     hand = best(lambda: hand_newton(p.f, p.fprime, x0, 1e-12), 20000)
-    print(f"seed-002 Newton ({r.iterations} iterations): solve {whole * 1e6:.2f} us = loop "
+    print(f"Freudenstein Newton ({r.iterations} iterations): solve {whole * 1e6:.2f} us = loop "
           f"{loop * 1e6:.2f} us + front door and Result {(whole - loop) * 1e6:.2f} us; hand loop "
           f"{hand * 1e6:.2f} us; the loop's checks {(loop - hand) / r.iterations * 1e6:.2f} us an iteration")
     q = system_problem("fourbar")["problem"]

@@ -1,8 +1,8 @@
-"""The seed-002 iteration tables (alpha = 70 deg), transcribed verbatim from the seed.
+"""The Freudenstein iteration tables (alpha = 70 deg), transcribed verbatim from the seed.
 
 Values are kept as the strings the seed printed: the number of decimals in each
 string sets the comparison tolerance (half a unit in the last printed digit).
-Source: ../shared/seeds/002 (student report), cross-checked with PROBLEMS.md P2.
+Source: ../shared/seeds/002 (student report), cross-checked with worked example P2, docs/worked_examples.md.
 """
 
 BISECTION = (
@@ -62,7 +62,7 @@ FIXED_POINT = (
 
 
 # Seed 000 (course notes): Newton on f(x) = x^2 - 4x + 1, columns k, x, f(x), f'(x), f/f'.
-# Rows 1-2 are restated in PROBLEMS.md P1. The notes' row 4 for x0 = 1 evaluates f at the
+# Rows 1-2 are restated in worked example P1, docs/worked_examples.md. The notes' row 4 for x0 = 1 evaluates f at the
 # rounded x = 0.2679 (f = 0.00017, f' = -3.4642, f/f' = -0.00005); at full precision
 # x = 0.267857, f = 0.00032 and f' = -3.46429, so for that row only x is compared.
 QUADRATIC_NEWTON = {
@@ -87,4 +87,4 @@ QUADRATIC_NEWTON = {
 }
 QUADRATIC_ROOTS = {"5": "3.7320508", "2.5": "3.7323", "1": "0.2679"}
 """x_5 in the notes. For x0 = 5 the scan reads "37320" (3.7320508 truncated), so the
-figure is PROBLEMS.md's 3.7320508; x0 = 2.5 shows 3.7323, a step behind 3.7320508."""
+figure is docs/worked_examples.md's 3.7320508; x0 = 2.5 shows 3.7323, a step behind 3.7320508."""

@@ -2,7 +2,7 @@
 (rates, joints, points), the same scaled tolerances and the same statuses; the stopping
 and continuity rules are defined once (linkage.rules), each numpy twin equal to its
 scalar. References: the slider-crank's closed form and its time derivatives, derived
-here (PROBLEMS.md P7's loop, differentiated by hand), not the code under test."""
+here (worked example P7, docs/worked_examples.md's loop, differentiated by hand), not the code under test."""
 
 from __future__ import annotations
 

@@ -11,7 +11,8 @@ import pytest
 def test_bench_quick_on_one_problem(cli, tmp_path):
     pytest.importorskip("matplotlib")
     plot = tmp_path / "wp.png"
-    run = cli("bench", "--quick", "--problem", "seed002", "--repeats", "1", "--no-cold", "--format", "json",
+    run = cli("bench", "--quick", "--problem", "freudenstein", "--repeats", "1", "--no-cold",
+              "--format", "json",
               "--plot", str(plot))
     assert run.code == 0, run.err
     doc = json.loads(run.out)

@@ -5,7 +5,7 @@ old closed_form key checked and noted, and every four-bar loop's Grashof class a
 transmission angle, whatever its names and whichever joint drives.
 
 References are computed here, independently of the code under test: circle intersections
-in complex numbers (no shared formula), the law of cosines, PROBLEMS.md P3 and the
+in complex numbers (no shared formula), the law of cosines, worked example P3, docs/worked_examples.md and the
 figures in the sample files' comments.
 """
 
@@ -56,7 +56,7 @@ def wrap(a: float) -> float:
 def fourbar_by_crank(a: float, b: float, c: float, d: float, t2: float) -> dict[str, tuple[float, float]]:
     """{name: (theta3, theta4)} in degrees of the loop a e^(i t2) + b e^(i t3) - c e^(i t4)
     - d = 0: B on the circle about A (b) and about O4 = d (c); open where the output turns
-    anticlockwise from the coupler, sin(theta4 - theta3) > 0 (PROBLEMS.md P3)."""
+    anticlockwise from the coupler, sin(theta4 - theta3) > 0 (worked example P3, docs/worked_examples.md)."""
     A = a * cmath.exp(1j * math.radians(t2))
     out = {}
     for B in circles(A, b, complex(d, 0.0), c):
@@ -71,7 +71,8 @@ def transmission(a: float, b: float, c: float, d: float, t2: float) -> float:
     return math.degrees(math.acos((b * b + c * c - ad2) / (2 * b * c)))
 
 
-P3 = (30.0, 60.0, 45.0, 90.0)  # input, coupler, output, ground (cm): PROBLEMS.md P3
+# input, coupler, output, ground (cm): worked example P3, docs/worked_examples.md
+P3 = (30.0, 60.0, 45.0, 90.0)
 P3_OPEN = (13.151499346, 114.827770616)  # theta3, theta4 at theta2 = 65, P3's figures
 P3_CROSSED = (-51.898819255, 206.424909476)
 
@@ -95,7 +96,7 @@ def solve_json(cli, *args: str) -> dict:
 # --- 1. reference and branch_of from the derivation -----------------------------------------
 
 def test_abcd_fourbar_gets_the_true_error_column_and_p3s_reference(cli, tmp_path):
-    """No key, names a, b, c, d: the reference is both of P3's assemblies (PROBLEMS.md),
+    """No key, names a, b, c, d: the reference is both of P3's assemblies (docs/worked_examples.md),
     and the iteration table has the true-error column against the branch solved."""
     path = abcd_file(tmp_path, "theta2", 65.0, {"theta3": 0.0, "theta4": 90.0})
     doc = solve_json(cli, path)

@@ -50,7 +50,7 @@ def circles(p, r, q, s):
 
 def crank_driven(links, theta2_deg, name):
     """(theta3, theta4) in degrees (mpmath) of the assembly called ``name`` (open where
-    sin(theta4 - theta3) > 0, PROBLEMS.md P3), driven by theta2; None if none."""
+    sin(theta4 - theta3) > 0, worked example P3, docs/worked_examples.md), driven by theta2; None if none."""
     a, b, c, d = (mp.mpf(x) for x in links)
     A = a * mp.expj(rad(theta2_deg))
     for B in circles(A, b, mp.mpf(d), c):

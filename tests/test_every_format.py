@@ -6,7 +6,7 @@ same numbers (CSV and JSON bit for bit, parquet bit for bit, xlsx to the 16 sign
 digits openpyxl writes). Display formats (plain, github, latex, rst) write a file that is
 not empty; LaTeX is a captioned table. An unknown suffix is refused by every command with
 one line and exit 2. Whether the numbers are right is other tests' business (they compare
-with closed forms, mpmath and PROBLEMS.md); here they must be the same everywhere.
+with closed forms, mpmath and docs/worked_examples.md); here they must be the same everywhere.
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ COMMANDS: dict[str, list[str]] = {
     "synthesize": ["synthesize", "--function", "log10(x)", "--x", "1:2", "--alpha", "90:150",
                    "--phi", "0:90"],
     "stress": ["stress", "--quick", "--method", "newton"],
-    "bench": ["bench", "--quick", "--no-cold", "--problem", "seed002", "--repeats", "1"],
+    "bench": ["bench", "--quick", "--no-cold", "--problem", "freudenstein", "--repeats", "1"],
 }
 OUTPUT_OPTION = {"samples": "--format"}  # the listing goes to standard output only
 
@@ -52,8 +52,8 @@ def quick_bench(monkeypatch: pytest.MonkeyPatch) -> None:
     """bench's measurements stubbed with fixed figures: the writers are under test, and a
     timing differs from run to run."""
     m = bench_module.Measurement
-    fixed = [m("seed002", "linkage newton", 1e-12, 2.5e-5, (2.25e-5, 3e-5), 1e-16, 5, 6),
-             m("seed002", "scipy brentq", 1e-12, 1e-4, (0.9e-4, 1.1e-4), 0.0, None, 9)]
+    fixed = [m("freudenstein", "linkage newton", 1e-12, 2.5e-5, (2.25e-5, 3e-5), 1e-16, 5, 6),
+             m("freudenstein", "scipy brentq", 1e-12, 1e-4, (0.9e-4, 1.1e-4), 0.0, None, 9)]
     monkeypatch.setattr(bench_module, "measure", lambda *a, **k: fixed)
     monkeypatch.setattr(bench_module, "sweep_times", lambda *a, **k: {"a sweep": 0.25, "another": 0.5})
     # solve --method all times each method: its "time per solve" column, too

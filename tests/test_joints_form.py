@@ -19,7 +19,8 @@ SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 
 
 def me581_drawing(theta2: float = 65.0, extra: str = "", links: str | None = None, driver: str = "") -> str:
-    """PROBLEMS.md P3's four-bar (r1..r4 = 90, 30, 60, 45 cm) drawn at theta2 on its open
+    """worked example P3, docs/worked_examples.md's four-bar (r1..r4 = 90, 30, 60, 45 cm) drawn at
+    theta2 on its open
     branch (theta3, theta4 by the law of cosines, derived here), with a coupler point P 30 cm
     from A at 40 deg to AB."""
     t2 = math.radians(theta2)

@@ -1,5 +1,6 @@
 """Velocities, accelerations, joints and points on links, each against an independent
-reference: PROBLEMS.md P7, closed forms differentiated by mpmath, central differences."""
+reference: worked example P7, docs/worked_examples.md, closed forms differentiated by mpmath, central
+differences."""
 
 from __future__ import annotations
 

@@ -21,7 +21,7 @@ MP_FUNCS = {name: getattr(mp, name) for name in
 
 
 def mp_function(entry):
-    if entry.equation is None:  # the seed-002 four-bar, phi in degrees
+    if entry.equation is None:  # the Freudenstein four-bar, phi in degrees
         d = mp.pi / 180
         return lambda x: (mp.mpf(5) / 3 * mp.cos(70 * d) - mp.mpf(5) / 2 * mp.cos(x * d)
                           + mp.mpf(11) / 6 - mp.cos((70 - x) * d))
@@ -73,7 +73,7 @@ def test_fixed_point_rate_matches_g_prime_at_the_40_digit_root():
 
 
 def test_newton_constant_sign_and_size_against_mpmath():
-    """f''(r)/(2 f'(r)) for seed 002 is +0.0117539 per degree (PROBLEMS.md prints it
+    """f''(r)/(2 f'(r)) for the student report is +0.0117539 per degree (docs/worked_examples.md prints it
     negative; both derivatives are positive at the root, and the iterates approach from
     above with e4/e3^2 > 0)."""
     entry = next(e for e in CATALOG if e.equation is None)

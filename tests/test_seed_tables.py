@@ -1,4 +1,5 @@
-"""The seed-002 four-bar tables and the seed-000 quadratic tables, row by row.
+"""The Freudenstein four-bar tables and the course notes' quadratic tables (docs/worked_examples.md P1,
+P2), row by row.
 
 Every value must round to the digits the seed printed. Run through the API and
 through the CLI (JSON and CSV), so both paths are held to the same reference.
@@ -114,7 +115,7 @@ def test_default_solve_is_the_seed_newton_table(cli):
 def test_seed_000_quadratic_newton_tables(x0):
     problem = equation_problem("x**2 - 4*x + 1")
     result = solve_scalar(problem, method="newton", x0=float(x0), tol=1e-4)
-    # seed 000 columns: k, x, f, f', f/f' (= x_k - x_k+1)
+    # the course notes columns: k, x, f, f', f/f' (= x_k - x_k+1)
     ours = [(i, x, f, d, x - x_next) for i, x, f, d, x_next, _ in result.history.rows]
     expected = QUADRATIC_NEWTON[x0]
     assert_rows(ours[: len(expected)], expected, label=f"x0={x0}")
@@ -159,7 +160,7 @@ def test_seed_002_solution_table_for_every_alpha(alpha, phi):
 ])
 def test_estimated_orders_printed_for_the_seed_runs(cli, method, order, rate):
     """Newton about 2, secant about 1.6, bisection and fixed-point linear at rates about
-    0.5 and 0.1275 (seed 002's convergence analyses)."""
+    0.5 and 0.1275 (the student report's convergence analyses)."""
     doc = json.loads(cli("solve", "--method", method, "--format", "json").out)
     conv = doc["convergence"]
     assert conv["order"] == pytest.approx(order, abs=0.06)

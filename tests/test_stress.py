@@ -130,7 +130,7 @@ def test_regression_tiny_step_from_a_far_slope():
 
 def test_rounding_noise_does_not_block_convergence():
     """The residual rules above must still let Newton finish where the last iterates
-    differ only by rounding noise (seed 002 at alpha = 10, tol 1e-12)."""
+    differ only by rounding noise (the student report at alpha = 10, tol 1e-12)."""
     r = solve_scalar(fourbar_equation(10.0), method="newton", tol=1e-12)
     assert r.converged and abs(r.x - 8.0693453136225160) < 1e-12
 

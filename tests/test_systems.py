@@ -23,7 +23,8 @@ from linkage.problems.loops import parse_mechanism
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 ME581 = str(SAMPLES / "fourbar_me581.toml")
 
-# PROBLEMS.md P3: k, theta3, theta4 (deg), Phi1, Phi2 (cm), det J, dtheta3, dtheta4 (rad)
+# worked example P3, docs/worked_examples.md: k, theta3, theta4 (deg), Phi1, Phi2 (cm), det J, dtheta3,
+# dtheta4 (rad)
 P3_ROWS = (
     ("1", "0", "90", "-17.3215", "-17.8108", "-2700.0", "0.2968461", "0.3849212"),
     ("2", "17.0080", "112.0544", "-3.04875", "3.03231", "-2689.53", "-0.0661765", "0.0452519"),

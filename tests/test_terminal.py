@@ -61,7 +61,7 @@ def test_every_number_and_status_is_printed_whole(args, cols):
 
 
 def test_seed_002s_table_from_one_command(cli):
-    """`linkage sweep --from 10 --to 160 --step 30`: seed 002's phi for each alpha."""
+    """`linkage sweep --from 10 --to 160 --step 30`: the student report's phi for each alpha."""
     printed = {10: "8.06934531362", 40: "32.01518035933", 70: "54.88776318878",
                100: "75.27087338607", 130: "90.12408036526", 160: "92.73496285135"}
     run_ = cli("sweep", "--from", "10", "--to", "160", "--step", "30", "--format", "json")

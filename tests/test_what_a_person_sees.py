@@ -103,7 +103,7 @@ def test_solve_help_names_the_mirror_branch_key(cli, monkeypatch):
 
 P7 = {"dtheta3/dt (rad/s)": -3.901274121944855, "dtheta4/dt (rad/s)": 5.353311575177702,
       "d2theta3/dt2 (rad/s^2)": 5.892333757673076, "d2theta4/dt2 (rad/s^2)": 71.37419488746042}
-"""PROBLEMS.md P7: the P3 four-bar at 65 deg, crank at 10 rad/s and 5 rad/s^2."""
+"""worked example P7, docs/worked_examples.md: the P3 four-bar at 65 deg, crank at 10 rad/s and 5 rad/s^2."""
 
 
 def _rates_rows(seen: str) -> list[list[str]]:
@@ -137,7 +137,7 @@ def test_rates_table_names_the_ill_conditioned_rates_as_the_note_does():
     note = " ".join(seen.split("ill-conditioned here", 1)[1].split())
     for label in ("dtheta3/dt", "d2theta3/dt2", "dtheta4/dt", "d2theta4/dt2"):
         assert label in rows and label in note, (label, rows)
-    # exact (PROBLEMS.md-style 50-digit closed form, README): theta3' = -3.40e6 rad/s
+    # exact (docs/worked_examples.md-style 50-digit closed form, README): theta3' = -3.40e6 rad/s
     value, bound = float(rows["dtheta3/dt"][0]), float(rows["dtheta3/dt"][1])
     assert rows["dtheta3/dt"][0] == "-3.4e+06" and abs(value - -3401211.6) <= bound
 

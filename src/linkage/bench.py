@@ -22,7 +22,7 @@ from typing import Any
 
 QUICK_TOLERANCES = (1e-3, 1e-8, 1e-13)
 FULL_TOLERANCES = (1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14)
-PROBLEMS = ("seed002", "quadratic", "fourbar", "rapier")
+PROBLEMS = ("freudenstein", "quadratic", "fourbar", "rapier")
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,7 @@ def scalar_problem(name: str) -> dict[str, Any]:
     from .problems.catalog import BENCH_SCALAR, entry
 
     e = entry(BENCH_SCALAR[name])
-    if e.equation is None:  # the seed-002 four-bar equation at alpha = 70 deg
+    if e.equation is None:  # the Freudenstein four-bar equation at alpha = 70 deg
         d = mp.pi / 180
         with mp.workdps(40):
             a = 70 * d
@@ -290,8 +290,8 @@ def count_measurements(problems: Sequence[str], tolerances: Sequence[float]) -> 
     """How many measurements ``measure`` will make (for a progress bar)."""
     total = 0
     for name in problems:
-        spec = scalar_problem(name) if name in ("seed002", "quadratic") else system_problem(name)
-        contenders = (scalar_contenders(spec, 1e-6) if name in ("seed002", "quadratic")
+        spec = scalar_problem(name) if name in ("freudenstein", "quadratic") else system_problem(name)
+        contenders = (scalar_contenders(spec, 1e-6) if name in ("freudenstein", "quadratic")
                       else system_contenders(name, spec, 1e-6))
         total += len(contenders) * len(tolerances)
     return total
@@ -306,11 +306,11 @@ def measure(
 ) -> list[Measurement]:
     out = []
     for name in problems:
-        spec = scalar_problem(name) if name in ("seed002", "quadratic") else system_problem(name)
+        spec = scalar_problem(name) if name in ("freudenstein", "quadratic") else system_problem(name)
         for tol in tolerances:
             contenders = (
                 scalar_contenders(spec, tol)
-                if name in ("seed002", "quadratic")
+                if name in ("freudenstein", "quadratic")
                 else system_contenders(name, spec, tol)
             )
             for label, call, summarise in contenders:
@@ -476,11 +476,13 @@ def interleaved(fns: dict[str, Callable[[], Any]], repeats: int) -> dict[str, tu
 TARGETS = (
     # (target, ratio label, numerator, denominator, bound: met when ratio <= bound, or >= -bound)
     ("1. scalar Newton, history off, within 2x of the hand loop", "linkage / hand",
-     ("seed002", "linkage newton (history off)"), ("seed002", "hand-written Newton (10 lines)"), 2.0),
+     ("freudenstein", "linkage newton (history off)"),
+     ("freudenstein", "hand-written Newton (10 lines)"), 2.0),
     ("1. scalar Newton, history on, within 3x of the hand loop", "linkage / hand",
-     ("seed002", "linkage newton (history on)"), ("seed002", "hand-written Newton (10 lines)"), 3.0),
+     ("freudenstein", "linkage newton (history on)"),
+     ("freudenstein", "hand-written Newton (10 lines)"), 3.0),
     ("1. scalar Newton at least 10x faster than scipy root_scalar newton", "scipy / linkage",
-     ("seed002", "scipy root_scalar newton"), ("seed002", "linkage newton (history off)"), -10.0),
+     ("freudenstein", "scipy root_scalar newton"), ("freudenstein", "linkage newton (history off)"), -10.0),
     ("2. four-bar Newton (user F, J), history off, within 2x of hand 2x2 Newton", "linkage / hand",
      ("fourbar", "linkage newton, callables F and J (history off)"),
      ("fourbar", "hand-written 2x2 Newton (Cramer)"), 2.0),

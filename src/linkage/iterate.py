@@ -28,8 +28,8 @@ Stopping tests run after every step, in this fixed order (first match wins):
    rounding-level steps, while still above the tolerance            -> ``PRECISION_LIMIT``;
 8. the iteration cap                                                -> ``MAX_ITER``.
 
-The step test mirrors seed 001 section 3.9 (epsilon_s on the step, epsilon_e on the
-residual) and, with ``ftol=None``, reproduces the seed-002 tables row for row.
+The step test mirrors the textbook section 3.9 (epsilon_s on the step, epsilon_e on the
+residual) and, with ``ftol=None``, reproduces the Freudenstein tables row for row.
 Recording is off unless asked for: with ``record=False`` no row is built. A recorded
 history has a fixed ceiling: the first ``HISTORY_HEAD`` and the last ``HISTORY_TAIL`` rows
 are kept and the count of rows left out between them is reported.

@@ -3,7 +3,8 @@ twin side by side. Every loop calls these (the generic loop, the lean loops, the
 and design engines); tests/test_batch_parity.py holds each twin equal to its scalar on
 random inputs, NaN and infinities included.
 
-A system of loop equations has converged (PROBLEMS.md P3, seed 001 section 3.9) when the
+A system of loop equations has converged (worked example P3, docs/worked_examples.md, the textbook
+section 3.9) when the
 step just taken and the residual it was taken from are both within tolerance, measured
 so that the answer does not depend on the mechanism's size or units:
 

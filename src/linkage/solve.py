@@ -624,7 +624,7 @@ def solve_system(
     (for instance ``linkage.load_mechanism(path).problem()``), which supplies the
     Jacobian, names, units and a default ``x0``. ``x0`` is in internal units (radians).
     Converges when max|dq| <= tol + rtol max|q| and max|Phi| <= ftol (ftol defaults to
-    tol), as in PROBLEMS.md P3. For a mechanism both are relative to its size
+    tol), as in worked example P3, docs/worked_examples.md. For a mechanism both are relative to its size
     (``problem.length_scale``, its longest length): Phi and length steps are compared
     with tol times that size, so units do not change the answer, and tolerances above
     MAX_RELATIVE_TOL are refused. ``damped`` (default) globalises Newton (see

@@ -7,7 +7,7 @@ Families (expected outcome in brackets; a deviation is counted when it does not 
    28, 1997), plus multiple roots, a jump and a pole inside a bracket. [Every method
    either converges to the reference root, or stops with a named reason; at a jump or a
    pole no method may claim a root.]
-2. ``fourbar-equation`` and ``fourbar``: random seed-002 input-output equations (closed
+2. ``fourbar-equation`` and ``fourbar``: random Freudenstein input-output equations (closed
    form for both roots) and random four-bar loop systems, link ratios 1e-3..1e3,
    absolute scales 1e-6..1e6, some within 1e-8 deg of a limit position. [Converge to
    the root or branch started near, another one, or stop with a named reason.]
@@ -110,7 +110,7 @@ def fourbar_cases(rng: random.Random, count: int) -> list[dict[str, Any]]:
 
 
 def fourbar_equation_cases(rng: random.Random, count: int) -> list[Case]:
-    """Random seed-002 equations: (R2 + cos a) cos phi + sin a sin phi = R1 cos a + R3, so
+    """Random Freudenstein equations: (R2 + cos a) cos phi + sin a sin phi = R1 cos a + R3, so
     phi = atan2(sin a, R2 + cos a) +- acos(K / sqrt(A^2 + B^2)) in closed form; some
     within 1e-8 deg of the limit where the two roots merge."""
     from .problems.freudenstein import fourbar_equation
@@ -161,7 +161,7 @@ def fourbar_equation_cases(rng: random.Random, count: int) -> list[Case]:
 
 
 def _mp_fourbar_roots(alpha: float, r1: float, r2: float, r3: float) -> tuple[float, float] | None:
-    """Both roots (deg) of the seed-002 equation in closed form, at 40 digits, from the
+    """Both roots (deg) of the Freudenstein equation in closed form, at 40 digits, from the
     exact double inputs: phi = atan2(B, A) +- acos(K / sqrt(A^2 + B^2))."""
     import mpmath as mp
 
@@ -227,7 +227,7 @@ def tiny_tol_cases() -> list[Case]:
         out.append(
             Case(
                 "tiny-tol",
-                f"seed-002 four-bar, tol {tol:.2g}",
+                f"Freudenstein four-bar, tol {tol:.2g}",
                 *_fourbar_fd(),
                 (50.0, 60.0),
                 50.0,

@@ -1,14 +1,14 @@
-"""Function generation: seed 002's equation run backwards (Freudenstein's synthesis).
+"""Function generation: the student report's equation run backwards (Freudenstein's synthesis).
 
 The seed solves R1 cos(alpha) - R2 cos(phi) + R3 - cos(alpha - phi) = 0 for phi given the
 constants. Here the constants are the unknowns: a function y = f(x) over LO..HI is mapped
 linearly onto the input angle alpha (LO -> A0, HI -> A1) and the output angle phi
-(f(LO) -> P0, f(HI) -> P1), both in the seed's convention (alpha at O2, phi at O4, from
+(f(LO) -> P0, f(HI) -> P1), both in the student report's convention (alpha at O2, phi at O4, from
 the line O4 -> O2), and at each precision point the equation is linear in (R1, R2, R3).
 Three points give a 3x3 system; more a least-squares fit by orthogonal factorisation.
 
 The linkage found is then analysed as a user's would be: the input-output equation is
-followed with continuation (kinematics.equation_sweep, the seed's own solver) over the
+followed with continuation (kinematics.equation_sweep, the four-bar equation's own solver) over the
 whole x range on the branch through the first precision point, and its output compared
 with the function asked for (the structural error). Defects are named, never hidden.
 
@@ -650,7 +650,7 @@ def _zero_between(errs: Sequence[float], xs: Sequence[float], x0: float, x1: flo
 
 
 def follow(design: Design, xs: Sequence[float], first: PrecisionPoint) -> list[float | None]:
-    """The generated phi (deg, the equation's convention) at each x, by the seed's solver
+    """The generated phi (deg, the equation's convention) at each x, by the four-bar equation's solver
     (Newton with continuation, kinematics.equation_sweep) from the first precision point,
     both ways; None from the first position it cannot reach on that branch onwards (a
     limit position in between, even one narrower than the steps). Near a limit the two
@@ -1177,10 +1177,10 @@ def synthesize_function(
     samples: int = TABLE_POINTS,
 ) -> FunctionSynthesis:
     """A four-bar function generator for y = f(x) over ``x_range``, x mapped onto the input
-    angle ``alpha_range`` and y onto the output angle ``phi_range`` (degrees, seed 002's
+    angle ``alpha_range`` and y onto the output angle ``phi_range`` (degrees, the student report's
     convention), by Freudenstein's equation at ``points`` precision points spaced by
     ``spacing`` (chebyshev, uniform or optimal) or placed ``at``; analysed over the range
-    with the seed's solver. ``f``: an expression in x (as ``--function``) or a callable."""
+    with the four-bar equation's solver. ``f``: an expression in x (as ``--function``) or a callable."""
     try:
         req = make_request(f, x_range, alpha_range, phi_range, points=points, spacing=spacing, at=at,
                            ground=ground, min_transmission=min_transmission, table_points=samples)

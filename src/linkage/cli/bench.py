@@ -19,8 +19,8 @@ def bench(
     *,
     quick: Annotated[bool, typer.Option("--quick", help="Two problems, three tolerances, short "
                      "timings (about 10 seconds).")] = False,
-    problem: Annotated[Optional[list[str]], typer.Option(help="seed002, quadratic, fourbar, rapier "
-                       "(repeatable; default: all, or seed002 and fourbar with --quick).")] = None,
+    problem: Annotated[Optional[list[str]], typer.Option(help="freudenstein, quadratic, fourbar, rapier "
+                       "(repeatable; default: all, or freudenstein and fourbar with --quick).")] = None,
     repeats: Annotated[Optional[int], typer.Option(help="Timed batches per measurement "
                        "(default 3, or 5 without --quick).")] = None,
     cold: Annotated[bool, typer.Option("--cold/--no-cold", help="Also time cold starts of the "
@@ -49,7 +49,7 @@ def bench(
 
     out_fmt = choose_format(fmt, output)
     check_paths([], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})
-    names = problem or (["seed002", "fourbar"] if quick else list(PROBLEMS))
+    names = problem or (["freudenstein", "fourbar"] if quick else list(PROBLEMS))
     for name in names:
         if name not in PROBLEMS:
             raise InputError(f"unknown problem {name!r}; choose from {', '.join(PROBLEMS)}")

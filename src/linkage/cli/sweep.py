@@ -176,7 +176,8 @@ def sweep(
 def sweep_equation(a: float, b: float, step: float | None, points: int | None, method: str,
                    r1: str | None, r2: str | None, r3: str | None, links: Any, tol: float, out_fmt: str,
                    output: Path | None, digits: int, plot: Path | None) -> None:
-    """The four-bar input-output equation over alpha (seed 002's table): the options
+    """The four-bar input-output equation over alpha (the student report's table,
+    docs/worked_examples.md P2): the options
     checked here, the walk in :func:`linkage.kinematics.equation_sweep.equation_sweep`."""
     from ..kinematics.equation_sweep import equation_sweep
     from ..kinematics.sweep import driver_values

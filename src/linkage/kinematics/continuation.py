@@ -1,6 +1,6 @@
 """Continuation: one position of a sweep from the last, on one assembly branch.
 
-Each position starts from the previous solution (seed 001, section 3.9): the tangent
+Each position starts from the previous solution (the textbook section, section 3.9): the tangent
 predictor dq/dv = -J^-1 dPhi/dv, then Newton. A solve that fails, or lands on another
 branch, is retried from the last solved position in 2, 4, ... 64 sub-steps; a step is
 accepted only on the target branch and close to the prediction

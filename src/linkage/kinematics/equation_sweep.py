@@ -1,4 +1,5 @@
-"""The four-bar input-output equation over alpha (seed 002's table): each alpha solved
+"""The four-bar input-output equation over alpha (the student report's table (docs/worked_examples.md
+P2)): each alpha solved
 from the previous alpha's root, walking along the tangent."""
 
 from __future__ import annotations
@@ -20,7 +21,8 @@ class EquationRow(NamedTuple):
 
 def equation_sweep(values: Sequence[float], rs: tuple[float, float, float], method: str,
                    tol: float, seed: tuple[float, float] | None = None) -> list[EquationRow]:
-    """The four-bar input-output equation over alpha: seed 002's table, each alpha solved
+    """The four-bar input-output equation over alpha: the student report's table
+    (docs/worked_examples.md P2), each alpha solved
     from the previous alpha's root (the first from the equation's own default start, or
     walked from ``seed``, an (alpha, phi) root on the branch to follow).
 
@@ -56,7 +58,7 @@ def equation_sweep(values: Sequence[float], rs: tuple[float, float, float], meth
                 return solve_scalar(problem, bracket=problem.guess, **kw)
             else:
                 # an open method starts inside the first bracket with a sign change, so
-                # every method anchors on the same root (the seed's branch)
+                # every method anchors on the same root (the starting root's branch)
                 guess = 0.5 * (problem.guess[0] + problem.guess[1])
         if method in BRACKETING:
             width = 0.5

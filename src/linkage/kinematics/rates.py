@@ -1,7 +1,7 @@
 """Velocity and acceleration of every unknown, joint and named point, at one position.
 
 Every vector of every loop is ``sign * r * e^(i theta)``. Differentiating the loops in
-time (PROBLEMS.md P7), with ' for d/dt:
+time (worked example P7, docs/worked_examples.md), with ' for d/dt:
 
     velocity:      sum sign (r' + i r theta') e^(i theta) = 0
                    -> J q' = -(dPhi/dv) v'

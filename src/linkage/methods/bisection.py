@@ -3,10 +3,12 @@
 Update: c = (a + b) / 2; keep [a, c] if f(a) and f(c) differ in sign, else [c, b].
 Order 1, rate 1/2: e_{k+1} = e_k / 2 with e_k = (b_k - a_k) / 2. One evaluation per
 step (two to start). A-priori count: (b - a) / 2^(n+1) <= tol gives
-n >= log2((b - a) / tol) - 1 (seed 002, bisection convergence analysis).
+n >= log2((b - a) / tol) - 1 (the student report's bisection convergence analysis,
+docs/worked_examples.md P2).
 Never fails on a valid bracket; it finds *a* root of odd multiplicity, or a pole
 where f changes sign (the residual then does not shrink: check it).
-Rows follow seed 002: the interval being bisected, its midpoint c, e = (b - a) / 2.
+Rows follow the student report (docs/worked_examples.md P2): the interval being bisected, its midpoint
+c, e = (b - a) / 2.
 """
 
 from __future__ import annotations

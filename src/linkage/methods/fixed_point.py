@@ -3,11 +3,12 @@
 Linear convergence with rate |g'(r)| when |g'(r)| < 1 (contraction); diverges or
 oscillates when |g'(r)| > 1. One evaluation of g per step; f at the new point enters the
 stopping tests only when a residual tolerance is given (otherwise the table computes
-it for display), so recording never changes where a run stops. For the seed-002 four-bar,
+it for display), so recording never changes where a run stops. For the Freudenstein four-bar,
 g(phi) = acos(u(phi)) with u = (R1 cos(alpha) + R3 - cos(alpha - phi)) / R2, and
-g'(phi) = sin(alpha - phi) / (R2 sqrt(1 - u^2)) ~ 0.1275 at the root (seed 002,
+g'(phi) = sin(alpha - phi) / (R2 sqrt(1 - u^2)) ~ 0.1275 at the root (the student report,
 fixed-point analysis). Fails with a domain error when |u| > 1 (acos undefined).
-Rows follow seed 002: i, x_i, u(x_i) (when the problem has u), x_{i+1}, f(x_{i+1}),
+Rows follow the student report (docs/worked_examples.md P2): i, x_i, u(x_i) (when the problem has u),
+x_{i+1}, f(x_{i+1}),
 g'(x_i), error = x_i - x_{i+1} (signed).
 """
 

@@ -1,11 +1,11 @@
-"""Levenberg-Marquardt: minimise sum Phi_i(q)^2, the analogue of the seed's spreadsheet solver.
+"""Levenberg-Marquardt: minimise sum Phi_i(q)^2, the analogue of the textbook section's spreadsheet solver.
 
 Step: (J^T J + mu diag(J^T J)) dq = -J^T Phi, accepted only if it lowers the sum of
 squares; mu shrinks by 3 after a success and doubles after a failure (Marquardt,
 SIAM J. Appl. Math. 11, 1963). Near a zero-residual solution it behaves like
 Gauss-Newton (fast, about quadratic); where the loops cannot close it settles on a
 least-squares point with residual above the tolerance, and the loop then reports
-``local_minimum`` rather than success (seed 001: the spreadsheet's Solver stops at a
+``local_minimum`` rather than success (the textbook section: the spreadsheet's Solver stops at a
 minimum, which is a solution only if the minimum is zero). Where a closed form proves
 that no assembly exists, the solve reports ``no_solution`` instead.
 """

@@ -1,12 +1,13 @@
 """Newton's method: x_{i+1} = x_i - f(x_i) / f'(x_i).
 
-Order 2 near a simple root: e_{i+1} ~ (f''(r) / (2 f'(r))) e_i^2 (seed 002, Newton
-convergence analysis; seed 001 section 3.9, eq. 4). Two evaluations per step (f and
+Order 2 near a simple root: e_{i+1} ~ (f''(r) / (2 f'(r))) e_i^2 (the student report, Newton
+convergence analysis; the textbook section 3.9, eq. 4). Two evaluations per step (f and
 f'), one more to start. Fails at f'(x) = 0 (stalls), near a local extremum (huge
 jumps, P1 with x0 = 2.5), at inflection points (may cycle: x^3 - 2x + 2 from 0) and
 where f flattens toward infinity (atan(x) from 1.5 diverges); multiple roots reduce
 it to linear convergence. Which root it finds depends on x0 (P1).
-Rows follow seed 002: i, x_i, f(x_i), f'(x_i), x_{i+1}, |x_{i+1} - x_i|.
+Rows follow the student report (docs/worked_examples.md P2): i, x_i, f(x_i), f'(x_i), x_{i+1}, |x_{i+1}
+- x_i|.
 """
 
 from __future__ import annotations
@@ -89,7 +90,7 @@ def newton_lean(problem: ScalarProblem, x0: float, tol: float, rtol: float, ftol
     (:mod:`linkage.iterate`, tests 1-8, in order) written out without states or method
     dispatch. Gives the generic loop's status, root, iteration count and, when ``rows``
     (an :class:`~linkage.iterate.Rows`) is given, its table row for row
-    (tests/test_compile.py checks both on the stress battery; the seed tables use it).
+    (tests/test_compile.py checks both on the stress battery; the worked examples' tables use it).
 
     Returns (x, f(x), last error, status, detail, iterations); ``certify(x, fx, width)``
     decides a small step as in the generic loop.

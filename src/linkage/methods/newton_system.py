@@ -1,8 +1,10 @@
 """Newton-Raphson for loop-closure systems: solve J(q_k) dq = -Phi(q_k), q_k+1 = q_k + dq.
 
-Quadratic convergence near a solution where J is nonsingular (seed 001 section 3.9,
-eq. 7; PROBLEMS.md P3). One residual and one Jacobian evaluation per step; with the
-Jacobian by forward differences (``newton-fd``, seed 000's recipe: perturb one
+Quadratic convergence near a solution where J is nonsingular (the textbook section 3.9,
+eq. 7; worked example P3, docs/worked_examples.md). One residual and one Jacobian evaluation per step;
+with the
+Jacobian by forward differences (``newton-fd``, the course notes' recipe, docs/worked_examples.md P3:
+perturb one
 coordinate by h, take (Phi(q + h e_j) - Phi(q)) / h as column j, restore it), n + 1
 residual evaluations and order falling toward linear as h grows. By default the step
 is globalised (``damped``, see :class:`NewtonSystem`): taken whole when it lowers
@@ -47,7 +49,8 @@ def max_abs(v: Any) -> float:
 
 def fd_jacobian(problem: SystemProblem, q: list[float], phi: list[float],
                 h: float | None) -> list[list[float]]:
-    """Forward differences, one coordinate at a time; columns as in seed 000."""
+    """Forward differences, one coordinate at a time; columns as in the course notes
+    (docs/worked_examples.md P3)."""
     n = len(q)
     cols = []
     for j in range(n):

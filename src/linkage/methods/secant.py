@@ -1,10 +1,12 @@
 """Secant method: x_{i+1} = x_i - f(x_i) (x_i - x_{i-1}) / (f(x_i) - f(x_{i-1})).
 
 Order (1 + sqrt 5) / 2 = 1.618 near a simple root:
-e_{i+1} ~ |f''(r) / (2 f'(r))|^0.618 e_i^1.618 (seed 002, secant convergence analysis).
+e_{i+1} ~ |f''(r) / (2 f'(r))|^0.618 e_i^1.618 (the student report's secant convergence analysis,
+docs/worked_examples.md P2).
 One evaluation per step, two to start; no derivative needed. Fails where the slope
 is zero (f(x_i) = f(x_{i-1})) and, like Newton, may wander to another root or diverge.
-Rows follow seed 002: row 0 is the first point; then i, x_i, f(x_i), the slope,
+Rows follow the student report (docs/worked_examples.md P2): row 0 is the first point; then i, x_i,
+f(x_i), the slope,
 x_{i+1}, |x_{i+1} - x_i|.
 """
 

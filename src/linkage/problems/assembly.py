@@ -193,7 +193,8 @@ def slider_crank_np(r2: Any, r3: Any, e: Any, t2: Any) -> tuple[list[tuple[Any, 
 
 
 def is_open(t3: float, t4: float) -> bool:
-    """A four-bar configuration is open where sin(theta4 - theta3) > 0 (PROBLEMS.md P3),
+    """A four-bar configuration is open where sin(theta4 - theta3) > 0 (worked example P3,
+    docs/worked_examples.md),
     crossed otherwise: a property of the configuration, whatever drives it (rad)."""
     return math.sin(t4 - t3) > 0.0
 

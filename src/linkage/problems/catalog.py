@@ -43,9 +43,9 @@ class CatalogEntry:
 
 
 CATALOG: tuple[CatalogEntry, ...] = (
-    CatalogEntry("quadratic-high", "x**2 - 4*x + 1", (3.0, 5.0), 5.0, 4.5, note="seed 000, x0 = 5"),
+    CatalogEntry("quadratic-high", "x**2 - 4*x + 1", (3.0, 5.0), 5.0, 4.5, note="worked example P1, x0 = 5"),
     CatalogEntry("quadratic-low", "x**2 - 4*x + 1", (0.0, 1.0), 1.0, 0.5, g="(x**2 + 1)/4",
-                 note="seed 000, x0 = 1"),
+                 note="worked example P1, x0 = 1"),
     CatalogEntry("cubic", "x**3 - 2*x - 5", (2.0, 3.0), 2.0, 3.0, note="Wallis's cubic"),
     CatalogEntry("kepler", "x - 0.8*sin(x) - 1", (0.0, 3.0), 1.0, 2.0, g="1 + 0.8*sin(x)",
                  note="Kepler's equation, e = 0.8, M = 1"),
@@ -54,8 +54,8 @@ CATALOG: tuple[CatalogEntry, ...] = (
     CatalogEntry("log", "log(x) + x - 2", (1.0, 2.0), 1.5, 2.0, g="2 - log(x)"),
     CatalogEntry("steep-atan", "atan(10*(x - 0.3))", (0.0, 1.0), 0.35, 0.4,
                  note="Newton diverges from far starts"),
-    CatalogEntry("fourbar-seed-002", None, (50.0, 60.0), 50.0, 60.0,
-                 note="seed 002 at alpha = 70 deg, phi in degrees"),
+    CatalogEntry("fourbar-alpha70", None, (50.0, 60.0), 50.0, 60.0,
+                 note="worked example P2 at alpha = 70 deg, phi in degrees"),
 )
 
 
@@ -66,7 +66,7 @@ def entry(name: str) -> CatalogEntry:
     raise KeyError(name)
 
 
-BENCH_SCALAR = {"seed002": "fourbar-seed-002", "quadratic": "quadratic-high"}
+BENCH_SCALAR = {"freudenstein": "fourbar-alpha70", "quadratic": "quadratic-high"}
 """``linkage bench``'s scalar problems: its names -> catalogue entries."""
 
 BENCH_SYSTEMS = {"fourbar": "fourbar_me581.toml", "rapier": "rapier_drive.toml"}

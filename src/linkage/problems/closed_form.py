@@ -12,7 +12,8 @@ Four-bar (names r1..r4, theta1..theta4; loop r2 e^(i t2) + r3 e^(i t3) = r1 e^(i
 r4 e^(i t4)): with theta2 or theta4 given, the free joint lies on one circle at a
 fixed distance from a known point, so it is a circle-circle intersection with two
 solutions, each labelled by the configuration rule whatever the driver: open where
-sin(theta4 - theta3) > 0 (as in PROBLEMS.md P3), crossed otherwise. With theta4 driving,
+sin(theta4 - theta3) > 0 (as in worked example P3, docs/worked_examples.md), crossed otherwise. With
+theta4 driving,
 the two solutions are the mirror images of A across the line O2-B and may carry the same
 label; the second is then keyed "open (mirror)" or "crossed (mirror)". No real
 intersection: the linkage cannot be assembled at that input. The formulas and the rules

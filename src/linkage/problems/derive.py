@@ -13,7 +13,8 @@ configuration's branch is the tuple of those signs, written ``+-`` (one characte
 two-way step). Where a name is conventional it is named in words (:func:`Derivation.name_of`):
 a loop that is a four-bar (four links of fixed length, one of them ground) is ``open``
 where the output link turns anticlockwise from the coupler (sin(theta_out - theta_coupler)
-> 0, PROBLEMS.md P3) and ``crossed`` otherwise, read with the loop as written and its
+> 0, worked example P3, docs/worked_examples.md) and ``crossed`` otherwise, read with the loop as
+written and its
 ground last: input, coupler, output. That is a property of the configuration, so it is the
 same whichever joint drives. A slider-crank loop is open where the coupler points the way
 the slide grows.

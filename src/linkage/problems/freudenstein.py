@@ -1,4 +1,5 @@
-"""The four-bar input-output equation of seed 002 (Freudenstein form), posed in degrees.
+"""The four-bar input-output equation of the student report (docs/worked_examples.md P2) (Freudenstein
+form), posed in degrees.
 
     f(phi) = R1 cos(alpha) - R2 cos(phi) + R3 - cos(alpha - phi) = 0
 
@@ -67,7 +68,7 @@ def fourbar_equation(
     r2: float = SEED_R[1],
     r3: float = SEED_R[2],
 ) -> ScalarProblem:
-    """The seed-002 equation at input angle ``alpha_deg``, unknown phi in degrees.
+    """The Freudenstein equation at input angle ``alpha_deg``, unknown phi in degrees.
 
     Supplies f, f' and f'' (per degree), the fixed-point form g(phi) = acos(u(phi))
     with u(phi) = (R1 cos(alpha) + R3 - cos(alpha - phi)) / R2, its derivative
@@ -132,7 +133,7 @@ def default_start(f: Callable[[float], float],
 
     x0 is the end whose Newton step stays inside the bracket (so open methods stay
     on the branch the bracket holds), x1 the other end; None if f never changes sign.
-    At alpha = 70 this is the seed's (50, 60).
+    At alpha = 70 this is the student report's (50, 60).
     """
     prev, fprev = 0.0, f(0.0)
     for i in range(1, 19):

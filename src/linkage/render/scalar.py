@@ -167,7 +167,7 @@ def scalar_report(problem: ScalarProblem, result: Result, conv: Convergence | No
             extra["fourbar"] = fourbar
         return result_dict(result, {problem.var: result.x}, conv.as_dict() if conv else None, extra)
 
-    # the seed's table alone: a spreadsheet or a script reads the CSV as it is (the
+    # the iteration table alone: a spreadsheet or a script reads the CSV as it is (the
     # outcome is the exit code; the convergence analysis is in the display and JSON)
     return Report(scalar_title(problem, digits, fourbar), (iterations_table(result),), blocks, document)
 

@@ -32,7 +32,7 @@ def real_angles(s: Any, alpha_deg: float, phi_deg: float) -> tuple[float, float]
 
 
 def check_command(s: Any, digits: int = 12) -> str | None:
-    """``linkage solve --links`` of the result at the first precision point: the seed's
+    """``linkage solve --links`` of the result at the first precision point: the iteration
     table for the real linkage (its own alpha and phi: + 180 for a link drawn the other
     way), started at the precision point's phi so it stays on the followed assembly."""
     k = s.linkage
@@ -107,7 +107,7 @@ def synthesis_report(s: Any, digits: int = 6, unit: str = "") -> Report:
         out: list[Block] = [
             Text(title(s), "bold"),
             Text(
-                f"Freudenstein's equation (seed 002): {EQUATION}; alpha at O2, phi at O4, "
+                f"Freudenstein's equation: {EQUATION}; alpha at O2, phi at O4, "
                 "both from the line O4 -> O2"
             ),
         ]
@@ -265,7 +265,7 @@ def design_text(s: Any, unit: str, made_by: str) -> str:
         f"# A function generator for y = {s.function} (linkage synthesize), made by:",
         f"#   {made_by}",
         f"# x {s.x_range[0]:g}..{s.x_range[1]:g} -> alpha {a0:g}..{a1:g} deg at O2; y -> phi "
-        f"{s.phi_range[0]:g}..{s.phi_range[1]:g} deg at O4 (seed 002's angles, from the line O4 -> O2).",
+        f"{s.phi_range[0]:g}..{s.phi_range[1]:g} deg at O4 (both from the line O4 -> O2).",
         f"# In this file angles are from +x (O2 -> O4): theta_crank = {_plus('alpha', shift)}, "
         f"theta_rocker = {_plus('phi', 180.0 + k.phi_shift())} (mod 360).",
         f"# Max structural error {s.max_error_deg:.6g} deg at x = {s.at_x:.6g}; {s.grashof}; "
