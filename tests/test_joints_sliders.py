@@ -89,7 +89,7 @@ def test_a_slider_can_drive(s: float) -> None:
 
 
 def rapier_drawing() -> tuple[str, dict[str, tuple[float, float]]]:
-    """Seed 001's rapier drive drawn from its vector-loop sample at 60 deg, moved by SHIFT:
+    """The rapier drive (worked example P5) drawn from its vector-loop sample at 60 deg, moved by SHIFT:
     link 4 carries B, C and D; the rapier slides along the ground's x direction carrying D
     and its tip E."""
     m = load(SAMPLES / "rapier_drive.toml")

@@ -62,7 +62,7 @@ def test_methods_reach_the_40_digit_root(entry, method):
 
 
 def test_fixed_point_rate_matches_g_prime_at_the_40_digit_root():
-    """Seed 002: |g'(r)| is about 0.1275; the observed ratio of successive errors too."""
+    """Worked example P2: |g'(r)| is about 0.1275; the observed ratio of successive errors too."""
     p = fourbar_equation(70.0)
     entry = next(e for e in CATALOG if e.equation is None)
     r = reference_root(entry)

@@ -78,7 +78,7 @@ def test_rapier_drive_sweeps_a_full_turn_and_reports_the_stroke(cli):
 
 
 def test_a_large_step_does_not_jump_branches():
-    """Seed 001: too large a step can land on the other branch; the sweep halves it."""
+    """Worked example P6: too large a step can land on the other branch; the sweep halves it."""
     m = load_mechanism(SAMPLES / "fourbar_me581.toml")
     coarse = sweep(m, driver_values(-110, 110, 55, None))
     assert {p.branch for p in coarse.positions} == {"open"}

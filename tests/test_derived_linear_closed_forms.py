@@ -1,4 +1,4 @@
-"""Issue 19, a second reading: regressions for the defects it found, each named after
+"""Linear closed forms derived from the loops (one assembly): regressions, each named after
 the defect. References are written here independently: a linear closed form solved by
 hand (s E + t F = r e^(i theta), Cramer), and the refusals solve already gives.
 """

@@ -1,4 +1,4 @@
-"""What a person sees from linkage synthesize (issue 22 look): the max error of a linkage
+"""What a person sees from linkage synthesize: the max error of a linkage
 that stops at a limit position, the check line, the design file's comments and the
 messages when there is no linkage."""
 

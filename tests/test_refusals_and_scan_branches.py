@@ -1,4 +1,5 @@
-"""Regressions from the second reading of issue 18, each named after what it found."""
+"""Refusals at every front door, and the assembly a scan follows: regressions, each named
+after what it found."""
 
 from __future__ import annotations
 

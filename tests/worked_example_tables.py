@@ -61,7 +61,7 @@ FIXED_POINT = (
 )
 
 
-# Seed 000 (course notes): Newton on f(x) = x^2 - 4x + 1, columns k, x, f(x), f'(x), f/f'.
+# Worked example P1 (course notes): Newton on f(x) = x^2 - 4x + 1, columns k, x, f(x), f'(x), f/f'.
 # Rows 1-2 are restated in worked example P1, docs/worked_examples.md. The notes' row 4 for x0 = 1 evaluates f at the
 # rounded x = 0.2679 (f = 0.00017, f' = -3.4642, f/f' = -0.00005); at full precision
 # x = 0.267857, f = 0.00032 and f' = -3.46429, so for that row only x is compared.

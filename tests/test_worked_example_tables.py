@@ -17,7 +17,7 @@ import pytest
 from conftest import assert_rows, matches
 from linkage import fourbar_equation, solve_scalar
 from linkage.problems.expression import equation_problem
-from seed_tables import (
+from worked_example_tables import (
     BISECTION,
     FIXED_POINT,
     NEWTON,

@@ -1,4 +1,5 @@
-"""Second reading of linkage synthesize (issue 22): each test failed before its fix.
+"""Which branch linkage synthesize follows (least squares, limits, change points, the
+search's twin of each rule): each test failed before its fix.
 
 The reference here is the linkage's own geometry at 40 digits (mpmath): R from the
 precision points, the links from R, the output where the coupler's circle about A meets

@@ -1,5 +1,6 @@
-"""What a person sees after issue 20 (one report, one writer registry): each test is named
-after what was wrong when the output was read at 80 columns, piped and in files."""
+"""The layout of reports as a person reads them (one report, one writer registry): each
+test is named after what was wrong when the output was read at 80 columns, piped and in
+files."""
 
 from __future__ import annotations
 

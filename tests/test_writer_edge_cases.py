@@ -1,5 +1,5 @@
-"""Issue 20, second reading: defects found in the writer registry (render/writers.py), each
-pinned by a test that failed before its fix."""
+"""Edge cases of the writer registry (render/writers.py), each pinned by a test that
+failed before its fix."""
 
 from __future__ import annotations
 

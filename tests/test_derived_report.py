@@ -1,4 +1,4 @@
-"""What a person sees of the derived closed forms (issue 19): headers and titles that read
+"""What a person sees of the derived closed forms: headers and titles that read
 on one line where the terminal has room, --branch's help and refusals in the same words in
 solve and sweep, the old closed_form key's refusal saying what to do, and a six-bar sweep
 saying which loop its one transmission column is."""
