@@ -281,11 +281,11 @@ def test_solve_sweep_and_draw_run_on_each_sample(cli, tmp_path, name: str) -> No
     assert (tmp_path / "x.png").stat().st_size > 1000
 
 
-def test_the_readme_shows_the_sample_beside_its_drawing() -> None:
-    """The README's mechanism section leads with the four-bar's file beside its picture:
-    that file is the sample's (its comments and description aside)."""
-    readme = (SAMPLES.parent / "README.md").read_text()
-    cell = readme.split('<td width="50%"><img src="docs/fourbar_me581_joints.png"', 1)[1]
+def test_the_mechanisms_page_shows_the_sample_beside_its_drawing() -> None:
+    """docs/mechanisms.md leads with the four-bar's file beside its picture: that file is the
+    sample's (its comments and description aside)."""
+    readme = (SAMPLES.parent / "docs" / "mechanisms.md").read_text()
+    cell = readme.split('<td width="50%"><img src="fourbar_me581_joints.png"', 1)[1]
     shown = tomllib.loads(cell.split("```toml\n", 1)[1].split("```", 1)[0])
     sample = tomllib.loads((SAMPLES / "fourbar_me581_joints.toml").read_text())
     sample.pop("description")

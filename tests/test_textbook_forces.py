@@ -101,11 +101,12 @@ def test_the_file_holds_the_books_data() -> None:
     assert {k: v.mass for k, v in loads.masses.items()} == {"crank": 1.0, "rod": 1.0, "slider": 1.0}
 
 
-def test_readme_shows_what_the_command_prints(capsys) -> None:
-    """The README's figures for the example are the output of the command shown beside them."""
+def test_loads_page_shows_the_textbook_example_as_printed(capsys) -> None:
+    """The figures of docs/loads.md for the example are the output of the command shown beside
+    them."""
     from linkage.cli import run_cli
 
-    readme = (ROOT / "README.md").read_text()
+    readme = (ROOT / "docs" / "loads.md").read_text()
     section = " ".join(readme.split("**A textbook's printed answer.**", 1)[1].split("\n\n", 1)[0].split())
     assert "linkage solve docs/marghitu_slider_crank.toml --speed 1 --gravity 10" in section
     assert run_cli(["solve", str(MARGHITU), "--speed", "1", "--gravity", "10", "-f", "plain"]) == 0
