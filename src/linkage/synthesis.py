@@ -801,6 +801,21 @@ def _synthesize(req: Request, xs: Sequence[float]) -> FunctionSynthesis:
     return result
 
 
+def drawn_position(s: FunctionSynthesis) -> tuple[float, float] | None:
+    """(alpha, phi) in the equation's convention of the reported linkage at precision
+    point 1, phi as the linkage generates it there (the followed value of the report's
+    curve, which a mechanism file of the linkage is drawn at): with more than three points
+    the fit passes near the desired phi, not through it, and a drawing at the desired phi
+    would be another linkage. None where the linkage has no position there."""
+    if s.linkage is None or not s.precision_points:
+        return None
+    p = s.precision_points[0]
+    c = next((c for c in s.curve if c.x == p.x), None)
+    if c is None or c.phi_generated_deg is None:
+        return None
+    return p.alpha_deg, c.phi_generated_deg
+
+
 def dense_curve(s: FunctionSynthesis, n: int = 401) -> list[CurvePoint]:
     """The structural error at ``n`` even steps of x (with the table's points, extrema and
     precision points), by the same solver as the table: for a plot."""
