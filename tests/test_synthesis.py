@@ -66,15 +66,24 @@ def _sense(k, alpha_real: float, phi_real: float) -> float:
 FUNCTIONS = ["log10(x)", "x**2", "exp(x)", "sin(x)", "1/x", "sqrt(x)", "x**1.5", "cos(x)"]
 
 
-@pytest.mark.parametrize("seed", range(40))
-def test_precision_points_satisfy_the_equation_against_40_digits(seed: int) -> None:
-    rng = random.Random(seed)
+Range = tuple[float, float]
+
+
+def random_task(rng: random.Random) -> tuple[str, Range, Range, Range]:
+    """A function, an x range and angle ranges of 30 to 150 deg either way, drawn by ``rng``."""
     fn = rng.choice(FUNCTIONS)
     lo = rng.uniform(0.2, 2.0)
     hi = lo + rng.uniform(0.3, 1.5)
     a0, p0 = rng.uniform(-180, 180), rng.uniform(-180, 180)
     ar = (a0, a0 + rng.choice([-1, 1]) * rng.uniform(30, 150))
     pr = (p0, p0 + rng.choice([-1, 1]) * rng.uniform(30, 150))
+    return fn, (lo, hi), ar, pr
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_precision_points_satisfy_the_equation_against_40_digits(seed: int) -> None:
+    rng = random.Random(seed)
+    fn, (lo, hi), ar, pr = random_task(rng)
     n = rng.choice([3, 3, 4, 6])
     s = synthesize_function(fn, (lo, hi), ar, pr, points=n)
     assert len(s.precision_points) == n

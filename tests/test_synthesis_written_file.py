@@ -18,10 +18,10 @@ from linkage.files import parse_toml
 from linkage.problems.freudenstein import branch_root
 from linkage.render.synthesis import real_angles, write_design
 from linkage.synthesis import FunctionSynthesis, drawn_position, synthesize_function
+from test_synthesis import random_task
 
 EPS = 2.220446049250313e-16
 TOL_DEG = 1e-9
-FUNCTIONS = ["log10(x)", "x**2", "exp(x)", "sin(x)", "1/x", "sqrt(x)", "x**1.5", "cos(x)"]
 
 
 def _rounding_deg(s: FunctionSynthesis, alpha_deg: float) -> float:
@@ -95,12 +95,7 @@ def check_against_report(s: FunctionSynthesis, path: Path) -> dict[str, int]:
 
 
 def _task(rng: random.Random) -> tuple[tuple, dict]:
-    fn = rng.choice(FUNCTIONS)
-    lo = rng.uniform(0.2, 2.0)
-    hi = lo + rng.uniform(0.3, 1.5)
-    a0, p0 = rng.uniform(-180, 180), rng.uniform(-180, 180)
-    ar = (a0, a0 + rng.choice([-1, 1]) * rng.uniform(30, 150))
-    pr = (p0, p0 + rng.choice([-1, 1]) * rng.uniform(30, 150))
+    fn, (lo, hi), ar, pr = random_task(rng)
     spacing = rng.choice(["chebyshev", "uniform", "optimal", "at"])
     options: dict = {"ground": rng.choice([1.0, 100.0, 0.37])}
     if spacing == "at":
