@@ -729,14 +729,13 @@ def test_range_narrower_than_rounding_is_judged_by_the_rounding_it_carries() -> 
     """The bound is rounding's own (eps |x| / width, eps |y| / width of y, times the angle
     spans), checked against 40 digits: a range at ten times the bound is accepted and its
     precision points are those of exact arithmetic to that bound."""
-    from linkage.synthesis import BRANCH_TOL_DEG, rounding_deg
+    from linkage.synthesis import BRANCH_TOL_DEG, make_request, rounding_deg
 
-    f = lambda v: v * v  # noqa: E731
-    assert rounding_deg(f, (1.0, 2.0), (1.0, 4.0), (90.0, 150.0), (0.0, 90.0)) == pytest.approx(
+    assert rounding_deg(make_request("x**2", (1, 2), (90, 150), (0, 90))) == pytest.approx(
         2.0**-52 * (2.0 / 1.0 + 4.0 / 3.0) * 90.0
     )
     s = synthesize_function("x**2", (1.0, 1.0 + 1e-6), (90, 150), (0, 90))
-    noise = rounding_deg(f, s.x_range, s.request.y_ends, (90.0, 150.0), (0.0, 90.0))
+    noise = rounding_deg(s.request)
     assert noise < BRANCH_TOL_DEG / 10
     mpmath.mp.dps = 40
     lo, hi = (mpmath.mpf(v) for v in s.x_range)

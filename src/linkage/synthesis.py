@@ -304,8 +304,7 @@ def make_request(
         raise InputError(
             f"f({xr[0]:g}) = f({xr[1]:g}) = {y_ends[0]:g}: the ends of y must differ to map onto --phi"
         )
-    check_conditioning(fn, xr, y_ends, ar, pr)
-    return Request(
+    return check_conditioning(Request(
         fn,
         text,
         xr,
@@ -318,56 +317,45 @@ def make_request(
         float(min_transmission),
         table_points,
         y_ends,
-    )
+    ))
 
 
 CONDITIONING_SAMPLES = 11
 """Points of x (ends included) at which |y| is read for :func:`rounding_deg`."""
+EPS = 2.0**-52
+"""The spacing of doubles at 1 (machine epsilon)."""
 
 
-def rounding_deg(
-    f: Callable[[float], float],
-    x_range: tuple[float, float],
-    y_ends: tuple[float, float],
-    alpha_range: tuple[float, float],
-    phi_range: tuple[float, float],
-) -> float:
+def rounding_deg(req: Request) -> float:
     """How far rounding alone moves a precision point's angles (deg), to first order. x is
     known to eps |x| and y = f(x) to eps |y| (its evaluation) plus eps |x f'(x)| (x's own
     rounding carried through f, whose condition is |x f'(x) / f(x)|; f' taken as the
     range's secant). Mapped onto the angles, t = (x - LO) / (HI - LO) then carries
     eps max|x| / (HI - LO) and u = (y - f(LO)) / (f(HI) - f(LO)) that plus
     eps max|y| / |f(HI) - f(LO)|; times the spans of alpha and phi."""
-    lo, hi = x_range
-    eps = 2.0**-52
-    width_x, width_y = hi - lo, abs(y_ends[1] - y_ends[0])
-    size_x = max(abs(lo), abs(hi))
+    (lo, hi), (y0, y1) = req.x_range, req.y_ends
+    (a0, a1), (p0, p1) = req.alpha_range, req.phi_range
     n = CONDITIONING_SAMPLES
-    size_y = max(abs(_value(f, lo + (hi - lo) * i / (n - 1))) for i in range(n))
-    t_noise = eps * size_x / width_x
-    u_noise = t_noise + eps * size_y / width_y
-    return max(t_noise * abs(alpha_range[1] - alpha_range[0]), u_noise * abs(phi_range[1] - phi_range[0]))
+    size_y = max(abs(_value(req.f, lo + (hi - lo) * i / (n - 1))) for i in range(n))
+    t_noise = EPS * max(abs(lo), abs(hi)) / (hi - lo)
+    u_noise = t_noise + EPS * size_y / abs(y1 - y0)
+    return max(t_noise * abs(a1 - a0), u_noise * abs(p1 - p0))
 
 
-def check_conditioning(
-    f: Callable[[float], float],
-    x_range: tuple[float, float],
-    y_ends: tuple[float, float],
-    alpha_range: tuple[float, float],
-    phi_range: tuple[float, float],
-) -> None:
-    """Refuse a range so narrow, for this f, that rounding moves the precision points'
-    angles (:func:`rounding_deg`) by more than BRANCH_TOL_DEG, the distance to which a
-    point is judged on its branch: the fit would be a fit of rounding noise."""
-    noise = rounding_deg(f, x_range, y_ends, alpha_range, phi_range)
+def check_conditioning(req: Request) -> Request:
+    """``req``, unless its range is so narrow, for its f, that rounding moves the precision
+    points' angles (:func:`rounding_deg`) by more than BRANCH_TOL_DEG, the distance to
+    which a point is judged on its branch: the fit would be a fit of rounding noise."""
+    noise = rounding_deg(req)
     if noise > BRANCH_TOL_DEG:
-        (lo, hi), (y0, y1) = x_range, y_ends
+        (lo, hi), (y0, y1) = req.x_range, req.y_ends
         raise InputError(
             f"--x {lo!r}:{hi!r} is too narrow for this function: x spans {hi - lo:.3g} and "
-            f"y {abs(y1 - y0):.3g}, so rounding (machine epsilon {2.0**-52:.3g}) moves the precision "
+            f"y {abs(y1 - y0):.3g}, so rounding (machine epsilon {EPS:.3g}) moves the precision "
             f"points' angles by up to {noise:.3g} deg, more than the {BRANCH_TOL_DEG:g} deg a point "
             "is judged to; widen --x"
         )
+    return req
 
 
 def _value(f: Callable[[float], float], x: float) -> float:
