@@ -15,7 +15,8 @@ with the function asked for (the structural error). Defects are named, never hid
 The rules live here once, each with its numpy twin where the search (many candidates at
 a time) needs one: the precision points (:func:`precision_xs`), the linear system
 (:func:`solve_coefficients`, :func:`solve_coefficients_np`), the linkage of a solution
-(:func:`linkage_of`), and the branch's closed form (freudenstein.branch_root and its twin).
+(:func:`linkage_of`), the branch's closed form (freudenstein.branch_root and its twin) and
+whether a precision point is off the followed branch (:func:`off_branch` and its twin).
 """
 
 from __future__ import annotations
