@@ -17,6 +17,7 @@ import mpmath
 import pytest
 
 from linkage.cli import run_cli
+from linkage.errors import InputError
 from linkage.synthesis import chebyshev_xs, synthesize_function
 
 GOOD = ("log10(x)", (1.0, 2.0), (90.0, 150.0), (0.0, 90.0))
@@ -66,15 +67,24 @@ def _sense(k, alpha_real: float, phi_real: float) -> float:
 FUNCTIONS = ["log10(x)", "x**2", "exp(x)", "sin(x)", "1/x", "sqrt(x)", "x**1.5", "cos(x)"]
 
 
-@pytest.mark.parametrize("seed", range(40))
-def test_precision_points_satisfy_the_equation_against_40_digits(seed: int) -> None:
-    rng = random.Random(seed)
+Range = tuple[float, float]
+
+
+def random_task(rng: random.Random) -> tuple[str, Range, Range, Range]:
+    """A function, an x range and angle ranges of 30 to 150 deg either way, drawn by ``rng``."""
     fn = rng.choice(FUNCTIONS)
     lo = rng.uniform(0.2, 2.0)
     hi = lo + rng.uniform(0.3, 1.5)
     a0, p0 = rng.uniform(-180, 180), rng.uniform(-180, 180)
     ar = (a0, a0 + rng.choice([-1, 1]) * rng.uniform(30, 150))
     pr = (p0, p0 + rng.choice([-1, 1]) * rng.uniform(30, 150))
+    return fn, (lo, hi), ar, pr
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_precision_points_satisfy_the_equation_against_40_digits(seed: int) -> None:
+    rng = random.Random(seed)
+    fn, (lo, hi), ar, pr = random_task(rng)
     n = rng.choice([3, 3, 4, 6])
     s = synthesize_function(fn, (lo, hi), ar, pr, points=n)
     assert len(s.precision_points) == n
@@ -598,3 +608,137 @@ def test_search_without_a_defect_free_candidate_exits_1(capsys) -> None:
     )
     out = capsys.readouterr().out
     assert code == 1 and "no candidate without defects" in out
+
+
+# --- issue 32 ------------------------------------------------------------------------------------
+
+
+def test_optimal_spacing_optimises_through_a_transmission_defect(capsys) -> None:
+    """y = 1/x: Chebyshev's design has a transmission angle of 24 deg (below the default
+    30), and optimal spacing kept Chebyshev's spacing for it, its comparison fields null."""
+    args = ("1/x", (1, 2), (30, 120), (60, 150))
+    cheb = synthesize_function(*args)
+    assert cheb.defect_names == ["transmission"] and 24.0 < cheb.transmission[0] < 25.0
+    s = synthesize_function(*args, spacing="optimal")
+    assert s.spacing == "optimal", s.notes
+    assert s.defect_names == ["transmission"]  # the optimum's own, reported
+    assert s.chebyshev_max_error_deg == pytest.approx(cheb.max_error_deg, rel=1e-12)
+    assert s.max_error_deg < 0.5 * cheb.max_error_deg
+    # equal ripple: four alternating extrema of one size, zero at the precision points
+    sizes = [abs(e) for _, e in s.extrema]
+    assert len(sizes) == 4 and (max(sizes) - min(sizes)) / max(sizes) <= 0.01
+    assert all((a > 0) != (b > 0) for (_, a), (_, b) in itertools.pairwise(s.extrema))
+    assert max(sizes) == pytest.approx(s.max_error_deg, rel=1e-12)
+    for p in s.precision_points:
+        assert abs(next(c for c in s.curve if c.x == p.x).error_deg) <= 1e-9
+    code = run_cli(["synthesize", "--function", "1/x", "--x", "1:2", "--alpha", "30:120", "--phi", "60:150",
+                    "--spacing", "optimal", "-f", "json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 1 and doc["defects"] == ["transmission"] and doc["spacing"] == "optimal"
+    assert doc["structural_error"]["chebyshev_max_deg"] is not None
+    assert doc["structural_error"]["equioscillation"] <= 0.01
+
+
+def test_optimal_spacing_reports_chebyshev_wherever_the_linkage_moves_through_the_range() -> None:
+    """The JSON's chebyshev_max_deg and equioscillation are never null where Chebyshev's
+    linkage moves its input through the range (no no_linkage, no grashof)."""
+    from linkage.render.synthesis import document_of
+
+    rng = random.Random(32)
+    optimised = 0
+    for _ in range(40):
+        args = random_task(rng)
+        cheb = synthesize_function(*args)
+        s = synthesize_function(*args, spacing="optimal")
+        errors = document_of(s)["structural_error"]
+        if cheb.linkage is None or {"no_linkage", "grashof"} & set(cheb.defect_names):
+            assert s.spacing == "chebyshev" and errors["chebyshev_max_deg"] is None
+            continue
+        assert errors["chebyshev_max_deg"] == pytest.approx(cheb.max_error_deg, rel=1e-12)
+        assert errors["equioscillation"] is not None and 0.0 <= errors["equioscillation"] <= 1.0
+        if s.spacing == "optimal":
+            optimised += 1
+            assert s.max_error_deg <= cheb.max_error_deg and errors["equioscillation"] <= 0.01
+    assert optimised >= 15
+
+
+def test_points_on_different_circuits_name_branch_and_grashof() -> None:
+    """A double rocker whose precision point 3 lies on the other assembly, beyond a stretch
+    of the input range where the linkage cannot be assembled: synthesize named only
+    grashof (the point is not reached, so it was not judged), the search's numpy twin
+    branch and grashof."""
+    from linkage.synthesis import evaluate_candidates, make_request
+
+    args = ("x**2", (1, 2), (30, -90), (150, 240))
+    s = synthesize_function(*args)
+    assert s.grashof == "double rocker"
+    assert {"branch", "grashof"} <= set(s.defect_names)
+    # the geometry: point 3 on the other side of O4 -> A than point 1, and an alpha between
+    # them where the coupler and output cannot close (|O4 A| outside [|b - c|, b + c])
+    k = s.linkage
+    p1, _, p3 = s.precision_points
+    senses = [_sense(k, p.alpha_deg + k.alpha_shift(), p.phi_deg + k.phi_shift()) for p in (p1, p3)]
+    assert senses[0] != senses[1]
+
+    def closes(alpha: float) -> bool:
+        al = math.radians(alpha + k.alpha_shift())
+        reach = math.hypot(k.d + k.a * math.cos(al), k.a * math.sin(al))
+        return abs(k.b - k.c) <= reach <= k.b + k.c
+
+    between = [p1.alpha_deg + (p3.alpha_deg - p1.alpha_deg) * i / 200 for i in range(201)]
+    assert closes(between[0]) and closes(between[-1]) and not all(closes(a) for a in between)
+    req = make_request(*args)
+    twin = evaluate_candidates(req, [30.0], [-120.0], [150.0], [90.0])
+    assert twin["defects"][0] == " ".join(s.defect_names)
+
+
+def test_numpy_defect_judgement_names_what_synthesize_names() -> None:
+    """One rule: the search's judgement (numpy, on the grid) and synthesize's agree on every
+    defect name, not only on which candidates have none."""
+    from linkage.synthesis import DEFECTS, evaluate_candidates, make_request
+
+    rng = random.Random(3)
+    named = set()
+    def pair(text: str) -> tuple[float, ...]:
+        return tuple(float(v) for v in text.split(":"))
+
+    cases = [(fn, pair(x), pair(a), pair(p), 3) for fn, x, a, p in DEFECT_CASES.values()]
+    cases += [(*random_task(rng), rng.choice([3, 3, 4, 5])) for _ in range(120)]
+    for fn, xr, ar, pr, n in cases:
+        s = synthesize_function(fn, xr, ar, pr, points=n)
+        twin = evaluate_candidates(make_request(fn, xr, ar, pr, points=n), [ar[0]], [ar[1] - ar[0]], [pr[0]],
+                                   [pr[1] - pr[0]])
+        assert twin["defects"][0] == " ".join(s.defect_names), (fn, xr, ar, pr, n)
+        named |= set(s.defect_names)
+    assert named == set(DEFECTS)
+
+
+@pytest.mark.parametrize("x", ["1:1.000000000000001", "1:1.00000001", "1000:1000.00000001"])
+def test_range_narrower_than_rounding_is_refused(x, capsys) -> None:
+    """--x 1:1.000000000000001 fitted rounding noise and said "no defects"."""
+    code = run_cli(["synthesize", "--function", "x**2", "--x", x, "--alpha", "90:150", "--phi", "0:90"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and err.startswith("error: --x") and "\n" not in err and "too narrow" in err
+    lo, hi = (float(v) for v in x.split(":"))
+    with pytest.raises(InputError, match=r"^x_range .* too narrow.*widen x_range$"):
+        synthesize_function("x**2", (lo, hi), (90, 150), (0, 90))
+
+
+def test_range_narrower_than_rounding_is_judged_by_the_rounding_it_carries() -> None:
+    """The bound is rounding's own (eps |x| / width, eps |y| / width of y, times the angle
+    spans), checked against 40 digits: a range at ten times the bound is accepted and its
+    precision points are those of exact arithmetic to that bound."""
+    from linkage.synthesis import BRANCH_TOL_DEG, make_request, rounding_deg
+
+    assert rounding_deg(make_request("x**2", (1, 2), (90, 150), (0, 90))) == pytest.approx(
+        2.0**-52 * (2.0 / 1.0 + 4.0 / 3.0) * 90.0
+    )
+    s = synthesize_function("x**2", (1.0, 1.0 + 1e-6), (90, 150), (0, 90))
+    noise = rounding_deg(s.request)
+    assert noise < BRANCH_TOL_DEG / 10
+    mpmath.mp.dps = 40
+    lo, hi = (mpmath.mpf(v) for v in s.x_range)
+    for p in s.precision_points:
+        x = mpmath.mpf(p.x)
+        phi = 90 * (x * x - lo * lo) / (hi * hi - lo * lo)
+        assert abs(p.phi_deg - float(phi)) <= 2 * noise

@@ -15,7 +15,8 @@ with the function asked for (the structural error). Defects are named, never hid
 The rules live here once, each with its numpy twin where the search (many candidates at
 a time) needs one: the precision points (:func:`precision_xs`), the linear system
 (:func:`solve_coefficients`, :func:`solve_coefficients_np`), the linkage of a solution
-(:func:`linkage_of`), and the branch's closed form (freudenstein.branch_root and its twin).
+(:func:`linkage_of`), the branch's closed form (freudenstein.branch_root and its twin) and
+whether a precision point is off the followed branch (:func:`off_branch` and its twin).
 """
 
 from __future__ import annotations
@@ -304,7 +305,7 @@ def make_request(
         raise InputError(
             f"f({xr[0]:g}) = f({xr[1]:g}) = {y_ends[0]:g}: the ends of y must differ to map onto --phi"
         )
-    return Request(
+    return check_conditioning(Request(
         fn,
         text,
         xr,
@@ -317,7 +318,45 @@ def make_request(
         float(min_transmission),
         table_points,
         y_ends,
-    )
+    ))
+
+
+CONDITIONING_SAMPLES = 11
+"""Points of x (ends included) at which |y| is read for :func:`rounding_deg`."""
+EPS = 2.0**-52
+"""The spacing of doubles at 1 (machine epsilon)."""
+
+
+def rounding_deg(req: Request) -> float:
+    """How far rounding alone moves a precision point's angles (deg), to first order. x is
+    known to eps |x| and y = f(x) to eps |y| (its evaluation) plus eps |x f'(x)| (x's own
+    rounding carried through f, whose condition is |x f'(x) / f(x)|; f' taken as the
+    range's secant). Mapped onto the angles, t = (x - LO) / (HI - LO) then carries
+    eps max|x| / (HI - LO) and u = (y - f(LO)) / (f(HI) - f(LO)) that plus
+    eps max|y| / |f(HI) - f(LO)|; times the spans of alpha and phi."""
+    (lo, hi), (y0, y1) = req.x_range, req.y_ends
+    (a0, a1), (p0, p1) = req.alpha_range, req.phi_range
+    n = CONDITIONING_SAMPLES
+    size_y = max(abs(_value(req.f, lo + (hi - lo) * i / (n - 1))) for i in range(n))
+    t_noise = EPS * max(abs(lo), abs(hi)) / (hi - lo)
+    u_noise = t_noise + EPS * size_y / abs(y1 - y0)
+    return max(t_noise * abs(a1 - a0), u_noise * abs(p1 - p0))
+
+
+def check_conditioning(req: Request) -> Request:
+    """``req``, unless its range is so narrow, for its f, that rounding moves the precision
+    points' angles (:func:`rounding_deg`) by more than BRANCH_TOL_DEG, the distance to
+    which a point is judged on its branch: the fit would be a fit of rounding noise."""
+    noise = rounding_deg(req)
+    if noise > BRANCH_TOL_DEG:
+        (lo, hi), (y0, y1) = req.x_range, req.y_ends
+        raise InputError(
+            f"--x {lo!r}:{hi!r} is too narrow for this function: x spans {hi - lo:.3g} and "
+            f"y {abs(y1 - y0):.3g}, so rounding (machine epsilon {EPS:.3g}) moves the precision "
+            f"points' angles by up to {noise:.3g} deg, more than the {BRANCH_TOL_DEG:g} deg a point "
+            "is judged to; widen --x"
+        )
+    return req
 
 
 def _value(f: Callable[[float], float], x: float) -> float:
@@ -494,6 +533,37 @@ def branch_label(k: Linkage, alpha_real_deg: float, phi_real_deg: float) -> str:
     from .problems.freudenstein import file_convention
 
     return str(file_convention(alpha_real_deg, phi_real_deg, (k.a, k.b, k.c, k.d))["branch"])
+
+
+def off_branch(alpha_real_deg: float, phi_real_deg: float, real_r: Sequence[float], sign: float) -> bool:
+    """Whether a precision point (its real angles) lies on the other assembly than the
+    branch ``sign`` (freudenstein.branch_root) followed from point 1, reached or not: its
+    own root (the one on its phi's side, freudenstein.branch_sign: the point itself for an
+    exact fit, the nearer root for least squares, whose points lie off the linkage by the
+    fit's error) and the followed branch's root differ by more than BRANCH_TOL_DEG. At a
+    limit position the two meet (no defect); where the linkage cannot be assembled at
+    all there is neither (the grashof defect says so)."""
+    from .problems.freudenstein import branch_root, branch_sign
+
+    own = branch_sign(alpha_real_deg, phi_real_deg, *real_r)
+    if own == sign:
+        return False
+    apart = math.remainder(
+        branch_root(alpha_real_deg, *real_r, own) - branch_root(alpha_real_deg, *real_r, sign), 360.0
+    )
+    return abs(apart) > BRANCH_TOL_DEG
+
+
+def off_branch_np(alpha_real_deg: Any, phi_real_deg: Any, r1: Any, r2: Any, r3: Any, sign: Any) -> Any:
+    """:func:`off_branch` over arrays (broadcast)."""
+    import numpy as np
+
+    from .problems.freudenstein import branch_root_np, branch_sign_np
+
+    own = branch_sign_np(alpha_real_deg, phi_real_deg, r1, r2, r3)
+    apart = branch_root_np(alpha_real_deg, r1, r2, r3, own) - branch_root_np(alpha_real_deg, r1, r2, r3, sign)
+    with np.errstate(invalid="ignore"):
+        return (own != sign) & (np.abs(np.remainder(apart + 180.0, 360.0) - 180.0) > BRANCH_TOL_DEG)
 
 
 def grashof_of(k: Linkage) -> str:
@@ -801,6 +871,21 @@ def _synthesize(req: Request, xs: Sequence[float]) -> FunctionSynthesis:
     return result
 
 
+def drawn_position(s: FunctionSynthesis) -> tuple[float, float] | None:
+    """(alpha, phi) in the equation's convention of the reported linkage at precision
+    point 1, phi as the linkage generates it there (the followed value of the report's
+    curve, which a mechanism file of the linkage is drawn at): with more than three points
+    the fit passes near the desired phi, not through it, and a drawing at the desired phi
+    would be another linkage. None where the linkage has no position there."""
+    if s.linkage is None or not s.precision_points:
+        return None
+    p = s.precision_points[0]
+    c = next((c for c in s.curve if c.x == p.x), None)
+    if c is None or c.phi_generated_deg is None:
+        return None
+    return p.alpha_deg, c.phi_generated_deg
+
+
 def dense_curve(s: FunctionSynthesis, n: int = 401) -> list[CurvePoint]:
     """The structural error at ``n`` even steps of x (with the table's points, extrema and
     precision points), by the same solver as the table: for a plot."""
@@ -855,26 +940,14 @@ def judge(
     req, k = design.req, design.linkage
     out: list[Defect] = []
     kind = grashof_of(k)
-    # branch: a precision point the followed assembly does not pass through (its root on
-    # the side of the point's phi: the point itself for an exact fit, the nearer root for
-    # least squares, whose points lie off the linkage by the fit's error)
-    from .problems.freudenstein import branch_root, branch_sign
-
+    # branch: a precision point on the other assembly than the one followed from point 1,
+    # reached or beyond a limit (the points are then on no one circuit: grashof too)
     first_label = branch_label(k, pts[0].alpha_deg + k.alpha_shift(), pts[0].phi_deg + k.phi_shift())
-    off = []
-    for j, p in enumerate(pts):
-        c = next((c for c in curve if c.x == p.x), None)
-        real = (p.alpha_deg + k.alpha_shift(), p.phi_deg + k.phi_shift())
-        own = branch_root(real[0], *design.real_R, branch_sign(*real, *design.real_R)) - k.phi_shift()
-        if (
-            c is not None
-            and c.phi_generated_deg is not None
-            and abs(math.remainder(c.phi_generated_deg - own, 360.0)) <= BRANCH_TOL_DEG
-        ):
-            continue
-        if c is not None and c.phi_generated_deg is None:
-            continue  # beyond a limit: named below
-        off.append((j, p))
+    off = [
+        (j, p)
+        for j, p in enumerate(pts)
+        if off_branch(p.alpha_deg + k.alpha_shift(), p.phi_deg + k.phi_shift(), design.real_R, design.sign)
+    ]
     if off:
         said = ", ".join(
             f"{j + 1} (x = {p.x:.6g}, "
@@ -1005,42 +1078,48 @@ def _turns_diff(gen: set[int], want: set[int], width: int = 3) -> list[int]:
 # --- optimal spacing ---------------------------------------------------------------------------
 
 
+def moves_through_range(s: FunctionSynthesis) -> bool:
+    """Whether a synthesis has a linkage that moves its input through the whole range on
+    the branch through point 1: neither no_linkage nor grashof (so its error curve exists
+    everywhere; a branch, order or transmission defect is a quality of that curve)."""
+    return s.linkage is not None and s.max_error_deg is not None and not {"no_linkage", "grashof"} & set(
+        s.defect_names
+    )
+
+
 def _optimal(req: Request) -> FunctionSynthesis:
     """Optimal (equal-ripple) spacing by a Remez exchange, from Chebyshev's design: on a
     reference of four alternating extrema, Newton's method finds the constants R and a
     level E with error(x_k) = +-E alternately; the reference then moves to the new
     extrema, until they are equal. The precision points are the error's zeros between
     them, and the design is synthesised from those again (so every figure reported is
-    the one rule's, from its precision points)."""
+    the one rule's, from its precision points). It runs whenever Chebyshev's linkage moves
+    through the range (:func:`moves_through_range`): the optimum's defects are reported as
+    any design's, not a reason to keep Chebyshev's."""
     cheb = _synthesize(replace(req, spacing="chebyshev"), chebyshev_xs(3, *req.x_range))
-    if cheb.defects or cheb.max_error_deg is None:
-        names = ", ".join(cheb.defect_names) or "no error curve"
+    if not moves_through_range(cheb):
+        names = ", ".join(n for n in cheb.defect_names if n in ("no_linkage", "grashof"))
         return replace(
             cheb,
             notes=(
                 *cheb.notes,
-                f"optimal spacing starts from Chebyshev's design, which has defects ({names}): kept "
-                "Chebyshev's spacing",
+                f"optimal spacing equalises the error over the range, and Chebyshev's design, "
+                f"where it starts, has none there ({names}): kept Chebyshev's spacing",
             ),
         )
     xs = remez(req, cheb)
     best = _synthesize(replace(req, spacing="optimal"), xs) if xs is not None else None
     spread = _spread(best) if best is not None else None
-    if (
-        best is None
-        or best.defects
-        or best.max_error_deg is None
-        or spread is None
-        or spread > EQUIOSCILLATION
-        or best.max_error_deg > cheb.max_error_deg
-    ):
-        why = (
-            "did not reach equal extrema"
-            if best is None or spread is None or spread > EQUIOSCILLATION
-            else f"has defects ({', '.join(best.defect_names)})"
-            if best.defects
-            else "came out no better"
-        )
+    why = (
+        "did not reach equal extrema"
+        if best is None or spread is None or spread > EQUIOSCILLATION
+        else f"gave a linkage that cannot move through the range ({', '.join(best.defect_names)})"
+        if not moves_through_range(best)
+        else "came out no better"
+        if best.max_error_deg is None or cheb.max_error_deg is None or best.max_error_deg > cheb.max_error_deg
+        else None
+    )
+    if why is not None or best is None:
         return replace(
             cheb,
             chebyshev_max_error_deg=cheb.max_error_deg,
@@ -1156,11 +1235,15 @@ def alternation_set(sizes: Sequence[float]) -> list[float]:
 
 
 def _spread(s: FunctionSynthesis) -> float | None:
-    """(largest - smallest) / largest over the alternation set (:func:`alternation_set`)."""
-    if len(s.extrema) < 4:
+    """(largest - smallest) / largest over the alternation set (:func:`alternation_set`); a
+    curve with fewer than four lobes (a precision point off the followed branch is no zero
+    of its error) lacks lobes of size 0, so its spread is 1. None without an error curve."""
+    if s.max_error_deg is None:
         return None
-    sizes = alternation_set([abs(e) for _, e in s.extrema])
-    return (max(sizes) - min(sizes)) / max(sizes) if max(sizes) > 0 else None
+    sizes = [abs(e) for _, e in s.extrema]
+    window = alternation_set(sizes + [0.0] * (4 - len(sizes)))
+    top = max(window)
+    return (top - min(window)) / top if top > 0.0 else 0.0
 
 
 def synthesize_function(
@@ -1279,11 +1362,18 @@ def evaluate_candidates(req: Request, a0: Any, da: Any, p0: Any, dp: Any, grid: 
         & np.all(np.isfinite(err), axis=-1)
         & ~assembly_gap_np(real[:, 0], real[:, 1], real[:, 2], lo_real, hi_real)
     )
-    # branch: the precision points' own signs against point 1's
-    signs = branch_sign_np(
-        alphas + shift_a[:, None], phis + shift_p[:, None], real[:, 0:1], real[:, 1:2], real[:, 2:3]
+    # branch: a precision point on the other assembly (the one rule, off_branch)
+    branch = linkage_ok & np.any(
+        off_branch_np(
+            alphas + shift_a[:, None],
+            phis + shift_p[:, None],
+            real[:, 0:1],
+            real[:, 1:2],
+            real[:, 2:3],
+            sign[:, None],
+        ),
+        axis=-1,
     )
-    branch = linkage_ok & np.any(signs != sign[:, None], axis=-1)
     mag = np.where(np.isfinite(err), np.abs(err), -1.0)
     k = np.argmax(mag, axis=-1)
     rows = np.arange(len(a0))

@@ -147,7 +147,7 @@ def synthesize(
 
     from ..problems.loops import LENGTH_UNITS
     from ..render import writers
-    from ..render.synthesis import design_text, error_plot, synthesis_report
+    from ..render.synthesis import error_plot, synthesis_report, write_design
     from ..synthesis import make_request
     from ..synthesis import synthesize as run
 
@@ -210,24 +210,23 @@ def synthesize(
         table_points=rows,
     )
     result = run(req)
+    written = False
     if design:
-        if result.linkage is None:
-            typer.echo(f"note: {output} not written: there is no real linkage", err=True)
-        else:
-            from ..files import write_atomic
-
-            made_by = (
-                " ".join(shlex.quote(w) for w in ["linkage", "synthesize", *sys.argv[2:]])
-                if len(sys.argv) > 1 and sys.argv[1] == "synthesize"
-                else "linkage synthesize"
-            )
-            write_atomic(output, design_text(result, unit, made_by))  # type: ignore[arg-type]
+        made_by = (
+            " ".join(shlex.quote(w) for w in ["linkage", "synthesize", *sys.argv[2:]])
+            if len(sys.argv) > 1 and sys.argv[1] == "synthesize"
+            else "linkage synthesize"
+        )
+        why_not = write_design(result, output, unit, made_by)  # type: ignore[arg-type]
+        if why_not is not None:
+            typer.echo(f"note: {output} not written: {why_not}", err=True)
+        written = why_not is None
     if plot is not None and result.linkage is not None and result.curve:
         error_plot(result, plot)
     elif plot is not None:
         typer.echo(f"note: {plot} not drawn: there is no real linkage", err=True)
     writers.write(synthesis_report(result, digits, unit), fmt, report_out)
-    if design and result.linkage is not None:
+    if written:
         typer.echo(
             f"wrote {output}: linkage sweep {shlex.quote(str(output))} runs it over the alpha range", err=True
         )

@@ -245,13 +245,19 @@ def document_of(s: Any) -> dict[str, Any]:
 
 
 def design_text(s: Any, unit: str, made_by: str) -> str:
-    """The result as a joints-form mechanism file, drawn at the first precision point, its
-    driver range the alpha range (in the file's convention: theta = alpha + 180)."""
+    """The result as a joints-form mechanism file, drawn at the first precision point as
+    the linkage generates it (synthesis.drawn_position: the file's joints give the reported
+    lengths), its driver range the alpha range (in the file's convention: theta = alpha +
+    180). ValueError where the linkage has no position at precision point 1."""
     from ..problems.joints import toml_value
+    from ..synthesis import drawn_position
 
     k = s.linkage
     p = s.precision_points[0]
-    t2, t4 = real_angles(s, p.alpha_deg, p.phi_deg)
+    drawn = drawn_position(s)
+    if drawn is None:
+        raise ValueError("the linkage has no position at precision point 1 to draw")
+    t2, t4 = real_angles(s, *drawn)
     a_pt = (k.a * math.cos(math.radians(t2)), k.a * math.sin(math.radians(t2)))
     b_pt = (k.d + k.c * math.cos(math.radians(t4)), k.c * math.sin(math.radians(t4)))
     a0, a1 = s.alpha_range
@@ -299,6 +305,20 @@ def design_text(s: Any, unit: str, made_by: str) -> str:
         + ("" if _plus("alpha", shift) == "alpha" else f", as {_plus('alpha', shift)}"),
     ]
     return "\n".join(lines) + "\n"
+
+
+def write_design(s: Any, path: Path, unit: str, made_by: str) -> str | None:
+    """``synthesize -o FILE.toml``: the result written as :func:`design_text` (completely or
+    not at all), or why not (None: written)."""
+    from ..files import write_atomic
+    from ..synthesis import drawn_position
+
+    if s.linkage is None:
+        return "there is no real linkage"
+    if drawn_position(s) is None:
+        return "the linkage cannot be assembled at precision point 1 (the pose a file is drawn at)"
+    write_atomic(path, design_text(s, unit, made_by))
+    return None
 
 
 def _plus(name: str, shift: float) -> str:
