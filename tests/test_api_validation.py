@@ -279,6 +279,13 @@ BATTERY = [
     ("analyze", "problem a number", lambda: linkage.analyze(_bisect_result(), 3), "problem"),
     ("synthesize_function", "at a number", lambda: _synth(at=3), "at"),
     ("synthesize_function", "samples 2.5", lambda: _synth(samples=2.5), "samples"),
+    ("assemblies", "mechanism None", lambda: linkage.assemblies(None), "mechanism"),
+    ("assemblies", "driver text", lambda: linkage.assemblies(M, "abc"), "driver"),
+    ("assemblies", "driver NaN", lambda: linkage.assemblies(M, math.nan), "driver"),
+    ("assemblies", "driver True", lambda: linkage.assemblies(M, True), "driver"),
+    ("assemblies", "driver 1e300 deg", lambda: linkage.assemblies(M, 1e300), "driver"),
+    ("assemblies", "seed -1", lambda: linkage.assemblies(M, seed=-1), "seed"),
+    ("assemblies", "seed 1.5", lambda: linkage.assemblies(M, seed=1.5), "seed"),
 ]
 
 

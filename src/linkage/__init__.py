@@ -11,6 +11,7 @@ The public API, in the order a reader meets it:
   :func:`position_rates` gives joints, velocities and accelerations at one solution.
 - :func:`scan_designs` runs many designs of a mechanism over their cycles: one record each.
 - :func:`synthesize_function` designs a four-bar function generator (Freudenstein).
+- :func:`assemblies` finds every assembly of a mechanism at a driver value (homotopy continuation).
 - :func:`forces` gives the input torque and joint forces of a joints-form mechanism at a position.
 - :func:`analyze` estimates convergence order and rate from a recorded history.
 """
@@ -34,10 +35,11 @@ _EXPORTS = {
     "scan_designs": ".scan",
     "synthesize_function": ".synthesis", "FunctionSynthesis": ".synthesis",
     "forces": ".kinematics.forces", "Forces": ".kinematics.forces",
+    "assemblies": ".kinematics.assemblies", "Assemblies": ".kinematics.assemblies",
     "Loads": ".problems.loads", "Mass": ".problems.loads",
 }
 _RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",
-            "scan_designs": "scan", "forces": "forces_at"}
+            "scan_designs": "scan", "forces": "forces_at", "assemblies": "every_assembly"}
 
 
 def __getattr__(name: str) -> Any:
@@ -58,6 +60,7 @@ def __dir__() -> list[str]:
 __version__ = "0.1.0"
 
 __all__ = [
+    "Assemblies",
     "Convergence",
     "Forces",
     "FunctionSynthesis",
@@ -78,6 +81,7 @@ __all__ = [
     "SweepResult",
     "SystemProblem",
     "analyze",
+    "assemblies",
     "coefficients_from_links",
     "equation_problem",
     "forces",

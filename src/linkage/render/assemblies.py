@@ -1,0 +1,105 @@
+"""The report of ``linkage assemblies``: every assembly, the paths that found them."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .data import DataTable, Report, from_rows
+from .report import Block, Text, denoise, table
+
+
+def _units(m: Any) -> list[str]:
+    return [u.unit if u.kind == "angle" else m.length_unit for u in m.unknowns]
+
+
+def assemblies_tables(a: Any) -> tuple[DataTable, ...]:
+    from ..kinematics.assemblies import display
+
+    m = a.mechanism
+    names = [u.name for u in m.unknowns]
+    rows = [(i + 1, s.branch, s.signs, *display(m, s.q), s.residual, s.condition, s.singular)
+            for i, s in enumerate(a.real)]
+    heads = [("assembly", "", "int"), ("branch", "", "text"), ("signs", "", "text"),
+             *[(n, u, "number") for n, u in zip(names, _units(m))],
+             ("residual", "", "number"), ("condition", "", "number"), ("near_limit", "", "bool")]
+    joints = [(i + 1, name, x, y) for i, s in enumerate(a.real) for name, (x, y) in s.joints.items()]
+    paths = [(k + 1, e.kind, e.real if e.kind in ("finite", "singular") else None, e.cycle, e.steps,
+              e.rejected, e.newton, e.smallest_step if math.isfinite(e.smallest_step) else None,
+              e.retracked, e.note) for k, e in enumerate(a.solutions.endpoints)]
+    return (
+        from_rows("assemblies", heads, rows),
+        from_rows("joints", [("assembly", "", "int"), ("joint", "", "text"), ("x", m.length_unit, "number"),
+                             ("y", m.length_unit, "number")], joints),
+        from_rows("paths", [("path", "", "int"), ("endpoint", "", "text"), ("real", "", "bool"),
+                            ("cycle", "", "int"), ("steps", "", "int"), ("rejected", "", "int"),
+                            ("newton", "", "int"), ("smallest_step", "", "number"), ("retracked", "", "bool"),
+                            ("note", "", "text")], paths),
+    )
+
+
+def title_of(a: Any) -> str:
+    m = a.mechanism
+    shown = a.driver / _scale(m.driver) if m.driver.kind == "angle" else a.driver
+    unit = m.driver.unit if m.driver.kind == "angle" else m.length_unit
+    return f"{m.name}: every assembly at {m.driver.name} = {float(f'{shown:.12g}'):g} {unit}"
+
+
+def _scale(q: Any) -> float:
+    from ..problems.loops import ANGLE_UNITS
+
+    return ANGLE_UNITS[q.unit]
+
+
+def summary_lines(a: Any) -> list[str]:
+    s = a.solutions
+    n_angles = sum(u.kind == "angle" for u in a.mechanism.unknowns)
+    retracked = sum(e.retracked for e in s.endpoints)
+    return [
+        f"polynomial system: {s.system.n} unknowns (cos and sin of {n_angles} angle"
+        f"{'s' if n_angles != 1 else ''}, c^2 + s^2 = 1 each), "
+        f"degrees {' '.join(map(str, s.system.degrees))}",
+        f"{len(s.endpoints)} paths (Bezout's bound), total-degree homotopy: {len(a.real)} real assembl"
+        f"{'y' if len(a.real) == 1 else 'ies'}, {a.complex_count} complex, {a.infinite} at infinity, "
+        f"{a.failed} failed" + (f" ({retracked} retracked)" if retracked else "")
+        + f"; {sum(e.steps for e in s.endpoints)} steps in {s.seconds:.2f} s",
+    ]
+
+
+def _display(t: DataTable, digits: int, scale: float = 0.0) -> Block:
+    """A table as the terminal shows it; with ``scale``, numbers within rounding of zero at
+    that scale (a joint at the origin computed as 2e-14) shown as 0."""
+    rows = [tuple(denoise(v, scale) if scale else v for v in row)
+            for row in zip(*[c.values for c in t.columns])]
+    return table("", [c.header for c in t.columns], rows, digits)
+
+
+def assemblies_report(a: Any, digits: int, show_paths: bool) -> Report:
+    tables = assemblies_tables(a)
+
+    def blocks() -> list[Block]:
+        out: list[Block] = [Text(title_of(a), "bold"), *[Text(line) for line in summary_lines(a)], Text("")]
+        if tables[0].row_count:
+            out.append(_display(tables[0], digits))
+        else:
+            out.append(Text("no real assembly: the mechanism cannot be assembled here"))
+        if any(s.singular for s in a.real):
+            out.append(Text("near_limit: close to a limit position, where two assemblies meet (condition "
+                            "above 1e8): digits beyond about 16 - log10(condition) are not significant"))
+        if tables[1].row_count:
+            size = max((abs(v) for s in a.real for xy in s.joints.values() for v in xy), default=0.0)
+            out += [Text("Joints"), _display(tables[1], digits, size)]
+        if show_paths:
+            out += [Text("Paths"), _display(tables[2], digits)]
+        for e in a.solutions.endpoints:
+            if e.kind == "failed":
+                out.append(Text(f"failed path: {e.note}"))
+        return out
+
+    def document() -> dict[str, Any]:
+        s = a.solutions
+        return {"title": title_of(a), "bezout": s.bezout, "paths": len(s.endpoints), "real": len(a.real),
+                "complex": a.complex_count, "infinite": a.infinite, "failed": a.failed,
+                "degrees": list(s.system.degrees), "seconds": s.seconds}
+
+    return Report(title_of(a), tables, blocks, document)
