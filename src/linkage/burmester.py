@@ -1,0 +1,158 @@
+"""Burmester's points: the pivots of every crank that carries a body through five poses.
+
+A pose j places a body at (x_j, y_j), turned by angle_j. A crank is a ground pivot G and a
+moving pivot z fixed in the body (body coordinates); at pose j the moving pivot is at
+M_j = d_j + R_j z, and the crank is rigid when |M_j - G| is the same for every pose:
+
+    |d_j + R_j z - G|^2 - |d_1 + R_1 z - G|^2 = 0,   j = 2..5,
+
+four equations in (Gx, Gy, zx, zy). |R_j z| = |z| makes the squares of z and G cancel: each
+equation is bilinear, of degree 2, and every root is found by homotopy continuation
+(:mod:`linkage.homotopy`). Five poses in general position have at most four real
+Burmester pairs (Burmester 1888; Sandor and Erdman, *Advanced Mechanism Design*, vol. 2,
+ch. 3; McCarthy and Soh, *Geometric Design of Linkages*, 2nd ed., ch. 4), and any two of
+them make a four-bar that moves the body through the five poses.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError
+from .homotopy import PolySystem, Solutions, solve
+
+
+@dataclass(frozen=True)
+class Pose:
+    x: float
+    y: float
+    angle_deg: float
+
+
+@dataclass(frozen=True)
+class Crank:
+    """A Burmester pair: the ground pivot, the moving pivot in the body's frame and where it
+    is at the first pose, the crank's length."""
+
+    ground: tuple[float, float]
+    body: tuple[float, float]
+    first: tuple[float, float]
+    length: float
+    residual: float  # max over poses of | |M_j - G| - length | / the poses' size
+    condition: float
+
+
+@dataclass(frozen=True)
+class Burmester:
+    poses: tuple[Pose, ...]
+    cranks: tuple[Crank, ...]
+    complex_count: int
+    infinite: int
+    singular: int
+    failed: int
+    solutions: Solutions
+
+
+def _checked(poses: Sequence[Pose | Sequence[float]]) -> tuple[Pose, ...]:
+    out = []
+    for k, p in enumerate(poses):
+        vals = (p.x, p.y, p.angle_deg) if isinstance(p, Pose) else tuple(p)
+        if len(vals) != 3 or any(isinstance(v, bool) for v in vals):
+            raise InputError(f"poses[{k}] must be (x, y, angle in deg), got {p!r}")
+        try:
+            x, y, a = (float(v) for v in vals)
+        except (TypeError, ValueError):
+            raise InputError(f"poses[{k}] must be numbers (x, y, angle in deg), got {p!r}") from None
+        if not all(math.isfinite(v) and abs(v) < 1e12 for v in (x, y, a)):
+            raise InputError(f"poses[{k}] must be finite numbers below 1e12 in size, got {p!r}")
+        out.append(Pose(x, y, a))
+    if len(out) != 5:
+        raise InputError(f"Burmester's points need exactly 5 poses, got {len(out)}")
+    for i in range(5):
+        for j in range(i):
+            a, b = out[i], out[j]
+            if math.hypot(a.x - b.x, a.y - b.y) == 0 and math.remainder(a.angle_deg - b.angle_deg, 360) == 0:
+                raise InputError(f"poses[{j}] and poses[{i}] are the same pose")
+    return tuple(out)
+
+
+def _frame(poses: tuple[Pose, ...]) -> tuple[complex, float]:
+    """The poses' centre and size: the system is posed in those units."""
+    d = [complex(p.x, p.y) for p in poses]
+    centre = sum(d) / len(d)
+    size = max(abs(z - centre) for z in d)
+    return centre, size if size > 0 else 1.0
+
+
+def burmester_system(poses: tuple[Pose, ...]) -> PolySystem:
+    """The four equations in (Gx, Gy, zx, zy), lengths in units of the poses' size about
+    their centre."""
+    centre, size = _frame(poses)
+    rows = []
+    d1 = (complex(poses[0].x, poses[0].y) - centre) / size
+    r1 = complex(math.cos(math.radians(poses[0].angle_deg)), math.sin(math.radians(poses[0].angle_deg)))
+    for p in poses[1:]:
+        dj = (complex(p.x, p.y) - centre) / size
+        rj = complex(math.cos(math.radians(p.angle_deg)), math.sin(math.radians(p.angle_deg)))
+        rows.append(_difference(dj, rj, d1, r1))
+    return PolySystem(4, tuple(rows))
+
+
+def _difference(dj: complex, rj: complex, d1: complex, r1: complex) -> dict[tuple[int, ...], complex]:
+    """|dj + rj z - G|^2 - |d1 + r1 z - G|^2 as a polynomial in (Gx, Gy, zx, zy)."""
+    def square(d: complex, r: complex) -> dict[tuple[int, ...], float]:
+        # |d + r z - G|^2 with r z = (r.re zx - r.im zy, r.im zx + r.re zy)
+        # components: u = d.re + r.re zx - r.im zy - Gx, v = d.im + r.im zx + r.re zy - Gy
+        lin_u = {(0, 0, 0, 0): d.real, (0, 0, 1, 0): r.real, (0, 0, 0, 1): -r.imag, (1, 0, 0, 0): -1.0}
+        lin_v = {(0, 0, 0, 0): d.imag, (0, 0, 1, 0): r.imag, (0, 0, 0, 1): r.real, (0, 1, 0, 0): -1.0}
+        out: dict[tuple[int, ...], float] = {}
+        for lin in (lin_u, lin_v):
+            for e1, c1 in lin.items():
+                for e2, c2 in lin.items():
+                    e = tuple(a + b for a, b in zip(e1, e2))
+                    out[e] = out.get(e, 0.0) + c1 * c2
+        return out
+
+    a, b = square(dj, rj), square(d1, r1)
+    diff = {e: a.get(e, 0.0) - b.get(e, 0.0) for e in set(a) | set(b)}
+    # the squares of z and of G cancel to rounding: drop what is rounding
+    return {e: complex(c) for e, c in diff.items() if abs(c) > 1e-14 * (1 + abs(a.get(e, 0.0)))}
+
+
+def burmester_points(poses: Sequence[Pose | Sequence[float]], seed: int = 0) -> Burmester:
+    """Every crank (centre point and circle point) that carries a body through five poses:
+    each real pair, and the complex, infinite, singular and failed paths counted."""
+    ps = _checked(poses)
+    system = burmester_system(ps)
+    sols = solve(system, seed=seed)
+    centre, size = _frame(ps)
+    cranks = []
+    for e in sols.endpoints:
+        if e.kind != "finite" or not e.real or e.x is None:
+            continue
+        gx, gy, zx, zy = e.x.real
+        G = complex(gx, gy) * size + centre
+        z = complex(zx, zy) * size  # body frame: the first pose's frame, scaled back
+        moving = []
+        for p in ps:
+            r = complex(math.cos(math.radians(p.angle_deg)), math.sin(math.radians(p.angle_deg)))
+            moving.append(complex(p.x, p.y) + r * z)
+        lengths = [abs(m - G) for m in moving]
+        length = lengths[0]
+        residual = max(abs(v - length) for v in lengths) / size
+        cranks.append(Crank((G.real, G.imag), (z.real, z.imag), (moving[0].real, moving[0].imag), length,
+                            residual, e.condition))
+    nonreal = sum(e.kind == "finite" and not e.real for e in sols.endpoints)
+    return Burmester(ps, tuple(cranks), nonreal, sols.count("infinite"), sols.count("singular"),
+                     sols.count("failed"), sols)
+
+
+def body_to_ground(p: Pose, z: tuple[float, float]) -> np.ndarray:
+    """Where the body point z (body coordinates) is at pose p."""
+    r = complex(math.cos(math.radians(p.angle_deg)), math.sin(math.radians(p.angle_deg)))
+    w = complex(p.x, p.y) + r * complex(*z)
+    return np.array([w.real, w.imag])
