@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import DigitsOpt, check_paths
+from .options import DigitsOpt, ForceOpt, check_paths, mechanism_output, write_mechanism
 from .root import app
 
 
@@ -123,9 +123,11 @@ def synthesize(
             "-o",
             help="FILE.toml: the linkage as a "
             "mechanism file (joints form, its driver range the alpha range), the report "
-            "still printed; any other suffix: the report in that format.",
+            "still printed, written only for a design without defects and kept if it exists "
+            "unless --force; any other suffix: the report in that format.",
         ),
     ] = None,
+    force: ForceOpt = False,
     plot: Annotated[
         Optional[Path],
         typer.Option(
@@ -155,6 +157,8 @@ def synthesize(
     report_out = None if design or output is None or str(output) == "-" else output
     fmt = writers.choose_format(fmt, report_out)
     check_paths([], [("--output", output)], {"--plot": (plot, (".png", ".svg", ".pdf"))})
+    if design:
+        mechanism_output(output, force)
     if unit not in LENGTH_UNITS:
         raise InputError(f"--unit {unit!r} is not a length unit (units: {', '.join(LENGTH_UNITS)})")
     if search:
@@ -211,26 +215,23 @@ def synthesize(
     )
     result = run(req)
     if design:
-        if result.linkage is None:
-            typer.echo(f"note: {output} not written: there is no real linkage", err=True)
+        if result.linkage is None or result.defects:
+            why = "there is no real linkage" if result.linkage is None else (
+                f"the design has defects ({', '.join(result.defect_names)})")
+            typer.echo(f"note: {output} not written: {why}", err=True)
         else:
-            from ..files import write_atomic
-
             made_by = (
                 " ".join(shlex.quote(w) for w in ["linkage", "synthesize", *sys.argv[2:]])
                 if len(sys.argv) > 1 and sys.argv[1] == "synthesize"
                 else "linkage synthesize"
             )
-            write_atomic(output, design_text(result, unit, made_by))  # type: ignore[arg-type]
+            write_mechanism(output, design_text(result, unit, made_by), force,  # type: ignore[arg-type]
+                            said=f": linkage sweep {shlex.quote(str(output))} runs it over the alpha range")
     if plot is not None and result.linkage is not None and result.curve:
         error_plot(result, plot)
     elif plot is not None:
         typer.echo(f"note: {plot} not drawn: there is no real linkage", err=True)
     writers.write(synthesis_report(result, digits, unit), fmt, report_out)
-    if design and result.linkage is not None:
-        typer.echo(
-            f"wrote {output}: linkage sweep {shlex.quote(str(output))} runs it over the alpha range", err=True
-        )
     if result.defects:
         raise typer.Exit(1)
 
