@@ -33,6 +33,10 @@ class Loads:
 
     def merged(self, other: Loads) -> Loads:
         """These loads with ``other``'s added or overriding (the command line's)."""
+        if not isinstance(other, Loads):
+            from ..arguments import describe
+
+            raise InputError(f"other: give a linkage.Loads to merge, got {describe(other)}")
         return Loads(
             {**self.forces, **other.forces},
             {**self.torques, **other.torques},
@@ -49,13 +53,12 @@ class Loads:
 
 
 def _finite(key: str, v: Any) -> float:
-    if (
-        isinstance(v, bool)
-        or not isinstance(v, (int, float))
-        or not math.isfinite(float(v))
-        or abs(v) > 1e100
-    ):
-        raise InputError(f"{key}: must be a finite number (within 1e100), got {v!r}")
+    """A load's number: a number by the one rule (arguments.is_real: not a bool, not a
+    string), finite and within 1e100."""
+    from ..arguments import describe, is_real
+
+    if not is_real(v) or not math.isfinite(float(v)) or abs(float(v)) > 1e100:
+        raise InputError(f"{key}: must be a finite number (within 1e100), got {describe(v)}")
     return float(v)
 
 

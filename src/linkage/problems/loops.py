@@ -179,7 +179,16 @@ class Mechanism:
         return self.parameters[name]
 
     def with_values(self, overrides: Mapping[str, float], guesses: Mapping[str, float]) -> Mechanism:
-        """Override parameters/driver (``--set``) and guesses (``--guess``), in file units."""
+        """Override parameters/driver (``--set``) and guesses (``--guess``), in file units:
+        each a mapping of name to number (arguments.check_number: not a bool, not a string)."""
+        from ..arguments import check_number, describe
+
+        checked = []
+        for label, given in (("overrides", overrides), ("guesses", guesses)):
+            if not isinstance(given, Mapping):
+                raise InputError(f"{label}: give a dict of name -> number, got {describe(given)}")
+            checked.append({k: check_number(f"{label}[{k!r}]", v) for k, v in given.items()})
+        overrides, guesses = checked
         params = dict(self.parameters)
         driver = self.driver
         for key, v in overrides.items():
