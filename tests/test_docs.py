@@ -45,3 +45,22 @@ def test_every_readme_example_runs(cli, args, code, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # examples that write files write them here
     run = cli(*args)
     assert run.code == code, run.err
+
+
+def first_console_block() -> tuple[list[str], list[str]]:
+    """The README's first figure: its ``$ linkage ...`` command and the lines shown under it."""
+    block = README.split("```console\n", 1)[1].split("```", 1)[0]
+    command, *shown = block.rstrip("\n").splitlines()
+    assert command.startswith("$ linkage "), command
+    return shlex.split(command[len("$ linkage "):]), shown
+
+
+def test_the_readme_first_figure_is_what_linkage_solve_prints(cli):
+    """It said R1 = 1.666666667 where linkage solve prints R1 = 1.66666666667: every line of
+    the figure (no timing in it: all deterministic) is the command's own, in order."""
+    args, shown = first_console_block()
+    assert args == ["solve"] and len(shown) > 20
+    run = cli(*args)
+    assert run.code == 0, run.err
+    printed = run.out.rstrip("\n").splitlines()
+    assert [line.rstrip() for line in shown] == [line.rstrip() for line in printed]
