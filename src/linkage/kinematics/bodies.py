@@ -161,12 +161,18 @@ def checked_loads(loads: Any, mechanism: Any) -> Loads:
     if not isinstance(loads, Loads):
         raise InputError(f"loads: give a linkage.Loads, got {type(loads).__name__}")
     frame = Frame.of(mechanism)
-    for field in ("forces", "torques", "masses"):
+    for field in ("forces", "torques", "masses", "on"):
         if not isinstance(getattr(loads, field), Mapping):
             raise InputError(f"loads: {field} must be a dict, got {type(getattr(loads, field)).__name__}")
+    for k in loads.on:
+        if k not in loads.forces:
+            raise InputError(f"loads: on[{k!r}]: there is no force at {k!r} (on names the link a force "
+                             "acts on)")
     table: dict[Any, Any] = {}
     for k, f in loads.forces.items():
         table[k] = {"force": list(f) if isinstance(f, (tuple, list)) else f}
+        if k in loads.on:
+            table[k]["on"] = loads.on[k]
     for k, t in loads.torques.items():
         if k in table:
             raise InputError(f"loads: {k!r} has a force and a torque: a name is a joint or a link")
@@ -185,6 +191,6 @@ def checked_loads(loads: Any, mechanism: Any) -> Loads:
         if not ok:
             raise InputError(f"loads: gravity {g!r}: give (gx, gy) in m/s^2, finite, within 1e6")
         g = (float(g[0]), float(g[1]))
-    out = Loads(parsed.forces, parsed.torques, parsed.masses, g)
+    out = Loads(parsed.forces, parsed.torques, parsed.masses, g, parsed.on)
     frame.check_masses(out)
     return out
