@@ -90,6 +90,18 @@ def is_real(value: Any) -> bool:
     return not hasattr(value, "imag") or getattr(value, "imag", 0) == 0
 
 
+def finite_real(value: Any) -> float | None:
+    """``value`` as a float when it is a finite number by :func:`is_real`, else None (an int
+    beyond the float range too)."""
+    if not is_real(value):
+        return None
+    try:
+        v = float(value)
+    except (TypeError, ValueError, OverflowError):
+        return None
+    return v if math.isfinite(v) else None
+
+
 def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: bool = True) -> float:
     """A finite float (and > 0 or >= 0 when asked), or an InputError naming the value: the
     one check of a number from Python. A number is what :func:`is_real` says (an int, a

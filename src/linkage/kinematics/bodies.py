@@ -155,7 +155,7 @@ def checked_loads(loads: Any, mechanism: Any) -> Loads:
     """A :class:`Loads` from Python checked as a file's are, by the file's one definition
     (problems.loads.parse_loads: names, shapes, finite values, units) and its gravity as
     the command line's; an InputError naming ``loads`` otherwise."""
-    from ..arguments import is_real
+    from ..arguments import describe, finite_real
     from ..problems.loads import Mass
 
     if not isinstance(loads, Loads):
@@ -187,9 +187,9 @@ def checked_loads(loads: Any, mechanism: Any) -> Loads:
     g = loads.gravity
     if g is not None:
         ok = isinstance(g, (tuple, list)) and len(g) == 2 and all(
-            is_real(v) and math.isfinite(float(v)) and abs(float(v)) <= 1e6 for v in g)
+            finite_real(v) is not None and abs(float(v)) <= 1e6 for v in g)
         if not ok:
-            raise InputError(f"loads: gravity {g!r}: give (gx, gy) in m/s^2, finite, within 1e6")
+            raise InputError(f"loads: gravity {describe(g)}: give (gx, gy) in m/s^2, finite, within 1e6")
         g = (float(g[0]), float(g[1]))
     out = Loads(parsed.forces, parsed.torques, parsed.masses, g, parsed.on)
     frame.check_masses(out)

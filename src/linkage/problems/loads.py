@@ -3,7 +3,6 @@ against its drawing; kinematics.forces solves for the forces they cause."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -78,13 +77,14 @@ def applied_rows(loads: Loads, drawing: Any) -> list[tuple[str, str, str, float 
 
 
 def _finite(key: str, v: Any) -> float:
-    """A load's number: a number by the one rule (arguments.is_real: not a bool, not a
-    string), finite and within 1e100."""
-    from ..arguments import describe, is_real
+    """A load's number: a number by the one rule (arguments.finite_real: not a bool, not a
+    string, finite), within 1e100."""
+    from ..arguments import describe, finite_real
 
-    if not is_real(v) or not math.isfinite(float(v)) or abs(float(v)) > 1e100:
+    x = finite_real(v)
+    if x is None or abs(x) > 1e100:
         raise InputError(f"{key}: must be a finite number (within 1e100), got {describe(v)}")
-    return float(v)
+    return x
 
 
 def _pair(key: str, v: Any) -> tuple[float, float]:
