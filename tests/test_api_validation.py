@@ -286,14 +286,92 @@ BATTERY = [
     ("assemblies", "driver 1e300 deg", lambda: linkage.assemblies(M, 1e300), "driver"),
     ("assemblies", "seed -1", lambda: linkage.assemblies(M, seed=-1), "seed"),
     ("assemblies", "seed 1.5", lambda: linkage.assemblies(M, seed=1.5), "seed"),
+    # bools are not numbers, anywhere (arguments.check_number, the one rule)
+    ("forces", "bool speed", lambda: linkage.forces(JM, JQ, speed=True), "speed"),
+    ("forces", "bool accel", lambda: linkage.forces(JM, JQ, accel=False), "accel"),
+    ("forces", "bool driver", lambda: linkage.forces(JM, JQ, driver=True), "driver"),
+    ("forces", "bool torque",
+     lambda: linkage.forces(JM, JQ, linkage.Loads(torques={"rocker": True})), "torque"),
+    ("forces", "bool force",
+     lambda: linkage.forces(JM, JQ, linkage.Loads(forces={"B": (True, 0.0)})), "force"),
+    ("forces", "bool mass", lambda: linkage.forces(JM, JQ, linkage.Loads(masses={
+        "rocker": linkage.Mass(True, (0.0, 0.0), 0.0)})), "mass"),
+    ("forces", "bool gravity",
+     lambda: linkage.forces(JM, JQ, linkage.Loads(torques={"rocker": 1.0}, gravity=(False, True))),
+     "gravity"),
+    ("forces", "torque beyond the float range",
+     lambda: linkage.forces(JM, JQ, linkage.Loads(torques={"rocker": 10**400})), "torque"),
+    ("forces", "gravity beyond the float range",
+     lambda: linkage.forces(JM, JQ, linkage.Loads(torques={"rocker": 1.0}, gravity=(10**400, 0.0))),
+     "gravity"),
+    ("synthesize_function", "bool ground", lambda: _synth(ground=True), "ground"),
+    ("synthesize_function", "bool x_range", lambda: _synth(x_range=(False, True)), "x_range"),
+    ("synthesize_function", "bool alpha_range", lambda: _synth(alpha_range=(False, 150)), "alpha_range"),
+    ("synthesize_function", "bool min_transmission",
+     lambda: _synth(min_transmission=True), "min_transmission"),
+    ("synthesize_function", "bool at", lambda: _synth(at=[True, 1.5, 2.0]), "at"),
+    ("sweep", "bool tol", lambda: linkage.sweep(M, TWO, tol=True), "tol"),
+    ("position_rates", "bool driver", lambda: linkage.position_rates(M, Q, driver=True), "driver"),
+    ("position_rates", "bool speed", lambda: linkage.position_rates(M, Q, speed=True), "speed"),
+    ("scan_designs", "bool lo", lambda: linkage.scan_designs(M, {"r2": (True, 1.5, 2)}, values=TWO), "vary"),
+    ("scan_designs", "bool speed",
+     lambda: linkage.scan_designs(JM, {"coupler": (100, 120, 2)}, values=TWO, speed=True), "speed"),
+    ("solve_scalar", "bool x0",
+     lambda: linkage.solve_scalar(lambda x: x - 1, method="newton", x0=True, fprime=lambda x: 1.0), "x0"),
+    ("solve_scalar", "bool tol",
+     lambda: linkage.solve_scalar(lambda x: x - 1, method="bisection", bracket=(0, 3), tol=True), "tol"),
+    ("solve_scalar", "bool bracket",
+     lambda: linkage.solve_scalar(lambda x: x - 1, method="bisection", bracket=(False, 3)), "bracket"),
+    ("solve_system", "bool x0", lambda: linkage.solve_system(M.problem(), (True, 1.0)), "x0"),
+    ("solve_system", "bool tol", lambda: linkage.solve_system(M.problem(), tol=True), "tol"),
+    ("fourbar_equation", "bool alpha", lambda: linkage.fourbar_equation(True), "alpha"),
+    ("fourbar_equation", "bool R1", lambda: linkage.fourbar_equation(40.0, True), "R1"),
+    ("coefficients_from_links", "bool a", lambda: _links(True, 1, 1, 1), "link length a"),
+    # the methods a user calls with numbers: Mechanism.with_values, Loads.merged
+    ("Mechanism.with_values", "text value",
+     lambda: JM.with_values({"coupler": "5"}, {}), "overrides['coupler']"),
+    ("Mechanism.with_values", "bool value",
+     lambda: JM.with_values({"coupler": True}, {}), "overrides['coupler']"),
+    ("Mechanism.with_values", "None overrides", lambda: JM.with_values(None, {}), "overrides"),
+    ("Mechanism.with_values", "bool guess", lambda: M.with_values({}, {"theta3": True}), "guesses['theta3']"),
+    ("Mechanism.with_values", "guesses a list",
+     lambda: M.with_values({}, [("theta3", 1.0)]), "guesses"),
+    ("Loads.merged", "None", lambda: linkage.Loads().merged(None), "Loads"),
+    ("Loads.merged", "a dict", lambda: linkage.Loads().merged({"torques": {"rocker": 1.0}}), "Loads"),
 ]
 
 
 def test_the_battery_covers_every_exported_function():
-    """A new public function joins the battery, or this fails."""
+    """A new public function joins the battery, or this fails (methods, "Class.method", too)."""
     functions = {name for name in linkage.__all__
                  if inspect.isfunction(getattr(linkage, name)) or inspect.isbuiltin(getattr(linkage, name))}
-    assert functions == {row[0] for row in BATTERY}
+    methods = {row[0] for row in BATTERY if "." in row[0]}
+    assert functions == {row[0] for row in BATTERY} - methods
+    for method in methods:
+        owner, name = method.split(".")
+        assert owner in linkage.__all__ and callable(getattr(getattr(linkage, owner), name))
+
+
+def test_bools_are_not_numbers_anywhere_in_the_api():
+    """speed=True, ground=True and x_range=(False, True) were read as 1 and 0, while
+    Loads(torques={"r": True}) was refused: one rule (arguments.check_number) refuses them all."""
+    from linkage.arguments import check_number, is_real
+
+    for value in (True, False, np.bool_(True), "5", b"5", 1j, np.complex128(1.0)):
+        assert not is_real(value)
+        with pytest.raises(InputError, match=r"must be a (real )?number"):
+            check_number("x", value)
+    for value, expected in ((5, 5.0), (2.5, 2.5), (np.float32(0.5), 0.5), (np.int64(3), 3.0)):
+        assert check_number("x", value) == expected
+
+
+def test_with_values_of_text_and_merged_of_none_are_input_errors():
+    """m.with_values({"coupler": "5"}, {}) raised TypeError; Loads().merged(None) AttributeError."""
+    with pytest.raises(InputError, match=r"overrides\['coupler'\] must be a number, got '5'"):
+        JM.with_values({"coupler": "5"}, {})
+    with pytest.raises(InputError, match=r"other: give a linkage.Loads to merge, got None"):
+        linkage.Loads().merged(None)
+    assert JM.with_values({"coupler": np.float64(130.0)}, {}).parameters["coupler"].value == 130.0
 
 
 @pytest.mark.parametrize("function,label,call,argument", BATTERY, ids=[f"{r[0]}: {r[1]}" for r in BATTERY])

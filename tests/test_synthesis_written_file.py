@@ -143,8 +143,10 @@ def test_every_written_file_sweeps_to_its_report(tmp_path) -> None:
         # the command: 5 Chebyshev points, least squares
         ["--function", "sin(x)", "--x", "0:1.5", "--alpha", "204.913:307.117", "--phi", "91.825:17.236",
          "--points", "5", "--ground", "1"],
+        # (its transmission angle falls to 21 deg: a defect, and a file is written only without
+        # one, so the floor is lowered to 10 deg)
         ["--function", "exp(x)", "--x", "0:1", "--alpha", "204.913:307.117", "--phi", "91.825:17.236",
-         "--points", "5", "--spacing", "uniform", "--ground", "1"],
+         "--points", "5", "--spacing", "uniform", "--ground", "1", "--min-transmission", "10"],
     ],
 )
 def test_least_squares_file_is_the_reported_linkage(args, tmp_path, capsys) -> None:
@@ -154,7 +156,7 @@ def test_least_squares_file_is_the_reported_linkage(args, tmp_path, capsys) -> N
     design = tmp_path / "r1.toml"
     code = run_cli(["synthesize", *args, "-o", str(design), "-f", "json"])
     report = json.loads(capsys.readouterr().out)
-    assert code in (0, 1) and design.exists()
+    assert code == 0 and design.exists()
     joints = parse_toml(design.read_text(), str(design))["joints"]
     (ax, ay), (bx, by), (ox, oy) = joints["A"], joints["B"], joints["O4"]
     assert joints["O2"] == [0.0, 0.0]

@@ -12,7 +12,9 @@ Decisions recorded here, once:
 - A whole number is an ``int`` (or a numpy integer), never a ``bool`` and never a float,
   even an integral one: ``2.7`` is refused, not truncated, and so is ``2.0``.
 - A real number is anything ``float()`` accepts except ``bool``, ``str``/``bytes`` and
-  complex numbers; it must be finite.
+  complex numbers; it must be finite. :func:`check_number` is that rule for one number and
+  every public function's numbers go through it (or :func:`check_reals`, :func:`is_real`
+  for a sequence): ``speed=True``, ``ground=True`` or ``{"coupler": "5"}`` is refused.
 - Driver values are a sequence (list, tuple, range, 1-D numpy array) of finite reals. A
   generator or iterator is refused: a sweep needs the count first, and reading it would
   consume it.
@@ -88,21 +90,39 @@ def is_real(value: Any) -> bool:
     return not hasattr(value, "imag") or getattr(value, "imag", 0) == 0
 
 
-def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: bool = True) -> float:
-    """A finite float (and > 0 or >= 0 when asked), or an InputError naming the value.
-    Whatever ``float()`` reads is a number here (a numeric string too), except a complex
-    one: numpy would drop its imaginary part with only a warning."""
-    if type(value) is not float and getattr(getattr(value, "dtype", None), "kind", "") == "c":
-        raise InputError(f"{name} must be a real number, got {describe(value)}")
+def finite_real(value: Any) -> float | None:
+    """``value`` as a float when it is a finite number by :func:`is_real`, else None (an int
+    beyond the float range too)."""
+    if not is_real(value):
+        return None
     try:
         v = float(value)
     except (TypeError, ValueError, OverflowError):
-        raise InputError(f"{name} must be a number, got {describe(value)}") from None
+        return None
+    return v if math.isfinite(v) else None
+
+
+def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: bool = True) -> float:
+    """A finite float (and > 0 or >= 0 when asked), or an InputError naming the value: the
+    one check of a number from Python. A number is what :func:`is_real` says (an int, a
+    float, a numpy real scalar), never a bool (``speed=True`` is not a speed of 1), a
+    string (``"5"``: the command line parses its text, the API does not) or a complex."""
+    if type(value) is not float and not is_real(value):
+        kind = "real number" if _complex(value) else "number"
+        raise InputError(f"{name} must be a {kind}, got {describe(value)}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"{name} must be a finite number, got {describe(value)}") from None
     if not math.isfinite(v):
         raise InputError(f"{name} must be finite, got {v!r}")
     if positive and (v < 0.0 or (v == 0.0 and not allow_zero)):
         raise InputError(f"{name} must be {'>' if not allow_zero else '>='} 0, got {v!r}")
     return v
+
+
+def _complex(value: Any) -> bool:
+    return isinstance(value, complex) or getattr(getattr(value, "dtype", None), "kind", "") == "c"
 
 
 def check_fps(name: str, value: Any) -> float:

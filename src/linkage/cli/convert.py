@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import MechanismFile, check_paths, stdout_errors
+from .options import ForceOpt, MechanismFile, mechanism_output, stdout_errors, write_mechanism
 from .root import app
 
 
@@ -21,7 +21,9 @@ def convert(
                     "loops (the vector loops a drawing implies) or joints (a loops file drawn as "
                     "joints and links). Default: the form the file is not in.")] = None,
     output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Write the converted file "
-                      "here (.toml) instead of standard output.")] = None,
+                      "here (.toml) instead of standard output; an existing file is kept unless "
+                      "--force.")] = None,
+    force: ForceOpt = False,
 ) -> None:
     """Convert a mechanism file between its two forms: a joints-and-links file to the
     vector loops it implies (each loop under a comment naming its joints), or a loops file
@@ -32,15 +34,13 @@ def convert(
     """
     import sys
 
-    from ..files import parse_toml, read_input, write_atomic
+    from ..files import parse_toml, read_input
     from ..problems.joints import is_joints_doc, loops_text
     from ..problems.loops import parse_mechanism
 
     if form is not None and form.lower() not in ("joints", "loops"):
         raise InputError(f"--form {form!r}: write joints or loops")
-    if output is not None and str(output) != "-" and output.suffix.lower() != ".toml":
-        raise InputError(f"-o {output}: a mechanism file: name it with .toml")
-    check_paths([file], [("--output", output)])
+    target = mechanism_output(output, force, [file])
     doc = parse_toml(read_input(file), str(file))
     now = "joints" if is_joints_doc(doc) else "loops"
     wanted = (form or ("loops" if now == "joints" else "joints")).lower()
@@ -54,10 +54,9 @@ def convert(
         from ..problems.to_joints import joints_text
 
         text = joints_text(mechanism, str(file))
-    if output is None or str(output) == "-":
+    if target is None:
         with stdout_errors():
             sys.stdout.write(text)
             sys.stdout.flush()
         return
-    write_atomic(output, text)
-    typer.echo(f"wrote {output}", err=True)
+    write_mechanism(target, text, force, [file])

@@ -10,8 +10,9 @@ def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Opt
     """The sweep's report with a ``loads`` table (and its summary lines) added; ``plot``:
     the input torque over the sweep, peak marked."""
     from ..kinematics.force_sweeps import with_forces
+    from ..problems.loads import applied_rows
     from ..render.data import Report
-    from ..render.forces import sweep_force_table, torque_plot
+    from ..render.forces import applied_block, sweep_force_table, torque_plot
     from ..render.report import Text, fmt, table
 
     angle = mechanism.driver.kind == "angle"
@@ -27,6 +28,9 @@ def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Opt
     loads_table = sweep_force_table(rows, name, unit, unit_in, pins)
     (at_in, at_pin), flagged = peaks_of(rows)
     lines = [Text(""), Text("loads over the sweep (matrix method, SI units)", "bold")]
+    applied = applied_rows(loads, mechanism.extra["drawing"])
+    if applied:
+        lines.append(applied_block(applied, digits))
     if at_in >= 0:
         peak, pin = rows[at_in], rows[at_pin]
         lines.append(Text(f"peak input {fmt(peak[2], digits)} {unit_in} at {name} = "

@@ -7,6 +7,7 @@ import typer
 
 from ..errors import InputError
 from ..problems.templates import KINDS, angles, links_order
+from .options import ForceOpt
 from .root import app
 
 OPTIONS = {"links": "--links", "angle_deg": "--angle", "branch": "--branch", "unit": "--unit",
@@ -43,7 +44,7 @@ def new(
                     "it implies, as linkage convert prints them).")] = "joints",
     output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Write the file here (.toml) "
                       "instead of standard output; an existing file is kept unless --force.")] = None,
-    force: Annotated[bool, typer.Option("--force", help="With -o: replace an existing file.")] = False,
+    force: ForceOpt = False,
 ) -> None:
     """Start a mechanism file from its link lengths: a four-bar, slider-crank, inverted
     slider-crank, Watt or Stephenson six-bar, drawn as a commented joints file.
@@ -58,7 +59,7 @@ def new(
 
     from ..numbers import parse_number
     from ..problems.templates import text
-    from .options import check_paths, stdout_errors
+    from .options import mechanism_output, stdout_errors, write_mechanism
 
     given = list(lengths or [])
     kinds = [item for item in given if item in KINDS]
@@ -73,22 +74,15 @@ def new(
     if links and not given:
         raise InputError(f"--links: give the lengths after it ({links_order(kind) or links_order()})")
     values = [parse_number(f"--links {item}", item) for item in given]
-    if output is not None and str(output) != "-" and output.suffix.lower() != ".toml":
-        raise InputError(f"-o {output}: a mechanism file: name it with .toml")
+    target = mechanism_output(output, force)
     try:
         content = text(kind, values or None, angle, branch, unit, name, form)
     except InputError as exc:  # the library names its arguments; say them as options
         word, sep, rest = str(exc).partition(" " if str(exc).startswith("links ") else ":")
         raise InputError(f"{OPTIONS.get(word, word)}{sep}{rest}") from None
-    if output is None or str(output) == "-":
+    if target is None:
         with stdout_errors():
             sys.stdout.write(content)
             sys.stdout.flush()
         return
-    if (output.exists() or output.is_symlink()) and not force:
-        raise InputError(f"-o {output} exists; choose a new name, or --force to replace it")
-    check_paths([], [("--output", output)])
-    from ..files import write_atomic
-
-    write_atomic(output, content)
-    typer.echo(f"wrote {output}", err=True)
+    write_mechanism(target, content, force)

@@ -1,6 +1,7 @@
 """What every command shares: the options, the output format and writer, path checks,
 --set/--guess parsing and the closed-form notes."""
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any, Optional
 
@@ -113,6 +114,39 @@ class stdout_errors:
 
             raise OutputError(f"cannot write to standard output: {exc.strerror or exc}") from None
         return False
+
+
+ForceOpt = Annotated[
+    bool, typer.Option("--force", help="With -o FILE.toml: replace an existing file (never the input).")
+]
+
+
+def mechanism_output(output: Path | None, force: bool, inputs: Sequence[Path | None] = ()) -> Path | None:
+    """The one rule for -o FILE.toml of every command that writes a mechanism file (new,
+    convert, synthesize), checked before any work: None for standard output; else a .toml
+    path that is not an input (not even with --force) and, without --force, not an existing
+    file."""
+    if output is None or str(output) == "-":
+        return None
+    if output.suffix.lower() != ".toml":
+        raise InputError(f"-o {output}: a mechanism file: name it with .toml")
+    check_paths(list(inputs), [("--output", output)])
+    if (output.exists() or output.is_symlink()) and not force:
+        raise InputError(f"-o {output} exists; choose a new name, or --force to replace it")
+    return output
+
+
+def write_mechanism(output: Path, text: str, force: bool, inputs: Sequence[Path | None] = (),
+                    said: str = "") -> None:
+    """Write a mechanism file by :func:`mechanism_output`'s rule, checked again (a file may
+    have appeared while the command worked) and atomically (files.write_atomic: a temporary
+    file renamed over the target). A command calls it only once it has succeeded, so a
+    failing command leaves the old file as it was. ``said``: what the "wrote" line adds."""
+    from ..files import write_atomic
+
+    mechanism_output(output, force, inputs)
+    write_atomic(output, text)
+    typer.echo(f"wrote {output}{said}", err=True)
 
 
 PICTURES = (".png", ".svg", ".pdf")

@@ -75,10 +75,12 @@ def _with_forces(report: Any, mechanism: Any, q: Any, loads: Any, speed: float |
                  digits: int) -> Any:
     """The solve's report with the loads answer added (kinematics.forces)."""
     from ..kinematics.forces import forces_at
+    from ..problems.loads import applied_rows
     from ..render.data import Report
-    from ..render.forces import force_blocks, force_document, force_tables
+    from ..render.forces import applied_document, force_blocks, force_document, force_tables
 
     f = forces_at(mechanism, q, loads, speed=speed or 0.0, accel=accel or 0.0)
+    applied = applied_rows(loads, mechanism.extra["drawing"])
     if loads.gravity is not None and not loads.masses:
         from .options import NOTED
 
@@ -87,7 +89,8 @@ def _with_forces(report: Any, mechanism: Any, q: Any, loads: Any, speed: float |
 
     def doc() -> Any:
         d = document() if document is not None else {}
-        return {**d, "forces": force_document(f)} if isinstance(d, dict) else d
+        forces = {**force_document(f), "applied": applied_document(applied)}
+        return {**d, "forces": forces} if isinstance(d, dict) else d
 
     return Report(report.title, (*report.tables, *force_tables(f)),
-                  lambda: [*report.blocks(), *force_blocks(f, digits)], doc)
+                  lambda: [*report.blocks(), *force_blocks(f, digits, applied)], doc)

@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import DigitsOpt, check_paths
+from .options import DigitsOpt, ForceOpt, check_paths, mechanism_output, write_mechanism
 from .root import app
 
 
@@ -123,9 +123,11 @@ def synthesize(
             "-o",
             help="FILE.toml: the linkage as a "
             "mechanism file (joints form, its driver range the alpha range), the report "
-            "still printed; any other suffix: the report in that format.",
+            "still printed, written only for a design without defects and kept if it exists "
+            "unless --force; any other suffix: the report in that format.",
         ),
     ] = None,
+    force: ForceOpt = False,
     plot: Annotated[
         Optional[Path],
         typer.Option(
@@ -155,6 +157,8 @@ def synthesize(
     report_out = None if design or output is None or str(output) == "-" else output
     fmt = writers.choose_format(fmt, report_out)
     check_paths([], [("--output", output)], {"--plot": (plot, (".png", ".svg", ".pdf"))})
+    if design:
+        mechanism_output(output, force)
     if unit not in LENGTH_UNITS:
         raise InputError(f"--unit {unit!r} is not a length unit (units: {', '.join(LENGTH_UNITS)})")
     if search:
@@ -210,26 +214,28 @@ def synthesize(
         table_points=rows,
     )
     result = run(req)
-    written = False
     if design:
-        made_by = (
-            " ".join(shlex.quote(w) for w in ["linkage", "synthesize", *sys.argv[2:]])
-            if len(sys.argv) > 1 and sys.argv[1] == "synthesize"
-            else "linkage synthesize"
-        )
-        why_not = write_design(result, output, unit, made_by)  # type: ignore[arg-type]
-        if why_not is not None:
-            typer.echo(f"note: {output} not written: {why_not}", err=True)
-        written = why_not is None
+        if result.linkage is None:
+            typer.echo(f"note: {output} not written: there is no real linkage", err=True)
+        elif result.defects:
+            typer.echo(f"note: {output} not written: the design has defects "
+                       f"({', '.join(result.defect_names)})", err=True)
+        else:
+            made_by = (
+                " ".join(shlex.quote(w) for w in ["linkage", "synthesize", *sys.argv[2:]])
+                if len(sys.argv) > 1 and sys.argv[1] == "synthesize"
+                else "linkage synthesize"
+            )
+            said = f": linkage sweep {shlex.quote(str(output))} runs it over the alpha range"
+            why_not = write_design(result, output, unit, made_by,  # type: ignore[arg-type]
+                                   write=lambda path, text: write_mechanism(path, text, force, said=said))
+            if why_not is not None:
+                typer.echo(f"note: {output} not written: {why_not}", err=True)
     if plot is not None and result.linkage is not None and result.curve:
         error_plot(result, plot)
     elif plot is not None:
         typer.echo(f"note: {plot} not drawn: there is no real linkage", err=True)
     writers.write(synthesis_report(result, digits, unit), fmt, report_out)
-    if written:
-        typer.echo(
-            f"wrote {output}: linkage sweep {shlex.quote(str(output))} runs it over the alpha range", err=True
-        )
     if result.defects:
         raise typer.Exit(1)
 

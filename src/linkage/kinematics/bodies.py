@@ -155,17 +155,24 @@ def checked_loads(loads: Any, mechanism: Any) -> Loads:
     """A :class:`Loads` from Python checked as a file's are, by the file's one definition
     (problems.loads.parse_loads: names, shapes, finite values, units) and its gravity as
     the command line's; an InputError naming ``loads`` otherwise."""
+    from ..arguments import describe, finite_real
     from ..problems.loads import Mass
 
     if not isinstance(loads, Loads):
         raise InputError(f"loads: give a linkage.Loads, got {type(loads).__name__}")
     frame = Frame.of(mechanism)
-    for field in ("forces", "torques", "masses"):
+    for field in ("forces", "torques", "masses", "on"):
         if not isinstance(getattr(loads, field), Mapping):
             raise InputError(f"loads: {field} must be a dict, got {type(getattr(loads, field)).__name__}")
+    for k in loads.on:
+        if k not in loads.forces:
+            raise InputError(f"loads: on[{k!r}]: there is no force at {k!r} (on names the link a force "
+                             "acts on)")
     table: dict[Any, Any] = {}
     for k, f in loads.forces.items():
         table[k] = {"force": list(f) if isinstance(f, (tuple, list)) else f}
+        if k in loads.on:
+            table[k]["on"] = loads.on[k]
     for k, t in loads.torques.items():
         if k in table:
             raise InputError(f"loads: {k!r} has a force and a torque: a name is a joint or a link")
@@ -180,11 +187,10 @@ def checked_loads(loads: Any, mechanism: Any) -> Loads:
     g = loads.gravity
     if g is not None:
         ok = isinstance(g, (tuple, list)) and len(g) == 2 and all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and abs(v) <= 1e6
-            for v in g)
+            finite_real(v) is not None and abs(float(v)) <= 1e6 for v in g)
         if not ok:
-            raise InputError(f"loads: gravity {g!r}: give (gx, gy) in m/s^2, finite, within 1e6")
+            raise InputError(f"loads: gravity {describe(g)}: give (gx, gy) in m/s^2, finite, within 1e6")
         g = (float(g[0]), float(g[1]))
-    out = Loads(parsed.forces, parsed.torques, parsed.masses, g)
+    out = Loads(parsed.forces, parsed.torques, parsed.masses, g, parsed.on)
     frame.check_masses(out)
     return out

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
-from ..problems.loads import Loads
+from ..problems.loads import Loads, load_link
 from .bodies import Frame, checked_loads, metre
 
 EPS = sys.float_info.epsilon
@@ -256,8 +256,7 @@ def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[s
 
     origin = (np.zeros(n_pos), np.zeros(n_pos))
     for j, f in loads.forces.items():
-        body = next((b for b in moving if j in d.bodies[b]), "ground")
-        known(body, pos[j], f, 0.0, vstar[j])
+        known(load_link(d, j, loads.on.get(j)), pos[j], f, 0.0, vstar[j])
     for b, t in loads.torques.items():
         known(b, origin, (0.0, 0.0), t, origin)
     g = loads.gravity

@@ -466,7 +466,8 @@ def _place(model: LoopModel, q: Any, d: float, qd: Any, vd: float, qdd: Any, vdd
             ba += ca + EPS * abs(a) if unc is not None else 0.0
         return p, v, a, bv, ba
 
-    return _walk(model, part, add, (complex(*m.origin), 0j, 0j, 0.0, 0.0))
+    return _walk(model, part, add, (complex(*m.origin), 0j, 0j, 0.0, 0.0),
+                 lambda xy: (complex(*xy), 0j, 0j, 0.0, 0.0))
 
 
 def place_np(model: LoopModel, q: Any, d: Any) -> dict[str, tuple[Any, Any]]:
@@ -494,26 +495,33 @@ def place_np(model: LoopModel, q: Any, d: Any) -> dict[str, tuple[Any, Any]]:
         return x, y
 
     origin0 = (zero + model.mechanism.origin[0], zero + model.mechanism.origin[1])
-    placed = _walk(model, part, add, origin0)
+    placed = _walk(model, part, add, origin0, lambda xy: (zero + xy[0], zero + xy[1]))
     # a constant joint (a ground pivot) as a full column, as every position has it
     return {k: (x + zero, y + zero) for k, (x, y) in placed.items()}
 
 
-def _walk(model: LoopModel, part: Any, add: Any, origin0: Any) -> dict[str, Any]:
+def _walk(model: LoopModel, part: Any, add: Any, origin0: Any, at_rest: Any) -> dict[str, Any]:
     """The placing rule, over any values: each loop from its first joint if an earlier loop
     placed it (else the origin), a joint reached along the side of its loop with fewer
     moving vectors (a ground pivot then has exactly zero velocity, and fewer terms round),
-    a point from its joint. ``part(term, (loop, index))`` is a vector's value (``None``
-    for a point's), ``add(start, parts, sign)`` their sum."""
+    a point from its joint; a joint of ``model.drawn`` (a fixed joint of a drawing) where it
+    was drawn, exactly. ``part(term, (loop, index))`` is a vector's value (``None`` for a
+    point's), ``add(start, parts, sign)`` their sum, ``at_rest((x, y))`` a joint standing
+    still there."""
     placed: dict[str, Any] = {}
     for i, (loop, terms) in enumerate(zip(model.mechanism.loops, model.terms)):
         names = loop.joints
+        if names and names[0] in model.drawn and names[0] not in placed:
+            placed[names[0]] = at_rest(model.drawn[names[0]])
         start = placed.get(names[0]) if names and names[0] else None
         origin = start if start is not None else origin0
         parts = [part(t, (i, j)) for j, t in enumerate(terms)]
         moving = [t[2] != FIXED or t[4] != FIXED for t in terms]
         for k in range(len(terms)):
             if not names or not names[k] or names[k] in placed:
+                continue
+            if names[k] in model.drawn:
+                placed[names[k]] = at_rest(model.drawn[names[k]])
                 continue
             forward, backward = range(k), range(k, len(terms))
             ahead = sum(moving[j] for j in forward) <= sum(moving[j] for j in backward)
@@ -618,7 +626,8 @@ def place_motion_np(model: LoopModel, q: Any, d: Any, qd: Any, vd: float, qdd: A
         return p, v, a
 
     origin0 = (zero + complex(*model.mechanism.origin), zero, zero)
-    return {k: (p + zero, v + zero, a + zero) for k, (p, v, a) in _walk(model, part, add, origin0).items()}
+    placed = _walk(model, part, add, origin0, lambda xy: (zero + complex(*xy), zero, zero))
+    return {k: (p + zero, v + zero, a + zero) for k, (p, v, a) in placed.items()}
 
 
 def _xy(c: complex) -> XY:

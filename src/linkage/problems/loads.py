@@ -3,7 +3,6 @@ against its drawing; kinematics.forces solves for the forces they cause."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -30,14 +29,24 @@ class Loads:
     masses: dict[str, Mass] = field(default_factory=dict)
     gravity: tuple[float, float] | None = None
     """m/s^2, or None."""
+    on: dict[str, str] = field(default_factory=dict)
+    """Joint -> the link its force acts on, where one is named (``on = "coupler"``); a force
+    at a joint two links share otherwise acts on the first link listing it (:func:`load_link`).
+    The pin forces there depend on it; the input does not."""
 
     def merged(self, other: Loads) -> Loads:
-        """These loads with ``other``'s added or overriding (the command line's)."""
+        """These loads with ``other``'s added or overriding (the command line's: a force it
+        gives at a joint keeps the link this one names there)."""
+        if not isinstance(other, Loads):
+            from ..arguments import describe
+
+            raise InputError(f"other: give a linkage.Loads to merge, got {describe(other)}")
         return Loads(
             {**self.forces, **other.forces},
             {**self.torques, **other.torques},
             {**self.masses, **other.masses},
             other.gravity if other.gravity is not None else self.gravity,
+            {**self.on, **other.on},
         )
 
     @property
@@ -45,18 +54,37 @@ class Loads:
         return not (self.forces or self.torques or self.masses)
 
 
+def load_link(drawing: Any, joint: str, on: str | None = None) -> str:
+    """The link a force at ``joint`` acts on: ``on`` where the load names one, else the first
+    moving link (in the order of [links]) that lists the joint (the ground if none does)."""
+    if on is not None:
+        return on
+    return next((b for b, js in drawing.bodies.items() if b != "ground" and joint in js), "ground")
+
+
+def applied_rows(loads: Loads, drawing: Any) -> list[tuple[str, str, str, float | None, float | None,
+                                                           float | None]]:
+    """Each force and torque as a report shows it: (name, kind, the link it acts on, Fx and
+    Fy in N, T in N m), the force's link by :func:`load_link`."""
+    rows: list[tuple[str, str, str, float | None, float | None, float | None]] = [
+        (j, "force", load_link(drawing, j, loads.on.get(j)), f[0], f[1], None)
+        for j, f in loads.forces.items()]
+    rows += [(b, "torque", b, None, None, t) for b, t in loads.torques.items()]
+    return rows
+
+
 # --- the loads of a file ---------------------------------------------------------------------
 
 
 def _finite(key: str, v: Any) -> float:
-    if (
-        isinstance(v, bool)
-        or not isinstance(v, (int, float))
-        or not math.isfinite(float(v))
-        or abs(v) > 1e100
-    ):
-        raise InputError(f"{key}: must be a finite number (within 1e100), got {v!r}")
-    return float(v)
+    """A load's number: a number by the one rule (arguments.finite_real: not a bool, not a
+    string, finite), within 1e100."""
+    from ..arguments import describe, finite_real
+
+    x = finite_real(v)
+    if x is None or abs(x) > 1e100:
+        raise InputError(f"{key}: must be a finite number (within 1e100), got {describe(v)}")
+    return x
 
 
 def _pair(key: str, v: Any) -> tuple[float, float]:
@@ -93,6 +121,7 @@ def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str,
     forces: dict[str, tuple[float, float]] = {}
     torques: dict[str, float] = {}
     masses: dict[str, Mass] = {}
+    acting: dict[str, str] = {}
     links = {b for b in drawing.bodies if b != "ground"}
     loads = doc.get("loads", {})
     if not isinstance(loads, Mapping):
@@ -101,10 +130,11 @@ def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str,
     for name, spec in loads.items():
         key = (named or {}).get(name) or f"{source}: loads.{name}"
         part = "" if name in (named or {}) else "."  # an option names its value itself
-        if (not isinstance(spec, Mapping) or set(spec) - {"force", "torque", "unit", "note"}
+        if (not isinstance(spec, Mapping) or set(spec) - {"force", "torque", "unit", "note", "on"}
                 or len(set(spec) & {"force", "torque"}) != 1):
-            raise InputError(f"{key}: give {{ force = [Fx, Fy] }} (N, at a joint or point) or "
-                             "{ torque = T } (N m, on a link), with unit = ... for another unit")
+            raise InputError(f"{key}: give {{ force = [Fx, Fy] }} (N, at a joint or point; on = LINK "
+                             "where two links share it) or { torque = T } (N m, on a link), with "
+                             "unit = ... for another unit")
         if "force" in spec:
             if name not in drawing.xy:
                 raise InputError(f"{key}: a force acts at a joint or point; joints: {', '.join(drawing.xy)}")
@@ -114,6 +144,10 @@ def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str,
             scale = _unit(key, spec, "unit", FORCE_UNITS)
             fx, fy = _pair(f"{key}{part and '.force'}", spec["force"])
             forces[str(name)] = (fx * scale, fy * scale)
+            if "on" in spec:
+                acting[str(name)] = _acting(f"{key}{part and '.on'}", spec["on"], str(name), drawing)
+        elif "on" in spec:
+            raise InputError(f"{key}: a torque acts on the link it is named after: drop on = ...")
         else:
             if name not in links:
                 raise InputError(f"{key}: a torque acts on a moving link; links: {', '.join(sorted(links))}")
@@ -139,4 +173,15 @@ def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str,
         if "cg" not in spec:
             raise InputError(f"{key}.cg: give the centre of mass [x, y] in the drawn pose")
         masses[str(name)] = Mass(m, _pair(f"{key}.cg", spec["cg"]), inertia)
-    return Loads(forces, torques, masses)
+    return Loads(forces, torques, masses, None, acting)
+
+
+def _acting(key: str, on: Any, joint: str, drawing: Any) -> str:
+    """``on = LINK`` of a force at ``joint``: a moving link that holds the joint."""
+    holders = [b for b, js in drawing.bodies.items() if b != "ground" and joint in js]
+    if not isinstance(on, str) or on not in holders:
+        from ..arguments import describe
+
+        raise InputError(f"{key}: {describe(on)} does not hold {joint}; a force there acts on one of the "
+                         f"links at it: {', '.join(holders)}")
+    return on

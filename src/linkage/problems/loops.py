@@ -179,7 +179,16 @@ class Mechanism:
         return self.parameters[name]
 
     def with_values(self, overrides: Mapping[str, float], guesses: Mapping[str, float]) -> Mechanism:
-        """Override parameters/driver (``--set``) and guesses (``--guess``), in file units."""
+        """Override parameters/driver (``--set``) and guesses (``--guess``), in file units:
+        each a mapping of name to number (arguments.check_number: not a bool, not a string)."""
+        from ..arguments import check_number, describe
+
+        checked = []
+        for label, given in (("overrides", overrides), ("guesses", guesses)):
+            if not isinstance(given, Mapping):
+                raise InputError(f"{label}: give a dict of name -> number, got {describe(given)}")
+            checked.append({k: check_number(f"{label}[{k!r}]", v) for k, v in given.items()})
+        overrides, guesses = checked
         params = dict(self.parameters)
         driver = self.driver
         for key, v in overrides.items():
@@ -301,6 +310,9 @@ def _keep_drawing(mechanism: Mechanism, doc: Mapping[str, Any], source: str) -> 
     driver = doc.get("driver", {})
     mechanism.extra["drawing"] = drawing
     mechanism.extra["drawing_driver"] = {k: driver[k] for k in ("link", "slider") if k in driver}
+    # the parameters as drawn (internal units): while the ground's are these, its joints
+    # are where they were drawn (LoopModel.drawn); a --set or a scan may change them
+    mechanism.extra["drawn_parameters"] = {k: q.value for k, q in mechanism.parameters.items()}
     try:
         mechanism.extra["loads"] = parse_loads(doc, drawing, source)
     except InputError as exc:
@@ -623,6 +635,27 @@ DRIVER = -2
 """Index marking a term that refers to the driver (``-1``: a fixed value)."""
 
 
+def drawn_ground(m: Mechanism, values: Mapping[str, Any]) -> dict[str, tuple[float, float]]:
+    """A drawing's fixed joints at their drawn (x, y), when ``values`` (the parameters a
+    model is compiled with) give every vector that turns with nothing (the ground's: no
+    unknown, no driver) its drawn length and angle; else none (a --set or a scan moved a
+    ground joint, and the vectors place it)."""
+    drawing = m.extra.get("drawing")
+    as_drawn = m.extra.get("drawn_parameters")
+    if drawing is None or as_drawn is None:
+        return {}
+    moving = {u.name for u in m.unknowns} | {m.driver.name}
+    for loop in m.loops:
+        for t in loop.vectors:
+            refs = (t.length, t.angle)
+            if any(isinstance(r, str) and r in moving for r in refs):
+                continue
+            for r in refs:
+                if isinstance(r, str) and not (type(values[r]) is float and values[r] == as_drawn.get(r)):
+                    return {}
+    return {j: drawing.xy[j] for j in drawing.ground}
+
+
 @dataclass(frozen=True)
 class LoopModel:
     """The loops compiled once: each term is (sign, length constant, length index, angle
@@ -633,6 +666,11 @@ class LoopModel:
     n: int
     point_terms: dict[str, tuple[str, tuple[tuple[float, float, int, float, int, float], ...]]] = field(
         default_factory=dict)
+    drawn: dict[str, tuple[float, float]] = field(default_factory=dict)
+    """Joints that do not move, each exactly where it was drawn: a drawing's fixed joints,
+    while the ground's lengths and angles are the drawn ones (:func:`drawn_ground`). The
+    placing rule (kinematics.rates._walk) reports them as drawn, not as the sum of
+    vectors that reaches them (a pivot drawn at 45.0 came out 44.99999999999999)."""
 
     @classmethod
     def compile(cls, m: Mechanism, values: Mapping[str, Any] | None = None) -> LoopModel:
@@ -663,7 +701,7 @@ class LoopModel:
         points = {name: (origin, tuple((t.sign, *resolve(t.length), *resolve(t.angle), t.offset)
                                        for t in vecs))
                   for name, (origin, vecs) in m.points.items()}
-        return cls(m, tuple(loops), len(m.unknowns), points)
+        return cls(m, tuple(loops), len(m.unknowns), points, drawn_ground(m, fixed))
 
     @functools.cached_property
     def factory(self) -> Any:

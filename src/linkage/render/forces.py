@@ -81,8 +81,22 @@ def force_tables(f: Any) -> list[Any]:
     return out
 
 
-def force_blocks(f: Any, digits: int) -> list[Block]:
+def applied_block(applied: Any, digits: int) -> Block:
+    """The loads given, each with the link it acts on (problems.loads.applied_rows): a force
+    at a joint two links share acts on the link its ``on`` names, else on the first listing it."""
+    return table("loads applied (ground frame; a shared joint's force on the link named)",
+                 ["load", "kind", "on", "fx (N)", "fy (N)", "torque (N m)"], list(applied), digits)
+
+
+def applied_document(applied: Any) -> list[dict[str, Any]]:
+    keys = ("load", "kind", "on", "fx", "fy", "torque")
+    return [dict(zip(keys, row)) for row in applied]
+
+
+def force_blocks(f: Any, digits: int, applied: Any = ()) -> list[Block]:
     out: list[Block] = [Text(""), Text("loads (matrix method; SI units)", "bold")]
+    if applied:
+        out.append(applied_block(applied, digits))
     if f.status == "undefined":
         out.append(
             Text(

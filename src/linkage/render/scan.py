@@ -172,9 +172,13 @@ def scan_meta(m: Any, source: str, setup: Any, driver: tuple[float, float, float
            "where": where, "sort": sort, "descending": descending, "designs": setup.plan.total}
     loads = setup.loads
     if loads is not None:
+        from ..problems.loads import applied_rows
+
         per_s = "rad/s" if m.driver.kind == "angle" else f"{m.length_unit}/s"
         out["loads"] = {
             "forces_N": {k: list(v) for k, v in loads.forces.items()},
+            "forces_on": {row[0]: row[2] for row in applied_rows(loads, m.extra["drawing"])
+                          if row[1] == "force"},
             "torques_N_m": dict(loads.torques),
             "masses": {k: {"mass_kg": v.mass, f"cg_{m.length_unit}": list(v.cg), "inertia_kg_m2": v.inertia}
                        for k, v in loads.masses.items()},
@@ -184,9 +188,12 @@ def scan_meta(m: Any, source: str, setup: Any, driver: tuple[float, float, float
 
 
 def loads_line(m: Any, loads: Any, motion: tuple[float, float]) -> str:
-    """One line saying which loads the load columns are for."""
-    parts = [f"{len(loads.forces)} force(s)", f"{len(loads.torques)} torque(s)",
-             f"{len(loads.masses)} mass(es)"]
+    """One line saying which loads the load columns are for, each force's link named."""
+    from ..problems.loads import applied_rows
+
+    acting = [f"{row[0]} on {row[2]}" for row in applied_rows(loads, m.extra["drawing"]) if row[1] == "force"]
+    parts = [f"{len(loads.forces)} force(s)" + (f" ({', '.join(acting)})" if acting else ""),
+             f"{len(loads.torques)} torque(s)", f"{len(loads.masses)} mass(es)"]
     if loads.gravity is not None:
         parts.append(f"gravity ({loads.gravity[0]:g}, {loads.gravity[1]:g}) m/s^2")
     per_s = "rad/s" if m.driver.kind == "angle" else f"{m.length_unit}/s"

@@ -4,6 +4,7 @@ the mechanism file of the result and the error plot."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -307,9 +308,11 @@ def design_text(s: Any, unit: str, made_by: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_design(s: Any, path: Path, unit: str, made_by: str) -> str | None:
+def write_design(s: Any, path: Path, unit: str, made_by: str,
+                 write: Callable[[Path, str], None] | None = None) -> str | None:
     """``synthesize -o FILE.toml``: the result written as :func:`design_text` (completely or
-    not at all), or why not (None: written)."""
+    not at all: ``write``, by default files.write_atomic; the command passes the one rule
+    for writing mechanism files), or why not (None: written)."""
     from ..files import write_atomic
     from ..synthesis import drawn_position
 
@@ -317,7 +320,7 @@ def write_design(s: Any, path: Path, unit: str, made_by: str) -> str | None:
         return "there is no real linkage"
     if drawn_position(s) is None:
         return "the linkage cannot be assembled at precision point 1 (the pose a file is drawn at)"
-    write_atomic(path, design_text(s, unit, made_by))
+    (write or write_atomic)(path, design_text(s, unit, made_by))
     return None
 
 
