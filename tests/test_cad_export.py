@@ -353,3 +353,20 @@ def test_ezdxf_is_imported_only_for_a_dxf(tmp_path):
              "print('ezdxf' in sys.modules, 'matplotlib' in sys.modules)")
     done = run_process(code=probe)
     assert done.stdout.split() == ["False", "False"], done.stderr
+
+
+def test_names_a_layer_cannot_hold_or_that_differ_by_case_give_distinct_valid_layers(cli, tmp_path):
+    text = (SAMPLES / "crank_rocker_joints.toml").read_text()
+    text = text.replace('crank = ["O2", "A"]', '"Crank/1" = ["O2", "A"]')
+    text = text.replace('link = "crank"', 'link = "Crank/1"')
+    text = text.replace('coupler = ["A", "B", "P"]', '"crank:1" = ["A", "B", "P"]')
+    text = text.replace("P = [", '"<P&1>" = [').replace('"B", "P"]', '"B", "<P&1>"]')
+    source = tmp_path / "names.toml"
+    source.write_text(text)
+    doc = ezdxf.readfile(draw(cli, tmp_path, source, ".dxf"))
+    assert not doc.audit().has_errors
+    layers = {layer.dxf.name for layer in doc.layers}
+    assert {"LINK_Crank_1", "LINK_crank_1-2"} <= layers
+    assert "<P&1>" in {t.dxf.text for t in doc.modelspace().query("TEXT")}
+    root = ET.parse(draw(cli, tmp_path, source, ".svg")).getroot()
+    assert "<P&1>" in {t.text for t in root.iter(f"{SVG}text")}
