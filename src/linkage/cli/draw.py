@@ -57,6 +57,8 @@ def draw(
     if fps is not None and animate is None:
         raise InputError("--fps sets the speed of the --animate GIF: give --animate PATH.gif as well")
     rate = check_fps("--fps", 12.0 if fps is None else fps)
+    if step is not None and not check_number("--step", step) > 0:
+        raise InputError("--step must be > 0 and --to must not be below --from")
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
     note_closed_form(mechanism)
     if output is not None:
@@ -76,10 +78,7 @@ def draw(
         from ..render.plots import animate_sweep, assembly_gaps, sweep_frames
 
         a, b = driver_span(mechanism, start, stop)
-        step = 5.0 if step is None else step
-        if not check_number("--step", step) > 0:
-            raise InputError("--step must be > 0 and --to must not be below --from")
-        values = driver_values(a, b, step, None)
+        values = driver_values(a, b, 5.0 if step is None else step, None)
         if len(values) > 2000:
             raise InputError(f"{len(values)} frames is too many for a GIF; use a larger --step")
         s = run_sweep(mechanism, values)
@@ -99,7 +98,6 @@ def _write_sheet(mechanism: Any, q: Any, output: Path, start: float | None, stop
     from ..arguments import driver_span
     from ..kinematics.sweep import driver_values, sweep_mechanism
     from ..render.cad import needs_sweep, sheet, write_sheet
-    from ..solve import check_number
 
     swept, note = None, ""
     # the sweep also sets how long a slider's line is drawn; a length driver without a
@@ -108,8 +106,6 @@ def _write_sheet(mechanism: Any, q: Any, output: Path, start: float | None, stop
         or (start is not None and stop is not None)
     if needs_sweep(mechanism) and (sweepable or mechanism.points):
         a, b = driver_span(mechanism, start, stop)
-        if step is not None and not check_number("--step", step) > 0:
-            raise InputError("--step must be > 0 and --to must not be below --from")
         values = driver_values(a, b, step, None if step is not None else 361)
         swept = sweep_mechanism(mechanism, values, joints=True)
         unit = mechanism.driver.unit
