@@ -370,3 +370,19 @@ def test_names_a_layer_cannot_hold_or_that_differ_by_case_give_distinct_valid_la
     assert "<P&1>" in {t.dxf.text for t in doc.modelspace().query("TEXT")}
     root = ET.parse(draw(cli, tmp_path, source, ".svg")).getroot()
     assert "<P&1>" in {t.text for t in root.iter(f"{SVG}text")}
+
+
+def test_a_slider_driven_file_without_a_range_is_drawn_at_its_pose(cli, tmp_path):
+    """A length driver has no natural range: with no points to trace, the sheet is the pose,
+    the slider's line reaching past its block."""
+    text = (SAMPLES / "slider_crank_joints.toml").read_text()
+    driver = '[driver]\nslider = "block"\nvalue = 146.88311367414514\n'
+    text = re.sub(r"\[driver\].*", driver, text, flags=re.S)
+    source = tmp_path / "slider_driven.toml"
+    source.write_text(text)
+    doc = ezdxf.readfile(draw(cli, tmp_path, source, ".dxf"))
+    assert not doc.audit().has_errors
+    assert dxf_paths(doc) == []
+    (line,) = doc.modelspace().query("LINE[layer=='GROUND']")
+    assert line.dxf.start.x < 146.88311367414514 < line.dxf.end.x and line.dxf.start.y == 10.0
+    assert {t.dxf.text for t in doc.modelspace().query("TEXT")} == {"O2", "A", "B"}

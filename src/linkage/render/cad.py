@@ -172,10 +172,11 @@ def sheet(mechanism: Any, q: Sequence[float], sweep: Any = None, sweep_note: str
 
 def needs_sweep(mechanism: Any) -> bool:
     """A sheet needs a sweep for its coupler curves (the file's points) and for how far its
-    sliders' lines reach (a loop vector whose length moves is a slider's travel)."""
-    moving = {u.name for u in mechanism.unknowns} | {mechanism.driver.name}
-    return bool(mechanism.points) or any(isinstance(t.length, str) and t.length in moving
-                                         for loop in mechanism.loops for t in loop.vectors)
+    sliders' lines reach."""
+    if mechanism.points:
+        return True
+    drawing = _drawing(mechanism)
+    return drawing is not None and bool(drawing.sliders)
 
 
 def curve_pieces(positions: Sequence[Any], name: str) -> tuple[tuple[Point, ...], ...]:
