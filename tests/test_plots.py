@@ -43,15 +43,18 @@ def test_drawings(cli, tmp_path, name):
     assert cli("draw", str(SAMPLES / f"{name}.toml"), "-o", str(png)).code == 0
     assert cli("draw", str(SAMPLES / f"{name}.toml"), "-o", str(svg)).code == 0
     assert_png(png)
-    assert_svg(svg)
+    # a drawing's .svg is the CAD sheet (render/cad.py, tests/test_cad_export.py): its links
+    # and joints, not a canvas of axes
+    root = ET.parse(svg).getroot()
+    assert root.tag.endswith("svg") and root.get("viewBox")
+    assert len([e for e in root.iter() if e.tag.endswith(("polyline", "polygon"))]) >= 2
 
 
 def test_drawing_labels_the_joints(cli, tmp_path):
     svg = tmp_path / "rapier.svg"
     cli("draw", str(SAMPLES / "rapier_drive.toml"), "-o", str(svg))
-    text = svg.read_text()
-    for joint in ("A0", "C0"):  # matplotlib writes text as glyph references plus a comment
-        assert f"<!-- {joint} -->" in text
+    labels = {e.text for e in ET.parse(svg).getroot().iter() if e.tag.endswith("text")}
+    assert {"A0", "C0"} <= labels
 
 
 def test_animation_gif(cli, tmp_path):
