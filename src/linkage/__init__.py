@@ -12,6 +12,8 @@ The public API, in the order a reader meets it:
 - :func:`scan_designs` runs many designs of a mechanism over their cycles: one record each.
 - :func:`synthesize_function` designs a four-bar function generator (Freudenstein).
 - :func:`forces` gives the input torque and joint forces of a joints-form mechanism at a position.
+- :func:`instant_centres` gives every instant centre of a mechanism at a pose, :func:`centrodes`
+  the fixed and moving centrodes of a body over a sweep.
 - :func:`analyze` estimates convergence order and rate from a recorded history.
 """
 
@@ -35,6 +37,8 @@ _EXPORTS = {
     "synthesize_function": ".synthesis", "FunctionSynthesis": ".synthesis",
     "forces": ".kinematics.forces", "Forces": ".kinematics.forces",
     "Loads": ".problems.loads", "Mass": ".problems.loads",
+    "instant_centres": ".kinematics.centres", "InstantCentres": ".kinematics.centres",
+    "centrodes": ".kinematics.centres", "Centrodes": ".kinematics.centres",
 }
 _RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",
             "scan_designs": "scan", "forces": "forces_at"}
@@ -58,11 +62,13 @@ def __dir__() -> list[str]:
 __version__ = "0.1.0"
 
 __all__ = [
+    "Centrodes",
     "Convergence",
     "Forces",
     "FunctionSynthesis",
     "History",
     "InputError",
+    "InstantCentres",
     "IterationRecord",
     "LinkageError",
     "Loads",
@@ -78,10 +84,12 @@ __all__ = [
     "SweepResult",
     "SystemProblem",
     "analyze",
+    "centrodes",
     "coefficients_from_links",
     "equation_problem",
     "forces",
     "fourbar_equation",
+    "instant_centres",
     "load_mechanism",
     "position_rates",
     "scan_designs",

@@ -7,7 +7,8 @@ from collections.abc import Sequence
 
 from .root import app
 
-COMMANDS = ("solve", "sweep", "scan", "draw", "convert", "new", "synthesize", "samples", "stress", "bench")
+COMMANDS = ("solve", "sweep", "centres", "scan", "draw", "convert", "new", "synthesize", "samples", "stress",
+            "bench")
 """In the order ``linkage --help`` lists them."""
 
 
