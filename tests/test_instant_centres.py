@@ -10,6 +10,7 @@ O2A meets O4B, I24 where AB meets O2O4; a slider's I14 at infinity across its li
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import random
@@ -190,14 +191,16 @@ def near(centre, point, size):
         AGREE * size * (1.0 + far * far)
 
 
-def _random_poses(make, count, seed):
+def _random_centres(make, count, seed):
+    """``count`` random mechanisms from ``make(rng)`` (text, joints, branch sign), each
+    checked against the velocities: (centres, the pose's joints, size), both branches met."""
     rng = random.Random(seed)
-    made = 0
-    while made < count:
+    signs = set()
+    while len(signs) < 2 or count > 0:
         built = make(rng)
         if built is None:
             continue
-        text, joints, sign = built
+        text, _, sign = built
         try:
             m = from_text(text, "random")
             _, pose, _ = at_driver(m)
@@ -205,8 +208,22 @@ def _random_poses(make, count, seed):
             continue  # a drawing too near a limit to pass the joints form's checks
         if pose.rates.status != "ok":
             continue
-        made += 1
-        yield m, pose, joints, sign
+        ic = linkage.instant_centres(m)
+        assert ic.status == "ok", ic.message
+        check_against_velocities(ic, pose)
+        signs.add(sign)
+        count -= 1
+        yield ic, pose.rates.joints, m.length_scale
+
+
+def _kennedy_at(ic, expected, size):
+    """Each labelled centre is Kennedy's and at its closed form's point (None: lines too
+    near parallel for the closed form's Cramer rule to be a reference)."""
+    for label, point in expected:
+        c = next(c for c in ic.centres if c.label == label)
+        assert c.how == "Kennedy"
+        if point is not None:
+            assert near(c, point, size), (label, c, point)
 
 
 def test_random_fourbars_both_branches_have_the_closed_form_centres():
@@ -216,22 +233,11 @@ def test_random_fourbars_both_branches_have_the_closed_form_centres():
         built = fourbar_text(a, b, c, d, rng.uniform(0, 2 * math.pi), sign)
         return None if built is None else (*built, sign)
 
-    signs = set()
-    for m, pose, joints, sign in _random_poses(make, 60, 31):
-        ic = linkage.instant_centres(m)
-        assert ic.status == "ok", ic.message
-        size = m.length_scale
-        O2, A, B, O4 = (pose.rates.joints[k] for k in ("O2", "A", "B", "O4"))
-        for label, point in (("I13", meet(O2, A, O4, B)), ("I24", meet(A, B, O2, O4))):
-            c = next(c for c in ic.centres if c.label == label)
-            assert c.how == "Kennedy"
-            if point is not None:
-                assert near(c, point, size), (label, c, point)
+    for ic, joints, size in _random_centres(make, 60, 31):
+        O2, A, B, O4 = (joints[k] for k in ("O2", "A", "B", "O4"))
+        _kennedy_at(ic, (("I13", meet(O2, A, O4, B)), ("I24", meet(A, B, O2, O4))), size)
         for label, at in (("I12", O2), ("I23", A), ("I34", B), ("I14", O4)):
             assert near(next(c for c in ic.centres if c.label == label), at, size)
-        check_against_velocities(ic, pose)
-        signs.add(sign)
-    assert signs == {1, -1}
 
 
 def test_random_slider_cranks_both_branches_have_the_closed_form_centres():
@@ -241,26 +247,15 @@ def test_random_slider_cranks_both_branches_have_the_closed_form_centres():
                             rng.uniform(0, 2 * math.pi), sign)
         return None if built is None else (*built, sign)
 
-    signs = set()
-    for m, pose, joints, sign in _random_poses(make, 60, 32):
-        ic = linkage.instant_centres(m)
-        assert ic.status == "ok", ic.message
-        size = m.length_scale
-        O2, A, B = (pose.rates.joints[k] for k in ("O2", "A", "B"))
+    for ic, joints, size in _random_centres(make, 60, 32):
+        O2, A, B = (joints[k] for k in ("O2", "A", "B"))
         i14 = ic.centre("ground", "block")
         assert i14.kind == "at infinity" and i14.how == "primary"
         assert min(abs(i14.direction_deg - 90.0), 180 - abs(i14.direction_deg - 90.0)) < 1e-9
         # I13 where O2A meets the perpendicular to the slide through B; I24 where AB meets the
         # perpendicular through O2
-        for label, point in (("I13", meet(O2, A, B, (B[0], B[1] + 1.0))),
-                             ("I24", meet(A, B, O2, (0.0, 1.0)))):
-            c = next(c for c in ic.centres if c.label == label)
-            assert c.how == "Kennedy"
-            if point is not None:
-                assert near(c, point, size), (label, c, point)
-        check_against_velocities(ic, pose)
-        signs.add(sign)
-    assert signs == {1, -1}
+        _kennedy_at(ic, (("I13", meet(O2, A, B, (B[0], B[1] + 1.0))), ("I24", meet(A, B, O2, (0.0, 1.0)))),
+                    size)
 
 
 # --- points at infinity ------------------------------------------------------------------------------
@@ -300,7 +295,8 @@ def test_a_fourbar_with_every_joint_on_one_line_has_undefined_centres():
     """The parallelogram folded flat: O2A and O4B are one line, and so are AB and O2O4, so
     Kennedy's lines coincide, and the velocities are undefined there (J is singular)."""
     joints = {"O2": (0.0, 0.0), "A": (40.0, 0.0), "B": (140.0, 0.0), "O4": (100.0, 0.0)}
-    text = _doc(joints, ["O2", "O4"], {"crank": ["O2", "A"], "coupler": ["A", "B"], "rocker": ["O4", "B"]}, 0.0)
+    links = {"crank": ["O2", "A"], "coupler": ["A", "B"], "rocker": ["O4", "B"]}
+    text = _doc(joints, ["O2", "O4"], links, 0.0)
     ic = linkage.instant_centres(from_text(text, "flat"))
     assert ic.status == "undefined"
     assert [c.label for c in ic.centres if c.kind == "undefined"] == ["I13", "I24"]
@@ -318,7 +314,8 @@ def test_the_velocity_check_catches_a_centre_off_by_1e_6_of_the_size():
     scale = fastest_motion(motions, pose.rates, frame)
     h = relative_centre(motions, "ground", "coupler")
     x, y = h[0] / h[2], h[1] / h[2]
-    good = velocity_residual((x, y, 1.0), "ground", "coupler", motions, pose.rates, frame, pose.mechanism, scale)
+    good = velocity_residual((x, y, 1.0), "ground", "coupler", motions, pose.rates, frame,
+                             pose.mechanism, scale)
     bad = velocity_residual((x + 1e-6, y, 1.0), "ground", "coupler", motions, pose.rates, frame,
                             pose.mechanism, scale)
     assert good <= 1e-14 and bad > 1e-7
@@ -349,6 +346,22 @@ def test_the_crank_rockers_centrodes_are_its_kennedy_i13_in_both_frames():
         x = ax + math.cos(t) * p.moving.x - math.sin(t) * p.moving.y
         y = ay + math.sin(t) * p.moving.x + math.cos(t) * p.moving.y
         assert math.hypot(x - p.fixed.x, y - p.fixed.y) <= 1e-9 * size * (1 + (math.hypot(x, y) / size) ** 2)
+
+
+def test_the_crank_rockers_fixed_centrode_passes_through_infinity_where_o2a_and_o4b_turn_parallel():
+    """I13 is at infinity where the crank O2A and the rocker O4B are parallel: the sweep
+    names the intervals where their cross product changes sign, and no others."""
+    m = linkage.load_mechanism(SAMPLES / "crank_rocker_joints.toml")
+    values = list(range(0, 361, 10))
+    cd = linkage.centrodes(m, values)
+
+    def parallel(v):
+        _, pose, _ = at_driver(m, v)
+        (ox, oy), (ax, ay), (bx, by), (px, py) = (pose.rates.joints[k] for k in ("O2", "A", "B", "O4"))
+        return (ax - ox) * (by - py) - (ay - oy) * (bx - px)
+
+    turns = [(a, b) for a, b in itertools.pairwise(values) if parallel(a) * parallel(b) < 0]
+    assert len(turns) == 2 and cd.through_infinity == tuple((float(a), float(b)) for a, b in turns)
 
 
 def test_the_centrodes_of_a_loops_file_and_its_drawing_agree():
@@ -402,8 +415,9 @@ def test_the_plot_draws_the_centres_and_the_centrodes(cli, tmp_path):
 def test_a_plot_does_not_load_matplotlib_unless_asked():
     from conftest import run_process
 
+    path = str(SAMPLES / "crank_rocker_joints.toml")
     r = run_process(code="import sys\nfrom linkage.cli.entry import run_cli\n"
-                         f"run_cli(['centres', {str(SAMPLES / 'crank_rocker_joints.toml')!r}, '--format', 'csv'])\n"
+                         f"run_cli(['centres', {path!r}, '--format', 'csv'])\n"
                          "print('matplotlib' in sys.modules)")
     assert r.stdout.strip().endswith("False"), r.stdout + r.stderr
 
@@ -419,8 +433,9 @@ def _one_line(r, code, *needles):
 
 def test_a_mechanism_of_mobility_two_is_refused(cli, tmp_path):
     path = tmp_path / "five.toml"
-    path.write_text('name = "five-bar"\nlength_unit = "mm"\nground = ["O2", "O4"]\n[joints]\nO2 = [0.0, 0.0]\n'
-                    'A = [0.0, 40.0]\nC = [50.0, 80.0]\nB = [100.0, 40.0]\nO4 = [100.0, 0.0]\n[links]\n'
+    path.write_text('name = "five-bar"\nlength_unit = "mm"\nground = ["O2", "O4"]\n[joints]\n'
+                    'O2 = [0.0, 0.0]\nA = [0.0, 40.0]\nC = [50.0, 80.0]\nB = [100.0, 40.0]\n'
+                    'O4 = [100.0, 0.0]\n[links]\n'
                     'crank = ["O2", "A"]\nl3 = ["A", "C"]\nl4 = ["C", "B"]\nrocker = ["O4", "B"]\n'
                     '[driver]\nlink = "crank"\nvalue = 90\n')
     _one_line(cli("centres", str(path)), 2, "mobility 2")

@@ -157,15 +157,20 @@ class Pose:
         return self.mechanism.extra["drawing"]
 
 
+def turning_with(drawing: Any, body: str) -> str | None:
+    """The link whose angle ``body`` turns with (the joints form's rule, problems.joints: a
+    link its own, first joint -> second; a slider its line's body's); None for the ground."""
+    while body in drawing.sliders:
+        body = drawing.sliders[body].on
+    return None if body == "ground" else body
+
+
 def body_angle(pose_mechanism: Any, q: Sequence[float], driver: float, body: str) -> float:
-    """A body's angle (rad) at a pose, as the joints form defines it (first joint -> second,
-    :mod:`..problems.joints`); a slider turns with its line's body; the ground's is 0."""
-    d = pose_mechanism.extra["drawing"]
-    if body == "ground":
+    """A body's angle (rad) at a pose (:func:`turning_with`); the ground's is 0."""
+    link = turning_with(pose_mechanism.extra["drawing"], body)
+    if link is None:
         return 0.0
-    if body in d.sliders:
-        return body_angle(pose_mechanism, q, driver, d.sliders[body].on)
-    name = f"theta_{body}"
+    name = f"theta_{link}"
     if name == pose_mechanism.driver.name:
         return driver
     names = [u.name for u in pose_mechanism.unknowns]
@@ -175,24 +180,21 @@ def body_angle(pose_mechanism: Any, q: Sequence[float], driver: float, body: str
 def drawn_angle(drawing: Any, body: str) -> float:
     """A body's angle (rad) in the drawing itself (what :func:`body_angle` is at the drawn
     pose)."""
-    if body == "ground":
+    link = turning_with(drawing, body)
+    if link is None:
         return 0.0
-    if body in drawing.sliders:
-        return drawn_angle(drawing, drawing.sliders[body].on)
-    a, b = drawing.links[body][:2]
+    a, b = drawing.links[link][:2]
     (ax, ay), (bx, by) = drawing.xy[a], drawing.xy[b]
     return math.atan2(by - ay, bx - ax)
 
 
 def angular_velocity(mechanism: Any, rates: Any, speed: float, body: str) -> float:
-    """A body's angular velocity (rad/s) from the rates: its angle's rate; the driver's
-    the driver's speed; a slider's its line's body's; the ground's 0."""
-    d = mechanism.extra["drawing"]
-    if body == "ground":
+    """A body's angular velocity (rad/s) from the rates: its angle's rate (the driver's: the
+    driver's speed; :func:`turning_with`); the ground's 0."""
+    link = turning_with(mechanism.extra["drawing"], body)
+    if link is None:
         return 0.0
-    if body in d.sliders:
-        return angular_velocity(mechanism, rates, speed, d.sliders[body].on)
-    name = f"theta_{body}"
+    name = f"theta_{link}"
     return speed if name == mechanism.driver.name else rates.velocities[name]
 
 
@@ -308,16 +310,18 @@ def pair(a: str, b: str, order: Mapping[str, int]) -> tuple[str, str]:
     return (a, b) if order[a] < order[b] else (b, a)
 
 
-def kennedy(bodies: Sequence[str], known: Mapping[tuple[str, str], H]) -> dict[tuple[str, str], H]:
+def kennedy(bodies: Sequence[str], known: Mapping[tuple[str, str], H]
+            ) -> dict[tuple[str, str], tuple[H, tuple[str, str]]]:
     """The centres Kennedy's theorem places from ``known``: repeatedly, of every centre
     still unknown, the one whose two lines I_ik I_kj and I_im I_mj meet most clearly
     (the largest of min(line strengths) x sine between the lines, each line's strength the
-    sine between its two points), until none has two distinct lines. Only the new ones."""
+    sine between its two points), until none has two distinct lines. Only the new ones,
+    each with the third bodies (k, m) of its two lines."""
     order = {b: k for k, b in enumerate(bodies)}
     have = {k: unit(v) for k, v in known.items()}
-    found: dict[tuple[str, str], H] = {}
+    found: dict[tuple[str, str], tuple[H, tuple[str, str]]] = {}
     while True:
-        best: tuple[float, tuple[str, str], H] | None = None
+        best: tuple[float, tuple[str, str], H, tuple[str, str]] | None = None
         for a in range(len(bodies)):
             for b in range(a + 1, len(bodies)):
                 i, j = bodies[a], bodies[b]
@@ -333,17 +337,17 @@ def kennedy(bodies: Sequence[str], known: Mapping[tuple[str, str], H]) -> dict[t
                     line = cross(p, r)
                     strength = norm(line)
                     if strength > DISTINCT:
-                        lines.append((strength, unit(line)))
+                        lines.append((strength, unit(line), k))
                 for x in range(len(lines)):
                     for y in range(x + 1, len(lines)):
                         meet = cross(lines[x][1], lines[y][1])
                         score = min(lines[x][0], lines[y][0]) * norm(meet)
                         if norm(meet) > DISTINCT and (best is None or score > best[0]):
-                            best = (score, (i, j), unit(meet))
+                            best = (score, (i, j), unit(meet), (lines[x][2], lines[y][2]))
         if best is None:
             return found
         have[best[1]] = best[2]
-        found[best[1]] = best[2]
+        found[best[1]] = (best[2], best[3])
 
 
 @dataclass(frozen=True)
@@ -366,6 +370,8 @@ class Centre:
     residual: float | None
     """The velocity check (:func:`velocity_residual`, relative to the fastest motion);
     None where the velocities are undefined."""
+    via: tuple[str, str] = ()
+    """Kennedy: the two lines it is on, each through two centres (\"I12 I23\")."""
     velocity_separation: float | None = None
     """How far the velocities' own centre is from this one (:func:`separation`); None where
     the velocities do not place it (undefined, or the two bodies at rest relative to each
@@ -406,6 +412,12 @@ def centres_at(pose: Pose) -> InstantCentres:
     d = pose.drawing
     bodies = tuple(d.bodies)
     order = {b: k for k, b in enumerate(bodies)}
+
+    def label(i: str, j: str) -> str:
+        """I13: bodies numbered 1 for the ground, then the links in the file's order."""
+        a, b = sorted((order[i] + 1, order[j] + 1))
+        return f"I{a}{b}" if len(bodies) < 10 else f"I{a},{b}"
+
     frame = Frame.of(rates.joints)
     primary = primary_centres(m, pose.q, pose.driver, rates.joints, frame)
     by_kennedy = kennedy(bodies, primary)
@@ -417,13 +429,15 @@ def centres_at(pose: Pose) -> InstantCentres:
         for b in range(a + 1, len(bodies)):
             i, j = bodies[a], bodies[b]
             key = pair(i, j, order)
+            via: tuple[str, ...] = ()
             h_v = relative_centre(motions, i, j) if moving else None
             if h_v is not None and at_rest(h_v, scale):
                 h_v = None
             if key in primary:
                 h, how = primary[key], "primary"
             elif key in by_kennedy:
-                h, how = by_kennedy[key], "Kennedy"
+                (h, thirds), how = by_kennedy[key], "Kennedy"
+                via = tuple(f"{label(i, k)} {label(k, j)}" for k in thirds)
             elif h_v is not None:
                 h, how = h_v, "velocity"
             else:
@@ -434,9 +448,8 @@ def centres_at(pose: Pose) -> InstantCentres:
             residual = (velocity_residual(h, i, j, motions, rates, frame, m, scale)
                         if moving and how != "undefined" else None)
             apart = separation(h, h_v) if h_v is not None and how != "undefined" else None
-            centres.append(Centre(f"I{a + 1}{b + 1}" if len(bodies) < 10 else f"I{a + 1},{b + 1}",
-                                  i, j, where.kind, where.x, where.y, where.direction_deg, how,
-                                  residual, apart))
+            centres.append(Centre(label(i, j), i, j, where.kind, where.x, where.y, where.direction_deg, how,
+                                  residual, via, apart))  # type: ignore[arg-type]
     worst = max((c.residual for c in centres if c.residual is not None), default=None)
     undefined = [c.label for c in centres if c.how == "undefined"]
     if undefined:
@@ -548,6 +561,9 @@ class CentrodePoint:
     """The centre in the ground's frame."""
     moving: Place
     """The same centre in the body's frame: from its first joint, x along its angle."""
+    omega: float | None = None
+    """The body's angular velocity at a unit driver speed (rad/s per driver unit/s): where it
+    changes sign between positions, the centre passes through infinity."""
 
 
 @dataclass(frozen=True)
@@ -564,6 +580,17 @@ class Centrodes:
     """The body's first joint: its frame's origin (x along the body's angle)."""
     size: float = 1.0
     """The mechanism's size (its longest length, the length unit)."""
+
+    @property
+    def through_infinity(self) -> tuple[tuple[float, float], ...]:
+        """The driver intervals between neighbouring solved positions over which the centre
+        passes through infinity: the body's angular velocity changes sign there (or is 0 at
+        a position, the centre at infinity)."""
+        out = []
+        for a, b in zip(self.points, self.points[1:]):
+            if a.omega is not None and b.omega is not None and a.omega * b.omega < 0.0:
+                out.append((a.input, b.input))
+        return tuple(out)
 
 
 def default_body(m: Any) -> str:
@@ -608,7 +635,7 @@ def centrode_point(m: Any, q: Sequence[float], driver: float, rates: Any, body: 
         moving = Place("at infinity", direction_deg=(fixed.direction_deg - math.degrees(turn)) % 180.0)
     else:
         moving = none
-    return CentrodePoint(shown, "ok" if fixed.kind != "undefined" else "undefined", fixed, moving)
+    return CentrodePoint(shown, "ok" if fixed.kind != "undefined" else "undefined", fixed, moving, h[2])
 
 
 def centrodes(mechanism: Any, values: Any, body: str | None = None, *, branch: str | None = None

@@ -18,8 +18,8 @@ def _where_scale(ic: Any) -> float:
 
 
 def centre_rows(ic: Any) -> list[tuple[Any, ...]]:
-    return [(c.label, c.i, c.j, c.x, c.y, c.kind, c.direction_deg, c.how, c.residual, c.velocity_separation)
-            for c in ic.centres]
+    return [(c.label, c.i, c.j, c.x, c.y, c.kind, c.direction_deg, c.how, ", ".join(c.via), c.residual,
+             c.velocity_separation) for c in ic.centres]
 
 
 def centrode_rows(cd: Any) -> list[tuple[Any, ...]]:
@@ -34,7 +34,7 @@ def centres_report(ic: Any, digits: int, cd: Any = None) -> Report:
     tables = [from_rows("centres", [("centre", "", "text"), ("body_i", "", "text"), ("body_j", "", "text"),
                                     ("x", unit, "number"), ("y", unit, "number"), ("where", "", "text"),
                                     ("direction", "deg", "number"), ("how", "", "text"),
-                                    ("velocity_check", "", "number"),
+                                    ("on_lines", "", "text"), ("velocity_check", "", "number"),
                                     ("velocity_separation", "", "number")], centre_rows(ic))]
     if cd is not None:
         tables.append(from_rows("centrodes", [
@@ -42,15 +42,18 @@ def centres_report(ic: Any, digits: int, cd: Any = None) -> Report:
             ("fixed_x", unit, "number"), ("fixed_y", unit, "number"), ("fixed_where", "", "text"),
             ("fixed_direction", "deg", "number"), ("moving_x", unit, "number"), ("moving_y", unit, "number"),
             ("moving_where", "", "text"), ("moving_direction", "deg", "number")], centrode_rows(cd)))
-    title = f"{ic.mechanism}: instant centres at {ic.driver} = {fmt(ic.driver_value, digits)} {ic.driver_unit}"
+    title = (f"{ic.mechanism}: instant centres at {ic.driver} = {fmt(ic.driver_value, digits)} "
+             f"{ic.driver_unit}")
 
     def blocks() -> list[Block]:
         scale = _where_scale(ic)
         names = ", ".join(f"{k + 1} {b}" for k, b in enumerate(ic.bodies))
         out: list[Block] = [Text(title, "bold"), Text(f"bodies: {names}")]
         if ic.converted:
-            out.append(Text("(a loops-form file: its bodies named as linkage convert --form joints draws it)"))
-        rows = [(c.label, c.i, c.j, denoise(c.x, scale), denoise(c.y, scale), c.kind, c.direction_deg, c.how,
+            out.append(Text("(a loops-form file: its bodies named as linkage convert --form joints "
+                            "draws it)"))
+        rows = [(c.label, c.i, c.j, denoise(c.x, scale), denoise(c.y, scale), c.kind, c.direction_deg,
+                 c.how + (f": {' x '.join(c.via)}" if c.via else ""),
                  None if c.residual is None else float(f"{c.residual:.2g}"))
                 for c in ic.centres]
         out += [Text(""), table("", ["centre", "body i", "body j", f"x ({unit})", f"y ({unit})", "where",
@@ -95,10 +98,15 @@ def centrode_blocks(cd: Any, digits: int) -> list[Block]:
                    "moving at infinity (deg)"], rows, digits),
         Text("positions: " + ", ".join(f"{k}: {n}" for k, n in counts.items())),
     ]
+    crossing = cd.through_infinity
+    if crossing:
+        spans = ", ".join(f"{fmt(a, digits)} and {fmt(b, digits)}" for a, b in crossing)
+        out.append(Text(f"the fixed centrode passes through infinity (the {cd.body}'s angular velocity "
+                        f"changes sign) between {cd.driver} = {spans} {cd.driver_unit}"))
     if at_inf:
+        listed = ", ".join(fmt(v, digits) for v in at_inf[:12]) + (" ..." if len(at_inf) > 12 else "")
         out.append(Text(f"at infinity (the {cd.body} translating for an instant) at {cd.driver} = "
-                        + ", ".join(fmt(v, digits) for v in at_inf[:12]) + (" ..." if len(at_inf) > 12 else "")
-                        + f" {cd.driver_unit}"))
+                        f"{listed} {cd.driver_unit}"))
     return out
 
 
@@ -146,14 +154,19 @@ def centres_plot(pose: Any, ic: Any, path: Path, cd: Any = None) -> None:
     notes = []
     if cd is not None:
         _centrode_curves(ax, pose, cd, w)
-    shown: dict[tuple[float, float], list[str]] = {}
+    _construction_lines(ax, ic, w)
+    shown: dict[tuple[float, float], list[Any]] = {}
     for c in ic.centres:
         if c.kind == "finite" and _inside(w, c.x, c.y):
-            shown.setdefault((round(c.x, 9), round(c.y, 9)), []).append(c.label)
+            shown.setdefault((round(c.x, 9), round(c.y, 9)), []).append(c)
             ax.plot([c.x], [c.y], "s" if c.how != "primary" else "o", ms=5 if c.how == "primary" else 6,
                     color=COLOURS.get(c.how, "tab:red"), zorder=7)
-    for (x, y), labels in shown.items():
-        ax.annotate(", ".join(labels), (x, y), textcoords="offset points", xytext=(6, 5), fontsize=8,
+    for (x, y), here in shown.items():
+        # a pin's labels above right of it, a constructed centre's above left: a centre
+        # beside a pin (a four-bar's I24 near O2) keeps its own label
+        pin = any(c.how == "primary" for c in here)
+        ax.annotate(", ".join(c.label for c in here), (x, y), textcoords="offset points",
+                    xytext=(6, 5) if pin else (-6, 6), ha="left" if pin else "right", fontsize=8,
                     color="tab:purple", zorder=8)
     far = [f"{c.label} ({c.x:.4g}, {c.y:.4g})" for c in ic.centres
            if c.kind == "finite" and not _inside(w, c.x, c.y)]
@@ -165,7 +178,7 @@ def centres_plot(pose: Any, ic: Any, path: Path, cd: Any = None) -> None:
     undefined = [c.label for c in ic.centres if c.kind == "undefined"]
     if undefined:
         notes.append("undefined: " + ", ".join(undefined))
-    notes.append("circles: primary (pins); squares: Kennedy" +
+    notes.append("circles: primary (pins); squares: Kennedy (dotted: its lines)" +
                  (", green: from the velocities" if any(c.how == "velocity" for c in ic.centres) else ""))
     ax.set_aspect("equal", adjustable="box")  # the window is square: both limits hold
     ax.set_xlim(w[0], w[1])
@@ -174,6 +187,22 @@ def centres_plot(pose: Any, ic: Any, path: Path, cd: Any = None) -> None:
 
     ax.set_title(title + "\n" + "\n".join(textwrap.fill(n, 110) for n in notes), fontsize=9)
     save_figure(fig, path)
+
+
+def _construction_lines(ax: Any, ic: Any, w: tuple[float, float, float, float]) -> None:
+    """Each Kennedy centre's two lines, thin and dotted: along each, from the finite one of
+    its two centres (or both) to the centre it places."""
+    by_label = {c.label: c for c in ic.centres}
+    for c in ic.centres:
+        if c.how != "Kennedy" or c.kind != "finite" or not _inside(w, c.x, c.y):
+            continue
+        for line in c.via:
+            ends = [by_label[k] for k in line.split()]
+            pts = [(e.x, e.y) for e in ends if e.kind == "finite"] + [(c.x, c.y)]
+            if len(pts) < 2:
+                continue
+            a, b = max(((p, r) for p in pts for r in pts), key=lambda pr: math.dist(*pr))
+            ax.plot([a[0], b[0]], [a[1], b[1]], color="tab:purple", lw=1.0, ls=":", zorder=1)
 
 
 def _centrode_curves(ax: Any, pose: Any, cd: Any, w: tuple[float, float, float, float]) -> None:
@@ -187,9 +216,15 @@ def _centrode_curves(ax: Any, pose: Any, cd: Any, w: tuple[float, float, float, 
     c, s = math.cos(turn), math.sin(turn)
     ox, oy = pose.rates.joints[cd.frame_joint]
 
+    breaks = {k + 1 for k, (a, b) in enumerate(zip(cd.points, cd.points[1:]))
+              if a.omega is not None and b.omega is not None and a.omega * b.omega < 0.0}
+
     def curve(points: list[tuple[float | None, float | None]]) -> tuple[list[float], list[float]]:
         xs, ys = [], []
-        for x, y in points:
+        for k, (x, y) in enumerate(points):
+            if k in breaks:  # through infinity between these two: never join them
+                xs.append(math.nan)
+                ys.append(math.nan)
             ok = _inside(w, x, y)
             xs.append(x if ok else math.nan)  # type: ignore[arg-type]
             ys.append(y if ok else math.nan)  # type: ignore[arg-type]
