@@ -285,6 +285,7 @@ BATTERY = [
     ("instant_centres", "driver_value text", lambda: linkage.instant_centres(JM, "abc"), "driver_value"),
     ("instant_centres", "NaN driver_value", lambda: linkage.instant_centres(JM, math.nan), "driver_value"),
     ("instant_centres", "complex driver_value", lambda: linkage.instant_centres(JM, 1j), "driver_value"),
+    ("instant_centres", "branch a number", lambda: linkage.instant_centres(JM, branch=3), "branch"),
     ("instant_centres", "a pose that does not assemble", lambda: linkage.instant_centres(JM, 150.0),
      "cannot be assembled"),
     ("centrodes", "mechanism None", lambda: linkage.centrodes(None, TWO), "mechanism"),

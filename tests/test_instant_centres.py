@@ -364,10 +364,30 @@ def test_the_crank_rockers_fixed_centrode_passes_through_infinity_where_o2a_and_
     assert len(turns) == 2 and cd.through_infinity == tuple((float(a), float(b)) for a, b in turns)
 
 
+def test_the_crossed_branch_has_its_own_centres_checked_against_its_velocities():
+    """--branch crossed: the other assembly at the same crank angle, B mirrored across the
+    line AO4; its I13 is where O2A meets O4B there, and its centrode follows it."""
+    for name in ("crank_rocker.toml", "crank_rocker_joints.toml"):
+        m = linkage.load_mechanism(SAMPLES / name)
+        _, pose, _ = at_driver(m, 30.0, "crossed")
+        ic = linkage.instant_centres(m, 30.0, branch="crossed")
+        assert ic.status == "ok"
+        check_against_velocities(ic, pose)
+        joints = pose.rates.joints
+        O2, A, B, O4 = (joints[k] for k in ("O2", "A", "B", "O4"))
+        assert B[1] < 0  # the crossed assembly at 30 deg: B below the ground line
+        coupler = ic.bodies[2]
+        assert near(ic.centre("ground", coupler), meet(O2, A, O4, B), m.length_scale)
+        cd = linkage.centrodes(m, [30.0], branch="crossed")
+        fixed = cd.points[0].fixed
+        assert near(ic.centre("ground", coupler), (fixed.x, fixed.y), m.length_scale)
+
+
 def test_the_centrodes_of_a_loops_file_and_its_drawing_agree():
     a = linkage.centrodes(SAMPLES / "crank_rocker.toml", [0, 45, 90])
     b = linkage.centrodes(SAMPLES / "crank_rocker_joints.toml", [0, 45, 90])
     assert a.body == "link3" and b.body == "coupler"
+    assert (a.driver, b.driver) == ("theta2", "theta_crank")
     for p, r in zip(a.points, b.points):
         assert math.hypot(p.fixed.x - r.fixed.x, p.fixed.y - r.fixed.y) < 1e-9 * 120
 

@@ -42,6 +42,9 @@ def centres(
                     "(default 360, or the file's [driver] range).")] = None,
     step: Annotated[Optional[float], typer.Option(help="With --centrodes: the driver's increment "
                     "(default 1).")] = None,
+    branch: Annotated[Optional[str], typer.Option(help="The assembly, by name or signs as in solve "
+                      "--branch (open, crossed, open/crossed for a six-bar, +-); default: the file's "
+                      "pose's (a drawing's drawn pose). --centrodes follows it.")] = None,
     plot: Annotated[Optional[Path], typer.Option(help="Draw the mechanism with its centres (and with "
                     "--centrodes the centrodes) into this picture (.png, .svg or .pdf; needs "
                     "matplotlib).")] = None,
@@ -71,7 +74,7 @@ def centres(
         raise InputError(f"{', '.join(given)} set the centrodes' sweep: give --centrodes as well")
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
     note_closed_form(mechanism)
-    mechanism, pose, converted = at_driver(mechanism)
+    mechanism, pose, converted = at_driver(mechanism, branch=branch)
     ic = as_given(centres_at(pose), mechanism, converted)
     cd = None
     if centrodes:
@@ -84,7 +87,7 @@ def centres(
         if step is not None and not check_number("--step", step) > 0:
             raise InputError("--step must be > 0")
         values = driver_values(a, b, 1.0 if step is None else step, None)
-        cd = run_centrodes(mechanism, values, body)
+        cd = run_centrodes(mechanism, values, body, branch=branch)
     emit_report(centres_report(ic, digits, cd), out_fmt, output, columns=columns)
     if plot is not None:
         from ..render.centres import centres_plot

@@ -370,7 +370,7 @@ class Centre:
     residual: float | None
     """The velocity check (:func:`velocity_residual`, relative to the fastest motion);
     None where the velocities are undefined."""
-    via: tuple[str, str] = ()
+    via: tuple[str, ...] = ()
     """Kennedy: the two lines it is on, each through two centres (\"I12 I23\")."""
     velocity_separation: float | None = None
     """How far the velocities' own centre is from this one (:func:`separation`); None where
@@ -449,7 +449,7 @@ def centres_at(pose: Pose) -> InstantCentres:
                         if moving and how != "undefined" else None)
             apart = separation(h, h_v) if h_v is not None and how != "undefined" else None
             centres.append(Centre(label(i, j), i, j, where.kind, where.x, where.y, where.direction_deg, how,
-                                  residual, via, apart))  # type: ignore[arg-type]
+                                  residual, via, apart))
     worst = max((c.residual for c in centres if c.residual is not None), default=None)
     undefined = [c.label for c in centres if c.how == "undefined"]
     if undefined:
@@ -505,21 +505,35 @@ def solve_pose(m: Any) -> Pose:
     return Pose(m, q, m.driver.value, position_rates(m.model, list(q), m.driver.value, 1.0, 0.0))
 
 
+def _drawing_unit(m: Any) -> float:
+    """The drawing's driver unit (deg, or the length unit) per the file's."""
+    from ..problems.loops import ANGLE_UNITS, length_factor
+
+    if m.driver.kind == "angle":
+        return math.degrees(ANGLE_UNITS[m.driver.unit])
+    return 1.0 if m.driver.unit == m.length_unit else length_factor(m.driver.unit, m.length_unit)
+
+
 def _driver_text(m: Any) -> str:
     d = m.driver
     v = math.degrees(d.value) if d.kind == "angle" else d.value
     return f"{d.name} = {v:.12g} {'deg' if d.kind == 'angle' else m.length_unit}"
 
 
-def at_driver(mechanism: Any, driver_value: Any = None) -> tuple[Any, Pose, bool]:
-    """(the mechanism as given, at ``driver_value``), its pose, and whether it was
-    converted from the loops form: the front door's work, shared by the command line."""
-    from ..arguments import check_number
+def at_driver(mechanism: Any, driver_value: Any = None, branch: Any = None) -> tuple[Any, Pose, bool]:
+    """(the mechanism as given, at ``driver_value``, started on ``branch``), its pose, and
+    whether it was converted from the loops form: the front door's work, shared by the
+    command line."""
+    from ..arguments import check_number, check_text
     from ..problems.loops import mechanism_of
 
     m = mechanism_of("mechanism", mechanism)
     if driver_value is not None:
         m = m.with_values({m.driver.name: check_number("driver_value", driver_value)}, {})
+    if check_text("branch", branch) is not None:
+        from ..problems.start import start_on_branch
+
+        m = start_on_branch(m, branch, False)
     if m.extra.get("drawing") is None:
         from ..solve import solve_system
 
@@ -529,15 +543,16 @@ def at_driver(mechanism: Any, driver_value: Any = None) -> tuple[Any, Pose, bool
     return m, solve_pose(jm), converted
 
 
-def instant_centres(mechanism: Any, driver_value: Any = None) -> InstantCentres:
+def instant_centres(mechanism: Any, driver_value: Any = None, *, branch: str | None = None) -> InstantCentres:
     """All n(n-1)/2 instant centres of a one-degree-of-freedom mechanism (a path or a
     :class:`~linkage.Mechanism`, either form) at ``driver_value`` (the driver's display
-    unit: degrees for an angle; default the file's): the public ``linkage.instant_centres``.
+    unit: degrees for an angle; default the file's), on the assembly ``branch`` names (as
+    ``solve --branch``; default the file's guesses): the public ``linkage.instant_centres``.
     Each :class:`Centre` is finite or at infinity (with its direction), says how it was
     found (primary, Kennedy, velocity) and how closely the velocities bear it out. A
     misuse, a mechanism that does not assemble at the value, or a loops file whose loops
     name no joints raises :class:`~linkage.errors.InputError`."""
-    m, pose, converted = at_driver(mechanism, driver_value)
+    m, pose, converted = at_driver(mechanism, driver_value, branch)
     return as_given(centres_at(pose), m, converted)
 
 
@@ -654,19 +669,25 @@ def centrodes(mechanism: Any, values: Any, body: str | None = None, *, branch: s
     check_text("branch", branch)
     if body is not None:
         check_text("body", body)
+    if branch is not None:  # the branch is named by the file as given: its assembly at its value
+        from ..problems.start import start_on_branch
+
+        m = start_on_branch(m, branch, False)
     jm, _ = joints_form(m)
     body = default_body(jm) if body is None else check_body(jm, body)
-    result = sweep_mechanism(jm, values, speed=1.0, branch=branch)
+    # the values in the file's driver unit; a drawing's is deg (or its length unit)
+    k = _drawing_unit(m)
+    result = sweep_mechanism(jm, [v * k for v in values], speed=1.0)
     names = [u.name for u in jm.unknowns]
     scale = math.pi / 180.0 if jm.driver.kind == "angle" else 1.0
     points = []
     none = Place("undefined")
     for p in result.positions:
         if p.solution is None:
-            points.append(CentrodePoint(p.input, p.status, none, none))
+            points.append(CentrodePoint(p.input / k, p.status, none, none))
             continue
         q = [math.radians(p.solution[n]) if u.kind == "angle" else p.solution[n]
              for n, u in zip(names, jm.unknowns)]
-        points.append(centrode_point(jm, q, p.input * scale, p.rates, body, p.input))
-    return Centrodes(jm.name, body, jm.driver.name, result.driver_unit, jm.length_unit, tuple(points),
+        points.append(centrode_point(jm, q, p.input * scale, p.rates, body, p.input / k))
+    return Centrodes(jm.name, body, m.driver.name, m.driver.unit, jm.length_unit, tuple(points),
                      jm.extra["drawing"].links[body][0], jm.length_scale)

@@ -71,7 +71,8 @@ def centres_report(ic: Any, digits: int, cd: Any = None) -> Report:
                                "converted_from_loops": ic.converted}
         if cd is not None:
             doc["centrodes"] = {"body": cd.body, "relative_to": "ground", "moving_frame":
-                                f"from {cd.frame_joint}, x along {cd.body}'s angle"}
+                                f"from {cd.frame_joint}, x along {cd.body}'s angle",
+                                "through_infinity": [list(span) for span in cd.through_infinity]}
         return doc
 
     return Report(title, tuple(tables), blocks, document)
@@ -101,11 +102,11 @@ def centrode_blocks(cd: Any, digits: int) -> list[Block]:
     crossing = cd.through_infinity
     if crossing:
         spans = ", ".join(f"{fmt(a, digits)} and {fmt(b, digits)}" for a, b in crossing)
-        out.append(Text(f"the fixed centrode passes through infinity (the {cd.body}'s angular velocity "
+        out.append(Text(f"the fixed centrode passes through infinity ({cd.body}'s angular velocity "
                         f"changes sign) between {cd.driver} = {spans} {cd.driver_unit}"))
     if at_inf:
         listed = ", ".join(fmt(v, digits) for v in at_inf[:12]) + (" ..." if len(at_inf) > 12 else "")
-        out.append(Text(f"at infinity (the {cd.body} translating for an instant) at {cd.driver} = "
+        out.append(Text(f"at infinity ({cd.body} translating for an instant) at {cd.driver} = "
                         f"{listed} {cd.driver_unit}"))
     return out
 
