@@ -199,7 +199,7 @@ def angular_velocity(mechanism: Any, rates: Any, speed: float, body: str) -> flo
 
 
 @dataclass(frozen=True)
-class Frame:
+class HomogeneousFrame:
     """The frame the homogeneous points are in: lengths from ``origin`` over ``size``."""
 
     origin: tuple[float, float]
@@ -209,14 +209,14 @@ class Frame:
         return finite((xy[0] - self.origin[0]) / self.size, (xy[1] - self.origin[1]) / self.size)
 
     @classmethod
-    def of(cls, joints: Mapping[str, tuple[float, float]]) -> Frame:
+    def of(cls, joints: Mapping[str, tuple[float, float]]) -> HomogeneousFrame:
         xs, ys = [p[0] for p in joints.values()], [p[1] for p in joints.values()]
         origin = (sum(xs) / len(xs), sum(ys) / len(ys))
         size = max(math.hypot(x - origin[0], y - origin[1]) for x, y in zip(xs, ys))
         return cls(origin, size if size > 0.0 and math.isfinite(size) else 1.0)
 
 
-def body_motions(mechanism: Any, rates: Any, frame: Frame, speed: float = 1.0
+def body_motions(mechanism: Any, rates: Any, frame: HomogeneousFrame, speed: float = 1.0
                  ) -> dict[str, tuple[float, tuple[float, float], tuple[float, float]]]:
     """Each body's (omega, a point, its velocity) in ``frame`` (per second), from the
     rates: the point is the body's first joint that is not a point on it."""
@@ -232,7 +232,7 @@ def body_motions(mechanism: Any, rates: Any, frame: Frame, speed: float = 1.0
     return out
 
 
-def fastest_motion(motions: Mapping[str, Any], rates: Any, frame: Frame) -> float:
+def fastest_motion(motions: Mapping[str, Any], rates: Any, frame: HomogeneousFrame) -> float:
     """The scale the velocity check and the rest test are relative to: the fastest joint's
     speed or the fastest turning, both per second in ``frame`` (a unit driver speed)."""
     v = max((math.hypot(*u) for u in rates.joint_velocities.values()), default=0.0) / frame.size
@@ -250,7 +250,7 @@ def at_rest(h: H, scale: float) -> bool:
     return not norm(h) > MOTION_RTOL * scale
 
 
-def velocity_residual(h: H, i: str, j: str, motions: Mapping[str, Any], rates: Any, frame: Frame,
+def velocity_residual(h: H, i: str, j: str, motions: Mapping[str, Any], rates: Any, frame: HomogeneousFrame,
                       mechanism: Any, scale: float) -> float:
     """The check of centre ``h`` of bodies i and j: at every joint P of either body, the
     velocity of j's point at P relative to i's must be (w_j - w_i) k x (P - I) about a
@@ -289,7 +289,7 @@ def velocity_residual(h: H, i: str, j: str, motions: Mapping[str, Any], rates: A
 # --- the centres ------------------------------------------------------------------------------
 
 def primary_centres(mechanism: Any, q: Sequence[float], driver: float, joints: Mapping[str, Any],
-                    frame: Frame) -> dict[tuple[str, str], H]:
+                    frame: HomogeneousFrame) -> dict[tuple[str, str], H]:
     """The centres the joints give: each pin shared by two bodies, and each slider's at
     infinity perpendicular to its line (the line turned with its body since the drawing)."""
     d = mechanism.extra["drawing"]
@@ -418,7 +418,7 @@ def centres_at(pose: Pose) -> InstantCentres:
         a, b = sorted((order[i] + 1, order[j] + 1))
         return f"I{a}{b}" if len(bodies) < 10 else f"I{a},{b}"
 
-    frame = Frame.of(rates.joints)
+    frame = HomogeneousFrame.of(rates.joints)
     primary = primary_centres(m, pose.q, pose.driver, rates.joints, frame)
     by_kennedy = kennedy(bodies, primary)
     moving = rates.status != "undefined" and bool(rates.joint_velocities)
@@ -633,7 +633,7 @@ def centrode_point(m: Any, q: Sequence[float], driver: float, rates: Any, body: 
     none = Place("undefined")
     if rates is None or rates.status == "undefined" or not rates.joint_velocities:
         return CentrodePoint(shown, "toggle", none, none)
-    frame = Frame.of(rates.joints)
+    frame = HomogeneousFrame.of(rates.joints)
     motions = body_motions(m, rates, frame)
     h = relative_centre(motions, "ground", body)
     if at_rest(h, fastest_motion(motions, rates, frame)):
