@@ -39,9 +39,9 @@ H = tuple[float, float, float]
 """A homogeneous point or line in the mechanism's frame."""
 
 INFINITY_RTOL = 1e-12
-"""A centre is at infinity where |W| <= INFINITY_RTOL * hypot(X, Y): beyond 1e12 times the
-mechanism's size, where a computed W that is exactly 0 lands after rounding (1e-16 of the
-others), and where no drawing can tell a point from one at infinity."""
+"""A centre is at infinity where |W| <= INFINITY_RTOL * hypot(X, Y) (:func:`is_at_infinity`):
+beyond 1e12 times the mechanism's size, where a computed W that is exactly 0 lands after
+rounding (1e-16 of the others), and where no drawing can tell a point from one at infinity."""
 
 DISTINCT = 1e-9
 """Two centres (or two lines) closer than this, as unit homogeneous vectors (the sine of
@@ -109,14 +109,19 @@ class Place:
     """At infinity: the direction, in [0, 180) deg (a point at infinity has no sense)."""
 
 
+def is_at_infinity(h: H) -> bool:
+    """The one rule for a point at infinity: |W| <= INFINITY_RTOL hypot(X, Y)."""
+    return abs(h[2]) <= INFINITY_RTOL * math.hypot(h[0], h[1])
+
+
 def place_of(h: H, origin: tuple[float, float], size: float) -> Place:
-    """The one rule for finite and at infinity: h in the frame (origin, size) -> the point
-    in the file's coordinates, at infinity where |W| <= INFINITY_RTOL hypot(X, Y)."""
+    """h in the frame (origin, size) -> the point in the file's coordinates, finite or at
+    infinity by :func:`is_at_infinity`, or undefined (h zero or not a number)."""
     x, y, w = h
     r = math.hypot(x, y)
     if not (math.isfinite(r) and math.isfinite(w)) or (r == 0.0 and w == 0.0):
         return Place("undefined")
-    if abs(w) <= INFINITY_RTOL * r:
+    if is_at_infinity(h):
         return Place("at infinity", direction_deg=math.degrees(math.atan2(y, x)) % 180.0)
     return Place("finite", origin[0] + size * x / w, origin[1] + size * y / w)
 
@@ -227,8 +232,9 @@ def body_motions(mechanism: Any, rates: Any, frame: HomogeneousFrame, speed: flo
         (x, y), (vx, vy) = rates.joints[j], rates.joint_velocities.get(j, (0.0, 0.0))
         if body == "ground":
             vx = vy = 0.0
-        p = ((x - frame.origin[0]) / frame.size, (y - frame.origin[1]) / frame.size)
-        out[body] = (angular_velocity(mechanism, rates, speed, body), p, (vx / frame.size, vy / frame.size))
+        px, py, _ = frame.point((x, y))
+        w = angular_velocity(mechanism, rates, speed, body)
+        out[body] = (w, (px, py), (vx / frame.size, vy / frame.size))
     return out
 
 
@@ -261,9 +267,8 @@ def velocity_residual(h: H, i: str, j: str, motions: Mapping[str, Any], rates: A
     wi, wj = motions[i][0], motions[j][0]
     dw = wj - wi
     unit_h = unit(h)
-    worst = 0.0
-    if abs(unit_h[2]) <= INFINITY_RTOL * math.hypot(unit_h[0], unit_h[1]):
-        worst = abs(dw)  # a relative translation: no relative turning
+    far = is_at_infinity(unit_h)
+    worst = abs(dw) if far else 0.0  # at infinity: a relative translation, no relative turning
     for joint in dict.fromkeys([*d.bodies[i], *d.bodies[j]]):
         x, y = frame.point(rates.joints[joint])[:2]
         v = {}
@@ -276,7 +281,7 @@ def velocity_residual(h: H, i: str, j: str, motions: Mapping[str, Any], rates: A
                 v[b] = (pvx - w * (y - py), pvy + w * (x - px))
         rx, ry = v[j][0] - v[i][0], v[j][1] - v[i][1]
         X, Y, W = unit_h
-        if abs(W) <= INFINITY_RTOL * math.hypot(X, Y):
+        if far:
             n = math.hypot(X, Y)
             miss = abs(rx * X + ry * Y) / n  # the relative velocity is across the direction
         else:
