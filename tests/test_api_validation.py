@@ -338,6 +338,22 @@ BATTERY = [
      lambda: M.with_values({}, [("theta3", 1.0)]), "guesses"),
     ("Loads.merged", "None", lambda: linkage.Loads().merged(None), "Loads"),
     ("Loads.merged", "a dict", lambda: linkage.Loads().merged({"torques": {"rocker": 1.0}}), "Loads"),
+    # instant_centres and centrodes: each argument by its own name
+    ("instant_centres", "mechanism None", lambda: linkage.instant_centres(None), "mechanism"),
+    ("instant_centres", "mechanism a number", lambda: linkage.instant_centres(3), "mechanism"),
+    ("instant_centres", "driver_value text", lambda: linkage.instant_centres(JM, "abc"), "driver_value"),
+    ("instant_centres", "NaN driver_value", lambda: linkage.instant_centres(JM, math.nan), "driver_value"),
+    ("instant_centres", "complex driver_value", lambda: linkage.instant_centres(JM, 1j), "driver_value"),
+    ("instant_centres", "branch a number", lambda: linkage.instant_centres(JM, branch=3), "branch"),
+    ("instant_centres", "a pose that does not assemble", lambda: linkage.instant_centres(JM, 150.0),
+     "cannot be assembled"),
+    ("centrodes", "mechanism None", lambda: linkage.centrodes(None, TWO), "mechanism"),
+    ("centrodes", "values None", lambda: linkage.centrodes(JM, None), "values"),
+    ("centrodes", "generator values", lambda: linkage.centrodes(JM, _gen()), "values"),
+    ("centrodes", "NaN value", lambda: linkage.centrodes(JM, [0.0, math.nan]), "values"),
+    ("centrodes", "body a number", lambda: linkage.centrodes(JM, TWO, 3), "body"),
+    ("centrodes", "body unknown", lambda: linkage.centrodes(JM, TWO, "wheel"), "body"),
+    ("centrodes", "branch a number", lambda: linkage.centrodes(JM, TWO, branch=3), "branch"),
 ]
 
 

@@ -37,6 +37,8 @@ COMMANDS: dict[str, list[str]] = {
     "sweep": ["sweep", str(SAMPLES / "crank_rocker.toml"), "--step", "30"],
     "sweep-rates": ["sweep", str(SAMPLES / "rapier_drive.toml"), "--step", "45", "--speed", "10"],
     "sweep-equation": ["sweep", "--step", "30"],
+    "centres": ["centres", str(SAMPLES / "slider_crank.toml")],
+    "centrodes": ["centres", str(SAMPLES / "crank_rocker_joints.toml"), "--centrodes", "--step", "90"],
     "scan": ["scan", str(SAMPLES / "crank_rocker.toml"), "--vary", "r2=30:40:3", "--step", "30"],
     "samples": ["samples"],
     "synthesize": ["synthesize", "--function", "log10(x)", "--x", "1:2", "--alpha", "90:150",

@@ -13,6 +13,8 @@ The public API, in the order a reader meets it:
 - :func:`synthesize_function` designs a four-bar function generator (Freudenstein).
 - :func:`assemblies` finds every assembly of a mechanism at a driver value (homotopy continuation).
 - :func:`forces` gives the input torque and joint forces of a joints-form mechanism at a position.
+- :func:`instant_centres` gives every instant centre of a mechanism at a pose, :func:`centrodes`
+  the fixed and moving centrodes of a body over a sweep.
 - :func:`analyze` estimates convergence order and rate from a recorded history.
 """
 
@@ -37,6 +39,8 @@ _EXPORTS = {
     "forces": ".kinematics.forces", "Forces": ".kinematics.forces",
     "assemblies": ".kinematics.assemblies", "Assemblies": ".kinematics.assemblies",
     "Loads": ".problems.loads", "Mass": ".problems.loads",
+    "instant_centres": ".kinematics.centres", "InstantCentres": ".kinematics.centres",
+    "centrodes": ".kinematics.centres", "Centrodes": ".kinematics.centres",
 }
 _RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",
             "scan_designs": "scan", "forces": "forces_at", "assemblies": "every_assembly"}
@@ -61,11 +65,13 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Assemblies",
+    "Centrodes",
     "Convergence",
     "Forces",
     "FunctionSynthesis",
     "History",
     "InputError",
+    "InstantCentres",
     "IterationRecord",
     "LinkageError",
     "Loads",
@@ -82,10 +88,12 @@ __all__ = [
     "SystemProblem",
     "analyze",
     "assemblies",
+    "centrodes",
     "coefficients_from_links",
     "equation_problem",
     "forces",
     "fourbar_equation",
+    "instant_centres",
     "load_mechanism",
     "position_rates",
     "scan_designs",

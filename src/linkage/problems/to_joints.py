@@ -40,14 +40,14 @@ class _Vector(NamedTuple):
     term: Any
 
 
-def _link_name(angle: str) -> str:
+def link_name(angle: str) -> str:
     if angle.startswith("theta_") and len(angle) > 6:
         return angle[6:]
     digits = re.fullmatch(r"theta(\d+)", angle)
     return f"link{digits.group(1)}" if digits else f"link_{angle}"
 
 
-def _slider_name(length: str) -> str:
+def slider_name(length: str) -> str:
     return length[2:] if length.startswith("s_") and len(length) > 2 else f"block_{length}"
 
 
@@ -114,7 +114,7 @@ def joints_doc(m: Any) -> dict[str, Any]:
         if len(pins) != 1:
             raise refuse(f"loops[{v.loop}] ({m.loops[v.loop].name}): cannot tell which end of the "
                          f"travel {v.term.length} carries the slider")
-        name = _slider_name(str(v.term.length))
+        name = slider_name(str(v.term.length))
         line = math.degrees(_value(m, v.term.angle, q, d) + v.term.offset)
         blocks.setdefault(name, {"pin": pins[0], "frame": v.frame, "line": line,
                                  "travel": v.term.length})
@@ -128,7 +128,7 @@ def joints_doc(m: Any) -> dict[str, Any]:
                 members[body].append(j)
 
     for b in blocks.values():
-        join(_slider_name(str(b["travel"])), b["pin"])
+        join(slider_name(str(b["travel"])), b["pin"])
     # a constant-angle vector touching a moving joint lies on a translating block
     pending = [v for v in vectors if not v.slide]
     grew = True
@@ -147,14 +147,14 @@ def joints_doc(m: Any) -> dict[str, Any]:
         if v.frame == GROUND and not ({v.start, v.end} - {""}) <= fixed:
             raise refuse(f"loops[{v.loop}] ({m.loops[v.loop].name}): vector {v.index} has a fixed "
                          "direction but moves, and no slider carries it")
-        join(GROUND if v.frame == GROUND else _link_name(v.frame), v.start, v.end)
+        join(GROUND if v.frame == GROUND else link_name(v.frame), v.start, v.end)
     for pname, (origin, terms) in m.points.items():
         frames = {frame(t) for t in terms}
         if len(frames) != 1 or any(isinstance(t.length, str) and t.length in lengths for t in terms):
             raise refuse(f"points.{pname}: its vectors run over more than one link")
         (f,) = frames
         if f != GROUND:
-            join(_link_name(f), pname)
+            join(link_name(f), pname)
             continue
         owner = next((s for s in blocks if origin in members.get(s, [])), None)
         if owner is None:
@@ -172,16 +172,16 @@ def joints_doc(m: Any) -> dict[str, Any]:
             joints.remove(blocks[body]["pin"])
             links[body] = [blocks[body]["pin"], *joints]
             continue
-        angle = next(f for f in angles if _link_name(f) == body)
+        angle = next(f for f in angles if link_name(f) == body)
         links[body] = _ordered(joints, [v for v in vectors if v.frame == angle and not v.slide])
     sliders = {}
     for s, b in blocks.items():
-        on = GROUND if b["frame"] == GROUND else _link_name(b["frame"])
+        on = GROUND if b["frame"] == GROUND else link_name(b["frame"])
         sliders[s] = {"on": on, "angle": _wrap(b["line"])}
     coords = {j: placed[j] for loop in m.loops for j in loop.joints if j} | {
         p: placed[p] for p in m.points}
     if m.driver.kind == "angle":
-        link = _link_name(m.driver.name)
+        link = link_name(m.driver.name)
         js = links[link]
         if js[0] not in ground:
             if len(js) == 2 and js[1] in ground:
@@ -295,7 +295,7 @@ def joints_text(m: Any, source: str) -> str:
     out += [f"{toml_key(j)} = {toml_value(xy)}" for j, xy in doc["joints"].items()]
     out += ["", "[links]  # the joints each rigid link carries; its angle: first joint -> second"]
     for link, js in doc["links"].items():
-        was = next((a for a in names if _link_name(a) == link), None)
+        was = next((a for a in names if link_name(a) == link), None)
         note = f"  # {was}: {', '.join(sorted(names[was]))}" if was else ""
         out.append(f"{toml_key(link)} = {toml_value(js)}{note}")
     if "sliders" in doc:

@@ -219,10 +219,10 @@ def _driven(mechanism: Any) -> str | None:
     doc = mechanism.extra.get("drawing_driver")
     if doc is not None:
         return doc.get("link") or doc.get("slider")
-    from ..problems.to_joints import _link_name, _slider_name
+    from ..problems.to_joints import link_name, slider_name
 
     name = mechanism.driver.name
-    return _link_name(name) if mechanism.driver.kind == "angle" else _slider_name(name)
+    return link_name(name) if mechanism.driver.kind == "angle" else slider_name(name)
 
 
 def _bodies(mechanism: Any, drawing: Any, placed: Mapping[str, Point], swept: Sequence[Any]
@@ -291,18 +291,18 @@ def _vectors_only(mechanism: Any, q: Sequence[float]
     """A loops-form file whose loops name no joints: each vector a segment on the layer of
     the link its angle turns with (``GROUND`` for a constant angle), each corner a joint
     without a name."""
-    from ..problems.to_joints import _link_name
+    from ..problems.to_joints import link_name
 
     moving = {u.name for u in mechanism.unknowns} | {mechanism.driver.name}
     angle_name = {str(t.angle) for loop in mechanism.loops for t in loop.vectors
                   if isinstance(t.angle, str) and t.angle in moving}
-    layers = layer_names(["ground", *sorted(_link_name(a) for a in angle_name)])
+    layers = layer_names(["ground", *sorted(link_name(a) for a in angle_name)])
     driven = _driven(mechanism)
     bodies, corners = [], {}
     for points, loop in zip(mechanism.model.points(q, mechanism.driver.value), mechanism.loops):
         for k, term in enumerate(loop.vectors):
             a, b = points[k], points[k + 1]
-            body = _link_name(term.angle) if term.angle in angle_name else "ground"
+            body = link_name(term.angle) if term.angle in angle_name else "ground"
             role = "ground" if body == "ground" else "driven" if body == driven else "link"
             bodies.append(Body(body, layers[body], ((a.real, a.imag), (b.real, b.imag)), False, role))
             corners.setdefault((a.real, a.imag), None)

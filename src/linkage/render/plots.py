@@ -281,6 +281,12 @@ def _named_points(mechanism: Any, q: Sequence[float], driver: float) -> dict[str
     return {name: (placed[origin][0], placed[name][0]) for name, (origin, _) in mechanism.points.items()}
 
 
+def draw_on(ax: Any, mechanism: Any, q: Sequence[float], driver: float, title: str) -> None:
+    """The mechanism at (q, driver) drawn on ``ax``, as :func:`draw_mechanism` draws it: for
+    pictures built on the drawing (the instant centres, render.centres)."""
+    _draw(ax, mechanism, q, driver, title)
+
+
 def draw_mechanism(mechanism: Any, q: Sequence[float], path: Path, title: str) -> None:
     _check_suffix(path, SUFFIXES)
     plt = pyplot()
