@@ -36,7 +36,7 @@ class Assembly:
     residual: float  # max |Phi| after polishing, relative to the mechanism's size
     condition: float  # the homotopy's condition number of the root
     singular: bool  # a double root: two assemblies meeting (a change point, a limit)
-    joints: dict[str, tuple[float, float]]
+    joints: dict[str, tuple[float, float]]  # every named joint and point
 
 
 @dataclass(frozen=True)
@@ -157,12 +157,11 @@ def _name(m: Mechanism, driver: float, q: list[float]) -> tuple[str, str]:
 
 
 def _joints(m: Mechanism, driver: float, q: list[float]) -> dict[str, tuple[float, float]]:
-    out: dict[str, tuple[float, float]] = {}
-    for loop, pts in zip(m.loops, m.model.points(q, driver)):
-        for name, p in zip(loop.joints, pts):
-            if name and name not in out:
-                out[name] = (p.real, p.imag)
-    return out
+    """Every named joint and point, by the one placing rule (rates.place: a drawing's fixed
+    joints where they were drawn)."""
+    from .rates import place
+
+    return {name: (p.real, p.imag) for name, (p, _, _) in place(m.model, q, driver).items()}
 
 
 def assemblies(m: Mechanism, driver: float | None = None, seed: int = 0) -> Assemblies:
