@@ -176,3 +176,18 @@ def test_every_example_prints_what_its_page_shows(cli, example, scratch, monkeyp
         assert _matches(actual, shown), (
             f"{example}\n--- the page shows ---\n" + "\n".join(shown)
             + "\n--- the command prints ---\n" + "\n".join(actual))
+
+
+def test_the_quick_start_names_every_test_extra():
+    """The quick start says what its second line installs: every package of the test extra."""
+    import re as _re
+
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]["test"]
+    said = " ".join(README.split("## Quick start", 1)[1].split("## ", 1)[0].split())
+    for requirement in extras:
+        name = _re.split(r"[\[<>=!~ ]", requirement, maxsplit=1)[0]
+        assert name in said, f"the quick start does not name {name}"
