@@ -509,8 +509,9 @@ class PeakTracker:
         at = self.seen + np.arange(len(status))
         for k, col in enumerate(columns):
             size = _peak_sizes(ok, np.asarray(col, dtype=float))
-            sizes = np.concatenate([self.sizes[k], size[ok]])
-            where = np.concatenate([self.where[k], at[ok]])
+            usable = size >= 0.0  # ok, with a number (the status rule gives every ok one)
+            sizes = np.concatenate([self.sizes[k], size[usable]])
+            where = np.concatenate([self.where[k], at[usable]])
             if len(sizes):
                 near = _near_top(sizes)
                 # the first position of each size (np.unique's first occurrence: in order)
