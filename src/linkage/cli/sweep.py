@@ -151,11 +151,14 @@ def sweep(
             advance(n, f"writing {out_fmt}")
         note = "" if data or not named else \
             "joints and points (x, y): with --format csv, json, parquet or xlsx"
-        report = sweep_report(result, digits, joints_note=note)
+        from ..kinematics.columns import sweep_columns
+
+        cols = sweep_columns(result)  # read once: a batch sweep's rates for its table and its loads
+        report = sweep_report(result, digits, joints_note=note, cols=cols)
         if not loads.empty or loads.gravity is not None:
             from .loads import sweep_loads
 
-            report = sweep_loads(report, mechanism, result, loads, w, a_, digits, torque_plot)
+            report = sweep_loads(report, mechanism, result, loads, w, a_, digits, torque_plot, cols)
         elif torque_plot is not None:
             raise InputError("--torque-plot needs loads: [loads] or [mass] in the file, or --load/--torque")
         emit_report(report, out_fmt, output, columns=columns,

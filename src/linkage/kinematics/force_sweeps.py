@@ -5,9 +5,9 @@ same matrix method), judged by the one status rule (kinematics.forces)."""
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 from ..problems.loads import Loads
 from .bodies import Frame, force_size, metre
@@ -100,54 +100,260 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
     return BatchForces(fa, status, inp, pin_max, shaking, vp)
 
 
-def sweep_forces(mechanism: Any, result: Any, loads: Loads, speed: float, accel: float
-                 ) -> list[Forces | None]:
-    """Every position of a sweep's forces (None where unsolved): each position's rates as the
-    sweep's own (kinematics.rates), the matrix method for all of them in one
-    :func:`solve_loads`."""
+LOADS_CHUNK = 4096
+"""Positions whose loads a sweep solves at once (as the batch engine computes its rates,
+kinematics.batch.RATES_CHUNK): one matrix-method call per chunk, and no more than a chunk
+of positions' rates and force matrices held at a time."""
+
+
+class SolvedPosition(NamedTuple):
+    """A solved position as the loads need it: its index in the sweep, the unknowns and the
+    driver (internal units) and the sweep's own rates there (None where it has none)."""
+
+    index: int
+    q: list[float]
+    driver: float
+    rates: Any
+
+
+@dataclass(frozen=True)
+class ChunkForces:
+    """The matrix method over a chunk's solved positions (:func:`chunk_forces`)."""
+
+    kept: tuple[tuple[int, Any, Any], ...]
+    """(index, rates at the driver's motion, rates at a unit speed) of each position solved."""
+    undefined: tuple[int, ...]
+    """Positions whose kinematics are undefined (a toggle): no forces."""
+    arrays: ForceArrays | None
+    """:func:`solve_loads`' answer for ``kept``, in its order (None where none is kept)."""
+
+
+def chunk_forces(mechanism: Any, frame: Frame, solved: Sequence[SolvedPosition], loads: Loads,
+                 speed: float, accel: float) -> ChunkForces:
+    """A chunk of a sweep's positions' forces: each position's rates as the sweep's own
+    (kinematics.rates: at the driver's motion where the sweep computed them, else here),
+    the matrix method for all of them in one :func:`solve_loads`."""
     import numpy as np
 
     from .rates import rates_at
 
-    frame = Frame.of(mechanism)
-    frame.check_masses(loads)
-    angle = mechanism.driver.kind == "angle"
     k = metre(frame.length_unit)
     kept: list[tuple[int, Any, Any]] = []
-    out: list[Forces | None] = [None] * len(result.positions)
-    for i, pos in enumerate(result.positions):
-        if pos.status != "converged" or pos.solution is None:
-            continue
-        q = [math.radians(pos.solution[u.name]) if u.kind == "angle" else pos.solution[u.name]
-             for u in mechanism.unknowns]
-        drv = math.radians(pos.input) if angle else pos.input
-        # the sweep's own rates where it computed them at this motion (--speed), else here
-        given = pos.rates if speed and pos.rates is not None and pos.rates.joint_velocities else None
-        actual = given or rates_at(mechanism, q, speed=speed, accel=accel, driver=drv)
-        unit = per_unit_speed(actual, speed) or rates_at(mechanism, q, speed=1.0, accel=0.0, driver=drv)
+    undefined: list[int] = []
+    for p in solved:
+        given = p.rates if speed and p.rates is not None and p.rates.joint_velocities else None
+        actual = given or rates_at(mechanism, p.q, speed=speed, accel=accel, driver=p.driver)
+        unit = (per_unit_speed(actual, speed)
+                or rates_at(mechanism, p.q, speed=1.0, accel=0.0, driver=p.driver))
         if actual.status == "undefined" or unit.status == "undefined":
-            out[i] = undefined_forces(frame, "the kinematics are undefined here")
+            undefined.append(p.index)
             continue
-        kept.append((i, actual, unit))
+        kept.append((p.index, actual, unit))
     if not kept:
-        return out
+        return ChunkForces((), tuple(undefined), None)
     names = list(kept[0][1].joints)
+    count = len(kept)
 
-    def stack(get: Any) -> dict[str, tuple[Any, Any]]:
-        return {j: (np.array([get(r)[j][0] * k for r in rows]),
-                    np.array([get(r)[j][1] * k for r in rows])) for j in names}
+    def stack(rows: Sequence[Any], get: Any) -> dict[str, tuple[Any, Any]]:
+        maps = [get(r) for r in rows]
+        return {j: (np.fromiter((m[j][0] for m in maps), float, count) * k,
+                    np.fromiter((m[j][1] for m in maps), float, count) * k) for j in names}
 
-    rows = [a for _, a, _ in kept]
+    actual_rates = [a for _, a, _ in kept]
     zero = {j: (0.0, 0.0) for j in names}
-    pos_a = stack(lambda r: r.joints)
-    vel_a = stack(lambda r: r.joint_velocities or zero)
-    acc_a = stack(lambda r: r.joint_accelerations or zero)
-    rows = [u for _, _, u in kept]
-    vstar = stack(lambda r: r.joint_velocities)
+    pos_a = stack(actual_rates, lambda r: r.joints)
+    vel_a = stack(actual_rates, lambda r: r.joint_velocities or zero)
+    acc_a = stack(actual_rates, lambda r: r.joint_accelerations or zero)
+    vstar = stack([u for _, _, u in kept], lambda r: r.joint_velocities)
     fa = solve_loads(frame, pos_a, vel_a, acc_a, vstar, loads, mechanism.source)
-    for n, (i, actual, unit) in enumerate(kept):
-        out[i] = position_forces(fa, n, unit, actual.status, loads)
+    return ChunkForces(tuple(kept), tuple(undefined), fa)
+
+
+def _display_scale(mechanism: Any) -> float:
+    """Internal units of the driver per display unit (a turning driver's degrees or radians)."""
+    from ..problems.loops import ANGLE_UNITS
+
+    return ANGLE_UNITS[mechanism.driver.unit] if mechanism.driver.kind == "angle" else 1.0
+
+
+def _internal(mechanism: Any, solution: Mapping[str, float]) -> list[float]:
+    return [math.radians(solution[u.name]) if u.kind == "angle" else float(solution[u.name])
+            for u in mechanism.unknowns]
+
+
+def solved_positions(mechanism: Any, positions: Sequence[Any], start: int, stop: int
+                     ) -> list[SolvedPosition]:
+    """The solved positions among ``positions[start:stop]`` (a sweep's Position objects)."""
+    scale = _display_scale(mechanism)
+    out = []
+    for i in range(start, stop):
+        p = positions[i]
+        if p.status == "converged" and p.solution is not None:
+            out.append(SolvedPosition(i, _internal(mechanism, p.solution), p.input * scale, p.rates))
     return out
+
+
+def solved_columns(mechanism: Any, cols: Any, start: int, stop: int) -> list[SolvedPosition]:
+    """The solved positions among rows ``start:stop`` of a sweep's columns
+    (:class:`~.columns.SweepColumns`: its report's, so a batch sweep's rates are not
+    computed a second time)."""
+    scale = _display_scale(mechanism)
+    names = [u.name for u in mechanism.unknowns]
+    out = []
+    for i in range(start, stop):
+        if cols.status[i] != "converged":
+            continue
+        sol = {n: float(cols.solution[n][i]) for n in names}
+        rates = cols.rates[i] if cols.rates is not None else None
+        out.append(SolvedPosition(i, _internal(mechanism, sol), float(cols.inputs[i]) * scale, rates))
+    return out
+
+
+def sweep_forces(mechanism: Any, result: Any, loads: Loads, speed: float, accel: float
+                 ) -> list[Forces | None]:
+    """Every position of a sweep's forces (None where unsolved): :func:`chunk_forces` a
+    chunk of LOADS_CHUNK positions at a time, each position judged by
+    :func:`position_forces`."""
+    frame = Frame.of(mechanism)
+    frame.check_masses(loads)
+    n = len(result.positions)
+    out: list[Forces | None] = [None] * n
+    for a in range(0, n, LOADS_CHUNK):
+        cf = chunk_forces(mechanism, frame, solved_positions(mechanism, result.positions, a,
+                                                             min(n, a + LOADS_CHUNK)),
+                          loads, speed, accel)
+        for i in cf.undefined:
+            out[i] = undefined_forces(frame, "the kinematics are undefined here")
+        for m, (i, actual, unit) in enumerate(cf.kept):
+            out[i] = position_forces(cf.arrays, m, unit, actual.status, loads)  # type: ignore[arg-type]
+    return out
+
+
+FORCE_KEYS = ("input", "virtual_power_input", "max_pin_force", "ground_fx", "ground_fy", "ground_moment",
+              "mechanical_advantage", "condition")
+"""A sweep's loads columns before each pin's and slider's (SweepResult.force_columns)."""
+
+
+class LoadChunk(NamedTuple):
+    """The loads of positions ``start`` to ``start + len(status)`` as arrays: each
+    position's FORCE_STATUSES code (-1: unsolved) and the columns of
+    SweepResult.force_columns (NaN where there is no number)."""
+
+    start: int
+    status: Any
+    columns: dict[str, Any]
+
+
+def load_chunks(mechanism: Any, cols: Any, loads: Loads, speed: float, accel: float,
+                chunk: int = LOADS_CHUNK) -> Iterator[LoadChunk]:
+    """A sweep's loads (``cols``: its :class:`~.columns.SweepColumns`) a chunk of
+    positions at a time, in order: each chunk by :func:`chunk_forces`, judged by the one
+    status rule (:func:`force_status_np` with :func:`matrix_bound` and
+    :func:`kinematic_bound`), every number as :func:`position_forces` gives it. Only the
+    chunk being solved is held: the caller keeps what it needs of each."""
+    frame = Frame.of(mechanism)
+    frame.check_masses(loads)
+    n = len(cols)
+    for a in range(0, n, chunk):
+        b = min(n, a + chunk)
+        cf = chunk_forces(mechanism, frame, solved_columns(mechanism, cols, a, b), loads, speed, accel)
+        yield _chunk_columns(cf, a, b - a, loads)
+
+
+def _chunk_columns(cf: ChunkForces, start: int, size: int, loads: Loads) -> LoadChunk:
+    import numpy as np
+
+    from .forces import FORCE_STATUSES, kinematic_bound, mechanical_advantage
+
+    status = np.full(size, -1, dtype=np.int8)
+    status[[i - start for i in cf.undefined]] = FORCE_STATUSES.index("undefined")
+    columns = {key: np.full(size, np.nan) for key in FORCE_KEYS}
+    fa = cf.arrays
+    if fa is None:
+        return LoadChunk(start, status, columns)
+    rows = np.array([i - start for i, _, _ in cf.kept], dtype=np.intp)
+    cond = fa.condition
+    bound = np.maximum(matrix_bound(cond), np.fromiter((kinematic_bound(u) for _, _, u in cf.kept), float,
+                                                       len(rows)))
+    kin_ok = np.fromiter((a.status == "ok" and u.status == "ok" for _, a, u in cf.kept), bool, len(rows))
+    codes = force_status_np(fa.input, cond, bound, kin_ok)
+    status[rows] = codes
+    number = codes != FORCE_STATUSES.index("undefined")  # flagged forces keep their numbers
+    at = rows[number]
+
+    def put(key: str, values: Any) -> None:
+        columns.setdefault(key, np.full(size, np.nan))[at] = np.asarray(values, dtype=float)[number]
+
+    inp = fa.input
+    # each magnitude as a PinForce's (math.hypot), so the columns equal the Forces' numbers
+    mags = [np.fromiter(map(math.hypot, fx.tolist(), fy.tolist()), float, len(rows))
+            for *_, fx, fy in fa.pins]
+    put("input", inp)
+    put("virtual_power_input", fa.virtual_power_input)
+    put("max_pin_force", np.max(mags, axis=0) if mags else np.full(len(rows), np.nan))
+    put("ground_fx", fa.ground[0])
+    put("ground_fy", fa.ground[1])
+    put("ground_moment", fa.ground[2])
+    ma = [mechanical_advantage(loads, x, fa.input_unit) for x in inp.tolist()]
+    put("mechanical_advantage", [math.nan if v is None else v for v in ma])
+    put("condition", cond)
+    for j, on, _, fx, fy in fa.pins:
+        put(f"{j}_on_{on}_fx", fx)
+        put(f"{j}_on_{on}_fy", fy)
+    for s, _, nn, mm in fa.sliders:
+        put(f"{s}_normal", nn)
+        put(f"{s}_couple", mm)
+    return LoadChunk(start, status, columns)
+
+
+@dataclass(frozen=True)
+class SweepLoads:
+    """A sweep's loads as columns (numpy arrays, one entry per position) and their peaks
+    (:func:`sweep_load_columns`)."""
+
+    status: Any
+    """FORCE_STATUSES codes; -1 where the position is unsolved."""
+    columns: dict[str, Any]
+    """SweepResult.force_columns' numbers (NaN where none), each pin's and slider's after
+    FORCE_KEYS."""
+    peak_input: int
+    """The position of the largest |input| by the one peak rule (force_peaks); -1: none."""
+    peak_pin: int
+    """The position of the largest pin force; -1: none."""
+    flagged: int
+    """Positions whose forces are flagged (near_toggle, ill_conditioned or undefined)."""
+
+    @property
+    def pins(self) -> list[str]:
+        """Each pin's and slider's column names, in order."""
+        return [k for k in self.columns if k not in FORCE_KEYS]
+
+
+def sweep_load_columns(mechanism: Any, cols: Any, loads: Loads, speed: float, accel: float,
+                chunk: int = LOADS_CHUNK) -> SweepLoads:
+    """A sweep's loads as columns, from :func:`load_chunks`: each chunk's numbers copied
+    into the columns (a few numbers a position) and its peaks accumulated
+    (:class:`~.forces.PeakTracker`, the one peak rule), the chunk then let go."""
+    import numpy as np
+
+    from .forces import PeakTracker
+
+    n = len(cols)
+    status = np.full(n, -1, dtype=np.int8)
+    columns: dict[str, Any] = {}
+    peaks = PeakTracker(2)
+    for c in load_chunks(mechanism, cols, loads, speed, accel, chunk):
+        b = c.start + len(c.status)
+        status[c.start:b] = c.status
+        for key, values in c.columns.items():
+            columns.setdefault(key, np.full(n, np.nan))[c.start:b] = values
+        peaks.add(c.status, c.columns["input"], c.columns["max_pin_force"])
+    (at_in, at_pin), flagged = peaks.peaks()
+    for key in FORCE_KEYS:
+        columns.setdefault(key, np.full(n, np.nan))
+    ordered = {k: columns[k] for k in FORCE_KEYS}
+    ordered.update((k, v) for k, v in columns.items() if k not in FORCE_KEYS)
+    return SweepLoads(status, ordered, at_in, at_pin, flagged)
 
 
 def with_forces(mechanism: Any, result: Any, loads: Loads, speed: float | None, accel: float) -> Any:

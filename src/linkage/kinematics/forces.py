@@ -410,6 +410,17 @@ def matrix_bound(cond: Any) -> Any:
     return 2.0 * cond * EPS * 4.0
 
 
+def kinematic_bound(unit: Any) -> float:
+    """The error bound the kinematics carry into the forces (relative): the unit-speed
+    rates' largest joint-velocity bound over the fastest joint's speed (near a toggle they
+    carry into the forces as into the velocities they balance); 0 where there is none.
+    A position's force bound is the larger of this and :func:`matrix_bound`."""
+    vmax = max((math.hypot(*v) for v in unit.joint_velocities.values()), default=0.0)
+    if vmax > 0.0 and unit.joint_velocity_bounds:
+        return max(unit.joint_velocity_bounds.values()) / vmax
+    return 0.0
+
+
 def force_status(cond: float, bound: float, kinematics_ok: bool) -> str:
     """The one rule judging a position's forces (``bound``: their error bound, relative):
     ill_conditioned where the bound exceeds FORCE_RTOL or the kinematics are flagged,
@@ -445,14 +456,77 @@ def force_peaks(status: Any, *columns: Any) -> tuple[list[Any], Any]:
     ok = status == 0
     any_ok = ok.any(axis=1)
     at = []
+    for col in columns:
+        size = _peak_sizes(ok, col)
+        at.append(np.where(any_ok, np.argmax(_near_top(size), axis=1), -1))
+    return at, _flagged(status).sum(axis=1)
+
+
+def _peak_sizes(ok: Any, col: Any) -> Any:
+    """What a peak is the largest of: |value| where the forces are ok and there is a
+    number, -1 elsewhere (never a peak)."""
+    import numpy as np
+
     with np.errstate(invalid="ignore"):
-        for col in columns:
-            size = np.where(ok & np.isfinite(col), np.abs(col), -1.0)
-            # the first of the largest within rounding: a closed cycle's 0 and 360 deg differ
-            # by an ulp, and the peak is at 0
-            top = size.max(axis=1, keepdims=True)
-            at.append(np.where(any_ok, np.argmax(size >= top * (1.0 - 8.0 * EPS), axis=1), -1))
-    return at, ((status > 0) & (status < len(FORCE_STATUSES))).sum(axis=1)
+        return np.where(ok & np.isfinite(col), np.abs(col), -1.0)
+
+
+def _near_top(size: Any) -> Any:
+    """The sizes equal to the largest (along the last axis) within rounding: the peak is
+    the first of them (a closed cycle's 0 and 360 deg differ by an ulp, and the peak is at 0)."""
+    top = size.max(axis=-1, keepdims=True)
+    return size >= top * (1.0 - 8.0 * EPS)
+
+
+def _flagged(status: Any) -> Any:
+    """Positions whose forces are flagged: near_toggle, ill_conditioned or undefined (a
+    negative code, an unsolved position, is neither)."""
+    return (status > 0) & (status < len(FORCE_STATUSES))
+
+
+class PeakTracker:
+    """:func:`force_peaks` of one sweep fed a chunk of positions at a time, in order: the
+    same indices and count as the rule over the whole sweep at once, holding only the
+    candidates (for each size within rounding of the largest so far, the first position
+    with it: a handful, whatever the sweep's length). A later, larger size drops the
+    candidates it leaves behind; one never among them cannot become the peak."""
+
+    def __init__(self, columns: int) -> None:
+        import numpy as np
+
+        self.seen = 0
+        self.flagged = 0
+        self.sizes = [np.empty(0) for _ in range(columns)]
+        self.where = [np.empty(0, dtype=np.int64) for _ in range(columns)]
+
+    def add(self, status: Any, *columns: Any) -> None:
+        """The next ``len(status)`` positions: their FORCE_STATUSES codes and columns."""
+        import numpy as np
+
+        status = np.asarray(status)
+        ok = status == 0
+        at = self.seen + np.arange(len(status))
+        for k, col in enumerate(columns):
+            size = _peak_sizes(ok, np.asarray(col, dtype=float))
+            usable = size >= 0.0  # ok, with a number (the status rule gives every ok one)
+            sizes = np.concatenate([self.sizes[k], size[usable]])
+            where = np.concatenate([self.where[k], at[usable]])
+            if len(sizes):
+                near = _near_top(sizes)
+                # the first position of each size (np.unique's first occurrence: in order)
+                kept, first = np.unique(sizes[near], return_index=True)
+                sizes, where = kept, where[near][first]
+            self.sizes[k], self.where[k] = sizes, where
+        self.seen += len(status)
+        self.flagged += int(_flagged(status).sum())
+
+    def peaks(self) -> tuple[list[int], int]:
+        """Per column the index of its peak (-1 where no position is ok), and how many
+        positions are flagged: :func:`force_peaks`' answer for the whole sweep."""
+        at = []
+        for sizes, where in zip(self.sizes, self.where):
+            at.append(int(where[_near_top(sizes)].min()) if len(sizes) else -1)
+        return at, self.flagged
 
 
 def mechanical_advantage(loads: Loads, inp: float, input_unit: str) -> float | None:
@@ -478,10 +552,7 @@ def position_forces(fa: ForceArrays, i: int, unit: Any, kinematics_status: str, 
     inp = float(fa.input[i])
     if not math.isfinite(inp):
         return Forces(None, fa.input_unit, (), (), None, None, None, cond, "undefined")
-    bound = matrix_bound(cond)
-    vmax = max((math.hypot(*v) for v in unit.joint_velocities.values()), default=0.0)
-    if vmax > 0.0 and unit.joint_velocity_bounds:
-        bound = max(bound, max(unit.joint_velocity_bounds.values()) / vmax)
+    bound = max(matrix_bound(cond), kinematic_bound(unit))
     status = force_status(cond, bound, kinematics_status == "ok" and unit.status == "ok")
     ma = mechanical_advantage(loads, inp, fa.input_unit)
     pins = tuple(PinForce(j, on, by, float(fx[i]), float(fy[i])) for j, on, by, fx, fy in fa.pins)

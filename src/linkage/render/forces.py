@@ -201,18 +201,31 @@ def force_document(f: Any) -> dict[str, Any]:
     }
 
 
-def sweep_force_table(rows: list[tuple[Any, ...]], driver: str, driver_unit: str, input_unit: str,
-                      pins: Any = ()) -> Any:
+def status_words(codes: Any) -> Any:
+    """Each position's forces status as text from its FORCE_STATUSES code (-1: unsolved)."""
+    import numpy as np
+
+    from ..kinematics.forces import FORCE_STATUSES
+
+    words = np.array([*FORCE_STATUSES, "unsolved"], dtype=object)
+    return words[np.asarray(codes, dtype=np.intp)]  # -1 is the last: unsolved
+
+
+def sweep_force_table(inputs: Any, status: Any, columns: Any, driver: str, driver_unit: str,
+                      input_unit: str, pins: Any = ()) -> Any:
     """The sweep's ``loads`` table: per position the status, the input, the largest pin
     force, the ground's force and moment, the condition number, each pin force's x and y
-    (``<joint>_on_<link>_fx``: on that link) and each slider's normal force and couple (SI)."""
-    return from_rows("loads", [(driver, driver_unit, "number"), ("forces_status", "", "text"),
-                               ("input", input_unit, "number"), ("max_pin_force", "N", "number"),
-                               ("ground_fx", "N", "number"), ("ground_fy", "N", "number"),
-                               ("ground_moment", "N m", "number"), ("condition", "", "number"),
-                               ("mechanical_advantage", "", "number"),
-                               *((k, "N m" if k.endswith("_couple") else "N", "number") for k in pins)],
-                     rows)
+    (``<joint>_on_<link>_fx``: on that link) and each slider's normal force and couple (SI).
+    ``columns``: kinematics.force_sweeps.SweepLoads' (arrays, NaN where no number)."""
+    from .data import DataTable, column
+
+    out = [column(driver, driver_unit, inputs), column("forces_status", "", status, "text")]
+    out += [column(k, u, columns[k]) for k, u in (("input", input_unit), ("max_pin_force", "N"),
+                                                   ("ground_fx", "N"), ("ground_fy", "N"),
+                                                   ("ground_moment", "N m"), ("condition", ""),
+                                                   ("mechanical_advantage", ""))]
+    out += [column(k, "N m" if k.endswith("_couple") else "N", columns[k]) for k in pins]
+    return DataTable("loads", tuple(out))
 
 
 def torque_plot(rows: list[tuple[Any, ...]], driver: str, driver_unit: str, input_unit: str, path: Any,

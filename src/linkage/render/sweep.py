@@ -68,11 +68,13 @@ def sweep_table(s: SweepResult, cols: SweepColumns | None = None) -> DataTable:
     return DataTable("positions", tuple(out))
 
 
-def sweep_report(s: SweepResult, digits: int, max_rows: int = 400, joints_note: str = "") -> Report:
+def sweep_report(s: SweepResult, digits: int, max_rows: int = 400, joints_note: str = "",
+                 cols: SweepColumns | None = None) -> Report:
     """The sweep as a :class:`~.data.Report`: one table (:func:`sweep_table`), the display
     blocks and the JSON document built only when a format asks for them. ``joints_note``:
-    a line the display adds (where the joints are written, say)."""
-    cols = sweep_columns(s)
+    a line the display adds (where the joints are written, say); ``cols``: the sweep's
+    columns, if already read (a loaded sweep's loads reuse them)."""
+    cols = sweep_columns(s) if cols is None else cols
     title = f"{s.mechanism}: sweep of {s.driver} over {len(cols)} positions"
 
     def blocks() -> list[Block]:
