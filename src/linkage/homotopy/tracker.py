@@ -131,6 +131,8 @@ def track(h: Homotopy, X: np.ndarray, tau: np.ndarray, tau_end: np.ndarray,
             last = np.where(contracting, d, np.inf)
             converged |= last <= CORRECTOR_TOL * size
             log.newton[index[a]] += 1
+            if converged.all():
+                break
         # the predictor is fourth order: a first correction that is not small against the
         # step itself means the step left its path's neighbourhood (path jumping)
         accept = converged & np.isfinite(_norm(Xp)) & (first <= 0.25 * moved + CORRECTOR_TOL * size)
