@@ -17,6 +17,7 @@ from .options import (
     OutputOpt,
     SetOpt,
     SpeedOpt,
+    TableOpt,
     TorqueOpt,
     check_paths,
     choose_format,
@@ -75,6 +76,7 @@ def sweep(
     output: OutputOpt = None,
     digits: DigitsOpt = 10,
     columns: ColumnsOpt = None,
+    table: TableOpt = None,
 ) -> None:
     """Solve a mechanism over a range of its driver, each position from the previous one.
 
@@ -158,7 +160,7 @@ def sweep(
             report = sweep_loads(report, mechanism, result, loads, w, a_, digits, torque_plot)
         elif torque_plot is not None:
             raise InputError("--torque-plot needs loads: [loads] or [mass] in the file, or --load/--torque")
-        emit_report(report, out_fmt, output, columns=columns,
+        emit_report(report, out_fmt, output, columns=columns, table=table,
                     progress=None if advance is None else (lambda rows: advance(n + rows)))
     if plot is not None:
         from ..arguments import motion_text

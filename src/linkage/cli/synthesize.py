@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import DigitsOpt, check_paths
+from .options import DigitsOpt, TableOpt, check_paths
 from .root import app
 
 
@@ -133,6 +133,7 @@ def synthesize(
         ),
     ] = None,
     digits: DigitsOpt = 6,
+    table: TableOpt = None,
 ) -> None:
     """Synthesise a four-bar function generator: Freudenstein's equation (seed 002's, run
     backwards) at precision points, then the linkage analysed over the whole range.
@@ -184,6 +185,7 @@ def synthesize(
             fmt=fmt,
             output=report_out,
             digits=digits,
+            table=table,
         )
         return
     for option, given in (
@@ -226,7 +228,7 @@ def synthesize(
         error_plot(result, plot)
     elif plot is not None:
         typer.echo(f"note: {plot} not drawn: there is no real linkage", err=True)
-    writers.write(synthesis_report(result, digits, unit), fmt, report_out)
+    writers.write(synthesis_report(result, digits, unit), fmt, report_out, table=table)
     if design and result.linkage is not None:
         typer.echo(
             f"wrote {output}: linkage sweep {shlex.quote(str(output))} runs it over the alpha range", err=True
