@@ -148,11 +148,12 @@ def parse_assignments(option: str, items: list[str]) -> dict[str, float]:
 
 def note_closed_form(mechanism: Any) -> None:
     """Once per command, a one-line note on standard error for a file that still says
-    ``closed_form = ...`` (read and checked, but derived from the loops now): kept here,
-    printed by :func:`run_cli` when the command ends."""
-    note = mechanism.closed_form_note
-    if note is not None and note not in NOTED:
-        NOTED.append(note)
+    ``closed_form = ...`` (read and checked, but derived from the loops now), and for a
+    drawing solved at a [driver] value other than the drawn one (where it was drawn): kept
+    here, printed by :func:`run_cli` when the command ends."""
+    for note in (mechanism.closed_form_note, mechanism.drawing_note):
+        if note is not None and note not in NOTED:
+            NOTED.append(note)
 
 
 NOTED: list[str] = []

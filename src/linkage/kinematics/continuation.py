@@ -82,7 +82,7 @@ class Solver:
         return fns
 
     def transmission(self, q: Sequence[float], value: float) -> float | None:
-        """The transmission angle (deg, in [0, 180]) of a mechanism whose loops include
+        """The transmission angle (deg, folded into [0, 90]) of a mechanism whose loops include
         four-bars (:func:`~linkage.problems.derive.fourbar_transmission`: the coupler as
         traversed against the output link from its pivot), at unknowns ``q`` (internal
         units) and the driver's ``value`` (display units). With several four-bar loops, the
@@ -172,6 +172,17 @@ class Solver:
             if by_signs:
                 return sign_text(d.signs_of(q, value * self.scale)) == target
         return (label if label is not None else self.branch(q, det, value)) == target
+
+
+def carried(m: Mechanism, start: float, q0: Sequence[float], to: float) -> tuple[float, ...] | None:
+    """The configuration at driver value ``to`` (display units) on the assembly ``q0`` is
+    on at ``start``: continuation along that branch (its name, or det J's sign), as a sweep
+    follows it; None where the branch ends before ``to`` (a fold, or no assembly)."""
+    solver = Solver(m, "newton", 1e-12, 50)
+    q0 = tuple(q0)
+    target = solver.branch(q0, solver.det(solver.problem(start), q0), start)
+    pos, q = walk(solver, to, [(start, q0)], target)
+    return q if pos.status == "converged" else None
 
 
 def solver_q(solver: Solver, pos: Position) -> tuple[float, ...]:

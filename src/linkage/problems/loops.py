@@ -217,6 +217,12 @@ class Mechanism:
             return None
         return f"{self.source}: closed_form is no longer needed: the closed form is derived from the loops"
 
+    @property
+    def drawing_note(self) -> str | None:
+        """Where a drawing was drawn when its [driver] value is elsewhere (None otherwise):
+        a program prints it beside its output, as :attr:`closed_form_note`."""
+        return self.extra.get("drawing_note")
+
     @functools.cached_property
     def derivation(self) -> Derivation:
         """The stepwise closed form derived from the loops (:mod:`.derive`), or why there
@@ -305,6 +311,39 @@ def _keep_drawing(mechanism: Mechanism, doc: Mapping[str, Any], source: str) -> 
         mechanism.extra["loads"] = parse_loads(doc, drawing, source)
     except InputError as exc:
         raise ParseError(str(exc)) from None
+
+
+def _at_driver_value(m: Mechanism, doc: Mapping[str, Any], source: str) -> Mechanism:
+    """A drawing whose [driver] value is not where it is drawn (problems.joints.off_drawing):
+    its guesses, the drawn pose, carried along the drawn assembly to that value
+    (kinematics.continuation.carried), so that solve, sweep and scan take the drawing's
+    assembly there; the note :attr:`Mechanism.drawing_note` says where it was drawn. A
+    value the drawn assembly does not reach is refused."""
+    from .closed_form import wrap_degrees
+    from .joints import off_drawing
+
+    driver = doc["driver"]
+    value = _display(m.driver)
+    drawn = off_drawing(m.extra["drawing"], driver, value)
+    if drawn is None:
+        return m
+    from ..kinematics.continuation import carried
+
+    angle = m.driver.kind == "angle"
+    what = f"{driver['link']} is drawn at {drawn:.9g} deg" if angle else \
+        f"{driver['slider']} is drawn at travel {drawn:.9g} {m.length_unit}"
+    unit = " deg" if angle else f" {m.length_unit}"
+    to = drawn + wrap_degrees(value - drawn) if angle else value  # an angle: the nearer way round
+    q = carried(m, drawn, [u.value for u in m.unknowns], to)
+    if q is None:
+        raise ParseError(f"{source}: driver.value: {value:g}{unit} is not reached from the drawing ({what}) "
+                         "along its assembly: the linkage does not assemble there that way; leave value "
+                         "out to solve where it is drawn")
+    moved = m.with_values({}, {u.name: math.degrees(v) if u.kind == "angle" else v
+                               for u, v in zip(m.unknowns, q)})
+    moved.extra["drawing_note"] = (f"{source}: {what}; solved at [driver] value = {value:g}{unit}, reached "
+                                   "along the drawn assembly")
+    return moved
 
 
 def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:
@@ -479,6 +518,7 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         raise fail(*clash)
     if drawn is not None:
         _keep_drawing(mechanism, drawn, source)
+        mechanism = _at_driver_value(mechanism, drawn, source)
     if closed_form is not None:
         from .closed_form import verify
 
