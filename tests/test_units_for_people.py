@@ -141,7 +141,8 @@ def test_command_line_loads_take_a_unit_as_speed_does(cli) -> None:
     for args in (("--torque", "rocker=-2Nm", "--load", "P=0,-20N"),
                  ("--torque", "rocker=-2 N m", "--load", "P=0N,-20N"),
                  ("--torque", "rocker=-2000Nmm", "--load", "P=0,-20000mN"),
-                 ("--torque", "rocker=-0.002kNm", "--load", "P=0kN,-0.02kN")):
+                 ("--torque", "rocker=-0.002kNm", "--load", "P=0kN,-0.02kN"),
+                 ("--torque", "rocker=-4/2", "--load", "P=0,-40/2")):  # bare fractions, as before
         assert _forces(cli, *args)["input"] == pytest.approx(file_loads["input"], rel=1e-15), args
     in_lbf = _forces(cli, "--load", "P=0,-1lbf")
     in_newton = _forces(cli, "--load", "P=0,-4.4482216152605")

@@ -57,9 +57,13 @@ def parse_quantity(name: str, text: str, units: dict[str, float]) -> tuple[float
     command line (--speed, --accel, --torque, --load)."""
     parts = split_unit(text)
     known = {unit_key(u): f for u, f in units.items()}
-    if (parts is None or unit_key(parts[1]) not in known) and "" in known and "/" in text:
-        return parse_number(name, text) * known[""], ""  # a bare fraction, 5/3
     if parts is None or unit_key(parts[1]) not in known:
         listed = ", ".join(u for u in units if u) or "none"
-        raise InputError(f"{name} {text!r}: give a number, optionally with one of these units: {listed}")
+        why = InputError(f"{name} {text!r}: give a number, optionally with one of these units: {listed}")
+        if "" not in known or "/" not in text:
+            raise why
+        try:
+            return parse_number(name, text) * known[""], ""  # a bare fraction, 5/3
+        except InputError:
+            raise why from None
     return parse_number(name, parts[0]) * known[unit_key(parts[1])], parts[1]

@@ -55,7 +55,7 @@ def sweep(
                       "whose loops have a closed form), by name or signs as in solve --branch: open, "
                       "crossed, open/crossed for a six-bar, 'open (mirror)', +-; default: the "
                       "assembly of the file's pose (its guesses solved at its driver value: a "
-                      "drawing's drawn pose).")] = None,
+                      "drawing's assembly as drawn).")] = None,
     set_: SetOpt = None,
     tol: Annotated[float, typer.Option(help="Step and residual tolerance per position.")] = 1e-12,
     batch: Annotated[Optional[bool], typer.Option("--batch/--no-batch", help="Use the numpy "
