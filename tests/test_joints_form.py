@@ -124,7 +124,7 @@ def test_a_driver_value_off_the_drawing_is_solved_there_on_the_drawn_assembly(br
     m = from_text(pick(me581_drawing(driver=f"value = {value!r}")), "<drawing>")
     assert math.degrees(m.driver.value) == value
     assert m.drawing_note == (f"<drawing>: crank is drawn at 65 deg; solved at [driver] value = {value:g} "
-                              "deg, reached along the drawn assembly")
+                              "deg, on the drawing's branch")
     r = solve_system(m.problem(), tol=1e-14)
     assert r.converged
     from linkage.kinematics.rates import rates_at
@@ -140,7 +140,7 @@ def test_a_driver_value_off_the_drawing_is_solved_there_on_the_drawn_assembly(br
 def test_a_driver_value_the_drawn_assembly_does_not_reach_is_refused() -> None:
     """ME581's crank cannot reach 180 deg (a triple rocker): one line, never another assembly."""
     with pytest.raises(InputError, match=re.escape("driver.value: 180 deg is not reached from the drawing "
-                                                   "(crank is drawn at 65 deg) along its assembly")):
+                                                   "(crank is drawn at 65 deg) on its branch")):
         from_text(me581_drawing(driver="value = 180"), "<drawing>")
 
 
@@ -162,7 +162,7 @@ def test_a_hand_drawn_driver_off_by_rounding_is_accepted_with_a_note(cli, tmp_pa
         r = cli("solve", str(path), "-f", "plain")
         assert r.code == 0, r.err
         assert r.err == (f"note: {path}: crank is drawn at 59.9992722 deg; solved at [driver] value = "
-                         "60 deg, reached along the drawn assembly\n")
+                         "60 deg, on the drawing's branch\n")
         r = cli("sweep", str(path), "--from", "0", "--to", "100", "--step", "10", "-f", "csv")
         assert r.code == 0 and "drawn at 59.9992722" in r.err
         rows = [line.split(",") for line in r.out.splitlines()]
@@ -203,14 +203,14 @@ def test_a_six_bar_drawing_gives_its_vector_loop_twins_answers(theta2: float) ->
 
 
 def test_a_drawing_off_its_value_converts_to_loops_on_the_drawn_assembly() -> None:
-    """linkage convert of such a drawing: its loops' guesses are the drawn assembly carried
-    to the value, so the loops file solves to the drawing's joints there too."""
+    """linkage convert of such a drawing: its loops' guesses are the drawing's branch at
+    the value, so the loops file solves to the drawing's joints there too."""
     from linkage.files import parse_toml
     from linkage.kinematics.rates import rates_at
     from linkage.problems.joints import loops_text
 
     text = _mirrored(me581_drawing(driver="value = 100"))
-    converted = loops_text(parse_toml(text, "<drawing>"), "<drawing>")
+    converted = loops_text(parse_toml(text, "<drawing>"), "<drawing>", from_text(text, "<drawing>"))
     assert "# crank is drawn at 65 deg; solved at [driver] value = 100 deg" in converted
     m = from_text(converted, "<loops>")
     r = solve_system(m.problem(), tol=1e-14)

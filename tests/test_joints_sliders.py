@@ -172,7 +172,7 @@ def test_a_drawing_driven_by_a_sliding_link_or_an_unreachable_travel_is_refused(
     with pytest.raises(InputError, match=re.escape("driver.value: 1000 mm is not reached from the drawing "
                                                    "(block is drawn at travel 146.883114 mm)")):
         from_text(slider_crank_drawing(driver='slider = "block"\nvalue = 1000'), "<drawing>")
-    # a travel the drawn assembly reaches: solved there (a driver value off the drawing is accepted)
+    # a travel the drawing's branch reaches: solved there (a driver value off the drawing is accepted)
     m = from_text(slider_crank_drawing(driver='slider = "block"\nvalue = 140'), "<drawing>")
     assert m.driver.value == 140.0 and "block is drawn at travel 146.883114 mm" in m.drawing_note
     assert solve_system(m.problem(), tol=1e-14).converged

@@ -174,17 +174,6 @@ class Solver:
         return (label if label is not None else self.branch(q, det, value)) == target
 
 
-def carried(m: Mechanism, start: float, q0: Sequence[float], to: float) -> tuple[float, ...] | None:
-    """The configuration at driver value ``to`` (display units) on the assembly ``q0`` is
-    on at ``start``: continuation along that branch (its name, or det J's sign), as a sweep
-    follows it; None where the branch ends before ``to`` (a fold, or no assembly)."""
-    solver = Solver(m, "newton", 1e-12, 50)
-    q0 = tuple(q0)
-    target = solver.branch(q0, solver.det(solver.problem(start), q0), start)
-    pos, q = walk(solver, to, [(start, q0)], target)
-    return q if pos.status == "converged" else None
-
-
 def solver_q(solver: Solver, pos: Position) -> tuple[float, ...]:
     assert pos.solution is not None
     return tuple(math.radians(pos.solution[n]) if k == "angle" else pos.solution[n]

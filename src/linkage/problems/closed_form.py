@@ -125,32 +125,15 @@ def wrap_degrees(a: float) -> float:
 
 TRANSMISSION = "transmission angle 0..90"
 """The transmission angle's name in every table (its unit deg beside it): folded, see
-:func:`folded_transmission`."""
-
-
-def folded_transmission(mu: float, half_turn: float = 180.0) -> float:
-    """The transmission angle, the one rule every engine reads: the angle ``mu`` in
-    [0, half_turn] between the coupler's direction and the output link's, folded into
-    [0, half_turn / 2] - the acute angle between the two links' lines, 90 deg transmitting
-    best and 0 a toggle, whichever way the linkage is assembled (Norton, Design of
-    Machinery, "the absolute value of the acute angle of the pair of angles at the
-    intersection of the two links"; Shigley and Uicker's |90 - mu| criterion reads the
-    same). The unfolded angle is theta_output - theta_coupler, in the same tables. Exact:
-    half_turn - mu is exact for mu >= half_turn / 2 (Sterbenz); NaN stays NaN."""
-    return min(mu, half_turn - mu)
-
-
-def folded_transmission_np(mu: Any, half_turn: float = 180.0) -> Any:
-    """:func:`folded_transmission` over arrays."""
-    import numpy as np
-
-    return np.minimum(mu, half_turn - mu)
+:func:`~.derive.folded_transmission`."""
 
 
 def transmission(t3_deg: float, t4_deg: float) -> float:
     """The transmission angle between coupler and output link (deg, in [0, 90]):
-    |theta4 - theta3| wrapped, then folded (:func:`folded_transmission`); NaN for a
-    non-finite angle."""
+    |theta4 - theta3| wrapped, then folded (:func:`~.derive.folded_transmission`); NaN for
+    a non-finite angle."""
+    from .derive import folded_transmission
+
     return folded_transmission(abs(wrap_degrees(t4_deg - t3_deg)))
 
 
@@ -159,6 +142,8 @@ def transmission_np(t3_deg: Any, t4_deg: Any) -> Any:
     import numpy as np
 
     w = np.fmod(np.asarray(t4_deg, float) - t3_deg, 360.0)
+    from .derive import folded_transmission_np
+
     w = np.where(w <= -180.0, w + 360.0, np.where(w > 180.0, w - 360.0, w))
     return folded_transmission_np(np.abs(w))
 

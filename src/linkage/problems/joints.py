@@ -29,8 +29,8 @@ with the body its line is on; its travel is measured along the line from the foo
 perpendicular from that body's first joint. The drawing gives the lengths and the
 assembly; [driver] value says where to solve (left out, the drawn angle or travel). A
 value other than the drawn one (beyond the drawing's rounding, :data:`DRIVER_TOLERANCE_DEG`)
-is reached from the drawn pose along its assembly (:func:`~.loops.parse_mechanism`), and a
-command says where the crank was drawn in a note.
+is solved on the drawing's branch (:func:`~.loops.parse_mechanism`), and a command says
+where the crank was drawn in a note.
 Derived names (stable: scans and scripts use them): unknowns ``theta_<link>`` and
 ``s_<slider>``; lengths ``<link>`` (first to second joint), ``<link>_<P>_<Q>``, ``ground``
 with its angle ``theta_ground`` (``ground_<P>_<Q>``, ``theta_ground_<P>_<Q>``), and each
@@ -540,19 +540,19 @@ def toml_key(k: str) -> str:
     return k if k and all(c.isascii() and (c.isalnum() or c in "_-") for c in k) else toml_value(k)
 
 
-def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>") -> str:
+def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>", mechanism: Any = None) -> str:
     """The derived loops-form file of a drawing, as TOML text: each loop under a comment
-    naming its joints, so the loop-closure equations the drawing implies can be read."""
-    from .loops import parse_mechanism
-
+    naming its joints, so the loop-closure equations the drawing implies can be read.
+    ``mechanism``: the drawing as read (problems.loops.parse_mechanism); when its [driver]
+    value is off the drawing, its guesses (the drawing's branch there) are written."""
     d = loops_doc(doc, source)
     out = [f"# the vector loops of {source}, derived from its joints and links (linkage convert)",
            f"name = {toml_value(d['name'])}"]
-    carried = parse_mechanism(doc, source)
-    if carried.drawing_note is not None:  # guesses on the drawn assembly at [driver] value
-        for u in carried.unknowns:
+    note = None if mechanism is None else mechanism.drawing_note
+    if note is not None:  # guesses on the drawing's branch at [driver] value
+        for u in mechanism.unknowns:
             d["unknowns"][u.name]["guess"] = math.degrees(u.value) if u.kind == "angle" else u.value
-        out.insert(1, f"# {carried.drawing_note.removeprefix(source + ': ')}: the guesses are there")
+        out.insert(1, f"# {note.removeprefix(source + ': ')}: the guesses are there")
     if d.get("description"):
         out.append(f"description = {toml_value(d['description'])}")
     first = d["loops"][0]["joints"][0] if d["loops"] else "the first joint"
