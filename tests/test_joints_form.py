@@ -122,7 +122,7 @@ def test_a_driver_value_off_the_drawing_is_solved_there_on_the_drawn_assembly(br
     drawing at that value (me581_drawing), mirrored for the crossed assembly."""
     pick = _mirrored if branch == "crossed" else (lambda t: t)
     m = from_text(pick(me581_drawing(driver=f"value = {value!r}")), "<drawing>")
-    assert math.degrees(m.driver.value) == value
+    assert math.degrees(m.driver.value) == pytest.approx(value, abs=1e-12)
     assert m.drawing_note == (f"<drawing>: crank is drawn at 65 deg; solved at [driver] value = {value:g} "
                               "deg, on the drawing's branch")
     r = solve_system(m.problem(), tol=1e-14)
@@ -219,3 +219,22 @@ def test_a_drawing_off_its_value_converts_to_loops_on_the_drawn_assembly() -> No
     placed = rates_at(m, r.x).joints
     for name in ("A", "B", "O4"):
         assert placed[name] == pytest.approx(want[name], abs=1e-9), name
+
+
+def test_a_drawing_without_a_closed_form_off_its_value_keeps_the_drawn_assembly() -> None:
+    """The rapier drive (no derived closed form) drawn at 60 deg with value = 200: solved
+    from the drawing there, it is the position a sweep reaches from the drawing by
+    continuation (kinematics.continuation), on the drawing's det J sign."""
+    import linkage
+
+    text = (SAMPLES / "rapier_drive_joints.toml").read_text()
+    drawn = from_text(text, "<rapier>")
+    assert not drawn.derivation.complete and math.degrees(drawn.driver.value) == pytest.approx(60.0)
+    m = from_text(text.replace("\nvalue = 60 ", "\nvalue = 200 "), "<rapier>")
+    assert m.drawing_note is not None and "drawn at 60 deg" in m.drawing_note
+    r = solve_system(m.problem(), tol=1e-14)
+    assert r.converged
+    swept = linkage.sweep(drawn, [60.0 + 10.0 * k for k in range(15)]).positions[-1]
+    assert swept.input == 200.0 and swept.status == "converged"
+    got = {u.name: math.degrees(v) if u.kind == "angle" else v for u, v in zip(m.unknowns, r.x)}
+    assert got == pytest.approx(swept.solution, abs=1e-8)
