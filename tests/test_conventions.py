@@ -92,3 +92,49 @@ def test_draw_of_the_six_bar_writes_a_picture(cli, tmp_path):
     out = tmp_path / "watt.png"
     run = cli("draw", str(SAMPLES / "watt_sixbar.toml"), "-o", str(out))
     assert run.code == 0 and out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+# --- the transmission angle: one rule (derive.folded_transmission) in every engine -----
+
+ME581 = Path(__file__).resolve().parents[1] / "sample_inputs" / "fourbar_me581.toml"
+
+
+def _mu_reference(theta2_deg: float) -> float:
+    """ME581's four-bar (a = 30, b = 60, c = 45, d = 90 cm): the angle at B between coupler
+    and rocker by the law of cosines in triangle A-B-O4 at 40 digits (mpmath), folded into
+    0..90 as Norton's transmission angle (the acute angle between the two links' lines)."""
+    import mpmath
+
+    mpmath.mp.dps = 40
+    a, b, c, d = 30, 60, 45, 90
+    t = mpmath.radians(mpmath.mpf(theta2_deg))
+    diag2 = a * a + d * d - 2 * a * d * mpmath.cos(t)
+    mu = mpmath.degrees(mpmath.acos((b * b + c * c - diag2) / (2 * b * c)))
+    return float(min(mu, 180 - mu))
+
+
+def test_the_transmission_angle_is_one_folded_rule_in_every_engine(cli, tmp_path):
+    """solve and sweep printed ME581's unfolded 101.7 deg at theta2 = 65 where scan and
+    synthesize folded into 0..90: now every engine reads derive.folded_transmission,
+    and its column says so (``transmission angle 0..90 (deg)``)."""
+    assert _mu_reference(65.0) == pytest.approx(180.0 - 101.6763, abs=1e-4)  # the issue's 101.7, folded
+    doc = json.loads(cli("solve", str(ME581), "-f", "json").out)
+    assert doc["fourbars"][0]["transmission_deg"] == pytest.approx(_mu_reference(65.0), abs=1e-11)
+    assert "transmission angle 0..90 = 78.32" in cli("solve", str(ME581), "-f", "plain").out
+    values = [float(v) for v in range(0, 101, 5)]
+    want = [_mu_reference(v) for v in values]
+    for engine in ("--no-batch", "--batch"):
+        r = cli("sweep", str(ME581), "--from", "0", "--to", "100", "--step", "5", engine, "-f", "csv")
+        lines = r.out.splitlines()
+        k = lines[0].split(",").index("transmission angle 0..90 (deg)")
+        got = [float(line.split(",")[k]) for line in lines[1:]]
+        assert got == pytest.approx(want, abs=1e-10), engine
+    api = linkage.sweep(load_mechanism(str(ME581)), values)
+    assert [p.transmission for p in api.positions] == pytest.approx(want, abs=1e-10)
+    r = cli("scan", str(ME581), "--vary", "r3=60:61:2", "--from", "0", "--to", "100", "--step", "5",
+            "-f", "json")
+    first = json.loads(r.out)["tables"][0]
+    row = dict(zip(first["columns"], first["rows"][0]))
+    assert row["r3"] == 60.0
+    assert row["min_transmission_deg"] == pytest.approx(min(want), abs=1e-10)
+    assert row["max_transmission_deg"] == pytest.approx(max(want), abs=1e-10)

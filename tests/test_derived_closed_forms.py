@@ -642,6 +642,7 @@ def test_fourbar_view_and_transmission_under_every_driver() -> None:
                 o4 = -flip * inp.vector(0, t["g"])
                 b, c = inp.length(0, t["cp"]), inp.length(0, t["out"])
                 mu = mpmath.acos((b * b + c * c - abs(pa - o4) ** 2) / (2 * b * c))
+                mu = min(mu, mpmath.pi - mu)  # folded: the acute angle between the lines
                 got = derive.fourbar_transmission(view, terms, der.params, m.driver.value, q)
                 worst = max(worst, float(abs(mu - got)))
     FIGURES["transmission"] = (worst, "rad, 120 four-bars")

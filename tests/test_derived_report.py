@@ -113,8 +113,10 @@ def test_a_refused_old_key_says_to_delete_it(cli, tmp_path, sample, key):
 
 
 def _mu(coupler_deg: float, output_deg: float) -> float:
-    """The angle between two link directions, in [0, 180] deg."""
-    return math.degrees(math.acos(math.cos(math.radians(output_deg - coupler_deg))))
+    """The transmission angle: the angle between two link directions (acos of the cosine,
+    [0, 180] deg), folded into 0..90 (the acute angle between the two lines)."""
+    mu = math.degrees(math.acos(math.cos(math.radians(output_deg - coupler_deg))))
+    return min(mu, 180.0 - mu)
 
 
 def test_watt_sweep_says_its_transmission_column_is_the_worst_loops(cli):
@@ -122,7 +124,7 @@ def test_watt_sweep_says_its_transmission_column_is_the_worst_loops(cli):
     column is that loop's angle (computed here from each loop's coupler and output)."""
     args = ("--from", "0", "--to", "360", "--step", "10")
     text = cli("sweep", str(SAMPLES / "watt_sixbar.toml"), *args, "--format", "plain").out
-    assert "transmission angle: at each position, of the four-bar loop farthest from 90 deg" in text
+    assert "transmission angle 0..90: at each position, of the four-bar loop farthest from 90 deg" in text
     one = cli("sweep", str(SAMPLES / "crank_rocker.toml"), *args, "--format", "plain").out
     assert "farthest from 90" not in one
     doc = json.loads(cli("sweep", str(SAMPLES / "watt_sixbar.toml"), *args, "--format", "json").out)

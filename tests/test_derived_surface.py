@@ -66,9 +66,11 @@ def fourbar_by_crank(a: float, b: float, c: float, d: float, t2: float) -> dict[
 
 
 def transmission(a: float, b: float, c: float, d: float, t2: float) -> float:
-    """The angle at B between coupler and output, by the law of cosines (deg)."""
+    """The transmission angle: the angle at B between coupler and output, by the law of
+    cosines (deg), folded into 0..90 (the acute angle between the two links' lines)."""
     ad2 = a * a + d * d - 2 * a * d * math.cos(math.radians(t2))
-    return math.degrees(math.acos((b * b + c * c - ad2) / (2 * b * c)))
+    mu = math.degrees(math.acos((b * b + c * c - ad2) / (2 * b * c)))
+    return min(mu, 180.0 - mu)
 
 
 # input, coupler, output, ground (cm): worked example P3, docs/worked_examples.md

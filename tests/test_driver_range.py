@@ -10,7 +10,7 @@ import pytest
 
 from linkage.kinematics.sweep import driver_values
 from linkage.problems.loops import from_text
-from report_reading import csv_sections
+from report_reading import csv_rows
 
 R2, R3, E = 40.0, 120.0, 10.0
 S0 = 146.88311367414514  # the slider's x with the crank at 45 deg (open: A above O2 -> B)
@@ -54,7 +54,7 @@ def test_a_sweep_runs_over_the_files_range_on_the_drawn_branch(cli, tmp_path) ->
     path.write_text(drawing())
     r = cli("sweep", str(path), "--format", "csv")
     assert r.code == 0, r.err
-    (rows,) = csv_sections(r.out).values()
+    rows = csv_rows(r.out)
     header, got = rows[0], rows[1:]
     assert header[0] == "s_block (mm)"
     s_col, crank_col = 0, header.index("theta_crank (deg)")

@@ -11,8 +11,6 @@ with closed forms, mpmath and docs/worked_examples.md); here they must be the sa
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 import struct
@@ -22,6 +20,7 @@ from typing import Any
 import pytest
 
 from linkage import bench as bench_module
+from report_reading import csv_files
 
 pq = pytest.importorskip("pyarrow.parquet")
 openpyxl = pytest.importorskip("openpyxl")
@@ -89,14 +88,9 @@ def same_number(a: Any, b: Any) -> bool:
     return bits(float(a)) == bits(float(b))
 
 
-def csv_tables(text: str) -> list[tuple[str | None, list[list[str]]]]:
-    out = []
-    for part in text.split("\n\n"):
-        lines = part.strip("\n").split("\n")
-        name = lines[0][2:] if lines[0].startswith("# ") else None
-        body = lines[1:] if name is not None else lines
-        out.append((name, list(csv.reader(io.StringIO("\n".join(body))))))
-    return out
+def csv_tables(path: Path, names: list[str]) -> list[tuple[str, list[list[str]]]]:
+    """Each table's rows: one file per table, the first at ``path`` (render.writers)."""
+    return list(csv_files(path, names).items())
 
 
 def header(name: str, unit: str) -> str:
@@ -113,10 +107,9 @@ def test_every_data_format_reads_back_the_same(cli: Any, tmp_path: Path, name: s
         assert len(t["columns"]) == len(t["units"]) and all(isinstance(u, str) for u in t["units"])
 
     # CSV: the same tables, headers "name (unit)", numbers bit for bit
-    found = csv_tables(run(cli, tmp_path, name, "csv").read_text())
+    found = csv_tables(run(cli, tmp_path, name, "csv"), [t["name"] for t in tables])
     assert len(found) == len(tables)
-    for (title, rows), t in zip(found, tables):
-        assert title == (t["name"] if len(tables) > 1 else None)
+    for (_, rows), t in zip(found, tables):
         assert rows[0] == [header(c, u) for c, u in zip(t["columns"], t["units"])]
         assert len(rows) - 1 == len(t["rows"])
         for got, want in zip(rows[1:], t["rows"]):
@@ -197,8 +190,9 @@ def test_an_unknown_suffix_is_refused(cli: Any, tmp_path: Path, name: str) -> No
 def test_solve_csv_carries_the_rates(cli: Any, tmp_path: Path) -> None:
     """solve FILE --speed -o f.csv: the velocities and accelerations JSON has, bit for bit."""
     doc = json.loads(run(cli, tmp_path, "solve-file-rates", "json").read_text())
-    text = run(cli, tmp_path, "solve-file-rates", "csv").read_text()
-    cells = {c for _, rows in csv_tables(text) for r in rows[1:] for c in r}
+    path = run(cli, tmp_path, "solve-file-rates", "csv")
+    names = [t["name"] for t in doc["tables"]]
+    cells = {c for _, rows in csv_tables(path, names) for r in rows[1:] for c in r}
     for value in [*doc["velocities"].values(), *doc["accelerations"].values()]:
         assert any(c and same_number(float(c), value) for c in cells if _is_number(c)), value
 

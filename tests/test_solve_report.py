@@ -16,7 +16,7 @@ import pytest
 
 from linkage.render.data import split_header
 from linkage.render.report import NOISE_ULPS, denoise, is_noise
-from report_reading import csv_sections as sections
+from report_reading import csv_files
 
 SAMPLES = Path(__file__).resolve().parent.parent / "sample_inputs"
 ME581 = str(SAMPLES / "fourbar_me581.toml")
@@ -41,7 +41,7 @@ def test_speed_csv_carries_the_rates_bit_for_bit_with_the_json(cli, tmp_path):
     assert cli(*args, "-o", str(tmp_path / "f.csv")).code == 0
     assert cli(*args, "-o", str(tmp_path / "f.json")).code == 0
     doc = json.loads((tmp_path / "f.json").read_text())
-    csvs = sections((tmp_path / "f.csv").read_text())
+    csvs = csv_files(tmp_path / "f.csv", [t["name"] for t in doc["tables"]])
     assert set(csvs) == {"iterations", "unknowns", "joints", "outcome"}
 
     unknowns = by_name(csvs["unknowns"])
@@ -111,10 +111,7 @@ def test_every_solve_report_reads_back_in_every_format(cli, tmp_path, case):
     doc = json.loads((tmp_path / "r.json").read_text())
     tables = {t["name"]: t for t in doc["tables"]}
     assert list(tables) == TABLES[case]
-    csvs = sections((tmp_path / "r.csv").read_text())
-    if list(csvs) == ["only"]:
-        csvs = {TABLES[case][0]: csvs["only"]}
-    assert list(csvs) == TABLES[case]
+    csvs = csv_files(tmp_path / "r.csv", TABLES[case])  # one file per table
     book = openpyxl.load_workbook(tmp_path / "r.xlsx")
     assert book.sheetnames == TABLES[case]
 
@@ -221,7 +218,7 @@ def test_a_still_joint_prints_0_and_the_file_keeps_every_bit(cli, tmp_path):
     args = ("solve", INVERTED, "--speed", "25")
     text = cli(*args, "--format", "plain").out
     assert cli(*args, "-o", str(tmp_path / "s.csv")).code == 0
-    joints = by_name(sections((tmp_path / "s.csv").read_text())["joints"])
+    joints = by_name(csv_files(tmp_path / "s.csv", ["iterations", "unknowns", "joints"])["joints"])
     lines = {ln.split()[0]: ln.split() for ln in text.split("Joints")[1].splitlines()[3:] if ln.strip()}
     assert set(lines) == set(joints)
     for j, row in joints.items():
@@ -271,8 +268,8 @@ def test_a_failed_file_solve_says_so_in_every_file(cli, tmp_path) -> None:
     not only in the JSON and on the screen."""
     r = cli("solve", str(SAMPLES / "fourbar_me581.toml"), "--max-iter", "1", "-o", str(tmp_path / "f.csv"))
     assert r.code == 1
-    parts = sections((tmp_path / "f.csv").read_text())
-    assert set(parts) == {"iterations", "outcome"}
+    parts = csv_files(tmp_path / "f.csv", ["iterations", "outcome"])
+    assert not (tmp_path / "f.unknowns.csv").exists() and not (tmp_path / "f.joints.csv").exists()
     head, row = parts["outcome"][0], parts["outcome"][1]
     outcome = dict(zip(head, row))
     assert outcome["converged"] == "false" and outcome["status"] == "max_iter"

@@ -101,9 +101,9 @@ def test_no_linkage_says_zero_and_that_the_plot_is_not_drawn(tmp_path, capsys) -
 
 def test_csv_holds_the_linkage_itself(capsys) -> None:
     assert run_cli(["synthesize", "--function", "log10(x)", "--x", "1:2", "--alpha", "90:150",
-                    "--phi", "0:90", "--ground", "100", "--unit", "cm", "-f", "csv"]) == 0
-    out = capsys.readouterr().out
-    block = out.split("# linkage\n", 1)[1].split("\n\n", 1)[0].splitlines()
+                    "--phi", "0:90", "--ground", "100", "--unit", "cm", "-f", "csv",
+                    "--table", "linkage"]) == 0
+    block = capsys.readouterr().out.splitlines()
     assert block[0] == "link,length (cm)"
     s = synthesize_function("log10(x)", (1, 2), (90, 150), (0, 90), ground=100.0)
     got = {name: float(v) for name, v in (r.split(",") for r in block[1:])}

@@ -340,10 +340,9 @@ def test_equation_count_must_match_unknowns(tmp_path, cli):
 
 
 def test_csv_for_a_mechanism_has_units_in_every_header(cli):
-    run = cli("solve", ME581, "--format", "csv")
+    run = cli("solve", ME581, "--format", "csv", "--table", "iterations")
     lines = run.out.splitlines()
-    assert lines[0] == "# iterations"  # the first of its tables: iterations, unknowns, joints
-    header = lines[1].split(",")
+    header = lines[0].split(",")
     assert all("(" in h for h in header if h not in ("k", "cond J")), header
 
 

@@ -118,3 +118,67 @@ def test_a_name_used_as_a_length_and_an_angle_needs_its_unit() -> None:
 def test_every_sample_still_loads_as_before() -> None:
     for path in sorted(SAMPLES.glob("*.toml")):
         load_mechanism(path)
+
+
+# --- one way to give a unit: a number with its unit, on the command line as in the file -----
+
+LOADED = Path(__file__).resolve().parents[1] / "docs" / "crank_rocker_loads.toml"
+
+
+def _forces(cli, *args: str, path: Path = LOADED) -> dict:
+    import json
+
+    r = cli("solve", str(path), "-f", "json", *args)
+    assert r.code == 0, r.err
+    return json.loads(r.out)["forces"]
+
+
+def test_command_line_loads_take_a_unit_as_speed_does(cli) -> None:
+    """--speed 600rpm took a unit but --torque rocker=-2Nm and --load P=0,-20N refused one:
+    now each reads "number+unit" by the one parser (numbers.parse_quantity), the units the
+    file's ``unit =`` names, each exactly its definition (1 lbf = 4.4482216152605 N)."""
+    file_loads = _forces(cli)  # the file's: rocker -2 N m, P (0, -20) N
+    for args in (("--torque", "rocker=-2Nm", "--load", "P=0,-20N"),
+                 ("--torque", "rocker=-2 N m", "--load", "P=0N,-20N"),
+                 ("--torque", "rocker=-2000Nmm", "--load", "P=0,-20000mN"),
+                 ("--torque", "rocker=-0.002kNm", "--load", "P=0kN,-0.02kN"),
+                 ("--torque", "rocker=-4/2", "--load", "P=0,-40/2")):  # bare fractions, as before
+        assert _forces(cli, *args)["input"] == pytest.approx(file_loads["input"], rel=1e-15), args
+    in_lbf = _forces(cli, "--load", "P=0,-1lbf")
+    in_newton = _forces(cli, "--load", "P=0,-4.4482216152605")
+    assert in_lbf == in_newton
+    in_lbf_in = _forces(cli, "--torque", "rocker=1lbf in")
+    assert in_lbf_in == _forces(cli, "--torque", f"rocker={4.4482216152605 * 0.0254!r}")
+
+
+@pytest.mark.parametrize("args, says", [
+    (("--torque", "rocker=-2kg"), "--torque rocker '-2kg': give a number, optionally with one of these "
+                                  "units: N m, N mm, kN m, lbf in, lbf ft"),
+    (("--load", "P=0,-20Nm"), "--load P '-20Nm': give a number, optionally with one of these units: "
+                              "N, kN, mN, lbf"),
+    (("--load", "P=1N,-2lbf"), "FX in N and FY in lbf: give one unit, after FY"),
+    (("--speed", "600 rpms"), "--speed '600 rpms': give a number, optionally with one of these units"),
+])
+def test_a_unit_a_load_cannot_take_is_one_line_naming_those_it_can(cli, args, says) -> None:
+    r = cli("solve", str(LOADED), *args)
+    assert r.code == 2 and r.err.count("\n") == 1 and says in r.err, r.err
+
+
+def test_mass_takes_unit_as_loads_do(cli, tmp_path: Path) -> None:
+    """[loads] took ``unit =`` but [mass] needed ``mass_unit``: now ``unit`` there too
+    (mass_unit still read, as its older name; both at once refused)."""
+    text = LOADED.read_text()
+    assert "coupler = { mass = 0.35," in text
+    kg = _forces(cli, "--gravity", "9.81")
+    for spelled in ('coupler = { mass = 350, unit = "g",', 'coupler = { mass = 350, mass_unit = "g",'):
+        path = tmp_path / "g.toml"
+        path.write_text(text.replace("coupler = { mass = 0.35,", spelled))
+        grams = _forces(cli, "--gravity", "9.81", path=path)
+        assert grams["input"] == pytest.approx(kg["input"], rel=1e-14), spelled
+    path.write_text(text.replace("coupler = { mass = 0.35,", 'coupler = { mass = 350, unit = "g", '
+                                                             'mass_unit = "g",'))
+    r = cli("solve", str(path))
+    assert r.code == 2 and "give unit (the mass's), not unit and mass_unit" in r.err
+    path.write_text(text.replace("coupler = { mass = 0.35,", 'coupler = { mass = 350, unit = "N",'))
+    r = cli("solve", str(path))
+    assert r.code == 2 and "mass.coupler.unit: 'N' is not one of kg, g, lb" in r.err

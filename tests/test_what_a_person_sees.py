@@ -19,9 +19,11 @@ LINKAGE = [sys.executable, "-m", "linkage"]
 def law_of_cosines_transmission(r1: float, r2: float, r3: float, r4: float, theta2_deg: float) -> float:
     """The angle at B between coupler and rocker (deg, 0..180), from the triangle A-B-O4:
     |A O4|^2 = r1^2 + r2^2 - 2 r1 r2 cos(theta2) (ground along +x), independent of any
-    solver output but theta2."""
+    solver output but theta2, folded into 0..90 (the transmission angle: the acute angle
+    between the two links' lines)."""
     d2 = r1 * r1 + r2 * r2 - 2.0 * r1 * r2 * math.cos(math.radians(theta2_deg))
-    return math.degrees(math.acos((r3 * r3 + r4 * r4 - d2) / (2.0 * r3 * r4)))
+    mu = math.degrees(math.acos((r3 * r3 + r4 * r4 - d2) / (2.0 * r3 * r4)))
+    return min(mu, 180.0 - mu)
 
 
 @pytest.mark.parametrize("engine", [[], ["--batch"]], ids=["stepwise", "batch"])
@@ -42,7 +44,7 @@ def test_rocker_driven_table_has_a_transmission_angle_in_every_solved_row(cli):
     run_ = cli("sweep", str(SAMPLES / "fourbar_me581_theta4.toml"), "--from", "120", "--to", "160",
                "--step", "20", "--format", "csv")
     header, *rows = [line.split(",") for line in run_.out.splitlines()]
-    j = header.index("transmission angle (deg)")
+    j = header.index("transmission angle 0..90 (deg)")
     assert [r[1] for r in rows] == ["converged"] * 3
     assert all(r[j] for r in rows), rows
 
@@ -177,11 +179,11 @@ def test_scan_help_states_the_step_default_once_and_names_top_k(cli, monkeypatch
 
 def test_rocker_driven_sweep_and_scan_agree_on_the_transmission_extremes(cli):
     """The scan of the rocker-driven file reported min/max_transmission_deg while its sweep
-    showed none; folded into 0..90, the sweep's extremes are now the scan's."""
+    showed none; the sweep's extremes (folded into 0..90 by the one rule) are the scan's."""
     args = ("--from", "0", "--to", "359", "--step", "1")
     doc = json.loads(cli("sweep", str(SAMPLES / "fourbar_me581_theta4.toml"), *args, "--format", "json").out)
-    folded = [min(t, 180.0 - t) for t in (p["transmission"] for p in doc["positions"]
-                                          if p["status"] == "converged")]
+    folded = [p["transmission"] for p in doc["positions"] if p["status"] == "converged"]
+    assert max(folded) <= 90.0
     table = json.loads(cli("scan", str(SAMPLES / "fourbar_me581_theta4.toml"), "--vary", "r2=30:30:1", *args,
                            "-f", "json").out)["tables"][0]
     scan = dict(zip(table["columns"], table["rows"][0]))

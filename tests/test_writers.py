@@ -16,7 +16,7 @@ from linkage.errors import InputError
 from linkage.render import writers
 from linkage.render.data import Column, DataTable, Report, split_header
 from linkage.render.report import Text, table
-from report_reading import csv_sections as read_csv_sections
+from report_reading import csv_files, csv_rows
 
 
 def awkward_numbers(n: int = 3000) -> np.ndarray:
@@ -59,7 +59,7 @@ def test_csv_and_json_read_back_bit_for_bit(tmp_path: Path, monkeypatch: pytest.
     x = awkward_numbers(3000)
     rep = report(x)
     writers.write(rep, "csv", tmp_path / "a.csv")
-    sections = read_csv_sections((tmp_path / "a.csv").read_text())
+    sections = csv_files(tmp_path / "a.csv", ["positions", "joints"])
     head, *rows = sections["positions"]
     assert [split_header(h) for h in head] == [("theta2", "deg"), ("status", ""), ("iterations", ""),
                                                ("open", "")]
@@ -173,3 +173,80 @@ class _Exploding(list):  # a column whose values fail half-way through the write
 
 class _ExplodingError(Exception):
     pass
+
+
+# --- CSV: one table per file (a loaded sweep's two tables read by any CSV reader) ---------------
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _uniform(rows: list[list[str]]) -> bool:
+    """A CSV every reader takes: a header and rows all as wide as it, no '#' section lines."""
+    return bool(rows) and all(len(r) == len(rows[0]) for r in rows) and not rows[0][0].startswith("#")
+
+
+def test_a_loaded_sweeps_csv_is_one_table_per_file(cli, tmp_path: Path) -> None:
+    """linkage sweep docs/crank_rocker_loads.toml -f csv -o x.csv wrote two tables into one
+    file, which pandas.read_csv cannot read: now x.csv (positions) and x.loads.csv."""
+    out = tmp_path / "x.csv"
+    loaded = str(ROOT / "docs" / "crank_rocker_loads.toml")
+    r = cli("sweep", loaded, "--step", "30", "-f", "csv", "-o", str(out))
+    assert r.code == 0, r.err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["x.csv", "x.loads.csv"]
+    assert f"wrote {out}, {tmp_path / 'x.loads.csv'}" in r.err
+    files = csv_files(out, ["positions", "loads"])
+    assert all(_uniform(rows) for rows in files.values())
+    positions, loads = files["positions"], files["loads"]
+    assert positions[0][0] == loads[0][0] == "theta_crank (deg)" and "input (N m)" in loads[0]
+    assert [r[0] for r in positions[1:]] == [r[0] for r in loads[1:]] == \
+        [repr(float(v)) for v in range(0, 361, 30)]
+    # the same tables as the JSON, row for row
+    cli("sweep", loaded, "--step", "30", "-o", str(tmp_path / "x.json"))
+    doc = json.loads((tmp_path / "x.json").read_text())
+    assert [t["name"] for t in doc["tables"]] == ["positions", "loads"]
+    assert len(loads) - 1 == len(doc["tables"][1]["rows"])
+
+
+def test_several_tables_of_csv_on_standard_output_need_table(cli) -> None:
+    """Refused with one line naming the tables (never two tables in one stream); --table
+    NAME writes that one, in any data format; an unknown name names those there are."""
+    args = ("sweep", str(ROOT / "docs" / "crank_rocker_loads.toml"), "--step", "90")
+    r = cli(*args, "-f", "csv")
+    assert r.code == 2 and r.out == ""
+    assert r.err.count("\n") == 1 and "(positions, loads)" in r.err and "--table NAME" in r.err
+    r = cli(*args, "-f", "csv", "--table", "loads")
+    assert r.code == 0, r.err
+    rows = csv_rows(r.out)
+    assert _uniform(rows) and "input (N m)" in rows[0] and len(rows) == 1 + 5
+    r = cli(*args, "-f", "json", "--table", "loads")
+    assert [t["name"] for t in json.loads(r.out)["tables"]] == ["loads"]
+    r = cli(*args, "-f", "csv", "--table", "nosuch")
+    assert r.code == 2 and "no such table; this report has positions, loads" in r.err
+    r = cli(*args, "-f", "plain", "--table", "loads")
+    assert r.code == 2 and "--table picks a table of csv" in r.err
+    # a report of one table is unchanged on standard output
+    r = cli("sweep", str(ROOT / "sample_inputs" / "crank_rocker.toml"), "--step", "90", "-f", "csv")
+    assert r.code == 0 and _uniform(csv_rows(r.out))
+
+
+def test_a_failed_second_table_leaves_no_csv_file(tmp_path: Path) -> None:
+    """Atomic across the files: a failure in the sidecar's table leaves neither file (nor a
+    temporary one)."""
+    rep = report([1.0, 2.0])
+    rep = rep._replace(tables=(rep.tables[0], DataTable("t", (Column("x", "", _Exploding()),))))
+    with pytest.raises(_ExplodingError):
+        writers.write(rep, "csv", tmp_path / "a.csv")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_csv_sidecars_stream_in_blocks(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """With a progress bar the rows go out a block at a time: each table's file whole."""
+    monkeypatch.setattr(writers, "PROGRESS_ROWS", 7)
+    x = np.arange(50, dtype=float) / 3.0
+    rep = report(x)
+    done: list[int] = []
+    writers.write(rep, "csv", tmp_path / "b.csv", progress=done.append)
+    assert done[-1] == 52 and len(done) > 8
+    files = csv_files(tmp_path / "b.csv", ["positions", "joints"])
+    assert [float(r[0]) for r in files["positions"][1:]] == x.tolist()
+    assert files["joints"] == [["joint", "x (mm)"], ["A", "1.5"], ['B, "c"', ""]]

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any
 
@@ -404,7 +403,7 @@ def guarded(call: Callable[[], Any], diagnose: Callable[[], None]) -> Any:
 
 def parse_motion(speed: str | None, accel: str | None, mechanism: Any) -> tuple[float | None, float]:
     """--speed and --accel in internal units (rad/s, rad/s^2, or length/s, length/s^2)."""
-    from .numbers import parse_number
+    from .numbers import parse_quantity
 
     if speed is None:
         if accel is not None:
@@ -414,19 +413,12 @@ def parse_motion(speed: str | None, accel: str | None, mechanism: Any) -> tuple[
     out = []
     accel = "0" if accel is None else accel  # an empty --accel '' is refused, not taken as 0
     for option, text, units in (("--speed", speed, tables[0]), ("--accel", accel, tables[1])):
-        m = _RATE.fullmatch(text)
-        if m is None or m.group(2) not in units:
-            known = ", ".join(u for u in units if u) or "none"
-            raise InputError(f"{option} {text!r}: give a number, optionally with one of these units: {known}")
-        value = parse_number(option, m.group(1)) * units[m.group(2)]
+        value, _ = parse_quantity(option, text, units)
         if not rate_in_range(value):
             raise InputError(f"{option} {text!r} is out of range "
                              f"(0, or {MIN_RATE:g} to {MAX_RATE:g} in size)")
         out.append(value)
     return out[0], out[1]
-
-
-_RATE = re.compile(r"\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*")  # a number, then its unit
 
 
 def _rate_units(mechanism: Any) -> tuple[dict[str, float], dict[str, float]]:
@@ -448,12 +440,14 @@ def motion_text(speed: str | None, accel: str | None, mechanism: Any) -> str | N
     if speed is None:
         return None
     per = "rad" if mechanism.driver.kind == "angle" else mechanism.length_unit
-    number, unit = _RATE.fullmatch(speed).groups()  # type: ignore[union-attr]
+    from .numbers import split_unit
+
+    number, unit = split_unit(speed)  # type: ignore[misc]
     unit = unit or f"{per}/s"
     if accel is None:
         a_number, a_unit = "0", "rpm/s" if unit == "rpm" else f"{unit}^2"
     else:
-        a_number, a_unit = _RATE.fullmatch(accel).groups()  # type: ignore[union-attr]
+        a_number, a_unit = split_unit(accel)  # type: ignore[misc]
         a_unit = a_unit or f"{per}/s^2"
     return f"{float(number):g} {unit}, {float(a_number):g} {a_unit}"
 

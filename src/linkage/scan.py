@@ -519,7 +519,7 @@ def fourbar_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray,
         out[g] = grashof_class(*lengths)
         mu = np.degrees(fourbar_transmission(view, loop, params, drv, q, xp=np))
         mu = np.broadcast_to(mu, (n_designs, n_pos))
-        out[lo], out[hi] = _extent(np.where(mu > 90.0, 180.0 - mu, mu), solved)
+        out[lo], out[hi] = _extent(mu, solved)  # folded by fourbar_transmission's one rule
     return out
 
 

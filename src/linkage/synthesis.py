@@ -496,14 +496,9 @@ def linkage_of_np(r: Any, ground: float) -> tuple[Any, Any, Any, Any, Any, Any]:
     )
 
 
-def folded(mu_deg: float) -> float:
-    """A transmission angle folded into 0..90 deg (its distance from the toggle's 0 or 180)."""
-    return min(mu_deg, 180.0 - mu_deg)
-
-
 def transmission_deg(k: Linkage, alpha_real_deg: float, phi_real_deg: float) -> float:
-    """The transmission angle (deg, 0..180) of the real linkage at its own angles: between
-    the coupler A -> B and the output link O4 -> B (closed_form.transmission), with O4 at
+    """The transmission angle (deg, folded into 0..90) of the real linkage at its own angles:
+    between the coupler A -> B and the output link O4 -> B (closed_form.transmission), with O4 at
     the origin, O2 at (d, 0), A = O2 + a e^(i alpha'), B = c e^(i phi')."""
     from .problems.closed_form import transmission
 
@@ -769,7 +764,7 @@ def structural_error(design: Design, xs: Sequence[float], first: PrecisionPoint)
             continue
         err = math.remainder(phi - want, 360.0)
         mu = transmission_deg(k, al + k.alpha_shift(), phi + k.phi_shift())
-        out.append(CurvePoint(x, y, al, want, phi, err, err * req.y_per_deg, folded(mu), "converged"))
+        out.append(CurvePoint(x, y, al, want, phi, err, err * req.y_per_deg, mu, "converged"))
     return out
 
 
@@ -921,8 +916,7 @@ def _dense_transmission(
     x = np.asarray(xs)[good]
     al = np.array([design.real_alpha(v) for v in x])
     ph = branch_root_np(al, *design.real_R, design.sign)
-    mu = transmission_deg_np(k.a, k.c, k.d, al, ph)
-    fold = np.minimum(mu, 180.0 - mu)
+    fold = transmission_deg_np(k.a, k.c, k.d, al, ph)  # folded (closed_form.transmission)
     i, j = int(np.nanargmin(fold)), int(np.nanargmax(fold))
     return [(float(fold[i]), float(x[i])), (float(fold[j]), float(x[j]))]
 
@@ -1390,8 +1384,7 @@ def evaluate_candidates(req: Request, a0: Any, da: Any, p0: Any, dp: Any, grid: 
     h = (hi - lo) / (grid - 1)
     at_x = gx[k] + offset * h
     max_err = np.where(assembles, peak, np.nan)
-    mu = transmission_deg_np(a[:, None], c[:, None], d[:, None], al_g, phi_g + shift_p[:, None])
-    fold = np.minimum(mu, 180.0 - mu)
+    fold = transmission_deg_np(a[:, None], c[:, None], d[:, None], al_g, phi_g + shift_p[:, None])
     lowest = np.min(np.where(np.isfinite(fold), fold, np.inf), axis=-1)
     min_mu = np.where(linkage_ok & np.isfinite(lowest), lowest, np.nan)
     with np.errstate(invalid="ignore"):

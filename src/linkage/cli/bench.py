@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import PICTURES, FormatOpt, OutputOpt, check_paths, choose_format, emit_report
+from .options import PICTURES, FormatOpt, OutputOpt, TableOpt, check_paths, choose_format, emit_report
 from .progress import progress_bar
 from .root import app
 
@@ -29,6 +29,7 @@ def bench(
                     "log10 time (.png, .svg or .pdf; needs matplotlib).")] = None,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
+    table: TableOpt = None,
 ) -> None:
     """Run time against achieved error for every method, beside scipy and a hand-written loop.
 
@@ -90,7 +91,7 @@ def bench(
         notes.append("pylinkage is not installed: the sweep comparison is skipped "
                      "(pip install 'pylinkage==1.3.0')")
     emit_report(bench_report(measurement_rows(results), sweeps, cold_times, target_rows, n_repeats, notes,
-                             has_scipy()), out_fmt, output)
+                             has_scipy()), out_fmt, output, table=table)
     if plot is not None:
         from ..render.plots import work_precision_plot
 

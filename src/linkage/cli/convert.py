@@ -49,7 +49,7 @@ def convert(
                          f"{'loops' if now == 'joints' else 'joints'} converts it")
     mechanism = parse_mechanism(doc, str(file))  # refuse what solve refuses: the printed file solves
     if wanted == "loops":
-        text = loops_text(doc, str(file))
+        text = loops_text(doc, str(file), mechanism)
     else:
         from ..problems.to_joints import joints_text
 

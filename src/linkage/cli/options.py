@@ -22,6 +22,12 @@ OutputOpt = Annotated[
                  "the format follows the suffix (.csv, .json, .parquet, .xlsx, .txt, .md, .tex, "
                  ".html, .rst) unless --format is given."),
 ]
+TableOpt = Annotated[
+    Optional[str],
+    typer.Option("--table", metavar="NAME", help="Write only this table of the report (csv, json, "
+                 "parquet, xlsx). CSV holds one table: a report of several needs it on standard "
+                 "output; to -o FILE.csv the others go beside it as FILE.NAME.csv."),
+]
 MechanismFile = Annotated[
     Path, typer.Argument(metavar="FILE", help="A mechanism file (TOML, see `linkage samples`).",
                          show_default=False)
@@ -92,14 +98,14 @@ def choose_format(fmt: str | None, output: Path | None) -> str:
 
 
 def emit_report(report: Any, fmt: str, output: Path | None, *, columns: str | None = None,
-                progress: Any = None) -> None:
+                progress: Any = None, table: str | None = None) -> None:
     """Write a command's report (render.data.Report) through the one writer registry;
-    ``columns`` (--columns) keeps only those columns."""
+    ``columns`` (--columns) keeps only those columns, ``table`` (--table) that table."""
     from ..render.writers import pick_columns, write
 
     if columns:
         report = pick_columns(report, columns)
-    write(report, fmt, output, progress=progress)
+    write(report, fmt, output, progress=progress, table=table)
 
 
 class stdout_errors:
@@ -176,11 +182,12 @@ def parse_assignments(option: str, items: list[str]) -> dict[str, float]:
 
 def note_closed_form(mechanism: Any) -> None:
     """Once per command, a one-line note on standard error for a file that still says
-    ``closed_form = ...`` (read and checked, but derived from the loops now): kept here,
-    printed by :func:`run_cli` when the command ends."""
-    note = mechanism.closed_form_note
-    if note is not None and note not in NOTED:
-        NOTED.append(note)
+    ``closed_form = ...`` (read and checked, but derived from the loops now), and for a
+    drawing solved at a [driver] value other than the drawn one (where it was drawn): kept
+    here, printed by :func:`run_cli` when the command ends."""
+    for note in (mechanism.closed_form_note, mechanism.drawing_note):
+        if note is not None and note not in NOTED:
+            NOTED.append(note)
 
 
 NOTED: list[str] = []

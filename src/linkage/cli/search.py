@@ -17,6 +17,7 @@ def search_command(
     fmt: str,
     output: Optional[Path],
     digits: int,
+    table: Optional[str] = None,
     **options: object,
 ) -> None:
     import time
@@ -41,6 +42,6 @@ def search_command(
     started = time.perf_counter()
     with progress_bar(total, minimum=2000, label="synthesising") as advance:
         result = search(function, x, alpha, phi, vary, progress=advance, **options)  # type: ignore[arg-type]
-    writers.write(search_report(result, digits, time.perf_counter() - started), fmt, output)
+    writers.write(search_report(result, digits, time.perf_counter() - started), fmt, output, table=table)
     if not result.without_defects:
         raise typer.Exit(1)

@@ -17,6 +17,7 @@ from .options import (
     OutputOpt,
     SetOpt,
     SpeedOpt,
+    TableOpt,
     TorqueOpt,
     check_paths,
     choose_format,
@@ -88,6 +89,7 @@ def solve(
     output: OutputOpt = None,
     digits: DigitsOpt = 12,
     columns: ColumnsOpt = None,
+    table: TableOpt = None,
 ) -> None:
     """Solve an equation, or a mechanism's loop equations, and print every iteration.
 
@@ -124,7 +126,7 @@ def solve(
         solve_file(file, method, set_ or [], guess or [], tol, rtol, ftol,
                     file_cap, fd_step, damped, show_jacobian,
                     out_fmt, output, digits, plot, (speed, accel), branch, columns,
-                    (load or [], torque or [], gravity))
+                    (load or [], torque or [], gravity), table)
         return
     given = [k for k, v in system_only.items() if v is not None]
     if given:
@@ -172,7 +174,7 @@ def solve(
                    "R": list(fourbar_coefficients(r1, r2, r3, links)[0])}
     report = scalar_report(problem, *runs[0][:2], digits, fourbar) if method != "all" else \
         summary_report(problem, runs, digits, fourbar)
-    emit_report(report, out_fmt, output, columns=columns)
+    emit_report(report, out_fmt, output, columns=columns, table=table)
     if plot is not None:
         convergence_plot([r for r, _, _ in runs], plot, report.title, problem.unit)
     if not all(r.converged for r, _, _ in runs):

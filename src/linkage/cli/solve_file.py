@@ -14,7 +14,8 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
                 show_jacobian: bool, out_fmt: str, output: Path | None, digits: int,
                 plot: Path | None = None, motion: tuple[str | None, str | None] = (None, None),
                 branch_wanted: str | None = None, columns: str | None = None,
-                loads_given: tuple[list[str], list[str], str | None] = ([], [], None)) -> None:
+                loads_given: tuple[list[str], list[str], str | None] = ([], [], None),
+                table: str | None = None) -> None:
     import dataclasses
 
     from ..analysis.convergence import analyze
@@ -55,7 +56,7 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
                            origin=mechanism.origin)
     if result.converged and (not loads.empty or loads.gravity is not None):
         report = _with_forces(report, mechanism, result.x, loads, speed, accel, digits)
-    emit_report(report, out_fmt, output, columns=columns)
+    emit_report(report, out_fmt, output, columns=columns, table=table)
     if plot is not None:
         convergence_plot([result], plot, report.title,
                           ", ".join(sorted({problem.step_unit(i) for i in range(problem.n)} - {""})))

@@ -5,7 +5,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import FormatOpt, OutputOpt, check_paths, choose_format, emit_report
+from .options import FormatOpt, OutputOpt, TableOpt, check_paths, choose_format, emit_report
 from .root import app
 
 
@@ -22,6 +22,7 @@ def stress(
                       "methods (repeatable).")] = None,
     fmt: FormatOpt = None,
     output: OutputOpt = None,
+    table: TableOpt = None,
 ) -> None:
     """Try to break every method (test functions, random four-bars, bad starts, tiny tolerances).
 
@@ -50,6 +51,7 @@ def stress(
     false, crashes = totals(rows)
     from ..render.tools import stress_report
 
-    emit_report(stress_report(report, rows, SUMMARY_HEADERS, quick, seed, false, crashes), out_fmt, output)
+    emit_report(stress_report(report, rows, SUMMARY_HEADERS, quick, seed, false, crashes), out_fmt, output,
+                table=table)
     if false or crashes:
         raise typer.Exit(1)

@@ -17,6 +17,7 @@ from .options import (
     OutputOpt,
     SetOpt,
     SpeedOpt,
+    TableOpt,
     TorqueOpt,
     check_paths,
     choose_format,
@@ -54,7 +55,7 @@ def sweep(
                       "whose loops have a closed form), by name or signs as in solve --branch: open, "
                       "crossed, open/crossed for a six-bar, 'open (mirror)', +-; default: the "
                       "assembly of the file's pose (its guesses solved at its driver value: a "
-                      "drawing's drawn pose).")] = None,
+                      "drawing's assembly as drawn).")] = None,
     set_: SetOpt = None,
     tol: Annotated[float, typer.Option(help="Step and residual tolerance per position.")] = 1e-12,
     batch: Annotated[Optional[bool], typer.Option("--batch/--no-batch", help="Use the numpy "
@@ -75,6 +76,7 @@ def sweep(
     output: OutputOpt = None,
     digits: DigitsOpt = 10,
     columns: ColumnsOpt = None,
+    table: TableOpt = None,
 ) -> None:
     """Solve a mechanism over a range of its driver, each position from the previous one.
 
@@ -161,7 +163,7 @@ def sweep(
             report = sweep_loads(report, mechanism, result, loads, w, a_, digits, torque_plot, cols)
         elif torque_plot is not None:
             raise InputError("--torque-plot needs loads: [loads] or [mass] in the file, or --load/--torque")
-        emit_report(report, out_fmt, output, columns=columns,
+        emit_report(report, out_fmt, output, columns=columns, table=table,
                     progress=None if advance is None else (lambda rows: advance(n + rows)))
     if plot is not None:
         from ..arguments import motion_text

@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import DigitsOpt, ForceOpt, check_paths, mechanism_output, write_mechanism
+from .options import DigitsOpt, ForceOpt, TableOpt, check_paths, mechanism_output, write_mechanism
 from .root import app
 
 
@@ -135,6 +135,7 @@ def synthesize(
         ),
     ] = None,
     digits: DigitsOpt = 6,
+    table: TableOpt = None,
 ) -> None:
     """Synthesise a four-bar function generator: Freudenstein's equation (run
     backwards) at precision points, then the linkage analysed over the whole range.
@@ -188,6 +189,7 @@ def synthesize(
             fmt=fmt,
             output=report_out,
             digits=digits,
+            table=table,
         )
         return
     for option, given in (
@@ -235,7 +237,7 @@ def synthesize(
         error_plot(result, plot)
     elif plot is not None:
         typer.echo(f"note: {plot} not drawn: there is no real linkage", err=True)
-    writers.write(synthesis_report(result, digits, unit), fmt, report_out)
+    writers.write(synthesis_report(result, digits, unit), fmt, report_out, table=table)
     if result.defects:
         raise typer.Exit(1)
 

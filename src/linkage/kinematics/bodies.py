@@ -22,12 +22,17 @@ def metre(length_unit: str) -> float:
 
 def command_loads(mechanism: Any, load: Sequence[str], torque: Sequence[str], gravity: str | None) -> Loads:
     """The file's loads with the command line's added or overriding: ``--load P=FX,FY``
-    (N), ``--torque LINK=T`` (N m), ``--gravity G`` (m/s^2 in -y) or ``GX,GY``."""
-    from ..numbers import parse_number
+    (N), ``--torque LINK=T`` (N m), ``--gravity G`` (m/s^2 in -y) or ``GX,GY``. A force or
+    torque may carry a unit as --speed does (:func:`~linkage.numbers.parse_quantity`), one
+    of the file's ``unit =`` names (problems.loads): ``--torque rocker=-2Nm``,
+    ``--load P=0,-20N`` (the unit after FY is FX's too)."""
+    from ..numbers import parse_number, parse_quantity
+    from ..problems.loads import TORQUE_UNITS
 
     base: Loads = mechanism.extra.get("loads") or Loads()
     spec: dict[str, Any] = {}
     named: dict[str, str] = {}
+    in_n_m = {"": 1.0, **TORQUE_UNITS}  # a bare number in N m
     for option, items in (("--load", load), ("--torque", torque)):
         for item in items:
             name, eq, value = item.partition("=")
@@ -38,10 +43,10 @@ def command_loads(mechanism: Any, load: Sequence[str], torque: Sequence[str], gr
             if option == "--load":
                 parts = value.split(",")
                 if len(parts) != 2:
-                    raise InputError(f"{option} {item!r}: the force is FX,FY in N")
-                spec[name] = {"force": [parse_number(f"{option} {name}", v) for v in parts]}
+                    raise InputError(f"{option} {item!r}: the force is FX,FY in N (or FX,FY with a unit)")
+                spec[name] = {"force": _force(f"{option} {name}", item, parts)}
             else:
-                spec[name] = {"torque": parse_number(f"{option} {name}", value)}
+                spec[name] = {"torque": parse_quantity(f"{option} {name}", value, in_n_m)[0]}
     g: tuple[float, float] | None = None
     if gravity is not None:
         parts = gravity.split(",")
@@ -62,6 +67,21 @@ def command_loads(mechanism: Any, load: Sequence[str], torque: Sequence[str], gr
         raise InputError(f"--gravity: it acts on the links' masses, and {mechanism.source} gives none: add "
                          "[mass] LINK = { mass = KG, cg = [x, y] } to the file")
     return out
+
+
+def _force(label: str, item: str, parts: Sequence[str]) -> list[float]:
+    """--load's FX,FY in N: a unit typed after either is both's (``0,-20N``, ``5lbf,0``),
+    two different units refused."""
+    from ..numbers import parse_quantity, unit_key
+    from ..problems.loads import FORCE_UNITS
+
+    units = {"": 1.0, **FORCE_UNITS}
+    (fx, ux), (fy, uy) = (parse_quantity(label, p, units) for p in parts)
+    if ux and uy and unit_key(ux) != unit_key(uy):
+        raise InputError(f"--load {item!r}: FX in {ux} and FY in {uy}: give one unit, after FY")
+    unit = ux or uy
+    return [v if own or not unit else parse_quantity(label, f"{p} {unit}", units)[0]
+            for p, v, own in zip(parts, (fx, fy), (ux, uy))]
 
 
 # --- one position ------------------------------------------------------------------------------

@@ -82,7 +82,7 @@ class Solver:
         return fns
 
     def transmission(self, q: Sequence[float], value: float) -> float | None:
-        """The transmission angle (deg, in [0, 180]) of a mechanism whose loops include
+        """The transmission angle (deg, folded into [0, 90]) of a mechanism whose loops include
         four-bars (:func:`~linkage.problems.derive.fourbar_transmission`: the coupler as
         traversed against the output link from its pivot), at unknowns ``q`` (internal
         units) and the driver's ``value`` (display units). With several four-bar loops, the

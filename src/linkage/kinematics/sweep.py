@@ -133,7 +133,7 @@ def sweep_mechanism(
 
 def file_branch(m: Mechanism) -> str | None:
     """The branch a sweep follows unless told: the assembly of the file's own pose (its
-    guesses solved at its driver value: a drawing's drawn pose), as signs, wherever the
+    guesses solved at its driver value: a drawing's assembly as drawn), as signs, wherever the
     sweep starts; None where the loops have no derived closed form with two-way steps or
     the pose does not solve (the sweep then starts from the guesses at its first value)."""
     d = m.derivation

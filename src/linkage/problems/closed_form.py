@@ -124,10 +124,18 @@ def wrap_degrees(a: float) -> float:
     return w
 
 
+TRANSMISSION = "transmission angle 0..90"
+"""The transmission angle's name in every table (its unit deg beside it): folded, see
+:func:`~.derive.folded_transmission`."""
+
+
 def transmission(t3_deg: float, t4_deg: float) -> float:
-    """The transmission angle between coupler and output link (deg, in [0, 180]):
-    |theta4 - theta3| wrapped; NaN for a non-finite angle."""
-    return abs(wrap_degrees(t4_deg - t3_deg))
+    """The transmission angle between coupler and output link (deg, in [0, 90]):
+    |theta4 - theta3| wrapped, then folded (:func:`~.derive.folded_transmission`); NaN for
+    a non-finite angle."""
+    from .derive import folded_transmission
+
+    return folded_transmission(abs(wrap_degrees(t4_deg - t3_deg)))
 
 
 def transmission_np(t3_deg: Any, t4_deg: Any) -> Any:
@@ -135,8 +143,10 @@ def transmission_np(t3_deg: Any, t4_deg: Any) -> Any:
     import numpy as np
 
     w = np.fmod(np.asarray(t4_deg, float) - t3_deg, 360.0)
+    from .derive import folded_transmission_np
+
     w = np.where(w <= -180.0, w + 360.0, np.where(w > 180.0, w - 360.0, w))
-    return np.abs(w)
+    return folded_transmission_np(np.abs(w))
 
 
 DRIVERS = {"fourbar": ("theta2", "theta4"), "slider_crank": ("theta2",)}
@@ -271,7 +281,7 @@ def fourbar_facts(m: Any, q: Sequence[float] | None = None,
     lengths, its Grashof class (:func:`fourbar_class`, with the loop's ground, input,
     coupler and output read as written with the ground last) and, given a configuration
     ``q`` (internal units) at ``driver`` (default the file's), its transmission angle in
-    degrees (:func:`~.derive.fourbar_transmission`, in [0, 180])."""
+    degrees (:func:`~.derive.fourbar_transmission`, folded into [0, 90])."""
     from .derive import fourbar_transmission, loop_terms
 
     derivation = m.derivation

@@ -350,9 +350,9 @@ class Derivation(NamedTuple):
 
     def transmission(self, q: Sequence[float], driver: float,
                      params: Mapping[str, float] | None = None) -> float | None:
-        """The transmission angle of a configuration (rad, in [0, pi]): of its four-bar loop,
-        or with several the one farthest from pi/2 (the loop that transmits worst); None
-        with no four-bar loop."""
+        """The transmission angle of a configuration (rad, folded into [0, pi/2]): of its
+        four-bar loop, or with several the one farthest from pi/2 (the loop that transmits
+        worst); None with no four-bar loop."""
         p = self._params(params)
         worst = None
         for view in self.fourbars:
@@ -530,17 +530,38 @@ def is_open_np(step: Step, params: Mapping[str, Any], d: Any, q: Sequence[Any]) 
     return _is_open(step, params, d, q, np)
 
 
+def folded_transmission(mu: float, half_turn: float = 180.0) -> float:
+    """The transmission angle, the one rule every engine reads: the angle ``mu`` in
+    [0, half_turn] between the coupler's direction and the output link's, folded into
+    [0, half_turn / 2] - the acute angle between the two links' lines, 90 deg transmitting
+    best and 0 a toggle, whichever way the linkage is assembled (Norton, Design of
+    Machinery, "the absolute value of the acute angle of the pair of angles at the
+    intersection of the two links"; Shigley and Uicker's |90 - mu| criterion reads the
+    same). The unfolded angle is theta_output - theta_coupler, in the same tables. Exact:
+    half_turn - mu is exact for mu >= half_turn / 2 (Sterbenz); NaN stays NaN."""
+    return min(mu, half_turn - mu)
+
+
+def folded_transmission_np(mu: Any, half_turn: float = 180.0) -> Any:
+    """:func:`folded_transmission` over arrays."""
+    import numpy as np
+
+    return np.minimum(mu, half_turn - mu)
+
+
 def fourbar_transmission(view: FourbarLoop, loop: Sequence[Term], params: Mapping[str, Any],
                          d: Any, q: Sequence[Any], xp: Any = math) -> Any:
-    """The transmission angle of a four-bar loop (rad, in [0, pi]): between the coupler as
-    traversed and the output link from its ground pivot."""
+    """The transmission angle of a four-bar loop (rad, folded into [0, pi/2] by the one rule,
+    :func:`folded_transmission`): between the coupler as traversed and the output link
+    from its ground pivot."""
     s2, _, a2, o2 = loop[view.coupler]
     s3, _, a3, o3 = loop[view.output]
     t2 = _val(a2, params, d, q) + o2 + (0.0 if s2 > 0 else math.pi)
     t3 = _val(a3, params, d, q) + o3 + (math.pi if s3 > 0 else 0.0)
     diff = t3 - t2
-    return xp.abs(xp.arctan2(xp.sin(diff), xp.cos(diff))) if xp is not math else \
-        abs(math.atan2(math.sin(diff), math.cos(diff)))
+    if xp is not math:
+        return folded_transmission_np(xp.abs(xp.arctan2(xp.sin(diff), xp.cos(diff))), math.pi)
+    return folded_transmission(abs(math.atan2(math.sin(diff), math.cos(diff))), math.pi)
 
 
 def _solve_step(case: str, first: Any, second: Any, k: Any, sigma: float) -> tuple[float, float] | None:

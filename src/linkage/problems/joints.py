@@ -21,12 +21,16 @@ equivalent loops-form document, so everything downstream works unchanged;
     block = { on = "ground", angle = 0 }   # drawn, at `angle` (or line = [P, Q] of `on`)
     [driver]
     link = "crank"                 # its angle at its first joint, degrees (or slider = NAME:
-    value = 45                     # its travel); the drawn pose is at this value
+    value = 45                     # its travel), where to solve; left out: the drawn angle
 
 Each link's angle is the angle of the line from its first joint to its second, as drawn
 and as it moves; its other joints are fixed in it by their drawn offsets. A slider turns
 with the body its line is on; its travel is measured along the line from the foot of the
-perpendicular from that body's first joint. The driver value must be the drawn one.
+perpendicular from that body's first joint. The drawing gives the lengths and the
+assembly; [driver] value says where to solve (left out, the drawn angle or travel). A
+value other than the drawn one (beyond the drawing's rounding, :data:`DRIVER_TOLERANCE_DEG`)
+is solved on the drawing's branch (:func:`~.loops.parse_mechanism`), and a command says
+where the crank was drawn in a note.
 Derived names (stable: scans and scripts use them): unknowns ``theta_<link>`` and
 ``s_<slider>``; lengths ``<link>`` (first to second joint), ``<link>_<P>_<Q>``, ``ground``
 with its angle ``theta_ground`` (``ground_<P>_<Q>``, ``theta_ground_<P>_<Q>``), and each
@@ -45,7 +49,8 @@ from .closed_form import wrap_degrees
 
 GROUND = "ground"
 DRIVER_TOLERANCE_DEG = 1e-6
-"""How far the drawn driver angle may be from [driver] value (the drawing's rounding)."""
+"""How far [driver] value may be from the drawn driver angle and still be the drawn pose
+(the drawing's rounding): solved from the drawing's guesses, with no note."""
 DRIVER_TOLERANCE_LENGTH = 1e-6
 """The same for a slider's travel, relative to the drawing's size."""
 MAX_JOINTS = 1000
@@ -110,8 +115,7 @@ def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, 
     drawing = _read(doc, fail)
     xy, ground, links, bodies, points, sliders = drawing
     unit = doc.get("length_unit")
-    scale = max(math.dist(xy[ground[0]], p) for p in xy.values()) or 1.0
-    dname, value = _driver(doc, drawing, scale, fail)
+    dname, value = _driver(doc, drawing, fail)
 
     # each body's frame: the angle its vectors turn with (an unknown, the driver, or None
     # for the ground) and the drawn angle of that reference (a link's first two joints)
@@ -223,8 +227,9 @@ def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, 
 EPS = 2.220446049250313e-16
 
 
-def _driver(doc: Mapping[str, Any], d: Drawing, scale: float, fail: Any) -> tuple[str, float]:
-    """The driver's derived name and its value, checked against the drawing."""
+def _driver(doc: Mapping[str, Any], d: Drawing, fail: Any) -> tuple[str, float]:
+    """The driver's derived name and its value: [driver] value, or the drawn one when it
+    is left out (:func:`drawn_driver`)."""
     drv = doc.get("driver")
     if not isinstance(drv, Mapping):
         raise fail("driver", "missing: [driver] link = NAME (an angle) or slider = NAME (a travel)")
@@ -244,14 +249,7 @@ def _driver(doc: Mapping[str, Any], d: Drawing, scale: float, fail: Any) -> tupl
         if d.sliders[s].on != GROUND:
             raise fail("driver.slider", f"{s} slides on {d.sliders[s].on}: a driving slider runs on "
                                         "the ground")
-        (jx, jy), (px, py) = d.xy[d.center(GROUND)], d.xy[d.center(s)]
-        t = math.radians(d.sliders[s].angle_deg)
-        drawn = (px - jx) * math.cos(t) + (py - jy) * math.sin(t)
-        value = drawn if value is None else float(value)
-        if abs(value - drawn) > DRIVER_TOLERANCE_LENGTH * scale:
-            raise fail("driver.value", f"{value:g}, but {s} is drawn at travel {drawn:.9g} (from "
-                                       f"the foot of {d.center(GROUND)} on its line)")
-        return f"s_{s}", value
+        return f"s_{s}", drawn_driver(d, drv) if value is None else float(value)
     link = drv["link"]
     if not isinstance(link, str) or link not in d.links:
         raise fail("driver.link", f"must name a link (links: {', '.join(d.links)})")
@@ -261,12 +259,30 @@ def _driver(doc: Mapping[str, Any], d: Drawing, scale: float, fail: Any) -> tupl
     if js[0] not in d.ground:
         fixed = ", ".join(j for j in js if j in d.ground) or "none of its joints is"
         raise fail("driver.link", f"{link} must turn about a ground joint: list it first ({fixed} fixed)")
-    drawn = _angle_deg(d.xy[js[0]], d.xy[js[1]])
-    value = drawn if value is None else float(value)
-    if abs(wrap_degrees(value - drawn)) > DRIVER_TOLERANCE_DEG:
-        raise fail("driver.value", f"{value:g} deg, but {link} is drawn at {drawn:.9g} deg "
-                                   f"({js[0]} -> {js[1]})")
-    return f"theta_{link}", value
+    return f"theta_{link}", drawn_driver(d, drv) if value is None else float(value)
+
+
+def drawn_driver(d: Drawing, driver: Mapping[str, Any]) -> float:
+    """Where the drawing puts its (checked) driver: a link's angle first joint -> second
+    (deg), or a slider's travel from the foot of the ground's first joint on its line."""
+    if "slider" in driver:
+        s = driver["slider"]
+        (jx, jy), (px, py) = d.xy[d.center(GROUND)], d.xy[d.center(s)]
+        t = math.radians(d.sliders[s].angle_deg)
+        return (px - jx) * math.cos(t) + (py - jy) * math.sin(t)
+    js = d.links[driver["link"]]
+    return _angle_deg(d.xy[js[0]], d.xy[js[1]])
+
+
+def off_drawing(d: Drawing, driver: Mapping[str, Any], value: float) -> float | None:
+    """The drawn driver value when [driver] ``value`` is not it (beyond the drawing's
+    rounding: :data:`DRIVER_TOLERANCE_DEG`, or :data:`DRIVER_TOLERANCE_LENGTH` of the
+    drawing's size), else None. An angle is compared a whole turn apart as the same."""
+    drawn = drawn_driver(d, driver)
+    if "slider" in driver:
+        scale = max(math.dist(d.xy[d.ground[0]], p) for p in d.xy.values()) or 1.0
+        return drawn if abs(value - drawn) > DRIVER_TOLERANCE_LENGTH * scale else None
+    return drawn if abs(wrap_degrees(value - drawn)) > DRIVER_TOLERANCE_DEG else None
 
 
 def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
@@ -524,12 +540,19 @@ def toml_key(k: str) -> str:
     return k if k and all(c.isascii() and (c.isalnum() or c in "_-") for c in k) else toml_value(k)
 
 
-def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>") -> str:
+def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>", mechanism: Any = None) -> str:
     """The derived loops-form file of a drawing, as TOML text: each loop under a comment
-    naming its joints, so the loop-closure equations the drawing implies can be read."""
+    naming its joints, so the loop-closure equations the drawing implies can be read.
+    ``mechanism``: the drawing as read (problems.loops.parse_mechanism); when its [driver]
+    value is off the drawing, its guesses (the drawing's branch there) are written."""
     d = loops_doc(doc, source)
     out = [f"# the vector loops of {source}, derived from its joints and links (linkage convert)",
            f"name = {toml_value(d['name'])}"]
+    note = None if mechanism is None else mechanism.drawing_note
+    if note is not None:  # guesses on the drawing's branch at [driver] value
+        for u in mechanism.unknowns:
+            d["unknowns"][u.name]["guess"] = math.degrees(u.value) if u.kind == "angle" else u.value
+        out.insert(1, f"# {note.removeprefix(source + ': ')}: the guesses are there")
     if d.get("description"):
         out.append(f"description = {toml_value(d['description'])}")
     first = d["loops"][0]["joints"][0] if d["loops"] else "the first joint"

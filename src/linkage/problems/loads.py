@@ -98,7 +98,7 @@ FORCE_UNITS = {"N": 1.0, "kN": 1e3, "mN": 1e-3, "lbf": LBF}
 TORQUE_UNITS = {"N m": 1.0, "N mm": 1e-3, "kN m": 1e3, "lbf in": LBF * INCH, "lbf ft": LBF * 12 * INCH}
 MASS_UNITS = {"kg": 1.0, "g": 1e-3, "lb": LB}
 INERTIA_UNITS = {"kg m^2": 1.0, "kg mm^2": 1e-6, "g cm^2": 1e-7, "lb in^2": LB * INCH * INCH}
-"""Units a load may name (``unit``, ``mass_unit``, ``inertia_unit``), each to SI, exactly as
+"""Units a load may name (``unit``, ``inertia_unit``), each to SI, exactly as
 defined (1 lbf = 4.4482216152605 N, 1 lb = 0.45359237 kg)."""
 
 
@@ -114,10 +114,11 @@ def _unit(key: str, spec: Mapping[str, Any], field_name: str, units: Mapping[str
 def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str,
                 named: Mapping[str, str] | None = None) -> Loads:
     """``[loads]`` and ``[mass]`` of a joints-form document, checked against its drawing, in SI:
-    a force in N and a torque in N m unless its ``unit`` says otherwise, a mass in kg and an
-    inertia in kg m^2 unless ``mass_unit`` / ``inertia_unit`` say; a cg in the file's
-    length unit (the drawing's). ``named``: how a message names an entry of ``[loads]``
-    (the command line's option, ``--torque rocker``) instead of ``source: loads.NAME``."""
+    a force in N, a torque in N m and a mass in kg unless its ``unit`` says otherwise (a
+    mass's also ``mass_unit``, its older name), an inertia in kg m^2 unless ``inertia_unit``
+    says; a cg in the file's length unit (the drawing's). ``named``: how a message names an
+    entry of ``[loads]`` (the command line's option, ``--torque rocker``) instead of
+    ``source: loads.NAME``."""
     forces: dict[str, tuple[float, float]] = {}
     torques: dict[str, float] = {}
     masses: dict[str, Mass] = {}
@@ -161,11 +162,15 @@ def parse_loads(doc: Mapping[str, Any], drawing: Any, source: str,
         if name not in links:
             raise InputError(f"{key}: not a moving link; links: {', '.join(sorted(links))}")
         if (not isinstance(spec, Mapping) or "mass" not in spec
-                or set(spec) - {"mass", "cg", "inertia", "mass_unit", "inertia_unit", "note"}):
+                or set(spec) - {"mass", "cg", "inertia", "unit", "mass_unit", "inertia_unit", "note"}):
             raise InputError(f"{key}: give {{ mass = KG, cg = [x, y], inertia = KG_M2 }} (cg in the "
-                             "drawn pose, the file's length unit; inertia about the cg; mass_unit and "
-                             "inertia_unit for others)")
-        m = _finite(f"{key}.mass", spec["mass"]) * _unit(key, spec, "mass_unit", MASS_UNITS)
+                             "drawn pose, the file's length unit; inertia about the cg; unit = ... for "
+                             "another mass unit, inertia_unit for the inertia's)")
+        if "unit" in spec and "mass_unit" in spec:
+            raise InputError(f"{key}: give unit (the mass's), not unit and mass_unit (its older name)")
+        # unit, as [loads] names a force's or a torque's; mass_unit, its older name, still read
+        which = "mass_unit" if "mass_unit" in spec else "unit"
+        m = _finite(f"{key}.mass", spec["mass"]) * _unit(key, spec, which, MASS_UNITS)
         inertia = _finite(f"{key}.inertia", spec.get("inertia", 0.0)) * _unit(key, spec, "inertia_unit",
                                                                              INERTIA_UNITS)
         if m < 0.0 or inertia < 0.0:

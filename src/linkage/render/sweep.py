@@ -9,6 +9,7 @@ from typing import Any
 from ..kinematics.angles import angle_extent, closes_circle, driver_turn
 from ..kinematics.columns import SweepColumns, sweep_columns
 from ..kinematics.sweep import SweepResult
+from ..problems.closed_form import TRANSMISSION
 from .data import DataTable, Report, column, from_rows, split_header
 from .rates import rate_cells, rate_headers, rate_units_dict, rates_dict
 from .report import Block, Text, fmt, table
@@ -36,7 +37,7 @@ def sweep_headers(s: SweepResult) -> list[str]:
     headers += [f"{n} ({unit})" for n, unit in zip(s.names, s.units)]
     headers += ["branch", "iterations", f"det J ({det_unit_of(s)})"]
     if s.classification:
-        headers.append("transmission angle (deg)")
+        headers.append(f"{TRANSMISSION} (deg)")
     return headers
 
 
@@ -52,7 +53,7 @@ def sweep_table(s: SweepResult, cols: SweepColumns | None = None) -> DataTable:
     out += [column("branch", "", c.branch, "text"), column("iterations", "", c.iterations, "int"),
             column("det J", det_unit_of(s), c.det)]
     if s.classification:
-        out.append(column("transmission angle", "deg", c.transmission))
+        out.append(column(TRANSMISSION, "deg", c.transmission))
     joints = list(c.joints)
     if c.rates is not None:  # the scalar rates, a row at a time (the one definition)
         heads = rate_headers(s.names, _kinds(s), s.length_unit, joints, True)
@@ -176,7 +177,7 @@ def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400,
             blocks.append(Text(f"four-bar{where}: {cl['type']} (s + l = {fmt(cl['s_plus_l'], 6)}, "
                                f"p + q = {fmt(cl['p_plus_q'], 6)})"))
         if len(s.classification.get("loops", ())) > 1:  # one column for several loops
-            blocks.append(Text("transmission angle: at each position, of the four-bar loop "
+            blocks.append(Text(f"{TRANSMISSION}: at each position, of the four-bar loop "
                                "farthest from 90 deg"))
     headers = sweep_headers(s)
     every = -(-n // max_rows)  # ceil: the fewest rows skipped that fit max_rows

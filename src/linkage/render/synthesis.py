@@ -8,6 +8,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from ..problems.closed_form import TRANSMISSION
 from .data import Report, from_rows
 from .report import Block, Text, fmt, table
 
@@ -68,7 +69,7 @@ def synthesis_report(s: Any, digits: int = 6, unit: str = "") -> Report:
         ("phi_generated", "deg", "number"),
         ("error", "deg", "number"),
         ("error_y", "", "number"),
-        ("transmission", "deg", "number"),
+        (TRANSMISSION, "deg", "number"),
         ("status", "", "text"),
     ]
     curve_rows = [
@@ -187,7 +188,7 @@ def synthesis_report(s: Any, digits: int = 6, unit: str = "") -> Report:
         if s.transmission is not None:
             out.append(
                 Text(
-                    f"transmission angle (folded into 0..90): min {fmt(s.transmission[0], 4)} deg "
+                    f"{TRANSMISSION}: min {fmt(s.transmission[0], 4)} deg "
                     f"(at x = {fmt(s.transmission_at_x, digits)}), max {fmt(s.transmission[1], 4)} deg"
                 )
             )

@@ -6,7 +6,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from ..analysis.convergence import Convergence
-from ..problems.closed_form import MIRROR
+from ..problems.closed_form import MIRROR, TRANSMISSION
 from ..problems.system import SystemProblem
 from ..result import Result
 from .data import DataTable, Report, column
@@ -99,7 +99,7 @@ def fourbar_line(fact: dict[str, Any], digits: int) -> str:
     """A four-bar loop's facts in one line: its Grashof class and transmission angle."""
     line = f"four-bar loop {fact['loop']}: {fact['type']}"
     if fact.get("transmission_deg") is not None:
-        line += f", transmission angle {fmt(fact['transmission_deg'], min(digits, 8))} deg"
+        line += f", {TRANSMISSION} = {fmt(fact['transmission_deg'], min(digits, 8))} deg"
     return line
 
 

@@ -5,17 +5,20 @@ Display formats (table, plain and tabulate's) show the report's blocks. Data for
 of rows at a time (never one Python object per cell of a large table):
 
 - csv: a header row of ``name (unit)``, numbers as the shortest text that reads back to
-  the same double, an empty cell where there is none. A report of several tables writes
-  them one after another, each under a ``# name`` line, a blank line between.
+  the same double, an empty cell where there is none: one table per file, so that any
+  CSV reader (``pandas.read_csv``) reads it. A report of several tables written to a file
+  puts the first at the path given and the others beside it as ``stem.name.csv``; on
+  standard output it needs ``--table NAME`` (:func:`pick_table`), and is refused without.
 - json: the command's document, with the tables under ``tables``: for each, its name,
   column names, units and rows.
 - parquet: one file per table (the first at the path given, the others beside it as
-  ``stem.name.parquet``), each field's unit in its metadata.
+  ``stem.name.parquet``, as csv), each field's unit in its metadata.
 - xlsx: one sheet per table, ``name (unit)`` in the header row, numbers as numbers.
 
 A file is written to a temporary name beside it and renamed when complete
 (:func:`~linkage.files.atomic_target`): a failed or interrupted run leaves no
-half-written file.
+half-written file (nor sidecar: each is renamed only when the whole report is written).
+``--table NAME`` keeps one table of any data format (:func:`pick_table`).
 """
 
 from __future__ import annotations
@@ -217,16 +220,23 @@ class Sink:
 
 
 class CsvSink(Sink):
+    """One table per output: a second table goes to the file ``paths(name)`` returns (the
+    sidecar's temporary file, renamed with the first; :func:`open_sink`)."""
+
     def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None,
-                 several: bool = False) -> None:
+                 paths: Callable[[str], IO[Any]] | None = None) -> None:
         super().__init__(out, path, meta)
-        self.several = several
+        self.paths = paths
 
     def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
         super().begin(name, columns, rows)
+        if self.tables > 1:
+            if self.paths is None:  # write() refuses this first; a caller of the sinks too
+                raise InputError(f"csv holds one table: {name!r} is a second on standard output")
+            self.out.flush()  # type: ignore[union-attr]
+            self.out = self.paths(safe_name(name))
         self.fast = rows is not None and rows * len(self.columns) >= FAST_CELLS and _pyarrow()
-        head = ("\n" if self.tables > 1 else "") + (f"# {name}\n" if self.several else "")
-        self.out.write(head + ",".join(_quote(c.header) for c in self.columns) + "\n")  # type: ignore[union-attr]
+        self.out.write(",".join(_quote(c.header) for c in self.columns) + "\n")  # type: ignore[union-attr]
 
     def rows(self, values: Sequence[Any]) -> None:
         n = len(values[0]) if values else 0
@@ -480,17 +490,21 @@ def _sidecar(path: str) -> Callable[[str], str]:
     return name
 
 
+SIDECAR_FORMATS = ("csv", "parquet")
+"""The formats that hold one table per file: a report's others go beside the first."""
+
+
 @contextlib.contextmanager
-def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None,
-              several: bool = False) -> Iterator[Sink]:
+def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None) -> Iterator[Sink]:
     """A sink for a data format, to ``output`` (None or "-": standard output), finished and
-    renamed into place only if the block completes."""
+    renamed into place only if the block completes; csv and parquet put a second table
+    in a sidecar file (:func:`side_paths`), renamed with the first."""
     to_stdout = output is None or str(output) == "-"
     kinds = {"csv": CsvSink, "json": JsonSink, "parquet": ParquetSink, "xlsx": XlsxSink}
     try:
         with contextlib.ExitStack() as stack:
             if to_stdout:
-                sink: Sink = _make(kinds[fmt], sys.stdout, None, meta, several)
+                sink: Sink = kinds[fmt](sys.stdout, None, meta)
                 yield sink
                 sink.close()
                 sys.stdout.flush()
@@ -499,7 +513,7 @@ def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None,
 
             tmp = stack.enter_context(atomic_target(output))  # type: ignore[arg-type]
             if fmt in ("parquet", "xlsx"):
-                sink = _make(kinds[fmt], None, tmp, meta, several)
+                sink = kinds[fmt](None, tmp, meta)
                 if isinstance(sink, ParquetSink):
                     sink.paths = lambda t: _extra_target(stack, output, t)  # type: ignore[arg-type]
                 try:
@@ -510,10 +524,13 @@ def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None,
                 sink.close()
             else:
                 fh = stack.enter_context(open(tmp, "w", encoding="utf-8", newline=""))
-                sink = _make(kinds[fmt], fh, tmp, meta, several)
+                sink = kinds[fmt](fh, tmp, meta)
+                if isinstance(sink, CsvSink):
+                    sink.paths = lambda t: stack.enter_context(  # type: ignore[arg-type]
+                        open(_extra_target(stack, output, t), "w", encoding="utf-8", newline=""))
                 yield sink
                 sink.close()
-                fh.flush()
+                sink.out.flush()  # type: ignore[union-attr]
     except OSError as exc:
         where = "standard output" if to_stdout else str(output)
         raise OutputError(f"cannot write to {where}: {exc.strerror or exc}") from None
@@ -527,14 +544,8 @@ def _extra_target(stack: contextlib.ExitStack, output: Path, table: str) -> str:
     return stack.enter_context(atomic_target(final))
 
 
-def _make(kind: type[Sink], out: Any, path: str | None, meta: Any, several: bool) -> Sink:
-    if kind is CsvSink:
-        return CsvSink(out, path, meta, several)
-    return kind(out, path, meta)
-
-
 def side_paths(output: Path, report: Report) -> list[Path]:
-    """The files a parquet report of several tables writes beside ``output``."""
+    """The files a csv or parquet report of several tables writes beside ``output``."""
     return [Path(_sidecar(str(output))(t.name)) for t in [t for t in report.tables if t.columns][1:]]
 
 
@@ -562,25 +573,32 @@ def write_tables(sink: Sink, tables: Sequence[DataTable],
 # --- the one entry point --------------------------------------------------------------------
 
 def write(report: Report, fmt: str, output: Path | None, *,
-          progress: Callable[[int], None] | None = None) -> None:
+          progress: Callable[[int], None] | None = None, table: str | None = None) -> None:
     """Write ``report`` in ``fmt`` to ``output`` (None or "-": standard output);
-    ``progress(rows written)`` as a data format's rows go out."""
+    ``progress(rows written)`` as a data format's rows go out; ``table`` (--table) keeps
+    that one of the report's tables (:func:`pick_table`)."""
     to_stdout = output is None or str(output) == "-"
-    sides: list[Path] = []  # a parquet report's sidecar files
+    sides: list[Path] = []  # a csv or parquet report's sidecar files
+    if table is not None:
+        report = pick_table(report, fmt, table)
     if is_data(fmt):
         tables = [t for t in report.tables if t.columns]
+        if fmt == "csv" and to_stdout and len(tables) > 1:
+            names = ", ".join(t.name for t in tables)
+            raise InputError(f"csv holds one table and this report has {len(tables)} ({names}): add "
+                             "--table NAME for one on standard output, or -o FILE.csv (one file each)")
         meta = report.document() if (fmt == "json" and report.document is not None) else \
             {"title": report.title} if fmt in ("json", "parquet") else {}
         if not isinstance(meta, dict):  # the tables go under a key: the document must be an object
             meta = {"title": report.title, "document": meta}
-        to_parquet_file = fmt == "parquet" and not to_stdout
-        sides = side_paths(output, report) if to_parquet_file else []  # type: ignore[arg-type]
-        if to_parquet_file:
+        to_side_files = fmt in SIDECAR_FORMATS and not to_stdout
+        sides = side_paths(output, report) if to_side_files else []  # type: ignore[arg-type]
+        if fmt == "parquet" and not to_stdout:
             # which files are this report's: a rerun with fewer tables leaves the last
             # run's sidecars beside it (nothing is deleted by pattern)
             files = [Path(str(output)).name] + [p.name for p in sides]
             meta = {**meta, "files": dict(zip([t.name for t in tables], files))}
-        with open_sink(fmt, output, meta, several=len(tables) > 1) as sink:
+        with open_sink(fmt, output, meta) as sink:
             write_tables(sink, tables, progress)
     else:
         from .display import display_text, print_table
@@ -605,6 +623,19 @@ def write(report: Report, fmt: str, output: Path | None, *,
     if not to_stdout:
         made = [str(output)] + [str(p) for p in sides]
         print(f"wrote {', '.join(made)}", file=sys.stderr)
+
+
+def pick_table(report: Report, fmt: str, name: str) -> Report:
+    """``--table NAME``: the report with that one of its tables (any data format; the
+    display formats show the whole report and refuse it). A name that is not one of the
+    report's tables is an InputError naming those there are."""
+    names = [t.name for t in report.tables if t.columns]
+    if not is_data(fmt):
+        raise InputError(f"--table picks a table of csv, json, parquet or xlsx output, not {fmt}")
+    kept = tuple(t for t in report.tables if t.name == name.strip() and t.columns)
+    if not kept:
+        raise InputError(f"--table {name!r}: no such table; this report has {', '.join(names) or 'none'}")
+    return report._replace(tables=kept)
 
 
 def pick_columns(report: Report, names: str) -> Report:
