@@ -26,6 +26,23 @@ def test_quick_start_is_two_commands_and_ci_runs_them_verbatim():
         assert line in ci
 
 
+def test_ci_reruns_the_numerics_sensitive_tests_with_numpys_simd_dispatch_off():
+    """After the quick start, .ci/run runs NUMERICS again under NPY_DISABLE_CPU_FEATURES set to
+    numpy's dispatch targets: every test file that holds a numpy twin to a bound in ulps
+    (tests/ulps.py) is among them, and each exists."""
+    ci = (ROOT / ".ci" / "run").read_text()
+    after = ci.split(quick_start()[1], 1)[1]
+    numerics = re.search(r'^NUMERICS="([^"]+)"', after, flags=re.M)
+    assert numerics, "no NUMERICS= line after the quick start"
+    files = numerics.group(1).split()
+    assert all((ROOT / f).is_file() for f in files), files
+    using = sorted(f"tests/{p.name}" for p in (ROOT / "tests").glob("test_*.py")
+                   if re.search(r"^from ulps import", p.read_text(), flags=re.M))
+    assert using and set(using) <= set(files), (using, files)
+    assert re.search(r'^NPY_DISABLE_CPU_FEATURES="\$targets" python -m pytest \$NUMERICS$', after, flags=re.M)
+    assert "__cpu_dispatch__" in after
+
+
 def readme_solve_examples() -> list[tuple[list[str], int]]:
     """Every ``$ linkage solve ...`` line, with the exit code its ``# exit N`` comment
     promises (0 without one)."""
@@ -45,3 +62,29 @@ def test_every_readme_example_runs(cli, args, code, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # examples that write files write them here
     run = cli(*args)
     assert run.code == code, run.err
+
+
+def readme_method_all_table() -> list[str]:
+    """The ```text block after "`--method all` runs every method": its lines."""
+    block = README.split("`--method all` runs every method", 1)[1].split("```text", 1)[1].split("```", 1)[0]
+    return [line for line in block.strip().splitlines() if line.strip()]
+
+
+def deterministic(lines: list[str]) -> list[list[str]]:
+    """A --method all table without its last column (time per solve, which is measured):
+    the lines down to the header's rule whole, each row after it split into cells."""
+    rule = next(k for k, line in enumerate(lines) if line.lstrip().startswith("---"))
+    return [line.split() for line in lines[:rule]] + [line.split()[:-1] for line in lines[rule + 1:]]
+
+
+def test_readme_method_all_table_is_what_the_command_prints(cli):
+    """Every column but the time is deterministic arithmetic: the README's table shows
+    what `linkage solve --method all` prints now (it showed 10 fixed-point evaluations,
+    from before the roots were certified, where the command printed 19)."""
+    run = cli("solve", "--method", "all")
+    assert run.code == 0, run.err
+    printed = [line for line in run.out.strip().splitlines() if line.strip()]
+    want = deterministic(readme_method_all_table())
+    assert deterministic(printed) == want
+    assert [row[0] for row in want[3:]] == ["bisection", "regula-falsi", "hybrid", "secant", "newton",
+                                            "fixed-point"]
