@@ -191,3 +191,20 @@ def test_the_quick_start_names_every_test_extra():
     for requirement in extras:
         name = _re.split(r"[\[<>=!~ ]", requirement, maxsplit=1)[0]
         assert name in said, f"the quick start does not name {name}"
+
+
+def test_ci_reruns_the_numerics_sensitive_tests_with_numpys_simd_dispatch_off():
+    """After the quick start, .ci/run runs NUMERICS again under NPY_DISABLE_CPU_FEATURES set to
+    numpy's dispatch targets: every test file that holds a numpy twin to a bound in ulps
+    (tests/ulps.py) is among them, and each exists."""
+    ci = (ROOT / ".ci" / "run").read_text()
+    after = ci.split(quick_start()[1], 1)[1]
+    numerics = re.search(r'^NUMERICS="([^"]+)"', after, flags=re.M)
+    assert numerics, "no NUMERICS= line after the quick start"
+    files = numerics.group(1).split()
+    assert all((ROOT / f).is_file() for f in files), files
+    using = sorted(f"tests/{p.name}" for p in (ROOT / "tests").glob("test_*.py")
+                   if re.search(r"^from ulps import", p.read_text(), flags=re.M))
+    assert using and set(using) <= set(files), (using, files)
+    assert re.search(r'^NPY_DISABLE_CPU_FEATURES="\$targets" python -m pytest \$NUMERICS$', after, flags=re.M)
+    assert "__cpu_dispatch__" in after

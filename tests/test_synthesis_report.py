@@ -17,6 +17,14 @@ TRANSMISSION = ("x**2", (1.0, 2.0), (270.0, 210.0), (60.0, 150.0))
 """R1, R2 > 0: no link drawn the other way, so the file's crank angle is alpha + 180."""
 
 
+AT_A_LIMIT_DEG = 10 * math.degrees(math.sqrt(2.0 ** -52))
+"""How closely two computations of the output angle at a limit position agree: there the
+half-chord is the square root of a discriminant that is zero to rounding, so the angle is
+determined to about sqrt(eps) rad (8.5e-7 deg); the linkage's R (LAPACK's solve, whose last
+bits depend on the BLAS kernel) moves the limit by as much. Measured 4.2e-7 deg (OpenBLAS
+SkylakeX) and 7.7e-7 deg (Sandybridge) between the reported and the plotted maximum."""
+
+
 def _argv(case) -> list[str]:
     fn, (x0, x1), (a0, a1), (p0, p1) = case
     return ["synthesize", "--function", fn, "--x", f"{x0:g}:{x1:g}", "--alpha", f"{a0:g}:{a1:g}",
@@ -29,7 +37,7 @@ def test_max_error_of_a_linkage_stopped_by_a_limit_is_the_largest_reached() -> N
     # the plotted curve (401 steps, the same solver) never exceeds the reported maximum
     plotted = [abs(c.error_deg) for c in dense_curve(s) if c.error_deg is not None]
     assert max(plotted) > 2.0  # the error plunges near the limit (it was reported as 1.515)
-    assert s.max_error_deg >= max(plotted) - 1e-9
+    assert s.max_error_deg >= max(plotted) - AT_A_LIMIT_DEG
     # the maximum is at the limit position: A is as far from O4 as coupler + output reach
     # (or as near as their difference), by the linkage's own geometry
     k = s.linkage

@@ -458,10 +458,9 @@ def linkage_of(r: Sequence[float], ground: float) -> tuple[Linkage | None, str |
         return None, "R1, R2, R3 are not finite"
     tiny = ZERO_R * max(1.0, abs(r1), abs(r2), abs(r3))
     if abs(r1) <= tiny or abs(r2) <= tiny:
-        # + 0.0: a zero of either sign is said as 0
-        which = (
-            f"output link (R1 = {r1 + 0.0:.3g})" if abs(r1) <= tiny else f"input link (R2 = {r2 + 0.0:.3g})"
-        )
+        # said as 0, which by ZERO_R it is: its rounding (a sign, 1e-16) is the LAPACK
+        # kernel's, different from one CPU to another
+        which = "output link (R1 = 0)" if abs(r1) <= tiny else "input link (R2 = 0)"
         return None, f"the {which} would be infinitely long: R = d / length is zero to rounding"
     d = ground
     a, c = d / r2, d / r1
