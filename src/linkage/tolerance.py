@@ -145,7 +145,7 @@ def plan_tolerances(m: Mechanism, tolerances: Sequence[Tolerance], doc: Mapping[
         if t.name in m.parameters:
             q = m.parameters[t.name]
             if q.kind != "length":
-                raise InputError(f"--tol {t.name}: not a length (a {q.kind}); a tolerance is on a length "
+                raise InputError(f"--tol {t.name}: not a length (an {q.kind}); a tolerance is on a length "
                                  f"or a fixed joint's coordinate; the lengths of {m.source} are "
                                  f"{', '.join(lengths)}")
             if not q.signed and not t.plus_minus < q.value:
@@ -160,7 +160,10 @@ def plan_tolerances(m: Mechanism, tolerances: Sequence[Tolerance], doc: Mapping[
                                 if m.extra.get("drawing") is not None else ""))
     varies = [Vary(t.name, _value_of(m, doc, t.name) - t.plus_minus,
                    _value_of(m, doc, t.name) + t.plus_minus, None) for t in tolerances]
-    renamed, moves = joint_moves(m, doc, varies, fixed)
+    try:
+        renamed, moves = joint_moves(m, doc, varies, fixed)
+    except InputError as exc:  # the scan's checks of a joint's coordinate, in this option's name
+        raise InputError(str(exc).replace("--vary ", "--tol ")) from None
     directions = []
     for t, v in zip(tolerances, renamed):
         nominal = _value_of(m, doc, t.name)

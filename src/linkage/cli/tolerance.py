@@ -85,7 +85,7 @@ def tolerance(
     from ..problems.loops import from_text
     from ..render.tolerance import tolerance_report
     from ..solve import check_criteria
-    from ..tolerance import MAX_SAMPLES, parse_tolerance, prepare, study
+    from ..tolerance import MAX_SAMPLES, outputs_of, parse_tolerance, prepare, study
 
     if output is not None and str(output) == "-":
         output = None
@@ -104,6 +104,9 @@ def tolerance(
     a, b = driver_span(mechanism, start, stop, turn_end=359.0)
     values = driver_values(a, b, step, None)
     doc = parse_toml(text, str(file)) if any("." in t.name for t in tolerances) else None
+    names = [o.name for o in outputs_of(mechanism)]
+    if plot_output is not None and plot_output not in names:
+        raise InputError(f"--plot-output {plot_output}: no such output; the outputs are {', '.join(names)}")
     plan, job = prepare(mechanism, tolerances, values, branch=branch, tol=tol, doc=doc, text=text,
                         overrides=tuple((k, float(v)) for k, v in fixed.items()), samples=samples,
                         distribution=distribution)
@@ -111,8 +114,6 @@ def tolerance(
         result = study(mechanism, plan, values, branch=job.branch, tol=tol, samples=samples, seed=seed,
                        distribution=distribution, job=job, scheduler=scheduler, workers=workers,
                        progress=advance)
-    if plot_output is not None:
-        result.output(plot_output)  # checked before anything is written
     emit_report(tolerance_report(result, digits), out_fmt, output, columns=columns)
     if plot is not None:
         from ..render.tolerance import tolerance_plot
