@@ -43,7 +43,7 @@ _EXPORTS = {
     "Loads": ".problems.loads", "Mass": ".problems.loads",
     "instant_centres": ".kinematics.centres", "InstantCentres": ".kinematics.centres",
     "centrodes": ".kinematics.centres", "Centrodes": ".kinematics.centres",
-    "tolerance": ".tolerance", "ToleranceStudy": ".tolerance",
+    "tolerance": ".kinematics.tolerance", "ToleranceStudy": ".kinematics.tolerance",
 }
 _RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",
             "scan_designs": "scan", "forces": "forces_at", "assemblies": "every_assembly"}

@@ -36,10 +36,10 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InputError, ParseError
-from .kinematics.designs import CONVERGED, solve_designs
-from .problems.loops import ANGLE_UNITS, LoopModel, Mechanism
-from .scan import JointMoves, ScanJob, Vary, job_mechanism, joint_moves
+from ..errors import InputError, ParseError
+from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism
+from ..scan import JointMoves, ScanJob, Vary, job_mechanism, joint_moves
+from .designs import CONVERGED, solve_designs
 
 DISTRIBUTIONS = ("normal", "uniform")
 """How ±D is drawn: normal with sigma D/3 (default), or uniform within ±D."""
@@ -66,7 +66,7 @@ class Tolerance:
 
 def parse_tolerance(text: str) -> Tolerance:
     """``NAME=±D``, ``NAME=+-D`` or ``NAME=D`` (D > 0, finite)."""
-    from .numbers import parse_number
+    from ..numbers import parse_number
 
     name, eq, spec = text.partition("=")
     name, spec = name.strip(), spec.strip()
@@ -77,15 +77,20 @@ def parse_tolerance(text: str) -> Tolerance:
             spec = spec[len(sign):].strip()
             break
     d = parse_number(f"--tol {name}", spec)
-    return check_tolerance(name, d, "--tol ")
+    return check_tolerance(name, d, OPTION)
 
 
-def check_tolerance(name: str, d: Any, prefix: str = "") -> Tolerance:
-    from .arguments import check_number
+OPTION = "--tol {}"
+"""How the command line names a tolerance in a message; the API names it ``API``."""
+API = "tolerances[{!r}]"
 
-    d = check_number(f"{prefix}{name}" if prefix else f"tolerances[{name!r}]", d)
+
+def check_tolerance(name: str, d: Any, label: str = API) -> Tolerance:
+    from ..arguments import check_number
+
+    d = check_number(label.format(name), d)
     if not d > 0.0:
-        raise InputError(f"{prefix}{name}: a tolerance ±D needs D > 0, got {d:g}")
+        raise InputError(f"{label.format(name)}: a tolerance ±D needs D > 0, got {d:g}")
     return Tolerance(name, d)
 
 
@@ -127,10 +132,10 @@ class Plan:
 
 
 def plan_tolerances(m: Mechanism, tolerances: Sequence[Tolerance], doc: Mapping[str, Any] | None,
-                    fixed: Sequence[str] = ()) -> Plan:
-    """Each tolerance checked (one InputError naming it): a length parameter of ``m``, or a
-    fixed joint's coordinate of a joints file (``doc``) as ``--vary`` takes it; given once;
-    D smaller than the length it is on."""
+                    fixed: Sequence[str] = (), label: str = OPTION) -> Plan:
+    """Each tolerance checked (one InputError naming it by ``label``): a length parameter of
+    ``m``, or a fixed joint's coordinate of a joints file (``doc``) as ``--vary`` takes it;
+    given once; D smaller than the length it is on."""
     if not tolerances:
         raise InputError("give at least one tolerance, --tol NAME=±D")
     if len(tolerances) > MAX_TOLERANCES:
@@ -138,32 +143,37 @@ def plan_tolerances(m: Mechanism, tolerances: Sequence[Tolerance], doc: Mapping[
     seen: set[str] = set()
     for t in tolerances:
         if t.name in seen:
-            raise InputError(f"--tol {t.name} is given twice")
+            raise InputError(f"{label.format(t.name)} is given twice")
         seen.add(t.name)
     lengths = [p for p, q in m.parameters.items() if q.kind == "length"]
     for t in tolerances:
         if t.name in m.parameters:
             q = m.parameters[t.name]
             if q.kind != "length":
-                raise InputError(f"--tol {t.name}: not a length (an {q.kind}); a tolerance is on a length "
-                                 f"or a fixed joint's coordinate; the lengths of {m.source} are "
+                raise InputError(f"{label.format(t.name)}: not a length (an {q.kind}); a tolerance is on a "
+                                 f"length or a fixed joint's coordinate; the lengths of {m.source} are "
                                  f"{', '.join(lengths)}")
             if not q.signed and not t.plus_minus < q.value:
-                raise InputError(f"--tol {t.name}=±{t.plus_minus:g}: as large as {t.name} itself "
+                raise InputError(f"{label.format(t.name)} = ±{t.plus_minus:g}: as large as {t.name} itself "
                                  f"({q.value:g} {m.length_unit}); a tolerance is smaller than its length")
         elif "." not in t.name:
             what = ("the driver (its value is set, not made)" if t.name == m.driver.name else
                     "an unknown (it follows from the lengths)" if t.name in {u.name for u in m.unknowns}
                     else "not a parameter")
-            raise InputError(f"--tol {t.name}: {what}; the lengths of {m.source} are {', '.join(lengths)}"
-                             + (", and in a joints file a fixed joint's coordinate such as O4.x"
-                                if m.extra.get("drawing") is not None else ""))
+            joint = (", and in a joints file a fixed joint's coordinate such as O4.x"
+                     if m.extra.get("drawing") is not None else "")
+            raise InputError(f"{label.format(t.name)}: {what}; the lengths of {m.source} are "
+                             f"{', '.join(lengths)}{joint}")
     varies = [Vary(t.name, _value_of(m, doc, t.name) - t.plus_minus,
                    _value_of(m, doc, t.name) + t.plus_minus, None) for t in tolerances]
     try:
         renamed, moves = joint_moves(m, doc, varies, fixed)
     except InputError as exc:  # the scan's checks of a joint's coordinate, in this option's name
-        raise InputError(str(exc).replace("--vary ", "--tol ")) from None
+        text = str(exc)
+        for t in tolerances:
+            text = text.replace(f"--vary {t.name}", label.format(t.name)).replace(f"vary {t.name!r}",
+                                                                                  label.format(t.name))
+        raise InputError(text) from None
     directions = []
     for t, v in zip(tolerances, renamed):
         nominal = _value_of(m, doc, t.name)
@@ -355,7 +365,7 @@ def sensitivities(m: Mechanism, plan: Plan, values: np.ndarray, q: np.ndarray, s
                   ) -> tuple[np.ndarray, np.ndarray]:
     """(sensitivity (outputs, tolerances, positions), J invertible per position) at the
     nominal solutions ``q`` (positions, unknowns; internal units)."""
-    from .kinematics.rates import place_motion_np, solve_rates_np
+    from .rates import place_motion_np, solve_rates_np
 
     outs = outputs_of(m)
     k = len(values)
@@ -460,7 +470,7 @@ def judge(exact: Mapping[str, np.ndarray], nominal: np.ndarray, s: np.ndarray, d
 def monte_carlo(base: ToleranceStudy, m: Mechanism, plan: Plan, samples: int, seed: int, job: ScanJob,
                 scheduler: str | None, workers: int | None, progress: Any = None) -> ToleranceStudy:
     """Draw the samples and run them as a scan's chunks (the scan engine's runner)."""
-    from .scan import pick_chunk, run_chunks
+    from ..scan import pick_chunk, run_chunks
 
     n_out, k = len(base.outputs), len(base.values)
     held = samples * k * (n_out + 1)
@@ -510,17 +520,17 @@ class _quiet:
 def prepare(m: Mechanism, tolerances: Sequence[Tolerance], values: Sequence[float], *,
             branch: str | None, tol: float, doc: Mapping[str, Any] | None, text: str = "",
             overrides: Sequence[tuple[str, float]] = (), samples: int | None = None,
-            distribution: str = "normal") -> tuple[Plan, ScanJob]:
+            distribution: str = "normal", label: str = OPTION) -> tuple[Plan, ScanJob]:
     """Everything checked before anything is solved: the plan and the scan job its designs
     run as (``text``: the file's text for workers; empty: the mechanism travels pickled)."""
-    from .kinematics.sweep import check_driver_values
-    from .scan import MAX_SCAN_POSITIONS, default_branch
+    from ..scan import MAX_SCAN_POSITIONS, default_branch
+    from .sweep import check_driver_values
 
     if distribution not in DISTRIBUTIONS:
         raise InputError(f"--distribution must be {' or '.join(DISTRIBUTIONS)}, got {distribution!r}")
     if samples is not None and not 1 <= samples <= MAX_SAMPLES:
         raise InputError(f"--samples must be between 1 and {MAX_SAMPLES:,}, got {samples}")
-    plan = plan_tolerances(m, tolerances, doc, [k for k, _ in overrides])
+    plan = plan_tolerances(m, tolerances, doc, [k for k, _ in overrides], label)
     if len(values) > MAX_SCAN_POSITIONS:
         raise InputError(f"{len(values):,} driver positions is more than {MAX_SCAN_POSITIONS:,}; use a "
                          "larger --step")
@@ -548,10 +558,10 @@ def tolerance(mechanism: Mechanism | str, tolerances: Mapping[str, float],
     from ``seed``, run on dask like :func:`linkage.scan_designs` (``scheduler``,
     ``workers``). Every argument is checked first: a misuse raises InputError naming it.
     See docs/tolerance.md."""
-    from .arguments import check_reals, check_scan_options, check_text, check_whole, describe
-    from .problems.loops import mechanism_of
-    from .scan import MAX_SCAN_POSITIONS
-    from .solve import check_criteria
+    from ..arguments import check_reals, check_scan_options, check_text, check_whole, describe
+    from ..problems.loops import mechanism_of
+    from ..scan import MAX_SCAN_POSITIONS
+    from ..solve import check_criteria
 
     m = mechanism_of("mechanism", mechanism)
     if not isinstance(tolerances, Mapping) or not tolerances:
@@ -571,8 +581,8 @@ def tolerance(mechanism: Mechanism | str, tolerances: Mapping[str, float],
     check_text("branch", branch)
     check_criteria(tol, 0.0, None, 50)
     if values is None:
-        from .arguments import driver_span
-        from .kinematics.sweep import driver_values
+        from ..arguments import driver_span
+        from .sweep import driver_values
 
         a, b = driver_span(m, None, None, turn_end=359.0)
         values = driver_values(a, b, 1.0, None)
@@ -583,12 +593,12 @@ def tolerance(mechanism: Mechanism | str, tolerances: Mapping[str, float],
     if not isinstance(mechanism, Mechanism) and any("." in t.name for t in tols):
         from pathlib import Path
 
-        from .files import parse_toml, read_input
+        from ..files import parse_toml, read_input
 
         doc = parse_toml(read_input(Path(mechanism)), str(mechanism))  # a joint's coordinates
     try:
         plan, job = prepare(m, tols, list(values), branch=branch, tol=tol, doc=doc, samples=samples,
-                            distribution=distribution)
+                            distribution=distribution, label=API)
     except ParseError as exc:
         raise InputError(str(exc)) from None
     return study(m, plan, list(values), branch=job.branch, tol=tol, samples=samples, seed=seed,
