@@ -171,13 +171,19 @@ def tolerance_plot(s: Any, name: str | None, path: Path) -> None:
     plt = pyplot()
     fig, (top, low) = plt.subplots(2, 1, figsize=(8, 7), sharex=True,
                                    gridspec_kw={"height_ratios": [1, 1.3]})
-    top.fill_between(x, nom - wc, nom + wc, color="tab:orange", alpha=0.35, lw=0, label="± worst case")
-    top.fill_between(x, nom - rss, nom + rss, color="tab:blue", alpha=0.35, lw=0, label="± RSS (3 sigma)")
+    # the bands are usually far thinner than the curve's swing: drawn magnified, and said so
+    swing = float(np.nanmax(nom) - np.nanmin(nom)) if np.isfinite(nom).any() else 0.0
+    widest = float(np.nanmax(wc)) if np.isfinite(wc).any() else 0.0
+    zoom = _zoom(swing, widest)
+    shown = f" x {zoom:g}" if zoom != 1 else ""
+    top.fill_between(x, nom - zoom * wc, nom + zoom * wc, color="#fdd0a2", lw=0, label=f"± worst case{shown}")
+    top.fill_between(x, nom - zoom * rss, nom + zoom * rss, color="#9ecae1", lw=0,
+                     label=f"± RSS (3 sigma){shown}")
     top.plot(x, nom, color="black", lw=1.2, label="nominal")
     top.set_ylabel(f"{o.name} ({o.unit})")
     top.legend(fontsize=8, loc="best")
-    low.fill_between(x, -wc, wc, color="tab:orange", alpha=0.35, lw=0, label="linear worst case")
-    low.fill_between(x, -rss, rss, color="tab:blue", alpha=0.35, lw=0, label="linear RSS (3 sigma)")
+    low.fill_between(x, -wc, wc, color="#fdd0a2", lw=0, label="linear worst case")
+    low.fill_between(x, -rss, rss, color="#9ecae1", lw=0, label="linear RSS (3 sigma)")
     if s.samples is not None:
         low.plot(x, s.mc_low[j] - nom, color="tab:green", lw=1.4,
                  label=f"Monte Carlo 0.135% / 99.865% ({s.samples:,} samples)")
@@ -198,6 +204,16 @@ def tolerance_plot(s: Any, name: str | None, path: Path) -> None:
     top.set_title(title, fontsize=9)
     fig.tight_layout()
     save_figure(fig, path)
+
+
+def _zoom(swing: float, widest: float) -> float:
+    """How much the top panel magnifies the bands: a round factor (1, 2, 5, 10, 20, ...)
+    making the widest worst-case band about a twentieth of the curve's swing, never below 1."""
+    if not (swing > 0.0 and widest > 0.0) or widest >= swing / 20.0:
+        return 1.0
+    want = swing / 20.0 / widest
+    step = 10.0 ** math.floor(math.log10(want))
+    return max(f * step for f in (1.0, 2.0, 5.0) if f * step <= want)
 
 
 def _default_output(s: Any) -> int:
