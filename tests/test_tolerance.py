@@ -51,7 +51,8 @@ def _assert_close(linear: np.ndarray, fd: np.ndarray) -> None:
 
 @pytest.mark.parametrize("path,names", [(CRANK, ["r1", "r2", "r3", "r4"]),
                                         (CRANK_JOINTS, ["crank", "coupler", "rocker", "ground",
-                                                        "coupler_A_P"])])
+                                                        "coupler_A_P"]),
+                                        (SAMPLES / "slider_crank_joints.toml", ["crank", "coupler", "e_block"])])
 def test_linear_bands_equal_finite_differences(path, names):
     m = linkage.load_mechanism(path)
     s = linkage.tolerance(path, {n: 0.05 for n in names}, VALUES, samples=None)
