@@ -49,10 +49,14 @@ def _assert_close(linear: np.ndarray, fd: np.ndarray) -> None:
     assert np.all(np.abs(linear - fd) <= 1e-6 * np.maximum(1.0, np.abs(fd))), np.max(np.abs(linear - fd))
 
 
-@pytest.mark.parametrize("path,names", [(CRANK, ["r1", "r2", "r3", "r4"]),
-                                        (CRANK_JOINTS, ["crank", "coupler", "rocker", "ground",
-                                                        "coupler_A_P"]),
-                                        (SAMPLES / "slider_crank_joints.toml", ["crank", "coupler", "e_block"])])
+SLIDER_JOINTS = SAMPLES / "slider_crank_joints.toml"
+
+
+JOINTS_LENGTHS = ["crank", "coupler", "rocker", "ground", "coupler_A_P"]
+
+
+@pytest.mark.parametrize("path,names", [(CRANK, ["r1", "r2", "r3", "r4"]), (CRANK_JOINTS, JOINTS_LENGTHS),
+                                        (SLIDER_JOINTS, ["crank", "coupler", "e_block"])])
 def test_linear_bands_equal_finite_differences(path, names):
     m = linkage.load_mechanism(path)
     s = linkage.tolerance(path, {n: 0.05 for n in names}, VALUES, samples=None)

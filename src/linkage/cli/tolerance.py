@@ -42,9 +42,9 @@ def tolerance(
     distribution: Annotated[str, typer.Option(help="How each ±D is drawn: normal (sigma D/3: ±D is "
                             "3 sigma) or uniform (within ±D).")] = "normal",
     start: Annotated[Optional[float], typer.Option("--from", help="First driver value (default 0, or "
-                     "the file's [driver] range).")] = None,
+                     "the file's driver range).")] = None,
     stop: Annotated[Optional[float], typer.Option("--to", help="Last driver value (default 359, or "
-                    "the file's [driver] range).")] = None,
+                    "the file's driver range).")] = None,
     step: Annotated[float, typer.Option(help="Driver increment (default 1).", show_default=False)] = 1.0,
     branch: Annotated[Optional[str], typer.Option(help="The assembly every design follows (open, "
                       "crossed, ...); default: the file's guess's.")] = None,
