@@ -50,8 +50,9 @@ NONLINEAR_LIMIT = 0.1
 +D or -D differs from the linear prediction by more than this share of the worst-case band."""
 MAX_TOLERANCES = 100
 MAX_SAMPLES = 10_000_000
-MAX_HELD = 50_000_000
-"""Samples x positions x (outputs + 1) the Monte Carlo holds at once (400 MB)."""
+MAX_HELD = 20_000_000
+"""Samples x positions x (outputs + 1) the Monte Carlo holds at once (160 MB; the
+percentiles sort a copy)."""
 DEFAULT_SAMPLES = 1000
 
 
@@ -240,10 +241,11 @@ def design_outputs(m: Mechanism, sol: Any) -> np.ndarray:
     return np.stack(cols, axis=-1) if cols else np.empty((n, k, 0))
 
 
-def wrap_near(x: np.ndarray, reference: np.ndarray, outputs: Sequence[Output]) -> np.ndarray:
+def wrap_near(x: np.ndarray, reference: np.ndarray, outputs: Sequence[Output], copy: bool = True
+              ) -> np.ndarray:
     """Angle outputs (deg) brought within half a turn of ``reference`` (the nominal): a
-    sample at -179 deg beside a nominal 179 deg is 181 deg."""
-    x = np.array(x, dtype=float, copy=True)
+    sample at -179 deg beside a nominal 179 deg is 181 deg (in place unless ``copy``)."""
+    x = np.array(x, dtype=float, copy=True) if copy else x
     for j, o in enumerate(outputs):
         if o.kind == "angle":
             x[..., j] = reference[..., j] + (x[..., j] - reference[..., j] + 180.0) % 360.0 - 180.0
@@ -490,7 +492,7 @@ def monte_carlo(base: ToleranceStudy, m: Mechanism, plan: Plan, samples: int, se
         done += len(rows)
         if progress is not None:
             progress(done)
-    outputs = wrap_near(outputs, base.nominal.T[None, :, :], base.outputs)
+    outputs = wrap_near(outputs, base.nominal.T[None, :, :], base.outputs, copy=False)
     with np.errstate(invalid="ignore"), _quiet():
         low, median, high = np.nanpercentile(outputs, PERCENTILES, axis=0)  # (positions, outputs) each
         counts = np.isfinite(outputs).sum(axis=0)
@@ -584,6 +586,9 @@ def tolerance(mechanism: Mechanism | str, tolerances: Mapping[str, float],
         from ..arguments import driver_span
         from .sweep import driver_values
 
+        if m.driver.kind != "angle" and m.driver_range is None:
+            raise InputError(f"values: {m.driver.name} is a length with no [driver] range in the file: "
+                             "give the driver values")
         a, b = driver_span(m, None, None, turn_end=359.0)
         values = driver_values(a, b, 1.0, None)
     values = check_reals("values", values, most=MAX_SCAN_POSITIONS)
