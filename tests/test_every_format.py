@@ -39,6 +39,8 @@ COMMANDS: dict[str, list[str]] = {
     "centres": ["centres", str(SAMPLES / "slider_crank.toml")],
     "centrodes": ["centres", str(SAMPLES / "crank_rocker_joints.toml"), "--centrodes", "--step", "90"],
     "scan": ["scan", str(SAMPLES / "crank_rocker.toml"), "--vary", "r2=30:40:3", "--step", "30"],
+    "tolerance": ["tolerance", str(SAMPLES / "crank_rocker.toml"), "--tol", "r2=0.05", "--tol", "r4=0.05",
+                  "--step", "90", "--samples", "200"],
     "samples": ["samples"],
     "synthesize": ["synthesize", "--function", "log10(x)", "--x", "1:2", "--alpha", "90:150",
                    "--phi", "0:90"],

@@ -15,6 +15,8 @@ The public API, in the order a reader meets it:
 - :func:`forces` gives the input torque and joint forces of a joints-form mechanism at a position.
 - :func:`instant_centres` gives every instant centre of a mechanism at a pose, :func:`centrodes`
   the fixed and moving centrodes of a body over a sweep.
+- :func:`tolerance` spreads manufacturing tolerances through a mechanism over its cycle:
+  linear worst-case and RSS bands beside a Monte Carlo (a :class:`ToleranceStudy`).
 - :func:`analyze` estimates convergence order and rate from a recorded history.
 """
 
@@ -41,6 +43,7 @@ _EXPORTS = {
     "Loads": ".problems.loads", "Mass": ".problems.loads",
     "instant_centres": ".kinematics.centres", "InstantCentres": ".kinematics.centres",
     "centrodes": ".kinematics.centres", "Centrodes": ".kinematics.centres",
+    "tolerance": ".kinematics.tolerance", "ToleranceStudy": ".kinematics.tolerance",
 }
 _RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",
             "scan_designs": "scan", "forces": "forces_at", "assemblies": "every_assembly"}
@@ -86,6 +89,7 @@ __all__ = [
     "Status",
     "SweepResult",
     "SystemProblem",
+    "ToleranceStudy",
     "analyze",
     "assemblies",
     "centrodes",
@@ -101,4 +105,5 @@ __all__ = [
     "solve_system",
     "sweep",
     "synthesize_function",
+    "tolerance",
 ]
