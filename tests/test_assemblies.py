@@ -94,12 +94,12 @@ def test_every_assembly_of_a_closed_form_sample_is_its_closed_forms(name):
         a = linkage.assemblies(m, value)
         want = [tuple(q) for _, q in m.derivation.solutions(a.driver)]
         assert _same_set([s.q for s in a.real], want, kinds, m.length_scale), (name, value)
-        names = {m.derivation.name_of(list(q), a.driver) for q in want}
+        names = set(m.derivation.named_solutions(a.driver))
         for s in a.real:
             assert s.residual <= 1e-12
             assert s.branch in names
-        assert a.failed == 0
-        assert len(a.real) + a.complex_count + a.infinite == a.bezout
+        assert a.failed == 0 and a.unresolved == 0
+        assert sum(a.multiplicity) + a.complex_count + a.infinite == a.bezout
 
 
 def _fourbar_text(r1: float, r2: float, r3: float, r4: float, theta2: float) -> str:
@@ -271,18 +271,74 @@ def test_the_offset_sliders_assemblies_against_a_one_dimensional_scan():
     assert _same_set([s.q for s in a.real], want_q, [u.kind for u in m.unknowns], m.length_scale)
 
 
-def test_within_a_hair_of_a_limit_both_assemblies_are_found_and_flagged():
-    """The ME581's limit is at theta2 = 112.0243128... deg: just inside it the two assemblies
-    are 0.03 deg apart and both are found, flagged near_limit; just outside there is none."""
+def test_within_a_hair_of_a_limit_both_assemblies_are_found_and_flagged_by_their_own_condition():
+    """The ME581's limit is at theta2 = 112.0243128... deg: inside it the two assemblies are
+    found as the closed form gives them, flagged near_limit where their own condition passes
+    1e6 (3e-10 deg inside), not 1.3e-5 deg inside (condition 8e3); 1e-10 deg outside there
+    is none (the loops cannot close by 1e-12 of the size), not a double root."""
     m = load(SAMPLES / "fourbar_me581.toml")
-    for value in (112.0243, 112.02431283):
+    for value, flagged in ((112.0243, False), (112.02431283, False), (112.024312837, True)):
         a = linkage.assemblies(m, value)
         want = [tuple(q) for _, q in m.derivation.solutions(a.driver)]
         assert _same_set([s.q for s in a.real], want, ["angle", "angle"], m.length_scale, tol=1e-7)
-        assert all(s.singular for s in a.real)
-    for value in (112.0243129, 112.02432, 112.03):
+        assert all(s.singular == flagged for s in a.real), value
+    for value in (112.02431283714216, 112.0243129, 112.02432, 112.03):
         a = linkage.assemblies(m, value)
-        assert a.real == () and a.complex_count == 2
+        assert a.real == () and a.complex_count == 2 and a.unresolved == 0, value
+
+
+def _crossing_reference(theta2_deg):
+    """The change-point crank-rocker (r1 = 100, r2 = 40, r3 = 120, r4 = 60: 40 + 120 = 100 +
+    60) by the law of cosines at 50 digits."""
+    return _law_of_cosines(mpmath.mpf(100), mpmath.mpf(40), mpmath.mpf(120), mpmath.mpf(60), theta2_deg)
+
+
+def test_near_a_change_point_both_crossing_assemblies_are_found_where_double_precision_separates_them():
+    """An adversary's pass found two assemblies 1.3e-6 rad off, 5e-6 rad apart, 1e-4 deg
+    from a change point (Newton stopped on an overshoot), and one of two called complex at
+    1e-6 deg. Now both are found to 1e-12 where they are apart by more than their own
+    uncertainty, and where they are not (at the change point, or 1e-6 deg from it: 3e-8
+    rad apart, uncertainty 1e-7) they are one double assembly, flagged, not one and a
+    complex."""
+    m = load(SAMPLES / "crank_rocker.toml").with_values({"r2": 40, "r4": 60}, {})
+    a = linkage.assemblies(m, 1e-4)
+    # each to its own uncertainty: rounding times its condition (3.8e6): 8e-10 rad
+    assert _same_set([s.q for s in a.real], _crossing_reference(1e-4), ["angle", "angle"], 1.0, tol=1e-9)
+    assert a.multiplicity == (1, 1) and all(s.singular for s in a.real)
+    for value in (0.0, 1e-6):
+        a = linkage.assemblies(m, value)
+        assert len(a.real) == 1 and a.multiplicity == (2,) and a.real[0].singular
+        assert a.complex_count == 0 and a.unresolved == 0
+        ref = _crossing_reference(value)
+        assert all(abs(math.remainder(x - y, 2 * math.pi)) < 2e-6
+                   for r in ref for x, y in zip(a.real[0].q, r))
+
+
+def test_a_six_bar_at_its_four_bars_change_point_has_two_double_assemblies():
+    """The Stephenson six-bar with r4 = 60 at theta2 = 0: the four-bar's double root times the
+    dyad's two assemblies: 2, each double (it printed 4, the double root twice)."""
+    m = load(SAMPLES / "stephenson_sixbar.toml").with_values({"r4": 60}, {})
+    a = linkage.assemblies(m, 0.0)
+    assert len(a.real) == 2 and a.multiplicity == (2, 2) and a.unresolved == 0
+
+
+def test_a_linkage_that_moves_with_its_driver_held_is_not_isolated():
+    """A rhombus (r1 = r2 = r3 = r4) at theta2 = 0 folds with A on O4: the coupler turns
+    freely. It listed 3 'assemblies' (4 with another seed)."""
+    m = load(SAMPLES / "crank_rocker.toml").with_values({"r1": 1, "r2": 1, "r3": 1, "r4": 1}, {})
+    a = linkage.assemblies(m, 0.0)
+    assert a.continuum and a.real == ()
+
+
+def test_a_rocker_driven_four_bars_mirror_assembly_is_named_as_branch_takes_it():
+    """Both assemblies of the rocker-driven ME581 at theta4 = 120 are open; the second is
+    'open (mirror)', the name --branch takes (both printed 'open')."""
+    m = load(SAMPLES / "fourbar_me581_theta4.toml")
+    a = linkage.assemblies(m, 120.0)
+    assert sorted(s.branch for s in a.real) == ["open", "open (mirror)"]
+    named = m.derivation.named_solutions(a.driver)
+    for s in a.real:
+        assert _same_set([s.q], [tuple(named[s.branch][1])], ["angle", "angle"], 90.0)
 
 
 # --- the command --------------------------------------------------------------------------

@@ -42,5 +42,5 @@ def assemblies(
     note_closed_form(mechanism)
     result = every_assembly(mechanism, seed=seed)  # its checks name --seed as seed
     emit_report(assemblies_report(result, digits, paths), out_fmt, output, columns=columns)
-    if result.failed or not result.real:
+    if result.failed or result.unresolved or result.continuum or not result.real:
         raise typer.Exit(1)

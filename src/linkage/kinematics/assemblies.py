@@ -13,13 +13,13 @@ counted. Bezout's bound (the product of the degrees) is the number of paths trac
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from ..errors import InputError
-from ..homotopy import PolySystem, Solutions, solve
+from ..homotopy import PolySystem, Solutions, condition, solve
 from ..problems.loops import ANGLE_UNITS, DRIVER, Mechanism
 from .angles import nearest_turn
 
@@ -34,8 +34,8 @@ class Assembly:
     branch: str
     signs: str  # the closed form's signs ("" without a closed form)
     residual: float  # max |Phi| after polishing, relative to the mechanism's size
-    condition: float  # the homotopy's condition number of the root
-    singular: bool  # a double root: two assemblies meeting (a change point, a limit)
+    condition: float  # homotopy.solve.condition of the polynomial system at this assembly
+    singular: bool  # near_limit: condition above NEAR_LIMIT (two assemblies meet close by)
     joints: dict[str, tuple[float, float]]  # every named joint and point
 
 
@@ -48,6 +48,9 @@ class Assemblies:
     infinite: int
     failed: int
     solutions: Solutions
+    multiplicity: tuple[int, ...] = ()  # of each real assembly: 2 for a double root
+    unresolved: int = 0  # roots near a singular point neither found real nor shown complex
+    continuum: bool = False  # the loops close all along a curve here: not isolated
 
     @property
     def bezout(self) -> int:
@@ -121,14 +124,23 @@ def assembly_system(m: Mechanism, driver: float) -> PolySystem:
 RESIDUAL = 1e-12
 """A real root of the polynomials is an assembly when the loops close to this, relative to
 the mechanism's size, after Newton's method on the loop equations themselves."""
-POLISH_STEPS = 60
+POLISH_STEPS = 80
 """Newton converges only linearly at a double root (a limit position): half the distance a
 step, so reaching rounding from the endgame's sqrt(eps) takes about 30."""
+DOUBLE = 1e-14
+"""Two assemblies that touch without crossing (a limit position exactly): the loops must
+close to this, relative to the size, where they meet. A driver 1e-10 deg past a limit
+leaves a gap of about 1e-12: no assembly."""
+NEAR_LIMIT = 1e6
+"""An assembly whose own condition (homotopy.solve.condition, at the assembly) exceeds this
+is flagged near_limit: two assemblies meet close by, and its last six digits are not
+significant."""
 
 
 def _polish(m: Mechanism, driver: float, q: list[float]) -> tuple[list[float], float]:
-    """Newton's method on the loop equations, each step kept only if it lowers max|Phi|
-    (near a singular J rounding throws a step anywhere): (q, max|Phi| / size)."""
+    """Newton's method on the loop equations with backtracking (a step is halved until it
+    lowers max|Phi|: near a singular J a full step overshoots), until the steps stop
+    shrinking: (q, max|Phi| / size)."""
     F, J = m.model.functions(driver)
     q = [float(v) for v in q]
     res = max(abs(v) for v in F(q))
@@ -137,23 +149,142 @@ def _polish(m: Mechanism, driver: float, q: list[float]) -> tuple[list[float], f
             dq = np.linalg.solve(np.array(J(q)), np.array(F(q)))
         except np.linalg.LinAlgError:
             break
-        trial = [a - b for a, b in zip(q, dq)]
-        r = max(abs(v) for v in F(trial))
-        if not r < res:
+        factor = 1.0
+        while factor > 1e-6:
+            trial = [a - factor * b for a, b in zip(q, dq)]
+            r = max(abs(v) for v in F(trial))
+            if r < res:
+                break
+            factor *= 0.5
+        else:
             break
         q, res = trial, r
+        if res == 0.0:
+            break
     return q, res / m.length_scale
 
 
-def _name(m: Mechanism, driver: float, q: list[float]) -> tuple[str, str]:
+def _local_roots(m: Mechanism, driver: float, q0: list[float]) -> tuple[list[list[float]], str]:
+    """The real roots of the loop equations near a singular point q0, and what was found:
+    "roots", "double" (one root where two meet, to rounding), "continuum" (the loops close
+    all along a curve: not isolated) or "none".
+
+    Lyapunov-Schmidt: with J(q0) = U S V^T, v its null direction and u its left null
+    vector, every q near q0 is q0 + s v + W y (W the other directions); for each s the
+    n - 1 equations P Phi = 0 (P the other left directions) fix y by Newton, and the roots
+    are where the one equation left, g(s) = u . Phi, vanishes. Two assemblies that meet
+    at a limit or cross at a change point are the roots of g, a fold or a crossing alike;
+    g is scanned on s = +-10^-12 .. 10^-1 (the roots sit about sqrt(gap) apart) and each
+    sign change bisected."""
+    F, J = m.model.functions(driver)
+    size = m.length_scale
+    scale = np.array([1.0 if u.kind == "angle" else size for u in m.unknowns])
+    base = np.array(q0, dtype=float)
+    try:
+        U, _, Vt = np.linalg.svd(np.array(J(list(base))) * scale[None, :] / size)
+    except np.linalg.LinAlgError:
+        return [], "none"
+    v, u = Vt[-1], U[:, -1]
+    W, P = Vt[:-1].T, U[:, :-1].T
+
+    def at(s: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        for _ in range(30):
+            q = base + scale * (s * v + W @ y)
+            if len(y) == 0:
+                break
+            Fq = np.array(F(list(q))) / size
+            A = P @ (np.array(J(list(q))) * scale[None, :] / size) @ W
+            try:
+                dy = np.linalg.solve(A, P @ Fq)
+            except np.linalg.LinAlgError:
+                break
+            y = y - dy
+            if np.abs(dy).max() <= 1e-16:
+                break
+        q = base + scale * (s * v + W @ y)
+        return q, y, float(u @ np.array(F(list(q)))) / size
+
+    grid = np.logspace(-12, -1, 45)
+    ss = np.concatenate([-grid[::-1], [0.0], grid])
+    ys, gs, qs = [], [], []
+    y = np.zeros(len(base) - 1)
+    for s in ss[len(grid)::-1]:  # from 0 outwards, each start the last solution
+        q, y, g = at(float(s), y)
+        ys.append(y), gs.append(g), qs.append(q)
+    ys, gs, qs = ys[::-1], gs[::-1], qs[::-1]
+    y = ys[-1]
+    for s in ss[len(grid) + 1:]:
+        q, y, g = at(float(s), y)
+        ys.append(y), gs.append(g), qs.append(q)
+    g_arr = np.array(gs)
+    far = np.abs(ss) >= 1e-3
+    if np.all(np.abs(g_arr[far]) <= 1e-14):  # the loops close all along the curve, far out too
+        return [list(qs[len(grid)])], "continuum"
+    roots: list[list[float]] = []
+    for k in range(len(ss) - 1):
+        if g_arr[k] == 0.0 or g_arr[k] * g_arr[k + 1] < 0:
+            lo, hi, glo, yl = ss[k], ss[k + 1], g_arr[k], ys[k]
+            q = qs[k]
+            for _ in range(80):
+                mid = 0.5 * (lo + hi)
+                q, ym, gm = at(float(mid), yl)
+                if gm == 0.0:
+                    break
+                if (gm < 0) == (glo < 0):
+                    lo, glo, yl = mid, gm, ym
+                else:
+                    hi = mid
+            q, res = _polish(m, driver, list(q))
+            if res <= RESIDUAL and not any(_same(q, tuple(o), m, 1e-12) for o in roots):
+                roots.append(q)
+    if len(roots) > 1:
+        # roots closer than their own uncertainty (rounding times the condition of J there)
+        # are one double root: at a change point exactly, the two assemblies are one
+        Js = np.array(J(roots[0])) * scale[None, :] / size
+        blur = 1e-14 * float(np.linalg.cond(Js)) if np.all(np.isfinite(Js)) else np.inf
+        if all(_same(a, tuple(b), m, blur) for a in roots for b in roots):
+            return [roots[0]], "double"
+    if roots:
+        return roots, "roots"
+    k = int(np.argmin(np.abs(g_arr)))
+    q, res = _polish(m, driver, list(qs[k]))
+    if abs(g_arr[k]) <= DOUBLE and res <= DOUBLE:
+        return [q], "double"
+    return [], "none"
+
+
+def _names(m: Mechanism, driver: float, qs: list[list[float]]) -> list[tuple[str, str]]:
+    """Each assembly's (branch name, signs) as sweeps and ``--branch`` name them: with a closed
+    form, the key of Derivation.named_solutions it is (the mirror image of a rocker-driven
+    four-bar is ``open (mirror)``), else its configuration's name; without one, the sign of
+    det J."""
     der = m.derivation
     if der.complete:
-        from ..problems.derive import sign_text
+        from ..problems.derive import Indeterminate, sign_text
 
-        return der.name_of(q, driver), sign_text(der.signs_of(q, driver))
+        try:
+            named = der.named_solutions(driver)
+        except Indeterminate:  # the closed form's own degenerate case: names by the configuration
+            named = {}
+        out = []
+        for q in qs:
+            key = next((k for k, (_, nq) in named.items() if _same(q, tuple(nq), m, 1e-7)), None)
+            try:
+                out.append((key or der.name_of(q, driver), sign_text(der.signs_of(q, driver))))
+            except (Indeterminate, ZeroDivisionError, ValueError):
+                out.append(("indeterminate", ""))
+        return out
     _, J = m.model.functions(driver)
-    det = float(np.linalg.det(np.array(J(q))))
-    return ("det J > 0" if det > 0 else "det J < 0" if det < 0 else "det J = 0"), ""
+    dets = [float(np.linalg.det(np.array(J(q)))) for q in qs]
+    return [("det J > 0" if d > 0 else "det J < 0" if d < 0 else "det J = 0", "") for d in dets]
+
+
+def _encode(m: Mechanism, q: list[float]) -> list[float]:
+    """The polynomial system's variables at q: (cos, sin) per angle, a length over the size."""
+    out: list[float] = []
+    for u, v in zip(m.unknowns, q):
+        out += [math.cos(v), math.sin(v)] if u.kind == "angle" else [v / m.length_scale]
+    return out
 
 
 def _joints(m: Mechanism, driver: float, q: list[float]) -> dict[str, tuple[float, float]]:
@@ -179,18 +310,21 @@ def assemblies(m: Mechanism, driver: float | None = None, seed: int = 0) -> Asse
                 for kind, k in var]
 
     real: list[Assembly] = []
+    multiplicity: list[int] = []
 
-    def keep(q: list[float], e: Any, singular: bool) -> bool:
+    def keep(q: list[float], times: int = 1) -> bool:
         q = [math.radians(nearest_turn(math.degrees(u.value), math.degrees(v))) if u.kind == "angle" else v
              for u, v in zip(m.unknowns, q)]  # angles in the turn of the file's guess
         if any(_same(q, a.q, m) for a in real):
             return False
-        branch, signs = _name(m, d, q)
         residual = max(abs(v) for v in m.model.functions(d)[0](q)) / m.length_scale
-        real.append(Assembly(tuple(q), branch, signs, residual, e.condition, singular, _joints(m, d, q)))
+        cond = condition(system, np.array(_encode(m, q), dtype=complex))
+        real.append(Assembly(tuple(q), "", "", residual, cond, not cond <= NEAR_LIMIT, _joints(m, d, q)))
+        multiplicity.append(times)
         return True
 
-    nonreal = 0
+    nonreal = unresolved = 0
+    continuum = False
     clusters: list[tuple[np.ndarray, list[Any]]] = []
     for e in sols.endpoints:
         if e.kind == "finite" and e.x is not None:
@@ -199,45 +333,35 @@ def assemblies(m: Mechanism, driver: float | None = None, seed: int = 0) -> Asse
                 continue
             q, residual = _polish(m, d, decode(e.x.real))
             if residual <= RESIDUAL:
-                keep(q, e, False)
+                keep(q)
             else:
-                nonreal += 1
+                unresolved += 1
         elif e.kind == "singular" and e.x is not None:
             for x, members in clusters:
-                if np.linalg.norm(x - e.x) <= 1e-6 * max(1.0, float(np.linalg.norm(x))):
+                if np.linalg.norm(x - e.x) <= 1e-5 * max(1.0, float(np.linalg.norm(x))):
                     members.append(e)
                     break
             else:
                 clusters.append((e.x, [e]))
     # a singular endpoint is two (or more) roots that meet, or nearly meet (a limit
-    # position): which of them are real is decided on the loops themselves
+    # position, a change point): which of them are real is decided on the loops themselves
     for x, members in clusters:
-        found = sum(keep(q, members[0], True) for q in _split(m, d, decode(x.real))[: len(members)])
-        nonreal += len(members) - found
-    return Assemblies(m, d, tuple(real), nonreal, sols.count("infinite"), sols.count("failed"), sols)
-
-
-def _split(m: Mechanism, driver: float, q0: list[float]) -> list[list[float]]:
-    """The real roots of the loop equations near a singular point q0: Newton's method from
-    q0, and from q0 +- s v along J's null direction v for s from 1e-9 to 1e-2 (two roots
-    that nearly meet sit on either side of it, sqrt(gap) apart), each kept if the loops
-    close to :data:`RESIDUAL`."""
-    _, J = m.model.functions(driver)
-    scale = np.array([1.0 if u.kind == "angle" else m.length_scale for u in m.unknowns])
-    try:
-        v = np.linalg.svd(np.array(J(q0)) * scale[None, :])[2][-1] * scale
-    except np.linalg.LinAlgError:
-        v = np.zeros(len(q0))
-    out: list[list[float]] = []
-    starts = [np.array(q0)] + [np.array(q0) + sign * s * v for s in np.logspace(-9, -2, 15)
-                                for sign in (1.0, -1.0)]
-    for start in starts:
-        q, residual = _polish(m, driver, list(start))
-        if residual <= RESIDUAL and not any(_same(q, tuple(o), m) for o in out):
-            out.append(q)
-        if len(out) >= 2 and start is not starts[0]:
-            break
-    return out
+        roots, how = _local_roots(m, d, decode(x.real))
+        k = len(members)
+        if how == "continuum":
+            continuum = True
+            unresolved += k
+        elif how == "double":
+            keep(roots[0], times=k)
+        elif how == "roots":
+            found = sum(keep(q) for q in roots[:k])
+            unresolved += k - found if found < k else 0
+        else:
+            nonreal += k  # g has no root and does not touch zero: a complex pair past a limit
+    named = _names(m, d, [list(a.q) for a in real])
+    real = [replace(a, branch=n, signs=s) for a, (n, s) in zip(real, named)]
+    return Assemblies(m, d, tuple(real), nonreal, sols.count("infinite"), sols.count("failed"), sols,
+                      tuple(multiplicity), unresolved, continuum)
 
 
 def every_assembly(mechanism: Mechanism | str | Any, driver: float | None = None, *,
@@ -267,8 +391,8 @@ def every_assembly(mechanism: Mechanism | str | Any, driver: float | None = None
     return assemblies(m, seed=seed)
 
 
-def _same(a: tuple[float, ...] | list[float], b: tuple[float, ...], m: Mechanism) -> bool:
-    tol = 1e-7
+def _same(a: tuple[float, ...] | list[float], b: tuple[float, ...], m: Mechanism, tol: float = 1e-9) -> bool:
+    """Whether two configurations are one, to ``tol`` (rad, or of the mechanism's size)."""
     for u, x, y in zip(m.unknowns, a, b):
         if u.kind == "angle":
             if abs(math.remainder(x - y, 2 * math.pi)) > tol:

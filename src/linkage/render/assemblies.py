@@ -18,11 +18,13 @@ def assemblies_tables(a: Any) -> tuple[DataTable, ...]:
 
     m = a.mechanism
     names = [u.name for u in m.unknowns]
-    rows = [(i + 1, s.branch, s.signs, *display(m, s.q), s.residual, s.condition, s.singular)
-            for i, s in enumerate(a.real)]
+    times = a.multiplicity or (1,) * len(a.real)
+    rows = [(i + 1, s.branch, s.signs, *display(m, s.q), s.residual, s.condition, s.singular, k)
+            for i, (s, k) in enumerate(zip(a.real, times))]
     heads = [("assembly", "", "int"), ("branch", "", "text"), ("signs", "", "text"),
              *[(n, u, "number") for n, u in zip(names, _units(m))],
-             ("residual", "", "number"), ("condition", "", "number"), ("near_limit", "", "bool")]
+             ("residual", "", "number"), ("condition", "", "number"), ("near_limit", "", "bool"),
+             ("multiplicity", "", "int")]
     joints = [(i + 1, name, x, y) for i, s in enumerate(a.real) for name, (x, y) in s.joints.items()]
     paths = [(k + 1, e.kind, e.real if e.kind in ("finite", "singular") else None, e.cycle, e.steps,
               e.rejected, e.newton, e.smallest_step if math.isfinite(e.smallest_step) else None,
@@ -55,6 +57,16 @@ def summary_lines(a: Any) -> list[str]:
     s = a.solutions
     n_angles = sum(u.kind == "angle" for u in a.mechanism.unknowns)
     retracked = sum(e.retracked for e in s.endpoints)
+    extra = []
+    doubles = sum(k > 1 for k in a.multiplicity)
+    if doubles:
+        extra.append(f"{doubles} of them double (two assemblies that meet here, to rounding: a limit "
+                     "position or a change point)")
+    if a.continuum:
+        extra.append("not isolated: the loops close all along a curve here (the mechanism can move "
+                     "with its driver held)")
+    elif a.unresolved:
+        extra.append(f"{a.unresolved} root(s) near a singular point neither found real nor shown complex")
     return [
         f"polynomial system: {s.system.n} unknowns (cos and sin of {n_angles} angle"
         f"{'s' if n_angles != 1 else ''}, c^2 + s^2 = 1 each), "
@@ -63,6 +75,7 @@ def summary_lines(a: Any) -> list[str]:
         f"{'y' if len(a.real) == 1 else 'ies'}, {a.complex_count} complex, {a.infinite} at infinity, "
         f"{a.failed} failed" + (f" ({retracked} retracked)" if retracked else "")
         + f"; {sum(e.steps for e in s.endpoints)} steps in {s.seconds:.2f} s",
+        *extra,
     ]
 
 
@@ -84,8 +97,8 @@ def assemblies_report(a: Any, digits: int, show_paths: bool) -> Report:
         else:
             out.append(Text("no real assembly: the mechanism cannot be assembled here"))
         if any(s.singular for s in a.real):
-            out.append(Text("near_limit: close to a limit position, where two assemblies meet (condition "
-                            "above 1e8): digits beyond about 16 - log10(condition) are not significant"))
+            out.append(Text("near_limit: close to where two assemblies meet (condition above 1e6): "
+                            "digits beyond about 16 - log10(condition) are not significant"))
         if tables[1].row_count:
             size = max((abs(v) for s in a.real for xy in s.joints.values() for v in xy), default=0.0)
             out += [Text("Joints"), _display(tables[1], digits, size)]
@@ -100,6 +113,7 @@ def assemblies_report(a: Any, digits: int, show_paths: bool) -> Report:
         s = a.solutions
         return {"title": title_of(a), "bezout": s.bezout, "paths": len(s.endpoints), "real": len(a.real),
                 "complex": a.complex_count, "infinite": a.infinite, "failed": a.failed,
+                "unresolved": a.unresolved, "continuum": a.continuum,
                 "degrees": list(s.system.degrees), "seconds": s.seconds}
 
     return Report(title_of(a), tables, blocks, document)
