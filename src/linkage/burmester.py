@@ -19,11 +19,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from .errors import InputError
-from .homotopy import PolySystem, Solutions, solve
+from .homotopy import PolySystem, Solutions, condition, solve
 
 
 @dataclass(frozen=True)
@@ -55,19 +56,23 @@ class Burmester:
     singular: int
     failed: int
     solutions: Solutions
+    unresolved: int = 0  # real roots of the polynomials that are not rigid cranks after Newton
 
 
-def _checked(poses: Sequence[Pose | Sequence[float]]) -> tuple[Pose, ...]:
+def _checked(poses: Any) -> tuple[Pose, ...]:
+    """Five poses of finite real numbers (x, y, angle in degrees), each pose its own: every
+    misuse an InputError naming it (arguments.check_number, the one rule for numbers)."""
+    from .arguments import check_number
+
+    if isinstance(poses, (str, bytes)) or not isinstance(poses, Sequence):
+        raise InputError(f"poses must be a list of 5 poses (x, y, angle in deg), got {poses!r}")
     out = []
     for k, p in enumerate(poses):
-        vals = (p.x, p.y, p.angle_deg) if isinstance(p, Pose) else tuple(p)
-        if len(vals) != 3 or any(isinstance(v, bool) for v in vals):
+        vals = (p.x, p.y, p.angle_deg) if isinstance(p, Pose) else p
+        if isinstance(vals, (str, bytes)) or not isinstance(vals, Sequence) or len(vals) != 3:
             raise InputError(f"poses[{k}] must be (x, y, angle in deg), got {p!r}")
-        try:
-            x, y, a = (float(v) for v in vals)
-        except (TypeError, ValueError):
-            raise InputError(f"poses[{k}] must be numbers (x, y, angle in deg), got {p!r}") from None
-        if not all(math.isfinite(v) and abs(v) < 1e12 for v in (x, y, a)):
+        x, y, a = (check_number(f"poses[{k}]", v) for v in vals)
+        if not all(abs(v) < 1e12 for v in (x, y, a)):
             raise InputError(f"poses[{k}] must be finite numbers below 1e12 in size, got {p!r}")
         out.append(Pose(x, y, a))
     if len(out) != 5:
@@ -77,6 +82,12 @@ def _checked(poses: Sequence[Pose | Sequence[float]]) -> tuple[Pose, ...]:
             a, b = out[i], out[j]
             if math.hypot(a.x - b.x, a.y - b.y) == 0 and math.remainder(a.angle_deg - b.angle_deg, 360) == 0:
                 raise InputError(f"poses[{j}] and poses[{i}] are the same pose")
+    if all(math.remainder(p.angle_deg - out[0].angle_deg, 360) == 0 for p in out):
+        raise InputError("poses: the body does not turn between them (every angle the same): every "
+                         "body point moves alike, and Burmester's construction needs rotation")
+    if all(p.x == out[0].x and p.y == out[0].y for p in out):
+        raise InputError("poses: the body only turns about one point (every x, y the same): that point "
+                         "and any crank through it fit, a continuum, not Burmester points")
     return tuple(out)
 
 
@@ -123,18 +134,32 @@ def _difference(dj: complex, rj: complex, d1: complex, r1: complex) -> dict[tupl
     return {e: complex(c) for e, c in diff.items() if abs(c) > 1e-14 * (1 + abs(a.get(e, 0.0)))}
 
 
+RIGID = 1e-12
+"""A crank is kept when its length varies by at most this much of the poses' size over the
+five poses, after Newton's method on the crank equations."""
+
+
 def burmester_points(poses: Sequence[Pose | Sequence[float]], seed: int = 0) -> Burmester:
     """Every crank (centre point and circle point) that carries a body through five poses:
     each real pair, and the complex, infinite, singular and failed paths counted."""
+    from .arguments import MAX_SEED, check_whole
+    from .homotopy import polish_real
+
     ps = _checked(poses)
+    seed = check_whole("seed", seed, 0, MAX_SEED)
     system = burmester_system(ps)
     sols = solve(system, seed=seed)
     centre, size = _frame(ps)
-    cranks = []
+    cranks: list[Crank] = []
+    nonreal = unresolved = 0
     for e in sols.endpoints:
-        if e.kind != "finite" or not e.real or e.x is None:
+        if e.kind not in ("finite", "singular") or e.x is None:
             continue
-        gx, gy, zx, zy = e.x.real
+        if not e.real:
+            nonreal += 1
+            continue
+        x, _ = polish_real(system, e.x.real)
+        gx, gy, zx, zy = x
         G = complex(gx, gy) * size + centre
         z = complex(zx, zy) * size  # body frame: the first pose's frame, scaled back
         moving = []
@@ -142,13 +167,17 @@ def burmester_points(poses: Sequence[Pose | Sequence[float]], seed: int = 0) -> 
             r = complex(math.cos(math.radians(p.angle_deg)), math.sin(math.radians(p.angle_deg)))
             moving.append(complex(p.x, p.y) + r * z)
         lengths = [abs(m - G) for m in moving]
-        length = lengths[0]
-        residual = max(abs(v - length) for v in lengths) / size
-        cranks.append(Crank((G.real, G.imag), (z.real, z.imag), (moving[0].real, moving[0].imag), length,
-                            residual, e.condition))
-    nonreal = sum(e.kind == "finite" and not e.real for e in sols.endpoints)
+        residual = max(abs(v - lengths[0]) for v in lengths) / size
+        if not residual <= RIGID:
+            unresolved += 1
+            continue
+        if any(abs(complex(*c.ground) - G) <= 1e-9 * (size + abs(G))
+               and abs(complex(*c.body) - z) <= 1e-9 * (size + abs(z)) for c in cranks):
+            continue  # a root two paths reached (a double root)
+        cranks.append(Crank((G.real, G.imag), (z.real, z.imag), (moving[0].real, moving[0].imag),
+                            lengths[0], residual, condition(system, x.astype(complex))))
     return Burmester(ps, tuple(cranks), nonreal, sols.count("infinite"), sols.count("singular"),
-                     sols.count("failed"), sols)
+                     sols.count("failed"), sols, unresolved)
 
 
 def body_to_ground(p: Pose, z: tuple[float, float]) -> np.ndarray:

@@ -234,6 +234,42 @@ def _refine(system: PolySystem, x: np.ndarray) -> tuple[np.ndarray, float, float
     return x, float(np.max(np.abs(F) / scale)), condition(system, x)
 
 
+def polish_real(system: PolySystem, x: np.ndarray, steps: int = 60) -> tuple[np.ndarray, float]:
+    """Newton's method on F in real arithmetic from the real point x, each step halved until
+    it lowers max|F| (near a singular J a full step overshoots): (x, the relative residual
+    as :class:`Endpoint` reports it)."""
+    x = np.asarray(x, dtype=float)
+
+    def worst(z: np.ndarray) -> float:
+        return float(np.abs(system.evaluate(z[None].astype(complex))[0]).max())
+
+    res = worst(x)
+    for _ in range(steps):
+        J = system.jacobian(x[None].astype(complex))[0].real
+        F = system.evaluate(x[None].astype(complex))[0].real
+        try:
+            dx = np.linalg.solve(J, F)
+        except np.linalg.LinAlgError:
+            break
+        factor = 1.0
+        while factor > 1e-6:
+            trial = x - factor * dx
+            r = worst(trial)
+            if r < res:
+                break
+            factor *= 0.5
+        else:
+            break
+        x, res = trial, r
+        if res == 0.0:
+            break
+    size = max(1.0, float(np.linalg.norm(x)))
+    scale = np.array([sum(abs(c) for c in p.values()) * size ** d
+                      for p, d in zip(system.polynomials, system.degrees)])
+    F = system.evaluate(x[None].astype(complex))[0]
+    return x, float(np.max(np.abs(F) / scale))
+
+
 def solve(system: PolySystem, seed: int = 0, max_step: float = 0.1) -> Solutions:
     """Every isolated solution of a square system by total-degree homotopy (one path per
     solution of the start system x_i^d_i = 1; Bezout's bound of them)."""
@@ -261,8 +297,11 @@ def solve(system: PolySystem, seed: int = 0, max_step: float = 0.1) -> Solutions
 
 
 def _duplicates(endpoints: list[Endpoint]) -> list[int]:
-    """Paths whose nonsingular endpoints coincide (a nonsingular root ends one path only)."""
-    fin = [(i, e.x) for i, e in enumerate(endpoints) if e.kind == "finite" and e.x is not None]
+    """Paths whose endpoints coincide at a well-conditioned root (a nonsingular root ends one
+    path only: two on it mean one jumped, and a root was missed). An endpoint reached with
+    cycle number 2 at a root of small condition is such a pair too."""
+    fin = [(i, e.x) for i, e in enumerate(endpoints)
+           if e.kind in ("finite", "singular") and e.x is not None and e.condition <= SINGULAR_CONDITION]
     out = []
     for a in range(len(fin)):
         for b in range(a + 1, len(fin)):
