@@ -440,17 +440,16 @@ def test_every_format(cli, tmp_path, fmt):
         assert t["centres"]["units"][3:5] == ["mm", "mm"]
         assert len(t["centres"]["rows"]) == 6 and len(t["centrodes"]["rows"]) == 5
         assert doc["status"] == "ok" and doc["bodies"] == ["ground", "crank", "coupler", "rocker"]
-    if fmt == "csv":
-        text = out.read_text()
-        assert "centre,body_i,body_j,x (mm),y (mm),where,direction (deg),how" in text
-        assert "theta_crank (deg),status,fixed_x (mm)" in text
+    if fmt == "csv":  # one table per file: c.csv and c.centrodes.csv
+        assert "centre,body_i,body_j,x (mm),y (mm),where,direction (deg),how" in out.read_text()
+        assert "theta_crank (deg),status,fixed_x (mm)" in (tmp_path / "c.centrodes.csv").read_text()
 
 
 def test_the_plot_draws_the_centres_and_the_centrodes(cli, tmp_path):
     pytest.importorskip("matplotlib")
     out = tmp_path / "c.png"
     r = cli("centres", str(SAMPLES / "crank_rocker_joints.toml"), "--centrodes", "--step", "10",
-            "--plot", str(out), "--format", "csv")
+            "--plot", str(out), "--format", "csv", "--table", "centres")
     assert r.code == 0, r.err
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 

@@ -5,7 +5,16 @@ from typing import Annotated
 
 import typer
 
-from .options import ColumnsOpt, DigitsOpt, FormatOpt, MechanismFile, OutputOpt, SetOpt, check_paths
+from .options import (
+    ColumnsOpt,
+    DigitsOpt,
+    FormatOpt,
+    MechanismFile,
+    OutputOpt,
+    SetOpt,
+    TableOpt,
+    check_paths,
+)
 from .root import app
 
 
@@ -24,6 +33,7 @@ def assemblies(
     output: OutputOpt = None,
     columns: ColumnsOpt = None,
     digits: DigitsOpt = 12,
+    table: TableOpt = None,
 ) -> None:
     """Every assembly of a mechanism at its driver value (the file's, or --set), by polynomial
     homotopy continuation: each real one with its unknowns, branch and residual, and the
@@ -41,6 +51,6 @@ def assemblies(
     mechanism = load(Path(file)).with_values(parse_assignments("--set", set_ or []), {})
     note_closed_form(mechanism)
     result = every_assembly(mechanism, seed=seed)  # its checks name --seed as seed
-    emit_report(assemblies_report(result, digits, paths), out_fmt, output, columns=columns)
+    emit_report(assemblies_report(result, digits, paths), out_fmt, output, columns=columns, table=table)
     if result.failed or result.unresolved or result.continuum or not result.real:
         raise typer.Exit(1)

@@ -14,6 +14,7 @@ from .options import (
     MechanismFile,
     OutputOpt,
     SetOpt,
+    TableOpt,
     check_paths,
     choose_format,
     emit_report,
@@ -51,6 +52,7 @@ def centres(
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 10,
+    table: TableOpt = None,
     columns: ColumnsOpt = None,
 ) -> None:
     """All n(n-1)/2 instant centres of a mechanism at a pose (the file's driver value, or
@@ -88,7 +90,7 @@ def centres(
             raise InputError("--step must be > 0")
         values = driver_values(a, b, 1.0 if step is None else step, None)
         cd = run_centrodes(mechanism, values, body, branch=branch)
-    emit_report(centres_report(ic, digits, cd), out_fmt, output, columns=columns)
+    emit_report(centres_report(ic, digits, cd), out_fmt, output, columns=columns, table=table)
     if plot is not None:
         from ..render.centres import centres_plot
 

@@ -14,6 +14,7 @@ from .options import (
     MechanismFile,
     OutputOpt,
     SetOpt,
+    TableOpt,
     check_paths,
     choose_format,
     emit_report,
@@ -64,6 +65,7 @@ def tolerance(
     fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 6,
+    table: TableOpt = None,
     columns: ColumnsOpt = None,
 ) -> None:
     """How manufacturing tolerances spread a mechanism's outputs over its cycle.
@@ -114,7 +116,7 @@ def tolerance(
         result = study(mechanism, plan, values, branch=job.branch, tol=tol, samples=samples, seed=seed,
                        distribution=distribution, job=job, scheduler=scheduler, workers=workers,
                        progress=advance)
-    emit_report(tolerance_report(result, digits), out_fmt, output, columns=columns)
+    emit_report(tolerance_report(result, digits), out_fmt, output, columns=columns, table=table)
     if plot is not None:
         from ..render.tolerance import tolerance_plot
 
