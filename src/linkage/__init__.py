@@ -15,6 +15,7 @@ The public API, in the order a reader meets it:
 - :func:`forces` gives the input torque and joint forces of a joints-form mechanism at a position.
 - :func:`instant_centres` gives every instant centre of a mechanism at a pose, :func:`centrodes`
   the fixed and moving centrodes of a body over a sweep.
+- :func:`simulate` integrates a mechanism's motion under a drive, its loads, gravity and friction.
 - :func:`analyze` estimates convergence order and rate from a recorded history.
 """
 
@@ -41,6 +42,7 @@ _EXPORTS = {
     "Loads": ".problems.loads", "Mass": ".problems.loads",
     "instant_centres": ".kinematics.centres", "InstantCentres": ".kinematics.centres",
     "centrodes": ".kinematics.centres", "Centrodes": ".kinematics.centres",
+    "simulate": ".kinematics.dynamics", "Simulation": ".kinematics.dynamics",
 }
 _RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",
             "scan_designs": "scan", "forces": "forces_at", "assemblies": "every_assembly"}
@@ -83,6 +85,7 @@ __all__ = [
     "Rates",
     "Result",
     "ScalarProblem",
+    "Simulation",
     "Status",
     "SweepResult",
     "SystemProblem",
@@ -97,6 +100,7 @@ __all__ = [
     "load_mechanism",
     "position_rates",
     "scan_designs",
+    "simulate",
     "solve_scalar",
     "solve_system",
     "sweep",

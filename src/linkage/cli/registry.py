@@ -7,7 +7,8 @@ from collections.abc import Sequence
 
 from .root import app
 
-COMMANDS = ("solve", "sweep", "centres", "scan", "assemblies", "draw", "convert", "new", "synthesize",
+COMMANDS = ("solve", "sweep", "simulate", "centres", "scan", "assemblies", "draw", "convert", "new",
+            "synthesize",
             "samples", "stress", "bench")
 """In the order ``linkage --help`` lists them."""
 
