@@ -79,7 +79,8 @@ def simulate_report(sim: Any, mechanism: Any, digits: int, energy_tol: float, dr
             out.append(f"last full turn, t = {fmt(c.start, 6)} to {fmt(c.end, 6)} s: speed "
                        f"{fmt(c.omega_min, 6)} to {fmt(c.omega_max, 6)} rad/s, "
                        f"mean {fmt(c.omega_mean, 6)} rad/s; "
-                       f"Cs = {fmt(c.cs, 4)}")
+                       f"Cs = {fmt(c.cs, 4)}" + ("" if c.steady else " (not steady: the turn before had "
+                                                 "another mean speed, or there was none)"))
             out.append(f"flywheel for Cs = {target_cs:g}: about {fmt(c.flywheel_for(target_cs), 4)} kg m^2 "
                        f"(kinetic energy swing {fmt(c.energy_swing, 4)} J over the turn)")
         out.append(f"integrator: DOP853, {sim.nfev} evaluations")
@@ -111,6 +112,7 @@ def simulate_report(sim: Any, mechanism: Any, digits: int, energy_tol: float, dr
                                                  "omega_max": c.omega_max, "omega_mean": c.omega_mean,
                                                  "cs": c.cs, "energy_swing": c.energy_swing,
                                                  "flywheel_for_target": c.flywheel_for(target_cs),
+                                                 "steady": c.steady,
                                                  "target_cs": target_cs}}
 
     return Report(title, tables, blocks, document)
