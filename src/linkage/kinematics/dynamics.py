@@ -291,8 +291,9 @@ class Simulation:
     """kinematics.forces.Forces at each time (the kinetostatic matrix method at the
     simulated speed and acceleration, the friction torques among the loads)."""
     drive_check: float
-    """max |kinetostatic input - simulated drive| relative to the largest drive (with the
-    flywheel's I_f alpha added to the kinetostatic input)."""
+    """max |kinetostatic input - simulated drive| (the flywheel's I_f alpha added to the
+    kinetostatic input) relative to the equation's terms: the largest sum of the sizes of
+    the drive, I alpha, I'/2 omega^2 and the loads', weights' and friction's torques."""
     event: str | None
     """None when the whole span was simulated, else one of EVENTS."""
     event_time: float | None
@@ -301,6 +302,8 @@ class Simulation:
     cycle: Cycle | None
     input_unit: str
     sliding: bool
+    flywheel: float = 0.0
+    """kg m^2, on the driver."""
     trace: tuple[Any, Any, Any] = ((), (), ())
     """(t, theta, omega) at 2001 times from the integrator's dense output, for pictures."""
 
@@ -564,7 +567,7 @@ def _outputs(dyn: Dynamics, drive: Callable[[float, float, float], float], sol: 
     alpha, tau, kin, pot = (np.zeros(n) for _ in range(4))
     unknowns = {u: np.zeros(n) for u in names}
     forces = []
-    worst = 0.0
+    worst = size = 0.0
     base = dyn.loads
     dyn.restart()
     for i in range(n):
@@ -577,6 +580,9 @@ def _outputs(dyn: Dynamics, drive: Callable[[float, float, float], float], sol: 
         tau[i] = drive(float(t[i]), theta, omega)
         fr = dyn.friction_force(p, omega)
         alpha[i] = (tau[i] + p.loads + p.weight + fr - p.half_slope * omega * omega) / p.inertia
+        # the size of the equation's terms, the drive check's scale (the drive may be zero)
+        size = max(size, abs(tau[i]) + abs(p.inertia * alpha[i]) + abs(p.half_slope * omega * omega)
+                   + abs(p.loads) + abs(p.weight) + abs(fr))
         kin[i] = 0.5 * p.inertia * omega * omega
         pot[i] = p.potential
         for u, v in zip(names, p.q):
@@ -592,19 +598,16 @@ def _outputs(dyn: Dynamics, drive: Callable[[float, float, float], float], sol: 
             need = f.input + dyn.flywheel * alpha[i]
             worst = max(worst, abs(need - tau[i]))
     total = kin + pot - y[2] - y[3] - y[4]
-    size = max(float(np.nanmax(np.abs(np.concatenate([kin, pot - pot[0], y[2], y[3], y[4]])))), 1e-300)
-    balance = float(np.nanmax(np.abs(total - total[0]))) / size
-    tau_size = max(float(np.nanmax(np.abs(tau))), 1e-300)
-    # the drive is zero: judge against the largest kinetostatic torque instead
-    if not np.nanmax(np.abs(tau)) > 0.0:
-        tau_size = max([abs(f.input) for f in forces if f is not None and f.input is not None] + [1e-300])
+    energy = max(float(np.nanmax(np.abs(np.concatenate([kin, pot - pot[0], y[2], y[3], y[4]])))), 1e-300)
+    balance = float(np.nanmax(np.abs(total - total[0]))) / energy
     cycle = None if dyn.sliding else _last_cycle(dyn, sol, float(t[-1]))
     unit = "N" if dyn.sliding else "N m"
     tt = np.linspace(float(t[0]), float(t[-1]), 2001)
     dense = sol.sol(tt)
     return Simulation(t, y[0], y[1], alpha, tau, unknowns, kin, pot, y[2], y[3], y[4], balance,
-                      tuple(forces), worst / tau_size, event, event_time, message, int(sol.nfev), cycle,
-                      unit, dyn.sliding, (tt, dense[0], dense[1]))
+                      tuple(forces), worst / max(size, 1e-300), event, event_time, message, int(sol.nfev),
+                      cycle,
+                      unit, dyn.sliding, dyn.flywheel, (tt, dense[0], dense[1]))
 
 
 def _last_cycle(dyn: Dynamics, sol: Any, t_end: float) -> Cycle | None:
@@ -641,6 +644,6 @@ def _last_cycle(dyn: Dynamics, sol: Any, t_end: float) -> Cycle | None:
     ke = 0.5 * inertia * w * w
     mean = 2.0 * math.pi / (t_end - t0)
     before = crossing(th_end - 2.0 * turn) if abs(th_end - th[0]) >= 4.0 * math.pi else None
-    steady = before is not None and abs(2.0 * math.pi / (t0 - before) - mean) <= STEADY_RTOL * mean
+    steady = bool(before is not None and abs(2.0 * math.pi / (t0 - before) - mean) <= STEADY_RTOL * mean)
     return Cycle(float(t0), t_end, float(np.max(np.abs(w))), float(np.min(np.abs(w))), mean,
                  float(ke.max() - ke.min()), float(inertia.mean()), steady)
