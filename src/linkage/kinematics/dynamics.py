@@ -52,9 +52,9 @@ STEADY_RTOL = 0.01
 of its own."""
 
 FOLLOW_STEP = 0.05
-"""The largest driver step Newton takes from a known position (rad; for a sliding driver,
-this fraction of the mechanism's size): farther, the position is reached in such steps,
-each predicted along the last one's rates."""
+"""The largest step Newton takes from a known position: the driver and the fastest unknown
+each move at most this (rad; lengths as this fraction of the mechanism's size); farther,
+the position is reached in such steps, each predicted along the last one's rates."""
 
 ASSEMBLY_RTOL = 1e-9
 """A position closes its loops to this, relative to the mechanism's size, or it is not
@@ -169,6 +169,13 @@ class Dynamics:
         self._last = self.initial
         self._memo = None
 
+    def sensitivity(self, qd: Sequence[float]) -> float:
+        """The fastest unknown's rate per driver rate, from ``qd`` per internal driver unit:
+        angles in rad, lengths in the mechanism's size, a sliding driver's too."""
+        fastest = max((abs(v) if k == "angle" else abs(v) / self.size for v, k in zip(qd, self.kinds)),
+                      default=0.0)
+        return fastest * (self.size if self.sliding else 1.0)
+
     def position(self, theta: float) -> list[float] | None:
         """The unknowns at driver ``theta`` (SI) on the followed assembly, or None where the
         loops do not close there."""
@@ -178,8 +185,9 @@ class Dynamics:
             return None
         t0, q0, qd0 = self._last
         # a long way from the last position: walk there in steps, so Newton cannot jump to
-        # another assembly
-        steps = max(1, math.ceil(abs(theta - t0) / self.follow_step))
+        # another assembly (each step moves the fastest unknown at most FOLLOW_STEP)
+        moved = abs(theta - t0) / self.follow_step  # the driver's move, in FOLLOW_STEPs
+        steps = max(1, math.ceil(moved * max(self.sensitivity(qd0), 1.0)))
         for i in range(1, steps + 1):
             at = t0 + (theta - t0) * i / steps
             dd = (at - t0) / self.c
@@ -235,8 +243,7 @@ class Dynamics:
         loads = sum(f[0] * vel[j][0] + f[1] * vel[j][1] for j, f in self.loads.forces.items())
         loads += sum(t * float(motion[b][1]) for b, t in self.loads.torques.items())
         pairs = tuple((j, a, b, float(motion[b][1] - motion[a][1])) for j, a, b in self.pin_pairs)
-        sens = max((abs(v) if kind == "angle" else abs(v) / self.size for v, kind in zip(qd, self.kinds)),
-                   default=0.0) * (self.size if self.sliding else 1.0)
+        sens = self.sensitivity(qd)
         point = Point(q, qd, float(inertia), float(half), float(loads), float(weight), float(potential),
                       pairs, sens)
         self._memo = (theta, point)
