@@ -51,7 +51,7 @@ STEADY_RTOL = 0.01
 """The last turn is a steady-state cycle where the turn before's mean speed is within this
 of its own."""
 
-FOLLOW_STEP = 0.05
+FOLLOW_STEP = 0.2
 """The largest step Newton takes from a known position: the driver and the fastest unknown
 each move at most this (rad; lengths as this fraction of the mechanism's size); farther,
 the position is reached in such steps, each predicted along the last one's rates."""
@@ -179,17 +179,29 @@ class Dynamics:
     def position(self, theta: float) -> list[float] | None:
         """The unknowns at driver ``theta`` (SI) on the followed assembly, or None where the
         loops do not close there."""
-        from .rates import polish, solve_rates
-
         if not math.isfinite(theta):
             return None
-        t0, q0, qd0 = self._last
+        start = self._last
         # a long way from the last position: walk there in steps, so Newton cannot jump to
-        # another assembly (each step moves the fastest unknown at most FOLLOW_STEP)
-        moved = abs(theta - t0) / self.follow_step  # the driver's move, in FOLLOW_STEPs
-        steps = max(1, math.ceil(moved * max(self.sensitivity(qd0), 1.0)))
+        # another assembly (each step moves the fastest unknown at most FOLLOW_STEP); where
+        # Newton does not close the loops, again in steps half as long, down to 1/64
+        moved = abs(theta - start[0]) / self.follow_step  # the driver's move, in FOLLOW_STEPs
+        steps = max(1, math.ceil(moved * max(self.sensitivity(start[2]), 1.0)))
+        for _ in range(7):
+            q = self._walk(start, theta, steps)
+            if q is not None:
+                return q
+            steps *= 2
+        return None
+
+    def _walk(self, start: tuple[float, list[float], list[float]], theta: float, steps: int
+              ) -> list[float] | None:
+        from .rates import polish, solve_rates
+
+        t0, q0, qd0 = start
+        q = q0
         for i in range(1, steps + 1):
-            at = t0 + (theta - t0) * i / steps
+            at = start[0] + (theta - start[0]) * i / steps
             dd = (at - t0) / self.c
             guess = [a + b * dd for a, b in zip(q0, qd0)]
             d = at / self.c
@@ -641,14 +653,14 @@ def _last_cycle(dyn: Dynamics, sol: Any, t_end: float) -> Cycle | None:
     t0 = crossing(th_end - turn)
     if t0 is None:
         return None
-    tt = np.linspace(t0, t_end, 2001)
-    y = sol.sol(tt)
-    w = y[1]
+    w = sol.sol(np.linspace(t0, t_end, 2001))[1]
     if not (np.all(w > 0) or np.all(w < 0)):
         return None
-    # followed back from the last output time, where the positions are
+    # the kinetic energy at 401 of those times, followed back from the last output time
+    # (where the positions are)
+    y = sol.sol(np.linspace(t0, t_end, 401))
     inertia = np.array([dyn.at(float(v)).inertia for v in y[0][::-1]])[::-1]  # type: ignore[union-attr]
-    ke = 0.5 * inertia * w * w
+    ke = 0.5 * inertia * y[1] * y[1]
     mean = 2.0 * math.pi / (t_end - t0)
     before = crossing(th_end - 2.0 * turn) if abs(th_end - th[0]) >= 4.0 * math.pi else None
     steady = bool(before is not None and abs(2.0 * math.pi / (t0 - before) - mean) <= STEADY_RTOL * mean)

@@ -81,8 +81,9 @@ def simulate_report(sim: Any, mechanism: Any, digits: int, energy_tol: float, dr
                        f"mean {fmt(c.omega_mean, 6)} rad/s; "
                        f"Cs = {fmt(c.cs, 4)}" + ("" if c.steady else " (not steady: the turn before had "
                                                  "another mean speed, or there was none)"))
-            out.append(f"flywheel for Cs = {target_cs:g}: about {fmt(c.flywheel_for(target_cs), 4)} kg m^2 "
-                       f"(kinetic energy swing {fmt(c.energy_swing, 4)} J over the turn)")
+            # an estimate: three digits
+            out.append(f"flywheel for Cs = {target_cs:g}: about {fmt(c.flywheel_for(target_cs), 3)} kg m^2 "
+                       f"(kinetic energy swing {fmt(c.energy_swing, 3)} J over the turn)")
         out.append(f"integrator: DOP853, {sim.nfev} evaluations")
         if sim.event is not None:
             out.append(f"event: {sim.event} at t = {fmt(sim.event_time, digits)} s: {sim.message}")
