@@ -51,6 +51,29 @@ def test_a_crank_inertia_alone_under_constant_torque_follows_the_closed_form(tor
     assert np.allclose(sim.alpha, torque / inertia, rtol=1e-12, atol=1e-12)
 
 
+def test_a_sliding_driver_with_the_only_mass_follows_the_closed_form(cli, tmp_path):
+    """The offset slider-crank driven by its block, the block's 2 kg the only mass, a constant
+    3 N along its line: x(t) = x0 + v0 t + F t^2 / (2 m), in m inside and mm on the page."""
+    text = (SAMPLES / "slider_crank_joints.toml").read_text()
+    text = text.replace('link = "crank"', 'slider = "block"')
+    text = text.replace("value = 45 ", "value = 146.88311367414514 ")
+    text += "\n[mass]\nblock = { mass = 2.0, cg = [146.88311367414514, 10.0], inertia = 0 }\n"
+    m = from_text(text, "block-driven")
+    sim = linkage.simulate(m, "3", (0.0, 0.05), omega0=200.0, samples=11)  # 200 mm/s
+    assert sim.event is None and sim.sliding
+    exact = 0.14688311367414514 + 0.2 * sim.t + 3.0 * sim.t ** 2 / 4.0
+    assert np.max(np.abs(sim.theta - exact)) <= 1e-8 * 0.01
+    assert sim.drive_check <= 1e-10
+    path = tmp_path / "block.toml"
+    path.write_text(text)
+    r = cli("simulate", str(path), "--drive", "3", "--omega0", "200mm/s", "--time", "0:0.05",
+            "--samples", "3", "-f", "csv")
+    assert r.code == 0, r.err
+    header, first = r.out.splitlines()[1:3]
+    assert header.startswith("t (s),s_block (mm),ds_block/dt (mm/s),d2s_block/dt2 (mm/s^2),drive (N)")
+    assert first.startswith("0.0,146.88311367414514,200.0,")
+
+
 # --- the kinetostatic matrix method ---------------------------------------------------------
 
 

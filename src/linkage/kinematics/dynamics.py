@@ -132,6 +132,7 @@ class Dynamics:
 
     def __init__(self, mechanism: Any, loads: Loads, friction: Friction, flywheel: float = 0.0) -> None:
         from .bodies import Frame, metre
+        from .forces import pin_pairs
 
         self.mechanism = mechanism
         self.model = mechanism.model
@@ -145,15 +146,7 @@ class Dynamics:
         self.size = mechanism.length_scale
         self.follow_step = FOLLOW_STEP * (self.size * self.k if self.sliding else 1.0)
         self.kinds = [u.kind for u in mechanism.unknowns]
-        d = self.frame.drawing
-        pairs = []
-        for j in d.xy:
-            on = [b for b, js in d.bodies.items() if j in js]
-            if len(on) < 2:
-                continue
-            first = "ground" if "ground" in on else on[0]
-            pairs += [(j, first, b) for b in on if b != first]
-        self.pin_pairs = tuple(pairs)
+        self.pin_pairs = tuple(pin_pairs(self.frame.drawing))
         self._last: tuple[float, list[float], list[float]] = (
             mechanism.driver.value * self.c, [u.value for u in mechanism.unknowns], [0.0] * self.model.n)
         self.initial = self._last
@@ -379,7 +372,9 @@ def _checked_friction(friction: Any, drawing: Any, what: str) -> tuple[float, di
         return float(x)
 
     if isinstance(friction, Mapping):
-        pins = {j for j in drawing.xy if sum(j in js for js in drawing.bodies.values()) >= 2}
+        from .forces import pin_pairs
+
+        pins = {j for j, _, _ in pin_pairs(drawing)}
         every, out = 0.0, {}
         for j, v in friction.items():
             if j == "*":

@@ -189,6 +189,20 @@ class ForceArrays:
     applied: tuple[Any, Any, Any]
 
 
+def pin_pairs(d: Any) -> list[tuple[str, str, str]]:
+    """The one rule for what a pin joins: (joint, owner, link) for each link on a joint that
+    two or more bodies share, other than its owner (the ground where the pin is fixed,
+    else the first body listing it); a pin shared by k bodies is k - 1 pairs."""
+    out = []
+    for j in d.xy:
+        on = [b for b, js in d.bodies.items() if j in js]
+        if len(on) < 2:
+            continue
+        first = "ground" if "ground" in on else on[0]
+        out += [(j, first, b) for b in on if b != first]
+    return out
+
+
 def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[str, tuple[Any, Any]],
                 acc: Mapping[str, tuple[Any, Any]], vstar: Mapping[str, tuple[Any, Any]], loads: Loads,
                 source: str = "<mechanism>") -> ForceArrays:
@@ -216,18 +230,11 @@ def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[s
         entries.extend([(r, cx, sign), (r + 2, cx, -sign * at[1]),
                         (r + 1, cy, sign), (r + 2, cy, sign * at[0])])
 
-    for j in d.xy:
-        on = [b for b, js in d.bodies.items() if j in js]
-        if len(on) < 2:
-            continue
-        first = "ground" if "ground" in on else on[0]
-        for b in on:
-            if b == first:
-                continue
-            cx, cy = len(cols), len(cols) + 1
-            cols += [("pin", (j, b, first)), ("pin_y", None)]
-            add_force(b, pos[j], cx, cy)
-            add_force(first, pos[j], cx, cy, sign=-1.0)
+    for j, first, b in pin_pairs(d):
+        cx, cy = len(cols), len(cols) + 1
+        cols += [("pin", (j, b, first)), ("pin_y", None)]
+        add_force(b, pos[j], cx, cy)
+        add_force(first, pos[j], cx, cy, sign=-1.0)
     line_dirs: dict[str, tuple[Any, Any]] = {}
     for s, slide in d.sliders.items():
         at = pos[d.bodies[s][0]]

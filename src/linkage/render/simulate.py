@@ -73,7 +73,9 @@ def simulate_report(sim: Any, mechanism: Any, digits: int, energy_tol: float, dr
                f"kinetostatic check: {verdict[drive_ok]} {drive_tol:.2g} (the matrix method's "
                f"input differs from the drive by {sim.drive_check:.2g} of the equation's terms)"]
         c = sim.cycle
-        if c is None:
+        if sim.sliding:
+            out.append("flywheel: a sliding driver has no turn to size one for")
+        elif c is None:
             out.append("flywheel: no full turn of the driver at the end of the span (no cycle to size for)")
         else:
             out.append(f"last full turn, t = {fmt(c.start, 6)} to {fmt(c.end, 6)} s: speed "
