@@ -106,7 +106,9 @@ def simulate(
     digits: DigitsOpt = 10,
     columns: ColumnsOpt = None,
 ) -> None:
-    """Forward dynamics of a one-degree-of-freedom mechanism with masses (a joints-form file
+    """How a mechanism with masses moves under a drive, its loads, gravity and friction.
+
+    Forward dynamics of a one-degree-of-freedom mechanism with masses (a joints-form file
     with a [mass] table): I(theta) theta'' + I'(theta) theta'^2 / 2 = Q(t, theta, theta'),
     I from every link's mass and inertia by the rates at unit driver speed, Q the virtual
     power of the drive (--drive), the file's loads, gravity and pin friction; integrated by
