@@ -67,6 +67,7 @@ def _synth(f="log10(x)", x_range=(1, 2), alpha_range=(90, 150), phi_range=(0, 90
 # (exported function, label, call, the argument the message must name)
 JM = linkage.load_mechanism(FOURBAR.parent / "fourbar_me581_joints.toml")
 JQ = [u.value for u in JM.unknowns]
+SM = linkage.load_mechanism(ROOT / "docs" / "crank_rocker_loads.toml")  # with masses, for simulate
 
 BATTERY = [
     # sweep: values, rates, options
@@ -386,6 +387,27 @@ BATTERY = [
     ("tolerance", "tol -1", lambda: linkage.tolerance(M, {"r2": 0.1}, TWO, tol=-1.0), "tol"),
     ("tolerance", "workers 0", lambda: linkage.tolerance(M, {"r2": 0.1}, TWO, workers=0), "workers"),
     ("tolerance", "scheduler 7", lambda: linkage.tolerance(M, {"r2": 0.1}, TWO, scheduler=7), "scheduler"),
+    # simulate: each argument by its own name
+    ("simulate", "mechanism None", lambda: linkage.simulate(None, "1", (0, 1)), "mechanism"),
+    ("simulate", "a mechanism without masses", lambda: linkage.simulate(JM, "1", (0, 1)), "mass"),
+    ("simulate", "time reversed", lambda: linkage.simulate(SM, "1", (1, 0)), "time"),
+    ("simulate", "time a number", lambda: linkage.simulate(SM, "1", 2.0), "time"),
+    ("simulate", "time bools", lambda: linkage.simulate(SM, "1", (False, True)), "time"),
+    ("simulate", "drive an unknown variable", lambda: linkage.simulate(SM, "x + 1", (0, 1)), "drive"),
+    ("simulate", "drive None", lambda: linkage.simulate(SM, None, (0, 1)), "drive"),
+    ("simulate", "drive bool", lambda: linkage.simulate(SM, True, (0, 1)), "drive"),
+    ("simulate", "constants NaN", lambda: linkage.simulate(SM, "T0", (0, 1), constants={"T0": math.nan}),
+     "constants"),
+    ("simulate", "theta0 text", lambda: linkage.simulate(SM, "1", (0, 1), theta0="a"), "theta0"),
+    ("simulate", "omega0 bool", lambda: linkage.simulate(SM, "1", (0, 1), omega0=True), "omega0"),
+    ("simulate", "negative viscous friction",
+     lambda: linkage.simulate(SM, "1", (0, 1), friction_viscous=-1.0), "friction_viscous"),
+    ("simulate", "coulomb friction at no pin",
+     lambda: linkage.simulate(SM, "1", (0, 1), friction_coulomb={"Z": 0.1}), "friction_coulomb"),
+    ("simulate", "negative flywheel", lambda: linkage.simulate(SM, "1", (0, 1), flywheel=-1.0), "flywheel"),
+    ("simulate", "samples 1", lambda: linkage.simulate(SM, "1", (0, 1), samples=1), "samples"),
+    ("simulate", "rtol 0", lambda: linkage.simulate(SM, "1", (0, 1), rtol=0.0), "rtol"),
+    ("simulate", "loads a dict", lambda: linkage.simulate(SM, "1", (0, 1), loads={"rocker": 1}), "loads"),
 ]
 
 

@@ -41,6 +41,8 @@ COMMANDS: dict[str, list[str]] = {
     "scan": ["scan", str(SAMPLES / "crank_rocker.toml"), "--vary", "r2=30:40:3", "--step", "30"],
     "tolerance": ["tolerance", str(SAMPLES / "crank_rocker.toml"), "--tol", "r2=0.05", "--tol", "r4=0.05",
                   "--step", "90", "--samples", "200"],
+    "simulate": ["simulate", str(SAMPLES.parent / "docs" / "crank_rocker_loads.toml"), "--time", "0:0.2",
+                 "--omega0", "39", "--drive", "0.1", "--flywheel", "0.01", "--samples", "5"],
     "samples": ["samples"],
     "synthesize": ["synthesize", "--function", "log10(x)", "--x", "1:2", "--alpha", "90:150",
                    "--phi", "0:90"],

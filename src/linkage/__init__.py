@@ -17,6 +17,7 @@ The public API, in the order a reader meets it:
   the fixed and moving centrodes of a body over a sweep.
 - :func:`tolerance` spreads manufacturing tolerances through a mechanism over its cycle:
   linear worst-case and RSS bands beside a Monte Carlo (a :class:`ToleranceStudy`).
+- :func:`simulate` integrates a mechanism's motion under a drive, its loads, gravity and friction.
 - :func:`analyze` estimates convergence order and rate from a recorded history.
 """
 
@@ -44,6 +45,7 @@ _EXPORTS = {
     "instant_centres": ".kinematics.centres", "InstantCentres": ".kinematics.centres",
     "centrodes": ".kinematics.centres", "Centrodes": ".kinematics.centres",
     "tolerance": ".kinematics.tolerance", "ToleranceStudy": ".kinematics.tolerance",
+    "simulate": ".kinematics.dynamics", "Simulation": ".kinematics.dynamics",
 }
 _RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",
             "scan_designs": "scan", "forces": "forces_at", "assemblies": "every_assembly"}
@@ -86,6 +88,7 @@ __all__ = [
     "Rates",
     "Result",
     "ScalarProblem",
+    "Simulation",
     "Status",
     "SweepResult",
     "SystemProblem",
@@ -101,6 +104,7 @@ __all__ = [
     "load_mechanism",
     "position_rates",
     "scan_designs",
+    "simulate",
     "solve_scalar",
     "solve_system",
     "sweep",

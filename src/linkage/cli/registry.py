@@ -7,8 +7,8 @@ from collections.abc import Sequence
 
 from .root import app
 
-COMMANDS = ("solve", "sweep", "centres", "scan", "tolerance", "assemblies", "draw", "convert", "new",
-            "synthesize", "samples", "stress", "bench")
+COMMANDS = ("solve", "sweep", "simulate", "centres", "scan", "tolerance", "assemblies", "draw", "convert",
+            "new", "synthesize", "samples", "stress", "bench")
 """In the order ``linkage --help`` lists them."""
 
 

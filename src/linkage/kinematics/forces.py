@@ -134,6 +134,33 @@ def _body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], a
     return out
 
 
+def cg_motion(d: Any, body: str, mass: Any, k: float, pos: Mapping[str, Any], vel: Mapping[str, Any],
+              acc: Mapping[str, Any], motion: tuple[Any, Any, Any]) -> tuple[Any, Any, Any]:
+    """The one rule for a link's centre of mass (``mass.cg``, drawn in the file's unit, ``k``
+    m per unit): its position, velocity and acceleration, each (x, y) in SI, from the
+    link's centre joint's (``pos``, ``vel``, ``acc``, m, m/s, m/s^2) and the link's
+    (rotation since the drawing, omega, alpha) (:func:`_body_motion`): r_G = r_0 + R rel,
+    v_G = v_0 + omega x rel, a_G = a_0 + alpha x rel - omega^2 rel. Floats or arrays."""
+    import numpy as np
+
+    j0 = d.center(body)
+    rot, w, al = motion
+    dx, dy = (mass.cg[0] - d.xy[j0][0]) * k, (mass.cg[1] - d.xy[j0][1]) * k
+    c, s = np.cos(rot), np.sin(rot)
+    rel = (c * dx - s * dy, s * dx + c * dy)
+    cg = (pos[j0][0] + rel[0], pos[j0][1] + rel[1])
+    vg = (vel[j0][0] - w * rel[1], vel[j0][1] + w * rel[0])
+    ag = (acc[j0][0] - al * rel[1] - w * w * rel[0], acc[j0][1] + al * rel[0] - w * w * rel[1])
+    return cg, vg, ag
+
+
+def body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], acc: Mapping[str, Any]
+                ) -> dict[str, tuple[Any, Any, Any]]:
+    """Each body's (rotation since the drawing, omega, alpha): :func:`_body_motion`, public
+    for the dynamics (kinematics.dynamics)."""
+    return _body_motion(frame, pos, vel, acc)
+
+
 def _two_apart(d: Any, joints: Sequence[str]) -> tuple[str, str] | None:
     for i, a in enumerate(joints):
         for b in joints[i + 1:]:
@@ -160,6 +187,20 @@ class ForceArrays:
     virtual_power_input: Any
     condition: Any
     applied: tuple[Any, Any, Any]
+
+
+def pin_pairs(d: Any) -> list[tuple[str, str, str]]:
+    """The one rule for what a pin joins: (joint, owner, link) for each link on a joint that
+    two or more bodies share, other than its owner (the ground where the pin is fixed,
+    else the first body listing it); a pin shared by k bodies is k - 1 pairs."""
+    out = []
+    for j in d.xy:
+        on = [b for b, js in d.bodies.items() if j in js]
+        if len(on) < 2:
+            continue
+        first = "ground" if "ground" in on else on[0]
+        out += [(j, first, b) for b in on if b != first]
+    return out
 
 
 def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[str, tuple[Any, Any]],
@@ -189,18 +230,11 @@ def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[s
         entries.extend([(r, cx, sign), (r + 2, cx, -sign * at[1]),
                         (r + 1, cy, sign), (r + 2, cy, sign * at[0])])
 
-    for j in d.xy:
-        on = [b for b, js in d.bodies.items() if j in js]
-        if len(on) < 2:
-            continue
-        first = "ground" if "ground" in on else on[0]
-        for b in on:
-            if b == first:
-                continue
-            cx, cy = len(cols), len(cols) + 1
-            cols += [("pin", (j, b, first)), ("pin_y", None)]
-            add_force(b, pos[j], cx, cy)
-            add_force(first, pos[j], cx, cy, sign=-1.0)
+    for j, first, b in pin_pairs(d):
+        cx, cy = len(cols), len(cols) + 1
+        cols += [("pin", (j, b, first)), ("pin_y", None)]
+        add_force(b, pos[j], cx, cy)
+        add_force(first, pos[j], cx, cy, sign=-1.0)
     line_dirs: dict[str, tuple[Any, Any]] = {}
     for s, slide in d.sliders.items():
         at = pos[d.bodies[s][0]]
@@ -261,14 +295,9 @@ def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[s
         known(b, origin, (0.0, 0.0), t, origin)
     g = loads.gravity
     for b, mass in loads.masses.items():
-        j0 = d.center(b)
-        rot, w, al = motion[b]
-        dx, dy = (mass.cg[0] - d.xy[j0][0]) * k, (mass.cg[1] - d.xy[j0][1]) * k
-        rel = (np.cos(rot) * dx - np.sin(rot) * dy, np.sin(rot) * dx + np.cos(rot) * dy)
-        cg = (pos[j0][0] + rel[0], pos[j0][1] + rel[1])
-        ag = (acc[j0][0] - al * rel[1] - w * w * rel[0], acc[j0][1] + al * rel[0] - w * w * rel[1])
-        ws = star[b][1]
-        vg = (vstar[j0][0] - ws * rel[1], vstar[j0][1] + ws * rel[0])
+        cg, _, ag = cg_motion(d, b, mass, k, pos, acc, acc, motion[b])
+        _, vg, _ = cg_motion(d, b, mass, k, pos, vstar, vstar, star[b])
+        al = motion[b][2]
         known(b, cg, (-mass.mass * ag[0], -mass.mass * ag[1]), -mass.inertia * al, vg)
         if g is not None:
             known(b, cg, (mass.mass * g[0], mass.mass * g[1]), 0.0, vg)

@@ -338,8 +338,8 @@ def polish(model: LoopModel, q: Any, d: float, funcs: Any = None) -> list[float]
     return q
 
 
-def _solve(jac: list[list[float]], dv: list[float], model: LoopModel, q: Any, d: float, speed: float,
-           accel: float) -> tuple[list[float], list[float]] | None:
+def rates_from_jacobian(jac: list[list[float]], dv: list[float], model: LoopModel, q: Any, d: float,
+                        speed: float, accel: float) -> tuple[list[float], list[float]] | None:
     # newton_direction solves J x = -rhs with the engine's equilibrated singularity test
     qd = newton_direction(jac, [speed * c for c in dv])[0]
     if qd is None or not all(map(math.isfinite, qd)):
@@ -366,7 +366,7 @@ def solve_rates(model: LoopModel, q: Any, d: float, speed: float,
     None where J is singular. No polishing and no bound: see :func:`position_rates`."""
     _, J, V = model.factory(d)
     q = list(q)
-    return _solve(J(q), V(q), model, q, d, speed, accel)
+    return rates_from_jacobian(J(q), V(q), model, q, d, speed, accel)
 
 
 class RateBounds(NamedTuple):
@@ -554,7 +554,7 @@ def inverse_np(a: Any) -> tuple[Any, Any]:
 
 def solve_rates_np(model: LoopModel, q: Any, d: Any, speed: float, accel: float
                    ) -> tuple[list[Any], list[Any], Any]:
-    """:func:`_solve`'s twin over arrays of positions (``model`` may carry arrays of
+    """:func:`rates_from_jacobian`'s twin over arrays of positions (``model`` may carry arrays of
     parameters, :meth:`LoopModel.compile`'s ``values``): (q', q'', solved), the same two
     linear solves, J q' = -(dPhi/dv) v' and J q'' = -(dPhi/dv) v'' - b, with J and
     dPhi/dv from each vector's derivatives and b its centripetal and Coriolis parts. NaN
@@ -648,7 +648,7 @@ def position_rates(model: LoopModel, q: Any, d: float, speed: float | None = Non
     q = polish(model, q, d, funcs)
     _, J, V = funcs
     jac = J(q)
-    solved = _solve(jac, V(q), model, q, d, speed, accel)
+    solved = rates_from_jacobian(jac, V(q), model, q, d, speed, accel)
     if solved is None:
         return Rates({k: _xy(p) for k, (p, _, _) in place(model, q, d).items()}, status="undefined")
     qd, qdd = solved

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import ast
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 from ..errors import ParseError
@@ -248,20 +248,39 @@ def walk_postorder(root: ast.AST, children: Callable[[ast.AST], list[ast.AST]],
         stack.extend((c, False) for c in reversed(children(node)))
 
 
-def parse_ops(text: str, *, what: str = "equation") -> tuple[Op, ...]:
-    """Parse user text into a checked operation list (the last one is the result)."""
+def parse_ops(text: str, *, what: str = "equation", variables: tuple[str, ...] = ("x",),
+              constants: Mapping[str, float] | None = None) -> tuple[Op, ...]:
+    """Parse user text into a checked operation list (the last one is the result).
+
+    ``variables``: the names it may use as variables (``x`` alone for an equation; a
+    variable other than the first is an ``Op("var", value=its index)``, for
+    :func:`function_of`); ``constants``: named numbers (``--const T0=5``), each read as a
+    literal of that value."""
     tree, _ = parse_tree(text, f"the {what}")
     shown = text if len(text) <= 60 else text[:57] + "..."
+    names = _Names(variables, dict(constants or {}))
     b = _Builder()
     out: list[int] = []
-    walk_postorder(tree.body, lambda node: _check(node, shown, what),
-                   lambda node: out.append(_emit(node, b, out)))
+    walk_postorder(tree.body, lambda node: _check(node, shown, what, names),
+                   lambda node: out.append(_emit(node, b, out, names)))
     # The result is the root's operation, which folding or sharing may have placed
     # before later (now unused) ones: keep the list up to it.
     return tuple(b.ops[: out[-1] + 1])
 
 
-def _check(node: ast.AST, shown: str, what: str) -> list[ast.AST]:
+@dataclass(frozen=True)
+class _Names:
+    """The names a text may use besides pi, e and the functions."""
+
+    variables: tuple[str, ...]
+    constants: dict[str, float]
+
+    def usage(self) -> str:
+        named = [*self.variables, *self.constants, *CONSTANTS]
+        return f"use {', '.join(named)} and {', '.join(sorted(FUNCTIONS))}"
+
+
+def _check(node: ast.AST, shown: str, what: str, names: _Names) -> list[ast.AST]:
     """Validate one node; return the children to visit first."""
     if isinstance(node, ast.Constant):
         if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
@@ -274,10 +293,9 @@ def _check(node: ast.AST, shown: str, what: str) -> list[ast.AST]:
             raise ParseError(f"a number in the {what} is too large for a double")
         return []
     if isinstance(node, ast.Name):
-        if node.id == "x" or node.id in CONSTANTS:
+        if node.id in names.variables or node.id in names.constants or node.id in CONSTANTS:
             return []
-        raise ParseError(f"unknown name {node.id!r} in the {what} {shown!r}; use x, pi, e and "
-                         f"{', '.join(sorted(FUNCTIONS))}")
+        raise ParseError(f"unknown name {node.id!r} in the {what} {shown!r}; {names.usage()}")
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub)):
         return [node.operand]
     if isinstance(node, ast.BinOp) and type(node.op) in BINOPS:
@@ -285,15 +303,20 @@ def _check(node: ast.AST, shown: str, what: str) -> list[ast.AST]:
     if isinstance(node, ast.Call):
         return [call_argument(node, f"in the {what} {shown!r}")]
     raise ParseError(f"{type(node).__name__} is not allowed in the {what} {shown!r}; "
-                     "use numbers, x, + - * / ** and functions")
+                     f"use numbers, {', '.join(names.variables)}, + - * / ** and functions")
 
 
-def _emit(node: ast.AST, b: _Builder, out: list[int]) -> int:
+def _emit(node: ast.AST, b: _Builder, out: list[int], names: _Names) -> int:
     if isinstance(node, ast.Constant):
         v = float(node.value)
         return b.add(_literal(v, v.is_integer() and abs(v) <= 2.0**53))
     if isinstance(node, ast.Name):
-        return b.add(Op("x")) if node.id == "x" else b.add(_literal(CONSTANTS[node.id], False))
+        if node.id in names.variables:
+            i = names.variables.index(node.id)
+            return b.add(Op("x") if i == 0 else Op("var", (), float(i)))
+        if node.id in names.constants:  # a named constant stands for its value, as written
+            return b.add(_literal(names.constants[node.id], False))
+        return b.add(_literal(CONSTANTS[node.id], False))
     if isinstance(node, ast.UnaryOp):
         a = out.pop()
         return a if isinstance(node.op, ast.UAdd) else b.add(Op("neg", (a,)))
@@ -333,6 +356,9 @@ def generate(ops: tuple[Op, ...], order: int) -> str:
             continue
         if op.kind == "x":
             push("x", "1.0" if order else None, None)
+            continue
+        if op.kind == "var":  # another variable: held fixed by the derivatives (partial in x)
+            push(f"v{int(op.value)}", None, None)
             continue
         a = op.args[0]
         va, da, dda = v[a], d[a], dd[a]
@@ -425,8 +451,8 @@ def generate_bound(ops: tuple[Op, ...]) -> str:
     u = repr(EPS)
     for i, op in enumerate(ops):
         t = f"t{i}"
-        if op.kind in ("num", "x"):
-            v.append(_num(op.value) if op.kind == "num" else "x")
+        if op.kind in ("num", "x", "var"):
+            v.append({"num": _num(op.value), "x": "x", "var": f"v{int(op.value)}"}[op.kind])
             err.append(repr(op.err) if op.kind == "num" and op.err else None)
             continue
         a = op.args[0]
@@ -501,6 +527,24 @@ class Expression:
 
     def rounding_bound(self) -> Fn:
         return build(self.source(-1))
+
+
+def function_of(text: str, variables: tuple[str, ...], constants: Mapping[str, float] | None = None,
+                *, what: str = "expression") -> Callable[..., float]:
+    """User text as a compiled function of several variables, called with them in the order
+    of ``variables`` (``function_of("T0*(1 - omega/w0)", ("t", "theta", "omega"), {"T0": 5,
+    "w0": 30})``); ``constants`` are named numbers. The same whitelist and code generation
+    as an equation's (:func:`parse_ops`, :func:`generate`): the code is built from this
+    module's own tokens, the variables named v0, v1, ... in it, never from user text."""
+    from ..arguments import check_text
+
+    check_text(what, text, optional=False)
+    clash = [k for k in (constants or {}) if k in variables or k in CONSTANTS or k in FUNCTIONS]
+    if clash:
+        raise ParseError(f"the constant {clash[0]!r} has the name of a variable, constant or function")
+    ops = parse_ops(text, what=what, variables=variables, constants=constants)
+    header = "def fn(" + ", ".join(["x", *(f"v{i}" for i in range(1, len(variables)))]) + "):"
+    return build(generate(ops, 0).replace("def fn(x):", header, 1))
 
 
 def equation_problem(equation: str, g: str | None = None) -> ScalarProblem:
