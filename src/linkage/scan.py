@@ -711,8 +711,8 @@ class Keeper:
 
 def default_branch(m: Mechanism, branch: str | None, tol: float) -> str | None:
     """The branch every design follows: the one asked for (a name or the signs of the
-    derivation's two-way steps, checked here), else (with a closed form) the branch the
-    file's own guess solves to at its driver value, by name where it has one, else None
+    derivation's two-way steps, checked here), else (with a closed form) the file's branch
+    (:func:`~linkage.kinematics.sweep.file_branch`), by name where it has one, else None
     (continuation from the file's guess, design by design)."""
     from .problems.derive import Indeterminate, read_branch, sign_text
 
@@ -728,17 +728,20 @@ def default_branch(m: Mechanism, branch: str | None, tol: float) -> str | None:
         return branch
     if not der.complete:
         return None
-    from .solve import solve_system
+    from .kinematics.sweep import file_branch
 
-    r = solve_system(m.problem(), tol=max(tol, 1e-12), record=False)
-    if not r.converged:
+    signs = file_branch(m)  # the one home of the file's branch, as a sweep of the file follows it
+    if signs is None:
         return sign_text(der.branches[0])
     try:
-        signs = der.signs_of(list(r.x), m.driver.value)
         named = der.named_solutions(m.driver.value)
     except Indeterminate:
-        return sign_text(der.branches[0])
-    return next((name for name, (s, _) in named.items() if s == signs), sign_text(signs))
+        return signs
+    for name, (s, q) in named.items():
+        if sign_text(s) == signs:
+            # by name, unless the pose is where assemblies meet (its name is rounding's)
+            return signs if any(der.meets(q, m.driver.value)) else name
+    return signs
 
 
 @dataclass(frozen=True)

@@ -570,14 +570,5 @@ def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence
     want = read_branch(der, target)
     kinds = {u.name: u.kind for u in m.unknowns}
     q = [np.radians(c) if kinds[n] == "angle" else c for n, c in zip(names, cols)]
-    ok = np.ones(len(det), dtype=bool)
-    with np.errstate(invalid="ignore"):
-        if want.signs is not None:
-            for side, sign in zip(der.signs_of_np(q, drivers), want.signs):
-                ok &= (side == sign) | (side == 0.0)
-        else:
-            # the name's words; which of two assemblies of one name (a mirror) a position
-            # is on, the continuity test has already decided
-            for word, wanted in zip(der.words_of_np(q, drivers), want.words):
-                ok &= word == wanted
-    return ok
+    # the derivation's one rule (a name's mirror: the continuity test has already decided)
+    return np.broadcast_to(der.on_branch_np(q, drivers, want), (len(det),))

@@ -168,9 +168,10 @@ def design_signs(der: Derivation, text: str, drivers: np.ndarray, columns: Mappi
     design's own: the assembly of that name (:meth:`Derivation.named_solutions`, distinct
     configurations in :attr:`Derivation.branches` order, the second of one name its
     mirror) at the first driver value (internal units, in the order given) where the
-    design has one, as a sweep of that design given ``--branch NAME`` starts on it. Where
-    the name is a function of the signs alone (a crank-driven four-bar, a slider-crank,
-    the Watt six-bar's two four-bar loops) that is one sign tuple for every design."""
+    design has one and no two assemblies meet (:meth:`Derivation.meets`), as a sweep of
+    that design given ``--branch NAME`` starts on it. Where the name is a function of the
+    signs alone (a crank-driven four-bar, a slider-crank, the Watt six-bar's two four-bar
+    loops) that is one sign tuple for every design."""
     want = read_branch(der, text)
     count = len(der.two_way)
     if want.signs is not None:
@@ -201,6 +202,9 @@ def design_signs(der: Derivation, text: str, drivers: np.ndarray, columns: Mappi
                 alike = np.logical_and.reduce([a == c for a, c in zip(words_e, words)]) if words else ok
                 same_name += distinct_e & alike
             hit = distinct & (same_name == want.mirrors)
+            for meet in der.meets_np(q, drv, sub):
+                # where assemblies meet (a change point) the name is a matter of rounding
+                hit &= ~np.broadcast_to(meet, ok.shape)
             for w, word in zip(words, want.words):
                 hit &= w == word
             col = np.where(hit.any(axis=1), hit.argmax(axis=1), cols.size)

@@ -156,6 +156,7 @@ def sweep_dict(s: SweepResult, cols: SweepColumns | None = None) -> dict[str, An
         ],
         "feasible_ranges": [list(r) for r in s.feasible_ranges],
         "toggles": list(s.toggles),
+        "meetings": list(s.meetings),
         "ranges": ranges_of(s, cols),
         "summary": s.summary,
     }
@@ -199,6 +200,9 @@ def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400,
                                                         for a, b in s.feasible_ranges) or "none")))
     blocks.append(Text("limit and toggle positions: " + (", ".join(f"{fmt(t, 13)} {u}" for t in s.toggles)
                                                          or "none")))
+    if s.meetings:
+        blocks.append(Text("assemblies meet (to rounding; the branch there is a matter of rounding, kept by "
+                           "its signs) at: " + ", ".join(f"{fmt(t, 13)} {u}" for t in s.meetings)))
     for name, r in ranges_of(s, c).items():
         unit = dict(zip(s.names, s.units))[name]
         blocks.append(Text(f"{name}: min {fmt(r['min'], 10)} {unit} at {s.driver} = {fmt(r['at_min'], 8)}, "
