@@ -166,11 +166,14 @@ class Solver:
             return True
         d = self.derivation
         if d is not None:
-            want = self._wanted.get(target)
-            if want is None:
-                want = self._wanted[target] = read_branch(d, target)
+            if target not in self._wanted:
+                try:
+                    self._wanted[target] = read_branch(d, target)
+                except ValueError:
+                    self._wanted[target] = None  # no branch of this mechanism: no position is on it
+            want = self._wanted[target]
             # the derivation's one rule: a step whose assemblies meet here is on either
-            return d.on_branch(q, value * self.scale, want)
+            return want is not None and d.on_branch(q, value * self.scale, want)
         return (label if label is not None else self.branch(q, det, value)) == target
 
 
