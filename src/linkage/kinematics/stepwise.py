@@ -105,7 +105,8 @@ def _at_meetings(solver: Solver, positions: list[Position], target: str | None
     flagged (:data:`MEETS_NOTE`) and named by the followed branch where that is a name: at a
     double point J is singular and Newton settles only to about the square root of the
     tolerance (1e-7 deg), while the closed form's one configuration is the meeting itself
-    to a few ulps. The driver values flagged are returned with the positions."""
+    to a few ulps; its det J is 0 (the meeting step's block is singular), not rounding's
+    sign. The driver values flagged are returned with the positions."""
     from dataclasses import replace
 
     from ..methods.newton_system import max_abs
@@ -125,12 +126,11 @@ def _at_meetings(solver: Solver, positions: list[Position], target: str | None
         signs = tuple(s if s != 0.0 else 1.0 for s in d.signs_of(q, drv))
         exact = d.solve(drv, signs)
         F, _, _ = solver.compiled(p.input)
-        det = p.det
         if exact is not None and max_abs(F(exact)) <= solver.gate:
             q = tuple(exact)
-            det = solver.det(solver.problem(p.input), q)
         note = f"{p.note}; {MEETS_NOTE}" if p.note else MEETS_NOTE
-        out.append(replace(p, solution=solver.display(q), branch=target if named else p.branch, det=det,
+        out.append(replace(p, solution=solver.display(q), branch=target if named else p.branch,
+                           det=0.0,  # the meeting step's 2 x 2 block is singular: J is, exactly
                            transmission=solver.transmission(q, p.input), note=note))
         where.append(p.input)
     return out, tuple(where)
