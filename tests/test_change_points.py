@@ -130,6 +130,8 @@ def _scan_and_sweeps(branch: str | None):
 
 
 def _ranges_agree(cols, i, sweep) -> None:
+    # the flag: the positions whose branch is a matter of rounding, as the sweep lists them
+    assert cols["meetings"][i] == len(sweep.meetings)
     solved = [p for p in sweep.positions if p.status == "converged"]
     assert cols["solved_fraction"][i] == pytest.approx(len(solved) / len(CYCLE), abs=0)
     for u in ("theta3", "theta4"):
@@ -146,6 +148,8 @@ def test_change_point_designs_in_a_scan_equal_their_own_sweeps():
     nearest assembly, a different rule; with the branch named, it agrees too (below)."""
     cols, swept = _scan_and_sweeps(None)
     assert len(swept) == 10
+    # no other design of the grid has a position where its assemblies meet
+    assert (cols["meetings"][cols["grashof"] != "change point"] == 0).all()
     compared = 0
     for i, m, sweep in swept:
         if file_branch(m) is None:

@@ -26,9 +26,17 @@ import numpy as np
 
 from .errors import InputError, ParseError
 from .kinematics.angles import angle_extent_array, closes_circle, driver_turn
-from .kinematics.designs import CONVERGED, DesignSolutions, engine_for, solve_designs
+from .kinematics.designs import CONVERGED, DesignSolutions, engine_for, meeting_counts, solve_designs
 from .problems.closed_form import grashof_np
-from .problems.columns import columns_of, extent_columns, fourbar_columns, fourbar_loops, path_columns
+from .problems.columns import (
+    MEETINGS,
+    columns_of,
+    extent_columns,
+    fourbar_columns,
+    fourbar_loops,
+    has_meetings,
+    path_columns,
+)
 from .problems.loops import ANGLE_UNITS, Mechanism
 
 MAX_DESIGNS = 10_000_000
@@ -449,6 +457,9 @@ def design_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray, sol:
     out["feasible_fraction"] = sol.feasible.mean(axis=1) if n_pos else np.zeros(n_designs)
     out["solved_fraction"] = solved.mean(axis=1) if n_pos else np.zeros(n_designs)
     out["full_cycle"] = solved.all(axis=1) & (n_pos > 0)
+    if has_meetings(m):
+        given = params if params is not None else {n: designs[:, j] for j, n in enumerate(names)}
+        out[MEETINGS[0]] = meeting_counts(m, given, sol)
     # angles by the range rule of kinematics.angles (continuous around the circle, a full
     # turn at most); lengths from their extremes
     closes = m.driver.kind == "angle" and closes_circle([float(v) for v in sol.values],

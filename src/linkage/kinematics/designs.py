@@ -628,6 +628,25 @@ def _sweep_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarr
     return q, status, feasible, "continuation, design by design"
 
 
+def meeting_counts(m: Mechanism, params: Mapping[str, np.ndarray], sol: DesignSolutions) -> np.ndarray:
+    """Per design, how many solved positions are where two assemblies of a two-way step
+    meet to rounding (:meth:`~linkage.problems.derive.Derivation.meets`: a change point, s + l
+    = p + q, or a limit exactly on the grid): there the branch is a matter of rounding, as
+    a sweep of the design flags it (:attr:`~.positions.SweepResult.meetings`)."""
+    der = m.derivation
+    solved = sol.status == CONVERGED
+    if not der.complete or not der.two_way:
+        return np.zeros(len(solved), dtype=np.int64)
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    drv = (np.asarray(sol.values, dtype=float) * scale)[None, :]
+    q = [np.radians(sol.solution[:, :, j]) if kind == "angle" else sol.solution[:, :, j]
+         for j, kind in enumerate(sol.kinds)]
+    meet = np.zeros(solved.shape, dtype=bool)
+    for m_step in der.meets_np(q, drv, _param_columns(m, params)):
+        meet |= np.broadcast_to(m_step, solved.shape)
+    return (meet & solved).sum(axis=1).astype(np.int64)
+
+
 # --- shared: joints and points, continuous angles ------------------------------------------------
 
 def _paths(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, q: list[np.ndarray],
