@@ -202,3 +202,27 @@ def test_change_point_batch_sweep_flags_what_the_one_at_a_time_sweep_flags():
     assert many.meetings == one.meetings == (0.0, 360.0)
     for u in ("theta3", "theta4"):
         assert np.max(np.abs(np.asarray(many.column(u), float) - np.asarray(one.column(u), float))) <= 1e-9
+
+
+def test_change_point_as_the_files_pose_is_flagged_not_picked_silently():
+    """A file drawn at its change point (theta2 = 0) names no branch: its guesses solve to
+    one by rounding. The sweep follows that one and says so (branch_note), the scan's header
+    too; with --branch nothing is flagged. Off the pose the note is absent."""
+    from typer.testing import CliRunner
+
+    from linkage.cli import app
+    from linkage.kinematics.sweep import POSE_MEETS, pose_meets
+
+    at_pose = load(CRANK_ROCKER).with_values({"r2": 40.0, "r4": 60.0, "theta2": 0.0}, {})
+    assert pose_meets(at_pose) and not pose_meets(_design(40.0, 60.0))
+    values = [float(k) for k in range(0, 361, 10)]
+    assert linkage.sweep(at_pose, values).branch_note == POSE_MEETS
+    assert linkage.sweep(at_pose, values, branch="crossed").branch_note == ""
+    assert linkage.sweep(_design(40.0, 60.0), values).branch_note == ""
+    args = ["scan", str(CRANK_ROCKER), "--set", "r4=60", "--set", "theta2=0", "--vary", "r2=39:41:3",
+            "-f", "plain"]
+    out = CliRunner().invoke(app, args)
+    assert out.exit_code == 0, out.output
+    assert f"branch: {POSE_MEETS}" in out.output
+    out = CliRunner().invoke(app, [*args, "--branch", "open"])
+    assert out.exit_code == 0 and POSE_MEETS not in out.output

@@ -766,6 +766,8 @@ class ScanSetup:
     values: list[float]
     moves: JointMoves | None = None
     loads: Any = None
+    branch_note: str = ""
+    """Why the branch is a matter of rounding, where it is (kinematics.sweep.POSE_MEETS)."""
 
 
 def check_loads(m: Mechanism, names: Sequence[str], loads: Any) -> None:
@@ -802,7 +804,10 @@ def prepare(m: Mechanism, varies: Sequence[Vary], *, samples: int | None, seed: 
     test = parse_where(where, known) if where is not None else None
     if sort is not None and sort not in known:
         raise InputError(f"--sort {sort}: no such column; the columns are {', '.join(known)}")
-    return ScanSetup(plan, spec, test, default_branch(m, branch, tol), listed, moves, loads)
+    from .kinematics.sweep import POSE_MEETS, pose_meets
+
+    note = POSE_MEETS if branch is None and pose_meets(m) else ""
+    return ScanSetup(plan, spec, test, default_branch(m, branch, tol), listed, moves, loads, note)
 
 
 def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, samples: int | None = None,

@@ -49,6 +49,9 @@ class SweepResult:
     followed branch meet to rounding (a change point, s + l = p + q, or a limit exactly on
     the grid): there the branch is a matter of rounding, and each such position says so in
     its note (:data:`~.stepwise.MEETS_NOTE`)."""
+    branch_note: str = ""
+    """Why the followed branch is a matter of rounding, where it is (the file's pose is
+    where its assemblies meet: :data:`~.sweep.POSE_MEETS`); "" otherwise."""
     forces: tuple[Any, ...] | None = None
     """With loads (``sweep(..., loads=...)``): each position's
     :class:`~linkage.kinematics.forces.Forces`, None where unsolved."""

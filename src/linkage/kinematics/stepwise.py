@@ -95,7 +95,8 @@ def sweep(
 
 
 MEETS_NOTE = ("the assemblies meet here (to rounding: a change point or a limit): its branch is a "
-              "matter of rounding; the closed form's configuration, on both")
+              "matter of rounding")
+EXACT_NOTE = "the closed form's configuration, on both"
 
 
 def _at_meetings(solver: Solver, positions: list[Position], target: str | None
@@ -126,11 +127,11 @@ def _at_meetings(solver: Solver, positions: list[Position], target: str | None
         signs = tuple(s if s != 0.0 else 1.0 for s in d.signs_of(q, drv))
         exact = d.solve(drv, signs)
         F, _, _ = solver.compiled(p.input)
+        note, det = "; ".join(n for n in (p.note, MEETS_NOTE) if n), p.det
         if exact is not None and max_abs(F(exact)) <= solver.gate:
-            q = tuple(exact)
-        note = f"{p.note}; {MEETS_NOTE}" if p.note else MEETS_NOTE
-        out.append(replace(p, solution=solver.display(q), branch=target if named else p.branch,
-                           det=0.0,  # the meeting step's 2 x 2 block is singular: J is, exactly
+            # the meeting step's 2 x 2 block is singular there, so J is, exactly
+            q, det, note = tuple(exact), 0.0, f"{note}; {EXACT_NOTE}"
+        out.append(replace(p, solution=solver.display(q), branch=target if named else p.branch, det=det,
                            transmission=solver.transmission(q, p.input), note=note))
         where.append(p.input)
     return out, tuple(where)

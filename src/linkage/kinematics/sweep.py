@@ -98,6 +98,15 @@ def sweep_mechanism(
                                               speed=speed, accel=accel, joints=joints), loads, speed, accel)
     if branch is not None:
         check_branch(m, branch)
+    elif pose_meets(m):
+        # the file's pose is where its assemblies meet: the branch its guesses solve to
+        # there is a matter of rounding, followed, and said so
+        from dataclasses import replace
+
+        result = sweep_mechanism(m, values, branch=file_branch(m), method=method, tol=tol,
+                                 max_iter=max_iter, batch=batch, progress=progress, speed=speed,
+                                 accel=accel, joints=joints)
+        return replace(result, branch_note=POSE_MEETS)
     else:
         branch = file_branch(m)
     n = len(values)
@@ -136,17 +145,38 @@ def file_branch(m: Mechanism) -> str | None:
     guesses solved at its driver value: a drawing's drawn pose), as signs, wherever the
     sweep starts; None where the loops have no derived closed form with two-way steps or
     the pose does not solve (the sweep then starts from the guesses at its first value)."""
+    from ..problems.derive import sign_text
+
+    pose = file_pose(m)
+    if pose is None:
+        return None
+    signs = m.derivation.signs_of(pose, m.driver.value)
+    return sign_text(signs) if all(signs) else None
+
+
+def file_pose(m: Mechanism) -> list[float] | None:
+    """The file's pose (internal units): its guesses solved at its driver value, where the
+    loops have a derived closed form with two-way steps; None otherwise or where it does
+    not solve. What :func:`file_branch` and :func:`pose_meets` read."""
     d = m.derivation
     if not d.complete or not d.two_way:
         return None
-    from ..problems.derive import sign_text
     from ..solve import solve_system
 
     r = solve_system(m.problem(), tol=1e-12)
-    if not r.converged:
-        return None
-    signs = d.signs_of(r.x, m.driver.value)
-    return sign_text(signs) if all(signs) else None
+    return list(r.x) if r.converged else None
+
+
+POSE_MEETS = ("the file's pose is where its assemblies meet (to rounding: a change point or a limit): "
+              "the branch its guesses solve to there is a matter of rounding; give --branch to choose")
+
+
+def pose_meets(m: Mechanism) -> bool:
+    """Whether the file's pose (its guesses solved at its driver value, as
+    :func:`file_branch` solves them) is where two assemblies of a step meet, to rounding
+    (:meth:`~linkage.problems.derive.Derivation.meets`): then the file names no branch."""
+    pose = file_pose(m)
+    return pose is not None and any(m.derivation.meets(pose, m.driver.value))
 
 
 def branch_choices(m: Mechanism) -> list[str]:
