@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import linkage
+from linkage.kinematics.pose import file_branch
 from linkage.kinematics.stepwise import MEETS_NOTE
-from linkage.kinematics.sweep import file_branch
 from linkage.problems.loops import load
 
 SAMPLES = Path(__file__).resolve().parent.parent / "sample_inputs"
@@ -211,7 +211,7 @@ def test_change_point_as_the_files_pose_is_flagged_not_picked_silently():
     from typer.testing import CliRunner
 
     from linkage.cli import app
-    from linkage.kinematics.sweep import POSE_MEETS, pose_meets
+    from linkage.kinematics.pose import POSE_MEETS, pose_meets
 
     at_pose = load(CRANK_ROCKER).with_values({"r2": 40.0, "r4": 60.0, "theta2": 0.0}, {})
     assert pose_meets(at_pose) and not pose_meets(_design(40.0, 60.0))

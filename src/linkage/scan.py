@@ -723,7 +723,7 @@ class Keeper:
 def default_branch(m: Mechanism, branch: str | None, tol: float) -> str | None:
     """The branch every design follows: the one asked for (a name or the signs of the
     derivation's two-way steps, checked here), else (with a closed form) the file's branch
-    (:func:`~linkage.kinematics.sweep.file_branch`), by name where it has one, else None
+    (:func:`~linkage.kinematics.pose.file_branch`), by name where it has one, else None
     (continuation from the file's guess, design by design)."""
     from .problems.derive import Indeterminate, read_branch, sign_text
 
@@ -739,7 +739,7 @@ def default_branch(m: Mechanism, branch: str | None, tol: float) -> str | None:
         return branch
     if not der.complete:
         return None
-    from .kinematics.sweep import file_branch
+    from .kinematics.pose import file_branch
 
     signs = file_branch(m)  # the one home of the file's branch, as a sweep of the file follows it
     if signs is None:
@@ -804,7 +804,7 @@ def prepare(m: Mechanism, varies: Sequence[Vary], *, samples: int | None, seed: 
     test = parse_where(where, known) if where is not None else None
     if sort is not None and sort not in known:
         raise InputError(f"--sort {sort}: no such column; the columns are {', '.join(known)}")
-    from .kinematics.sweep import POSE_MEETS, pose_meets
+    from .kinematics.pose import POSE_MEETS, pose_meets
 
     note = POSE_MEETS if branch is None and pose_meets(m) else ""
     return ScanSetup(plan, spec, test, default_branch(m, branch, tol), listed, moves, loads, note)

@@ -51,7 +51,7 @@ class SweepResult:
     its note (:data:`~.stepwise.MEETS_NOTE`)."""
     branch_note: str = ""
     """Why the followed branch is a matter of rounding, where it is (the file's pose is
-    where its assemblies meet: :data:`~.sweep.POSE_MEETS`); "" otherwise."""
+    where its assemblies meet: :data:`~.pose.POSE_MEETS`); "" otherwise."""
     forces: tuple[Any, ...] | None = None
     """With loads (``sweep(..., loads=...)``): each position's
     :class:`~linkage.kinematics.forces.Forces`, None where unsolved."""
