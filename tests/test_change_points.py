@@ -226,3 +226,21 @@ def test_change_point_as_the_files_pose_is_flagged_not_picked_silently():
     assert f"branch: {POSE_MEETS}" in out.output
     out = CliRunner().invoke(app, [*args, "--branch", "open"])
     assert out.exit_code == 0 and POSE_MEETS not in out.output
+
+
+@pytest.mark.parametrize("branch", ["open", "crossed"])
+def test_change_point_solves_on_either_named_branch(branch):
+    """At the change point the one configuration is both assemblies: solve --branch takes
+    either name (it said "no such assembly" for the one rounding did not give it), and the
+    answer is the collinear pose, theta3 = theta4 = 0 (by hand)."""
+    from typer.testing import CliRunner
+
+    from linkage.cli import app
+
+    args = ["solve", str(CRANK_ROCKER), "--set", "r2=40", "--set", "r4=60", "--set", "theta2=0",
+            "--branch", branch, "-f", "json"]
+    out = CliRunner().invoke(app, args)
+    assert out.exit_code == 0, out.output
+    named = _design(40.0, 60.0).derivation.named_solutions(0.0)
+    assert set(named) == {"open", "crossed"} and named["open"] == named["crossed"]
+    assert named["open"][1] == [0.0, 0.0]

@@ -487,7 +487,10 @@ class Derivation(NamedTuple):
     def named_solutions(self, driver: float, params: Mapping[str, float] | None = None
                         ) -> dict[str, tuple[tuple[float, ...], list[float]]]:
         """Every assembly keyed by its name; a second assembly of one name (the two mirror
-        images of a rocker-driven four-bar can both be open) is keyed ``NAME (mirror)``."""
+        images of a rocker-driven four-bar can both be open) is keyed ``NAME (mirror)``. A
+        configuration where a step's assemblies meet (:meth:`meets`: a change point) is on
+        both of that step's branches, so it is keyed by the other word there too, where no
+        assembly has that name."""
         out: dict[str, tuple[tuple[float, ...], list[float]]] = {}
         sols = self.solutions(driver, params)
         # the mirror key goes to the later in :attr:`branches` order ("+" before "-")
@@ -497,6 +500,13 @@ class Derivation(NamedTuple):
             while key in out:
                 key += MIRROR
             out[key] = (signs, q)
+        for signs, q in sols:
+            names = [self.words_of(q, driver, params)]
+            for i, meet in enumerate(self.meets(q, driver, params)):
+                if meet:
+                    names += [[*w[:i], _OTHER_WORD[w[i]], *w[i + 1:]] for w in names]
+            for words in names[1:]:
+                out.setdefault("/".join(words), (signs, q))
         return out
 
 
@@ -518,6 +528,7 @@ class Derivation(NamedTuple):
 
 
 MIRROR = " (mirror)"
+_OTHER_WORD = {"open": "crossed", "crossed": "open", "+": "-", "-": "+"}
 
 
 def sign_text(signs: Sequence[float]) -> str:
