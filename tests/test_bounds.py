@@ -184,7 +184,7 @@ def test_a_sorted_scan_that_would_hold_every_record_is_refused_before_solving(cl
     big = ["--vary", "r2=20:60:3000", "--vary", "r3=80:160:1000", "--sort", "theta4_range"]
     run = cli("scan", str(CRANK_ROCKER), *big, "-f", "csv")
     one_line_exit_2(run)
-    assert "3,000,000 designs x 19 columns is 57,000,000 values" in run.err
+    assert "3,000,000 designs x 20 columns is 60,000,000 values" in run.err
     with pytest.raises(InputError, match="give top of at most"):
         scan.scan(str(CRANK_ROCKER), {"r2": (20, 60, 3000), "r3": (80, 160, 1000)})
 

@@ -37,7 +37,8 @@ def expected_unit(name: str) -> str:
         return "deg"
     if name in ("r2", "r4") or name.startswith("P_"):
         return "mm"
-    assert name in ("design", "feasible_fraction", "solved_fraction", "full_cycle", "grashof"), name
+    assert name in ("design", "feasible_fraction", "solved_fraction", "full_cycle", "meetings",
+                    "grashof"), name
     return ""
 
 
@@ -116,7 +117,7 @@ def test_csv_json_parquet_and_xlsx_read_back_the_records_bit_for_bit_with_units(
             return {"true": True, "false": False}[text]
         if kinds[name] == "text":
             return text
-        if name == "design":
+        if name in ("design", "meetings"):  # counts
             return int(text)
         return None if text == "" else float(text)
 

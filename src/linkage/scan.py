@@ -26,9 +26,17 @@ import numpy as np
 
 from .errors import InputError, ParseError
 from .kinematics.angles import angle_extent_array, closes_circle, driver_turn
-from .kinematics.designs import CONVERGED, DesignSolutions, engine_for, solve_designs
+from .kinematics.designs import CONVERGED, DesignSolutions, engine_for, meeting_counts, solve_designs
 from .problems.closed_form import grashof_np
-from .problems.columns import columns_of, extent_columns, fourbar_columns, fourbar_loops, path_columns
+from .problems.columns import (
+    MEETINGS,
+    columns_of,
+    extent_columns,
+    fourbar_columns,
+    fourbar_loops,
+    has_meetings,
+    path_columns,
+)
 from .problems.loops import ANGLE_UNITS, Mechanism
 
 MAX_DESIGNS = 10_000_000
@@ -449,6 +457,9 @@ def design_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray, sol:
     out["feasible_fraction"] = sol.feasible.mean(axis=1) if n_pos else np.zeros(n_designs)
     out["solved_fraction"] = solved.mean(axis=1) if n_pos else np.zeros(n_designs)
     out["full_cycle"] = solved.all(axis=1) & (n_pos > 0)
+    if has_meetings(m):
+        given = params if params is not None else {n: designs[:, j] for j, n in enumerate(names)}
+        out[MEETINGS[0]] = meeting_counts(m, given, sol)
     # angles by the range rule of kinematics.angles (continuous around the circle, a full
     # turn at most); lengths from their extremes
     closes = m.driver.kind == "angle" and closes_circle([float(v) for v in sol.values],
@@ -711,8 +722,8 @@ class Keeper:
 
 def default_branch(m: Mechanism, branch: str | None, tol: float) -> str | None:
     """The branch every design follows: the one asked for (a name or the signs of the
-    derivation's two-way steps, checked here), else (with a closed form) the branch the
-    file's own guess solves to at its driver value, by name where it has one, else None
+    derivation's two-way steps, checked here), else (with a closed form) the file's branch
+    (:func:`~linkage.kinematics.pose.file_branch`), by name where it has one, else None
     (continuation from the file's guess, design by design)."""
     from .problems.derive import Indeterminate, read_branch, sign_text
 
@@ -728,17 +739,20 @@ def default_branch(m: Mechanism, branch: str | None, tol: float) -> str | None:
         return branch
     if not der.complete:
         return None
-    from .solve import solve_system
+    from .kinematics.pose import file_branch
 
-    r = solve_system(m.problem(), tol=max(tol, 1e-12), record=False)
-    if not r.converged:
+    signs = file_branch(m)  # the one home of the file's branch, as a sweep of the file follows it
+    if signs is None:
         return sign_text(der.branches[0])
     try:
-        signs = der.signs_of(list(r.x), m.driver.value)
         named = der.named_solutions(m.driver.value)
     except Indeterminate:
-        return sign_text(der.branches[0])
-    return next((name for name, (s, _) in named.items() if s == signs), sign_text(signs))
+        return signs
+    for name, (s, q) in named.items():
+        if sign_text(s) == signs:
+            # by name, unless the pose is where assemblies meet (its name is rounding's)
+            return signs if any(der.meets(q, m.driver.value)) else name
+    return signs
 
 
 @dataclass(frozen=True)
@@ -752,6 +766,8 @@ class ScanSetup:
     values: list[float]
     moves: JointMoves | None = None
     loads: Any = None
+    branch_note: str = ""
+    """Why the branch is a matter of rounding, where it is (kinematics.sweep.POSE_MEETS)."""
 
 
 def check_loads(m: Mechanism, names: Sequence[str], loads: Any) -> None:
@@ -788,7 +804,10 @@ def prepare(m: Mechanism, varies: Sequence[Vary], *, samples: int | None, seed: 
     test = parse_where(where, known) if where is not None else None
     if sort is not None and sort not in known:
         raise InputError(f"--sort {sort}: no such column; the columns are {', '.join(known)}")
-    return ScanSetup(plan, spec, test, default_branch(m, branch, tol), listed, moves, loads)
+    from .kinematics.pose import POSE_MEETS, pose_meets
+
+    note = POSE_MEETS if branch is None and pose_meets(m) else ""
+    return ScanSetup(plan, spec, test, default_branch(m, branch, tol), listed, moves, loads, note)
 
 
 def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, samples: int | None = None,

@@ -86,12 +86,14 @@ def scan(
     """Scan a range of designs: each over its whole cycle, one record per design.
 
     Each record: the varied parameters, feasible_fraction (positions where an assembly
-    exists), solved_fraction (positions solved on the followed branch), full_cycle, every
-    unknown's _min, _max and _range, for four-bars grashof and min/max_transmission_deg
-    (folded into 0..90), and the x/y extents of each [points] path. With loads ([loads] or
-    [mass] in a joints-form file, or --load/--torque/--gravity; --speed for inertia):
-    peak_input (the largest |input torque|), max_pin_force, max_shaking_force (over the
-    positions whose forces are ok) and forces_flagged (positions near a toggle).
+    exists), solved_fraction (positions solved on the followed branch), full_cycle, with a
+    closed form meetings (positions where two assemblies meet to rounding, a change point:
+    the branch there is a matter of rounding), every unknown's _min, _max and _range, for
+    four-bars grashof and min/max_transmission_deg (folded into 0..90), and the x/y extents
+    of each [points] path. With loads ([loads] or [mass] in a joints-form file, or
+    --load/--torque/--gravity; --speed for inertia): peak_input (the largest |input
+    torque|), max_pin_force, max_shaking_force (over the positions whose forces are ok) and
+    forces_flagged (positions near a toggle).
 
     Example: linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60:5 --vary r4=60:120:7
     """

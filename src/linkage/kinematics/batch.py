@@ -63,7 +63,23 @@ class BatchResult:
         motion = self.rates if self.rates is not None and self.rates[0] is not None else None
         return SweepResult(c.mechanism, c.driver, c.driver_unit, c.names, c.units, BatchPositions(self),
                            c.feasible_ranges, c.toggles, c.branch, c.classification, c.method,
-                           motion=motion, length_unit=c.length_unit)
+                           motion=motion, length_unit=c.length_unit, meetings=self.meetings())
+
+    def meetings(self) -> tuple[float, ...]:
+        """The driver values of solved positions where two assemblies meet to rounding
+        (:meth:`~linkage.problems.derive.Derivation.meets_np`), as the one-at-a-time engine
+        lists them (:attr:`~.positions.SweepResult.meetings`)."""
+        m = self.source
+        if m is None or not m.derivation.complete or not m.derivation.two_way or not len(self.values):
+            return ()
+        scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+        q = [np.radians(self.solution[:, j]) if u.kind == "angle" else self.solution[:, j]
+             for j, u in enumerate(m.unknowns)]
+        meet = self.status == STATUS_CODES["converged"]
+        hit = np.zeros(len(self.values), dtype=bool)
+        for step in m.derivation.meets_np(q, self.values * scale):
+            hit |= np.broadcast_to(step, hit.shape)
+        return tuple(float(v) for v in self.values[meet & hit])
 
 
 RATES_CHUNK = 4096
@@ -570,14 +586,5 @@ def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence
     want = read_branch(der, target)
     kinds = {u.name: u.kind for u in m.unknowns}
     q = [np.radians(c) if kinds[n] == "angle" else c for n, c in zip(names, cols)]
-    ok = np.ones(len(det), dtype=bool)
-    with np.errstate(invalid="ignore"):
-        if want.signs is not None:
-            for side, sign in zip(der.signs_of_np(q, drivers), want.signs):
-                ok &= (side == sign) | (side == 0.0)
-        else:
-            # the name's words; which of two assemblies of one name (a mirror) a position
-            # is on, the continuity test has already decided
-            for word, wanted in zip(der.words_of_np(q, drivers), want.words):
-                ok &= word == wanted
-    return ok
+    # the derivation's one rule (a name's mirror: the continuity test has already decided)
+    return np.broadcast_to(der.on_branch_np(q, drivers, want), (len(det),))

@@ -28,7 +28,7 @@ from typing import Any
 
 from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve, lu_two
 from ..methods.newton_system import max_abs, newton_system_lean
-from ..problems.derive import parse_signs, sign_text
+from ..problems.derive import parse_signs, read_branch
 from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..problems.system import LeanProblem
 from ..result import Status
@@ -60,7 +60,7 @@ class Solver:
         self.derivation = d if d.complete and d.two_way else None
         self.count = len(d.two_way)
         self._params = {k: q.value for k, q in m.parameters.items()}
-        self._by_signs: dict[str, bool] = {}  # a target: followed by its signs (else its name)
+        self._wanted: dict[str, Any] = {}  # a target read as a BranchText (derive.read_branch)
         self._problems: dict[float, Any] = {}
         self._compiled: tuple[float, Any] = (math.nan, None)
         self.gate = residual_gate(tol, m.length_scale)
@@ -166,11 +166,14 @@ class Solver:
             return True
         d = self.derivation
         if d is not None:
-            by_signs = self._by_signs.get(target)
-            if by_signs is None:
-                by_signs = self._by_signs[target] = parse_signs(target, self.count) is not None
-            if by_signs:
-                return sign_text(d.signs_of(q, value * self.scale)) == target
+            if target not in self._wanted:
+                try:
+                    self._wanted[target] = read_branch(d, target)
+                except ValueError:
+                    self._wanted[target] = None  # no branch of this mechanism: no position is on it
+            want = self._wanted[target]
+            # the derivation's one rule: a step whose assemblies meet here is on either
+            return want is not None and d.on_branch(q, value * self.scale, want)
         return (label if label is not None else self.branch(q, det, value)) == target
 
 
@@ -218,7 +221,11 @@ def on_branch_guess(solver: Solver, v: float, target: str,
         except Indeterminate:
             return None
     got = found.get(target)
-    return got[1] if got is not None else None
+    if got is None:
+        # where the assemblies meet (a change point) the one configuration is on both
+        # branches, whichever name rounding gave it
+        return next((q for _, q in found.values() if solver.on_target(q, 1.0, v, target)), None)
+    return got[1]
 
 
 CLOSED_FORM_KEPT = "the closed form: Newton's step cannot settle here (J nearly singular)"

@@ -168,9 +168,10 @@ def design_signs(der: Derivation, text: str, drivers: np.ndarray, columns: Mappi
     design's own: the assembly of that name (:meth:`Derivation.named_solutions`, distinct
     configurations in :attr:`Derivation.branches` order, the second of one name its
     mirror) at the first driver value (internal units, in the order given) where the
-    design has one, as a sweep of that design given ``--branch NAME`` starts on it. Where
-    the name is a function of the signs alone (a crank-driven four-bar, a slider-crank,
-    the Watt six-bar's two four-bar loops) that is one sign tuple for every design."""
+    design has one and no two assemblies meet (:meth:`Derivation.meets`), as a sweep of
+    that design given ``--branch NAME`` starts on it. Where the name is a function of the
+    signs alone (a crank-driven four-bar, a slider-crank, the Watt six-bar's two four-bar
+    loops) that is one sign tuple for every design."""
     want = read_branch(der, text)
     count = len(der.two_way)
     if want.signs is not None:
@@ -201,6 +202,9 @@ def design_signs(der: Derivation, text: str, drivers: np.ndarray, columns: Mappi
                 alike = np.logical_and.reduce([a == c for a, c in zip(words_e, words)]) if words else ok
                 same_name += distinct_e & alike
             hit = distinct & (same_name == want.mirrors)
+            for meet in der.meets_np(q, drv, sub):
+                # where assemblies meet (a change point) the name is a matter of rounding
+                hit &= ~np.broadcast_to(meet, ok.shape)
             for w, word in zip(words, want.words):
                 hit &= w == word
             col = np.where(hit.any(axis=1), hit.argmax(axis=1), cols.size)
@@ -622,6 +626,25 @@ def _sweep_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarr
                     q[j][d * k + i] = math.radians(v) if u.kind == "angle" else v
     feasible = (status == CONVERGED) | (status == OFF_BRANCH)
     return q, status, feasible, "continuation, design by design"
+
+
+def meeting_counts(m: Mechanism, params: Mapping[str, np.ndarray], sol: DesignSolutions) -> np.ndarray:
+    """Per design, how many solved positions are where two assemblies of a two-way step
+    meet to rounding (:meth:`~linkage.problems.derive.Derivation.meets`: a change point, s + l
+    = p + q, or a limit exactly on the grid): there the branch is a matter of rounding, as
+    a sweep of the design flags it (:attr:`~.positions.SweepResult.meetings`)."""
+    der = m.derivation
+    solved = sol.status == CONVERGED
+    if not der.complete or not der.two_way:
+        return np.zeros(len(solved), dtype=np.int64)
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    drv = (np.asarray(sol.values, dtype=float) * scale)[None, :]
+    q = [np.radians(sol.solution[:, :, j]) if kind == "angle" else sol.solution[:, :, j]
+         for j, kind in enumerate(sol.kinds)]
+    meet = np.zeros(solved.shape, dtype=bool)
+    for m_step in der.meets_np(q, drv, _param_columns(m, params)):
+        meet |= np.broadcast_to(m_step, solved.shape)
+    return (meet & solved).sum(axis=1).astype(np.int64)
 
 
 # --- shared: joints and points, continuous angles ------------------------------------------------

@@ -43,11 +43,12 @@ def sweep(
     if have_closed:
         for i, v in enumerate(values):
             pos, q = solve_position(solver, v, None, None, guess0, target, True)
-            if pos.status == "converged" and q is not None:
-                seed, target = (v, q), target if target is not None else seed_target(solver, q, v)
-                done[i] = pos
-                break
             done[i] = pos
+            # not where two assemblies meet (a change point): no tangent there, and the
+            # branch it would name is a matter of rounding
+            if pos.status == "converged" and q is not None and not meets_here(solver, pos):
+                seed, target = (v, q), target if target is not None else seed_target(solver, q, v)
+                break
     else:
         v0 = m.driver.value / solver.scale
         p0, r0 = solver.solve(v0, guess0)
@@ -80,6 +81,9 @@ def sweep(
         if progress is not None:
             progress(len(done))
     positions = [done[j] for j in range(len(values))]
+    meetings: tuple[float, ...] = ()
+    if have_closed:
+        positions, meetings = _at_meetings(solver, positions, target)
     positions = _continuous_angles(solver, positions)
     limits, ranges = closed_form_limits(solver, positions, lo, hi, target) if have_closed else \
         ([], solved_ranges(positions))
@@ -87,7 +91,50 @@ def sweep(
     return SweepResult(m.name, m.driver.name, m.driver.unit, solver.names,
                        tuple("deg" if k == "angle" else m.length_unit for k in solver.kinds),
                        tuple(positions), ranges, tuple(found), target,
-                       classification_of(m), method, length_unit=m.length_unit)
+                       classification_of(m), method, length_unit=m.length_unit, meetings=meetings)
+
+
+MEETS_NOTE = ("the assemblies meet here (to rounding: a change point or a limit): its branch is a "
+              "matter of rounding")
+EXACT_NOTE = "the closed form's configuration, on both"
+
+
+def _at_meetings(solver: Solver, positions: list[Position], target: str | None
+                 ) -> tuple[list[Position], tuple[float, ...]]:
+    """Each solved position where two assemblies meet to rounding
+    (:meth:`~linkage.problems.derive.Derivation.meets`) as the closed form gives it there,
+    flagged (:data:`MEETS_NOTE`) and named by the followed branch where that is a name: at a
+    double point J is singular and Newton settles only to about the square root of the
+    tolerance (1e-7 deg), while the closed form's one configuration is the meeting itself
+    to a few ulps; its det J is 0 (the meeting step's block is singular), not rounding's
+    sign. The driver values flagged are returned with the positions."""
+    from dataclasses import replace
+
+    from ..methods.newton_system import max_abs
+    from ..problems.derive import parse_signs
+
+    d = solver.derivation
+    assert d is not None
+    named = target is not None and parse_signs(target, solver.count) is None
+    out, where = [], []
+    for p in positions:
+        if not meets_here(solver, p):
+            out.append(p)
+            continue
+        drv = p.input * solver.scale
+        q = solver_q(solver, p)
+        # the step that meets gives one configuration for either sign; the others keep theirs
+        signs = tuple(s if s != 0.0 else 1.0 for s in d.signs_of(q, drv))
+        exact = d.solve(drv, signs)
+        F, _, _ = solver.compiled(p.input)
+        note, det = "; ".join(n for n in (p.note, MEETS_NOTE) if n), p.det
+        if exact is not None and max_abs(F(exact)) <= solver.gate:
+            # the meeting step's 2 x 2 block is singular there, so J is, exactly
+            q, det, note = tuple(exact), 0.0, f"{note}; {EXACT_NOTE}"
+        out.append(replace(p, solution=solver.display(q), branch=target if named else p.branch, det=det,
+                           transmission=solver.transmission(q, p.input), note=note))
+        where.append(p.input)
+    return out, tuple(where)
 
 
 def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -> str | None:
@@ -98,7 +145,7 @@ def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -
     is the signs of its assembly
     at the first driver value where the name appears (InputError where it appears nowhere)."""
     from ..errors import InputError
-    from ..problems.derive import MIRROR, Indeterminate, parse_signs, sign_text
+    from ..problems.derive import MIRROR, parse_signs, sign_text
 
     d = solver.derivation
     if branch is None or d is None:
@@ -106,9 +153,8 @@ def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -
     if parse_signs(branch, solver.count) is not None and d.names_are_signs:
         # each name is one sign branch: follow (and report) it by its name
         for v in values:
-            try:
-                named = d.named_solutions(v * solver.scale)
-            except Indeterminate:
+            named = _named_apart(solver, v)
+            if named is None:
                 continue
             for name, (signs, _) in named.items():
                 if sign_text(signs) == branch:
@@ -123,9 +169,8 @@ def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -
     # it is, and every position is then off that branch
     first: tuple[float, list[str]] | None = None
     for v in values:
-        try:
-            named = d.named_solutions(v * solver.scale)
-        except Indeterminate:
+        named = _named_apart(solver, v)
+        if named is None:
             continue
         if branch in named:
             return sign_text(named[branch][0])
@@ -135,6 +180,33 @@ def follow_target(solver: Solver, values: Sequence[float], branch: str | None) -
     there = f"; at {first[0]:g}: {', '.join(first[1])}" if first else ": it assembles nowhere there"
     raise InputError(f"branch: no {branch!r} assembly anywhere in {where}{there} (or give the "
                      f"signs: one + or - per closed-form step with two roots, e.g. {'+' * solver.count})")
+
+
+def _named_apart(solver: Solver, v: float) -> dict[str, Any] | None:
+    """Every assembly at ``v`` (display units) keyed by its name, or None where the names
+    say nothing: a change point (the closed form is indeterminate) or where two assemblies
+    meet to rounding (:meth:`~linkage.problems.derive.Derivation.meets`: their one
+    configuration's open/crossed is a matter of rounding)."""
+    from ..problems.derive import Indeterminate
+
+    d = solver.derivation
+    assert d is not None
+    drv = v * solver.scale
+    try:
+        named = d.named_solutions(drv)
+    except Indeterminate:
+        return None
+    if any(any(d.meets(q, drv)) for _, q in named.values()):
+        return None
+    return named
+
+
+def meets_here(solver: Solver, pos: Position) -> bool:
+    """Whether a solved position is where two assemblies of a step meet, to rounding
+    (:meth:`~linkage.problems.derive.Derivation.meets`): its branch is a matter of rounding."""
+    d = solver.derivation
+    return (d is not None and pos.solution is not None
+            and any(d.meets(solver_q(solver, pos), pos.input * solver.scale)))
 
 
 def seed_target(solver: Solver, q: Sequence[float], v: float) -> str:

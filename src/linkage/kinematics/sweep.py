@@ -14,6 +14,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from ..problems.loops import Mechanism
+from .pose import POSE_MEETS, file_branch, pose_meets
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
 from .stepwise import sweep
 
@@ -98,6 +99,15 @@ def sweep_mechanism(
                                               speed=speed, accel=accel, joints=joints), loads, speed, accel)
     if branch is not None:
         check_branch(m, branch)
+    elif pose_meets(m):
+        # the file's pose is where its assemblies meet: the branch its guesses solve to
+        # there is a matter of rounding, followed, and said so
+        from dataclasses import replace
+
+        result = sweep_mechanism(m, values, branch=file_branch(m), method=method, tol=tol,
+                                 max_iter=max_iter, batch=batch, progress=progress, speed=speed,
+                                 accel=accel, joints=joints)
+        return replace(result, branch_note=POSE_MEETS)
     else:
         branch = file_branch(m)
     n = len(values)
@@ -129,24 +139,6 @@ def sweep_mechanism(
     from .rates import with_rates  # here: a sweep without rates does not load them
 
     return with_rates(m, result, speed, accel)
-
-
-def file_branch(m: Mechanism) -> str | None:
-    """The branch a sweep follows unless told: the assembly of the file's own pose (its
-    guesses solved at its driver value: a drawing's assembly as drawn), as signs, wherever the
-    sweep starts; None where the loops have no derived closed form with two-way steps or
-    the pose does not solve (the sweep then starts from the guesses at its first value)."""
-    d = m.derivation
-    if not d.complete or not d.two_way:
-        return None
-    from ..problems.derive import sign_text
-    from ..solve import solve_system
-
-    r = solve_system(m.problem(), tol=1e-12)
-    if not r.converged:
-        return None
-    signs = d.signs_of(r.x, m.driver.value)
-    return sign_text(signs) if all(signs) else None
 
 
 def branch_choices(m: Mechanism) -> list[str]:
@@ -194,5 +186,5 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-__all__ = ["BATCH_ABOVE", "MAX_POSITIONS", "Position", "SweepResult", "check_driver_values",
-           "driver_values", "sweep", "sweep_mechanism"]
+__all__ = ["BATCH_ABOVE", "MAX_POSITIONS", "POSE_MEETS", "Position", "SweepResult", "check_driver_values",
+           "driver_values", "file_branch", "pose_meets", "sweep", "sweep_mechanism"]

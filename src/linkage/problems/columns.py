@@ -19,6 +19,17 @@ from typing import Any
 DESIGN = "design"
 SUMMARY = (("feasible_fraction", "number", ""), ("solved_fraction", "number", ""),
            ("full_cycle", "bool", ""))
+MEETINGS = ("meetings", "int", "")
+"""A mechanism with two-way closed-form steps: how many solved positions are where two
+assemblies meet to rounding (a change point, or a limit on the grid): the branch there is
+a matter of rounding (linkage.kinematics.designs.meeting_counts)."""
+
+
+def has_meetings(m: Any) -> bool:
+    """Whether ``m``'s scan has the :data:`MEETINGS` column."""
+    return bool(m.derivation.complete and m.derivation.two_way)
+
+
 FOURBAR = (("grashof", "text", ""), ("min_transmission_deg", "number", "deg"),
            ("max_transmission_deg", "number", "deg"))
 """A four-bar loop's columns: its Grashof class and the extremes of its transmission angle
@@ -73,6 +84,8 @@ def sourced_columns(m: Any, names: Sequence[str], loads: bool = False
     # a varied name that is no parameter is a joint's coordinate (scan.coordinate_column)
     cols += [(n, "number", unit.get(n, m.length_unit), f"parameter {n}", f"parameters.{n}") for n in names]
     cols += [(c, t, u, own, "") for c, t, u in SUMMARY]
+    if has_meetings(m):
+        cols.append((*MEETINGS, own, ""))
     for q in m.unknowns:
         uu = "deg" if q.kind == "angle" else m.length_unit
         cols += [(c, "number", uu, f"unknown {q.name}", f"unknowns.{q.name}") for c in extent_columns(q.name)]

@@ -33,6 +33,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any, NamedTuple
 
 from . import dyads
+from .assembly import TANGENT_SLACK
 
 DRIVER = -2
 """The reference of the driver; an int >= 0 is an unknown, a str a parameter, a float a number."""
@@ -270,6 +271,64 @@ class Derivation(NamedTuple):
             out.append(_side(step.case, first, second, k, q[step.unknowns[0]], q[step.unknowns[1]]))
         return tuple(out)
 
+    def meets(self, q: Sequence[float], driver: float,
+              params: Mapping[str, float] | None = None) -> tuple[bool, ...]:
+        """Whether each two-way step's two assemblies meet at a configuration, to rounding:
+        its margin within :data:`~.assembly.TANGENT_SLACK` of zero (a limit position, or a
+        four-bar's change point, s + l = p + q, where all four joints are collinear). There
+        the step's sign and its open/crossed word are a matter of rounding: the one
+        configuration is on both branches (Norton, Design of Machinery, section 2.8)."""
+        p = self._params(params)
+        out = []
+        for step in self.steps:
+            if step.two_way:
+                first, second, k = _coefficients(step, p, driver, q, math)
+                out.append(abs(_margin(step.case, first, second, k)) <= TANGENT_SLACK)
+        return tuple(out)
+
+    def meets_np(self, q: Sequence[Any], driver: Any, params: Mapping[str, Any] | None = None) -> list[Any]:
+        """:meth:`meets` over arrays (NaN: False)."""
+        import numpy as np
+
+        p = self._params(params)
+        out = []
+        with np.errstate(invalid="ignore", divide="ignore"):
+            for step in self.steps:
+                if step.two_way:
+                    first, second, k = _coefficients(step, p, np.asarray(driver, float), q, np)
+                    out.append(np.abs(_margin_np(step.case, first, second, k)) <= TANGENT_SLACK)
+        return out
+
+    def on_branch(self, q: Sequence[float], driver: float, want: BranchText,
+                  params: Mapping[str, float] | None = None) -> bool:
+        """Whether a configuration is on the branch ``want`` (:func:`read_branch`): each
+        two-way step on its sign (0, on the line, counts as either) or its word, except
+        where the step's assemblies meet (:meth:`meets`), which is on either. Which of two
+        assemblies of one name (a mirror) a position is on is the continuity test's to
+        decide. The one rule of every engine; :meth:`on_branch_np` is its twin."""
+        meets = self.meets(q, driver, params)
+        if want.signs is not None:
+            sides = self.signs_of(q, driver, params)
+            return all(s == w or s == 0.0 or m for s, w, m in zip(sides, want.signs, meets))
+        words = self.words_of(q, driver, params)
+        return all((w in ("open", "+")) == wanted or m for w, wanted, m in zip(words, want.words, meets))
+
+    def on_branch_np(self, q: Sequence[Any], driver: Any, want: BranchText,
+                     params: Mapping[str, Any] | None = None) -> Any:
+        """:meth:`on_branch` over arrays."""
+        import numpy as np
+
+        meets = self.meets_np(q, driver, params)
+        ok: Any = True
+        with np.errstate(invalid="ignore"):
+            if want.signs is not None:
+                for side, sign, m in zip(self.signs_of_np(q, driver, params), want.signs, meets):
+                    ok = ok & ((side == sign) | (side == 0.0) | m)
+            else:
+                for word, wanted, m in zip(self.words_of_np(q, driver, params), want.words, meets):
+                    ok = ok & ((word == wanted) | m)
+        return ok
+
     def margins(self, driver: float, signs: Sequence[float],
                 params: Mapping[str, float] | None = None) -> list[float]:
         """Each two-way step's margin on branch ``signs`` (relative; negative where it
@@ -429,7 +488,10 @@ class Derivation(NamedTuple):
     def named_solutions(self, driver: float, params: Mapping[str, float] | None = None
                         ) -> dict[str, tuple[tuple[float, ...], list[float]]]:
         """Every assembly keyed by its name; a second assembly of one name (the two mirror
-        images of a rocker-driven four-bar can both be open) is keyed ``NAME (mirror)``."""
+        images of a rocker-driven four-bar can both be open) is keyed ``NAME (mirror)``. A
+        configuration where a step's assemblies meet (:meth:`meets`: a change point) is on
+        both of that step's branches, so it is keyed by the other word there too, where no
+        assembly has that name."""
         out: dict[str, tuple[tuple[float, ...], list[float]]] = {}
         sols = self.solutions(driver, params)
         # the mirror key goes to the later in :attr:`branches` order ("+" before "-")
@@ -439,6 +501,13 @@ class Derivation(NamedTuple):
             while key in out:
                 key += MIRROR
             out[key] = (signs, q)
+        for signs, q in sols:
+            names = [self.words_of(q, driver, params)]
+            for i, meet in enumerate(self.meets(q, driver, params)):
+                if meet:
+                    names += [[*w[:i], _OTHER_WORD[w[i]], *w[i + 1:]] for w in names]
+            for words in names[1:]:
+                out.setdefault("/".join(words), (signs, q))
         return out
 
 
@@ -460,6 +529,7 @@ class Derivation(NamedTuple):
 
 
 MIRROR = " (mirror)"
+_OTHER_WORD = {"open": "crossed", "crossed": "open", "+": "-", "-": "+"}
 
 
 def sign_text(signs: Sequence[float]) -> str:

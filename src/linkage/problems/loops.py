@@ -328,7 +328,7 @@ def _keep_drawing(mechanism: Mechanism, doc: Mapping[str, Any], source: str) -> 
 def _at_driver_value(m: Mechanism, doc: Mapping[str, Any], source: str) -> Mechanism:
     """A drawing whose [driver] value is not where it is drawn (problems.joints.off_drawing):
     its guesses moved to that value on the drawing's branch - the drawn pose's signs, the
-    branch a sweep follows unless told (kinematics.sweep.file_branch), solved there by the
+    branch a sweep follows unless told (kinematics.pose.file_branch), solved there by the
     derived closed form (:meth:`~.derive.Derivation.solve`) - so that solve, sweep and scan
     take the drawing's assembly there; the note :attr:`Mechanism.drawing_note` says where
     it was drawn. Loops without a closed form are solved there from the drawn pose and

@@ -220,6 +220,8 @@ def scan_summary(m: Any, setup: Any, driver: tuple[float, float, float], scanned
     lines = [f"{m.name}: {scanned:,} of {total:,} designs scanned{stopped}{where_note}; {elapsed:.2f} s",
              f"{len(setup.values)} positions each ({m.driver.name} {start:g}..{stop:g} "
              f"{m.driver.unit}, step {step:g}); branch: {branch}; engine: {engine}"]
+    if setup.branch_note:
+        lines.append(f"branch: {setup.branch_note}")
     if setup.loads is not None:
         lines.append(loads_line(m, setup.loads, motion))
     n_held = len(held["design"]) if held else 0

@@ -144,6 +144,7 @@ def sweep_dict(s: SweepResult, cols: SweepColumns | None = None) -> dict[str, An
         "driver": {"name": s.driver, "unit": s.driver_unit},
         "method": s.method,
         "branch": s.branch,
+        **({"branch_note": s.branch_note} if s.branch_note else {}),
         "classification": s.classification or None,
         "units": dict(zip(s.names, s.units)),
         "length_unit": s.length_unit,
@@ -159,6 +160,7 @@ def sweep_dict(s: SweepResult, cols: SweepColumns | None = None) -> dict[str, An
         ],
         "feasible_ranges": [list(r) for r in s.feasible_ranges],
         "toggles": list(s.toggles),
+        "meetings": list(s.meetings),
         "ranges": ranges_of(s, cols),
         "summary": s.summary,
     }
@@ -198,10 +200,15 @@ def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400,
     blocks.append(table("", headers, rows, digits, notes=note))
     counts = ", ".join(f"{k}: {v}" for k, v in sorted(s.summary.items()))
     blocks.append(Text(f"positions: {counts}; branch: {s.branch}", "bold"))
+    if s.branch_note:
+        blocks.append(Text(f"branch: {s.branch_note}"))
     blocks.append(Text("feasible ranges: " + (", ".join(f"[{fmt(a, 12)}, {fmt(b, 12)}] {u}"
                                                         for a, b in s.feasible_ranges) or "none")))
     blocks.append(Text("limit and toggle positions: " + (", ".join(f"{fmt(t, 13)} {u}" for t in s.toggles)
                                                          or "none")))
+    if s.meetings:
+        blocks.append(Text("assemblies meet (to rounding; the branch there is a matter of rounding, kept by "
+                           "its signs) at: " + ", ".join(f"{fmt(t, 13)} {u}" for t in s.meetings)))
     for name, r in ranges_of(s, c).items():
         unit = dict(zip(s.names, s.units))[name]
         blocks.append(Text(f"{name}: min {fmt(r['min'], 10)} {unit} at {s.driver} = {fmt(r['at_min'], 8)}, "
