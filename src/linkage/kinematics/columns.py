@@ -90,7 +90,9 @@ def _array_columns(s: SweepResult, b: Any) -> SweepColumns:
     status = words[b.status.astype(np.intp)]
     nan = np.float64(math.nan)
     solution = {name: np.where(solved, b.solution[:, j], nan) for j, name in enumerate(s.names)}
-    branch = np.where(solved, b.branch, None) if b.branch is not None else np.full(n, None, dtype=object)
+    branch = np.full(n, None, dtype=object)
+    if b.branch is not None:  # one text object shared, not one made per position
+        branch[solved] = b.branch
     det = np.where(solved, b.det, nan)
     m = b.source
     transmission = np.full(n, nan)

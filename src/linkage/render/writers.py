@@ -254,7 +254,7 @@ class CsvSink(Sink):
         self.count += n
 
 
-FAST_BLOCK = 16 * SLICE
+FAST_BLOCK = 2 * SLICE
 """Rows a CSV block formats and joins in pyarrow at a time (:func:`_arrow_block`)."""
 
 
