@@ -345,7 +345,7 @@ class LoadColumns:
     never all held; :meth:`result` computes whatever chunks are left."""
 
     def __init__(self, mechanism: Any, cols: Any, loads: Loads, speed: float, accel: float,
-                 chunk: int = LOADS_CHUNK) -> None:
+                 chunk: int | None = None) -> None:
         import numpy as np
 
         from .forces import PeakTracker
@@ -353,13 +353,17 @@ class LoadColumns:
         self.frame = Frame.of(mechanism)
         self.frame.check_masses(loads)
         self.mechanism, self.cols, self.loads, self.speed, self.accel = mechanism, cols, loads, speed, accel
-        self.chunk, self.n, self.next = chunk, len(cols), 0
+        rates = cols.rates
+        # ``chunk`` None: the rates' own chunks where they are computed as read, and
+        # followed (each chunk's loads as its rates are computed); else LOADS_CHUNK
+        own = getattr(rates, "chunk", None) if hasattr(rates, "listen") else None
+        self.chunk = chunk or own or LOADS_CHUNK
+        self.n, self.next = len(cols), 0
         self.status = np.full(self.n, -1, dtype=np.int8)
         self.columns: dict[str, Any] = {}
         self.tracker = PeakTracker(2)
         self._done: SweepLoads | None = None
-        rates = cols.rates
-        self.following = hasattr(rates, "listen") and getattr(rates, "chunk", None) == chunk
+        self.following = own is not None and own == self.chunk
         if self.following:
             rates.listen(self._heard)
 
@@ -410,7 +414,7 @@ class LoadColumns:
 
 
 def sweep_load_columns(mechanism: Any, cols: Any, loads: Loads, speed: float, accel: float,
-                       chunk: int = LOADS_CHUNK) -> SweepLoads:
+                       chunk: int | None = None) -> SweepLoads:
     """A sweep's loads as columns, every chunk at once (:class:`LoadColumns`)."""
     return LoadColumns(mechanism, cols, loads, speed, accel, chunk).result()
 
