@@ -13,7 +13,7 @@ medians: wall time (from start to exit) and peak resident memory (the child's ru
 from os.wait4), with the loaded sweep's extra memory per position
 ((loaded - unloaded peak) / positions) beside them.
 
-    python benchmarks/sweep_loads.py                        # steps 0.01 and 0.001, 3 repeats
+    python benchmarks/sweep_loads.py                        # steps 0.01, 0.0036, 0.001, 3 repeats
     python benchmarks/sweep_loads.py --steps 0.01 --repeats 5
     python benchmarks/sweep_loads.py --static               # without --speed (static loads)
     python benchmarks/sweep_loads.py --linkage "env PYTHONPATH=OLD/src python -m linkage"  # another version
@@ -61,7 +61,8 @@ def positions(step: float) -> int:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--steps", type=float, nargs="+", default=[0.01, 0.001])
+    ap.add_argument("--steps", type=float, nargs="+", default=[0.01, 0.0036, 0.001],
+                    help="driver steps (deg): 36,001, 100,001 and 360,001 positions")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--static", action="store_true", help="without --speed: static loads")
     ap.add_argument("--linkage", default=shutil.which("linkage") or "linkage",

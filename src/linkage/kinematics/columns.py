@@ -8,14 +8,17 @@ engine's tuple of positions gives plain lists, without importing numpy (a small 
 command stays numpy-free for its cold start).
 
 Rates with a driver speed stay on the scalar definition (each position's
-:class:`~.rates.Rates`, read a chunk at a time for a batch result): ``rates`` then holds
-them, one per position (None where unsolved).
+:class:`~.rates.Rates`, None where unsolved): ``rates`` then gives them, one per position.
+A batch result's are a :class:`RateChunks`: computed a chunk of positions at a time as
+they are read, only the last chunk held, so a table written a block at a time (a
+sweep's positions to CSV or parquet) holds one chunk of rates whatever the sweep's length
+(docs/performance_loads.md).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, NamedTuple
 
 from .positions import SweepResult
@@ -36,7 +39,9 @@ class SweepColumns(NamedTuple):
     joints: dict[str, tuple[Any, Any]]
     """Joint or point name -> (x, y) columns, when the sweep computed joints."""
     rates: Sequence[Any] | None
-    """Each position's :class:`~.rates.Rates` (None where unsolved) with a driver speed."""
+    """Each position's :class:`~.rates.Rates` (None where unsolved) with a driver speed: a
+    list, or for a batch result a :class:`RateChunks` (read in order: one chunk computed at
+    a time)."""
     arrays: bool
     """True: numpy arrays (NaN where no value); False: lists (None where no value)."""
 
@@ -85,7 +90,9 @@ def _array_columns(s: SweepResult, b: Any) -> SweepColumns:
     status = words[b.status.astype(np.intp)]
     nan = np.float64(math.nan)
     solution = {name: np.where(solved, b.solution[:, j], nan) for j, name in enumerate(s.names)}
-    branch = np.where(solved, b.branch, None) if b.branch is not None else np.full(n, None, dtype=object)
+    branch = np.full(n, None, dtype=object)
+    if b.branch is not None:  # one text object shared, not one made per position
+        branch[solved] = b.branch
     det = np.where(solved, b.det, nan)
     m = b.source
     transmission = np.full(n, nan)
@@ -98,9 +105,11 @@ def _array_columns(s: SweepResult, b: Any) -> SweepColumns:
         if m.derivation.fourbars:
             transmission = transmission_column(m, q, d, solved)
         if b.rates is not None and b.rates[0] is not None:
-            # read once, in order (the batch computes them a chunk at a time)
-            rates = [p.rates for p in s.positions]
-            joints = _joints_of_rates(rates, n)
+            # computed as read, a chunk at a time (the batch's own chunks), never all held
+            rates = RateChunks(s.positions)
+            first = next((i for i in np.flatnonzero(solved)), None)
+            names = list(rates[int(first)].joints) if first is not None else []
+            joints = {j: (RateColumn(rates, j, 0), RateColumn(rates, j, 1)) for j in names}
         elif b.rates is not None:
             from .rates import place_np
 
@@ -120,15 +129,68 @@ def transmission_column(m: Any, q: Sequence[Any], d: Any, solved: Any) -> Any:
     return np.where(solved, np.degrees(mu), np.nan)
 
 
-def _joints_of_rates(rates: Sequence[Any], n: int) -> dict[str, tuple[Any, Any]]:
-    import numpy as np
+class RateChunks(Sequence):  # type: ignore[type-arg]
+    """Each position's rates of a batch sweep with a driver speed (None where unsolved),
+    read a chunk of positions at a time (kinematics.batch.RATES_CHUNK: one call of the one
+    definition, :func:`~.rates.with_rates`, per chunk, as the batch's positions compute
+    them) and only the last chunk held. :meth:`listen`: a callback given each chunk as it
+    is computed, so a second reader in step (a sweep's loads, kinematics.force_sweeps)
+    takes the same rates without computing them again."""
 
-    names = next((list(r.joints) for r in rates if r is not None), [])
-    out = {j: (np.full(n, np.nan), np.full(n, np.nan)) for j in names}
-    for i, r in enumerate(rates):
-        if r is None:
-            continue
-        for j, (x, y) in r.joints.items():
-            out[j][0][i] = x
-            out[j][1][i] = y
-    return out
+    def __init__(self, positions: Sequence[Any], chunk: int | None = None) -> None:
+        from .batch import RATES_CHUNK
+
+        self.positions = positions
+        self.chunk = RATES_CHUNK if chunk is None else chunk
+        self._last: tuple[int, list[Any]] = (-1, [])
+        self._listeners: list[Callable[[int, list[Any]], None]] = []
+
+    def __len__(self) -> int:
+        return len(self.positions)
+
+    def __getitem__(self, i: Any) -> Any:
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        if i < 0:
+            i += len(self)
+        if not 0 <= i < len(self):
+            raise IndexError(i)
+        return self.load(i - i % self.chunk)[i % self.chunk]
+
+    def load(self, start: int) -> list[Any]:
+        """The rates of the chunk from ``start`` (a multiple of ``chunk``)."""
+        if self._last[0] != start:
+            self._last = (-1, [])  # the last chunk let go before the next is computed
+            got = [p.rates for p in self.positions[start:start + self.chunk]]
+            self._last = (start, got)
+            for listener in self._listeners:
+                listener(start, got)
+        return self._last[1]
+
+    def listen(self, listener: Callable[[int, list[Any]], None]) -> None:
+        """Call ``listener(start, rates)`` for every chunk computed from now on."""
+        self._listeners.append(listener)
+
+
+class RateColumn(Sequence):  # type: ignore[type-arg]
+    """A joint's x (``part`` 0) or y (1) over a sweep, read from its rates as they are
+    read (:class:`RateChunks`); a slice is a numpy array, NaN where there is no value."""
+
+    def __init__(self, rates: Sequence[Any], joint: str, part: int) -> None:
+        self.rates, self.joint, self.part = rates, joint, part
+
+    def __len__(self) -> int:
+        return len(self.rates)
+
+    def _one(self, i: int) -> float:
+        r = self.rates[i]
+        xy = r.joints.get(self.joint) if r is not None else None
+        return math.nan if xy is None else float(xy[self.part])
+
+    def __getitem__(self, i: Any) -> Any:
+        if isinstance(i, slice):
+            import numpy as np
+
+            idx = range(*i.indices(len(self)))
+            return np.fromiter((self._one(k) for k in idx), float, len(idx))
+        return self._one(i if i >= 0 else i + len(self))

@@ -255,9 +255,14 @@ def load_chunks(mechanism: Any, cols: Any, loads: Loads, speed: float, accel: fl
     frame.check_masses(loads)
     n = len(cols)
     for a in range(0, n, chunk):
-        b = min(n, a + chunk)
-        cf = chunk_forces(mechanism, frame, solved_columns(mechanism, cols, a, b), loads, speed, accel)
-        yield _chunk_columns(cf, a, b - a, loads)
+        yield chunk_loads(mechanism, frame, cols, loads, speed, accel, a, min(n, a + chunk))
+
+
+def chunk_loads(mechanism: Any, frame: Frame, cols: Any, loads: Loads, speed: float, accel: float,
+                start: int, stop: int) -> LoadChunk:
+    """The loads of rows ``start:stop`` of a sweep's columns (:func:`load_chunks`' chunk)."""
+    cf = chunk_forces(mechanism, frame, solved_columns(mechanism, cols, start, stop), loads, speed, accel)
+    return _chunk_columns(cf, start, stop - start, loads)
 
 
 def _chunk_columns(cf: ChunkForces, start: int, size: int, loads: Loads) -> LoadChunk:
@@ -329,31 +334,89 @@ class SweepLoads:
         return [k for k in self.columns if k not in FORCE_KEYS]
 
 
-def sweep_load_columns(mechanism: Any, cols: Any, loads: Loads, speed: float, accel: float,
-                chunk: int = LOADS_CHUNK) -> SweepLoads:
-    """A sweep's loads as columns, from :func:`load_chunks`: each chunk's numbers copied
-    into the columns (a few numbers a position) and its peaks accumulated
-    (:class:`~.forces.PeakTracker`, the one peak rule), the chunk then let go."""
-    import numpy as np
+class LoadColumns:
+    """A sweep's loads (``cols``: its :class:`~.columns.SweepColumns`) computed a chunk of
+    positions at a time, in order, into columns (a few numbers a position), each chunk
+    by :func:`chunk_forces` and judged by the one status rule (:func:`_chunk_columns`), its
+    peaks accumulated (:class:`~.forces.PeakTracker`, the one peak rule), the chunk then
+    let go. Where the sweep's rates are computed as they are read
+    (:class:`~.columns.RateChunks`), each chunk's loads are taken as its rates are
+    computed for the positions table, so the rates are computed once for both tables and
+    never all held; :meth:`result` computes whatever chunks are left."""
 
-    from .forces import PeakTracker
+    def __init__(self, mechanism: Any, cols: Any, loads: Loads, speed: float, accel: float,
+                 chunk: int | None = None) -> None:
+        import numpy as np
 
-    n = len(cols)
-    status = np.full(n, -1, dtype=np.int8)
-    columns: dict[str, Any] = {}
-    peaks = PeakTracker(2)
-    for c in load_chunks(mechanism, cols, loads, speed, accel, chunk):
-        b = c.start + len(c.status)
-        status[c.start:b] = c.status
+        from .forces import PeakTracker
+
+        self.frame = Frame.of(mechanism)
+        self.frame.check_masses(loads)
+        self.mechanism, self.cols, self.loads, self.speed, self.accel = mechanism, cols, loads, speed, accel
+        rates = cols.rates
+        # ``chunk`` None: the rates' own chunks where they are computed as read, and
+        # followed (each chunk's loads as its rates are computed); else LOADS_CHUNK
+        own = getattr(rates, "chunk", None) if hasattr(rates, "listen") else None
+        self.chunk = chunk or own or LOADS_CHUNK
+        self.n, self.next = len(cols), 0
+        self.status = np.full(self.n, -1, dtype=np.int8)
+        self.columns: dict[str, Any] = {}
+        self.tracker = PeakTracker(2)
+        self._done: SweepLoads | None = None
+        self.following = own is not None and own == self.chunk
+        if self.following:
+            rates.listen(self._heard)
+
+    def _heard(self, start: int, _rates: Any) -> None:
+        if start == self.next:  # in order only (the peaks are accumulated in order)
+            self._take(start)
+
+    def _take(self, a: int) -> None:
+        import numpy as np
+
+        b = min(self.n, a + self.chunk)
+        c = chunk_loads(self.mechanism, self.frame, self.cols, self.loads, self.speed, self.accel, a, b)
+        self.status[a:b] = c.status
         for key, values in c.columns.items():
-            columns.setdefault(key, np.full(n, np.nan))[c.start:b] = values
-        peaks.add(c.status, c.columns["input"], c.columns["max_pin_force"])
-    (at_in, at_pin), flagged = peaks.peaks()
-    for key in FORCE_KEYS:
-        columns.setdefault(key, np.full(n, np.nan))
-    ordered = {k: columns[k] for k in FORCE_KEYS}
-    ordered.update((k, v) for k, v in columns.items() if k not in FORCE_KEYS)
-    return SweepLoads(status, ordered, at_in, at_pin, flagged)
+            self.columns.setdefault(key, np.full(self.n, np.nan))[a:b] = values
+        self.tracker.add(c.status, c.columns["input"], c.columns["max_pin_force"])
+        self.next = b
+
+    def _step(self) -> None:
+        """The next chunk: through the rates (which hand it to :meth:`_heard`), or here."""
+        start = self.next
+        if self.following:
+            self.cols.rates.load(start)
+        if self.next == start:  # not heard (its rates were already at hand)
+            self._take(start)
+
+    def pins(self) -> list[str]:
+        """Each pin's and slider's column names, in order: known from the first chunk with
+        a solved position (the chunks up to it computed here)."""
+        while self.next < self.n and not any(k not in FORCE_KEYS for k in self.columns):
+            self._step()
+        return [k for k in self.columns if k not in FORCE_KEYS]
+
+    def result(self) -> SweepLoads:
+        """Every chunk's loads (those not yet taken computed now) and the peaks."""
+        if self._done is None:
+            import numpy as np
+
+            while self.next < self.n:
+                self._step()
+            (at_in, at_pin), flagged = self.tracker.peaks()
+            for key in FORCE_KEYS:
+                self.columns.setdefault(key, np.full(self.n, np.nan))
+            ordered = {k: self.columns[k] for k in FORCE_KEYS}
+            ordered.update((k, v) for k, v in self.columns.items() if k not in FORCE_KEYS)
+            self._done = SweepLoads(self.status, ordered, at_in, at_pin, flagged)
+        return self._done
+
+
+def sweep_load_columns(mechanism: Any, cols: Any, loads: Loads, speed: float, accel: float,
+                       chunk: int | None = None) -> SweepLoads:
+    """A sweep's loads as columns, every chunk at once (:class:`LoadColumns`)."""
+    return LoadColumns(mechanism, cols, loads, speed, accel, chunk).result()
 
 
 def with_forces(mechanism: Any, result: Any, loads: Loads, speed: float | None, accel: float) -> Any:

@@ -57,16 +57,67 @@ def sweep_table(s: SweepResult, cols: SweepColumns | None = None) -> DataTable:
     joints = list(c.joints)
     if c.rates is not None:  # the scalar rates, a row at a time (the one definition)
         heads = rate_headers(s.names, _kinds(s), s.length_unit, joints, True)
-        cells = [rate_cells(r, s.names, joints, True) for r in c.rates]
-        by_column = list(zip(*cells)) if cells else [() for _ in heads]
-        for h, values in zip(heads, by_column):
+        cells = RateCells(c.rates, s.names, joints, len(heads))
+        for k, h in enumerate(heads):
             name, unit = split_header(h)
-            out.append(column(name, unit, list(values), "text" if name == "rates status" else "number"))
+            kind = "text" if name == "rates status" else "number"
+            out.append(column(name, unit, CellColumn(cells, k), kind))
     else:
         for j in joints:
             x, y = c.joints[j]
             out += [column(f"{j}.x", s.length_unit, x), column(f"{j}.y", s.length_unit, y)]
     return DataTable("positions", tuple(out))
+
+
+class RateCells:
+    """The rate columns' cells of a sweep's positions table (:func:`rate_cells`, one row
+    per position), made a block of rows at a time as a writer asks for them: the last
+    block's kept, so the table's columns read side by side compute each row once, and no
+    more than a block of rows (and the rates' chunk, kinematics.columns.RateChunks) is
+    held however long the sweep."""
+
+    def __init__(self, rates: Sequence[Any], names: Sequence[str], joints: Sequence[str], width: int) -> None:
+        self.rates, self.names, self.joints, self.width = rates, names, joints, width
+        self._last: tuple[int, int, list[list[Any]]] = (-1, -1, [])
+
+    def __len__(self) -> int:
+        return len(self.rates)
+
+    def block(self, start: int, stop: int) -> list[list[Any]]:
+        """Rows ``start:stop``, one list per column."""
+        if self._last[:2] != (start, stop):
+            self._last = (-1, -1, [])
+            rows = [rate_cells(self.rates[i], self.names, self.joints, True) for i in range(start, stop)]
+            cols = [list(v) for v in zip(*rows)] if rows else [[] for _ in range(self.width)]
+            self._last = (start, stop, cols)
+        return self._last[2]
+
+
+class CellColumn(Sequence):  # type: ignore[type-arg]
+    """One rate column of :class:`RateCells`: a slice is a list of its cells (None where
+    there is none); ``block``, the rows a writer should take at a time
+    (render.writers.write_tables)."""
+
+    def __init__(self, cells: RateCells, k: int) -> None:
+        self.cells, self.k = cells, k
+        # a few of the rates' chunks (a parquet row group, a CSV block, of that many rows)
+        self.block = 4 * getattr(cells.rates, "chunk", BLOCK_ROWS // 4)
+
+    def __len__(self) -> int:
+        return len(self.cells)
+
+    def __getitem__(self, i: Any) -> Any:
+        if isinstance(i, slice):
+            start, stop, step = i.indices(len(self))
+            got = self.cells.block(start, max(start, stop))[self.k]
+            return got if step == 1 else got[::step]
+        if i < 0:
+            i += len(self)
+        return self.cells.block(i, i + 1)[self.k][0]
+
+
+BLOCK_ROWS = 4096
+"""Rows of rate cells made at a time where the rates are a list (the one-at-a-time engine's)."""
 
 
 def sweep_report(s: SweepResult, digits: int, max_rows: int = 400, joints_note: str = "",

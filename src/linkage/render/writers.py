@@ -264,7 +264,7 @@ class CsvSink(Sink):
         self.count += n
 
 
-FAST_BLOCK = 16 * SLICE
+FAST_BLOCK = 2 * SLICE
 """Rows a CSV block formats and joins in pyarrow at a time (:func:`_arrow_block`)."""
 
 
@@ -555,12 +555,18 @@ PROGRESS_ROWS = 16 * SLICE
 
 def write_tables(sink: Sink, tables: Sequence[DataTable],
                  progress: Callable[[int], None] | None = None) -> None:
-    """Every table into ``sink``; ``progress(rows written so far)`` after each block."""
+    """Every table into ``sink``; ``progress(rows written so far)`` after each block. A
+    column made as it is read (its values with a ``block`` attribute: a sweep's rates,
+    render.sweep.CellColumn) sets the rows handed over at a time, so no more than a block
+    of it is ever made."""
     done = 0
     for t in tables:
         n = t.row_count
         sink.begin(t.name, t.columns, n)
         step = PROGRESS_ROWS if progress is not None else max(n, 1)
+        blocks = [b for b in (getattr(c.values, "block", None) for c in t.columns) if b]
+        if blocks:
+            step = min(step, *blocks)
         for a in range(0, n, step):
             whole = step >= n
             sink.rows([c.values if whole else c.values[a:a + step] for c in t.columns])
