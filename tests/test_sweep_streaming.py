@@ -29,15 +29,12 @@ ME581_ARGS = ["--from", "0", "--to", "360", "--step", "0.25", "--speed", "4", "-
               "--batch"]
 
 
-def _tables(text: str) -> dict[str, list[list[str]]]:
-    """A CSV of several tables (``# name`` lines) as name -> rows (header first)."""
-    out: dict[str, list[list[str]]] = {}
-    name = "positions"
-    for part in text.split("\n\n"):
-        lines = part.splitlines()
-        if lines and lines[0].startswith("# "):
-            name, lines = lines[0][2:], lines[1:]
-        out[name] = list(csv.reader(io.StringIO("\n".join(lines))))
+def _tables(path: Path) -> dict[str, list[list[str]]]:
+    """A report's CSV files (one table a file: ``x.csv`` positions, ``x.NAME.csv`` beside it)
+    as name -> rows (header first)."""
+    out = {"positions": list(csv.reader(io.StringIO(path.read_text())))}
+    for other in path.parent.glob(f"{path.stem}.*.csv"):
+        out[other.name[len(path.stem) + 1:-len(".csv")]] = list(csv.reader(io.StringIO(other.read_text())))
     return out
 
 
@@ -62,10 +59,11 @@ def test_a_loaded_sweeps_file_is_the_same_whatever_the_chunk(tmp_path, monkeypat
     chunked = _run(tmp_path, "chunked.csv", ME581_ARGS)
     _run(tmp_path, "chunked.parquet", ME581_ARGS)
     assert chunked.read_bytes() == whole.read_bytes()
+    assert (tmp_path / "chunked.loads.csv").read_bytes() == (tmp_path / "whole.loads.csv").read_bytes()
     for stem in ("", ".loads"):
         a, b = (pq.read_table(tmp_path / f"{k}{stem}.parquet") for k in ("whole", "chunked"))
         assert a.num_rows == 1441 and a.equals(b), stem
-    tables = _tables(whole.read_text())
+    tables = _tables(whole)
     head, body = tables["positions"][0], tables["positions"][1:]
     status = [row[1] for row in body]
     forces = [row[1] for row in tables["loads"][1:]]
