@@ -500,3 +500,30 @@ def test_centrode_options_without_centrodes_are_refused(cli):
               "--step", "--centrodes")
     _one_line(cli("centres", str(SAMPLES / "crank_rocker_joints.toml"), "--centrodes", "--body", "wheel"), 2,
               "body must name a link")
+
+
+def test_a_pinned_bodys_centrode_never_passes_through_infinity():
+    """An adversary's pass: the rocker's centre relative to the ground is O4 at every position,
+    yet its reversals were listed as passes through infinity (the homogeneous point flips
+    sign with omega, the point does not move)."""
+    import linkage
+
+    cd = linkage.centrodes(str(SAMPLES / "crank_rocker_joints.toml"), [x * 2.5 for x in range(144)],
+                           body="rocker")
+    assert cd.through_infinity == ()
+    coupler = linkage.centrodes(str(SAMPLES / "crank_rocker_joints.toml"), [x * 2.5 for x in range(144)])
+    assert coupler.through_infinity == ((67.5, 70.0), (292.5, 295.0))  # as docs/centres.md says
+
+
+def test_a_translating_coupler_reports_no_crossings(tmp_path):
+    """A parallelogram's coupler never turns: its centre is at infinity throughout, and the
+    sign of its rounding-noise angular velocity is no crossing."""
+    import linkage
+
+    path = tmp_path / "pg.toml"
+    path.write_text('name = "parallelogram"\nlength_unit = "mm"\nground = ["O2", "O4"]\n[joints]\n'
+                    'O2 = [0.0, 0.0]\nA = [34.64101615137755, 20.0]\nB = [134.64101615137756, 20.0]\n'
+                    'O4 = [100.0, 0.0]\n[links]\ncrank = ["O2", "A"]\ncoupler = ["A", "B"]\n'
+                    'rocker = ["O4", "B"]\n[driver]\nlink = "crank"\nvalue = 30\n')
+    cd = linkage.centrodes(str(path), [30, 60, 90, 120, 150])
+    assert cd.through_infinity == ()

@@ -293,3 +293,41 @@ def test_an_equation_in_x_is_unchanged_by_the_variables():
 
     e = Expression.parse("x^3 - 2*x")
     assert e.function()(2.0) == 4.0 and e.derivative()(2.0) == 10.0 and e.second_derivative()(2.0) == 12.0
+
+
+def _crank_on_its_pivot(tmp_path):
+    """The crank-rocker with only a 2 kg crank centred on its pivot (inertia 0.01 kg m^2)."""
+    text = (ROOT / "sample_inputs" / "crank_rocker_joints.toml").read_text()
+    text += '\n[mass]\ncrank = { mass = 2.0, cg = [0, 0], inertia = 0.01 }\n'
+    path = tmp_path / "pivot.toml"
+    path.write_text(text)
+    return path
+
+
+def test_a_driver_stopped_by_coulomb_friction_is_the_stopped_event_not_bad_input(cli, tmp_path):
+    """An adversary's pass: the speed at the stop, 7.5e-13, was refused by the kinetostatic
+    check's range for a person's input ('speed must be 0 or from 1e-12'): exit 2. A crank
+    with I = 0.01 from 10 rad/s under 0.05 N m of friction stops at t = I omega0 / M = 2 s."""
+    r = cli("simulate", str(_crank_on_its_pivot(tmp_path)), "--time", "0:3", "--omega0", "10",
+            "--friction-coulomb", "O2=0.05", "--samples", "4", "-f", "plain")
+    assert r.code == 1, r.err
+    assert "event: stopped at t = 2 s" in r.out
+
+
+def test_a_mechanism_without_inertia_is_refused_not_a_hang(cli, tmp_path):
+    text = (ROOT / "sample_inputs" / "crank_rocker_joints.toml").read_text()
+    path = tmp_path / "massless.toml"
+    path.write_text(text + '\n[mass]\ncrank = { mass = 0.0, cg = [0, 0], inertia = 0.0 }\n')
+    r = cli("simulate", str(path), "--time", "0:1", "--drive", "1")
+    assert r.code == 2 and "no inertia" in r.err and r.err.count("\n") == 1
+
+
+def test_a_drive_that_cannot_be_evaluated_is_one_line_or_a_named_event(cli):
+    """'1/0' said 'internal error (please report this)'; a drive that fails mid-run ends as
+    integration_failed at the time it failed, its rows kept."""
+    loads = str(ROOT / "docs" / "me581_masses.toml")
+    r = cli("simulate", loads, "--time", "0:1", "--drive", "1/0")
+    assert r.code == 2 and "the drive cannot be evaluated at t = 0 s" in r.err
+    r = cli("simulate", loads, "--time", "0:1", "--drive", "theta/(t-0.5)", "--samples", "3", "-f", "plain")
+    assert r.code == 1 and "internal error" not in r.err
+    assert "event: integration_failed at t = 0.5 s" in r.out and "to 0.5 s" in r.out

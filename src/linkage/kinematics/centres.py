@@ -604,12 +604,20 @@ class Centrodes:
     @property
     def through_infinity(self) -> tuple[tuple[float, float], ...]:
         """The driver intervals between neighbouring solved positions over which the centre
-        passes through infinity: the body's angular velocity changes sign there (or is 0 at
-        a position, the centre at infinity)."""
+        passes through infinity: the body's angular velocity changes sign there while the
+        centre is finite on both sides and not the same point. A body pinned to the ground
+        reverses about its pivot (its centre stays put), and a translating body's centre is
+        at infinity throughout, its angular velocity rounding noise: neither passes."""
         out = []
         for a, b in zip(self.points, self.points[1:]):
-            if a.omega is not None and b.omega is not None and a.omega * b.omega < 0.0:
-                out.append((a.input, b.input))
+            if a.omega is None or b.omega is None or not a.omega * b.omega < 0.0:
+                continue
+            pa, pb = a.fixed, b.fixed
+            if pa.kind != "finite" or pb.kind != "finite":
+                continue
+            if math.hypot(pa.x - pb.x, pa.y - pb.y) <= 1e-9 * max(1.0, math.hypot(pa.x, pa.y)):
+                continue
+            out.append((a.input, b.input))
         return tuple(out)
 
 

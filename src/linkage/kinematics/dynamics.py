@@ -447,7 +447,7 @@ def simulate(
         loads = checked_loads(loads, mechanism)
     if not loads.masses:
         raise InputError(f"{mechanism.source}: the dynamics need masses: add [mass] LINK = {{ mass = KG, "
-                         "cg = [x, y], inertia = KG_M2 }} to the file")
+                         "cg = [x, y], inertia = KG_M2 } to the file")
     fv_default, fv = _checked_friction(friction_viscous, frame.drawing, "friction_viscous")
     fc_default, fc = _checked_friction(friction_coulomb, frame.drawing, "friction_coulomb")
     flywheel = check_number("flywheel", flywheel)
@@ -501,13 +501,28 @@ def integrate(dyn: Dynamics, drive: Callable[[float, float, float], float], thet
     p0 = dyn.at(theta0)
     if p0 is None or not p0.sensitivity < DEAD_POINT_SENSITIVITY:
         raise InputError("theta0: the mechanism is at a dead point or not assembled there")
+    if not p0.inertia > 0.0:
+        raise InputError("the mechanism has no inertia to move: give its links a mass or an inertia in "
+                         "[mass], or a flywheel (--flywheel)")
+
+    calls = [0]
+    last_t = [start]
 
     def rhs(t: float, y: Any) -> Any:
+        calls[0] += 1
+        if calls[0] > MAX_EVALUATIONS:
+            raise _TooLong(f"more than {MAX_EVALUATIONS:,} evaluations of the equation of motion "
+                           f"(at t = {t:.6g} s): shorten --time")
         theta, omega = float(y[0]), float(y[1])
         p = dyn.at(theta)
         if p is None or not p.inertia > 0.0:
             return np.full(5, np.nan)  # not assembled: the step is refused and shortened
-        tau = drive(t, theta, omega)
+        try:
+            tau = float(drive(t, theta, omega))
+        except (ArithmeticError, ValueError) as exc:
+            raise _TooLong(f"the drive cannot be evaluated at t = {t:.6g} s, theta = {theta:.6g} rad, "
+                           f"omega = {omega:.6g} rad/s ({exc})") from None
+        last_t[0] = t
         fr = dyn.friction_force(p, omega)
         q = tau + p.loads + p.weight + fr
         return np.array([omega, (q - p.half_slope * omega * omega) / p.inertia,
@@ -528,10 +543,26 @@ def integrate(dyn: Dynamics, drive: Callable[[float, float, float], float], thet
         stopped.terminal = True  # type: ignore[attr-defined]
         events.append(stopped)
     t_eval = np.linspace(start, end, samples)
+    try:
+        rhs(start, np.array([theta0, omega0, 0.0, 0.0, 0.0]))
+    except _TooLong as exc:
+        raise InputError(f"drive: {exc}") from None
     with np.errstate(all="ignore"):
-        sol = solve_ivp(rhs, (start, end), [theta0, omega0, 0.0, 0.0, 0.0], method="DOP853",
-                        t_eval=t_eval, rtol=rtol, atol=[atol, atol, atol, atol, atol],
-                        events=events, dense_output=True)
+        try:
+            sol = solve_ivp(rhs, (start, end), [theta0, omega0, 0.0, 0.0, 0.0], method="DOP853",
+                            t_eval=t_eval, rtol=rtol, atol=[atol, atol, atol, atol, atol],
+                            events=events, dense_output=True)
+        except _TooLong as exc:
+            # the rows up to the last time the equation could be evaluated, by integrating
+            # again to it (with a budget of its own)
+            stop = last_t[0]
+            if not stop > start:
+                raise InputError(f"drive: {exc}") from None
+            calls[0] = -MAX_EVALUATIONS
+            sol = solve_ivp(rhs, (start, stop), [theta0, omega0, 0.0, 0.0, 0.0], method="DOP853",
+                            t_eval=np.append(t_eval[t_eval < stop], stop), rtol=rtol, atol=[atol] * 5,
+                            dense_output=True)
+            return _outputs(dyn, drive, sol, sol.t, sol.y, "integration_failed", stop, str(exc))
     event, event_time, message = None, None, ""
     t_out, y_out = sol.t, sol.y
     if sol.status == 1:
@@ -557,8 +588,31 @@ def integrate(dyn: Dynamics, drive: Callable[[float, float, float], float], thet
                        else "the driver can no longer drive the mechanism (J is singular here)")
     elif sol.status != 0:
         event, message = "integration_failed", sol.message
-        event_time = float(sol.t[-1]) if len(sol.t) else start
+        ts = getattr(sol.sol, "ts", None) if sol.sol is not None else None
+        event_time = float(ts[-1]) if ts is not None and len(ts) else last_t[0]
+        if ts is not None and len(ts) and event_time > float(t_out[-1]):  # the row where it stopped
+            t_out = np.append(t_out, event_time)
+            y_out = np.column_stack([y_out, sol.sol(event_time)])
     return _outputs(dyn, drive, sol, t_out, y_out, event, event_time, message)
+
+
+def _at_rest(rate: float) -> float:
+    """A simulated rate as the kinetostatic solver takes it: below arguments.MIN_RATE (a
+    driver stopped by friction, or reversing at an output time) it is rest, 0; the solver
+    refuses such a size as input from a person, where it would be a typo."""
+    from ..arguments import MIN_RATE
+
+    return 0.0 if abs(rate) < MIN_RATE else rate
+
+
+MAX_EVALUATIONS = 200_000
+"""Evaluations of the equation of motion one simulation may take (about 30 s here; a 2-s
+run of the crank-rocker from rest takes 19,454): a run whose steps collapse ends as a named
+event, not after hours."""
+
+
+class _TooLong(Exception):
+    pass
 
 
 def _dead_or_limit(dyn: Dynamics, theta: float, omega: float) -> str:
@@ -606,7 +660,8 @@ def _outputs(dyn: Dynamics, drive: Callable[[float, float, float], float], sol: 
             torques[b] = torques.get(b, 0.0) + tq
         loads = Loads(base.forces, torques, base.masses, base.gravity, base.on)
         c = dyn.c
-        f = forces_at(dyn.mechanism, p.q, loads, speed=omega / c, accel=alpha[i] / c, driver=theta / c)
+        f = forces_at(dyn.mechanism, p.q, loads, speed=_at_rest(omega / c), accel=_at_rest(alpha[i] / c),
+                      driver=theta / c)
         forces.append(f)
         if f.input is not None:
             need = f.input + dyn.flywheel * alpha[i]

@@ -118,9 +118,11 @@ def tolerance_report(s: Any, digits: int) -> Report:
 
 
 def _reading(s: Any) -> str:
-    spread = ("normal, sigma D/3" if s.distribution == "normal" else "uniform within ±D")
-    return (f"±D read as 3 sigma: RSS = sqrt(sum (dq/dp D)^2) is the 3-sigma band; sigma linear "
-            f"and the Monte Carlo draw {spread}")
+    if s.distribution == "normal":
+        return ("±D read as 3 sigma: RSS = sqrt(sum (dq/dp D)^2) is the 3-sigma band; sigma linear "
+                "= RSS/3, and the Monte Carlo draws normal, sigma D/3")
+    return ("±D the bounds of a uniform draw: RSS = sqrt(sum (dq/dp D)^2) is sqrt(3) sigma; sigma "
+            "linear = RSS/sqrt(3), and the Monte Carlo draws uniform within ±D")
 
 
 def _output_table(s: Any, j: int, digits: int) -> Any:
