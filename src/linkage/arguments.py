@@ -31,6 +31,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any
 
 from .errors import InputError
+from .units import RAD_PER_DEG
 
 MAX_RATE = 1e12
 """The largest |speed| or |accel| accepted (the command line's --speed bound too)."""
@@ -426,7 +427,7 @@ def _rate_units(mechanism: Any) -> tuple[dict[str, float], dict[str, float]]:
     given, internal)."""
     unit = mechanism.length_unit
     if mechanism.driver.kind == "angle":
-        deg, rpm = math.pi / 180.0, math.pi / 30.0
+        deg, rpm = RAD_PER_DEG, math.pi / 30.0
         return ({"": 1.0, "rad/s": 1.0, "deg/s": deg, "rpm": rpm},
                 {"": 1.0, "rad/s^2": 1.0, "rad/s2": 1.0, "deg/s^2": deg, "deg/s2": deg, "rpm/s": rpm})
     return {"": 1.0, f"{unit}/s": 1.0}, {"": 1.0, f"{unit}/s^2": 1.0, f"{unit}/s2": 1.0}

@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
+from ..units import radians
 
 SUFFIXES = (".dxf", ".svg")
 """The suffixes that ``draw -o`` writes as CAD sheets (the rest go to matplotlib)."""
@@ -258,7 +259,7 @@ def _slide(drawing: Any, name: str, placed: Mapping[str, Point], swept: Sequence
         if slide.on != "ground":
             a, b = drawing.bodies[slide.on][:2]
             turn = _angle(at[a], at[b]) - _angle(drawing.xy[a], drawing.xy[b])
-        t = math.radians(slide.angle_deg) + turn
+        t = radians(slide.angle_deg) + turn
         return math.cos(t), math.sin(t)
 
     def along(at: Mapping[str, Any]) -> float:

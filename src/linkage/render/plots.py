@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
+from ..units import RAD_PER_DEG, radians
 
 SUFFIXES = (".png", ".svg", ".pdf")
 
@@ -145,8 +146,8 @@ def path_plot(result: Any, mechanism: Any, names: Sequence[str], path: Path) -> 
     fig, ax = plt.subplots(figsize=(7, 5.5))
     first = next((p for p in result.positions if p.rates is not None), None)
     if first is not None:
-        scale = math.pi / 180.0 if mechanism.driver.kind == "angle" else 1.0
-        q = [math.radians(first.solution[u.name]) if u.kind == "angle" else first.solution[u.name]
+        scale = RAD_PER_DEG if mechanism.driver.kind == "angle" else 1.0
+        q = [radians(first.solution[u.name]) if u.kind == "angle" else first.solution[u.name]
              for u in mechanism.unknowns]
         # the second line says where the faint linkage stands: without it a reader takes
         # it for any position of the curve
@@ -318,9 +319,9 @@ def frame_notes(values: Sequence[float], gaps: Sequence[tuple[float, float]], un
 def sweep_frames(mechanism: Any, sweep: Any) -> list[tuple[float, list[float]]]:
     """The solved positions of a sweep as animation frames: (driver, unknowns), angles in
     radians (the file's degrees converted), lengths as they are."""
-    scale = math.pi / 180.0 if mechanism.driver.kind == "angle" else 1.0
+    scale = RAD_PER_DEG if mechanism.driver.kind == "angle" else 1.0
     return [(p.input * scale,
-             [math.radians(p.solution[u.name]) if u.kind == "angle" else p.solution[u.name]
+             [radians(p.solution[u.name]) if u.kind == "angle" else p.solution[u.name]
               for u in mechanism.unknowns]) for p in sweep.positions if p.solution]
 
 
