@@ -235,14 +235,14 @@ def _local_roots(m: Mechanism, driver: float, q0: list[float]) -> tuple[list[lis
                 else:
                     hi = mid
             q, res = _polish(m, driver, list(q))
-            if res <= RESIDUAL and not any(_same(q, tuple(o), m, 1e-12) for o in roots):
+            if res <= RESIDUAL and not any(same_configuration(q, tuple(o), m, 1e-12) for o in roots):
                 roots.append(q)
     if len(roots) > 1:
         # roots closer than their own uncertainty (rounding times the condition of J there)
         # are one double root: at a change point exactly, the two assemblies are one
         Js = np.array(J(roots[0])) * scale[None, :] / size
         blur = 1e-14 * float(np.linalg.cond(Js)) if np.all(np.isfinite(Js)) else np.inf
-        if all(_same(a, tuple(b), m, blur) for a in roots for b in roots):
+        if all(same_configuration(a, tuple(b), m, blur) for a in roots for b in roots):
             return [roots[0]], "double"
     if roots:
         return roots, "roots"
@@ -268,7 +268,7 @@ def _names(m: Mechanism, driver: float, qs: list[list[float]]) -> list[tuple[str
             named = {}
         out = []
         for q in qs:
-            key = next((k for k, (_, nq) in named.items() if _same(q, tuple(nq), m, 1e-7)), None)
+            key = next((k for k, (_, nq) in named.items() if same_configuration(q, tuple(nq), m, 1e-7)), None)
             try:
                 out.append((key or der.name_of(q, driver), sign_text(der.signs_of(q, driver))))
             except (Indeterminate, ZeroDivisionError, ValueError):
@@ -315,7 +315,7 @@ def assemblies(m: Mechanism, driver: float | None = None, seed: int = 0) -> Asse
     def keep(q: list[float], times: int = 1) -> bool:
         q = [math.radians(nearest_turn(math.degrees(u.value), math.degrees(v))) if u.kind == "angle" else v
              for u, v in zip(m.unknowns, q)]  # angles in the turn of the file's guess
-        if any(_same(q, a.q, m) for a in real):
+        if any(same_configuration(q, a.q, m) for a in real):
             return False
         residual = max(abs(v) for v in m.model.functions(d)[0](q)) / m.length_scale
         cond = condition(system, np.array(_encode(m, q), dtype=complex))
@@ -391,7 +391,7 @@ def every_assembly(mechanism: Mechanism | str | Any, driver: float | None = None
     return assemblies(m, seed=seed)
 
 
-def _same(a: tuple[float, ...] | list[float], b: tuple[float, ...], m: Mechanism, tol: float = 1e-9) -> bool:
+def same_configuration(a: tuple[float, ...] | list[float], b: tuple[float, ...], m: Mechanism, tol: float = 1e-9) -> bool:
     """Whether two configurations are one, to ``tol`` (rad, or of the mechanism's size)."""
     for u, x, y in zip(m.unknowns, a, b):
         if u.kind == "angle":

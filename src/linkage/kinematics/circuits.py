@@ -1,0 +1,271 @@
+"""Circuits: which assemblies a mechanism can reach from one another by moving.
+
+Every real assembly at the driver's value lies on a closed curve of configurations, the
+solutions (q, driver) of the loop equations Phi(q, driver) = 0: the mechanism's circuit.
+Two assemblies are on one circuit when the mechanism can move from one to the other
+without taking it apart; it then passes through limit positions, where the driver turns
+back (Chase and Mirth 1993, "Circuits and branches of single-degree-of-freedom planar
+linkages", J. Mech. Des. 115(2):223-230). A sweep over the driver cannot follow a circuit
+past a limit position; this follows the curve itself, by its arc length (pseudo-arclength
+continuation: Allgower and Georg, "Introduction to Numerical Continuation Methods",
+SIAM 2003, chapter 2):
+
+- the tangent t spans the null space of [J | dPhi/d(driver)], oriented as the last one;
+- predict y + h t, correct by Newton's method on Phi = 0 with t . (y - y_pred) = 0;
+- a step whose corrector needs more than CORRECTOR_STEPS iterations, or moves more than
+  half the step, is halved (so it cannot jump to a neighbouring curve);
+- where the tangent's driver part changes sign, the driver turns back: a limit position,
+  refined by fitting the driver along the arc;
+- where the curve crosses the starting driver value, the configuration is solved at that
+  value exactly and matched against the assemblies; meeting the first one again closes the
+  circuit.
+
+Variables are in units of the mechanism's size (angles in radians), so that a step's
+length means the same for a crank angle and a slide.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..problems.loops import Mechanism
+from .assemblies import Assemblies, assemblies, same_configuration
+
+MAX_STEP = 0.05
+"""Largest arc step (rad, or of the mechanism's size): a picture needs about 1/20 rad."""
+MIN_STEP = 1e-9
+CORRECTOR_STEPS = 5
+MAX_STEPS = 40_000
+"""A circuit longer than this many steps is reported as unfinished, with its rows."""
+TOLERANCE = 1e-13
+"""A corrected point: max|Phi| at most this, relative to the mechanism's size."""
+MATCH = 1e-7
+"""Configurations closer than this (rad, or of the size) are the same assembly."""
+
+
+@dataclass(frozen=True)
+class Circuit:
+    """One closed curve of configurations, and the assemblies at the start value on it."""
+
+    members: tuple[int, ...]  # indices into Assemblies.real (0-based)
+    status: str  # "closed", "unfinished" (MAX_STEPS), "failed" (steps below MIN_STEP), "unbounded"
+    driver_low: float  # internal units: the smallest and largest driver value on the curve
+    driver_high: float
+    full_turn: bool  # an angle driver turns a full revolution on this circuit
+    limits: tuple[float, ...]  # driver values (internal units) where the driver turns back
+    crossings: int  # singular points passed (det of the augmented Jacobian changes sign)
+    steps: int
+    rejected: int
+    drivers: tuple[float, ...]  # the curve, for a picture (internal units, unwrapped)
+    configurations: tuple[tuple[float, ...], ...]
+
+
+@dataclass(frozen=True)
+class Circuits:
+    assemblies: Assemblies
+    circuits: tuple[Circuit, ...]
+
+    def circuit_of(self, member: int) -> int:
+        """The circuit (0-based) that assembly ``member`` (0-based) lies on."""
+        for k, c in enumerate(self.circuits):
+            if member in c.members:
+                return k
+        raise KeyError(member)
+
+
+def _scales(m: Mechanism) -> np.ndarray:
+    """The unit of each variable (unknowns, then the driver): 1 for an angle, the size for
+    a length."""
+    size = m.length_scale
+    return np.array([1.0 if u.kind == "angle" else size for u in m.unknowns]
+                    + [1.0 if m.driver.kind == "angle" else size])
+
+
+class _Curve:
+    """Phi and its full Jacobian [J | dPhi/dd] in scaled variables y = (q, d) / scales."""
+
+    def __init__(self, m: Mechanism) -> None:
+        self.m = m
+        self.scale = _scales(m)
+        self.size = m.length_scale
+
+    def at(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        x = y * self.scale
+        F, J, V = self.m.model.factory(float(x[-1]))
+        q = [float(v) for v in x[:-1]]
+        jac = np.empty((len(q), len(q) + 1))
+        jac[:, :-1] = np.array(J(q), dtype=float)
+        jac[:, -1] = np.array(V(q), dtype=float)
+        return np.array(F(q), dtype=float) / self.size, jac * self.scale / self.size
+
+
+def _tangent(jac: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
+    """The unit null vector of the n x (n+1) Jacobian, pointing along ``previous``."""
+    t = np.linalg.svd(jac)[2][-1]
+    if previous is not None and float(t @ previous) < 0.0:
+        t = -t
+    return t
+
+
+def _correct(curve: _Curve, y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray | None, int]:
+    """Newton's method on Phi(y) = 0, t . (y - y_pred) = 0, from the prediction ``y``."""
+    y0 = y.copy()
+    for k in range(1, CORRECTOR_STEPS + 1):
+        f, jac = curve.at(y)
+        if not np.all(np.isfinite(f)):
+            return None, k
+        a = np.vstack([jac, t])
+        rhs = np.concatenate([f, [float(t @ (y - y0))]])
+        try:
+            dy = np.linalg.solve(a, rhs)
+        except np.linalg.LinAlgError:
+            return None, k
+        y = y - dy
+        if float(np.max(np.abs(dy))) <= 1e-14 * max(1.0, float(np.max(np.abs(y)))):
+            f, _ = curve.at(y)
+            return (y, k) if float(np.max(np.abs(f))) <= TOLERANCE * 10 else (None, k)
+    f, _ = curve.at(y)
+    return (y, CORRECTOR_STEPS) if float(np.max(np.abs(f))) <= TOLERANCE else (None, CORRECTOR_STEPS)
+
+
+def _solve_at(curve: _Curve, y: np.ndarray, d: float) -> np.ndarray | None:
+    """The configuration at driver ``d`` (scaled) near ``y``: Newton on Phi with d fixed."""
+    y = y.copy()
+    y[-1] = d
+    for _ in range(8):
+        f, jac = curve.at(y)
+        try:
+            dq = np.linalg.solve(jac[:, :-1], f)
+        except np.linalg.LinAlgError:
+            return None
+        y[:-1] -= dq
+        if float(np.max(np.abs(dq))) <= 1e-15 * max(1.0, float(np.max(np.abs(y)))):
+            break
+    f, _ = curve.at(y)
+    return y if float(np.max(np.abs(f))) <= 1e-12 else None
+
+
+def _limit(curve: _Curve, a: np.ndarray, ta: np.ndarray, h: float, slope_end: float) -> float:
+    """The driver (scaled) at the limit position within the arc step of length ``h`` from
+    ``a``: where the driver's slope along the arc (the tangent's last part) is zero,
+    found by the Illinois method on the arc coordinate s along ``ta``, each trial point
+    corrected onto the curve. Near its extremum the driver is quadratic in s, so an error
+    e in s is an error of order e^2 in the driver."""
+    s_lo, g_lo, s_hi, g_hi = 0.0, float(ta[-1]), h, slope_end
+    best = a
+    side = 0
+    for _ in range(40):
+        s = s_lo - g_lo * (s_hi - s_lo) / (g_hi - g_lo)
+        y, _k = _correct(curve, a + s * ta, ta)
+        if y is None:
+            break
+        best = y
+        g = float(_tangent(curve.at(y)[1], ta)[-1])
+        if abs(g) <= 1e-14 or s_hi - s_lo <= 1e-15 * max(1.0, h):
+            break
+        if (g > 0) == (g_lo > 0):
+            s_lo, g_lo = s, g
+            if side == -1:
+                g_hi *= 0.5
+            side = -1
+        else:
+            s_hi, g_hi = s, g
+            if side == 1:
+                g_lo *= 0.5
+            side = 1
+    return float(best[-1])
+
+
+def _phase(m: Mechanism, d: float, d0: float) -> float:
+    """Where ``d`` is relative to the start value: a signed distance, folded into one turn
+    for an angle driver (so that a crank meets its start again after 2 pi)."""
+    if m.driver.kind == "angle":
+        return (d - d0 + math.pi) % (2.0 * math.pi) - math.pi
+    return d - d0
+
+
+def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
+    m = start.mechanism
+    y = np.array([*list(start.real[first].q), start.driver]) / curve.scale
+    _f, jac = curve.at(y)
+    t = _tangent(jac, None)
+    if t[-1] < 0:
+        t = -t  # leave with the driver increasing
+    ys, ts = [y], [t]
+    members, limits = {first}, []
+    h, steps, rejected, crossings = MAX_STEP / 4, 0, 0, 0
+    sign = np.sign(np.linalg.det(np.vstack([jac, t])))
+    travelled = 0.0
+    size_bound = 1e4 * max(1.0, float(np.max(np.abs(y[:-1]))))
+    status = "unfinished"
+    while steps < MAX_STEPS:
+        predicted = ys[-1] + h * ts[-1]
+        y_new, k = _correct(curve, predicted, ts[-1])
+        if y_new is not None:
+            t_new = _tangent(curve.at(y_new)[1], ts[-1])
+        if (y_new is None or float(np.linalg.norm(y_new - predicted)) > 0.5 * h
+                or float(t_new @ ts[-1]) < 0.9):
+            rejected += 1
+            h *= 0.5
+            if h < MIN_STEP:
+                status = "failed"
+                break
+            continue
+        _f, jac = curve.at(y_new)
+        steps += 1
+        travelled += float(np.linalg.norm(y_new - ys[-1]))
+        new_sign = np.sign(np.linalg.det(np.vstack([jac, t_new])))
+        if new_sign != sign and new_sign != 0:
+            crossings += 1
+            sign = new_sign
+        ys.append(y_new)
+        ts.append(t_new)
+        if ts[-2][-1] * t_new[-1] < 0:
+            h_step = float((y_new - ys[-2]) @ ts[-2])
+            limits.append(float(_limit(curve, ys[-2], ts[-2], h_step, float(t_new[-1])) * curve.scale[-1]))
+        if float(np.max(np.abs(y_new[:-1]))) > size_bound:
+            status = "unbounded"
+            break
+        p0 = _phase(m, float(ys[-2][-1] * curve.scale[-1]), float(start.driver))
+        p1 = _phase(m, float(y_new[-1] * curve.scale[-1]), float(start.driver))
+        if (p0 <= 0.0 < p1 or p1 <= 0.0 < p0) and abs(p1 - p0) < math.pi:
+            # crossed the start value: which assembly is this?
+            d_cross = float(y_new[-1]) - p1 / curve.scale[-1]
+            at = _solve_at(curve, y_new, d_cross)
+            if at is not None:
+                q = list(at[:-1] * curve.scale[:-1])
+                for i, a in enumerate(start.real):
+                    if same_configuration(q, a.q, m, MATCH):
+                        if i == first and travelled > 4.0 * MAX_STEP:
+                            status = "closed"
+                            ys[-1] = at  # end on the start configuration, not past it
+                        members.add(i)
+                        break
+            if status == "closed":
+                break
+        h = min(MAX_STEP, h * (1.5 if k <= 2 else 1.0))
+    drivers = [float(v[-1] * curve.scale[-1]) for v in ys]
+    configurations = [tuple(float(x) for x in v[:-1] * curve.scale[:-1]) for v in ys]
+    full = m.driver.kind == "angle" and max(drivers) - min(drivers) >= 2.0 * math.pi - 1e-9
+    low, high = min(drivers + limits), max(drivers + limits)  # a limit is refined, a sample is not
+    return Circuit(tuple(sorted(members)), status, low, high, full, tuple(limits),
+                   crossings, steps, rejected, tuple(drivers), tuple(configurations))
+
+
+def circuits(m: Mechanism, driver: float | None = None, seed: int = 0,
+             found: Assemblies | None = None) -> Circuits:
+    """Every real assembly at ``driver`` (internal units; the file's by default) and the
+    circuit each lies on (module docstring)."""
+    start = found if found is not None else assemblies(m, driver, seed=seed)
+    curve = _Curve(start.mechanism)
+    out: list[Circuit] = []
+    for i in range(len(start.real)):
+        if any(i in c.members for c in out):
+            continue
+        out.append(_trace(curve, start, i))
+    return Circuits(start, tuple(out))
+
+
