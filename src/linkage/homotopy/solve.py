@@ -28,7 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .polynomials import PolySystem, total_degree_start, total_degree_start_points
+from .polynomials import PolySystem
+from .start import start_for
 from .tracker import Homotopy, PathLog, track
 
 ENDGAME_RADIUS = 0.01
@@ -52,7 +53,8 @@ SINGULAR_CONDITION = 1e8
 double root computed in double precision sits about sqrt(eps) = 1.5e-8 from its twin, and
 its condition is then about 1e8."""
 REAL = 1e-9
-"""A solution is real when every imaginary part is within this of max(1, |x|)."""
+"""A solution is real when it is within this of its conjugate (:meth:`PolySystem.realness`),
+against max(1, |x|)."""
 
 
 @dataclass(frozen=True)
@@ -81,10 +83,17 @@ class Solutions:
     endpoints: tuple[Endpoint, ...]
     gamma: complex
     seconds: float
+    start: str = "total degree"  # the start system: "total degree" or "linear product"
 
     @property
     def bezout(self) -> int:
+        """The total-degree (Bezout) bound, whichever start was tracked."""
         return self.system.bezout
+
+    @property
+    def bound(self) -> int:
+        """The start system's root count, the paths tracked: the bound on isolated roots."""
+        return len(self.endpoints)
 
     def count(self, kind: str) -> int:
         return sum(e.kind == kind for e in self.endpoints)
@@ -271,8 +280,9 @@ def polish_real(system: PolySystem, x: np.ndarray, steps: int = 60) -> tuple[np.
 
 
 def solve(system: PolySystem, seed: int = 0, max_step: float = 0.1) -> Solutions:
-    """Every isolated solution of a square system by total-degree homotopy (one path per
-    solution of the start system x_i^d_i = 1; Bezout's bound of them)."""
+    """Every isolated solution of a square system: one path per root of the start system
+    (:func:`.start.start_for`: a linear product matched to ``system.groups`` where that
+    needs fewer paths, else x_i^d_i = 1, Bezout's bound of them)."""
     if len(system.polynomials) != system.n:
         raise ValueError(f"{len(system.polynomials)} equations in {system.n} unknowns: not square")
     began = time.perf_counter()
@@ -280,9 +290,10 @@ def solve(system: PolySystem, seed: int = 0, max_step: float = 0.1) -> Solutions
     gamma = complex(np.exp(2j * np.pi * rng.random()))
     patch = rng.normal(size=system.n + 1) + 1j * rng.normal(size=system.n + 1)
     patch /= np.linalg.norm(patch)
-    start = total_degree_start(system.degrees)
-    h = Homotopy(system.homogeneous, start.homogeneous, gamma, patch)
-    x0 = total_degree_start_points(system.degrees)
+    start = start_for(system, rng)
+    target = system.homogenised(start.degrees) if start.degrees != system.degrees else system.homogeneous
+    h = Homotopy(target, start.form, gamma, patch)
+    x0 = start.points
     X = np.concatenate([np.ones((len(x0), 1), dtype=complex), x0], axis=1)
     X = X / (X @ patch)[:, None]
     endpoints = _run(system, h, X, np.arange(len(X)), max_step, retracked=False)
@@ -293,7 +304,7 @@ def solve(system: PolySystem, seed: int = 0, max_step: float = 0.1) -> Solutions
         idx = np.array(sorted(set(again)))
         for i, e in zip(idx, _run(system, h, X[idx], idx, max_step / 16.0, retracked=True)):
             endpoints[i] = e
-    return Solutions(system, tuple(endpoints), gamma, time.perf_counter() - began)
+    return Solutions(system, tuple(endpoints), gamma, time.perf_counter() - began, start.kind)
 
 
 def _duplicates(endpoints: list[Endpoint]) -> list[int]:
@@ -312,6 +323,44 @@ def _duplicates(endpoints: list[Endpoint]) -> list[int]:
     return out
 
 
+STRAIGHT_CONDITION = 1e6
+"""A path tracked on from t = 1 - ENDGAME_RADIUS to t = 1 itself ends there without the
+endgame when its end is finite (|X0| / |X| above ENDGAME_FINITE) and the target's Jacobian
+on the patch, rows scaled to unit length, has a condition number below this: a
+nonsingular root, reached by a converged corrector (cycle number 1). Every other path,
+singular or going to infinity, takes the endgame from t = 1 - ENDGAME_RADIUS."""
+ENDGAME_FINITE = 1e-4
+
+
+def _straight(h: Homotopy, X: np.ndarray, ok: np.ndarray, log: PathLog,
+              step: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Which paths end at a nonsingular root when tracked straight on to t = 1, and their
+    ends: (mask over all paths, ends). The attempt's steps are added to the paths' logs; a
+    path whose attempt fails is not failed (the endgame takes it), so its reason is dropped."""
+    P = len(X)
+    mask = np.zeros(P, bool)
+    live = np.flatnonzero(ok)
+    if not len(live):
+        return mask, X
+    trial = PathLog.empty(len(live))
+    ends, good, _ = track(h, X[live], np.full(len(live), 1.0 - ENDGAME_RADIUS), np.ones(len(live)),
+                          lambda t: t + 0j, lambda t: np.ones_like(t) + 0j, trial, np.arange(len(live)),
+                          step[live].copy(), ENDGAME_RADIUS)
+    log.steps[live] += trial.steps
+    log.rejected[live] += trial.rejected
+    log.newton[live] += trial.newton
+    log.smallest_step[live] = np.minimum(log.smallest_step[live], trial.smallest_step)
+    finite = np.abs(ends[:, 0]) > ENDGAME_FINITE * _norm(ends)
+    _, J, _ = h.residual_and_jacobians(ends, np.ones(len(live)))
+    J = J / np.maximum(_norm(J), 1e-300)[:, :, None]
+    with np.errstate(all="ignore"):
+        cond = np.linalg.cond(J)
+    mask[live] = good & finite & (cond <= STRAIGHT_CONDITION)
+    out = X.copy()
+    out[live] = ends
+    return mask, out
+
+
 def _run(system: PolySystem, h: Homotopy, X: np.ndarray, paths: np.ndarray, max_step: float,
          retracked: bool) -> list[Endpoint]:
     P = len(X)
@@ -322,7 +371,9 @@ def _run(system: PolySystem, h: Homotopy, X: np.ndarray, paths: np.ndarray, max_
                         lambda t: np.ones_like(t) + 0j, log, index, step, max_step)
     est = np.full(X.shape, np.nan + 0j)
     cycle = np.zeros(P, int)
-    live = np.flatnonzero(ok)
+    straight, ends = _straight(h, X, ok, log, step)
+    est[straight], cycle[straight] = ends[straight], 1
+    live = np.flatnonzero(ok & ~straight)
     if len(live):
         e, c, good = _endgame(h, X[live], live, log, step[live], max_step)
         est[live], cycle[live] = e, c
@@ -342,8 +393,8 @@ def _run(system: PolySystem, h: Homotopy, X: np.ndarray, paths: np.ndarray, max_
             continue
         x, residual, cond = _refine(system, Xi[1:] / Xi[0])
         singular = cycle[i] > 1 or not cond <= SINGULAR_CONDITION
-        real = bool(np.all(np.abs(x.imag) <= REAL * max(1.0, float(np.linalg.norm(x)))))
+        real = system.realness(x) <= REAL
         if real:
-            x = x.real + 0j
+            x = system.nearest_real(x)
         out.append(Endpoint("singular" if singular else "finite", x, real, residual, cond, **common))
     return out

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .polynomials import HomogeneousForm
+from .start import LinearProduct
 
 CORRECTOR_TOL = 1e-11
 """A corrector has converged when its last Newton step is this small against |X|."""
@@ -33,7 +34,7 @@ class Homotopy:
     """H(X, t) = (1 - t) gamma G + t F on the patch a.X = 1."""
 
     target: HomogeneousForm
-    start: HomogeneousForm
+    start: HomogeneousForm | LinearProduct
     gamma: complex
     patch: np.ndarray  # (n + 1,)
 
