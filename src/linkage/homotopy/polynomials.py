@@ -105,10 +105,15 @@ class HomogeneousForm:
     max_power: int
 
     @classmethod
-    def of(cls, system: PolySystem, degrees: Sequence[int] | None = None) -> HomogeneousForm:
-        degrees = system.degrees if degrees is None else tuple(degrees)
-        if any(d < own for d, own in zip(degrees, system.degrees)) or len(degrees) != len(system.degrees):
-            raise ValueError(f"degrees {degrees} below the polynomials' own {system.degrees}")
+    def of(cls, system: PolySystem, degrees: Sequence[int] | None = None,
+           counted: int | None = None) -> HomogeneousForm:
+        """``counted``: only the first so many variables count toward a term's degree (the
+        unknowns of a family whose last variables are its parameters, :mod:`.parameter`)."""
+        counted = system.n if counted is None else counted
+        own = tuple(max(sum(e[:counted]) for e in p) for p in system.polynomials)
+        degrees = own if degrees is None else tuple(degrees)
+        if any(d < o for d, o in zip(degrees, own)) or len(degrees) != len(own):
+            raise ValueError(f"degrees {degrees} below the polynomials' own {own}")
         index: dict[tuple[int, ...], int] = {}
 
         def slot(e: tuple[int, ...]) -> int:
@@ -119,7 +124,7 @@ class HomogeneousForm:
         terms = []
         for d, p in zip(degrees, system.polynomials):
             for e, c in p.items():
-                terms.append((d, (d - sum(e), *e), complex(c)))
+                terms.append((d, (d - sum(e[:counted]), *e), complex(c)))
         # every monomial and every first derivative's monomial, in one list
         for _, e, _ in terms:
             slot(e)
@@ -131,7 +136,7 @@ class HomogeneousForm:
         D = np.zeros((m, nv, len(index)), dtype=complex)
         for i, (d, p) in enumerate(zip(degrees, system.polynomials)):
             for e, c in p.items():
-                h = (d - sum(e), *e)
+                h = (d - sum(e[:counted]), *e)
                 C[i, index[h]] += c
                 for v, k in enumerate(h):
                     if k:

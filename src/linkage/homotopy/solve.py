@@ -30,7 +30,7 @@ import numpy as np
 
 from .polynomials import PolySystem
 from .start import start_for
-from .tracker import Homotopy, PathLog, track
+from .tracker import Homotopy, PathHomotopy, PathLog, track
 
 ENDGAME_RADIUS = 0.01
 """Where the endgame starts: t = 1 - ENDGAME_RADIUS."""
@@ -115,7 +115,7 @@ SINGULAR_RESIDUAL = 1e-7
 """A singular endpoint's relative residual: a double root is found to about sqrt(eps)."""
 
 
-def _projective_residual(h: Homotopy, X: np.ndarray) -> np.ndarray:
+def _projective_residual(h: PathHomotopy, X: np.ndarray) -> np.ndarray:
     """max_i |F_i(X)| / (sum |coefficients of F_i| |X|^d_i), F the target system."""
     F = h.target.evaluate(X)
     size = _norm(X)
@@ -124,7 +124,7 @@ def _projective_residual(h: Homotopy, X: np.ndarray) -> np.ndarray:
     return (np.abs(F) / (coef[None, :] * size[:, None] ** degree)).max(axis=1)
 
 
-def _endgame(h: Homotopy, X: np.ndarray, index: np.ndarray, log: PathLog, step: np.ndarray,
+def _endgame(h: PathHomotopy, X: np.ndarray, index: np.ndarray, log: PathLog, step: np.ndarray,
              max_step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Cauchy's endgame for paths at t = 1 - ENDGAME_RADIUS: (estimates, cycle numbers, ok).
     Around a circle the steps are in its angle, up to one sample's arc; along the real line
@@ -293,18 +293,27 @@ def solve(system: PolySystem, seed: int = 0, max_step: float = 0.1) -> Solutions
     start = start_for(system, rng)
     target = system.homogenised(start.degrees) if start.degrees != system.degrees else system.homogeneous
     h = Homotopy(target, start.form, gamma, patch)
-    x0 = start.points
-    X = np.concatenate([np.ones((len(x0), 1), dtype=complex), x0], axis=1)
-    X = X / (X @ patch)[:, None]
+    endpoints = track_all(system, h, on_patch(start.points, patch), max_step)
+    return Solutions(system, tuple(endpoints), gamma, time.perf_counter() - began, start.kind)
+
+
+def on_patch(x: np.ndarray, patch: np.ndarray) -> np.ndarray:
+    """Affine points (P, n) as projective ones (1, x) scaled onto the patch a.X = 1."""
+    X = np.concatenate([np.ones((len(x), 1), dtype=complex), x], axis=1)
+    return X / (X @ patch)[:, None]
+
+
+def track_all(system: PolySystem, h: PathHomotopy, X: np.ndarray, max_step: float = 0.1) -> list[Endpoint]:
+    """Every path of ``h`` from the projective points X (on its patch) to t = 1, each endpoint
+    classified against ``system`` (the target, affine). A failed path, or two paths on one
+    nonsingular solution (one jumped), is tracked again with smaller steps."""
     endpoints = _run(system, h, X, np.arange(len(X)), max_step, retracked=False)
-    # a failed path, or two paths on one nonsingular solution (one jumped), is tracked
-    # again with smaller steps
     again = [i for i, e in enumerate(endpoints) if e.kind == "failed"] + _duplicates(endpoints)
     if again:
         idx = np.array(sorted(set(again)))
         for i, e in zip(idx, _run(system, h, X[idx], idx, max_step / 16.0, retracked=True)):
             endpoints[i] = e
-    return Solutions(system, tuple(endpoints), gamma, time.perf_counter() - began, start.kind)
+    return endpoints
 
 
 def _duplicates(endpoints: list[Endpoint]) -> list[int]:
@@ -332,7 +341,7 @@ singular or going to infinity, takes the endgame from t = 1 - ENDGAME_RADIUS."""
 ENDGAME_FINITE = 1e-4
 
 
-def _straight(h: Homotopy, X: np.ndarray, ok: np.ndarray, log: PathLog,
+def _straight(h: PathHomotopy, X: np.ndarray, ok: np.ndarray, log: PathLog,
               step: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Which paths end at a nonsingular root when tracked straight on to t = 1, and their
     ends: (mask over all paths, ends). The attempt's steps are added to the paths' logs; a
@@ -361,7 +370,7 @@ def _straight(h: Homotopy, X: np.ndarray, ok: np.ndarray, log: PathLog,
     return mask, out
 
 
-def _run(system: PolySystem, h: Homotopy, X: np.ndarray, paths: np.ndarray, max_step: float,
+def _run(system: PolySystem, h: PathHomotopy, X: np.ndarray, paths: np.ndarray, max_step: float,
          retracked: bool) -> list[Endpoint]:
     P = len(X)
     log = PathLog.empty(P)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
@@ -27,6 +28,24 @@ CORRECTOR_STEPS = 3
 MIN_STEP = 1e-13
 MAX_STEPS = 20_000
 """Steps a path may take before it is called failed (a path wandering near a singularity)."""
+
+
+class PathHomotopy(Protocol):
+    """What the tracker and the endgame need of a homotopy: H on the patch with its
+    Jacobians, and the target system (homogeneous) that t = 1 reaches."""
+
+    target: HomogeneousForm
+
+    def residual_and_jacobians(self, X: np.ndarray,
+                               t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+    def velocity(self, X: np.ndarray, t: np.ndarray, dt: np.ndarray) -> np.ndarray: ...
+
+
+def velocity(h: PathHomotopy, X: np.ndarray, t: np.ndarray, dt: np.ndarray) -> np.ndarray:
+    """dX along the path for a change dt of t: -H_X^-1 H_t dt (the patch held)."""
+    _, J, Ht = h.residual_and_jacobians(X, t)
+    return -_solve(J, Ht * dt[:, None])
 
 
 @dataclass(frozen=True)
@@ -54,8 +73,7 @@ class Homotopy:
                 np.concatenate([Ht, np.zeros((P, 1), dtype=complex)], axis=1))
 
     def velocity(self, X: np.ndarray, t: np.ndarray, dt: np.ndarray) -> np.ndarray:
-        _, J, Ht = self.residual_and_jacobians(X, t)
-        return -_solve(J, Ht * dt[:, None])
+        return velocity(self, X, t, dt)
 
 
 @dataclass
@@ -92,7 +110,7 @@ def _norm(X: np.ndarray) -> np.ndarray:
     return np.sqrt((X.real ** 2 + X.imag ** 2).sum(axis=1))
 
 
-def track(h: Homotopy, X: np.ndarray, tau: np.ndarray, tau_end: np.ndarray,
+def track(h: PathHomotopy, X: np.ndarray, tau: np.ndarray, tau_end: np.ndarray,
           t_of: Callable[[np.ndarray], np.ndarray], dt_of: Callable[[np.ndarray], np.ndarray],
           log: PathLog, index: np.ndarray, step: np.ndarray,
           max_step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
