@@ -64,7 +64,7 @@ class Endpoint:
     kind: str  # finite, singular, infinite, failed
     x: np.ndarray | None  # the affine point (complex), None at infinity or failed
     real: bool
-    residual: float  # max |F_i(x)| / (sum |coefficients of F_i| max(1, |x|)^d_i)
+    residual: float  # relative_residual: max |F_i(x)| / (F_i's terms' sizes at x)
     condition: float  # :func:`condition` at x (inf where singular or not finite)
     cycle: int  # the endgame's cycle number (0 where the path failed before it)
     steps: int
@@ -201,20 +201,38 @@ def _endgame(h: PathHomotopy, X: np.ndarray, index: np.ndarray, log: PathLog, st
     return estimate, cycle, ok
 
 
+def weights(x: np.ndarray) -> np.ndarray:
+    """Each variable's size at x, max(1, |x_v|): the unit its perturbations are measured in."""
+    return np.maximum(1.0, np.abs(x))
+
+
+def equation_sizes(system: PolySystem, x: np.ndarray) -> np.ndarray:
+    """Each equation's natural size at x: sum over its terms of |c| prod_v w_v^e_v, w the
+    :func:`weights` (what |F_i| is measured against: rounding in evaluating F_i is about eps
+    times this)."""
+    w = weights(x)
+    return np.array([sum(abs(c) * float(np.prod(w ** np.array(e))) for e, c in p.items())
+                     for p in system.polynomials])
+
+
 def condition(system: PolySystem, x: np.ndarray) -> float:
-    """mu = 1 / (sigma_min(D J) max(1, |x|)): J = dF/dx at x, each row scaled by D_i = 1 /
-    (the sum of |coefficients| of equation i times max(1, |x|)^(d_i - 1)), the size its
-    terms have at x. A scale-free stand-in for Shub and Smale's condition number (a 1 x 1
-    Jacobian has the 2-norm condition number 1 even at a triple root): small for a simple
-    root, unbounded at a multiple one."""
-    size = max(1.0, float(np.linalg.norm(x)))
+    """mu = 1 / sigma_min(D J W): J = dF/dx at x, each row scaled by D_i = 1 /
+    :func:`equation_sizes` and each column by W_v = :func:`weights`. A scale-free stand-in
+    for Shub and Smale's condition number (a 1 x 1 Jacobian has the 2-norm condition number
+    1 even at a triple root): how much a relative change of the equations moves the root,
+    relative to each variable's size; small for a simple root, unbounded at a multiple one."""
     J = system.jacobian(x[None])[0]
-    scale = np.array([sum(abs(c) for c in p.values()) * size ** (d - 1)
-                      for p, d in zip(system.polynomials, system.degrees)])
     if not np.all(np.isfinite(J)):
         return np.inf
-    smallest = float(np.linalg.svd(J / scale[:, None], compute_uv=False)[-1])
-    return np.inf if smallest == 0.0 else 1.0 / (smallest * size)
+    M = J * weights(x)[None, :] / equation_sizes(system, x)[:, None]
+    smallest = float(np.linalg.svd(M, compute_uv=False)[-1])
+    return np.inf if smallest == 0.0 else 1.0 / smallest
+
+
+def relative_residual(system: PolySystem, x: np.ndarray) -> float:
+    """max_i |F_i(x)| / :func:`equation_sizes` (x): about eps at a root computed to rounding."""
+    F = system.evaluate(x[None])[0]
+    return float(np.max(np.abs(F) / equation_sizes(system, x)))
 
 
 def _refine(system: PolySystem, x: np.ndarray) -> tuple[np.ndarray, float, float]:
@@ -236,11 +254,7 @@ def _refine(system: PolySystem, x: np.ndarray) -> tuple[np.ndarray, float, float
         x, F, last = x - dx, F_new, size
         if size <= 1e-16 * max(1.0, float(np.linalg.norm(x))):
             break
-    F = system.evaluate(x[None])[0]
-    size = max(1.0, float(np.linalg.norm(x)))
-    scale = np.array([sum(abs(c) for c in p.values()) * size ** d
-                      for p, d in zip(system.polynomials, system.degrees)])
-    return x, float(np.max(np.abs(F) / scale)), condition(system, x)
+    return x, relative_residual(system, x), condition(system, x)
 
 
 def polish_real(system: PolySystem, x: np.ndarray, steps: int = 60) -> tuple[np.ndarray, float]:
@@ -272,11 +286,7 @@ def polish_real(system: PolySystem, x: np.ndarray, steps: int = 60) -> tuple[np.
         x, res = trial, r
         if res == 0.0:
             break
-    size = max(1.0, float(np.linalg.norm(x)))
-    scale = np.array([sum(abs(c) for c in p.values()) * size ** d
-                      for p, d in zip(system.polynomials, system.degrees)])
-    F = system.evaluate(x[None].astype(complex))[0]
-    return x, float(np.max(np.abs(F) / scale))
+    return x, relative_residual(system, x.astype(complex))
 
 
 def solve(system: PolySystem, seed: int = 0, max_step: float = 0.1) -> Solutions:
