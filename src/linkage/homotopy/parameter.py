@@ -27,6 +27,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from itertools import pairwise
+from typing import Protocol
 
 import numpy as np
 
@@ -56,9 +57,9 @@ class Family:
         return tuple(max(sum(e[:self.n]) for e in p) for p in self.polynomials)
 
     @cached_property
-    def form(self) -> HomogeneousForm:
+    def form(self) -> JointForm:
         """Homogenised in x only, over the columns (X0, x, p)."""
-        return HomogeneousForm.of(self.joint, self.degrees, counted=self.n)
+        return JointForm(HomogeneousForm.of(self.joint, self.degrees, counted=self.n), self.n)
 
     def at(self, p: Sequence[complex] | np.ndarray) -> PolySystem:
         """The member at p, a system in x."""
@@ -73,11 +74,47 @@ class Family:
         return PolySystem(self.n, tuple(polys), groups=self.groups, conjugate=self.conjugate)
 
 
+class ParameterForm(Protocol):
+    """What a parameter homotopy needs of a family: F, dF/dX and dF/dp along a direction."""
+
+    def jet(self, X: np.ndarray, p: np.ndarray,
+            dp: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+
+class ParameterFamily(Protocol):
+    """A family as :func:`track_parameters` and :func:`monodromy` take it (:class:`Family`
+    or a family with its own evaluation, such as :mod:`.ninepoint`'s)."""
+
+    n: int
+    k: int
+
+    @property
+    def degrees(self) -> tuple[int, ...]: ...
+
+    @property
+    def form(self) -> ParameterForm: ...
+
+    def at(self, p: np.ndarray) -> PolySystem: ...
+
+
+@dataclass(frozen=True)
+class JointForm:
+    """A family's polynomials over (X0, x, p) as one HomogeneousForm."""
+
+    form: HomogeneousForm
+    n: int
+
+    def jet(self, X: np.ndarray, p: np.ndarray, dp: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """F (P, m), dF/dX (P, m, n + 1) and dF/dp . dp (P, m) at (X, p), one row a path."""
+        F, J = self.form.both(np.concatenate([X, p], axis=1))
+        return F, J[:, :, :self.n + 1], np.einsum("pmk,pk->pm", J[:, :, self.n + 1:], dp)
+
+
 @dataclass(frozen=True)
 class ParameterHomotopy:
     """H(X, t) = F(X; p(t)), p(t) = p0 + tau(t) (p1 - p0), on the patch a.X = 1."""
 
-    form: HomogeneousForm
+    form: ParameterForm
     target: HomogeneousForm
     n: int
     p0: np.ndarray
@@ -91,20 +128,22 @@ class ParameterHomotopy:
         below = t + self.gamma * (1.0 - t)
         tau, dtau = t / below, self.gamma / below ** 2
         p = self.p0[None, :] + tau[:, None] * (self.p1 - self.p0)[None, :]
-        F, J = self.form.both(np.concatenate([X, p], axis=1))
-        Ht = (J[:, :, self.n + 1:] @ (self.p1 - self.p0)) * dtau[:, None]
+        F, JX, Ht = self.form.jet(X, p, dtau[:, None] * (self.p1 - self.p0)[None, :])
         P = X.shape[0]
         patch = np.broadcast_to(self.patch, (P, 1, X.shape[1]))
         return (np.concatenate([F, (X @ self.patch - 1.0)[:, None]], axis=1),
-                np.concatenate([J[:, :, :self.n + 1], patch], axis=1),
+                np.concatenate([JX, patch], axis=1),
                 np.concatenate([Ht, np.zeros((P, 1), dtype=complex)], axis=1))
 
     def velocity(self, X: np.ndarray, t: np.ndarray, dt: np.ndarray) -> np.ndarray:
         return velocity(self, X, t, dt)
 
 
-def track_parameters(family: Family, p0: Sequence[complex] | np.ndarray, p1: Sequence[complex] | np.ndarray,
-                     roots: np.ndarray, seed: int = 0, max_step: float = 0.1) -> Solutions:
+Parameters = Sequence[complex] | np.ndarray
+
+
+def track_parameters(family: ParameterFamily, p0: Parameters, p1: Parameters, roots: np.ndarray,
+                     seed: int = 0, max_step: float = 0.1) -> Solutions:
     """Every root of F(x; p0) in ``roots`` (affine, one a row) tracked to p1; each endpoint
     classified, refined and checked against F(x; p1) as :func:`.solve.solve` does."""
     began = time.perf_counter()
@@ -147,10 +186,11 @@ def _is_new(x: np.ndarray, known: list[np.ndarray]) -> bool:
     return all(np.linalg.norm(x - y) > SAME * size for y in known)
 
 
-def monodromy(family: Family, p: Sequence[complex] | np.ndarray, seeds: np.ndarray, stable_loops: int = 5,
-              max_loops: int = 200, seed: int = 0) -> Monodromy:
+def monodromy(family: ParameterFamily, p: Parameters, seeds: np.ndarray, stable_loops: int = 5,
+              max_loops: int = 200, seed: int = 0, max_seconds: float = np.inf) -> Monodromy:
     """Loops p -> p1 -> p2 -> p through random complex parameters, each tracking every known
-    root, until ``stable_loops`` loops in a row add none (or ``max_loops`` loops)."""
+    root, until ``stable_loops`` loops in a row add none, or after ``max_loops`` loops, or
+    the first loop to end past ``max_seconds`` (then ``stable`` says how settled it was)."""
     began = time.perf_counter()
     rng = np.random.default_rng(seed)
     p = np.asarray(p, dtype=complex)
@@ -179,6 +219,6 @@ def monodromy(family: Family, p: Sequence[complex] | np.ndarray, seeds: np.ndarr
                     known.append(x)
         counts.append(len(known))
         stable = 0 if len(known) > before else stable + 1
-        if stable >= stable_loops:
+        if stable >= stable_loops or time.perf_counter() - began > max_seconds:
             break
     return Monodromy(p, np.array(known), tuple(counts), stable, paths, dropped, time.perf_counter() - began)

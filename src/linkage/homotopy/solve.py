@@ -210,9 +210,9 @@ def equation_sizes(system: PolySystem, x: np.ndarray) -> np.ndarray:
     """Each equation's natural size at x: sum over its terms of |c| prod_v w_v^e_v, w the
     :func:`weights` (what |F_i| is measured against: rounding in evaluating F_i is about eps
     times this)."""
-    w = weights(x)
-    return np.array([sum(abs(c) * float(np.prod(w ** np.array(e))) for e, c in p.items())
-                     for p in system.polynomials])
+    form = system.homogeneous
+    W = np.concatenate([[1.0], weights(x)])[None].astype(complex)
+    return (np.abs(form.coefficients) @ form.monomials(W).real)[:, 0]
 
 
 def condition(system: PolySystem, x: np.ndarray) -> float:
