@@ -366,7 +366,18 @@ def test_json_and_csv_carry_the_counts_and_every_table(cli, tmp_path):
     names = [t["name"] for t in doc["tables"]]
     assert names == ["assemblies", "joints", "paths"]
     r = cli("assemblies", str(SAMPLES / "rapier_drive.toml"), "--paths", "-f", "plain")
-    assert "Paths" in r.out and "cycle" in r.out
+    assert "Paths" in r.out and "cycle" in r.out and "endgame" in r.out
+
+
+def test_a_path_to_a_limit_position_takes_the_endgame_and_a_clean_root_does_not():
+    """Tracked to t = 1 itself, a path that ends at a nonsingular root needs no endgame; a
+    near-double root (the ME581 3e-10 deg inside its limit position) is not, and takes it."""
+    m = load(SAMPLES / "fourbar_me581.toml")
+    clean = linkage.assemblies(m)
+    assert [e.endgame for e in clean.solutions.endpoints] == [False, False]
+    limit = linkage.assemblies(m, 112.024312837)
+    assert [e.endgame for e in limit.solutions.endpoints] == [True, True]
+    assert len(limit.real) == 2
 
 
 @pytest.mark.parametrize("args,says", [

@@ -73,6 +73,7 @@ class Endpoint:
     smallest_step: float
     retracked: bool
     note: str = ""
+    endgame: bool = True  # the Cauchy endgame ran (False: tracked to t = 1 itself, nonsingular there)
 
 
 @dataclass(frozen=True)
@@ -401,7 +402,7 @@ def _run(system: PolySystem, h: PathHomotopy, X: np.ndarray, paths: np.ndarray, 
     for i in range(P):
         common = dict(cycle=int(cycle[i]), steps=int(log.steps[i]), rejected=int(log.rejected[i]),
                       newton=int(log.newton[i]), smallest_step=float(log.smallest_step[i]),
-                      retracked=retracked)
+                      retracked=retracked, endgame=not straight[i])
         if not ok[i] or not np.all(np.isfinite(est[i])):
             out.append(Endpoint("failed", None, False, np.inf, np.inf, note=log.failure[i] or "no estimate",
                                 **common))

@@ -28,7 +28,7 @@ def assemblies_tables(a: Any) -> tuple[DataTable, ...]:
     joints = [(i + 1, name, x, y) for i, s in enumerate(a.real) for name, (x, y) in s.joints.items()]
     paths = [(k + 1, e.kind, e.real if e.kind in ("finite", "singular") else None, e.cycle, e.steps,
               e.rejected, e.newton, e.smallest_step if math.isfinite(e.smallest_step) else None,
-              e.retracked, e.note) for k, e in enumerate(a.solutions.endpoints)]
+              e.retracked, e.endgame, e.note) for k, e in enumerate(a.solutions.endpoints)]
     return (
         from_rows("assemblies", heads, rows),
         from_rows("joints", [("assembly", "", "int"), ("joint", "", "text"), ("x", m.length_unit, "number"),
@@ -36,7 +36,7 @@ def assemblies_tables(a: Any) -> tuple[DataTable, ...]:
         from_rows("paths", [("path", "", "int"), ("endpoint", "", "text"), ("real", "", "bool"),
                             ("cycle", "", "int"), ("steps", "", "int"), ("rejected", "", "int"),
                             ("newton", "", "int"), ("smallest_step", "", "number"), ("retracked", "", "bool"),
-                            ("note", "", "text")], paths),
+                            ("endgame", "", "bool"), ("note", "", "text")], paths),
     )
 
 
