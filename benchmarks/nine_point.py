@@ -29,22 +29,25 @@ def main() -> None:
     args = parser.parse_args()
     family = NinePointFamily()
     p, v = seed_instance(np.random.default_rng(args.seed))
+    cpu = time.process_time()
     found = monodromy(family, p, v[None], stable_loops=5, seed=args.seed, max_seconds=args.seconds)
-    rate = found.paths / found.seconds
+    cpu = time.process_time() - cpu
     print(f"monodromy: {len(found.roots)} roots of a generic instance (of {GENERIC_ROOTS}) after "
           f"{len(found.counts)} loops, counts {list(found.counts)}; {found.paths} paths in "
-          f"{found.seconds:.1f} s = {rate:.2f} paths/s; {found.dropped} paths lost on some leg")
-    began = time.perf_counter()
+          f"{found.seconds:.1f} s = {found.paths / found.seconds:.2f} paths/s ({cpu:.1f} s of CPU = "
+          f"{found.paths / cpu:.2f} paths per CPU second); {found.dropped} paths lost on some leg")
+    began, cpu = time.perf_counter(), time.process_time()
     ends = track_parameters(family, p, parameters(PROBLEM_3), found.roots, seed=args.seed)
-    seconds = time.perf_counter() - began
+    seconds, cpu = time.perf_counter() - began, time.process_time() - cpu
     kinds = {k: sum(e.kind == k for e in ends.endpoints)
              for k in ("finite", "singular", "infinite", "failed")}
     real = sum(e.kind == "finite" and e.real for e in ends.endpoints)
     paths = len(ends.endpoints)
-    print(f"to Problem 3: {paths} paths in {seconds:.1f} s = {paths / seconds:.2f} paths/s; "
-          f"endpoints {kinds}, {real} real (finite and nonsingular)")
-    print(f"estimate for all {GENERIC_ROOTS} at these rates: tracking them to a new instance "
-          f"{GENERIC_ROOTS / (len(ends.endpoints) / seconds) / 60:.0f} min")
+    print(f"to Problem 3: {paths} paths in {seconds:.1f} s = {paths / seconds:.2f} paths/s ({cpu:.1f} s of "
+          f"CPU = {paths / cpu:.2f} paths per CPU second); endpoints {kinds}, {real} real (finite and "
+          "nonsingular)")
+    print(f"at that rate all {GENERIC_ROOTS} tracked to a new instance would take "
+          f"{GENERIC_ROOTS / (paths / cpu) / 60:.0f} CPU minutes")
 
 
 if __name__ == "__main__":
