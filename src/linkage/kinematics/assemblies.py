@@ -23,6 +23,7 @@ import numpy as np
 from ..errors import InputError
 from ..homotopy import PolySystem, Solutions, condition, solve
 from ..problems.loops import ANGLE_UNITS, DRIVER, Mechanism
+from ..units import degrees, radians
 from .angles import nearest_turn
 
 Monomials = dict[tuple[int, ...], complex]
@@ -345,7 +346,7 @@ def assemblies(m: Mechanism, driver: float | None = None, seed: int = 0) -> Asse
     multiplicity: list[int] = []
 
     def keep(q: list[float], times: int = 1) -> bool:
-        q = [math.radians(nearest_turn(math.degrees(u.value), math.degrees(v))) if u.kind == "angle" else v
+        q = [radians(nearest_turn(degrees(u.value), degrees(v))) if u.kind == "angle" else v
              for u, v in zip(m.unknowns, q)]  # angles in the turn of the file's guess
         if any(_same(q, a.q, m) for a in real):
             return False
