@@ -99,7 +99,7 @@ def test_every_assembly_of_a_closed_form_sample_is_its_closed_forms(name):
             assert s.residual <= 1e-12
             assert s.branch in names
         assert a.failed == 0 and a.unresolved == 0
-        assert sum(a.multiplicity) + a.complex_count + a.infinite == a.bezout
+        assert sum(a.multiplicity) + a.complex_count + a.infinite == a.bound <= a.bezout
 
 
 def _fourbar_text(r1: float, r2: float, r3: float, r4: float, theta2: float) -> str:
@@ -346,8 +346,8 @@ def test_a_rocker_driven_four_bars_mirror_assembly_is_named_as_branch_takes_it()
 def test_the_command_lists_every_assembly_and_counts_the_paths(cli):
     r = cli("assemblies", str(SAMPLES / "watt_sixbar.toml"), "-f", "plain")
     assert r.code == 0, r.err
-    assert ("16 paths (Bezout's bound), total-degree homotopy: 4 real assemblies, 0 complex, 12 at infinity"
-            in r.out)
+    assert ("4 paths (the linear-product Bezout number of the grouping {z}, {w}; total degree 16): "
+            "4 real assemblies, 0 complex, 0 at infinity" in r.out)
     for name in ("open/open", "open/crossed", "crossed/open", "crossed/crossed"):
         assert f" {name} " in r.out
 
@@ -361,11 +361,23 @@ def test_no_assembly_is_exit_1_with_a_line_saying_so(cli):
 def test_json_and_csv_carry_the_counts_and_every_table(cli, tmp_path):
     r = cli("assemblies", str(SAMPLES / "rapier_drive.toml"), "-f", "json")
     doc = json.loads(r.out)
-    assert (doc["bezout"], doc["real"], doc["complex"], doc["infinite"], doc["failed"]) == (8, 4, 2, 2, 0)
+    assert (doc["bezout"], doc["bound"], doc["real"], doc["complex"], doc["infinite"], doc["failed"]) == (
+        8, 6, 4, 2, 0, 0)
     names = [t["name"] for t in doc["tables"]]
     assert names == ["assemblies", "joints", "paths"]
     r = cli("assemblies", str(SAMPLES / "rapier_drive.toml"), "--paths", "-f", "plain")
-    assert "Paths" in r.out and "cycle" in r.out
+    assert "Paths" in r.out and "cycle" in r.out and "endgame" in r.out
+
+
+def test_a_path_to_a_limit_position_takes_the_endgame_and_a_clean_root_does_not():
+    """Tracked to t = 1 itself, a path that ends at a nonsingular root needs no endgame; a
+    near-double root (the ME581 3e-10 deg inside its limit position) is not, and takes it."""
+    m = load(SAMPLES / "fourbar_me581.toml")
+    clean = linkage.assemblies(m)
+    assert [e.endgame for e in clean.solutions.endpoints] == [False, False]
+    limit = linkage.assemblies(m, 112.024312837)
+    assert [e.endgame for e in limit.solutions.endpoints] == [True, True]
+    assert len(limit.real) == 2
 
 
 @pytest.mark.parametrize("args,says", [
@@ -380,13 +392,18 @@ def test_bad_input_is_one_line_and_exit_2(cli, args, says):
 
 
 def test_the_polynomial_system_is_the_loops():
-    """At a real assembly the polynomials vanish, and c^2 + s^2 = 1 holds: the system is
-    the loops, not a look-alike."""
+    """At a real assembly the polynomials vanish, and z w = 1 holds: the system is the
+    loops, not a look-alike; a point off the assembly does not make them vanish."""
     from linkage.kinematics.assemblies import assembly_system
 
     m = load(SAMPLES / "rapier_drive.toml")
     system = assembly_system(m, m.driver.value)
-    x = []
-    for u, v in zip(m.unknowns, linkage.assemblies(m).real[0].q):
-        x += [math.cos(v), math.sin(v)] if u.kind == "angle" else [v / m.length_scale]
-    assert np.abs(system.evaluate(np.array([x], dtype=complex))).max() < 1e-13
+    for s in linkage.assemblies(m).real:
+        x = []
+        for u, v in zip(m.unknowns, s.q):
+            z = complex(math.cos(v), math.sin(v))
+            x += [z, z.conjugate()] if u.kind == "angle" else [v / m.length_scale]
+        assert np.abs(system.evaluate(np.array([x]))).max() < 1e-13
+        assert system.realness(np.array(x)) == 0.0
+        x[0] *= complex(math.cos(1e-3), math.sin(1e-3))
+        assert np.abs(system.evaluate(np.array([x]))).max() > 1e-5

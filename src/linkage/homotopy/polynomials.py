@@ -28,6 +28,13 @@ class PolySystem:
     n: int
     polynomials: tuple[Polynomial, ...]
     names: tuple[str, ...] = ()
+    groups: tuple[tuple[int, ...], ...] = ()
+    """A partition of the variables for a multihomogeneous start system (:mod:`.start`);
+    empty: the total-degree start."""
+    conjugate: tuple[int, ...] = ()
+    """The real structure: a point x is real when x[conjugate] = conj(x). Isotropic
+    coordinates (z = e^(i theta), w = e^(-i theta)) pair z with w; empty: every variable is
+    its own conjugate (the usual real points)."""
 
     def __post_init__(self) -> None:
         for p in self.polynomials:
@@ -36,6 +43,24 @@ class PolySystem:
                     raise ValueError(f"exponent {e} does not fit {self.n} variables")
             if not p:
                 raise ValueError("a polynomial with no terms")
+        if self.groups and sorted(v for g in self.groups for v in g) != list(range(self.n)):
+            raise ValueError(f"groups {self.groups} are not a partition of the {self.n} variables")
+        if self.conjugate and sorted(self.conjugate) != list(range(self.n)):
+            raise ValueError(f"conjugate {self.conjugate} is not a permutation of the {self.n} variables")
+
+    @property
+    def mirror(self) -> np.ndarray:
+        """The conjugate's index array (the identity without one)."""
+        return np.array(self.conjugate or range(self.n), dtype=np.intp)
+
+    def realness(self, x: np.ndarray) -> float:
+        """How far x is from real, against max(1, |x|): max |x[conjugate] - conj(x)| / 2."""
+        gap = float(np.abs(x[self.mirror] - np.conj(x)).max(initial=0.0)) / 2
+        return gap / max(1.0, float(np.linalg.norm(x)))
+
+    def nearest_real(self, x: np.ndarray) -> np.ndarray:
+        """The real point nearest x: (x + conj(x[conjugate])) / 2."""
+        return (x + np.conj(x[self.mirror])) / 2
 
     @cached_property
     def degrees(self) -> tuple[int, ...]:
@@ -52,6 +77,11 @@ class PolySystem:
     @cached_property
     def homogeneous(self) -> HomogeneousForm:
         return HomogeneousForm.of(self)
+
+    def homogenised(self, degrees: Sequence[int]) -> HomogeneousForm:
+        """Each polynomial homogenised to the given degree (at least its own): a start system
+        whose equation i has more factors than F_i's degree needs F_i at that degree."""
+        return HomogeneousForm.of(self, degrees)
 
     def evaluate(self, x: np.ndarray) -> np.ndarray:
         """F at affine points ``x`` (P, n): (P, m)."""
@@ -75,7 +105,15 @@ class HomogeneousForm:
     max_power: int
 
     @classmethod
-    def of(cls, system: PolySystem) -> HomogeneousForm:
+    def of(cls, system: PolySystem, degrees: Sequence[int] | None = None,
+           counted: int | None = None) -> HomogeneousForm:
+        """``counted``: only the first so many variables count toward a term's degree (the
+        unknowns of a family whose last variables are its parameters, :mod:`.parameter`)."""
+        counted = system.n if counted is None else counted
+        own = tuple(max(sum(e[:counted]) for e in p) for p in system.polynomials)
+        degrees = own if degrees is None else tuple(degrees)
+        if any(d < o for d, o in zip(degrees, own)) or len(degrees) != len(own):
+            raise ValueError(f"degrees {degrees} below the polynomials' own {own}")
         index: dict[tuple[int, ...], int] = {}
 
         def slot(e: tuple[int, ...]) -> int:
@@ -84,9 +122,9 @@ class HomogeneousForm:
             return index[e]
 
         terms = []
-        for d, p in zip(system.degrees, system.polynomials):
+        for d, p in zip(degrees, system.polynomials):
             for e, c in p.items():
-                terms.append((d, (d - sum(e), *e), complex(c)))
+                terms.append((d, (d - sum(e[:counted]), *e), complex(c)))
         # every monomial and every first derivative's monomial, in one list
         for _, e, _ in terms:
             slot(e)
@@ -96,9 +134,9 @@ class HomogeneousForm:
         m, nv = len(system.polynomials), system.n + 1
         C = np.zeros((m, len(index)), dtype=complex)
         D = np.zeros((m, nv, len(index)), dtype=complex)
-        for i, (d, p) in enumerate(zip(system.degrees, system.polynomials)):
+        for i, (d, p) in enumerate(zip(degrees, system.polynomials)):
             for e, c in p.items():
-                h = (d - sum(e), *e)
+                h = (d - sum(e[:counted]), *e)
                 C[i, index[h]] += c
                 for v, k in enumerate(h):
                     if k:

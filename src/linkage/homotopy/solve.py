@@ -28,8 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .polynomials import PolySystem, total_degree_start, total_degree_start_points
-from .tracker import Homotopy, PathLog, track
+from .polynomials import PolySystem
+from .start import start_for
+from .tracker import Homotopy, PathHomotopy, PathLog, track
 
 ENDGAME_RADIUS = 0.01
 """Where the endgame starts: t = 1 - ENDGAME_RADIUS."""
@@ -52,7 +53,8 @@ SINGULAR_CONDITION = 1e8
 double root computed in double precision sits about sqrt(eps) = 1.5e-8 from its twin, and
 its condition is then about 1e8."""
 REAL = 1e-9
-"""A solution is real when every imaginary part is within this of max(1, |x|)."""
+"""A solution is real when it is within this of its conjugate (:meth:`PolySystem.realness`),
+against max(1, |x|)."""
 
 
 @dataclass(frozen=True)
@@ -62,7 +64,7 @@ class Endpoint:
     kind: str  # finite, singular, infinite, failed
     x: np.ndarray | None  # the affine point (complex), None at infinity or failed
     real: bool
-    residual: float  # max |F_i(x)| / (sum |coefficients of F_i| max(1, |x|)^d_i)
+    residual: float  # relative_residual: max |F_i(x)| / (F_i's terms' sizes at x)
     condition: float  # :func:`condition` at x (inf where singular or not finite)
     cycle: int  # the endgame's cycle number (0 where the path failed before it)
     steps: int
@@ -71,6 +73,7 @@ class Endpoint:
     smallest_step: float
     retracked: bool
     note: str = ""
+    endgame: bool = True  # the Cauchy endgame ran (False: tracked to t = 1 itself, nonsingular there)
 
 
 @dataclass(frozen=True)
@@ -81,10 +84,17 @@ class Solutions:
     endpoints: tuple[Endpoint, ...]
     gamma: complex
     seconds: float
+    start: str = "total degree"  # the start system: "total degree" or "linear product"
 
     @property
     def bezout(self) -> int:
+        """The total-degree (Bezout) bound, whichever start was tracked."""
         return self.system.bezout
+
+    @property
+    def bound(self) -> int:
+        """The start system's root count, the paths tracked: the bound on isolated roots."""
+        return len(self.endpoints)
 
     def count(self, kind: str) -> int:
         return sum(e.kind == kind for e in self.endpoints)
@@ -106,7 +116,7 @@ SINGULAR_RESIDUAL = 1e-7
 """A singular endpoint's relative residual: a double root is found to about sqrt(eps)."""
 
 
-def _projective_residual(h: Homotopy, X: np.ndarray) -> np.ndarray:
+def _projective_residual(h: PathHomotopy, X: np.ndarray) -> np.ndarray:
     """max_i |F_i(X)| / (sum |coefficients of F_i| |X|^d_i), F the target system."""
     F = h.target.evaluate(X)
     size = _norm(X)
@@ -115,7 +125,7 @@ def _projective_residual(h: Homotopy, X: np.ndarray) -> np.ndarray:
     return (np.abs(F) / (coef[None, :] * size[:, None] ** degree)).max(axis=1)
 
 
-def _endgame(h: Homotopy, X: np.ndarray, index: np.ndarray, log: PathLog, step: np.ndarray,
+def _endgame(h: PathHomotopy, X: np.ndarray, index: np.ndarray, log: PathLog, step: np.ndarray,
              max_step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Cauchy's endgame for paths at t = 1 - ENDGAME_RADIUS: (estimates, cycle numbers, ok).
     Around a circle the steps are in its angle, up to one sample's arc; along the real line
@@ -192,20 +202,38 @@ def _endgame(h: Homotopy, X: np.ndarray, index: np.ndarray, log: PathLog, step: 
     return estimate, cycle, ok
 
 
+def weights(x: np.ndarray) -> np.ndarray:
+    """Each variable's size at x, max(1, |x_v|): the unit its perturbations are measured in."""
+    return np.maximum(1.0, np.abs(x))
+
+
+def equation_sizes(system: PolySystem, x: np.ndarray) -> np.ndarray:
+    """Each equation's natural size at x: sum over its terms of |c| prod_v w_v^e_v, w the
+    :func:`weights` (what |F_i| is measured against: rounding in evaluating F_i is about eps
+    times this)."""
+    form = system.homogeneous
+    W = np.concatenate([[1.0], weights(x)])[None].astype(complex)
+    return (np.abs(form.coefficients) @ form.monomials(W).real)[:, 0]
+
+
 def condition(system: PolySystem, x: np.ndarray) -> float:
-    """mu = 1 / (sigma_min(D J) max(1, |x|)): J = dF/dx at x, each row scaled by D_i = 1 /
-    (the sum of |coefficients| of equation i times max(1, |x|)^(d_i - 1)), the size its
-    terms have at x. A scale-free stand-in for Shub and Smale's condition number (a 1 x 1
-    Jacobian has the 2-norm condition number 1 even at a triple root): small for a simple
-    root, unbounded at a multiple one."""
-    size = max(1.0, float(np.linalg.norm(x)))
+    """mu = 1 / sigma_min(D J W): J = dF/dx at x, each row scaled by D_i = 1 /
+    :func:`equation_sizes` and each column by W_v = :func:`weights`. A scale-free stand-in
+    for Shub and Smale's condition number (a 1 x 1 Jacobian has the 2-norm condition number
+    1 even at a triple root): how much a relative change of the equations moves the root,
+    relative to each variable's size; small for a simple root, unbounded at a multiple one."""
     J = system.jacobian(x[None])[0]
-    scale = np.array([sum(abs(c) for c in p.values()) * size ** (d - 1)
-                      for p, d in zip(system.polynomials, system.degrees)])
     if not np.all(np.isfinite(J)):
         return np.inf
-    smallest = float(np.linalg.svd(J / scale[:, None], compute_uv=False)[-1])
-    return np.inf if smallest == 0.0 else 1.0 / (smallest * size)
+    M = J * weights(x)[None, :] / equation_sizes(system, x)[:, None]
+    smallest = float(np.linalg.svd(M, compute_uv=False)[-1])
+    return np.inf if smallest == 0.0 else 1.0 / smallest
+
+
+def relative_residual(system: PolySystem, x: np.ndarray) -> float:
+    """max_i |F_i(x)| / :func:`equation_sizes` (x): about eps at a root computed to rounding."""
+    F = system.evaluate(x[None])[0]
+    return float(np.max(np.abs(F) / equation_sizes(system, x)))
 
 
 def _refine(system: PolySystem, x: np.ndarray) -> tuple[np.ndarray, float, float]:
@@ -227,11 +255,7 @@ def _refine(system: PolySystem, x: np.ndarray) -> tuple[np.ndarray, float, float
         x, F, last = x - dx, F_new, size
         if size <= 1e-16 * max(1.0, float(np.linalg.norm(x))):
             break
-    F = system.evaluate(x[None])[0]
-    size = max(1.0, float(np.linalg.norm(x)))
-    scale = np.array([sum(abs(c) for c in p.values()) * size ** d
-                      for p, d in zip(system.polynomials, system.degrees)])
-    return x, float(np.max(np.abs(F) / scale)), condition(system, x)
+    return x, relative_residual(system, x), condition(system, x)
 
 
 def polish_real(system: PolySystem, x: np.ndarray, steps: int = 60) -> tuple[np.ndarray, float]:
@@ -263,16 +287,13 @@ def polish_real(system: PolySystem, x: np.ndarray, steps: int = 60) -> tuple[np.
         x, res = trial, r
         if res == 0.0:
             break
-    size = max(1.0, float(np.linalg.norm(x)))
-    scale = np.array([sum(abs(c) for c in p.values()) * size ** d
-                      for p, d in zip(system.polynomials, system.degrees)])
-    F = system.evaluate(x[None].astype(complex))[0]
-    return x, float(np.max(np.abs(F) / scale))
+    return x, relative_residual(system, x.astype(complex))
 
 
 def solve(system: PolySystem, seed: int = 0, max_step: float = 0.1) -> Solutions:
-    """Every isolated solution of a square system by total-degree homotopy (one path per
-    solution of the start system x_i^d_i = 1; Bezout's bound of them)."""
+    """Every isolated solution of a square system: one path per root of the start system
+    (:func:`.start.start_for`: a linear product matched to ``system.groups`` where that
+    needs fewer paths, else x_i^d_i = 1, Bezout's bound of them)."""
     if len(system.polynomials) != system.n:
         raise ValueError(f"{len(system.polynomials)} equations in {system.n} unknowns: not square")
     began = time.perf_counter()
@@ -280,20 +301,30 @@ def solve(system: PolySystem, seed: int = 0, max_step: float = 0.1) -> Solutions
     gamma = complex(np.exp(2j * np.pi * rng.random()))
     patch = rng.normal(size=system.n + 1) + 1j * rng.normal(size=system.n + 1)
     patch /= np.linalg.norm(patch)
-    start = total_degree_start(system.degrees)
-    h = Homotopy(system.homogeneous, start.homogeneous, gamma, patch)
-    x0 = total_degree_start_points(system.degrees)
-    X = np.concatenate([np.ones((len(x0), 1), dtype=complex), x0], axis=1)
-    X = X / (X @ patch)[:, None]
+    start = start_for(system, rng)
+    target = system.homogenised(start.degrees) if start.degrees != system.degrees else system.homogeneous
+    h = Homotopy(target, start.form, gamma, patch)
+    endpoints = track_all(system, h, on_patch(start.points, patch), max_step)
+    return Solutions(system, tuple(endpoints), gamma, time.perf_counter() - began, start.kind)
+
+
+def on_patch(x: np.ndarray, patch: np.ndarray) -> np.ndarray:
+    """Affine points (P, n) as projective ones (1, x) scaled onto the patch a.X = 1."""
+    X = np.concatenate([np.ones((len(x), 1), dtype=complex), x], axis=1)
+    return X / (X @ patch)[:, None]
+
+
+def track_all(system: PolySystem, h: PathHomotopy, X: np.ndarray, max_step: float = 0.1) -> list[Endpoint]:
+    """Every path of ``h`` from the projective points X (on its patch) to t = 1, each endpoint
+    classified against ``system`` (the target, affine). A failed path, or two paths on one
+    nonsingular solution (one jumped), is tracked again with smaller steps."""
     endpoints = _run(system, h, X, np.arange(len(X)), max_step, retracked=False)
-    # a failed path, or two paths on one nonsingular solution (one jumped), is tracked
-    # again with smaller steps
     again = [i for i, e in enumerate(endpoints) if e.kind == "failed"] + _duplicates(endpoints)
     if again:
         idx = np.array(sorted(set(again)))
         for i, e in zip(idx, _run(system, h, X[idx], idx, max_step / 16.0, retracked=True)):
             endpoints[i] = e
-    return Solutions(system, tuple(endpoints), gamma, time.perf_counter() - began)
+    return endpoints
 
 
 def _duplicates(endpoints: list[Endpoint]) -> list[int]:
@@ -312,7 +343,45 @@ def _duplicates(endpoints: list[Endpoint]) -> list[int]:
     return out
 
 
-def _run(system: PolySystem, h: Homotopy, X: np.ndarray, paths: np.ndarray, max_step: float,
+STRAIGHT_CONDITION = 1e6
+"""A path tracked on from t = 1 - ENDGAME_RADIUS to t = 1 itself ends there without the
+endgame when its end is finite (|X0| / |X| above ENDGAME_FINITE) and the target's Jacobian
+on the patch, rows scaled to unit length, has a condition number below this: a
+nonsingular root, reached by a converged corrector (cycle number 1). Every other path,
+singular or going to infinity, takes the endgame from t = 1 - ENDGAME_RADIUS."""
+ENDGAME_FINITE = 1e-4
+
+
+def _straight(h: PathHomotopy, X: np.ndarray, ok: np.ndarray, log: PathLog,
+              step: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Which paths end at a nonsingular root when tracked straight on to t = 1, and their
+    ends: (mask over all paths, ends). The attempt's steps are added to the paths' logs; a
+    path whose attempt fails is not failed (the endgame takes it), so its reason is dropped."""
+    P = len(X)
+    mask = np.zeros(P, bool)
+    live = np.flatnonzero(ok)
+    if not len(live):
+        return mask, X
+    trial = PathLog.empty(len(live))
+    ends, good, _ = track(h, X[live], np.full(len(live), 1.0 - ENDGAME_RADIUS), np.ones(len(live)),
+                          lambda t: t + 0j, lambda t: np.ones_like(t) + 0j, trial, np.arange(len(live)),
+                          step[live].copy(), ENDGAME_RADIUS)
+    log.steps[live] += trial.steps
+    log.rejected[live] += trial.rejected
+    log.newton[live] += trial.newton
+    log.smallest_step[live] = np.minimum(log.smallest_step[live], trial.smallest_step)
+    finite = np.abs(ends[:, 0]) > ENDGAME_FINITE * _norm(ends)
+    _, J, _ = h.residual_and_jacobians(ends, np.ones(len(live)))
+    J = J / np.maximum(_norm(J), 1e-300)[:, :, None]
+    with np.errstate(all="ignore"):
+        cond = np.linalg.cond(J)
+    mask[live] = good & finite & (cond <= STRAIGHT_CONDITION)
+    out = X.copy()
+    out[live] = ends
+    return mask, out
+
+
+def _run(system: PolySystem, h: PathHomotopy, X: np.ndarray, paths: np.ndarray, max_step: float,
          retracked: bool) -> list[Endpoint]:
     P = len(X)
     log = PathLog.empty(P)
@@ -322,7 +391,9 @@ def _run(system: PolySystem, h: Homotopy, X: np.ndarray, paths: np.ndarray, max_
                         lambda t: np.ones_like(t) + 0j, log, index, step, max_step)
     est = np.full(X.shape, np.nan + 0j)
     cycle = np.zeros(P, int)
-    live = np.flatnonzero(ok)
+    straight, ends = _straight(h, X, ok, log, step)
+    est[straight], cycle[straight] = ends[straight], 1
+    live = np.flatnonzero(ok & ~straight)
     if len(live):
         e, c, good = _endgame(h, X[live], live, log, step[live], max_step)
         est[live], cycle[live] = e, c
@@ -331,7 +402,7 @@ def _run(system: PolySystem, h: Homotopy, X: np.ndarray, paths: np.ndarray, max_
     for i in range(P):
         common = dict(cycle=int(cycle[i]), steps=int(log.steps[i]), rejected=int(log.rejected[i]),
                       newton=int(log.newton[i]), smallest_step=float(log.smallest_step[i]),
-                      retracked=retracked)
+                      retracked=retracked, endgame=not straight[i])
         if not ok[i] or not np.all(np.isfinite(est[i])):
             out.append(Endpoint("failed", None, False, np.inf, np.inf, note=log.failure[i] or "no estimate",
                                 **common))
@@ -342,8 +413,8 @@ def _run(system: PolySystem, h: Homotopy, X: np.ndarray, paths: np.ndarray, max_
             continue
         x, residual, cond = _refine(system, Xi[1:] / Xi[0])
         singular = cycle[i] > 1 or not cond <= SINGULAR_CONDITION
-        real = bool(np.all(np.abs(x.imag) <= REAL * max(1.0, float(np.linalg.norm(x)))))
+        real = system.realness(x) <= REAL
         if real:
-            x = x.real + 0j
+            x = system.nearest_real(x)
         out.append(Endpoint("singular" if singular else "finite", x, real, residual, cond, **common))
     return out

@@ -15,10 +15,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
 from .polynomials import HomogeneousForm
+from .start import LinearProduct
 
 CORRECTOR_TOL = 1e-11
 """A corrector has converged when its last Newton step is this small against |X|."""
@@ -28,12 +30,30 @@ MAX_STEPS = 20_000
 """Steps a path may take before it is called failed (a path wandering near a singularity)."""
 
 
+class PathHomotopy(Protocol):
+    """What the tracker and the endgame need of a homotopy: H on the patch with its
+    Jacobians, and the target system (homogeneous) that t = 1 reaches."""
+
+    target: HomogeneousForm
+
+    def residual_and_jacobians(self, X: np.ndarray,
+                               t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+    def velocity(self, X: np.ndarray, t: np.ndarray, dt: np.ndarray) -> np.ndarray: ...
+
+
+def velocity(h: PathHomotopy, X: np.ndarray, t: np.ndarray, dt: np.ndarray) -> np.ndarray:
+    """dX along the path for a change dt of t: -H_X^-1 H_t dt (the patch held)."""
+    _, J, Ht = h.residual_and_jacobians(X, t)
+    return -_solve(J, Ht * dt[:, None])
+
+
 @dataclass(frozen=True)
 class Homotopy:
     """H(X, t) = (1 - t) gamma G + t F on the patch a.X = 1."""
 
     target: HomogeneousForm
-    start: HomogeneousForm
+    start: HomogeneousForm | LinearProduct
     gamma: complex
     patch: np.ndarray  # (n + 1,)
 
@@ -53,8 +73,7 @@ class Homotopy:
                 np.concatenate([Ht, np.zeros((P, 1), dtype=complex)], axis=1))
 
     def velocity(self, X: np.ndarray, t: np.ndarray, dt: np.ndarray) -> np.ndarray:
-        _, J, Ht = self.residual_and_jacobians(X, t)
-        return -_solve(J, Ht * dt[:, None])
+        return velocity(self, X, t, dt)
 
 
 @dataclass
@@ -91,7 +110,7 @@ def _norm(X: np.ndarray) -> np.ndarray:
     return np.sqrt((X.real ** 2 + X.imag ** 2).sum(axis=1))
 
 
-def track(h: Homotopy, X: np.ndarray, tau: np.ndarray, tau_end: np.ndarray,
+def track(h: PathHomotopy, X: np.ndarray, tau: np.ndarray, tau_end: np.ndarray,
           t_of: Callable[[np.ndarray], np.ndarray], dt_of: Callable[[np.ndarray], np.ndarray],
           log: PathLog, index: np.ndarray, step: np.ndarray,
           max_step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -1,13 +1,15 @@
 """Every assembly of a mechanism at one driver value, by polynomial homotopy continuation.
 
-The loop equations become polynomials: each unknown angle theta is the pair (c, s) =
-(cos theta, sin theta) with c^2 + s^2 = 1, each unknown length stays a variable, and each
-loop's sum of vectors sign * length * e^(i (angle + offset)) splits into its real and
-imaginary parts, polynomials of degree 1 (2 where a vector both turns and slides). Every
-root of that system (:mod:`linkage.homotopy`) is an assembly: the real ones are the
-mechanism's, each polished by Newton's method on the loop equations themselves and named
-as sweeps name it (its closed form's branch, or the sign of det J); the complex ones are
-counted. Bezout's bound (the product of the degrees) is the number of paths tracked.
+The loop equations become polynomials in isotropic coordinates: each unknown angle theta is
+the pair z = e^(i theta), w = e^(-i theta) with z w = 1, each unknown length stays a
+variable, and each loop's sum of vectors sign * length * e^(i (angle + offset)) is one
+equation in the z's and its conjugate in the w's, of degree 1 (2 where a vector both turns
+and slides). Every root of that system (:mod:`linkage.homotopy`) is an assembly: the real
+ones (w = conj(z), |z| = 1) are the mechanism's, each polished by Newton's method on the
+loop equations themselves and named as sweeps name it (its closed form's branch, or the
+sign of det J); the complex ones are counted. The paths tracked are the roots of a
+linear-product start system matched to the grouping {z}, {w}, {lengths}: the
+multihomogeneous Bezout number or fewer, stated beside the total degree.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import numpy as np
 from ..errors import InputError
 from ..homotopy import PolySystem, Solutions, condition, solve
 from ..problems.loops import ANGLE_UNITS, DRIVER, Mechanism
+from ..units import degrees, radians
 from .angles import nearest_turn
 
 Monomials = dict[tuple[int, ...], complex]
@@ -54,11 +57,17 @@ class Assemblies:
 
     @property
     def bezout(self) -> int:
+        """The total degree of the polynomial system."""
         return self.solutions.bezout
+
+    @property
+    def bound(self) -> int:
+        """The paths tracked, the start system's root count: the bound on isolated assemblies."""
+        return self.solutions.bound
 
 
 def _variables(m: Mechanism) -> list[tuple[str, int]]:
-    """(kind, first variable) of each unknown: an angle takes (c, s), a length one."""
+    """(kind, first variable) of each unknown: an angle takes (z, w), a length one."""
     out, k = [], 0
     for u in m.unknowns:
         out.append((u.kind, k))
@@ -67,11 +76,18 @@ def _variables(m: Mechanism) -> list[tuple[str, int]]:
 
 
 def assembly_system(m: Mechanism, driver: float) -> PolySystem:
-    """The loop equations at ``driver`` (internal units) as polynomials in (c, s) per
-    unknown angle and one variable per unknown length, in units of the mechanism's size
-    (so that every variable is of order 1: a path tracker's steps and tests are relative
-    to |X|, and a slide of 90 cm beside cosines would swamp them), with c^2 + s^2 - 1 per
-    angle."""
+    """The loop equations at ``driver`` (internal units) as polynomials in isotropic
+    coordinates: z = e^(i theta) and w = e^(-i theta) per unknown angle, with z w = 1, and
+    one variable per unknown length, in units of the mechanism's size (so that every
+    variable is of order 1: a path tracker's steps and tests are relative to |X|, and a
+    slide of 90 cm beside cosines would swamp them). Each loop's sum of vectors sign *
+    length * e^(i (angle + offset)) = 0 is one equation in the z's and its conjugate one in
+    the w's (Wampler, Morgan and Sommese, "Complete solution of the nine-point path
+    synthesis problem for four-bar linkages", J. Mech. Des. 114, 1992, sec. 2). Grouped as
+    {z}, {w}, {lengths}, the linear-product start (:mod:`linkage.homotopy.start`) has the
+    multihomogeneous Bezout number of paths or fewer: 2 for a four-bar, 4 for the two
+    four-bars of a Watt six-bar, at most C(4, 2) = 6 for a six-bar, against total degrees of
+    4 and 16 (every path beyond the assemblies' own count goes to infinity)."""
     var = _variables(m)
     size = m.length_scale
     n = sum(2 if kind == "angle" else 1 for kind, _ in var)
@@ -84,41 +100,48 @@ def assembly_system(m: Mechanism, driver: float) -> PolySystem:
 
     polys: list[Monomials] = []
     for terms in m.model.terms:
-        loop: Monomials = {}
+        loop: Monomials = {}  # in z's; its conjugate swaps each z for its w
+        swap: dict[tuple[int, ...], tuple[int, ...]] = {}
 
-        def add(e: tuple[int, ...], c: complex, loop: Monomials = loop) -> None:
+        def add(e: tuple[int, ...], c: complex, mirror: tuple[int, ...], loop: Monomials = loop,
+                swap: dict[tuple[int, ...], tuple[int, ...]] = swap) -> None:
             loop[e] = loop.get(e, 0j) + c
+            swap[e] = mirror
 
         for sign, lc, li, ac, ai, off in terms:
             length = (driver if li == DRIVER else lc) / size
             angle = driver if ai == DRIVER else ac
             if ai >= 0:
                 rot = sign * complex(math.cos(off), math.sin(off))
-                c, s = var[ai][1], var[ai][1] + 1
+                z, w = var[ai][1], var[ai][1] + 1
                 if li >= 0:
-                    j = var[li][1]
-                    add(mono(j, c), rot)
-                    add(mono(j, s), 1j * rot)
+                    add(mono(var[li][1], z), rot, mono(var[li][1], w))
                 else:
-                    add(mono(c), rot * length)
-                    add(mono(s), 1j * rot * length)
+                    add(mono(z), rot * length, mono(w))
             else:
                 e = sign * complex(math.cos(angle + off), math.sin(angle + off))
                 if li >= 0:
-                    add(mono(var[li][1]), e)
+                    add(mono(var[li][1]), e, mono(var[li][1]))
                 else:
-                    add(mono(), e * length)
+                    add(mono(), e * length, mono())
         scale = max((abs(v) for v in loop.values()), default=1.0) or 1.0
-        for part in (lambda z: z.real, lambda z: z.imag):
-            poly = {e: complex(part(c) / scale) for e, c in loop.items()}
-            poly = {e: c for e, c in poly.items() if c != 0}
-            if not poly:
-                raise InputError(f"{m.source}: a loop's equations are identically zero")
-            polys.append(poly)
+        poly = {e: c / scale for e, c in loop.items() if c != 0}
+        if not poly:
+            raise InputError(f"{m.source}: a loop's equations are identically zero")
+        polys += [poly, {swap[e]: c.conjugate() for e, c in poly.items()}]
     for kind, k in var:
         if kind == "angle":
-            polys.append({mono(k, k): 1 + 0j, mono(k + 1, k + 1): 1 + 0j, mono(): -1 + 0j})
-    return PolySystem(n, tuple(polys))
+            polys.append({mono(k, k + 1): 1 + 0j, mono(): -1 + 0j})
+    angles = [k for kind, k in var if kind == "angle"]
+    lengths = tuple(k for kind, k in var if kind != "angle")
+    groups = tuple(g for g in (tuple(angles), tuple(k + 1 for k in angles), lengths) if g)
+    conjugate = [0] * n
+    for kind, k in var:
+        if kind == "angle":
+            conjugate[k], conjugate[k + 1] = k + 1, k
+        else:
+            conjugate[k] = k
+    return PolySystem(n, tuple(polys), groups=groups, conjugate=tuple(conjugate))
 
 
 RESIDUAL = 1e-12
@@ -279,11 +302,26 @@ def _names(m: Mechanism, driver: float, qs: list[list[float]]) -> list[tuple[str
     return [("det J > 0" if d > 0 else "det J < 0" if d < 0 else "det J = 0", "") for d in dets]
 
 
-def _encode(m: Mechanism, q: list[float]) -> list[float]:
-    """The polynomial system's variables at q: (cos, sin) per angle, a length over the size."""
-    out: list[float] = []
+def encode(m: Mechanism, q: list[float] | tuple[float, ...]) -> list[complex]:
+    """The polynomial system's variables at q: (e^(i theta), e^(-i theta)) per angle, a
+    length over the size."""
+    out: list[complex] = []
     for u, v in zip(m.unknowns, q):
-        out += [math.cos(v), math.sin(v)] if u.kind == "angle" else [v / m.length_scale]
+        out += [complex(math.cos(v), math.sin(v)), complex(math.cos(v), -math.sin(v))] if u.kind == "angle" \
+            else [complex(v / m.length_scale)]
+    return out
+
+
+def decode(m: Mechanism, x: np.ndarray) -> list[float]:
+    """The unknowns at the real point nearest x (the system's variables): theta = arg of
+    (z + conj(w)) / 2, a length the real part times the size."""
+    out = []
+    for u, k in zip(m.unknowns, [k for _, k in _variables(m)]):
+        if u.kind == "angle":
+            e = (complex(x[k]) + complex(x[k + 1]).conjugate()) / 2
+            out.append(math.atan2(e.imag, e.real))
+        else:
+            out.append(float(complex(x[k]).real) * m.length_scale)
     return out
 
 
@@ -303,22 +341,17 @@ def assemblies(m: Mechanism, driver: float | None = None, seed: int = 0) -> Asse
         raise InputError(f"{m.source}: {len(system.polynomials)} equations in {system.n} polynomial "
                          "unknowns: the loops do not fix the unknowns (mobility is not 1)")
     sols = solve(system, seed=seed)
-    var = _variables(m)
-
-    def decode(x: np.ndarray) -> list[float]:
-        return [math.atan2(x[k + 1], x[k]) if kind == "angle" else float(x[k]) * m.length_scale
-                for kind, k in var]
 
     real: list[Assembly] = []
     multiplicity: list[int] = []
 
     def keep(q: list[float], times: int = 1) -> bool:
-        q = [math.radians(nearest_turn(math.degrees(u.value), math.degrees(v))) if u.kind == "angle" else v
+        q = [radians(nearest_turn(degrees(u.value), degrees(v))) if u.kind == "angle" else v
              for u, v in zip(m.unknowns, q)]  # angles in the turn of the file's guess
         if any(same_configuration(q, a.q, m) for a in real):
             return False
         residual = max(abs(v) for v in m.model.functions(d)[0](q)) / m.length_scale
-        cond = condition(system, np.array(_encode(m, q), dtype=complex))
+        cond = condition(system, np.array(encode(m, q), dtype=complex))
         real.append(Assembly(tuple(q), "", "", residual, cond, not cond <= NEAR_LIMIT, _joints(m, d, q)))
         multiplicity.append(times)
         return True
@@ -331,7 +364,7 @@ def assemblies(m: Mechanism, driver: float | None = None, seed: int = 0) -> Asse
             if not e.real:
                 nonreal += 1
                 continue
-            q, residual = _polish(m, d, decode(e.x.real))
+            q, residual = _polish(m, d, decode(m, e.x))
             if residual <= RESIDUAL:
                 keep(q)
             else:
@@ -346,7 +379,7 @@ def assemblies(m: Mechanism, driver: float | None = None, seed: int = 0) -> Asse
     # a singular endpoint is two (or more) roots that meet, or nearly meet (a limit
     # position, a change point): which of them are real is decided on the loops themselves
     for x, members in clusters:
-        roots, how = _local_roots(m, d, decode(x.real))
+        roots, how = _local_roots(m, d, decode(m, x))
         k = len(members)
         if how == "continuum":
             continuum = True

@@ -28,7 +28,7 @@ def assemblies_tables(a: Any) -> tuple[DataTable, ...]:
     joints = [(i + 1, name, x, y) for i, s in enumerate(a.real) for name, (x, y) in s.joints.items()]
     paths = [(k + 1, e.kind, e.real if e.kind in ("finite", "singular") else None, e.cycle, e.steps,
               e.rejected, e.newton, e.smallest_step if math.isfinite(e.smallest_step) else None,
-              e.retracked, e.note) for k, e in enumerate(a.solutions.endpoints)]
+              e.retracked, e.endgame, e.note) for k, e in enumerate(a.solutions.endpoints)]
     return (
         from_rows("assemblies", heads, rows),
         from_rows("joints", [("assembly", "", "int"), ("joint", "", "text"), ("x", m.length_unit, "number"),
@@ -36,7 +36,7 @@ def assemblies_tables(a: Any) -> tuple[DataTable, ...]:
         from_rows("paths", [("path", "", "int"), ("endpoint", "", "text"), ("real", "", "bool"),
                             ("cycle", "", "int"), ("steps", "", "int"), ("rejected", "", "int"),
                             ("newton", "", "int"), ("smallest_step", "", "number"), ("retracked", "", "bool"),
-                            ("note", "", "text")], paths),
+                            ("endgame", "", "bool"), ("note", "", "text")], paths),
     )
 
 
@@ -67,16 +67,29 @@ def summary_lines(a: Any) -> list[str]:
                      "with its driver held)")
     elif a.unresolved:
         extra.append(f"{a.unresolved} root(s) near a singular point neither found real nor shown complex")
+    n_lengths = len(a.mechanism.unknowns) - n_angles
     return [
-        f"polynomial system: {s.system.n} unknowns (cos and sin of {n_angles} angle"
-        f"{'s' if n_angles != 1 else ''}, c^2 + s^2 = 1 each), "
+        f"polynomial system: {s.system.n} unknowns (z = e^(i theta) and w = e^(-i theta) of {n_angles} "
+        f"angle{'s' if n_angles != 1 else ''}, z w = 1 each"
+        + (f"; {n_lengths} length{'s' if n_lengths != 1 else ''}" if n_lengths else "") + "), "
         f"degrees {' '.join(map(str, s.system.degrees))}",
-        f"{len(s.endpoints)} paths (Bezout's bound), total-degree homotopy: {len(a.real)} real assembl"
+        f"{_bound_text(s, n_lengths > 0)}: {len(a.real)} real assembl"
         f"{'y' if len(a.real) == 1 else 'ies'}, {a.complex_count} complex, {a.infinite} at infinity, "
         f"{a.failed} failed" + (f" ({retracked} retracked)" if retracked else "")
         + f"; {sum(e.steps for e in s.endpoints)} steps in {s.seconds:.2f} s",
         *extra,
     ]
+
+
+def _bound_text(s: Any, lengths: bool) -> str:
+    """How many paths, and which bound that is (issue 34: the bound stated)."""
+    from ..homotopy.start import LINEAR_PRODUCT
+
+    if s.start == LINEAR_PRODUCT:
+        grouping = "{z}, {w}" + (", {lengths}" if lengths else "")
+        return (f"{s.bound} paths (the linear-product Bezout number of the grouping {grouping}; "
+                f"total degree {s.bezout})")
+    return f"{s.bound} paths (Bezout's bound, the total degree)"
 
 
 def _display(t: DataTable, digits: int, scale: float = 0.0) -> Block:
@@ -111,7 +124,8 @@ def assemblies_report(a: Any, digits: int, show_paths: bool) -> Report:
 
     def document() -> dict[str, Any]:
         s = a.solutions
-        return {"title": title_of(a), "bezout": s.bezout, "paths": len(s.endpoints), "real": len(a.real),
+        return {"title": title_of(a), "bezout": s.bezout, "bound": s.bound, "start": s.start,
+                "paths": len(s.endpoints), "real": len(a.real),
                 "complex": a.complex_count, "infinite": a.infinite, "failed": a.failed,
                 "unresolved": a.unresolved, "continuum": a.continuum,
                 "degrees": list(s.system.degrees), "seconds": s.seconds}
