@@ -391,7 +391,8 @@ def every_assembly(mechanism: Mechanism | str | Any, driver: float | None = None
     return assemblies(m, seed=seed)
 
 
-def same_configuration(a: tuple[float, ...] | list[float], b: tuple[float, ...], m: Mechanism, tol: float = 1e-9) -> bool:
+def same_configuration(a: tuple[float, ...] | list[float], b: tuple[float, ...], m: Mechanism,
+                       tol: float = 1e-9) -> bool:
     """Whether two configurations are one, to ``tol`` (rad, or of the mechanism's size)."""
     for u, x, y in zip(m.unknowns, a, b):
         if u.kind == "angle":
