@@ -127,3 +127,75 @@ def test_problem_3_has_the_published_64_real_four_bars(problem_3):
     assert len(res.solutions) + res.missing == 1442
     # the paths lost to double precision are few and counted (1,437 found here)
     assert res.missing <= 10
+
+
+def _grashof_crank_rocker_points(other_side: set[int], order: list[int] | None = None):
+    """Nine coupler points of a Grashof crank-rocker (ground 3, crank 1, coupler 3, rocker
+    2.5: 1 + 3 < 3 + 2.5), those in ``other_side`` taken in the other assembly, in
+    ``order``. Returns the points and the four-bar (P_0 at the origin) by plane geometry."""
+    A, B, r1, L, r2, k = 0j, 3 + 0j, 1.0, 3.0, 2.5, 0.4 + 0.6j
+    pts, pose = [], None
+    for i, phi in enumerate(np.linspace(0.2, 5.8, 9)):
+        M = A + r1 * cmath.exp(1j * phi)
+        d = abs(B - M)
+        along = (L * L - r2 * r2 + d * d) / (2 * d)
+        h = math.sqrt(L * L - along * along) * (-1 if i in other_side else 1)
+        u = (B - M) / d
+        N = M + along * u + h * u * 1j
+        pts.append(M + (N - M) * k)
+        if pose is None:
+            pose = (M, N)
+    if order is not None:
+        pts = [pts[i] for i in order]
+    M, N = pose
+    P0 = pts[0]
+    z = np.array([A - P0, M - P0, B - P0, N - P0])
+    return pts, np.concatenate([z, np.conj(z)])
+
+
+def test_a_design_through_its_points_in_order_on_one_circuit_has_no_defect():
+    from linkage.synthesis_path import judge
+
+    pts, z = _grashof_crank_rocker_points(set())
+    fb = judge(z, pts)
+    assert fb.defects == () and fb.grashof == "crank-rocker"
+    assert fb.max_point_error <= 1e-12 * 3
+    d = np.array(pts[1:]) - pts[0]
+    assert np.abs(npt.equations(z[None, :], d, np.conj(d))[0]).max() <= 1e-10
+
+
+def test_points_on_the_other_assembly_are_a_branch_defect():
+    from linkage.synthesis_path import judge
+
+    pts, z = _grashof_crank_rocker_points({4, 5})
+    d = np.array(pts[1:]) - pts[0]
+    assert np.abs(npt.equations(z[None, :], d, np.conj(d))[0]).max() <= 1e-10  # still through them
+    assert judge(z, pts).defects == ("branch",)
+
+
+def test_points_met_out_of_order_are_an_order_defect():
+    from linkage.synthesis_path import judge
+
+    pts, z = _grashof_crank_rocker_points(set(), [0, 1, 2, 5, 4, 3, 6, 7, 8])
+    assert judge(z, pts).defects == ("order",)
+    # the same points in reverse are met in order, turning the crank the other way
+    pts, z = _grashof_crank_rocker_points(set(), [0, 8, 7, 6, 5, 4, 3, 2, 1])
+    assert judge(z, pts).defects == ()
+
+
+@pytest.mark.parametrize("bad", [
+    [(0, 0)] * 9,
+    [(i, i * i) for i in range(8)],
+    [(i, i * i) for i in range(10)],
+    [(float("nan"), 0), *[(i, i * i) for i in range(1, 9)]],
+    [(0, 0), (0, 0), *[(i, i * i) for i in range(2, 9)]],
+    [(1e200, 0), *[(i, i * i) for i in range(1, 9)]],
+    "nine points",
+])
+def test_bad_points_are_refused_with_one_line(bad):
+    from linkage.errors import InputError
+    from linkage.synthesis_path import synthesize_path
+
+    with pytest.raises(InputError) as err:
+        synthesize_path(bad)
+    assert "\n" not in str(err.value)

@@ -1,7 +1,7 @@
 """Wampler, Morgan and Sommese's Problem 3: every four-bar whose coupler point passes
 through nine points, by parameter homotopy from the stored generic instance.
 
-    python benchmarks/nine_point.py [--routes 4] [--seed 0]
+    python benchmarks/path_synthesis_problem3.py [--routes 4] [--seed 0]
 
 Prints the time, the paths tracked per route, failures, the orbits found (four-bars up to
 Roberts cognates and the order of the dyads) and the real ones. Published: 1,442 orbits
