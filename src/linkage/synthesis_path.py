@@ -64,6 +64,17 @@ class PathSynthesis:
     solutions: ninepoint.NinePointSolutions
 
 
+def chunk_runner(scheduler: str | None, workers: int | None):  # type: ignore[no-untyped-def]
+    """The scan's chunk runner (one home for sending chunks to dask) in the form
+    :func:`linkage.homotopy.ninepoint.solve_points` calls."""
+    from .scan import run_chunks
+
+    def run(task, job, plan, size):  # type: ignore[no-untyped-def]
+        return run_chunks(job, plan, size, scheduler=scheduler, workers=workers, task=task)
+
+    return run
+
+
 def check_points(points: object) -> list[complex]:
     """Nine finite, distinct points (pairs x, y), or InputError naming what is wrong."""
     try:
@@ -211,11 +222,14 @@ def _in_order(at: list[int], n: int) -> bool:
     return forward == sorted(forward) or backward == sorted(backward)
 
 
-def synthesize_path(points: object, seed: int = 0) -> PathSynthesis:
+def synthesize_path(points: object, seed: int = 0, scheduler: str | None = None,
+                    workers: int | None = None) -> PathSynthesis:
     """Every four-bar whose coupler point passes through nine points; the real ones judged
-    by moving them (module docstring). ``points``: nine (x, y) pairs."""
+    by moving them (module docstring). ``points``: nine (x, y) pairs. The paths are tracked
+    in chunks by the scan's runner: here, on dask's local threads or processes, or on a
+    cluster (``scheduler`` tcp://HOST:PORT), ``workers`` at a time."""
     pts = check_points(points)
-    sols = ninepoint.solve_points(pts, seed=seed)
+    sols = ninepoint.solve_points(pts, seed=seed, run=chunk_runner(scheduler, workers))
     designs = []
     for z, real in zip(sols.solutions, sols.real):
         if not real:

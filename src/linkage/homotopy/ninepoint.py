@@ -433,19 +433,77 @@ SINGULAR = 1e12
 """An endpoint whose Jacobian's condition exceeds this is not counted as a solution."""
 
 
+@dataclass(frozen=True)
+class Route:
+    """One way from the stored instance to the target: its legs (points at each end) and
+    each leg's projective patch. A value, so that a chunk of paths can be sent to a worker."""
+
+    legs: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], ...]
+    patches: tuple[np.ndarray, ...]
+    target: tuple[np.ndarray, np.ndarray]
+
+
+def track_route(route: Route, first: int, Z: np.ndarray) -> dict[str, np.ndarray]:
+    """Paths ``Z`` (start solutions; ``first`` is the index of the first, for the caller's
+    order) along every leg of ``route``, polished at the target; endpoints that will not
+    settle in double precision polished at PRECISE_DIGITS. A chunk's records: ``z``
+    (settled endpoints, canonical), ``failed``, ``unsettled``, ``steps`` (counts)."""
+    ok = np.ones(len(Z), bool)
+    steps = 0
+    for (a, ab, b, bb), patch in zip(route.legs, route.patches):
+        Z, k, log = track_segment(ParameterSegment(a, ab, b, bb, patch), Z)
+        ok &= k
+        steps += int(log.steps.sum())
+    d1, db1 = route.target
+    Z, last, cond = polish(Z[ok], d1, db1)
+    good = (last <= REFINED) & (cond <= SINGULAR)
+    precise = [polish_precisely(z, d1, db1) for z in Z[~good] if np.all(np.isfinite(z))]
+    settled = [z for z in precise if z is not None]
+    Z = canonical(np.vstack([Z[good], *[z[None, :] for z in settled]]))
+    return {"z": Z, "failed": np.array([int((~ok).sum())]), "steps": np.array([steps]),
+            "unsettled": np.array([int((~good).sum()) - len(settled)])}
+
+
+class StartRows:
+    """The stored instance's solutions as a plan of chunks (``total``, ``chunk(a, b)``),
+    the shape the scan's chunk runner takes."""
+
+    def __init__(self, solutions: np.ndarray) -> None:
+        self.solutions = solutions
+        self.total = len(solutions)
+
+    def chunk(self, a: int, b: int) -> np.ndarray:
+        return self.solutions[a:b]
+
+
+def _here(task, job, plan, size):  # type: ignore[no-untyped-def]
+    """Chunks one after another, in this process (the default runner)."""
+    for a in range(0, plan.total, size):
+        yield task(job, a, plan.chunk(a, min(a + size, plan.total)))
+
+
+CHUNK = 256
+"""Paths per task: numpy blocks big enough to amortise the interpreter, small enough that
+two workers share Problem 3's 1,442 paths evenly."""
+
+
 def solve_points(points: list[complex] | tuple[complex, ...], seed: int = 0,
-                 max_routes: int = MAX_ROUTES) -> NinePointSolutions:
+                 max_routes: int = MAX_ROUTES, run=None, orbits: int | None = None,  # type: ignore[no-untyped-def]
+                 ) -> NinePointSolutions:
     """Every four-bar whose coupler point passes through nine points (complex numbers
     x + iy), by parameter homotopy from the stored generic instance (:func:`load_start`).
     The first route is the straight segment; a path that fails, or ends where Newton's
     method does not settle, leaves its endpoint to another route, through a random complex
     instance, which carries every path again (a route permutes the endpoints, so the union
     over routes is what is counted); routes stop when every orbit is found or at
-    ``max_routes``."""
+    ``max_routes``. ``run(task, job, plan, size)`` runs the chunks of paths (default: here,
+    one after another; the scan's runner sends them to dask). ``orbits``: track only the
+    first so many of the stored orbits (a quick look; the counts are then of those)."""
     import time
 
     began = time.perf_counter()
     start = load_start()
+    rows = start.solutions if orbits is None else start.solutions[:orbits]
     p = np.asarray(points, dtype=complex)
     d1 = p[1:] - p[0]
     db1 = np.conj(d1)
@@ -456,35 +514,24 @@ def solve_points(points: list[complex] | tuple[complex, ...], seed: int = 0,
     steps: list[int] = []
     for route in range(max_routes):
         if route == 0:
-            legs = [(start.delta, start.deltabar, d1, db1)]
+            legs = ((start.delta, start.deltabar, d1, db1),)
         else:
             m, mb = _random_points(rng)
-            legs = [(start.delta, start.deltabar, m, mb), (m, mb, d1, db1)]
-        Z = start.solutions
-        ok = np.ones(len(Z), bool)
-        total = 0
-        for a, ab, b, bb in legs:
-            Z, k, log = track_segment(ParameterSegment(a, ab, b, bb, random_patch(rng)), Z)
-            ok &= k
-            total += int(log.steps.sum())
-        Z, last, cond = polish(Z[ok], d1, db1)
-        good = (last <= REFINED) & (cond <= SINGULAR)
-        failed.append(int((~ok).sum()))
-        steps.append(total)
-        # what does not settle in double precision is polished at PRECISE_DIGITS
-        precise = [polish_precisely(z, d1, db1) for z in Z[~good] if np.all(np.isfinite(z))]
-        settled = [z for z in precise if z is not None]
-        unrefined.append(int((~good).sum()) - len(settled))
-        Z = canonical(np.vstack([Z[good], *[z[None, :] for z in settled]]))
-        both = np.vstack([found, Z])
+            legs = ((start.delta, start.deltabar, m, mb), (m, mb, d1, db1))
+        job = Route(legs, tuple(random_patch(rng) for _ in legs), (d1, db1))
+        parts = list((run or _here)(track_route, job, StartRows(rows), CHUNK))
+        failed.append(sum(int(c["failed"][0]) for c in parts))
+        unrefined.append(sum(int(c["unsettled"][0]) for c in parts))
+        steps.append(sum(int(c["steps"][0]) for c in parts))
+        both = np.vstack([found, *[c["z"] for c in parts]])
         found = both[distinct(both)]
-        if len(found) >= len(start.solutions):
+        if len(found) >= len(rows):
             break
     Z = found
     _, J, _, _ = equations(Z, d1, db1)
     cond = np.linalg.cond(J) if len(Z) else np.zeros(0)
     real = is_real(Z)
     Z[real, 4:] = np.conj(Z[real, :4])
-    return NinePointSolutions(tuple(complex(v) for v in p), Z, real, cond, len(start.solutions),
+    return NinePointSolutions(tuple(complex(v) for v in p), Z, real, cond, len(rows),
                               len(failed), tuple(failed), tuple(unrefined), tuple(steps),
                               time.perf_counter() - began)
