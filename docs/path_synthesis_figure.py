@@ -10,13 +10,13 @@ from __future__ import annotations
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-from linkage.kinematics.assemblies import assemblies, same_configuration  # noqa: E402
-from linkage.kinematics.circuits import circuits  # noqa: E402
-from linkage.kinematics.rates import place  # noqa: E402
-from linkage.problems.loops import from_text  # noqa: E402
-from linkage.synthesis_path import mechanism_text, synthesize_path  # noqa: E402
+from linkage.kinematics.assemblies import assemblies, same_configuration
+from linkage.kinematics.circuits import circuits
+from linkage.kinematics.rates import place
+from linkage.problems.loops import from_text
+from linkage.synthesis_path import mechanism_text, synthesize_path
 
 PROBLEM_3 = [(0.25, 0.0), (0.52, 0.1), (0.8, 0.7), (1.2, 1.0), (1.4, 1.3), (1.1, 1.48), (0.7, 1.4),
              (0.2, 1.0), (0.02, 0.4)]
@@ -32,7 +32,8 @@ def main() -> None:
         start = assemblies(m)
         first = next(i for i, s in enumerate(start.real)
                      if same_configuration([m.unknowns[0].value, m.unknowns[1].value], s.q, m, 1e-6))
-        circ = circuits(m, found=start).circuits[0 if first is None else circuits(m, found=start).circuit_of(first)]
+        traced = circuits(m, found=start)
+        circ = traced.circuits[traced.circuit_of(first)]
         xs, ys = [], []
         for d, q in zip(circ.drivers, circ.configurations):
             p = place(m.model, list(q), d)["P"][0]
