@@ -119,7 +119,7 @@ LAYERS: tuple[frozenset[str], ...] = (
     frozenset({"methods", "iterate", "analysis", "codegen", "kernel"}),
     frozenset({"solve", "homotopy"}),
     frozenset({"kinematics"}),
-    frozenset({"scan", "synthesis", "burmester"}),
+    frozenset({"scan", "synthesis", "burmester", "synthesis_path"}),
     frozenset({"render"}),
     frozenset({"measure", "bench", "stress", "mgh_table", "cli"}),
     frozenset({"linkage", "__main__"}),

@@ -1,204 +1,536 @@
-"""The nine-point path synthesis problem for four-bars as a parameter family (Wampler,
-Morgan and Sommese, "Complete solution of the nine-point path synthesis problem for
-four-bar linkages", J. Mech. Des. 114, 1992; Sommese and Wampler 2005, sec. 9.6).
+"""Nine-point path synthesis of four-bars as a polynomial system, and its symmetries.
 
-Isotropic coordinates, relative to the first precision point P0: a and b are the fixed
-pivots, x and y the vectors from the coupler point to the moving pivots at the first
-position, and each has its conjugate as an independent unknown (x~ is conj(x) for a real
-four-bar): v = (x, a, y, b, x~, a~, y~, b~). At point j = 1..8 the coupler point is at P0 +
-d_j and the coupler has turned by Theta_j = 1 + Q_j. The links keep their lengths:
+A four-bar's coupler point P passes through nine given points P_0..P_8. Following Wampler,
+Morgan and Sommese ("Complete solution of the nine-point path synthesis problem for
+four-bar linkages", J. Mech. Des. 114(1):153-159, 1992), put P_0 at the origin, write
+delta_j = P_j - P_0 and work in isotropic coordinates: each planar vector v is the pair
+(v, vbar), v = v_x + i v_y and vbar = v_x - i v_y, which are conjugates for a real linkage
+and independent complex unknowns for the algebra.
 
-    |d_j + Theta_j x - a|^2 = |x - a|^2,  the same for y and b,
+The unknowns, with the coupler point at the origin in the first position:
+    a, b   the ground pivots;  x, y  the moving pivots;  and their bars.
+In position j the coupler has turned by Theta_j (Theta_j Thetabar_j = 1), the moving pivot
+is at delta_j + Theta_j x, and its distance to a is unchanged:
+    (delta_j + Theta_j x - a)(deltabar_j + Thetabar_j xbar - abar) = (x - a)(xbar - abar),
+that is (with Theta Thetabar = 1)  Theta_j P_j + Thetabar_j Pb_j + R_j = 0, where
+    P_j = x (deltabar_j - abar),  Pb_j = xbar (delta_j - a),
+    R_j = delta_j deltabar_j - delta_j abar - deltabar_j a + x abar + xbar a,
+and Theta_j Q_j + Thetabar_j Qb_j + S_j = 0 likewise for (b, y). Cramer's rule gives
+Theta_j = N1/D and Thetabar_j = N2/D with N1 = Pb S - R Qb, N2 = Q R - P S, D = P Qb - Pb Q,
+and Theta_j Thetabar_j = 1 becomes one equation per position,
+    E_j = N1 N2 - D^2 = 0,   j = 1..8:
+eight equations in the eight unknowns. The published count: 8,652 nondegenerate solutions
+for generic points, 1,442 four-bars up to the symmetries below (WMS 1992).
 
-which read A Q + B Q~ = C and D Q + E Q~ = F with
-
-    A = x (d~ - a~),  B = x~ (d - a),  C = -(d~ (x - a) + d (x~ - a~) + d d~),
-
-D, E, F the same in y and b. Cramer's rule gives Q and Q~, and Theta Theta~ = 1, that is Q +
-Q~ + Q Q~ = 0, becomes one equation of degree 7 per point:
-
-    (CE - BF)(AE - BD) + (AF - CD)(AE - BD) + (CE - BF)(AF - CD) = 0.
-
-The parameters are p = (d_1..d_8, d~_1..d~_8); for real points d~_j = conj(d_j). A generic
-member has 8652 nonsingular roots (1442 four-bars up to Roberts' cognates, times 3, times
-the relabelling x <-> y); Problem 3's nine points have 64 real four-bars up to those six
-(WMS 1992, table 3). The total degree is 7^8 = 5,764,801 and the two-homogeneous Bezout
-number of {x, a, y, b}, {x~, a~, y~, b~} is 4,587,520, so its roots are reached by a
-parameter homotopy from a generic instance, whose roots monodromy finds (:mod:`.parameter`).
-
-:class:`NinePointForm` evaluates the family and every derivative (in X and in p) as numpy
-blocks by forward differentiation of that chain of products: the expanded polynomials have
-thousands of terms each. :meth:`NinePointFamily.at` expands one member (for Newton
-refinement and the condition number of an endpoint).
+Two symmetries map solutions to solutions for any points, so one solution in each orbit
+of six is enough to track (:func:`orbit`):
+- exchanging the two dyads, (a, x) <-> (b, y);
+- Roberts' cognates: three four-bars trace one coupler curve. Writing the coupler point as
+  delta_j = c + psi_j u - phi_j v, where phi_j, psi_j are the cranks' rotations and
+      c = (x b - y a)/(x - y),  u = x (y - b)/(x - y),  v = y (x - a)/(x - y),
+  the four-bar with ground pivots a and c, moving pivots a - x and v, traces the same
+  points (its coupler turns with the first crank; derivation in :func:`cognate`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .polynomials import HomogeneousForm, PolySystem
+if TYPE_CHECKING:
+    from .tracker import PathLog
 
-N = 8
-"""Unknowns: x, a, y, b, then their conjugates."""
-K = 16
-"""Parameters: d_1..d_8, then d~_1..d~_8."""
-DEGREE = 7
-GROUPS = ((0, 1, 2, 3), (4, 5, 6, 7))
-CONJUGATE = (4, 5, 6, 7, 0, 1, 2, 3)
-GENERIC_ROOTS = 8652
-"""A generic member's nonsingular roots (WMS 1992)."""
+A, X, B, Y, AB, XB, BB, YB = range(8)
+"""Columns of an unknown vector: a, x, b, y, abar, xbar, bbar, ybar."""
+
+
+def _dyad(g: np.ndarray, m: np.ndarray, gb: np.ndarray, mb: np.ndarray, d: np.ndarray,
+          db: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The dyad's coefficients P, Pb, R, homogenised with w (w = 1: the affine ones), and
+    their derivatives: with respect to its ground pivot g, moving pivot m, their bars
+    (order g, m, gb, mb) and w; and with respect to delta and deltabar."""
+    P = m * (db * w - gb)
+    Pb = mb * (d * w - g)
+    R = d * db * w * w - (d * gb + db * g) * w + m * gb + mb * g
+    zero = np.zeros_like(P)
+    dP = (zero, db * w - gb, -m, zero, m * db)
+    dPb = (-mb, zero, zero, d * w - g, mb * d)
+    dR = (-db * w + mb, gb, -d * w + m, g, 2.0 * d * db * w - d * gb - db * g)
+    pP = (zero, m * w)
+    pPb = (mb * w, zero)
+    pR = (db * w * w - gb * w, d * w * w - g * w)
+    return P, Pb, R, dP, dPb, dR, pP, pPb, pR
+
+
+def equations(z: np.ndarray, d: np.ndarray, db: np.ndarray, w: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """E (paths, 8), its Jacobian in the unknowns (paths, 8, 8; with ``w``, the
+    homogenising coordinate, a ninth column for it), and its derivatives in delta_j and
+    deltabar_j (paths, 8) each (E_j depends on delta_j and deltabar_j only). ``z`` is
+    (paths, 8); ``d``, ``db`` are (paths, 8) or (8,); ``w`` (paths,) or None for 1."""
+    d = np.broadcast_to(d, (z.shape[0], 8))
+    db = np.broadcast_to(db, (z.shape[0], 8))
+    wcol = np.ones((z.shape[0], 1), dtype=z.dtype) if w is None else np.asarray(w)[:, None]
+    col = [z[:, k:k + 1] for k in range(8)]
+    P, Pb, R, dP, dPb, dR, pP, pPb, pR = _dyad(col[A], col[X], col[AB], col[XB], d, db, wcol)
+    Q, Qb, S, dQ, dQb, dS, pQ, pQb, pS = _dyad(col[B], col[Y], col[BB], col[YB], d, db, wcol)
+    N1 = Pb * S - R * Qb
+    N2 = Q * R - P * S
+    D = P * Qb - Pb * Q
+    E = N1 * N2 - D * D
+
+    def chain(dp, dpb, dr, dq, dqb, ds):
+        dn1 = dpb * S + Pb * ds - dr * Qb - R * dqb
+        dn2 = dq * R + Q * dr - dp * S - P * ds
+        dd = dp * Qb + P * dqb - dpb * Q - Pb * dq
+        return dn1 * N2 + N1 * dn2 - 2.0 * D * dd
+
+    zero = np.zeros_like(E)
+    J = np.empty((z.shape[0], 8, 8 if w is None else 9), dtype=z.dtype)
+    # the first dyad's unknowns (a, x, abar, xbar), then the second's
+    for k, col_index in enumerate((A, X, AB, XB)):
+        J[:, :, col_index] = chain(dP[k], dPb[k], dR[k], zero, zero, zero)
+    for k, col_index in enumerate((B, Y, BB, YB)):
+        J[:, :, col_index] = chain(zero, zero, zero, dQ[k], dQb[k], dS[k])
+    if w is not None:
+        J[:, :, 8] = chain(dP[4], dPb[4], dR[4], dQ[4], dQb[4], dS[4])
+    Ed = chain(pP[0], pPb[0], pR[0], pQ[0], pQb[0], pS[0])
+    Edb = chain(pP[1], pPb[1], pR[1], pQ[1], pQb[1], pS[1])
+    return E, J, Ed, Edb
+
+
+def rotations(z: np.ndarray, d: np.ndarray, db: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Theta_j and Thetabar_j (paths, 8): the coupler's rotation in each position."""
+    d = np.broadcast_to(d, (z.shape[0], 8))
+    db = np.broadcast_to(db, (z.shape[0], 8))
+    col = [z[:, k:k + 1] for k in range(8)]
+    one = np.ones_like(col[A])
+    P, Pb, R = _dyad(col[A], col[X], col[AB], col[XB], d, db, one)[:3]
+    Q, Qb, S = _dyad(col[B], col[Y], col[BB], col[YB], d, db, one)[:3]
+    D = P * Qb - Pb * Q
+    return (Pb * S - R * Qb) / D, (Q * R - P * S) / D
+
+
+def swap(z: np.ndarray) -> np.ndarray:
+    """The same four-bar with its dyads named the other way round."""
+    return z[..., [B, Y, A, X, BB, YB, AB, XB]]
+
+
+def cognate(z: np.ndarray) -> np.ndarray:
+    """A Roberts cognate: ground pivots a and c, moving pivots a - x and v (module
+    docstring). From the crank relations delta + Theta x - a = phi (x - a) and
+    delta + Theta y - b = psi (y - b), eliminating Theta gives delta = c + psi u - phi v; the
+    point a - Theta x = delta + phi (a - x) is at a fixed distance |x| from a, and
+    delta + phi v = c + psi u at a fixed distance |u| from c, both rigid with a body that
+    turns by phi."""
+    a, x, b, y = (z[..., k] for k in (A, X, B, Y))
+    ab, xb, bb, yb = (z[..., k] for k in (AB, XB, BB, YB))
+    c = (x * b - y * a) / (x - y)
+    v = y * (x - a) / (x - y)
+    cb = (xb * bb - yb * ab) / (xb - yb)
+    vb = yb * (xb - ab) / (xb - yb)
+    return np.stack([a, a - x, c, v, ab, ab - xb, cb, vb], axis=-1)
+
+
+def orbit(z: np.ndarray) -> np.ndarray:
+    """The six solutions a solution stands for: its three cognates, each with its dyads
+    either way round. ``z`` (8,) -> (6, 8)."""
+    first = z[None, :]
+    second = cognate(first)
+    third = cognate(swap(first))
+    three = np.concatenate([first, second, third])
+    return np.concatenate([three, swap(three)])
 
 
 @dataclass(frozen=True)
-class _Dual:
-    """A value over paths and points (P, 8) with its derivatives (P, 8, 1 + N + 1): in X0,
-    each unknown, and along the parameters' direction."""
+class ParameterSegment:
+    """The points moving on a straight line, delta(t) = (1 - t) start + t end, for all
+    paths at once; an instance of the homotopy protocol of :func:`.tracker.track`
+    (``residual_and_jacobians`` and ``velocity``). Points are projective, (z, w) with z/w
+    the unknowns, on the random patch ``patch`` . (z, w) = 1, so that a solution that is
+    large at an instance (a nearly degenerate four-bar: pivots far away) stays bounded."""
 
-    val: np.ndarray
-    grad: np.ndarray
+    d0: np.ndarray  # (8,) delta at t = 0
+    db0: np.ndarray
+    d1: np.ndarray  # (8,) at t = 1
+    db1: np.ndarray
+    patch: np.ndarray  # (9,)
 
-    def __add__(self, o: _Dual) -> _Dual:
-        return _Dual(self.val + o.val, self.grad + o.grad)
+    def at(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        t = np.asarray(t)[:, None]
+        return (1 - t) * self.d0 + t * self.d1, (1 - t) * self.db0 + t * self.db1
 
-    def __sub__(self, o: _Dual) -> _Dual:
-        return _Dual(self.val - o.val, self.grad - o.grad)
+    def residual_and_jacobians(self, Z: np.ndarray, t: np.ndarray
+                               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        d, db = self.at(t)
+        E, J, Ed, Edb = equations(Z[:, :8], d, db, Z[:, 8])
+        Ht = Ed * (self.d1 - self.d0) + Edb * (self.db1 - self.db0)
+        n = len(Z)
+        patch = np.broadcast_to(self.patch, (n, 1, 9))
+        return (np.concatenate([E, (Z @ self.patch - 1.0)[:, None]], axis=1),
+                np.concatenate([J, patch], axis=1),
+                np.concatenate([Ht, np.zeros((n, 1), dtype=complex)], axis=1))
 
-    def __neg__(self) -> _Dual:
-        return _Dual(-self.val, -self.grad)
+    def velocity(self, Z: np.ndarray, t: np.ndarray, dt: np.ndarray) -> np.ndarray:
+        from .tracker import velocity
 
-    def __mul__(self, o: _Dual) -> _Dual:
-        return _Dual(self.val * o.val, self.val[..., None] * o.grad + o.val[..., None] * self.grad)
-
-
-def _equations(h: _Dual, x: _Dual, a: _Dual, y: _Dual, b: _Dual, xc: _Dual, ac: _Dual, yc: _Dual, bc: _Dual,
-               d: _Dual, dc: _Dual) -> _Dual:
-    """The eight equations, homogenised by h (each term of degree 7 in (h, v))."""
-    A, B = x * (dc * h - ac), xc * (d * h - a)
-    C = -(dc * (x - a) + d * (xc - ac) + d * dc * h)
-    D, E = y * (dc * h - bc), yc * (d * h - b)
-    F = -(dc * (y - b) + d * (yc - bc) + d * dc * h)
-    q, qc, det = C * E - B * F, A * F - C * D, A * E - B * D
-    return q * det + qc * det + q * qc * h
-
-
-@dataclass(frozen=True)
-class NinePointForm:
-    """The family, homogeneous of degree 7 in (X0, v), with its derivatives by forward
-    differentiation: a :class:`.parameter.ParameterForm`."""
-
-    def jet(self, X: np.ndarray, p: np.ndarray, dp: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """F (P, 8), dF/dX (P, 8, 9) and dF/dp . dp (P, 8) at (X, p), one row a path."""
-        P, width = X.shape[0], N + 2
-        eye = np.eye(width, dtype=complex)
-
-        def column(c: int) -> _Dual:
-            return _Dual(np.broadcast_to(X[:, c:c + 1], (P, N)), np.broadcast_to(eye[c], (P, N, width)))
-
-        def parameter(first: int) -> _Dual:
-            grad = np.zeros((P, N, width), dtype=complex)
-            grad[:, :, -1] = dp[:, first:first + N]
-            return _Dual(p[:, first:first + N], grad)
-
-        out = _equations(column(0), *[column(1 + i) for i in range(N)], parameter(0), parameter(N))
-        return out.val, out.grad[:, :, :-1], out.grad[:, :, -1]
+        return velocity(self, Z, t, dt)
 
 
-# --- members expanded, for refinement and conditions --------------------------------------
+def random_patch(rng: np.random.Generator) -> np.ndarray:
+    patch = rng.normal(size=9) + 1j * rng.normal(size=9)
+    return patch / np.linalg.norm(patch)
 
-Poly = dict[tuple[int, ...], complex]
+
+def lift(z: np.ndarray, patch: np.ndarray) -> np.ndarray:
+    """Affine solutions (paths, 8) to projective points on the patch."""
+    Z = np.concatenate([z, np.ones((len(z), 1), dtype=complex)], axis=1)
+    return Z / (Z @ patch)[:, None]
 
 
-def _mul(p: Poly, q: Poly) -> Poly:
-    out: Poly = {}
-    for e, c in p.items():
-        for f, k in q.items():
-            g = tuple(i + j for i, j in zip(e, f))
-            out[g] = out.get(g, 0j) + c * k
+def affine(Z: np.ndarray) -> np.ndarray:
+    """Projective points back to affine solutions (inf where w is 0)."""
+    with np.errstate(all="ignore"):
+        return Z[:, :8] / Z[:, 8:9]
+
+
+def seed_instance(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A random complex instance with one solution known: random unknowns z and random
+    delta_j, then each deltabar_j a root of E_j (a cubic in deltabar_j, fitted exactly
+    from four values). Returns (z, delta, deltabar)."""
+    z = rng.normal(size=8) + 1j * rng.normal(size=8)
+    d = rng.normal(size=8) + 1j * rng.normal(size=8)
+    db = np.empty(8, dtype=complex)
+    probe = np.array([-1.0, 0.0, 1.0, 2.0]) + 0.5j
+    for j in range(8):
+        values = []
+        for p in probe:
+            dd, ddb = d.copy(), np.zeros(8, dtype=complex)
+            ddb[j] = p
+            values.append(equations(z[None, :], dd, ddb)[0][0, j])
+        coeffs = np.polyfit(probe, np.array(values), 3)
+        roots = np.roots(coeffs)
+        db[j] = roots[np.argmax(np.abs(roots.imag))]  # any root; the least real is generic
+    # polish deltabar so that z solves the instance to rounding
+    for _ in range(3):
+        E, _J, _Ed, Edb = equations(z[None, :], d, db)
+        db = db - E[0] / Edb[0]
+    return z, d, db
+
+
+MAX_STEP = 0.05
+"""Largest step in t along a parameter segment."""
+CORRECTOR_TOL = 1e-9
+"""The tracker's corrector tolerance here (relative): the equations are of degree 8 and a
+path's Jacobian has a condition number up to about 1e6 along the way, so Newton's method
+in double precision stalls near 1e-11 (measured); the endpoints are refined at the end."""
+SAME = 1e-8
+"""Two solutions closer than this (relative to their size) are one."""
+
+
+def track_segment(segment: ParameterSegment, Z: np.ndarray, max_step: float = MAX_STEP
+                  ) -> tuple[np.ndarray, np.ndarray, PathLog]:
+    """Every row of ``Z`` (affine solutions at t = 0) tracked to t = 1 in projective
+    coordinates: (affine Z at 1, ok, the log)."""
+    from .tracker import PathLog, track
+
+    n = len(Z)
+    log = PathLog.empty(n)
+    Z1, ok, _ = track(segment, lift(Z, segment.patch), np.zeros(n), np.ones(n), lambda t: t, np.ones_like,
+                      log, np.arange(n), np.full(n, max_step / 4.0), max_step, CORRECTOR_TOL)
+    z1 = affine(Z1)
+    return z1, ok & np.all(np.isfinite(z1), axis=1), log
+
+
+KEY = np.array([0.3141592653589793 + 0.2718281828459045j, -0.5772156649015329 + 0.1618033988749895j,
+                0.6931471805599453 - 0.4142135623730950j, 0.2236067977499790 + 0.7320508075688772j,
+                -0.1234567890123456 + 0.9876543210987654j, 0.4472135954999579 - 0.3010299956639812j,
+                0.8660254037844386 + 0.1111111111111111j, -0.7071067811865476 - 0.5j])
+"""A fixed generic direction: a solution's key is the real part of its projection on it."""
+
+
+def canonical(Z: np.ndarray) -> np.ndarray:
+    """Each row replaced by the member of its orbit with the smallest key, so that two
+    solutions of one orbit have one canonical form (rows that are not finite stay)."""
+    out = Z.copy()
+    for i, z in enumerate(Z):
+        if not np.all(np.isfinite(z)):
+            continue
+        with np.errstate(all="ignore"):
+            members = orbit(z)
+        members = members[np.all(np.isfinite(members), axis=1)]
+        if len(members):
+            out[i] = members[np.argmin((members @ KEY).real)]
     return out
 
 
-def _add(p: Poly, q: Poly, sign: float = 1.0) -> Poly:
-    out = dict(p)
-    for e, c in q.items():
-        out[e] = out.get(e, 0j) + sign * c
-    return out
-
-
-def _var(i: int) -> Poly:
-    return {tuple(int(k == i) for k in range(N)): 1 + 0j}
-
-
-def _const(c: complex) -> Poly:
-    return {(0,) * N: complex(c)}
-
-
-def member(d: complex, dc: complex) -> Poly:
-    """One point's equation with numbers for d and d~, expanded in v."""
-    x, a, y, b, xc, ac, yc, bc = (_var(i) for i in range(N))
-    A, B = _mul(x, _add(_const(dc), ac, -1)), _mul(xc, _add(_const(d), a, -1))
-    C = _add(_add(_mul(_const(-dc), _add(x, a, -1)), _mul(_const(-d), _add(xc, ac, -1))), _const(-d * dc))
-    D, E = _mul(y, _add(_const(dc), bc, -1)), _mul(yc, _add(_const(d), b, -1))
-    F = _add(_add(_mul(_const(-dc), _add(y, b, -1)), _mul(_const(-d), _add(yc, bc, -1))), _const(-d * dc))
-    q = _add(_mul(C, E), _mul(B, F), -1)
-    qc = _add(_mul(A, F), _mul(C, D), -1)
-    det = _add(_mul(A, E), _mul(B, D), -1)
-    out = _add(_add(_mul(q, det), _mul(qc, det)), _mul(q, qc))
-    return {e: c for e, c in out.items() if c != 0}
+def distinct(Z: np.ndarray) -> np.ndarray:
+    """Indices of the rows of ``Z`` that no earlier row equals (to SAME, relative): of
+    rows that are one solution, the first. Rows are sorted by key, and only rows whose keys
+    are within reach are compared (|key difference| <= |difference| |KEY|)."""
+    keys = (Z @ KEY).real
+    order = np.argsort(keys, kind="stable")
+    scale = np.maximum(1.0, np.linalg.norm(Z, axis=1))
+    reach = SAME * scale * float(np.linalg.norm(KEY)) * 1.01
+    keep = np.ones(len(Z), bool)
+    for pos, i in enumerate(order):
+        for direction in (-1, 1):
+            q = pos + direction
+            while 0 <= q < len(order) and abs(keys[order[q]] - keys[i]) <= reach[i]:
+                j = order[q]
+                if j < i and np.linalg.norm(Z[i] - Z[j]) <= SAME * scale[i]:
+                    keep[i] = False
+                    break
+                q += direction
+            if not keep[i]:
+                break
+    return np.flatnonzero(keep)
 
 
 @dataclass(frozen=True)
-class NinePointFamily:
-    """The family as :func:`.parameter.track_parameters` and :func:`.parameter.monodromy`
-    take it (n, k, degrees, form, at)."""
+class Instance:
+    """Points (delta, deltabar: P_j - P_0 in isotropic coordinates, j = 1..8) and the
+    solutions known for them, one per orbit of six (:func:`orbit`)."""
 
-    n: int = N
-    k: int = K
+    delta: np.ndarray
+    deltabar: np.ndarray
+    solutions: np.ndarray  # (orbits, 8)
+
+
+def _random_points(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    return (rng.normal(size=8) + 1j * rng.normal(size=8), rng.normal(size=8) + 1j * rng.normal(size=8))
+
+
+def monodromy_loop(instance: Instance, rng: np.random.Generator, max_step: float = MAX_STEP
+                   ) -> tuple[Instance, int, int, float]:
+    """Move the points around a random triangle back to themselves, carrying every known
+    solution; endpoints that are new orbits join. Returns (instance, new orbits, failed
+    paths, seconds)."""
+    import time
+
+    began = time.perf_counter()
+    d1, db1 = _random_points(rng)
+    d2, db2 = _random_points(rng)
+    d0, db0 = instance.delta, instance.deltabar
+    Z = instance.solutions
+    ok_all = np.ones(len(Z), bool)
+    for (a, ab), (b, bb) in (((d0, db0), (d1, db1)), ((d1, db1), (d2, db2)), ((d2, db2), (d0, db0))):
+        Z, ok, _log = track_segment(ParameterSegment(a, ab, b, bb, random_patch(rng)), Z, max_step)
+        ok_all &= ok
+    Z = Z[ok_all]
+    # polish at the instance, then keep the orbits not yet known
+    for _ in range(3):
+        E, J, _, _ = equations(Z, d0, db0)
+        Z = Z - np.linalg.solve(J, E[..., None])[..., 0]
+    Z = canonical(Z[np.all(np.isfinite(Z), axis=1)])
+    both = np.vstack([instance.solutions, Z])
+    fresh = [i - len(instance.solutions) for i in distinct(both) if i >= len(instance.solutions)]
+    kept = [Z[i] for i in fresh]
+    solutions = np.vstack([instance.solutions, *[k[None, :] for k in kept]]) if kept else instance.solutions
+    return (Instance(d0, db0, solutions), len(kept), int((~ok_all).sum()),
+            time.perf_counter() - began)
+
+
+START = "data/nine_point_start.npz"
+"""A generic complex instance with one solution of each of its 1,442 orbits, made by
+:func:`monodromy_loop` from one seed (benchmarks/nine_point_start.py remakes it)."""
+POLISH_STEPS = 8
+REFINED = 1e-10
+"""An endpoint is a solution when Newton's steps at the target fall below this, relative."""
+REAL = 1e-8
+"""A solution is real when each bar is the conjugate of its unbarred twin to this, relative."""
+
+
+def load_start() -> Instance:
+    from importlib.resources import files
+
+    with files("linkage.homotopy").joinpath(START).open("rb") as fh:
+        data = np.load(fh)
+        return Instance(data["d"], data["db"], data["z"])
+
+
+def polish(Z: np.ndarray, d: np.ndarray, db: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Newton's method at the target: (Z, last relative step, condition of J)."""
+    last = np.full(len(Z), np.inf)
+    for _ in range(POLISH_STEPS):
+        E, J, _, _ = equations(Z, d, db)
+        good = np.all(np.isfinite(J.reshape(len(J), -1)), axis=1) & np.all(np.isfinite(E), axis=1)
+        step = np.full(Z.shape, np.nan + 0j)
+        if good.any():
+            from .tracker import solve_batched
+
+            step[good] = solve_batched(J[good], E[good])
+        Z = np.where(np.isfinite(step), Z - step, Z)
+        last = np.linalg.norm(step, axis=1) / np.maximum(1.0, np.linalg.norm(Z, axis=1))
+    _, J, _, _ = equations(Z, d, db)
+    cond = np.full(len(Z), np.inf)
+    fin = np.all(np.isfinite(J.reshape(len(J), -1)), axis=1)
+    if fin.any():
+        cond[fin] = np.linalg.cond(J[fin])
+    return Z, np.where(np.isfinite(last), last, np.inf), cond
+
+
+PRECISE_DIGITS = 60
+PRECISE_STEPS = 40
+
+
+def polish_precisely(z: np.ndarray, d: np.ndarray, db: np.ndarray) -> np.ndarray | None:
+    """Newton's method at PRECISE_DIGITS digits (mpmath) from an endpoint that would not
+    settle in double precision (a solution whose condition is near 1/eps: its digits are
+    lost in double arithmetic, not in the method). The solution rounded to double, or None
+    when the steps do not fall below 1e-40 of its size or the Jacobian is singular there."""
+    import mpmath
+
+    with mpmath.workdps(PRECISE_DIGITS):
+        Z = np.array([[mpmath.mpc(complex(v)) for v in z]], dtype=object)
+        dd = np.array([mpmath.mpc(complex(v)) for v in d], dtype=object)
+        ddb = np.array([mpmath.mpc(complex(v)) for v in db], dtype=object)
+        for _ in range(PRECISE_STEPS):
+            E, J, _, _ = equations(Z, dd, ddb)
+            try:
+                step = mpmath.lu_solve(mpmath.matrix(J[0].tolist()), mpmath.matrix(E[0].tolist()))
+            except ZeroDivisionError:
+                return None
+            Z = Z - np.array([[step[k] for k in range(8)]], dtype=object)
+            size = max(mpmath.mpf(1), max(abs(v) for v in Z[0]))
+            if max(abs(step[k]) for k in range(8)) <= mpmath.mpf(10) ** -40 * size:
+                return np.array([complex(v) for v in Z[0]])
+    return None
+
+
+def is_real(Z: np.ndarray) -> np.ndarray:
+    scale = np.maximum(1.0, np.max(np.abs(Z), axis=1))
+    return np.max(np.abs(Z[:, 4:] - np.conj(Z[:, :4])), axis=1) <= REAL * scale
+
+
+@dataclass(frozen=True)
+class NinePointSolutions:
+    """The four-bars through nine points, one per orbit (cognates and dyad order), and how
+    they were found."""
+
+    points: tuple[complex, ...]  # P_0..P_8
+    solutions: np.ndarray  # (orbits found, 8): a, x, b, y, bars; P_0 at the origin
+    real: np.ndarray  # (orbits found,) bool
+    condition: np.ndarray  # (orbits found,)
+    paths: int  # tracked per route (the start instance's orbits)
+    routes: int  # straight, then through random complex points, until every orbit is found
+    failed: tuple[int, ...]  # per route
+    unrefined: tuple[int, ...]  # per route: ended where Newton's method does not settle
+    steps: tuple[int, ...]  # per route, total
+    seconds: float
 
     @property
-    def degrees(self) -> tuple[int, ...]:
-        return (DEGREE,) * N
-
-    @cached_property
-    def form(self) -> NinePointForm:
-        return NinePointForm()
-
-    def at(self, p: np.ndarray) -> PolySystem:
-        p = np.asarray(p, dtype=complex)
-        polys = tuple(member(p[j], p[N + j]) for j in range(N))
-        return PolySystem(N, polys, groups=GROUPS, conjugate=CONJUGATE)
-
-    def homogeneous_at(self, p: np.ndarray) -> HomogeneousForm:
-        return HomogeneousForm.of(self.at(p), self.degrees)
+    def missing(self) -> int:
+        """Orbits of the start instance whose endpoint no route reached."""
+        return self.paths - len(self.solutions)
 
 
-def parameters(points: list[tuple[float, float]] | np.ndarray) -> np.ndarray:
-    """p for nine points in the plane: d_j = P_j - P_0 as complex numbers and their
-    conjugates."""
-    z = np.array([complex(px, py) for px, py in points])
-    if len(z) != 9:
-        raise ValueError(f"nine points are needed, got {len(z)}")
-    d = z[1:] - z[0]
-    return np.concatenate([d, d.conjugate()])
+MAX_ROUTES = 4
+SINGULAR = 1e12
+"""An endpoint whose Jacobian's condition exceeds this is not counted as a solution."""
 
 
-def seed_instance(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """A generic complex member with one root known: v random, each d_j random and d~_j a
-    root of point j's equation, a cubic in d~_j once v and d_j are numbers. (p, v)."""
-    v = rng.normal(size=N) + 1j * rng.normal(size=N)
-    p = np.zeros(K, dtype=complex)
-    form = NinePointForm()
-    samples = np.array([-1.0, -0.5, 0.0, 0.5, 1.0, 1.5]) * (1 + 0.3j)
-    for j in range(N):
-        d = complex(rng.normal(), rng.normal())
-        values = []
-        for s in samples:
-            trial = p.copy()
-            trial[j], trial[N + j] = d, s
-            F, _, _ = form.jet(np.concatenate([[1.0 + 0j], v])[None], trial[None], np.zeros((1, K)))
-            values.append(F[0, j])
-        roots = np.roots(np.polyfit(samples, np.array(values), 3))
-        p[j], p[N + j] = d, roots[np.argmin(np.abs(roots))]
-    return p, v
+@dataclass(frozen=True)
+class Route:
+    """One way from the stored instance to the target: its legs (points at each end) and
+    each leg's projective patch. A value, so that a chunk of paths can be sent to a worker."""
+
+    legs: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], ...]
+    patches: tuple[np.ndarray, ...]
+    target: tuple[np.ndarray, np.ndarray]
+
+
+def track_route(route: Route, first: int, Z: np.ndarray) -> dict[str, np.ndarray]:
+    """Paths ``Z`` (start solutions; ``first`` is the index of the first, for the caller's
+    order) along every leg of ``route``, polished at the target; endpoints that will not
+    settle in double precision polished at PRECISE_DIGITS. A chunk's records: ``z``
+    (settled endpoints, canonical), ``failed``, ``unsettled``, ``steps`` (counts)."""
+    ok = np.ones(len(Z), bool)
+    steps = 0
+    for (a, ab, b, bb), patch in zip(route.legs, route.patches):
+        Z, k, log = track_segment(ParameterSegment(a, ab, b, bb, patch), Z)
+        ok &= k
+        steps += int(log.steps.sum())
+    d1, db1 = route.target
+    Z, last, cond = polish(Z[ok], d1, db1)
+    good = (last <= REFINED) & (cond <= SINGULAR)
+    precise = [polish_precisely(z, d1, db1) for z in Z[~good] if np.all(np.isfinite(z))]
+    settled = [z for z in precise if z is not None]
+    Z = canonical(np.vstack([Z[good], *[z[None, :] for z in settled]]))
+    return {"z": Z, "failed": np.array([int((~ok).sum())]), "steps": np.array([steps]),
+            "unsettled": np.array([int((~good).sum()) - len(settled)])}
+
+
+class StartRows:
+    """The stored instance's solutions as a plan of chunks (``total``, ``chunk(a, b)``),
+    the shape the scan's chunk runner takes."""
+
+    def __init__(self, solutions: np.ndarray) -> None:
+        self.solutions = solutions
+        self.total = len(solutions)
+
+    def chunk(self, a: int, b: int) -> np.ndarray:
+        return self.solutions[a:b]
+
+
+def _here(task, job, plan, size):  # type: ignore[no-untyped-def]
+    """Chunks one after another, in this process (the default runner)."""
+    for a in range(0, plan.total, size):
+        yield task(job, a, plan.chunk(a, min(a + size, plan.total)))
+
+
+CHUNK = 256
+"""Paths per task: numpy blocks big enough to amortise the interpreter, small enough that
+two workers share Problem 3's 1,442 paths evenly."""
+
+
+def solve_points(points: list[complex] | tuple[complex, ...], seed: int = 0,
+                 max_routes: int = MAX_ROUTES, run=None, orbits: int | None = None,  # type: ignore[no-untyped-def]
+                 ) -> NinePointSolutions:
+    """Every four-bar whose coupler point passes through nine points (complex numbers
+    x + iy), by parameter homotopy from the stored generic instance (:func:`load_start`).
+    The first route is the straight segment; a path that fails, or ends where Newton's
+    method does not settle, leaves its endpoint to another route, through a random complex
+    instance, which carries every path again (a route permutes the endpoints, so the union
+    over routes is what is counted); routes stop when every orbit is found or at
+    ``max_routes``. ``run(task, job, plan, size)`` runs the chunks of paths (default: here,
+    one after another; the scan's runner sends them to dask). ``orbits``: track only the
+    first so many of the stored orbits (a quick look; the counts are then of those)."""
+    import time
+
+    began = time.perf_counter()
+    start = load_start()
+    rows = start.solutions if orbits is None else start.solutions[:orbits]
+    p = np.asarray(points, dtype=complex)
+    d1 = p[1:] - p[0]
+    db1 = np.conj(d1)
+    rng = np.random.default_rng(seed)
+    found = np.zeros((0, 8), dtype=complex)
+    failed: list[int] = []
+    unrefined: list[int] = []
+    steps: list[int] = []
+    for route in range(max_routes):
+        if route == 0:
+            legs = ((start.delta, start.deltabar, d1, db1),)
+        else:
+            m, mb = _random_points(rng)
+            legs = ((start.delta, start.deltabar, m, mb), (m, mb, d1, db1))
+        job = Route(legs, tuple(random_patch(rng) for _ in legs), (d1, db1))
+        parts = list((run or _here)(track_route, job, StartRows(rows), CHUNK))
+        failed.append(sum(int(c["failed"][0]) for c in parts))
+        unrefined.append(sum(int(c["unsettled"][0]) for c in parts))
+        steps.append(sum(int(c["steps"][0]) for c in parts))
+        both = np.vstack([found, *[c["z"] for c in parts]])
+        found = both[distinct(both)]
+        if len(found) >= len(rows):
+            break
+    Z = found
+    _, J, _, _ = equations(Z, d1, db1)
+    cond = np.linalg.cond(J) if len(Z) else np.zeros(0)
+    real = is_real(Z)
+    Z[real, 4:] = np.conj(Z[real, :4])
+    return NinePointSolutions(tuple(complex(v) for v in p), Z, real, cond, len(rows),
+                              len(failed), tuple(failed), tuple(unrefined), tuple(steps),
+                              time.perf_counter() - began)

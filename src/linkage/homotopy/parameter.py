@@ -83,7 +83,7 @@ class ParameterForm(Protocol):
 
 class ParameterFamily(Protocol):
     """A family as :func:`track_parameters` and :func:`monodromy` take it (:class:`Family`
-    or a family with its own evaluation, such as :mod:`.ninepoint`'s)."""
+    or a family with its own evaluation)."""
 
     n: int
     k: int

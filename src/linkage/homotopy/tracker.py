@@ -45,7 +45,7 @@ class PathHomotopy(Protocol):
 def velocity(h: PathHomotopy, X: np.ndarray, t: np.ndarray, dt: np.ndarray) -> np.ndarray:
     """dX along the path for a change dt of t: -H_X^-1 H_t dt (the patch held)."""
     _, J, Ht = h.residual_and_jacobians(X, t)
-    return -_solve(J, Ht * dt[:, None])
+    return -solve_batched(J, Ht * dt[:, None])
 
 
 @dataclass(frozen=True)
@@ -92,7 +92,7 @@ class PathLog:
                    np.full(paths, np.inf), [""] * paths)
 
 
-def _solve(J: np.ndarray, b: np.ndarray) -> np.ndarray:
+def solve_batched(J: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Batched solve; a singular matrix gives NaN for its path, not an exception."""
     try:
         return np.linalg.solve(J, b[..., None])[..., 0]
@@ -113,10 +113,14 @@ def _norm(X: np.ndarray) -> np.ndarray:
 def track(h: PathHomotopy, X: np.ndarray, tau: np.ndarray, tau_end: np.ndarray,
           t_of: Callable[[np.ndarray], np.ndarray], dt_of: Callable[[np.ndarray], np.ndarray],
           log: PathLog, index: np.ndarray, step: np.ndarray,
-          max_step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+          max_step: float, corrector_tol: float = CORRECTOR_TOL) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Track paths ``index`` from parameter ``tau`` to ``tau_end`` (real; t = t_of(tau),
     dt/dtau = dt_of(tau)), with per-path step sizes ``step``. Returns (X, ok, step): a path
-    that fails keeps its last point, ``ok`` False and its reason in ``log.failure``."""
+    that fails keeps its last point, ``ok`` False and its reason in ``log.failure``.
+    ``corrector_tol``: a corrector has converged when its last step is this small against
+    |X| (a path whose Jacobian's condition is k cannot be corrected below about k eps: a
+    parameter homotopy of degree-8 equations, :mod:`.ninepoint`, needs 1e-9; Bertini's
+    default is 1e-5 before its endgame)."""
     X = X.copy()
     tau = tau.astype(float).copy()
     step = np.minimum(step.astype(float).copy(), max_step)
@@ -140,7 +144,7 @@ def track(h: PathHomotopy, X: np.ndarray, tau: np.ndarray, tau_end: np.ndarray,
         last = np.full(len(a), np.inf)
         for it in range(CORRECTOR_STEPS):
             R, J, _ = h.residual_and_jacobians(Xp, t_new)
-            dX = _solve(J, R)
+            dX = solve_batched(J, R)
             Xp = Xp - dX
             d = _norm(dX)
             if it == 0:
@@ -148,13 +152,13 @@ def track(h: PathHomotopy, X: np.ndarray, tau: np.ndarray, tau_end: np.ndarray,
             # a corrector that does not contract is heading for another path
             contracting = (it == 0) | (d <= 0.5 * last)
             last = np.where(contracting, d, np.inf)
-            converged |= last <= CORRECTOR_TOL * size
+            converged |= last <= corrector_tol * size
             log.newton[index[a]] += 1
             if converged.all():
                 break
         # the predictor is fourth order: a first correction that is not small against the
         # step itself means the step left its path's neighbourhood (path jumping)
-        accept = converged & np.isfinite(_norm(Xp)) & (first <= 0.25 * moved + CORRECTOR_TOL * size)
+        accept = converged & np.isfinite(_norm(Xp)) & (first <= 0.25 * moved + corrector_tol * size)
         log.steps[index[a]] += 1
         acc, rej = a[accept], a[~accept]
         X[acc] = Xp[accept]

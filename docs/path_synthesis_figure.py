@@ -1,0 +1,59 @@
+"""Draw docs/path_synthesis_problem3.png: Problem 3's nine points and the coupler curves of
+its real four-bars without defects (one of each cognate group), each curve the circuit
+through the first point, followed by the engine.
+
+    python docs/path_synthesis_figure.py
+"""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+from linkage.kinematics.assemblies import assemblies, same_configuration
+from linkage.kinematics.circuits import circuits
+from linkage.kinematics.rates import place
+from linkage.problems.loops import from_text
+from linkage.synthesis_path import mechanism_text, synthesize_path
+
+PROBLEM_3 = [(0.25, 0.0), (0.52, 0.1), (0.8, 0.7), (1.2, 1.0), (1.4, 1.3), (1.1, 1.48), (0.7, 1.4),
+             (0.2, 1.0), (0.02, 0.4)]
+
+
+def main() -> None:
+    res = synthesize_path(PROBLEM_3)
+    good = [group for group in res.designs if not group[0].defects]
+    fig, ax = plt.subplots(figsize=(7, 7))
+    for group in good:
+        fb = group[0]
+        m = from_text(mechanism_text(fb), "<figure>")
+        start = assemblies(m)
+        first = next(i for i, s in enumerate(start.real)
+                     if same_configuration([m.unknowns[0].value, m.unknowns[1].value], s.q, m, 1e-6))
+        traced = circuits(m, found=start)
+        circ = traced.circuits[traced.circuit_of(first)]
+        xs, ys = [], []
+        for d, q in zip(circ.drivers, circ.configurations):
+            p = place(m.model, list(q), d)["P"][0]
+            xs.append(p.real)
+            ys.append(p.imag)
+        ax.plot(xs, ys, lw=0.8)
+    ax.plot([x for x, _ in PROBLEM_3], [y for _, y in PROBLEM_3], "ko", ms=6, zorder=5)
+    for k, (x, y) in enumerate(PROBLEM_3):
+        ax.annotate(str(k + 1), (x, y), textcoords="offset points", xytext=(5, 5))
+    ax.set_xlim(-1.5, 2.5)
+    ax.set_ylim(-1.5, 2.5)
+    ax.set_aspect("equal")
+    ax.grid(True, alpha=0.3)
+    ax.set_title(f"Problem 3 (Wampler, Morgan, Sommese 1992): {len(good)} of {len(res.designs)} real "
+                 "four-bars without defects,\ntheir coupler curves through the nine points")
+    fig.savefig("docs/path_synthesis_problem3.png", dpi=110, bbox_inches="tight")
+    print(f"{len(res.designs)} real, {len(good)} without defects; wrote docs/path_synthesis_problem3.png")
+    for group in res.designs:
+        print(group[0].grashof, group[0].defects, [g.defects for g in group[1:]])
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,239 @@
+"""Path generation: every four-bar whose coupler point passes through nine points, each
+real one checked by the mechanism engine.
+
+The four-bars come from :mod:`linkage.homotopy.ninepoint` (Wampler, Morgan and Sommese
+1992). Each real solution is one group of Roberts cognates; each member becomes a
+mechanism (a vector loop A-M-N-B, driven by the crank at A, the coupler point P on the
+coupler) and is checked as a designer would check it, by moving it:
+
+- ``positions``: at each point's crank angle the loops close and the engine places P on
+  the point (to 1e-9 of the linkage's size);
+- ``branch`` defect: the points are not all on the circuit through the first one (the
+  circuit is followed by arc length through limit positions, :mod:`linkage.kinematics.
+  circuits`): the mechanism would have to be taken apart between them;
+- ``order`` defect: moving along that circuit, the points are not met in their order
+  (either way round);
+- its Grashof class, and the least transmission angle at the points (folded 0..90).
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError
+from .homotopy import ninepoint
+from .units import degrees
+
+POINTS = 9
+ON_POINT = 1e-9
+"""A position reaches its point when P is within this of it, relative to the linkage's size."""
+
+
+@dataclass(frozen=True)
+class PathFourBar:
+    """One four-bar through the points, in the plane of the points (first position)."""
+
+    ground_a: complex
+    ground_b: complex
+    pin_m: complex  # the coupler's pin on the crank at A
+    pin_n: complex  # the coupler's pin on the crank at B
+    coupler_point: complex  # P, at the first point
+    grashof: str
+    defects: tuple[str, ...]
+    max_point_error: float  # max |P - point| over the points, engine-placed, in lengths
+    transmission_min_deg: float
+    crank_deg: tuple[float, ...]  # the crank at A's angle at each point
+
+    @property
+    def lengths(self) -> tuple[float, float, float, float]:
+        """Ground |AB|, crank |AM|, coupler |MN|, rocker |BN|."""
+        return (abs(self.ground_b - self.ground_a), abs(self.pin_m - self.ground_a),
+                abs(self.pin_n - self.pin_m), abs(self.pin_n - self.ground_b))
+
+
+@dataclass(frozen=True)
+class PathSynthesis:
+    points: tuple[complex, ...]
+    designs: tuple[tuple[PathFourBar, ...], ...]  # per real orbit: its three cognates
+    found: int  # orbits (complex and real)
+    missing: int
+    solutions: ninepoint.NinePointSolutions
+
+
+def chunk_runner(scheduler: str | None, workers: int | None):  # type: ignore[no-untyped-def]
+    """The scan's chunk runner (one home for sending chunks to dask) in the form
+    :func:`linkage.homotopy.ninepoint.solve_points` calls."""
+    from .scan import run_chunks
+
+    def run(task, job, plan, size):  # type: ignore[no-untyped-def]
+        return run_chunks(job, plan, size, scheduler=scheduler, workers=workers, task=task)
+
+    return run
+
+
+def check_points(points: object) -> list[complex]:
+    """Nine finite, distinct points (pairs x, y), or InputError naming what is wrong."""
+    try:
+        pts = [complex(float(p[0]), float(p[1])) for p in points]  # type: ignore[attr-defined, index]
+    except (TypeError, ValueError, IndexError):
+        raise InputError("points must be pairs of numbers (x, y)") from None
+    if len(pts) != POINTS:
+        raise InputError(f"path synthesis takes exactly {POINTS} points (the four-bar has 9 dimensions "
+                         f"of design), got {len(pts)}")
+    if not all(math.isfinite(p.real) and math.isfinite(p.imag) for p in pts):
+        raise InputError("points must be finite numbers")
+    size = max(abs(p - pts[0]) for p in pts)
+    if size > 1e150 or size == 0.0:
+        raise InputError("the points must be distinct and at most about 1e150 apart")
+    for i in range(POINTS):
+        for j in range(i):
+            if abs(pts[i] - pts[j]) <= 1e-9 * size:
+                raise InputError(f"points {j + 1} and {i + 1} coincide: {pts[i].real:g}, {pts[i].imag:g}")
+    return pts
+
+
+def mechanism_text(fb: PathFourBar, name: str = "path four-bar") -> str:
+    """The four-bar as a mechanism file (loops form): driver theta2 (the crank at A), unknowns
+    theta3 (the coupler MN) and theta4 (the rocker BN), the coupler point P."""
+    r1, r2, r3, r4 = fb.lengths
+    ground = degrees(cmath.phase(fb.ground_b - fb.ground_a))
+    theta2 = degrees(cmath.phase(fb.pin_m - fb.ground_a))
+    theta3 = degrees(cmath.phase(fb.pin_n - fb.pin_m))
+    theta4 = degrees(cmath.phase(fb.pin_n - fb.ground_b))
+    offset = degrees(cmath.phase((fb.coupler_point - fb.pin_m) / (fb.pin_n - fb.pin_m)))
+    reach = abs(fb.coupler_point - fb.pin_m)
+    return f"""name = {name!r}
+length_unit = "m"
+origin = [{fb.ground_a.real!r}, {fb.ground_a.imag!r}]
+
+[parameters]
+r1 = {{ value = {r1!r}, unit = "m" }}
+r2 = {{ value = {r2!r}, unit = "m" }}
+r3 = {{ value = {r3!r}, unit = "m" }}
+r4 = {{ value = {r4!r}, unit = "m" }}
+theta1 = {{ value = {ground!r}, unit = "deg" }}
+
+[driver]
+name = "theta2"
+value = {theta2!r}
+unit = "deg"
+
+[unknowns]
+theta3 = {{ guess = {theta3!r}, unit = "deg" }}
+theta4 = {{ guess = {theta4!r}, unit = "deg" }}
+
+[[loops]]
+name = "A-M-N-B"
+joints = ["A", "M", "N", "B"]
+vectors = [
+  {{ length = "r2", angle = "theta2" }},
+  {{ length = "r3", angle = "theta3" }},
+  {{ length = "r4", angle = "theta4", sign = -1 }},
+  {{ length = "r1", angle = "theta1", sign = -1 }},
+]
+
+[points.P]
+from = "M"
+vectors = [ {{ length = {reach!r}, angle = "theta3", offset = {offset!r} }} ]
+"""
+
+
+def _positions(z: np.ndarray, points: list[complex]) -> list[tuple[float, float, float]]:
+    """(crank angle at A, coupler angle, rocker angle) in radians at each point, from the
+    solution's rotations: M_j = P_j + Theta_j x, N_j = P_j + Theta_j y."""
+    d = np.array(points[1:]) - points[0]
+    theta, _ = ninepoint.rotations(z[None, :], d, np.conj(d))
+    rot = [1.0 + 0j, *theta[0]]
+    a, x, b, y = (z[k] for k in (ninepoint.A, ninepoint.X, ninepoint.B, ninepoint.Y))
+    out = []
+    for p, r in zip(points, rot):
+        r = r / abs(r)
+        m, n = p + r * x, p + r * y
+        A, B = points[0] + a, points[0] + b
+        out.append((cmath.phase(m - A), cmath.phase(n - m), cmath.phase(n - B)))
+    return out
+
+
+def judge(z: np.ndarray, points: list[complex]) -> PathFourBar:
+    """One real solution as a four-bar, moved through the points by the engine."""
+    from .kinematics.assemblies import assemblies, same_configuration
+    from .kinematics.circuits import circuits
+    from .kinematics.rates import place
+    from .problems.closed_form import grashof
+    from .problems.loops import from_text
+
+    a, x, b, y = (complex(z[k]) for k in (ninepoint.A, ninepoint.X, ninepoint.B, ninepoint.Y))
+    P0 = points[0]
+    fb = PathFourBar(P0 + a, P0 + b, P0 + x, P0 + y, P0, "", (), math.inf, math.nan, ())
+    m = from_text(mechanism_text(fb), "<path synthesis>")
+    size = m.length_scale
+    poses = _positions(z, points)
+    errors, trans = [], []
+    for (phi, t3, t4), p in zip(poses, points):
+        q = [t3, t4]
+        F, _ = m.model.functions(phi)
+        placed = place(m.model, q, phi)["P"][0]
+        closes = max(abs(v) for v in F(q)) <= ON_POINT * size
+        errors.append(abs(placed - p) if closes else math.inf)
+        mu = abs(math.remainder(t4 - t3, math.pi))
+        trans.append(min(mu, math.pi - mu))
+    defects: list[str] = []
+    start = assemblies(m, poses[0][0])
+    first = next((i for i, s in enumerate(start.real)
+                  if same_configuration(list(poses[0][1:]), s.q, m, 1e-7)), None)
+    if first is None:
+        defects.append("branch")
+    else:
+        traced = circuits(m, found=start)
+        circ = traced.circuits[traced.circuit_of(first)]
+        at = [_arc_index(circ, phi, (t3, t4)) for phi, t3, t4 in poses]
+        if any(k is None for k in at):
+            defects.append("branch")
+        elif not _in_order([k for k in at if k is not None], len(circ.drivers)):
+            defects.append("order")
+    max_error = max(errors) / size
+    if max_error > ON_POINT:
+        defects.append("positions")
+    return PathFourBar(fb.ground_a, fb.ground_b, fb.pin_m, fb.pin_n, P0, grashof(*fb.lengths),
+                       tuple(defects), max(errors), degrees(min(trans)), tuple(degrees(p[0]) for p in poses))
+
+
+def _arc_index(circ, phi: float, q: tuple[float, float]) -> int | None:
+    """Where along the traced circuit the configuration (phi, q) lies: the nearest traced
+    sample, accepted when it is within two arc steps (angles compared modulo a turn)."""
+    best, where = math.inf, None
+    for k, (d, c) in enumerate(zip(circ.drivers, circ.configurations)):
+        gap = max(abs(math.remainder(d - phi, 2 * math.pi)),
+                  *(abs(math.remainder(u - v, 2 * math.pi)) for u, v in zip(c, q)))
+        if gap < best:
+            best, where = gap, k
+    return where if best <= 0.1 else None
+
+
+def _in_order(at: list[int], n: int) -> bool:
+    """Whether arc positions increase, or decrease, around the circuit (of ``n`` samples)
+    from the first point's."""
+    forward = [(k - at[0]) % n for k in at]
+    backward = [(at[0] - k) % n for k in at]
+    return forward == sorted(forward) or backward == sorted(backward)
+
+
+def synthesize_path(points: object, seed: int = 0, scheduler: str | None = None,
+                    workers: int | None = None) -> PathSynthesis:
+    """Every four-bar whose coupler point passes through nine points; the real ones judged
+    by moving them (module docstring). ``points``: nine (x, y) pairs. The paths are tracked
+    in chunks by the scan's runner: here, on dask's local threads or processes, or on a
+    cluster (``scheduler`` tcp://HOST:PORT), ``workers`` at a time."""
+    pts = check_points(points)
+    sols = ninepoint.solve_points(pts, seed=seed, run=chunk_runner(scheduler, workers))
+    designs = []
+    for z, real in zip(sols.solutions, sols.real):
+        if not real:
+            continue
+        members = ninepoint.orbit(z)[:3]
+        designs.append(tuple(judge(mz, pts) for mz in members))
+    return PathSynthesis(tuple(pts), tuple(designs), len(sols.solutions), sols.missing, sols)

@@ -1,0 +1,228 @@
+"""Nine-point path synthesis (linkage.homotopy.ninepoint) against independent references:
+finite differences for the derivatives, a four-bar's coupler points computed by circle
+intersection (not from the isotropic equations), and the published counts of Wampler,
+Morgan and Sommese (1992), Problem 3: 1,442 four-bars up to cognates, 64 real."""
+
+from __future__ import annotations
+
+import cmath
+import math
+
+import numpy as np
+import pytest
+
+from linkage.homotopy import ninepoint as npt
+
+PROBLEM_3 = [(0.25, 0.0), (0.52, 0.1), (0.8, 0.7), (1.2, 1.0), (1.4, 1.3), (1.1, 1.48), (0.7, 1.4),
+             (0.2, 1.0), (0.02, 0.4)]
+
+
+def _coupler_points(rng: np.random.Generator) -> tuple[list[complex], np.ndarray]:
+    """A random real four-bar and nine of its coupler points, by plane geometry: the crank
+    turns to each angle, the coupler's second pivot is where the circles about the crank
+    pin (coupler length) and about the second ground pivot (rocker length) meet, on one
+    side throughout. Returns the points and the four-bar as unknowns (P_0 at the origin)."""
+    while True:
+        A, B = 0j, complex(rng.uniform(2, 4), rng.uniform(-1, 1))
+        r1, r2, L = rng.uniform(0.8, 1.5), rng.uniform(1.5, 3), rng.uniform(2, 3.5)
+        k = complex(rng.uniform(0.2, 0.8), rng.uniform(0.3, 1.0))  # P = M + (N - M) k
+        phis = np.sort(rng.uniform(0, 2 * math.pi, 9))
+        pts, pose = [], None
+        for phi in phis:
+            M = A + r1 * cmath.exp(1j * phi)
+            d = abs(B - M)
+            if not abs(L - r2) < d < L + r2:
+                break
+            along = (L * L - r2 * r2 + d * d) / (2 * d)
+            h = math.sqrt(max(0.0, L * L - along * along))
+            u = (B - M) / d
+            N = M + along * u + h * u * 1j
+            pts.append(M + (N - M) * k)
+            if pose is None:
+                pose = (M, N)
+        else:
+            P0 = pts[0]
+            M, N = pose
+            z = np.array([A - P0, M - P0, B - P0, N - P0])
+            return pts, np.concatenate([z, np.conj(z)])
+
+
+def _instance(pts: list[complex]) -> tuple[np.ndarray, np.ndarray]:
+    p = np.array(pts)
+    return p[1:] - p[0], np.conj(p[1:] - p[0])
+
+
+def test_a_four_bar_and_its_cognates_solve_the_equations_of_its_coupler_points():
+    rng = np.random.default_rng(11)
+    for _ in range(20):
+        pts, z = _coupler_points(rng)
+        d, db = _instance(pts)
+        for member in npt.orbit(z):
+            E = npt.equations(member[None, :], d, db)[0]
+            # relative to the size of the terms (degree 8 in lengths of about 3)
+            assert np.abs(E).max() <= 1e-11 * max(1.0, float(np.abs(member).max())) ** 8
+
+
+def test_derivatives_match_finite_differences_affine_and_projective():
+    rng = np.random.default_rng(5)
+    z, d, db = npt.seed_instance(rng)
+    w = np.array([0.7 - 0.2j])
+    for homogeneous in (None, w):
+        E, J, Ed, Edb = npt.equations(z[None, :], d, db, homogeneous)
+        h = 1e-7
+        for k in range(8 if homogeneous is None else 9):
+            zp = z.copy()
+            wp = None if homogeneous is None else w.copy()
+            if k < 8:
+                zp[k] += h
+            else:
+                wp[0] += h
+            Ep = npt.equations(zp[None, :], d, db, wp)[0]
+            assert np.abs((Ep - E)[0] / h - J[0, :, k]).max() <= 1e-5 * np.abs(J[0, :, k]).max()
+        for j in range(8):
+            dp, dbp = d.copy(), db.copy()
+            dp[j] += h
+            dbp[j] += h
+            assert abs((npt.equations(z[None, :], dp, db, homogeneous)[0][0, j] - E[0, j]) / h - Ed[0, j]) \
+                <= 1e-5 * abs(Ed[0, j])
+            assert abs((npt.equations(z[None, :], d, dbp, homogeneous)[0][0, j] - E[0, j]) / h - Edb[0, j]) \
+                <= 1e-5 * abs(Edb[0, j])
+
+
+def test_the_stored_start_instance_has_1442_distinct_nonsingular_orbits():
+    start = npt.load_start()
+    assert start.solutions.shape == (1442, 8)
+    Z, last, cond = npt.polish(start.solutions, start.delta, start.deltabar)
+    # Newton's last step against the size: at rounding for all but the largest solutions
+    # (pivots a thousand times the points' spread), whose affine condition reaches 1e12
+    assert np.median(last) <= 1e-13
+    assert np.percentile(last, 99) <= 1e-11
+    assert np.all(last <= 1e-13 * cond)
+    assert len(npt.distinct(npt.canonical(Z))) == 1442
+    # no two stored solutions are of one orbit
+    members = np.concatenate([npt.orbit(z) for z in Z])
+    assert len(npt.distinct(members)) == 6 * 1442
+
+
+def test_a_known_four_bar_is_found_among_the_solutions_through_its_points():
+    pts, z = _coupler_points(np.random.default_rng(2))
+    res = npt.solve_points(pts, max_routes=1)
+    assert res.paths == 1442
+    want = npt.canonical(z[None, :])[0]
+    gaps = np.linalg.norm(res.solutions - want, axis=1)
+    assert gaps.min() <= 1e-8 * max(1.0, float(np.linalg.norm(want)))
+    assert res.real[int(np.argmin(gaps))]
+
+
+@pytest.fixture(scope="module")
+def problem_3():
+    return npt.solve_points([complex(x, y) for x, y in PROBLEM_3])
+
+
+def test_problem_3_has_the_published_64_real_four_bars(problem_3):
+    res = problem_3
+    assert int(res.real.sum()) == 64
+    # every one found is a solution, once: distinct orbits, nonsingular
+    assert len(npt.distinct(npt.canonical(res.solutions))) == len(res.solutions)
+    # the published 1,442 orbits (8,652 solutions): endpoints that will not settle in double
+    # precision are polished at 60 digits, and a path that fails leaves its endpoint to the
+    # next route
+    assert len(res.solutions) == 1442 and res.missing == 0
+
+
+def _grashof_crank_rocker_points(other_side: set[int], order: list[int] | None = None):
+    """Nine coupler points of a Grashof crank-rocker (ground 3, crank 1, coupler 3, rocker
+    2.5: 1 + 3 < 3 + 2.5), those in ``other_side`` taken in the other assembly, in
+    ``order``. Returns the points and the four-bar (P_0 at the origin) by plane geometry."""
+    A, B, r1, L, r2, k = 0j, 3 + 0j, 1.0, 3.0, 2.5, 0.4 + 0.6j
+    pts, pose = [], None
+    for i, phi in enumerate(np.linspace(0.2, 5.8, 9)):
+        M = A + r1 * cmath.exp(1j * phi)
+        d = abs(B - M)
+        along = (L * L - r2 * r2 + d * d) / (2 * d)
+        h = math.sqrt(L * L - along * along) * (-1 if i in other_side else 1)
+        u = (B - M) / d
+        N = M + along * u + h * u * 1j
+        pts.append(M + (N - M) * k)
+        if pose is None:
+            pose = (M, N)
+    if order is not None:
+        pts = [pts[i] for i in order]
+    M, N = pose
+    P0 = pts[0]
+    z = np.array([A - P0, M - P0, B - P0, N - P0])
+    return pts, np.concatenate([z, np.conj(z)])
+
+
+def test_a_design_through_its_points_in_order_on_one_circuit_has_no_defect():
+    from linkage.synthesis_path import judge
+
+    pts, z = _grashof_crank_rocker_points(set())
+    fb = judge(z, pts)
+    assert fb.defects == () and fb.grashof == "crank-rocker"
+    assert fb.max_point_error <= 1e-12 * 3
+    d = np.array(pts[1:]) - pts[0]
+    assert np.abs(npt.equations(z[None, :], d, np.conj(d))[0]).max() <= 1e-10
+
+
+def test_points_on_the_other_assembly_are_a_branch_defect():
+    from linkage.synthesis_path import judge
+
+    pts, z = _grashof_crank_rocker_points({4, 5})
+    d = np.array(pts[1:]) - pts[0]
+    assert np.abs(npt.equations(z[None, :], d, np.conj(d))[0]).max() <= 1e-10  # still through them
+    assert judge(z, pts).defects == ("branch",)
+
+
+def test_points_met_out_of_order_are_an_order_defect():
+    from linkage.synthesis_path import judge
+
+    pts, z = _grashof_crank_rocker_points(set(), [0, 1, 2, 5, 4, 3, 6, 7, 8])
+    assert judge(z, pts).defects == ("order",)
+    # the same points in reverse are met in order, turning the crank the other way
+    pts, z = _grashof_crank_rocker_points(set(), [0, 8, 7, 6, 5, 4, 3, 2, 1])
+    assert judge(z, pts).defects == ()
+
+
+@pytest.mark.parametrize("bad", [
+    [(0, 0)] * 9,
+    [(i, i * i) for i in range(8)],
+    [(i, i * i) for i in range(10)],
+    [(float("nan"), 0), *[(i, i * i) for i in range(1, 9)]],
+    [(0, 0), (0, 0), *[(i, i * i) for i in range(2, 9)]],
+    [(1e200, 0), *[(i, i * i) for i in range(1, 9)]],
+    "nine points",
+])
+def test_bad_points_are_refused_with_one_line(bad):
+    from linkage.errors import InputError
+    from linkage.synthesis_path import synthesize_path
+
+    with pytest.raises(InputError) as err:
+        synthesize_path(bad)
+    assert "\n" not in str(err.value)
+
+
+def _same_sets(a: np.ndarray, b: np.ndarray) -> bool:
+    if len(a) != len(b):
+        return False
+    return all(np.min(np.linalg.norm(b - z, axis=1)) <= 1e-8 * max(1.0, float(np.linalg.norm(z))) for z in a)
+
+
+def test_paths_tracked_as_dask_tasks_on_threads_and_a_loopback_cluster_end_where_they_end_here():
+    """Issue 34, done-when 4: the tracking runs as tasks (chunks of paths) on the scan's
+    runner: dask's local threads and a dask.distributed cluster of two worker processes on
+    127.0.0.1; the endpoints are those tracked here (to 1e-8: a chunk's corrector steps
+    are shared by its paths, so the last bits may differ)."""
+    distributed = pytest.importorskip("distributed")
+    from linkage.synthesis_path import chunk_runner
+
+    pts = [complex(x, y) for x, y in PROBLEM_3]
+    here = npt.solve_points(pts, max_routes=1, orbits=300)
+    threads = npt.solve_points(pts, max_routes=1, orbits=300, run=chunk_runner("threads", 2))
+    assert len(here.solutions) >= 290 and _same_sets(here.solutions, threads.solutions)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        remote = npt.solve_points(pts, max_routes=1, orbits=300,
+                                  run=chunk_runner(cluster.scheduler_address, None))
+    assert _same_sets(here.solutions, remote.solutions)
+    assert remote.failed == here.failed
