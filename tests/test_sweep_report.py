@@ -291,7 +291,7 @@ def test_a_small_sweeps_report_does_not_import_numpy():
 
 
 def test_the_csv_block_path_reads_back_as_the_plain_repr_path(tmp_path):
-    """pyarrow's block formatting (render.writers._arrow_block, for big tables) against
+    """pyarrow's block formatting (render.writers.arrow_table written by pyarrow.csv, for big tables) against
     Python's repr, cell by cell: the same doubles back (NaN and infinities empty), the same
     integers and words; text that needs quoting goes cell by cell."""
     pytest.importorskip("pyarrow")

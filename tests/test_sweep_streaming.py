@@ -133,7 +133,7 @@ from linkage.render import writers
 # small chunks and blocks (rates, loads, CSV rows): what a block holds is then small beside
 # the growth measured, at sizes a test can afford
 batch.RATES_CHUNK = force_sweeps.LOADS_CHUNK = 128
-writers.SLICE, writers.FAST_BLOCK, loads._Later.block = 256, 512, 512
+writers.SLICE, writers.ARROW_BATCH, loads._Later.block = 256, 512, 512
 tracemalloc.start()
 code = run_cli(sys.argv[1:])
 print(tracemalloc.get_traced_memory()[1])

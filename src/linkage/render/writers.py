@@ -240,63 +240,85 @@ class CsvSink(Sink):
 
     def rows(self, values: Sequence[Any]) -> None:
         n = len(values[0]) if values else 0
-        if self.fast and n >= SLICE:
-            for a in range(0, n, FAST_BLOCK):
-                body = _arrow_block(self.columns, [v[a:a + FAST_BLOCK] for v in values])
-                if body is None:
-                    break
-                if hasattr(self.out, "buffer"):  # a file: its bytes, no str of the block
-                    self.out.flush()  # type: ignore[union-attr]
-                    self.out.buffer.write(body)  # type: ignore[union-attr]
-                    self.out.buffer.write(b"\n")  # type: ignore[union-attr]
-                else:
-                    self.out.write(bytes(body).decode("utf-8") + "\n")  # type: ignore[union-attr]
-            else:
-                self.count += n
-                return
-            values = [v[a:] for v in values]  # the rest cell by cell
-            self.count += a
-            n -= a
-        for a in range(0, n, SLICE):
-            b = min(n, a + SLICE)
+        done = self._arrow_rows(values) if self.fast and n else 0
+        if done:
+            values = [v[done:] for v in values]  # the rest (text that needs quoting) cell by cell
+        for a in range(0, n - done, SLICE):
+            b = min(n - done, a + SLICE)
             cells = [cell_texts(c, v[a:b], self.fast) for c, v in zip(self.columns, values)]
             self.out.write("\n".join(map(",".join, zip(*cells))) + "\n")  # type: ignore[union-attr]
         self.count += n
 
+    def _arrow_rows(self, values: Sequence[Any]) -> int:
+        """Rows written by pyarrow's CSV writer (:func:`arrow_table`; 0 where it cannot), a
+        window of rows formatted in one pass then written into the file's bytes. A window
+        refused (text that needs quoting) stops it at that window's first row, none of which
+        is written. One thread: formatting side by side on two threads measured slower on
+        this shared machine (benchmarks/writers_speed.py) and costs the same CPU."""
+        table = arrow_table(self.columns, values)
+        if table is None:
+            return 0
+        binary = getattr(self.out, "buffer", None)  # a file or standard output: its bytes
+        self.out.flush()  # type: ignore[union-attr]
+        for a in range(0, table.num_rows, CSV_WINDOW):
+            text = csv_bytes(table.slice(a, CSV_WINDOW))
+            if text is None:
+                return a
+            if binary is not None:
+                binary.write(text)
+            else:
+                self.out.write(text.to_pybytes().decode("utf-8"))  # type: ignore[union-attr]
+        return table.num_rows
 
-FAST_BLOCK = 2 * SLICE
-"""Rows a CSV block formats and joins in pyarrow at a time (:func:`_arrow_block`)."""
+
+CSV_WINDOW = 16 * SLICE
+"""Rows formatted before they are written: their text (about 30 MB for a sweep's 18
+columns) is all a CSV holds at once."""
 
 
-def _arrow_block(columns: Sequence[Column], values: Sequence[Any]) -> Any:
-    """A block of CSV rows formatted and joined by pyarrow: the same cells as
-    :func:`cell_texts` with pyarrow's numbers (tests check it), without a Python string
-    per cell, as a buffer of UTF-8 bytes; None (the caller goes cell by cell) for a column
-    that is not a numpy number or integer array or text that needs no quoting. The
-    columns' numbers are formatted on every core (pyarrow releases the GIL)."""
+def csv_bytes(table: Any) -> Any:
+    """A table's rows as CSV (no header, nothing quoted) in a pyarrow buffer; None where a
+    text cell needs quoting (pyarrow refuses it: the caller goes cell by cell)."""
+    import pyarrow as pa
+    import pyarrow.csv as pcsv
+
+    out = pa.BufferOutputStream()
+    try:
+        pcsv.write_csv(table, out, pcsv.WriteOptions(include_header=False, quoting_style="none",
+                                                     batch_size=ARROW_BATCH))
+    except pa.ArrowInvalid:
+        return None
+    return out.getvalue()
+
+
+ARROW_BATCH = 4 * SLICE
+"""Rows pyarrow's CSV writer formats at a time (its write to the file between batches)."""
+
+
+def arrow_table(columns: Sequence[Column], values: Sequence[Any]) -> Any:
+    """A block of rows as a pyarrow table whose CSV text (``quoting_style="none"``) is the
+    cells :func:`cell_texts` makes with pyarrow's numbers (tests check it): numbers
+    NaN and infinities masked (no value), integers, booleans and text as they are; None
+    where a column is not a numpy array of its kind (the caller goes cell by cell). Text
+    that needs quoting is refused by the writer itself, before it writes a row."""
     import numpy as np
     import pyarrow as pa
-    import pyarrow.compute as pc
 
-    def text(c: Column, v: Any) -> Any:
-        if c.kind == "number" and _is_array(v) and v.dtype.kind == "f":
-            return pc.cast(pa.array(v, mask=~np.isfinite(v)), pa.string())
-        if c.kind == "int" and _is_array(v) and v.dtype.kind in "iu":
-            return pc.cast(pa.array(v), pa.string())
-        if c.kind == "text":
-            arr = pa.array(v if _is_array(v) and v.dtype.kind == "O" else _plain(v), type=pa.string())
-            return None if pc.any(pc.match_substring_regex(arr, '[,"\n\r]')).as_py() else arr
-        return None
-
-    from concurrent.futures import ThreadPoolExecutor
-
-    with ThreadPoolExecutor() as pool:
-        texts = list(pool.map(text, columns, values))
-    if any(t is None for t in texts):
-        return None
-    lines = pc.binary_join_element_wise(*[pc.fill_null(t, "") for t in texts], ",")
-    body = pc.binary_join(pa.array([lines], type=pa.list_(pa.string())), "\n")[0]
-    return memoryview(body.as_buffer()) if len(lines) else None
+    arrays = []
+    for c, v in zip(columns, values):
+        kind = v.dtype.kind if _is_array(v) else ""
+        if c.kind == "number" and kind == "f":
+            arrays.append(pa.array(v, mask=~np.isfinite(v)))
+        elif (c.kind == "int" and kind in "iu" and kind) or (c.kind == "bool" and kind == "b"):
+            arrays.append(pa.array(v))
+        elif c.kind == "text" and kind in ("O", "U", ""):
+            try:
+                arrays.append(pa.array(v, type=pa.string()))
+            except (pa.ArrowException, TypeError):  # not text throughout
+                return None
+        else:
+            return None
+    return pa.Table.from_arrays(arrays, names=[str(j) for j in range(len(arrays))])
 
 
 class JsonSink(Sink):
