@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from linkage.errors import InputError
-from linkage.render import writers
+from linkage.render import cells, formats, writers
 from linkage.render.data import Column, DataTable, Report, split_header
 from linkage.render.report import Text, table
 from report_reading import csv_files, csv_rows
@@ -55,7 +55,7 @@ def test_csv_and_json_read_back_bit_for_bit(tmp_path: Path, monkeypatch: pytest.
                                             fast: bool) -> None:
     if fast:
         pytest.importorskip("pyarrow")
-        monkeypatch.setattr(writers, "FAST_CELLS", 1000)
+        monkeypatch.setattr(cells, "FAST_CELLS", 1000)
     x = awkward_numbers(3000)
     rep = report(x)
     writers.write(rep, "csv", tmp_path / "a.csv")
@@ -260,14 +260,14 @@ def test_a_word_needing_quotes_late_in_a_big_csv_is_quoted_and_no_row_is_written
     import csv
     import io
 
-    n = writers.CSV_WINDOW * 2 + 5
+    n = cells.CSV_WINDOW * 2 + 5
     words = np.array(["ok"] * n, dtype=object)
-    words[writers.CSV_WINDOW + 3] = "a,b"
+    words[cells.CSV_WINDOW + 3] = "a,b"
     x = np.arange(n) * 0.5
     cols = (Column("x", "mm", x), Column("s", "", words, "text"))
     fast = tmp_path / "fast.csv"
     with open(fast, "w", encoding="utf-8", newline="") as fh:
-        sink = writers.CsvSink(fh, None)
+        sink = formats.CsvSink(fh, None)
         sink.begin("t", cols, n)
         assert sink.fast
         sink.rows([c.values for c in cols])
@@ -275,4 +275,4 @@ def test_a_word_needing_quotes_late_in_a_big_csv_is_quoted_and_no_row_is_written
     rows = list(csv.reader(io.StringIO(fast.read_text(encoding="utf-8"))))
     assert len(rows) == n + 1 and rows[0] == ["x (mm)", "s"]
     assert [float(r[0]) for r in rows[1:]] == list(x)
-    assert rows[writers.CSV_WINDOW + 4][1] == "a,b" and {r[1] for r in rows[1:]} == {"ok", "a,b"}
+    assert rows[cells.CSV_WINDOW + 4][1] == "a,b" and {r[1] for r in rows[1:]} == {"ok", "a,b"}

@@ -8,6 +8,7 @@ from .options import (
     AccelOpt,
     ColumnsOpt,
     DigitsOpt,
+    FormatOpt,
     GravityOpt,
     LoadOpt,
     MechanismFile,
@@ -68,9 +69,7 @@ def scan(
                        "core).")] = None,
     chunk: Annotated[Optional[int], typer.Option(help="Designs per task (default: about "
                      "200,000 positions per task).")] = None,
-    fmt: Annotated[Optional[str], typer.Option("--format", "-f", help="table (default on a "
-                   "terminal), plain, csv, json, parquet, xlsx or a tabulate format (github, "
-                   "latex, ...); -o FILE picks by suffix.")] = None,
+    fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 6,
     columns: ColumnsOpt = None,

@@ -95,7 +95,7 @@ def sweep(
     from ..kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
     from ..problems.loops import load
     from ..render.sweep import sweep_report
-    from ..render.writers import is_data
+    from ..render.writers import data_formats, is_data
     from ..solve import SYSTEM_METHODS, check_criteria, check_number
 
     out_fmt = choose_format(fmt, output)
@@ -152,7 +152,7 @@ def sweep(
         if advance is not None and data:
             advance(n, f"writing {out_fmt}")
         note = "" if data or not named else \
-            "joints and points (x, y): with --format csv, json, parquet or xlsx"
+            f"joints and points (x, y): with --format {data_formats()}"
         from ..kinematics.columns import sweep_columns
 
         cols = sweep_columns(result)  # read once: a batch sweep's rates for its table and its loads
