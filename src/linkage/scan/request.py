@@ -215,8 +215,18 @@ def open_scan(req: ScanRequest) -> OpenScan:
                     sort=req.sort, doc=req.doc, fixed=tuple(k for k, _ in req.fixed), loads=loads)
     job = ScanJob(req.text, m.source, req.fixed, setup.plan.names, tuple(setup.values), setup.branch,
                   req.tol, None if req.text else m, setup.moves, loads, (req.speed or 0.0, req.accel))
-    size = pick_chunk(m, len(setup.values), setup.branch, req.chunk, setup.plan.total)
+    size = pick_chunk(m, len(setup.values), setup.branch, req.chunk, setup.plan.total, local_workers(req))
     return OpenScan(req, setup, job, size)
+
+
+def local_workers(req: ScanRequest) -> int:
+    """The workers a scan's chunks run on here: 1 synchronous or on a cluster (its size is
+    its own), else --workers or one per core."""
+    import os
+
+    if req.scheduler == "synchronous" or (req.scheduler is not None and "://" in req.scheduler):
+        return 1
+    return req.workers or os.cpu_count() or 1
 
 
 @dataclass(frozen=True)

@@ -130,6 +130,24 @@ def chunk_size(m: Mechanism, positions: int, branch: str | None) -> int:
     return min(CHUNK_DESIGNS_SWEEP, most)
 
 
+TASKS_PER_WORKER = 2
+"""Chunks per worker a scan is cut into at least, where its designs allow: 900 designs in
+chunks of 555 kept one of two cores idle for 40% of the scan."""
+MIN_TASK_POSITIONS = 20_000
+"""Designs x positions a task keeps at least when cut for the workers: enough for numpy's
+array work to outweigh a task's fixed cost."""
+
+
+def balanced(size: int, designs: int, positions: int, workers: int) -> int:
+    """``size`` designs per task, or fewer so that ``designs`` make at least
+    TASKS_PER_WORKER tasks per worker, of nearly equal size (each at least
+    MIN_TASK_POSITIONS positions): every worker busy to the end on a local scheduler."""
+    if workers <= 1:
+        return size
+    tasks = max(1, min(TASKS_PER_WORKER * workers, designs * max(positions, 1) // MIN_TASK_POSITIONS))
+    return max(1, min(size, -(-designs // tasks)))
+
+
 def cell_width(m: Mechanism) -> int:
     """Numbers a task holds per design and position: status, each unknown, x and y of each
     point."""
@@ -147,11 +165,12 @@ def check_held(designs: int, columns: int, top: int | None, what: str, option: s
 
 
 def pick_chunk(m: Mechanism, positions: int, branch: str | None, chunk: int | None,
-               designs: int) -> int:
+               designs: int, workers: int = 1) -> int:
     """Designs per task: ``chunk`` if given and a task's results (of at most ``designs``)
-    fit in CHUNK_CELLS numbers (else an InputError with the numbers), or :func:`chunk_size`."""
+    fit in CHUNK_CELLS numbers (else an InputError with the numbers), or :func:`chunk_size`,
+    cut smaller where that would leave some of ``workers`` idle (:func:`balanced`)."""
     if chunk is None:
-        return chunk_size(m, positions, branch)
+        return balanced(chunk_size(m, positions, branch), designs, positions, workers)
     cells = min(chunk, designs) * positions * cell_width(m)
     if cells > CHUNK_CELLS:
         raise InputError(f"--chunk {chunk:,}: {min(chunk, designs):,} designs x {positions:,} positions x "
