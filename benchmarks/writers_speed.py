@@ -7,6 +7,7 @@ medians of the repeats and of the per-repeat ratios, of wall-clock time (the tar
 of CPU time (user + system over every thread: what the machine's other load cannot hide).
 
     python benchmarks/writers_speed.py [--repeats 7] [--formats csv,parquet]
+    python benchmarks/writers_speed.py --before OLD/src   # also another version's commands, interleaved
 
 Targets: CSV within 2x of the API process, parquet within 1.5x.
 """
@@ -30,9 +31,12 @@ API = ("from linkage.kinematics.sweep import sweep_mechanism\n"
 TARGETS = {"csv": 2.0, "parquet": 1.5, "json": None, "xlsx": None}
 
 
-def timed(cmd: list[str]) -> tuple[float, float]:
-    """The command's wall-clock seconds and its CPU seconds (user + system, every thread)."""
+def timed(cmd: list[str], src: str | None = None) -> tuple[float, float]:
+    """The command's wall-clock seconds and its CPU seconds (user + system, every thread);
+    ``src``: run another version's source tree (PYTHONPATH)."""
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    if src is not None:
+        env["PYTHONPATH"] = src
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     subprocess.run(cmd, check=True, capture_output=True, env=env)
@@ -45,8 +49,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--formats", default="csv,parquet")
+    ap.add_argument("--before", metavar="SRC", help="another version's src/ directory, timed in the same "
+                    "repeats (e.g. a checkout of main)")
     args = ap.parse_args()
     formats = args.formats.split(",")
+    versions = [("", None)] + ([(" (before)", args.before)] if args.before else [])
+    formats = [f + tag for f in formats for tag, _ in versions]
+    source = {f + tag: src for f in args.formats.split(",") for tag, src in versions}
     api: list[float] = []
     cli: dict[str, list[float]] = {f: [] for f in formats}
     ratios: dict[str, list[float]] = {f: [] for f in formats}
@@ -57,9 +66,9 @@ def main() -> None:
             a, a_cpu = timed([sys.executable, "-c", API])
             api.append(a)
             for f in formats:
-                out = os.path.join(tmp, f"sweep.{f}")
+                out = os.path.join(tmp, f"sweep.{f.split()[0]}")
                 c, c_cpu = timed([sys.executable, "-m", "linkage", "sweep", str(SAMPLE), "--step", "0.001",
-                           "--to", "360", "-o", out])
+                                  "--to", "360", "-o", out], source[f])
                 cli[f].append(c)
                 ratios[f].append(c / a)
                 cpu_ratios[f].append(c_cpu / a_cpu)
@@ -67,9 +76,9 @@ def main() -> None:
     print(f"  API process (sweep, no output)   {statistics.median(api) * 1e3:8.0f} ms")
     for f in formats:
         r = statistics.median(ratios[f])
-        target = TARGETS.get(f)
+        target = TARGETS.get(f) if " " not in f else None
         verdict = "" if target is None else f"  (target <= {target}x: {'met' if r <= target else 'NOT met'})"
-        print(f"  CLI to {f:<8}                  {statistics.median(cli[f]) * 1e3:8.0f} ms  "
+        print(f"  CLI to {f:<17}         {statistics.median(cli[f]) * 1e3:8.0f} ms  "
               f"{r:5.2f}x{verdict}; CPU seconds {statistics.median(cpu_ratios[f]):5.2f}x")
 
 

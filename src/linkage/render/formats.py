@@ -64,18 +64,16 @@ class CsvSink(Sink):
         self.count += n
 
     def _arrow_rows(self, values: Sequence[Any]) -> int:
-        """Rows written by pyarrow's CSV writer (:func:`.cells.arrow_table`; 0 where it cannot), a
-        window of rows formatted in one pass then written into the file's bytes. A window
-        refused (text that needs quoting) stops it at that window's first row, none of which
-        is written. One thread: formatting side by side on two threads measured slower on
-        this shared machine (benchmarks/writers_speed.py) and costs the same CPU."""
+        """Rows written by pyarrow's CSV writer (:func:`.cells.arrow_table`; 0 where it
+        cannot), its slices formatted in one pass each (:func:`.cells.csv_slices`) and
+        written in order into the file's bytes. A slice refused (text that needs quoting)
+        stops it at that slice's first row, none of which is written."""
         table = cells.arrow_table(self.columns, values)
         if table is None:
             return 0
         binary = getattr(self.out, "buffer", None)  # a file or standard output: its bytes
         self.out.flush()  # type: ignore[union-attr]
-        for a in range(0, table.num_rows, cells.CSV_WINDOW):
-            text = cells.csv_bytes(table.slice(a, cells.CSV_WINDOW))
+        for a, text in cells.csv_slices(table):
             if text is None:
                 return a
             if binary is not None:
