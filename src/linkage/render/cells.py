@@ -89,8 +89,8 @@ def json_values(col: Column, values: Any) -> list[Any]:
 
 
 
-CSV_WINDOW = 16 * SLICE
-"""Rows formatted before they are written, over every core: their text (about 30 MB for a
+CSV_WINDOW = 4 * SLICE
+"""Rows formatted before they are written, over every core: their text (about 7 MB for a
 sweep's 18 columns) is all a CSV holds at once."""
 MAX_CSV_THREADS = 8
 """Threads formatting a CSV's slices side by side: one per core, at most this many."""

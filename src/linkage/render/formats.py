@@ -293,13 +293,13 @@ class Format(NamedTuple):
 
 FORMATS: dict[str, Format] = {f.name: f for f in (
     Format("table", (), None, help="rich, default on a terminal"),
-    Format("plain", (".txt", ""), None, help="headers over a rule, default when piped"),
+    Format("plain", (".txt", ""), None, help="default when piped"),
     Format("csv", (".csv",), CsvSink, one_table=True),
     Format("json", (".json",), JsonSink),
     Format("parquet", (".parquet",), ParquetSink, binary=True, one_table=True,
-           needs=("pyarrow.parquet", "pip install 'linkage-kinematics[scan]'"), help="to -o FILE"),
+           needs=("pyarrow.parquet", "pip install 'linkage-kinematics[scan]'")),
     Format("xlsx", (".xlsx",), XlsxSink, binary=True,
-           needs=("openpyxl", "pip install 'linkage-kinematics[xlsx]'"), help="to -o FILE"),
+           needs=("openpyxl", "pip install 'linkage-kinematics[xlsx]'")),
 )}
 """Every format of linkage's own, in the order help lists them."""
 TABULATE_SUFFIXES = {".md": "github", ".tex": "latex", ".html": "html", ".rst": "rst"}

@@ -55,9 +55,13 @@ def data_formats() -> str:
 
 
 def format_help() -> str:
-    """--format's help, from the registry."""
-    own = ", ".join(f"{f.name} ({f.help})" if f.help else f.name for f in FORMATS.values())
-    return f"{own}, or any tabulate format ({', '.join(COMMON_TABULATE[:3])}, ...)."
+    """--format's help, from the registry: the display formats with what they are, the data
+    formats and which of them need -o FILE, and tabulate's."""
+    shown = [f"{f.name} ({f.help})" if f.help else f.name for f in FORMATS.values() if not f.streams]
+    binary = [f.name for f in FORMATS.values() if f.binary]
+    files = f" ({' and '.join(binary)} to -o FILE)" if binary else ""
+    return (f"{', '.join(shown)}, {data_formats()}{files}, or any tabulate format "
+            f"({', '.join(COMMON_TABULATE[:3])}, ...).")
 
 
 def output_help() -> str:
