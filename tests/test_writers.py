@@ -260,9 +260,10 @@ def test_a_word_needing_quotes_late_in_a_big_csv_is_quoted_and_no_row_is_written
     import csv
     import io
 
-    n = cells.CSV_WINDOW * 2 + 5
+    n = max(2 * cells.CSV_WINDOW, cells.FAST_CELLS // 2) + 5  # two columns: the block path
+    late = n - cells.CSV_WINDOW // 2  # in a later window than the first
     words = np.array(["ok"] * n, dtype=object)
-    words[cells.CSV_WINDOW + 3] = "a,b"
+    words[late] = "a,b"
     x = np.arange(n) * 0.5
     cols = (Column("x", "mm", x), Column("s", "", words, "text"))
     fast = tmp_path / "fast.csv"
@@ -275,4 +276,4 @@ def test_a_word_needing_quotes_late_in_a_big_csv_is_quoted_and_no_row_is_written
     rows = list(csv.reader(io.StringIO(fast.read_text(encoding="utf-8"))))
     assert len(rows) == n + 1 and rows[0] == ["x (mm)", "s"]
     assert [float(r[0]) for r in rows[1:]] == list(x)
-    assert rows[cells.CSV_WINDOW + 4][1] == "a,b" and {r[1] for r in rows[1:]} == {"ok", "a,b"}
+    assert rows[late + 1][1] == "a,b" and {r[1] for r in rows[1:]} == {"ok", "a,b"}
