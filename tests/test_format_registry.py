@@ -57,6 +57,10 @@ def test_the_help_and_the_refusals_name_every_registered_format(cli):
 class ProbeSink(Sink):
     """A format made up here: one line per row, its cells joined by '|'."""
 
+    @classmethod
+    def modules(cls, rows):
+        return tuple(f.needs[0] for f in formats.FORMATS.values() if f.sink is cls and f.needs)
+
     def begin(self, name, columns, rows=None):
         super().begin(name, columns, rows)
 
@@ -79,3 +83,27 @@ def test_a_format_added_to_the_registry_alone_is_chosen_and_written(monkeypatch,
     writers.write(report, "probe", out)
     assert out.read_text() == "1|3\n2|4\n"
     assert "probe" in writers.data_formats()
+
+
+def test_a_format_whose_package_is_missing_or_broken_is_refused_in_one_line(monkeypatch, tmp_path):
+    """choose_format finds the package without importing it (the import runs beside the
+    command's computing, writers.prefetch); a package found that fails to import is
+    refused where the writer opens, and nothing is written."""
+    from linkage.errors import InputError
+    from linkage.render.data import Column, DataTable, Report
+
+    monkeypatch.setitem(formats.FORMATS, "gone", formats.Format(
+        "gone", (".gone",), ProbeSink, needs=("linkage_test_no_such_package", "pip install it")))
+    with pytest.raises(InputError, match="gone output needs linkage_test_no_such_package: pip install it"):
+        writers.choose_format("gone", tmp_path / "t.gone")
+    (tmp_path / "linkage_test_broken").mkdir()
+    (tmp_path / "linkage_test_broken" / "__init__.py").write_text("raise ImportError('broken')\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setitem(formats.FORMATS, "gone", formats.Format(
+        "gone", (".gone",), ProbeSink, needs=("linkage_test_broken", "pip install it")))
+    assert writers.choose_format("gone", tmp_path / "t.gone") == "gone"
+    writers.prefetch("gone", 10)  # a failing import on the prefetch thread is quiet
+    report = Report("t", (DataTable("rows", (Column("a", "", [1]),)),), lambda: ())
+    with pytest.raises(InputError, match="gone output needs linkage_test_broken"):
+        writers.write(report, "gone", tmp_path / "t.gone")
+    assert not (tmp_path / "t.gone").exists()

@@ -124,6 +124,8 @@ def scan(
     setup, motion = opened.setup, (w or 0.0, a_)
     spec = pick_spec(setup.spec, columns) if columns else setup.spec
     streamed = writers.is_data(fmt)
+    if streamed:
+        writers.prefetch(fmt, setup.plan.total)  # the writer's imports beside the scan's solving
     meta = scan_meta(mechanism, str(file), setup, (a, b, step), where, sort, desc, motion)
     sink = RecordSink(fmt, output, spec, meta) if streamed else None
     done = run_scan(opened, output=sink, holding=f"--sort {sort} with --format {fmt}",

@@ -95,7 +95,7 @@ def sweep(
     from ..kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
     from ..problems.loops import load
     from ..render.sweep import sweep_report
-    from ..render.writers import data_formats, is_data
+    from ..render.writers import data_formats, is_data, prefetch
     from ..solve import SYSTEM_METHODS, check_criteria, check_number
 
     out_fmt = choose_format(fmt, output)
@@ -139,6 +139,8 @@ def sweep(
         batch = False
     n = len(values)
     data = is_data(out_fmt)
+    if data:
+        prefetch(out_fmt, n)  # the writer's imports beside the solving
     # one bar for solving and writing (n positions each), on screen until the file is complete
     with progress_bar(2 * n if data else n, minimum=4000 if data else 2000) as advance:
         result = sweep_mechanism(mechanism, values, method=method, branch=branch, tol=tol, batch=batch,

@@ -215,6 +215,12 @@ class Sink:
         return None
 
     @classmethod
+    def modules(cls, rows: int | None) -> tuple[str, ...]:
+        """The modules this format imports to write a table of ``rows`` rows (None: not
+        known), for writers.prefetch."""
+        return ()
+
+    @classmethod
     def meta_of(cls, report: Report, files: Sequence[str]) -> dict[str, Any]:
         """What this format writes besides the tables, from ``report`` (``files``: the
         names of the files its tables go to, for a one-table format written to a file)."""

@@ -52,6 +52,11 @@ class CsvSink(Sink):
         self.fast = rows is not None and rows * len(self.columns) >= cells.FAST_CELLS and has_pyarrow()
         self.out.write(",".join(quote_csv(c.header) for c in self.columns) + "\n")  # type: ignore[union-attr]
 
+    @classmethod
+    def modules(cls, rows: int | None) -> tuple[str, ...]:
+        # the block path, from FAST_CELLS cells (every table has two columns at least)
+        return ("pyarrow.csv",) if rows is not None and 2 * rows >= cells.FAST_CELLS else ()
+
     def rows(self, values: Sequence[Any]) -> None:
         n = len(values[0]) if values else 0
         done = self._arrow_rows(values) if self.fast and n else 0
@@ -131,6 +136,10 @@ class JsonSink(Sink):
 class ParquetSink(Sink):
     """One parquet file per table: the first at the path, the others beside it."""
 
+    @classmethod
+    def modules(cls, rows: int | None) -> tuple[str, ...]:
+        return ("pyarrow.parquet",)
+
     def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
         super().__init__(out, path, meta)
         self.writer: Any = None
@@ -205,6 +214,10 @@ XLSX_ROWS = 1_048_575
 
 
 class XlsxSink(Sink):
+    @classmethod
+    def modules(cls, rows: int | None) -> tuple[str, ...]:
+        return ("openpyxl",)
+
     def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
         super().__init__(out, path, meta)
         from openpyxl import Workbook
