@@ -7,7 +7,8 @@ a 9 x 9 force matrix: three moving links, three equations each), on the default 
 (dask's threads) and on one worker. The baseline: ``numpy.linalg.solve`` of 324,000 random
 well-conditioned 9 x 9 systems with one right-hand side, in chunks of the scan's size
 (numpy's batched LAPACK, one thread), timed in the same process. Each repeat times both,
-one after the other (interleaved); the figures are medians.
+one after the other (interleaved); the figures are medians, with the CPU seconds (every thread) beside the
+wall-clock ones: CPU / wall is the cores a run kept busy.
 
     python benchmarks/loaded_scan.py [--repeats 5]
 
@@ -49,18 +50,21 @@ def main() -> None:
 
     scan(None)  # warm: imports, the derivation's caches
     times: dict[str, list[float]] = {"threads": [], "one worker": [], "hand": []}
+    cpu: dict[str, list[float]] = {k: [] for k in times}
     for _ in range(args.repeats):
         for label, run in (("threads", lambda: scan(None)), ("one worker", lambda: scan(1)),
                            ("hand", lambda: hand_solve(a, b, 20_000))):
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             run()
             times[label].append(time.perf_counter() - t0)
+            cpu[label].append(time.process_time() - c0)
     hand = statistics.median(times["hand"])
     print(f"900 designs x 360 positions with loads, medians of {args.repeats} interleaved repeats")
     print(f"  hand-written numpy 9x9 batched solve  {hand * 1e3:8.0f} ms")
     for label in ("threads", "one worker"):
-        t = statistics.median(times[label])
-        print(f"  loaded scan, {label:<12}            {t * 1e3:8.0f} ms  {t / hand:5.2f}x")
+        t, c = statistics.median(times[label]), statistics.median(cpu[label])
+        print(f"  loaded scan, {label:<12}            {t * 1e3:8.0f} ms  {t / hand:5.2f}x  "
+              f"(CPU {c * 1e3:.0f} ms: {c / t:.2f} cores busy)")
 
 
 if __name__ == "__main__":
