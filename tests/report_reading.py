@@ -1,4 +1,4 @@
-"""Reading our CSV back in tests: one table per file (render.writers.CsvSink), a report's
+"""Reading our CSV back in tests: one table per file (render.formats.CsvSink), a report's
 first table at the path given, each other beside it as ``stem.name.csv``."""
 
 from __future__ import annotations

@@ -159,7 +159,7 @@ def test_the_toml_shape_check_passes_what_a_mechanism_file_holds(tmp_path):
 
 
 def test_a_scan_of_a_file_with_1000_points_is_refused_and_a_task_stays_bounded(cli, tmp_path):
-    from linkage.scan import CHUNK_CELLS, chunk_size, pick_chunk
+    from linkage.scan.task import CHUNK_CELLS, chunk_size, pick_chunk
 
     pts = write(tmp_path, "pts.toml", chain(1, points=MAX_POINTS + 1))
     run = cli("scan", str(pts), "--vary", "r2=30:40:2")
@@ -179,8 +179,9 @@ def test_a_scan_of_a_file_with_1000_points_is_refused_and_a_task_stays_bounded(c
 
 def test_a_sorted_scan_that_would_hold_every_record_is_refused_before_solving(cli, monkeypatch):
     import linkage.scan as scan
+    import linkage.scan.engine as engine
 
-    monkeypatch.setattr(scan, "run_chunk", lambda *a: pytest.fail("solved before refusing"))
+    monkeypatch.setattr(engine, "run_chunk", lambda *a: pytest.fail("solved before refusing"))
     big = ["--vary", "r2=20:60:3000", "--vary", "r3=80:160:1000", "--sort", "theta4_range"]
     run = cli("scan", str(CRANK_ROCKER), *big, "-f", "csv")
     one_line_exit_2(run)
@@ -190,13 +191,13 @@ def test_a_sorted_scan_that_would_hold_every_record_is_refused_before_solving(cl
 
 
 def test_ten_million_samples_of_ten_parameters_are_refused_before_drawing(cli, monkeypatch):
-    import linkage.scan as scan
+    import linkage.scan.designs as scan
 
     r = in_child("scan", str(CRANK_ROCKER), *[f"--vary={k}=1:2" for k in ("r1", "r2", "r3", "r4")],
                 "--samples", "10000000")
     one_line_exit_2(r)
     assert "--samples 10,000,000 x 4 varied parameters is 40,000,000 values" in r.err
-    monkeypatch.setattr(scan, "_draw", lambda *a: pytest.fail("drawn before refusing"))
+    monkeypatch.setattr(scan, "draw_designs", lambda *a: pytest.fail("drawn before refusing"))
     run = cli("scan", str(CRANK_ROCKER), "--vary", "r2=30:40", "--vary", "r3=100:120",
               "--samples", str(scan.MAX_SAMPLE_VALUES // 2 + 1))
     one_line_exit_2(run)

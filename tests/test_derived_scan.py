@@ -19,7 +19,8 @@ from linkage.kinematics.angles import angle_extent, closes_circle
 from linkage.kinematics.designs import CONVERGED, engine_for, solve_designs
 from linkage.problems.closed_form import grashof
 from linkage.problems.loops import from_text, load
-from linkage.scan import ScanJob, default_branch, run_chunk
+from linkage.scan import ScanJob, run_chunk
+from linkage.scan.request import default_branch
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 STATUS = {0: "converged", 1: "no_solution", 2: "failed", 3: "off_branch"}
@@ -282,7 +283,9 @@ def test_a_four_bar_with_any_names_gets_the_four_bar_columns(cli, tmp_path):
 
 def test_the_second_four_bar_loop_has_suffixed_columns_that_may_not_clash():
     m = load(SAMPLES / "watt_sixbar.toml")
-    cols = [c[0] for c in linkage.scan.columns_of(m, ("r2",))]
+    from linkage.problems.columns import columns_of
+
+    cols = [c[0] for c in columns_of(m, ("r2",))]
     for loop in ("", "_2"):
         assert {f"grashof{loop}", f"min_transmission_deg{loop}", f"max_transmission_deg{loop}"} <= set(cols)
     r7 = 'r7 = { value = 80, unit = "mm" }'

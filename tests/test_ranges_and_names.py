@@ -311,7 +311,7 @@ def test_every_column_a_scan_writes_is_a_reserved_name(tmp_path):
     """The reserved names are the scan's own columns (not a second list): every key of a
     real scan's records, named as a parameter, is refused; the file as it is loads."""
     rec = run_scan(np.array([[100.0, 40.0, 120.0, 80.0]]), "open")
-    from linkage.scan import columns_of
+    from linkage.problems.columns import columns_of
 
     m = load(CRANK)
     assert list(rec) == [c[0] for c in columns_of(m, LINKS)]

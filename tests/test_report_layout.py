@@ -86,4 +86,4 @@ def test_unknown_format_names_the_tabulate_formats_people_use(cli):
 def test_format_help_says_which_formats_need_a_file(cli):
     r = cli("solve", "--help")
     text = " ".join(r.out.replace("│", " ").split())
-    assert "parquet or xlsx (these two to -o FILE)" in text, text
+    assert "csv, json, parquet or xlsx (parquet and xlsx to -o FILE)" in text, text

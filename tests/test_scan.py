@@ -18,7 +18,7 @@ import pytest
 from linkage.kinematics.designs import _sweep_engine, solve_designs
 from linkage.problems.closed_form import fourbar_class
 from linkage.problems.loops import load
-from linkage.scan import grashof_class
+from linkage.scan.metrics import grashof_class
 
 ROOT = Path(__file__).resolve().parent.parent
 CRANK = ROOT / "sample_inputs" / "crank_rocker.toml"
@@ -352,7 +352,7 @@ def test_where_cannot_execute_code(cli, tmp_path, expr):
 
 
 def test_a_failed_scan_leaves_the_old_output_intact(cli, tmp_path, monkeypatch):
-    import linkage.scan as scan_module
+    import linkage.scan.engine as scan_module
 
     out = tmp_path / "designs.csv"
     out.write_text("precious\n")

@@ -20,7 +20,7 @@ import pytest
 import linkage
 from linkage.kinematics.rates import place, place_np
 from linkage.problems.loops import load
-from linkage.render import writers
+from linkage.render import cells, formats, writers
 from linkage.render.sweep import equation_report, ranges_of, sweep_report
 from ulps import assert_ulps
 
@@ -281,7 +281,8 @@ def test_a_small_sweeps_report_does_not_import_numpy():
             "rep = sweep_report(r, 6)\n"
             "from linkage.render.writers import open_sink, write_tables\n"
             "out = io.StringIO()\n"
-            "sink = writers.CsvSink(out, None)\n"
+            "from linkage.render.formats import CsvSink\n"
+            "sink = CsvSink(out, None)\n"
             "write_tables(sink, rep.tables)\n"
             "assert out.getvalue().count('\\n') == 4\n"
             "print('HEAVY', [m for m in ('numpy', 'pyarrow') if m in sys.modules])\n")
@@ -291,7 +292,7 @@ def test_a_small_sweeps_report_does_not_import_numpy():
 
 
 def test_the_csv_block_path_reads_back_as_the_plain_repr_path(tmp_path):
-    """pyarrow's block formatting (render.writers._arrow_block, for big tables) against
+    """pyarrow's block formatting (render.cells.arrow_table written by pyarrow.csv, for big tables) against
     Python's repr, cell by cell: the same doubles back (NaN and infinities empty), the same
     integers and words; text that needs quoting goes cell by cell."""
     pytest.importorskip("pyarrow")
@@ -300,7 +301,7 @@ def test_the_csv_block_path_reads_back_as_the_plain_repr_path(tmp_path):
     from linkage.render.data import Column, DataTable
 
     rng = np.random.default_rng(20)
-    n = writers.FAST_CELLS // 3 + writers.SLICE + 17
+    n = cells.FAST_CELLS // 3 + cells.SLICE + 17
     x = rng.standard_normal(n) * 10.0 ** rng.integers(-300, 300, n)
     x[::97] = np.nan
     x[5] = np.inf
@@ -309,11 +310,11 @@ def test_the_csv_block_path_reads_back_as_the_plain_repr_path(tmp_path):
     words = np.array(["converged", None, "no_solution"], dtype=object)[np.arange(n) % 3]
     cols = (Column("x", "mm", x), Column("k", "", np.arange(n) - 5, "int"), Column("s", "", words, "text"))
     fast, plain = io.StringIO(), io.StringIO()
-    sink = writers.CsvSink(fast, None)
+    sink = formats.CsvSink(fast, None)
     sink.begin("t", cols, n)
     assert sink.fast
     sink.rows([c.values for c in cols])
-    sink = writers.CsvSink(plain, None)
+    sink = formats.CsvSink(plain, None)
     sink.begin("t", cols)  # no row count: the cell-by-cell path with repr
     assert not sink.fast
     sink.rows([c.values for c in cols])
@@ -328,5 +329,5 @@ def test_the_csv_block_path_reads_back_as_the_plain_repr_path(tmp_path):
     # a word with a comma: quoted, cell by cell
     quoted = (Column("s", "", np.array(["a,b"] * n, dtype=object), "text"), cols[0])
     out = io.StringIO()
-    writers.write_tables(writers.CsvSink(out, None), [DataTable("t", quoted)])
+    writers.write_tables(formats.CsvSink(out, None), [DataTable("t", quoted)])
     assert [r[0] for r in csv.reader(io.StringIO(out.getvalue()))][1:] == ["a,b"] * n

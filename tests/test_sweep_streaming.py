@@ -98,7 +98,7 @@ def test_the_positions_rates_are_not_all_computed_before_writing(monkeypatch, tm
     """The rates are computed as the writer takes the rows: when the first block of rows
     reaches the file, only the chunks of that block have been computed (the loads taken
     from the same chunks), not the sweep's."""
-    from linkage.render import writers
+    from linkage.render import formats
 
     monkeypatch.setattr(batch_engine, "RATES_CHUNK", 16)
     computed: list[int] = []
@@ -111,14 +111,14 @@ def test_the_positions_rates_are_not_all_computed_before_writing(monkeypatch, tm
 
     monkeypatch.setattr(batch_engine.BatchPositions, "__getitem__", counted)
     seen: list[tuple[int, int]] = []
-    rows = writers.CsvSink.rows
+    rows = formats.CsvSink.rows
 
     def watched(self, values):
         if self.name == "positions" and not seen:
             seen.append((len(values[0]), len(set(computed))))
         return rows(self, values)
 
-    monkeypatch.setattr(writers.CsvSink, "rows", watched)
+    monkeypatch.setattr(formats.CsvSink, "rows", watched)
     _run(tmp_path, "s.csv", ME581_ARGS)
     first_block, chunks_then = seen[0]
     assert first_block == 64 and chunks_then <= 64 // 16 + 1  # (+1: the first solved, for the joints' names)
@@ -129,11 +129,11 @@ GROWTH = """
 import sys, tracemalloc
 from linkage.cli import loads, run_cli
 from linkage.kinematics import batch, force_sweeps
-from linkage.render import writers
+from linkage.render import cells
 # small chunks and blocks (rates, loads, CSV rows): what a block holds is then small beside
 # the growth measured, at sizes a test can afford
 batch.RATES_CHUNK = force_sweeps.LOADS_CHUNK = 128
-writers.SLICE, writers.FAST_BLOCK, loads._Later.block = 256, 512, 512
+cells.SLICE, cells.ARROW_BATCH, cells.CSV_WINDOW, loads._Later.block = 256, 512, 512, 512
 tracemalloc.start()
 code = run_cli(sys.argv[1:])
 print(tracemalloc.get_traced_memory()[1])

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from linkage.render import writers
+from linkage.render import formats, writers
 from linkage.render.data import Column, DataTable, Report
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -81,7 +81,7 @@ def test_interrupted_xlsx_is_not_saved_and_the_interrupt_is_kept(tmp_path: Path,
                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
     pytest.importorskip("openpyxl")
     saved: list[str] = []
-    monkeypatch.setattr(writers.XlsxSink, "close", lambda self: saved.append("save"))
+    monkeypatch.setattr(formats.XlsxSink, "close", lambda self: saved.append("save"))
     with pytest.raises(KeyboardInterrupt):
         with writers.open_sink("xlsx", tmp_path / "i.xlsx") as sink:
             sink.begin("t", [Column("x", "", ())])

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from linkage.errors import InputError
-from linkage.render import writers
+from linkage.render import cells, formats, writers
 from linkage.render.data import Column, DataTable, Report, split_header
 from linkage.render.report import Text, table
 from report_reading import csv_files, csv_rows
@@ -55,7 +55,7 @@ def test_csv_and_json_read_back_bit_for_bit(tmp_path: Path, monkeypatch: pytest.
                                             fast: bool) -> None:
     if fast:
         pytest.importorskip("pyarrow")
-        monkeypatch.setattr(writers, "FAST_CELLS", 1000)
+        monkeypatch.setattr(cells, "FAST_CELLS", 1000)
     x = awkward_numbers(3000)
     rep = report(x)
     writers.write(rep, "csv", tmp_path / "a.csv")
@@ -250,3 +250,30 @@ def test_csv_sidecars_stream_in_blocks(tmp_path: Path, monkeypatch: pytest.Monke
     files = csv_files(tmp_path / "b.csv", ["positions", "joints"])
     assert [float(r[0]) for r in files["positions"][1:]] == x.tolist()
     assert files["joints"] == [["joint", "x (mm)"], ["A", "1.5"], ['B, "c"', ""]]
+
+
+def test_a_word_needing_quotes_late_in_a_big_csv_is_quoted_and_no_row_is_written_twice(tmp_path):
+    """The CSV block path (pyarrow's writer, a window of rows at a time) meeting a word with
+    a comma in a later window: the windows before are written as blocks, that window and
+    the rest cell by cell; the rows read back as the cell-by-cell path writes them."""
+    pytest.importorskip("pyarrow")
+    import csv
+    import io
+
+    n = max(2 * cells.CSV_WINDOW, cells.FAST_CELLS // 2) + 5  # two columns: the block path
+    late = n - cells.CSV_WINDOW // 2  # in a later window than the first
+    words = np.array(["ok"] * n, dtype=object)
+    words[late] = "a,b"
+    x = np.arange(n) * 0.5
+    cols = (Column("x", "mm", x), Column("s", "", words, "text"))
+    fast = tmp_path / "fast.csv"
+    with open(fast, "w", encoding="utf-8", newline="") as fh:
+        sink = formats.CsvSink(fh, None)
+        sink.begin("t", cols, n)
+        assert sink.fast
+        sink.rows([c.values for c in cols])
+        assert sink.count == n
+    rows = list(csv.reader(io.StringIO(fast.read_text(encoding="utf-8"))))
+    assert len(rows) == n + 1 and rows[0] == ["x (mm)", "s"]
+    assert [float(r[0]) for r in rows[1:]] == list(x)
+    assert rows[late + 1][1] == "a,b" and {r[1] for r in rows[1:]} == {"ok", "a,b"}

@@ -44,7 +44,7 @@ _EXPORTS = {
     "Loads": ".problems.loads", "Mass": ".problems.loads",
     "instant_centres": ".kinematics.centres", "InstantCentres": ".kinematics.centres",
     "centrodes": ".kinematics.centres", "Centrodes": ".kinematics.centres",
-    "tolerance": ".kinematics.tolerance", "ToleranceStudy": ".kinematics.tolerance",
+    "tolerance": ".scan.tolerance", "ToleranceStudy": ".scan.tolerance",
     "simulate": ".kinematics.dynamics", "Simulation": ".kinematics.dynamics",
 }
 _RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",

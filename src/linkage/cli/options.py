@@ -9,23 +9,15 @@ import typer
 
 from ..errors import InputError
 from ..numbers import parse_number
+from ..render.writers import data_formats, format_help, output_help
 
-FormatOpt = Annotated[
-    Optional[str],
-    typer.Option("--format", "-f", help="table (rich, default on a terminal), plain (default "
-                 "when piped), csv, json, parquet or xlsx (these two to -o FILE), or any tabulate "
-                 "format (github, grid, latex, ...)."),
-]
-OutputOpt = Annotated[
-    Optional[Path],
-    typer.Option("--output", "-o", help="Write to this file instead of standard output; "
-                 "the format follows the suffix (.csv, .json, .parquet, .xlsx, .txt, .md, .tex, "
-                 ".html, .rst) unless --format is given."),
-]
+FormatOpt = Annotated[Optional[str], typer.Option("--format", "-f", help=format_help())]
+"""--format: its choices and help from the one registry of formats (render.formats)."""
+OutputOpt = Annotated[Optional[Path], typer.Option("--output", "-o", help=output_help())]
 TableOpt = Annotated[
     Optional[str],
-    typer.Option("--table", metavar="NAME", help="Write only this table of the report (csv, json, "
-                 "parquet, xlsx). CSV holds one table: a report of several needs it on standard "
+    typer.Option("--table", metavar="NAME", help=f"Write only this table of the report ({data_formats()}). "
+                 "CSV holds one table: a report of several needs it on standard "
                  "output; to -o FILE.csv the others go beside it as FILE.NAME.csv."),
 ]
 MechanismFile = Annotated[

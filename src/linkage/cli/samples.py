@@ -36,9 +36,9 @@ def samples(
         if output is not None:
             raise InputError("give the NAME of the sample to write with -o")
         from ..render.tools import samples_report
-        from ..render.writers import OWN_FORMATS
+        from ..render.writers import is_binary
 
-        if fmt in OWN_FORMATS and OWN_FORMATS[fmt].binary:  # the registry would ask for -o FILE
+        if fmt is not None and is_binary(fmt.strip().lower()):  # the registry would ask for -o FILE
             raise InputError(f"--format {fmt}: the list of samples goes to standard output; "
                              "use table, plain, csv, json or a tabulate format")
         emit_report(samples_report(shipped()), choose_format(fmt, None), None)

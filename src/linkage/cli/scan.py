@@ -1,16 +1,14 @@
 """linkage scan."""
 
-import contextlib
-import time
 from typing import Annotated, Optional
 
 import typer
 
-from ..errors import InputError
 from .options import (
     AccelOpt,
     ColumnsOpt,
     DigitsOpt,
+    FormatOpt,
     GravityOpt,
     LoadOpt,
     MechanismFile,
@@ -71,9 +69,7 @@ def scan(
                        "core).")] = None,
     chunk: Annotated[Optional[int], typer.Option(help="Designs per task (default: about "
                      "200,000 positions per task).")] = None,
-    fmt: Annotated[Optional[str], typer.Option("--format", "-f", help="table (default on a "
-                   "terminal), plain, csv, json, parquet, xlsx or a tabulate format (github, "
-                   "latex, ...); -o FILE picks by suffix.")] = None,
+    fmt: FormatOpt = None,
     output: OutputOpt = None,
     digits: DigitsOpt = 6,
     columns: ColumnsOpt = None,
@@ -97,78 +93,48 @@ def scan(
 
     Example: linkage scan sample_inputs/crank_rocker.toml --vary r2=20:60:5 --vary r4=60:120:7
     """
-    from ..arguments import check_scan_options, driver_span
+    from ..arguments import driver_span, parse_motion
     from ..files import parse_toml, read_input
+    from ..kinematics.bodies import command_loads
     from ..kinematics.sweep import driver_values
     from ..problems.loops import from_text
     from ..render import writers
     from ..render.scan import RecordSink, pick_spec, scan_meta, scan_report, scan_summary
-    from ..scan import MAX_DESIGNS, Keeper, ScanJob, check_held, feed, parse_vary, pick_chunk, prepare
-    from ..solve import check_criteria
+    from ..scan import ScanRequest, open_scan, parse_vary, run_scan
 
     if output is not None and str(output) == "-":
         output = None
     fmt = writers.choose_format(fmt, output)
     check_paths([file], [("--output", output)])
-    check_criteria(tol, 0.0, None, 50)
-    check_scan_options(seed=seed, samples=samples, top=top, chunk=chunk, workers=workers,
-                       scheduler=scheduler, max_designs=MAX_DESIGNS, prefix="--")
-    if not vary:
-        raise InputError("give at least one --vary NAME=LO:HI[:N]")
-    varies = [parse_vary(v) for v in vary]
+    varies = [parse_vary(v) for v in vary or []]
     text = read_input(file)
     fixed = parse_assignments("--set", set_ or [])
-    both = sorted({v.name for v in varies} & set(fixed))
-    if both:
-        raise InputError(f"{both[0]} is given by --set and by --vary; a scanned parameter takes its "
-                         "values from --vary only")
     mechanism = from_text(text, str(file)).with_values(fixed, {})
     note_closed_form(mechanism)
-    from ..arguments import parse_motion
-    from ..kinematics.bodies import command_loads
-
     w, a_ = parse_motion(speed, accel, mechanism)
-    motion = (w or 0.0, a_)
-    loads = command_loads(mechanism, force or [], torque or [], gravity)
-    used = loads if not loads.empty or loads.gravity is not None else None
-    if used is None and speed is not None:
-        if mechanism.extra.get("drawing") is None:
-            from ..kinematics.bodies import Frame
-
-            Frame.of(mechanism)  # says why: loads need the joints form
-        raise InputError("--speed in a scan is for the loads' inertia: give loads ([loads] or [mass] in "
-                         "the file, or --load/--torque)")
     a, b = driver_span(mechanism, start, stop, turn_end=359.0)
-    if desc and sort is None:
-        raise InputError("--desc orders by --sort: give --sort COLUMN")
-    setup = prepare(mechanism, varies, samples=samples, seed=seed, sampling=sampling,
-                    values=driver_values(a, b, step, None), branch=branch, tol=tol, where=where, sort=sort,
-                    doc=parse_toml(text, str(file)) if any("." in v.name for v in varies) else None,
-                    fixed=tuple(fixed), loads=used)
+    doc = parse_toml(text, str(file)) if any("." in v.name for v in varies) else None
+    request = ScanRequest(
+        mechanism, tuple(varies), tuple(driver_values(a, b, step, None)), samples=samples, seed=seed,
+        sampling=sampling, branch=branch, tol=tol, where=where, sort=sort, descending=desc, top=top,
+        scheduler=scheduler, workers=workers, chunk=chunk,
+        loads=command_loads(mechanism, force or [], torque or [], gravity), speed=w, accel=a_, doc=doc,
+        text=text, fixed=tuple((k, float(v)) for k, v in fixed.items()), cli=True)
+    opened = open_scan(request)
+    setup, motion = opened.setup, (w or 0.0, a_)
     spec = pick_spec(setup.spec, columns) if columns else setup.spec
     streamed = writers.is_data(fmt)
-    if sort is not None and streamed:
-        check_held(setup.plan.total, len(setup.spec), top, f"--sort {sort} with --format {fmt}")
-    job = ScanJob(text, str(file), tuple((k, float(v)) for k, v in fixed.items()), setup.plan.names,
-                  tuple(setup.values), setup.branch, tol, moves=setup.moves, loads=used,
-                  motion=motion)
-    size = pick_chunk(mechanism, len(setup.values), setup.branch, chunk, setup.plan.total)
+    if streamed:
+        writers.prefetch(fmt, setup.plan.total)  # the writer's imports beside the scan's solving
     meta = scan_meta(mechanism, str(file), setup, (a, b, step), where, sort, desc, motion)
-    started = time.perf_counter()
-    with contextlib.ExitStack() as stack:
-        # a data format streams every record through the registry's sink (sorted: once, at
-        # the end); a display holds the rows it shows
-        sink = stack.enter_context(RecordSink(fmt, output, spec, meta)) if streamed else None
-        keeper = Keeper(sort, desc, top, sink if sort is None else None, show=None if streamed else 20)
-        advance = stack.enter_context(progress_bar(setup.plan.total, minimum=2 * size))
-        scanned = feed(keeper, job, setup, size, scheduler=scheduler, workers=workers, progress=advance)
-        held = keeper.result()
-        if sink is not None and sort is not None:
-            sink(held)
-    summary = scan_summary(mechanism, setup, (a, b, step), scanned, keeper, held,
-                           time.perf_counter() - started, shown=not streamed, motion=motion)
+    sink = RecordSink(fmt, output, spec, meta) if streamed else None
+    done = run_scan(opened, output=sink, holding=f"--sort {sort} with --format {fmt}",
+                    show=None if streamed else 20,
+                    progress=lambda total, size: progress_bar(total, minimum=2 * size))
+    summary = scan_summary(mechanism, setup, (a, b, step), done.scanned, done.keeper, done.held,
+                           done.seconds, shown=not streamed, motion=motion)
     if sink is None:
-        writers.write(scan_report(held, spec, summary, digits, meta), fmt, output)
+        writers.write(scan_report(done.held, spec, summary, digits, meta), fmt, output)
     else:
         typer.echo(f"{summary[0]}; wrote {sink.count:,} records" +
                    (f" to {output}" if output is not None else ""), err=True)

@@ -95,7 +95,7 @@ def sweep(
     from ..kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
     from ..problems.loops import load
     from ..render.sweep import sweep_report
-    from ..render.writers import is_data
+    from ..render.writers import data_formats, is_data, prefetch
     from ..solve import SYSTEM_METHODS, check_criteria, check_number
 
     out_fmt = choose_format(fmt, output)
@@ -128,23 +128,19 @@ def sweep(
     values = driver_values(a, b, step, points)
     note_closed_form(mechanism)
     w, a_ = parse_motion(speed, accel, mechanism)
+    motion = (speed, accel)
     from ..kinematics.bodies import command_loads
 
     loads = command_loads(mechanism, force or [], torque or [], gravity)
-    named = [j for loop in mechanism.loops for j in loop.joints if j] + list(mechanism.points)
-    if path:
-        if plot is None:
-            raise InputError("--path draws into the --plot file: give --plot PATH.png as well")
-        for name in path:
-            if name not in named:
-                raise InputError(f"--path {name}: no joint or point of that name in {file} "
-                                 f"(named: {', '.join(dict.fromkeys(named)) or 'none'})")
+    named = check_path_names(mechanism, path, plot, file)
     if batch is None and len(values) <= BATCH_ABOVE:
         # the numpy engines (closed form, batch) cost a fresh process numpy's import, more
         # than the one-at-a-time sweep of this many positions (the cold-start target)
         batch = False
     n = len(values)
     data = is_data(out_fmt)
+    if data:
+        prefetch(out_fmt, n)  # the writer's imports beside the solving
     # one bar for solving and writing (n positions each), on screen until the file is complete
     with progress_bar(2 * n if data else n, minimum=4000 if data else 2000) as advance:
         result = sweep_mechanism(mechanism, values, method=method, branch=branch, tol=tol, batch=batch,
@@ -152,7 +148,7 @@ def sweep(
         if advance is not None and data:
             advance(n, f"writing {out_fmt}")
         note = "" if data or not named else \
-            "joints and points (x, y): with --format csv, json, parquet or xlsx"
+            f"joints and points (x, y): with --format {data_formats()}"
         from ..kinematics.columns import sweep_columns
 
         cols = sweep_columns(result)  # read once: a batch sweep's rates for its table and its loads
@@ -166,16 +162,36 @@ def sweep(
         emit_report(report, out_fmt, output, columns=columns, table=table,
                     progress=None if advance is None else (lambda rows: advance(n + rows)))
     if plot is not None:
-        from ..arguments import motion_text
-        from ..render.plots import path_plot, sweep_plot
-
-        if path:
-            path_plot(result, mechanism, path, plot)
-        else:
-            sweep_plot(result, plot, motion_text(speed, accel, mechanism))
-        typer.echo(f"wrote {plot}", err=True)
+        draw_sweep(result, mechanism, path, plot, motion)
     if result.summary.get("failed"):
         raise typer.Exit(1)
+
+
+def check_path_names(mechanism: Any, path: list[str] | None, plot: Path | None, file: Path) -> list[str]:
+    """The mechanism's named joints and points; each --path one of them, drawn into --plot."""
+    named = [j for loop in mechanism.loops for j in loop.joints if j] + list(mechanism.points)
+    if path:
+        if plot is None:
+            raise InputError("--path draws into the --plot file: give --plot PATH.png as well")
+        for name in path:
+            if name not in named:
+                raise InputError(f"--path {name}: no joint or point of that name in {file} "
+                                 f"(named: {', '.join(dict.fromkeys(named)) or 'none'})")
+    return named
+
+
+def draw_sweep(result: Any, mechanism: Any, path: list[str] | None, plot: Path,
+               motion: tuple[str | None, str | None]) -> None:
+    """--plot: the --path joints' paths, else the sweep's unknowns (with the --speed/--accel
+    they were computed at)."""
+    from ..arguments import motion_text
+    from ..render.plots import path_plot, sweep_plot
+
+    if path:
+        path_plot(result, mechanism, path, plot)
+    else:
+        sweep_plot(result, plot, motion_text(motion[0], motion[1], mechanism))
+    typer.echo(f"wrote {plot}", err=True)
 
 
 def sweep_equation(a: float, b: float, step: float | None, points: int | None, method: str,

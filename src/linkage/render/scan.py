@@ -81,11 +81,10 @@ class RecordSink:
     def __init__(self, fmt_: str, path: Path | None, spec: Sequence[Column],
                  meta: Mapping[str, Any]) -> None:
         from ..errors import InputError
-        from .writers import OWN_FORMATS, choose_format, is_data
+        from .writers import choose_format, data_formats, is_data
 
         if not is_data(fmt_):
-            data = ", ".join(f for f in OWN_FORMATS if is_data(f))
-            raise InputError(f"{fmt_} is not a data format; use {data}")
+            raise InputError(f"{fmt_} is not a data format; use {data_formats()}")
         choose_format(fmt_, path)  # the registry's refusals: binary to standard output, a missing extra
         self.fmt, self.path, self.spec, self.meta = fmt_, path, list(spec), dict(meta)
         self.to_stdout = path is None or str(path) == "-"
@@ -224,9 +223,12 @@ def scan_summary(m: Any, setup: Any, driver: tuple[float, float, float], scanned
         lines.append(f"branch: {setup.branch_note}")
     if setup.loads is not None:
         lines.append(loads_line(m, setup.loads, motion))
+    from .formats import FORMATS
+    from .writers import is_data
+
     n_held = len(held["design"]) if held else 0
     if shown and n_held < keeper.kept:
         lines.append(f"showing {n_held} of {keeper.kept:,}"
                      + (f" by {sort}{' (largest first)' if keeper.descending else ''}" if sort else "")
-                     + "; --top K or --format csv/json/parquet/xlsx for more")
+                     + f"; --top K or --format {'/'.join(f for f in FORMATS if is_data(f))} for more")
     return lines

@@ -1,19 +1,7 @@
-"""One registry of output formats; each writes a :class:`~.data.Report`.
-
-Display formats (table, plain and tabulate's) show the report's blocks. Data formats
-(csv, json, parquet, xlsx) write its tables, every column with its unit, streamed a block
-of rows at a time (never one Python object per cell of a large table):
-
-- csv: a header row of ``name (unit)``, numbers as the shortest text that reads back to
-  the same double, an empty cell where there is none: one table per file, so that any
-  CSV reader (``pandas.read_csv``) reads it. A report of several tables written to a file
-  puts the first at the path given and the others beside it as ``stem.name.csv``; on
-  standard output it needs ``--table NAME`` (:func:`pick_table`), and is refused without.
-- json: the command's document, with the tables under ``tables``: for each, its name,
-  column names, units and rows.
-- parquet: one file per table (the first at the path given, the others beside it as
-  ``stem.name.parquet``, as csv), each field's unit in its metadata.
-- xlsx: one sheet per table, ``name (unit)`` in the header row, numbers as numbers.
+"""Writing a report in the format asked: the format chosen from --format or -o's suffix
+(every choice read from the registry, :data:`.formats.FORMATS`), the tables streamed into
+the format's sink a block of rows at a time (never one Python object per cell of a large
+table), or the display shown.
 
 A file is written to a temporary name beside it and renamed when complete
 (:func:`~linkage.files.atomic_target`): a failed or interrupted run leaves no
@@ -24,58 +12,63 @@ half-written file (nor sidecar: each is renamed only when the whole report is wr
 from __future__ import annotations
 
 import contextlib
-import math
 import sys
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import IO, Any, NamedTuple
+from typing import Any
 
 from ..errors import InputError, OutputError
+from .cells import SLICE, Sink, safe_name
 from .data import Column, DataTable, Report
-
-
-class Format(NamedTuple):
-    name: str
-    suffixes: tuple[str, ...]
-    data: bool  # writes the tables (else the display blocks)
-    binary: bool = False
-    help: str = ""
-
-
-OWN_FORMATS = {f.name: f for f in (
-    Format("table", (), False, help="rich, on a terminal"),
-    Format("plain", (".txt", ""), False, help="headers over a rule"),
-    Format("csv", (".csv",), True),
-    Format("json", (".json",), True),
-    Format("parquet", (".parquet",), True, binary=True, help="needs pyarrow"),
-    Format("xlsx", (".xlsx",), True, binary=True, help="needs openpyxl"),
-)}
-TABULATE_SUFFIXES = {".md": "github", ".tex": "latex", ".html": "html", ".rst": "rst"}
-EXTRAS = {"parquet": ("pyarrow.parquet", "pip install 'linkage-kinematics[scan]'"),
-          "xlsx": ("openpyxl", "pip install 'linkage-kinematics[xlsx]'")}
-COMMON_TABULATE = ("github", "grid", "latex", "latex_booktabs", "html", "rst", "tsv")
-"""The tabulate formats an unknown --format names (the first eight by name were asciidoc,
-colon_grid, double_grid, ...)."""
-SLICE = 8192
-"""Rows formatted at a time."""
-FAST_CELLS = 200_000
-"""From this many cells in a table, CSV numbers are formatted by pyarrow when it is
-installed; the choice is made once per table, so a column's numbers read alike throughout."""
+from .formats import COMMON_TABULATE, FORMATS, TABULATE_SUFFIXES
 
 
 def tabulate_formats() -> list[str]:
     from tabulate import tabulate_formats as names
 
-    return [n for n in names if n not in OWN_FORMATS]
+    return [n for n in names if n not in FORMATS]
 
 
 def suffix_map() -> dict[str, str]:
-    out = {s: f.name for f in OWN_FORMATS.values() for s in f.suffixes}
+    out = {s: f.name for f in FORMATS.values() for s in f.suffixes}
     return {**out, **TABULATE_SUFFIXES}
 
 
 def known_suffixes() -> str:
     return ", ".join(f"{s} ({n})" for s, n in suffix_map().items() if s)
+
+
+def is_data(fmt: str) -> bool:
+    """Writes the report's tables (a sink's format), not its display."""
+    return fmt in FORMATS and FORMATS[fmt].streams
+
+
+def is_binary(fmt: str) -> bool:
+    """Written to a file only."""
+    return fmt in FORMATS and FORMATS[fmt].binary
+
+
+def data_formats() -> str:
+    """The formats that write the tables, as a sentence's list: ``csv, json, parquet or xlsx``."""
+    names = [f.name for f in FORMATS.values() if f.streams]
+    return ", ".join(names[:-1]) + f" or {names[-1]}" if len(names) > 1 else "".join(names)
+
+
+def format_help() -> str:
+    """--format's help, from the registry: the display formats with what they are, the data
+    formats and which of them need -o FILE, and tabulate's."""
+    shown = [f"{f.name} ({f.help})" if f.help else f.name for f in FORMATS.values() if not f.streams]
+    binary = [f.name for f in FORMATS.values() if f.binary]
+    files = f" ({' and '.join(binary)} to -o FILE)" if binary else ""
+    return (f"{', '.join(shown)}, {data_formats()}{files}, or any tabulate format "
+            f"({', '.join(COMMON_TABULATE[:3])}, ...).")
+
+
+def output_help() -> str:
+    """-o's help, from the registry."""
+    suffixes = ", ".join(s for s in suffix_map() if s)
+    return (f"Write to this file instead of standard output; the format follows the suffix "
+            f"({suffixes}) unless --format is given.")
 
 
 def choose_format(fmt: str | None, output: Path | None, *, terminal: bool | None = None) -> str:
@@ -96,415 +89,71 @@ def choose_format(fmt: str | None, output: Path | None, *, terminal: bool | None
         else:
             tty = sys.stdout.isatty() if terminal is None else terminal
             fmt = "table" if tty else "plain"
-    elif fmt not in OWN_FORMATS and fmt not in tabulate_formats():
-        raise InputError(f"unknown format {fmt!r}; use {', '.join(OWN_FORMATS)} or a tabulate format "
+    elif fmt not in FORMATS and fmt not in tabulate_formats():
+        raise InputError(f"unknown format {fmt!r}; use {', '.join(FORMATS)} or a tabulate format "
                          f"({', '.join(f for f in COMMON_TABULATE if f in tabulate_formats())}, ...)")
-    if to_stdout and fmt in OWN_FORMATS and OWN_FORMATS[fmt].binary:
-        raise InputError(f"{fmt} is a binary format: give -o FILE.{fmt}")
-    if fmt in EXTRAS:
-        module, how = EXTRAS[fmt]
-        try:
-            __import__(module)
-        except ImportError:
-            raise InputError(f"{fmt} output needs {module.split('.')[0]}: {how}") from None
+    spec = FORMATS.get(fmt)
+    if to_stdout and spec is not None and spec.binary:
+        raise InputError(f"{fmt} is a binary format: give -o FILE{spec.suffixes[0]}")
+    if spec is not None and spec.needs is not None:
+        from importlib.util import find_spec
+
+        if find_spec(spec.needs[0].split(".")[0]) is None:  # found, not imported: see prefetch
+            raise InputError(missing(fmt))
     return fmt
 
 
-def is_data(fmt: str) -> bool:
-    return fmt in OWN_FORMATS and OWN_FORMATS[fmt].data
+def missing(fmt: str) -> str:
+    """The refusal of a format whose package is not installed."""
+    module, how = FORMATS[fmt].needs  # type: ignore[misc]
+    return f"{fmt} output needs {module.split('.')[0]}: {how}"
 
 
-# --- cells ----------------------------------------------------------------------------------
+def prefetch(fmt: str, rows: int | None = None) -> None:
+    """Start importing, on a thread, the modules ``fmt``'s writer will need for a table of
+    ``rows`` rows, so that the import (pyarrow: 0.13 to 0.17 s, a third of a
+    360,001-position sweep's computing) runs beside the command's computing; the writer's
+    own import then finds them loaded, or waits for them. An import that fails here is
+    left to fail where the writer needs it (:func:`open_sink` says so in one line)."""
+    spec = FORMATS.get(fmt)
+    names = [m for m in (spec.sink.modules(rows) if spec and spec.sink else ()) if m not in sys.modules]
+    if names:
+        import threading
 
-def number_texts(values: Any, fast: bool = False) -> list[str]:
-    """Each number as the shortest text that reads back to the same double: Python's repr,
-    or with ``fast`` (a large table, pyarrow installed) pyarrow's shortest form (``100``
-    where repr says ``100.0``, ``0.000012345`` for ``1.2345e-05``); both read back bit for
-    bit. "" for NaN, infinities and None."""
-    if fast and _is_array(values) and values.dtype.kind == "f" and _pyarrow():
-        import numpy as np
-        import pyarrow as pa
-        import pyarrow.compute as pc
-
-        finite = np.isfinite(values)
-        arr = pa.array(values, mask=~finite)
-        return pc.fill_null(pc.cast(arr, pa.string()), "").to_pylist()  # type: ignore[no-any-return]
-    seq = _plain(values)
-    return ["" if v is None or (isinstance(v, float) and not math.isfinite(v)) else
-            repr(v) if isinstance(v, float) else str(v) for v in seq]
+        threading.Thread(target=import_quietly, args=(names,), name="linkage-prefetch").start()
 
 
-def _is_array(values: Any) -> bool:
-    return hasattr(values, "dtype") and hasattr(values, "tolist")
-
-
-def _plain(values: Any) -> list[Any]:
-    """The values as Python objects: an array's ``tolist``; in a list, numpy scalars (a
-    median, a ratio) as Python numbers (numpy 2's repr of one is ``np.float64(0.1)``, and
-    json cannot encode ``np.int64``)."""
-    if _is_array(values):
-        return values.tolist()  # type: ignore[no-any-return]
-    return [v.item() if _is_array(v) else v for v in values]
-
-
-_HAS_PYARROW: list[bool] = []
-
-
-def _pyarrow() -> bool:
-    if not _HAS_PYARROW:
+def import_quietly(names: Sequence[str]) -> None:
+    for name in names:
         try:
-            import pyarrow.compute  # noqa: F401
-            _HAS_PYARROW.append(True)
-        except ImportError:
-            _HAS_PYARROW.append(False)
-    return _HAS_PYARROW[0]
-
-
-def _quote(text: str) -> str:
-    if any(c in text for c in ',"\n\r'):
-        return '"' + text.replace('"', '""') + '"'
-    return text
-
-
-def cell_texts(col: Column, values: Any, fast: bool = False) -> list[str]:
-    """One column's cells as CSV text."""
-    if col.kind == "number":
-        return number_texts(values, fast)
-    seq = _plain(values)
-    if col.kind == "bool":
-        return ["" if v is None else "true" if v else "false" for v in seq]
-    if col.kind == "int":
-        return ["" if v is None else str(int(v)) for v in seq]
-    return ["" if v is None else _quote(str(v)) for v in seq]
-
-
-def json_values(col: Column, values: Any) -> list[Any]:
-    seq = _plain(values)
-    if col.kind == "number":
-        return [v if v is None or isinstance(v, int) or math.isfinite(v) else None for v in seq]
-    if col.kind == "bool":
-        return [None if v is None else bool(v) for v in seq]
-    return seq
-
-
-# --- sinks: a table at a time, a block of rows at a time --------------------------------------
-
-class Sink:
-    """Writes tables to one output: ``begin(name, columns)``, ``rows(values)`` (one
-    sequence per column, any number of times), ``end()``; ``close()`` finishes the output."""
-
-    def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
-        self.out, self.path, self.meta = out, path, meta or {}
-        self.count = 0  # rows written in the current table
-        self.tables = 0
-        self.columns: tuple[Column, ...] = ()
-
-    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
-        """A new table; ``rows``, when known, its number of rows."""
-        self.name, self.columns, self.count = name, tuple(columns), 0
-        self.tables += 1
-
-    def rows(self, values: Sequence[Any]) -> None:
-        raise NotImplementedError
-
-    def end(self) -> None:
-        return None
-
-    def close(self) -> None:
-        return None
-
-    def abandon(self) -> None:
-        """Stop after a failure or an interrupt: release what is open, finish nothing (the
-        temporary file is removed)."""
-        return None
-
-
-class CsvSink(Sink):
-    """One table per output: a second table goes to the file ``paths(name)`` returns (the
-    sidecar's temporary file, renamed with the first; :func:`open_sink`)."""
-
-    def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None,
-                 paths: Callable[[str], IO[Any]] | None = None) -> None:
-        super().__init__(out, path, meta)
-        self.paths = paths
-
-    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
-        super().begin(name, columns, rows)
-        if self.tables > 1:
-            if self.paths is None:  # write() refuses this first; a caller of the sinks too
-                raise InputError(f"csv holds one table: {name!r} is a second on standard output")
-            self.out.flush()  # type: ignore[union-attr]
-            self.out = self.paths(safe_name(name))
-        self.fast = rows is not None and rows * len(self.columns) >= FAST_CELLS and _pyarrow()
-        self.out.write(",".join(_quote(c.header) for c in self.columns) + "\n")  # type: ignore[union-attr]
-
-    def rows(self, values: Sequence[Any]) -> None:
-        n = len(values[0]) if values else 0
-        if self.fast and n >= SLICE:
-            for a in range(0, n, FAST_BLOCK):
-                body = _arrow_block(self.columns, [v[a:a + FAST_BLOCK] for v in values])
-                if body is None:
-                    break
-                if hasattr(self.out, "buffer"):  # a file: its bytes, no str of the block
-                    self.out.flush()  # type: ignore[union-attr]
-                    self.out.buffer.write(body)  # type: ignore[union-attr]
-                    self.out.buffer.write(b"\n")  # type: ignore[union-attr]
-                else:
-                    self.out.write(bytes(body).decode("utf-8") + "\n")  # type: ignore[union-attr]
-            else:
-                self.count += n
-                return
-            values = [v[a:] for v in values]  # the rest cell by cell
-            self.count += a
-            n -= a
-        for a in range(0, n, SLICE):
-            b = min(n, a + SLICE)
-            cells = [cell_texts(c, v[a:b], self.fast) for c, v in zip(self.columns, values)]
-            self.out.write("\n".join(map(",".join, zip(*cells))) + "\n")  # type: ignore[union-attr]
-        self.count += n
-
-
-FAST_BLOCK = 2 * SLICE
-"""Rows a CSV block formats and joins in pyarrow at a time (:func:`_arrow_block`)."""
-
-
-def _arrow_block(columns: Sequence[Column], values: Sequence[Any]) -> Any:
-    """A block of CSV rows formatted and joined by pyarrow: the same cells as
-    :func:`cell_texts` with pyarrow's numbers (tests check it), without a Python string
-    per cell, as a buffer of UTF-8 bytes; None (the caller goes cell by cell) for a column
-    that is not a numpy number or integer array or text that needs no quoting. The
-    columns' numbers are formatted on every core (pyarrow releases the GIL)."""
-    import numpy as np
-    import pyarrow as pa
-    import pyarrow.compute as pc
-
-    def text(c: Column, v: Any) -> Any:
-        if c.kind == "number" and _is_array(v) and v.dtype.kind == "f":
-            return pc.cast(pa.array(v, mask=~np.isfinite(v)), pa.string())
-        if c.kind == "int" and _is_array(v) and v.dtype.kind in "iu":
-            return pc.cast(pa.array(v), pa.string())
-        if c.kind == "text":
-            arr = pa.array(v if _is_array(v) and v.dtype.kind == "O" else _plain(v), type=pa.string())
-            return None if pc.any(pc.match_substring_regex(arr, '[,"\n\r]')).as_py() else arr
-        return None
-
-    from concurrent.futures import ThreadPoolExecutor
-
-    with ThreadPoolExecutor() as pool:
-        texts = list(pool.map(text, columns, values))
-    if any(t is None for t in texts):
-        return None
-    lines = pc.binary_join_element_wise(*[pc.fill_null(t, "") for t in texts], ",")
-    body = pc.binary_join(pa.array([lines], type=pa.list_(pa.string())), "\n")[0]
-    return memoryview(body.as_buffer()) if len(lines) else None
-
-
-class JsonSink(Sink):
-    """The document's keys, then ``"tables": [{"name", "columns", "units", "rows"}, ...]``."""
-
-    def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
-        super().__init__(out, path, meta)
-        import json
-
-        from .export import clean
-
-        head = json.dumps(clean(self.meta), indent=2, allow_nan=False)
-        self.out.write(head[:-1].rstrip() + (",\n" if self.meta else "") + '  "tables": [')  # type: ignore[union-attr]
-
-    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
-        super().begin(name, columns, rows)
-        spec = {"name": name, "columns": [c.name for c in self.columns],
-                "units": [c.unit for c in self.columns]}
-        import json
-
-        text = json.dumps(spec, allow_nan=False)[:-1] + ', "rows": ['
-        self.out.write(("," if self.tables > 1 else "") + "\n    " + text)  # type: ignore[union-attr]
-
-    def rows(self, values: Sequence[Any]) -> None:
-        n = len(values[0]) if values else 0
-        for a in range(0, n, SLICE):
-            b = min(n, a + SLICE)
-            cols = [json_values(c, v[a:b]) for c, v in zip(self.columns, values)]
-            import json
-
-            text = ",".join("\n      " + json.dumps(r, allow_nan=False) for r in map(list, zip(*cols)))
-            self.out.write(("," if self.count or a else "") + text)  # type: ignore[union-attr]
-        self.count += n
-
-    def end(self) -> None:
-        self.out.write("\n    ]}" if self.count else "]}")  # type: ignore[union-attr]
-
-    def close(self) -> None:
-        self.out.write("\n  ]\n}\n")  # type: ignore[union-attr]
-
-
-class ParquetSink(Sink):
-    """One parquet file per table: the first at the path, the others beside it."""
-
-    def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None,
-                 paths: Callable[[str], str] | None = None) -> None:
-        super().__init__(out, path, meta)
-        self.paths = paths
-        self.writer: Any = None
-
-    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-
-        super().begin(name, columns, rows)
-        types = {"number": pa.float64(), "int": pa.int64(), "bool": pa.bool_(), "text": pa.string()}
-        fields = [pa.field(c.name, types[c.kind], metadata={"unit": c.unit} if c.unit else None)
-                  for c in self.columns]
-        import json
-
-        from .export import clean
-
-        self.schema = pa.schema(fields, metadata={"linkage": json.dumps(clean({**self.meta, "table": name}))})
-        target = self.path if self.tables == 1 or self.paths is None else self.paths(safe_name(name))
-        # a dictionary only for text (a status, a branch: few distinct words); tried on
-        # every column of doubles it costs 3x the write (0.40 s against 0.13 s for a
-        # 360,001-position sweep) and saves nothing, as the doubles rarely repeat
-        words = [c.name for c in self.columns if c.kind == "text"]
-        self.writer = pq.ParquetWriter(target, self.schema, use_dictionary=words or False)
-
-    def rows(self, values: Sequence[Any]) -> None:
-        import pyarrow as pa
-
-        arrays = []
-        for c, f, v in zip(self.columns, self.schema, values):
-            if c.kind == "number":  # NaN and infinities are no value, as in CSV and JSON
-                import numpy as np
-
-                x = np.asarray(v if _is_array(v) else [math.nan if x is None else x for x in v], dtype=float)
-                arrays.append(pa.array(x, type=f.type, mask=~np.isfinite(x)))
-            else:
-                arrays.append(pa.array(v.tolist() if _is_array(v) else list(v), type=f.type))
-        self.writer.write_table(pa.Table.from_arrays(arrays, schema=self.schema))
-        self.count += len(values[0]) if values else 0
-
-    def end(self) -> None:
-        self.writer.close()
-        self.writer = None
-
-    def close(self) -> None:
-        if self.tables == 0 and self.path is not None:  # no table: still a parquet file
-            import json
-
-            import pyarrow as pa
-            import pyarrow.parquet as pq
-
-            from .export import clean
-
-            schema = pa.schema([], metadata={"linkage": json.dumps(clean(self.meta))})
-            pq.ParquetWriter(self.path, schema).close()
-        self.abandon()
-
-    def abandon(self) -> None:
-        if self.writer is not None:
-            with contextlib.suppress(Exception):
-                self.writer.close()
-
-
-XLSX_ROWS = 1_048_575
-"""Rows a sheet holds below its header row (Excel's limit)."""
-
-
-class XlsxSink(Sink):
-    def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
-        super().__init__(out, path, meta)
-        from openpyxl import Workbook
-
-        self.book = Workbook(write_only=True)
-        self.sheet: Any = None
-
-    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
-        super().begin(name, columns, rows)
-        title = safe_name(name)[:31] or f"table {self.tables}"
-        used = {s.title for s in self.book.worksheets}
-        k = 1
-        while title in used:  # two names alike in their first 31 characters
-            k += 1
-            title = f"{safe_name(name)[:31 - len(str(k)) - 1]} {k}"
-        self.sheet = self.book.create_sheet(title=title)
-        self.sheet.append([self._cell(c.header) for c in self.columns])
-
-    def _cell(self, v: Any) -> Any:
-        """Text as text: openpyxl makes a string beginning with "=" a formula (a joint
-        named "=HYPERLINK(...)" in a mechanism file would be live in the workbook)."""
-        if not (isinstance(v, str) and v.startswith("=")):
-            return v
-        from openpyxl.cell import WriteOnlyCell
-
-        cell = WriteOnlyCell(self.sheet, value=v)
-        cell.data_type = "s"
-        return cell
-
-    def rows(self, values: Sequence[Any]) -> None:
-        n = len(values[0]) if values else 0
-        if self.count + n > XLSX_ROWS:
-            raise InputError(f"{self.count + n:,} rows is more than an xlsx sheet holds ({XLSX_ROWS:,}); "
-                             "use csv or parquet")
-        for a in range(0, n, SLICE):
-            b = min(n, a + SLICE)
-            cols = [json_values(c, v[a:b]) for c, v in zip(self.columns, values)]
-            text = [j for j, c in enumerate(self.columns) if c.kind == "text"]
-            for r in zip(*cols):
-                if text:
-                    r = tuple(self._cell(v) if j in text else v for j, v in enumerate(r))
-                self.sheet.append(r)
-        self.count += n
-
-    def abandon(self) -> None:
-        # each sheet's row stream closed here, not left to the garbage collector (which
-        # printed "Exception ignored" tracebacks after an interrupt)
-        for ws in self.book.worksheets:
-            with contextlib.suppress(Exception):
-                ws.close()
-
-    def close(self) -> None:
-        if self.sheet is None:
-            self.book.create_sheet(title="empty")
-        # saved in memory, then written: openpyxl saving straight to a full disk left its
-        # half-closed zip to the garbage collector, which printed tracebacks after the error
-        import io
-
-        buf = io.BytesIO()
-        self.book.save(buf)
-        with open(self.path, "wb") as fh:  # type: ignore[arg-type]
-            fh.write(buf.getbuffer())
-
-
-UNSAFE = frozenset('[]:*?/\\\0')
-"""Characters an xlsx sheet name or a file name cannot hold."""
-
-
-def safe_name(table: str) -> str:
-    """A table's name as a sheet and a sidecar file name: ``_`` for each unsafe character."""
-    return "".join("_" if c in UNSAFE else c for c in table)
-
-
-def _sidecar(path: str) -> Callable[[str], str]:
-    def name(table: str) -> str:
-        p = Path(path)
-        return str(p.with_name(f"{p.stem}.{safe_name(table)}{p.suffix}"))
-    return name
-
-
-SIDECAR_FORMATS = ("csv", "parquet")
-"""The formats that hold one table per file: a report's others go beside the first."""
+            __import__(name)
+        except Exception:
+            return
+
+
+def sidecar_name(output: Path | str, table: str) -> str:
+    """Where a one-table format puts a report's table ``table`` beside ``output``."""
+    p = Path(output)
+    return str(p.with_name(f"{p.stem}.{safe_name(table)}{p.suffix}"))
 
 
 @contextlib.contextmanager
 def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None) -> Iterator[Sink]:
     """A sink for a data format, to ``output`` (None or "-": standard output), finished and
-    renamed into place only if the block completes; csv and parquet put a second table
+    renamed into place only if the block completes; a one-table format puts a second table
     in a sidecar file (:func:`side_paths`), renamed with the first."""
     to_stdout = output is None or str(output) == "-"
-    kinds = {"csv": CsvSink, "json": JsonSink, "parquet": ParquetSink, "xlsx": XlsxSink}
+    spec = FORMATS[fmt]
+    make: Any = spec.sink
+    if spec.needs is not None:
+        try:
+            __import__(spec.needs[0])
+        except ImportError:
+            raise InputError(missing(fmt)) from None
     try:
         with contextlib.ExitStack() as stack:
             if to_stdout:
-                sink: Sink = kinds[fmt](sys.stdout, None, meta)
+                sink: Sink = make(sys.stdout, None, meta)
                 yield sink
                 sink.close()
                 sys.stdout.flush()
@@ -512,10 +161,10 @@ def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None)
             from ..files import atomic_target
 
             tmp = stack.enter_context(atomic_target(output))  # type: ignore[arg-type]
-            if fmt in ("parquet", "xlsx"):
-                sink = kinds[fmt](None, tmp, meta)
-                if isinstance(sink, ParquetSink):
-                    sink.paths = lambda t: _extra_target(stack, output, t)  # type: ignore[arg-type]
+            if spec.binary:
+                sink = make(None, tmp, meta)
+                if spec.one_table:
+                    sink.side = lambda t: sidecar_target(stack, output, t)  # type: ignore[arg-type]
                 try:
                     yield sink
                 except BaseException:
@@ -524,10 +173,10 @@ def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None)
                 sink.close()
             else:
                 fh = stack.enter_context(open(tmp, "w", encoding="utf-8", newline=""))
-                sink = kinds[fmt](fh, tmp, meta)
-                if isinstance(sink, CsvSink):
-                    sink.paths = lambda t: stack.enter_context(  # type: ignore[arg-type]
-                        open(_extra_target(stack, output, t), "w", encoding="utf-8", newline=""))
+                sink = make(fh, tmp, meta)
+                if spec.one_table:
+                    sink.side = lambda t: stack.enter_context(
+                        open(sidecar_target(stack, output, t), "w", encoding="utf-8", newline=""))  # type: ignore[arg-type]
                 yield sink
                 sink.close()
                 sink.out.flush()  # type: ignore[union-attr]
@@ -536,17 +185,16 @@ def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None)
         raise OutputError(f"cannot write to {where}: {exc.strerror or exc}") from None
 
 
-def _extra_target(stack: contextlib.ExitStack, output: Path, table: str) -> str:
+def sidecar_target(stack: contextlib.ExitStack, output: Path, table: str) -> str:
     """A sidecar file's temporary path, renamed into place (synced) with the main file."""
     from ..files import atomic_target
 
-    final = Path(_sidecar(str(output))(table))
-    return stack.enter_context(atomic_target(final))
+    return stack.enter_context(atomic_target(Path(sidecar_name(output, table))))
 
 
 def side_paths(output: Path, report: Report) -> list[Path]:
-    """The files a csv or parquet report of several tables writes beside ``output``."""
-    return [Path(_sidecar(str(output))(t.name)) for t in [t for t in report.tables if t.columns][1:]]
+    """The files a one-table format's report of several tables writes beside ``output``."""
+    return [Path(sidecar_name(output, t.name)) for t in [t for t in report.tables if t.columns][1:]]
 
 
 PROGRESS_ROWS = 16 * SLICE
@@ -587,24 +235,17 @@ def write(report: Report, fmt: str, output: Path | None, *,
     sides: list[Path] = []  # a csv or parquet report's sidecar files
     if table is not None:
         report = pick_table(report, fmt, table)
-    if is_data(fmt):
+    spec = FORMATS.get(fmt)
+    if spec is not None and spec.sink is not None:
         tables = [t for t in report.tables if t.columns]
-        if fmt == "csv" and to_stdout and len(tables) > 1:
+        if spec.one_table and to_stdout and len(tables) > 1:
             names = ", ".join(t.name for t in tables)
-            raise InputError(f"csv holds one table and this report has {len(tables)} ({names}): add "
-                             "--table NAME for one on standard output, or -o FILE.csv (one file each)")
-        meta = report.document() if (fmt == "json" and report.document is not None) else \
-            {"title": report.title} if fmt in ("json", "parquet") else {}
-        if not isinstance(meta, dict):  # the tables go under a key: the document must be an object
-            meta = {"title": report.title, "document": meta}
-        to_side_files = fmt in SIDECAR_FORMATS and not to_stdout
-        sides = side_paths(output, report) if to_side_files else []  # type: ignore[arg-type]
-        if fmt == "parquet" and not to_stdout:
-            # which files are this report's: a rerun with fewer tables leaves the last
-            # run's sidecars beside it (nothing is deleted by pattern)
-            files = [Path(str(output)).name] + [p.name for p in sides]
-            meta = {**meta, "files": dict(zip([t.name for t in tables], files))}
-        with open_sink(fmt, output, meta) as sink:
+            raise InputError(f"{fmt} holds one table and this report has {len(tables)} ({names}): add "
+                             f"--table NAME for one on standard output, or -o FILE{spec.suffixes[0]} "
+                             "(one file each)")
+        sides = side_paths(output, report) if spec.one_table and not to_stdout else []  # type: ignore[arg-type]
+        files = [Path(str(output)).name] + [p.name for p in sides] if not to_stdout else []
+        with open_sink(fmt, output, spec.sink.meta_of(report, files)) as sink:
             write_tables(sink, tables, progress)
     else:
         from .display import display_text, print_table
@@ -637,7 +278,7 @@ def pick_table(report: Report, fmt: str, name: str) -> Report:
     report's tables is an InputError naming those there are."""
     names = [t.name for t in report.tables if t.columns]
     if not is_data(fmt):
-        raise InputError(f"--table picks a table of csv, json, parquet or xlsx output, not {fmt}")
+        raise InputError(f"--table picks a table of {data_formats()} output, not {fmt}")
     kept = tuple(t for t in report.tables if t.name == name.strip() and t.columns)
     if not kept:
         raise InputError(f"--table {name!r}: no such table; this report has {', '.join(names) or 'none'}")
@@ -674,3 +315,4 @@ def pick_columns(report: Report, names: str) -> Report:
             return blocks()  # the display shows fewer columns than the tables: keep it whole
 
     return report._replace(tables=tuple(tables), blocks=picked)
+

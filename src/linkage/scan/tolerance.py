@@ -14,7 +14,7 @@ Two answers, side by side, at every driver value:
   distribution the Monte Carlo draws (RSS / 3 for normal, RSS / sqrt(3) for uniform
   within ±D).
 - **Monte Carlo**: ``samples`` designs, each parameter drawn from its distribution, run
-  as a scan (:func:`linkage.scan.run_chunks`: on dask like any scan), every design
+  as a scan (:func:`linkage.scan.engine.run_chunks`: on dask like any scan), every design
   following the nominal assembly. Per driver value: the 0.135, 50 and 99.865 percentiles
   (the normal model's -3 sigma, median and +3 sigma) and standard deviation of each
   output over the samples that assemble there, and the share that do not.
@@ -30,6 +30,7 @@ singular.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
@@ -37,9 +38,12 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, ParseError
+from ..kinematics.designs import CONVERGED, solve_designs
 from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism
-from ..scan import JointMoves, ScanJob, Vary, job_mechanism, joint_moves
-from .designs import CONVERGED, solve_designs
+from ..units import degrees, radians
+from .designs import MAX_SCAN_POSITIONS, Vary
+from .moves import JointMoves, joint_moves
+from .task import ScanJob, job_mechanism
 
 DISTRIBUTIONS = ("normal", "uniform")
 """How ±D is drawn: normal with sigma D/3 (default), or uniform within ±D."""
@@ -277,7 +281,7 @@ def tolerance_chunk(job: ScanJob, start: int, designs: np.ndarray) -> dict[str, 
 @dataclass(frozen=True)
 class Samples:
     """The Monte Carlo's designs, drawn once (design i the same whatever the chunking or
-    the scheduler): what :func:`linkage.scan.run_chunks` reads as its plan."""
+    the scheduler): what :func:`linkage.scan.engine.run_chunks` reads as its plan."""
 
     designs: np.ndarray
 
@@ -367,7 +371,7 @@ def sensitivities(m: Mechanism, plan: Plan, values: np.ndarray, q: np.ndarray, s
                   ) -> tuple[np.ndarray, np.ndarray]:
     """(sensitivity (outputs, tolerances, positions), J invertible per position) at the
     nominal solutions ``q`` (positions, unknowns; internal units)."""
-    from .rates import place_motion_np, solve_rates_np
+    from ..kinematics.rates import place_motion_np, solve_rates_np
 
     outs = outputs_of(m)
     k = len(values)
@@ -388,7 +392,7 @@ def sensitivities(m: Mechanism, plan: Plan, values: np.ndarray, q: np.ndarray, s
                 v = moved[o.point][1]
                 rows.append(v.real if o.axis == "x" else v.imag)
             else:
-                rows.append(np.degrees(qd[o.index]) if o.kind == "angle" else qd[o.index])
+                rows.append(degrees(qd[o.index]) if o.kind == "angle" else qd[o.index])
         by_parameter[name] = np.array(rows).reshape(len(outs), k)
     s = np.stack([sum(rate * by_parameter[p] for p, rate in d.rates) for d in plan.directions], axis=1) \
         if plan.directions else np.empty((len(outs), 0, k))
@@ -426,7 +430,7 @@ def study(m: Mechanism, plan: Plan, values: Sequence[float], *, branch: str | No
     exact = tolerance_chunk(job, 0, np.array(rows))
     solved = exact["assembled"][0]
     nominal = exact["outputs"][0]  # (positions, outputs)
-    q = np.stack([np.radians(nominal[:, o.index]) if o.kind == "angle" else nominal[:, o.index]
+    q = np.stack([radians(nominal[:, o.index]) if o.kind == "angle" else nominal[:, o.index]
                   for o in outs if not o.point], axis=1) if m.unknowns else np.empty((len(vals), 0))
     s, invertible = sensitivities(m, plan, vals, q, solved)
     status, nonlinearity = judge(exact, nominal, s, d, outs, solved, invertible)
@@ -472,14 +476,14 @@ def judge(exact: Mapping[str, np.ndarray], nominal: np.ndarray, s: np.ndarray, d
 def monte_carlo(base: ToleranceStudy, m: Mechanism, plan: Plan, samples: int, seed: int, job: ScanJob,
                 scheduler: str | None, workers: int | None, progress: Any = None) -> ToleranceStudy:
     """Draw the samples and run them as a scan's chunks (the scan engine's runner)."""
-    from ..scan import pick_chunk, run_chunks
+    from .engine import run_chunks
+    from .task import pick_chunk
 
     n_out, k = len(base.outputs), len(base.values)
     held = samples * k * (n_out + 1)
     if held > MAX_HELD:
-        raise InputError(f"--samples {samples:,} x {k:,} positions x {n_out + 1} numbers is {held:,}, "
-                         f"more than the {MAX_HELD:,} a tolerance study holds; use fewer samples or a "
-                         "larger --step")
+        raise InputError(f"--samples {samples:,} x {k:,} positions x {n_out + 1} numbers is {held:,}, more "
+                         f"than the {MAX_HELD:,} a tolerance study holds; use fewer samples or larger --step")
     drawn = draw(plan, samples, seed, base.distribution)
     size = pick_chunk(m, k, job.branch, None, samples)
     assembled = np.zeros((samples, k), dtype=bool)
@@ -493,28 +497,15 @@ def monte_carlo(base: ToleranceStudy, m: Mechanism, plan: Plan, samples: int, se
         if progress is not None:
             progress(done)
     outputs = wrap_near(outputs, base.nominal.T[None, :, :], base.outputs, copy=False)
-    with np.errstate(invalid="ignore"), _quiet():
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        # numpy's warnings of a position no sample assembles at (all NaN): not_assembled says so
+        warnings.simplefilter("ignore", RuntimeWarning)
         low, median, high = np.nanpercentile(outputs, PERCENTILES, axis=0)  # (positions, outputs) each
         counts = np.isfinite(outputs).sum(axis=0)
         sigma = np.where(counts > 1, np.nanstd(outputs, axis=0, ddof=1) if samples > 1 else np.nan, np.nan)
     return replace(base, samples=samples, seed=seed, mc_low=low.T, mc_median=median.T, mc_high=high.T,
                    mc_sigma=sigma.T, not_assembled=1.0 - assembled.mean(axis=0),
                    not_assembled_anywhere=float(1.0 - assembled.all(axis=1).mean()) if k else 0.0)
-
-
-class _quiet:
-    """numpy's warnings about a position no sample assembles at (all NaN) silenced: the
-    study says so in not_assembled."""
-
-    def __enter__(self) -> None:
-        import warnings
-
-        self._w = warnings.catch_warnings()
-        self._w.__enter__()
-        warnings.simplefilter("ignore", RuntimeWarning)
-
-    def __exit__(self, *exc: Any) -> None:
-        self._w.__exit__(*exc)
 
 
 # --- the checked front doors ---------------------------------------------------------------------
@@ -525,8 +516,8 @@ def prepare(m: Mechanism, tolerances: Sequence[Tolerance], values: Sequence[floa
             distribution: str = "normal", label: str = OPTION) -> tuple[Plan, ScanJob]:
     """Everything checked before anything is solved: the plan and the scan job its designs
     run as (``text``: the file's text for workers; empty: the mechanism travels pickled)."""
-    from ..scan import MAX_SCAN_POSITIONS, default_branch
-    from .sweep import check_driver_values
+    from ..kinematics.sweep import check_driver_values
+    from .request import default_branch
 
     if distribution not in DISTRIBUTIONS:
         raise InputError(f"--distribution must be {' or '.join(DISTRIBUTIONS)}, got {distribution!r}")
@@ -562,7 +553,6 @@ def tolerance(mechanism: Mechanism | str, tolerances: Mapping[str, float],
     See docs/tolerance.md."""
     from ..arguments import check_reals, check_scan_options, check_text, check_whole, describe
     from ..problems.loops import mechanism_of
-    from ..scan import MAX_SCAN_POSITIONS
     from ..solve import check_criteria
 
     m = mechanism_of("mechanism", mechanism)
@@ -584,7 +574,7 @@ def tolerance(mechanism: Mechanism | str, tolerances: Mapping[str, float],
     check_criteria(tol, 0.0, None, 50)
     if values is None:
         from ..arguments import driver_span
-        from .sweep import driver_values
+        from ..kinematics.sweep import driver_values
 
         if m.driver.kind != "angle" and m.driver_range is None:
             raise InputError(f"values: {m.driver.name} is a length with no [driver] range in the file: "

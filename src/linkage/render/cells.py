@@ -1,0 +1,227 @@
+"""How a report's cells are written, whatever the format: numbers as the shortest text that
+reads back to the same double, CSV quoting, JSON values, a block of rows through pyarrow's
+CSV writer; and :class:`Sink`, what every format's writer is (:mod:`.formats`)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator, Sequence
+from typing import IO, Any
+
+from .data import Column, Report
+
+SLICE = 8192
+"""Rows formatted at a time."""
+FAST_CELLS = 200_000
+"""From this many cells in a table, CSV numbers are formatted by pyarrow when it is
+installed; the choice is made once per table, so a column's numbers read alike throughout."""
+
+
+def number_texts(values: Any, fast: bool = False) -> list[str]:
+    """Each number as the shortest text that reads back to the same double: Python's repr,
+    or with ``fast`` (a large table, pyarrow installed) pyarrow's shortest form (``100``
+    where repr says ``100.0``, ``0.000012345`` for ``1.2345e-05``); both read back bit for
+    bit. "" for NaN, infinities and None."""
+    if fast and is_array(values) and values.dtype.kind == "f" and has_pyarrow():
+        import numpy as np
+        import pyarrow as pa
+        import pyarrow.compute as pc
+
+        finite = np.isfinite(values)
+        arr = pa.array(values, mask=~finite)
+        return pc.fill_null(pc.cast(arr, pa.string()), "").to_pylist()  # type: ignore[no-any-return]
+    seq = plain_values(values)
+    return ["" if v is None or (isinstance(v, float) and not math.isfinite(v)) else
+            repr(v) if isinstance(v, float) else str(v) for v in seq]
+
+
+def is_array(values: Any) -> bool:
+    return hasattr(values, "dtype") and hasattr(values, "tolist")
+
+
+def plain_values(values: Any) -> list[Any]:
+    """The values as Python objects: an array's ``tolist``; in a list, numpy scalars (a
+    median, a ratio) as Python numbers (numpy 2's repr of one is ``np.float64(0.1)``, and
+    json cannot encode ``np.int64``)."""
+    if is_array(values):
+        return values.tolist()  # type: ignore[no-any-return]
+    return [v.item() if is_array(v) else v for v in values]
+
+
+HAS_PYARROW: list[bool] = []
+
+
+def has_pyarrow() -> bool:
+    if not HAS_PYARROW:
+        try:
+            import pyarrow.csv  # noqa: F401  (the block path; pyarrow.compute, 30 ms more, only where used)
+            HAS_PYARROW.append(True)
+        except ImportError:
+            HAS_PYARROW.append(False)
+    return HAS_PYARROW[0]
+
+
+def quote_csv(text: str) -> str:
+    if any(c in text for c in ',"\n\r'):
+        return '"' + text.replace('"', '""') + '"'
+    return text
+
+
+def cell_texts(col: Column, values: Any, fast: bool = False) -> list[str]:
+    """One column's cells as CSV text."""
+    if col.kind == "number":
+        return number_texts(values, fast)
+    seq = plain_values(values)
+    if col.kind == "bool":
+        return ["" if v is None else "true" if v else "false" for v in seq]
+    if col.kind == "int":
+        return ["" if v is None else str(int(v)) for v in seq]
+    return ["" if v is None else quote_csv(str(v)) for v in seq]
+
+
+def json_values(col: Column, values: Any) -> list[Any]:
+    seq = plain_values(values)
+    if col.kind == "number":
+        return [v if v is None or isinstance(v, int) or math.isfinite(v) else None for v in seq]
+    if col.kind == "bool":
+        return [None if v is None else bool(v) for v in seq]
+    return seq
+
+
+
+CSV_WINDOW = 4 * SLICE
+"""Rows formatted before they are written, over every core: their text (about 7 MB for a
+sweep's 18 columns) is all a CSV holds at once."""
+MAX_CSV_THREADS = 8
+"""Threads formatting a CSV's slices side by side: one per core, at most this many."""
+
+
+def csv_slices(table: Any) -> Iterator[tuple[int, Any]]:
+    """``table``'s rows as CSV (:func:`csv_bytes`), in order: (first row, its text, None where
+    refused) for each slice of CSV_WINDOW / cores rows. Each slice is one task, formatted in
+    one pass by pyarrow (which releases the GIL) on a thread per core, a window of slices
+    ahead of the one written: a task per core per window, no per-column or per-block round
+    trip, and the slices' text the only copy."""
+    import os
+
+    workers = max(1, min(os.cpu_count() or 1, MAX_CSV_THREADS))
+    step = max(1, -(-CSV_WINDOW // workers))
+    starts = range(0, table.num_rows, step)
+    if workers == 1 or len(starts) == 1:
+        for a in starts:
+            yield a, csv_bytes(table.slice(a, step))
+        return
+    from collections import deque
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(workers) as pool:
+        ahead: deque[tuple[int, Any]] = deque()
+        for a in starts:
+            ahead.append((a, pool.submit(csv_bytes, table.slice(a, step))))
+            if len(ahead) > 2 * workers:
+                first, done = ahead.popleft()
+                yield first, done.result()
+        while ahead:
+            first, done = ahead.popleft()
+            yield first, done.result()
+
+
+def csv_bytes(table: Any) -> Any:
+    """A table's rows as CSV (no header, nothing quoted) in a pyarrow buffer; None where a
+    text cell needs quoting (pyarrow refuses it: the caller goes cell by cell)."""
+    import pyarrow as pa
+    import pyarrow.csv as pcsv
+
+    out = pa.BufferOutputStream()
+    try:
+        pcsv.write_csv(table, out, pcsv.WriteOptions(include_header=False, quoting_style="none",
+                                                     batch_size=ARROW_BATCH))
+    except pa.ArrowInvalid:
+        return None
+    return out.getvalue()
+
+
+ARROW_BATCH = 4 * SLICE
+"""Rows pyarrow's CSV writer formats at a time (its write to the file between batches)."""
+
+
+def arrow_table(columns: Sequence[Column], values: Sequence[Any]) -> Any:
+    """A block of rows as a pyarrow table whose CSV text (``quoting_style="none"``) is the
+    cells :func:`cell_texts` makes with pyarrow's numbers (tests check it): numbers
+    NaN and infinities masked (no value), integers, booleans and text as they are; None
+    where a column is not a numpy array of its kind (the caller goes cell by cell). Text
+    that needs quoting is refused by the writer itself, before it writes a row."""
+    import numpy as np
+    import pyarrow as pa
+
+    arrays = []
+    for c, v in zip(columns, values):
+        kind = v.dtype.kind if is_array(v) else ""
+        if c.kind == "number" and kind == "f":
+            arrays.append(pa.array(v, mask=~np.isfinite(v)))
+        elif (c.kind == "int" and kind in "iu" and kind) or (c.kind == "bool" and kind == "b"):
+            arrays.append(pa.array(v))
+        elif c.kind == "text" and kind in ("O", "U", ""):
+            try:
+                arrays.append(pa.array(v, type=pa.string()))
+            except (pa.ArrowException, TypeError):  # not text throughout
+                return None
+        else:
+            return None
+    return pa.Table.from_arrays(arrays, names=[str(j) for j in range(len(arrays))])
+
+
+UNSAFE = frozenset('[]:*?/\\\0')
+"""Characters an xlsx sheet name or a file name cannot hold."""
+
+
+def safe_name(table: str) -> str:
+    """A table's name as a sheet and a sidecar file name: ``_`` for each unsafe character."""
+    return "".join("_" if c in UNSAFE else c for c in table)
+
+
+
+class Sink:
+    """Writes tables to one output: ``begin(name, columns)``, ``rows(values)`` (one
+    sequence per column, any number of times), ``end()``; ``close()`` finishes the output.
+    ``out`` is the text output (a text format's) or None, ``path`` the file (a binary
+    format writes it itself); ``side(name)`` gives a one-table format's next table's output
+    (an open text file, or a binary format's path), set by writers.open_sink."""
+
+    def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
+        self.out, self.path, self.meta = out, path, meta or {}
+        self.side: Callable[[str], Any] | None = None
+        self.count = 0  # rows written in the current table
+        self.tables = 0
+        self.columns: tuple[Column, ...] = ()
+
+    def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
+        """A new table; ``rows``, when known, its number of rows."""
+        self.name, self.columns, self.count = name, tuple(columns), 0
+        self.tables += 1
+
+    def rows(self, values: Sequence[Any]) -> None:
+        raise NotImplementedError
+
+    def end(self) -> None:
+        return None
+
+    def close(self) -> None:
+        return None
+
+    def abandon(self) -> None:
+        """Stop after a failure or an interrupt: release what is open, finish nothing (the
+        temporary file is removed)."""
+        return None
+
+    @classmethod
+    def modules(cls, rows: int | None) -> tuple[str, ...]:
+        """The modules this format imports to write a table of ``rows`` rows (None: not
+        known), for writers.prefetch."""
+        return ()
+
+    @classmethod
+    def meta_of(cls, report: Report, files: Sequence[str]) -> dict[str, Any]:
+        """What this format writes besides the tables, from ``report`` (``files``: the
+        names of the files its tables go to, for a one-table format written to a file)."""
+        return {}
