@@ -26,7 +26,7 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve, lu_two
+from ..linalg import SingularMatrix, det_from_lu, lu, lu_solve, lu_two
 from ..methods.newton_system import max_abs, newton_system_lean
 from ..problems.derive import parse_signs, read_branch
 from ..problems.loops import ANGLE_UNITS, Mechanism
@@ -137,7 +137,7 @@ class Solver:
         return {n: (math.degrees(v) if k == "angle" else v) for n, v, k in zip(self.names, q, self.kinds)}
 
     def det(self, p: Any, q: Sequence[float]) -> float:
-        from ..methods._linalg import SingularMatrix, det_from_lu, lu
+        from ..linalg import SingularMatrix, det_from_lu, lu
 
         try:
             return det_from_lu(lu(p.J(list(q))))

@@ -14,7 +14,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve
+from ..linalg import SingularMatrix, det_from_lu, lu, lu_solve
 from ..methods.newton_system import max_abs
 from ..problems.derive import sign_text
 from ..problems.derive_limits import (
@@ -256,7 +256,7 @@ ordinary mechanism's smallest transmission angle is far above, and costs nothing
 def _touch_det(solver: Solver, a: Position, b: Position, c: Position) -> float | None:
     """The driver value in [a, c] where the branch's J is nearest singular (golden-section
     search on hadamard_ratio, to LOCATE_TOL), if J is singular there; else None."""
-    from ..methods._linalg import hadamard_ratio
+    from ..linalg import hadamard_ratio
 
     q_b = solver_q(solver, b)
     if not hadamard_ratio(solver.problem(b.input).J(list(q_b))) <= TOUCH_CANDIDATE:

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 from operator import mul
 from typing import TYPE_CHECKING, Any, NamedTuple
 
-from ..methods._linalg import SingularMatrix, lu, lu_solve
+from ..linalg import SingularMatrix, lu, lu_solve
 from ..methods.newton_system import max_abs, newton_direction
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel
 from .labels import rate_label

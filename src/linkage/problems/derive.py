@@ -658,16 +658,16 @@ def _side(case: str, first: Any, second: Any, k: Any, a: float, b: float) -> flo
     if case == TWO_ANGLES:
         return dyads.two_angles_side(first, k, a)
     if case == ITS_LENGTH:
-        return dyads.line_side(dyads._cdiv(first, second), b)
-    return dyads.line_side(dyads._cdiv(k, second), b)
+        return dyads.line_side(dyads.cdiv(first, second), b)
+    return dyads.line_side(dyads.cdiv(k, second), b)
 
 
 def _side_np(case: str, first: Any, second: Any, k: Any, a: Any, b: Any) -> Any:
     if case == TWO_ANGLES:
         return dyads.two_angles_side_np(first, k, a)
     if case == ITS_LENGTH:
-        return dyads.line_side_np(dyads._cdiv(first, second), b)
-    return dyads.line_side_np(dyads._cdiv(k, second), b)
+        return dyads.line_side_np(dyads.cdiv(first, second), b)
+    return dyads.line_side_np(dyads.cdiv(k, second), b)
 
 
 def _margin(case: str, first: Any, second: Any, k: Any) -> float:
@@ -675,9 +675,9 @@ def _margin(case: str, first: Any, second: Any, k: Any) -> float:
         return dyads.two_angles_margin(first, second, k)
     try:
         if case == ITS_LENGTH:
-            return dyads.line_circle_margin(dyads._cdiv(first, second),
+            return dyads.line_circle_margin(dyads.cdiv(first, second),
                                             dyads.norm(*k) / dyads.norm(*second))
-        return dyads.line_circle_margin(dyads._cdiv(k, second), dyads.norm(*first) / dyads.norm(*second))
+        return dyads.line_circle_margin(dyads.cdiv(k, second), dyads.norm(*first) / dyads.norm(*second))
     except ZeroDivisionError:
         return math.nan
 
@@ -687,9 +687,9 @@ def _margin_np(case: str, first: Any, second: Any, k: Any) -> Any:
         return dyads.two_angles_margin_np(first, second, k)
     norm = dyads.norm_np
     if case == ITS_LENGTH:
-        return dyads.line_circle_margin_np(dyads._cdiv(first, second),
+        return dyads.line_circle_margin_np(dyads.cdiv(first, second),
                                            norm(k[0], k[1]) / norm(second[0], second[1]))
-    return dyads.line_circle_margin_np(dyads._cdiv(k, second),
+    return dyads.line_circle_margin_np(dyads.cdiv(k, second),
                                        norm(first[0], first[1]) / norm(second[0], second[1]))
 
 

@@ -362,7 +362,7 @@ def _at_driver_value(m: Mechanism, doc: Mapping[str, Any], source: str) -> Mecha
 def _on_drawn_branch(m: Mechanism, q0: list[float], start: float, to: float) -> list[float] | None:
     """The configuration at driver ``to`` on the branch of ``q0`` (the drawn pose, exact
     at ``start``), internal units; None where that branch has no assembly there."""
-    from ..methods._linalg import SingularMatrix, det_from_lu, lu
+    from ..linalg import SingularMatrix, det_from_lu, lu
     from ..solve import solve_system
 
     d = m.derivation
