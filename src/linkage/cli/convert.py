@@ -51,7 +51,7 @@ def convert(
     if wanted == "loops":
         text = loops_text(doc, str(file), mechanism)
     else:
-        from ..problems.to_joints import joints_text
+        from ..kinematics.to_joints import joints_text
 
         text = joints_text(mechanism, str(file))
     if target is None:

@@ -22,7 +22,7 @@ and j moves relative to the other body as omega_ij x r (:func:`velocity_residual
 ``CHECK_RTOL`` of the mechanism's fastest motion.
 
 A loops-form mechanism has no bodies of its own: it is drawn as joints and links at the
-pose first, as ``linkage convert --form joints`` draws it (:mod:`..problems.to_joints`),
+pose first, as ``linkage convert --form joints`` draws it (:mod:`.to_joints`),
 and its bodies are named as that command names them.
 """
 
@@ -491,7 +491,7 @@ def joints_form(m: Any) -> tuple[Any, bool]:
     if m.extra.get("drawing") is not None:
         return m, False
     from ..problems.loops import parse_mechanism
-    from ..problems.to_joints import joints_doc
+    from .to_joints import joints_doc
 
     return parse_mechanism(joints_doc(m), m.source), True
 
