@@ -13,10 +13,10 @@ import tomllib
 
 from linkage import solve_system
 from linkage.errors import InputError
+from linkage.kinematics.loading import from_text, load
 from linkage.kinematics.rates import rates_at
 from linkage.kinematics.to_joints import joints_doc
 from linkage.problems.joints import loops_text
-from linkage.problems.loops import from_text, load
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 DRAWINGS = sorted(SAMPLES.glob("*_joints.toml"))

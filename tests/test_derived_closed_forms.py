@@ -21,8 +21,8 @@ import pytest
 from mpmath import mpf
 
 import derived_reference as ref
+from linkage.kinematics.loading import load
 from linkage.problems import derive, dyads
-from linkage.problems.loops import load
 from ulps import assert_ulps
 
 SAMPLES = Path(__file__).resolve().parent.parent / "sample_inputs"

@@ -8,8 +8,8 @@ import math
 
 import pytest
 
+from linkage.kinematics.loading import from_text
 from linkage.kinematics.sweep import driver_values
-from linkage.problems.loops import from_text
 from report_reading import csv_rows
 
 R2, R3, E = 40.0, 120.0, 10.0

@@ -14,8 +14,8 @@ import pytest
 
 from linkage import solve_system
 from linkage.files import parse_toml
+from linkage.kinematics.loading import from_text
 from linkage.kinematics.rates import rates_at
-from linkage.problems.loops import from_text
 from linkage.problems.start import start_on_branch
 
 # lengths for which both branches assemble over a whole crank turn (the Stephenson sample's

@@ -229,7 +229,7 @@ def test_the_lean_continuation_step_changes_no_position(name, monkeypatch):
 
     from linkage.kinematics import continuation
     from linkage.kinematics import sweep as sweep_module
-    from linkage.problems.loops import load
+    from linkage.kinematics.loading import load
 
     m = load(SAMPLES / name)
     designs = [m]

@@ -341,7 +341,7 @@ class ScanJob:
 
 @functools.lru_cache(maxsize=8)
 def job_mechanism(text: str, source: str, overrides: tuple[tuple[str, float], ...]) -> Mechanism:
-    from .problems.loops import from_text
+    from .kinematics.loading import from_text
 
     return from_text(text, source).with_values(dict(overrides), {})
 
@@ -844,7 +844,7 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
         check_text,
         check_vary,
     )
-    from .problems.loops import mechanism_of
+    from .kinematics.loading import mechanism_of
     from .solve import check_criteria
 
     m = mechanism_of("mechanism", mechanism)

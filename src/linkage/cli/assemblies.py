@@ -42,7 +42,7 @@ def assemblies(
     Example: linkage assemblies sample_inputs/stephenson_sixbar.toml --set theta2=200
     """
     from ..kinematics.assemblies import every_assembly
-    from ..problems.loops import load
+    from ..kinematics.loading import load
     from ..render.assemblies import assemblies_report
     from .options import choose_format, emit_report, note_closed_form, parse_assignments
 

@@ -35,8 +35,8 @@ def convert(
     import sys
 
     from ..files import parse_toml, read_input
+    from ..kinematics.loading import parse_mechanism
     from ..problems.joints import is_joints_doc, loops_text
-    from ..problems.loops import parse_mechanism
 
     if form is not None and form.lower() not in ("joints", "loops"):
         raise InputError(f"--form {form!r}: write joints or loops")

@@ -99,8 +99,8 @@ def scan(
     """
     from ..arguments import check_scan_options, driver_span
     from ..files import parse_toml, read_input
+    from ..kinematics.loading import from_text
     from ..kinematics.sweep import driver_values
-    from ..problems.loops import from_text
     from ..render import writers
     from ..render.scan import RecordSink, pick_spec, scan_meta, scan_report, scan_summary
     from ..scan import MAX_DESIGNS, Keeper, ScanJob, check_held, feed, parse_vary, pick_chunk, prepare

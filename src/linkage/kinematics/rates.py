@@ -705,7 +705,7 @@ def rates_at(mechanism: Any, q: Any, *, speed: float | None = None, accel: float
     is the command line's); every argument is checked first, and a misuse raises
     :class:`~linkage.errors.InputError` naming it."""
     from ..arguments import check_motion, check_number, check_reals
-    from ..problems.loops import mechanism_of
+    from .loading import mechanism_of
 
     mechanism = mechanism_of("mechanism", mechanism)
     names = [u.name for u in mechanism.unknowns]

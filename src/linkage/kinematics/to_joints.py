@@ -37,8 +37,8 @@ def _check(doc: dict[str, Any], coords: dict[str, tuple[float, float]], m: Any) 
     """The drawing's own loops, solved at the drawn value from the drawing, give back the
     placed joints: otherwise the reading of the loops was wrong and nothing is printed."""
     from ..errors import ParseError
-    from ..problems.loops import parse_mechanism
     from ..solve import solve_system
+    from .loading import parse_mechanism
     from .rates import rates_at
 
     try:

@@ -561,9 +561,9 @@ def tolerance(mechanism: Mechanism | str, tolerances: Mapping[str, float],
     ``workers``). Every argument is checked first: a misuse raises InputError naming it.
     See docs/tolerance.md."""
     from ..arguments import check_reals, check_scan_options, check_text, check_whole, describe
-    from ..problems.loops import mechanism_of
     from ..scan import MAX_SCAN_POSITIONS
     from ..solve import check_criteria
+    from .loading import mechanism_of
 
     m = mechanism_of("mechanism", mechanism)
     if not isinstance(tolerances, Mapping) or not tolerances:

@@ -1,7 +1,7 @@
 """A mechanism from its drawing: joints with coordinates, links as lists of joints,
 sliders, a driver. Derives what the loops form states by hand: each link's lengths and the
 fixed angles inside it, the mobility (Gruebler-Kutzbach) and the independent loops (a
-cycle basis of the joint-link graph), and hands :func:`~.loops.parse_mechanism` the
+cycle basis of the joint-link graph), and hands :func:`~linkage.kinematics.loading.parse_mechanism` the
 equivalent loops-form document, so everything downstream works unchanged;
 :func:`loops_text` is ``linkage convert``. The shape of the file::
 
@@ -29,7 +29,7 @@ with the body its line is on; its travel is measured along the line from the foo
 perpendicular from that body's first joint. The drawing gives the lengths and the
 assembly; [driver] value says where to solve (left out, the drawn angle or travel). A
 value other than the drawn one (beyond the drawing's rounding, :data:`DRIVER_TOLERANCE_DEG`)
-is solved on the drawing's branch (:func:`~.loops.parse_mechanism`), and a command says
+is solved on the drawing's branch (:func:`~linkage.kinematics.loading.parse_mechanism`), and a command says
 where the crank was drawn in a note.
 Derived names (stable: scans and scripts use them): unknowns ``theta_<link>`` and
 ``s_<slider>``; lengths ``<link>`` (first to second joint), ``<link>_<P>_<Q>``, ``ground``
@@ -543,7 +543,7 @@ def toml_key(k: str) -> str:
 def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>", mechanism: Any = None) -> str:
     """The derived loops-form file of a drawing, as TOML text: each loop under a comment
     naming its joints, so the loop-closure equations the drawing implies can be read.
-    ``mechanism``: the drawing as read (problems.loops.parse_mechanism); when its [driver]
+    ``mechanism``: the drawing as read (kinematics.loading.parse_mechanism); when its [driver]
     value is off the drawing, its guesses (the drawing's branch there) are written."""
     d = loops_doc(doc, source)
     out = [f"# the vector loops of {source}, derived from its joints and links (linkage convert)",

@@ -34,8 +34,6 @@ import math
 import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from os import PathLike
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from ..errors import InputError, ParseError
@@ -278,34 +276,6 @@ def _requantify(q: Quantity, value: float) -> Quantity:
 
 # --- loading ------------------------------------------------------------------------------
 
-def load(path: str | Path) -> Mechanism:
-    """Read and validate a mechanism file; every error names the file and the key."""
-    from ..arguments import check_path  # (arguments imports nothing of ours: no cycle)
-    from ..files import read_input
-
-    p = Path(check_path("path", path))
-    return from_text(read_input(p), str(p))
-
-
-def mechanism_of(name: str, value: Any) -> Mechanism:
-    """A Mechanism, or a path (str or os.PathLike) to a mechanism file, loaded: the API's
-    front doors take either (:mod:`linkage.arguments` checks everything else)."""
-    from ..arguments import describe
-
-    if isinstance(value, Mechanism):
-        return value
-    if isinstance(value, (str, PathLike)):
-        return load(value)
-    raise InputError(f"{name} must be a Mechanism or a path to a mechanism file, got {describe(value)}")
-
-
-def from_text(text: str, source: str) -> Mechanism:
-    """A mechanism from the text of a file (read once: ``-`` cannot be read twice)."""
-    from ..files import parse_toml
-
-    return parse_mechanism(parse_toml(text, source), source)
-
-
 def _keep_drawing(mechanism: Mechanism, doc: Mapping[str, Any], source: str) -> None:
     """A drawing's bodies, driver and loads kept with its mechanism (kinematics.forces)."""
     from ..errors import InputError
@@ -325,67 +295,11 @@ def _keep_drawing(mechanism: Mechanism, doc: Mapping[str, Any], source: str) -> 
         raise ParseError(str(exc)) from None
 
 
-def _at_driver_value(m: Mechanism, doc: Mapping[str, Any], source: str) -> Mechanism:
-    """A drawing whose [driver] value is not where it is drawn (problems.joints.off_drawing):
-    its guesses moved to that value on the drawing's branch - the drawn pose's signs, the
-    branch a sweep follows unless told (kinematics.pose.file_branch), solved there by the
-    derived closed form (:meth:`~.derive.Derivation.solve`) - so that solve, sweep and scan
-    take the drawing's assembly there; the note :attr:`Mechanism.drawing_note` says where
-    it was drawn. Loops without a closed form are solved there from the drawn pose and
-    must keep its sign of det J. A value the drawing's branch does not reach is refused."""
-    from .closed_form import wrap_degrees
-    from .joints import off_drawing
-
-    driver = doc["driver"]
-    value = _display(m.driver)
-    drawn = off_drawing(m.extra["drawing"], driver, value)
-    if drawn is None:
-        return m
-    angle = m.driver.kind == "angle"
-    scale = ANGLE_UNITS[m.driver.unit] if angle else 1.0
-    what = f"{driver['link']} is drawn at {drawn:.9g} deg" if angle else \
-        f"{driver['slider']} is drawn at travel {drawn:.9g} {m.length_unit}"
-    unit = " deg" if angle else f" {m.length_unit}"
-    to = (drawn + wrap_degrees(value - drawn) if angle else value) * scale  # an angle: the same turn
-    q = _on_drawn_branch(m, [u.value for u in m.unknowns], drawn * scale, to)
-    if q is None:
-        raise ParseError(f"{source}: driver.value: {value:g}{unit} is not reached from the drawing ({what}) "
-                         "on its branch: the linkage does not assemble there that way; leave value out to "
-                         "solve where it is drawn")
-    moved = m.with_values({}, {u.name: math.degrees(v) if u.kind == "angle" else v
-                               for u, v in zip(m.unknowns, q)})
-    moved.extra["drawing_note"] = (f"{source}: {what}; solved at [driver] value = {value:g}{unit}, on the "
-                                   "drawing's branch")
-    return moved
-
-
-def _on_drawn_branch(m: Mechanism, q0: list[float], start: float, to: float) -> list[float] | None:
-    """The configuration at driver ``to`` on the branch of ``q0`` (the drawn pose, exact
-    at ``start``), internal units; None where that branch has no assembly there."""
-    from ..linalg import SingularMatrix, det_from_lu, lu
-    from ..solve import solve_system
-
-    d = m.derivation
-    if d.complete:
-        from .derive import Indeterminate
-
-        signs = d.signs_of(q0, start)
-        try:
-            return d.solve(to, signs) if all(signs) or not d.two_way else None
-        except Indeterminate:
-            return None
-    r = solve_system(m.model.problem_at(to, tuple(q0)), tol=1e-12)
-
-    def det_sign(driver: float, q: Any) -> float:
-        try:
-            return math.copysign(1.0, det_from_lu(lu(m.model.problem_at(driver).J(list(q)))))
-        except SingularMatrix:
-            return 0.0
-
-    return list(r.x) if r.converged and det_sign(to, r.x) == det_sign(start, q0) != 0.0 else None
-
-
-def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:
+def read_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:
+    """The mechanism a parsed file describes, every error naming the file and the key. A
+    drawing (the joints form) is read as drawn: its guesses are the drawn pose even where
+    its [driver] value is elsewhere; :func:`linkage.kinematics.loading.parse_mechanism`,
+    which every loader calls, solves them there (a solve is a layer above this one)."""
     def fail(key: str, msg: str) -> ParseError:
         return ParseError(f"{source}: {key}: {msg}")
 
@@ -557,7 +471,6 @@ def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mech
         raise fail(*clash)
     if drawn is not None:
         _keep_drawing(mechanism, drawn, source)
-        mechanism = _at_driver_value(mechanism, drawn, source)
     if closed_form is not None:
         from .closed_form import verify
 
@@ -941,5 +854,6 @@ def build_problem(m: Mechanism) -> SystemProblem:
     return m.model.problem_at(m.driver.value)
 
 
-def _display(q: Quantity) -> float:
+def shown_value(q: Quantity) -> float:
+    """A quantity in the unit its file gave it (degrees for an angle in deg)."""
     return q.value / ANGLE_UNITS[q.unit] if q.kind == "angle" else q.value
