@@ -1,4 +1,4 @@
-"""Mechanism files loaded: read (:func:`linkage.problems.loops.read_mechanism`) and, for a
+"""Mechanism files loaded: read (:func:`linkage.problems.read_loops.read_mechanism`) and, for a
 drawing whose [driver] value is not where it is drawn, posed there on the drawing's branch.
 Posing may take a Newton solve, so it lives here, above :mod:`linkage.solve`, and every
 front door (the API's and the commands') loads through this module."""
@@ -13,7 +13,8 @@ from typing import Any
 
 from ..errors import InputError, ParseError
 from ..problems.joints import is_joints_doc, off_drawing
-from ..problems.loops import ANGLE_UNITS, Mechanism, read_mechanism, shown_value
+from ..problems.loops import ANGLE_UNITS, Mechanism, shown_value
+from ..problems.read_loops import read_mechanism
 from ..units import degrees
 
 
@@ -46,7 +47,7 @@ def from_text(text: str, source: str) -> Mechanism:
 
 
 def parse_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:
-    """The mechanism a parsed file describes (:func:`~linkage.problems.loops.read_mechanism`),
+    """The mechanism a parsed file describes (:func:`~linkage.problems.read_loops.read_mechanism`),
     a drawing posed at its [driver] value (:func:`at_driver_value`)."""
     m = read_mechanism(doc, source)
     if is_joints_doc(doc):
