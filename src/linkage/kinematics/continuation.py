@@ -83,7 +83,7 @@ class Solver:
 
     def transmission(self, q: Sequence[float], value: float) -> float | None:
         """The transmission angle (deg, folded into [0, 90]) of a mechanism whose loops include
-        four-bars (:func:`~linkage.problems.derive.fourbar_transmission`: the coupler as
+        four-bars (:func:`~linkage.problems.steps.fourbar_transmission`: the coupler as
         traversed against the output link from its pivot), at unknowns ``q`` (internal
         units) and the driver's ``value`` (display units). With several four-bar loops, the
         one farthest from 90 deg: the loop that transmits worst."""

@@ -126,14 +126,14 @@ def wrap_degrees(a: float) -> float:
 
 TRANSMISSION = "transmission angle 0..90"
 """The transmission angle's name in every table (its unit deg beside it): folded, see
-:func:`~.derive.folded_transmission`."""
+:func:`~.steps.folded_transmission`."""
 
 
 def transmission(t3_deg: float, t4_deg: float) -> float:
     """The transmission angle between coupler and output link (deg, in [0, 90]):
-    |theta4 - theta3| wrapped, then folded (:func:`~.derive.folded_transmission`); NaN for
+    |theta4 - theta3| wrapped, then folded (:func:`~.steps.folded_transmission`); NaN for
     a non-finite angle."""
-    from .derive import folded_transmission
+    from .steps import folded_transmission
 
     return folded_transmission(abs(wrap_degrees(t4_deg - t3_deg)))
 
@@ -143,7 +143,7 @@ def transmission_np(t3_deg: Any, t4_deg: Any) -> Any:
     import numpy as np
 
     w = np.fmod(np.asarray(t4_deg, float) - t3_deg, 360.0)
-    from .derive import folded_transmission_np
+    from .steps import folded_transmission_np
 
     w = np.where(w <= -180.0, w + 360.0, np.where(w > 180.0, w - 360.0, w))
     return folded_transmission_np(np.abs(w))
@@ -281,8 +281,9 @@ def fourbar_facts(m: Any, q: Sequence[float] | None = None,
     lengths, its Grashof class (:func:`fourbar_class`, with the loop's ground, input,
     coupler and output read as written with the ground last) and, given a configuration
     ``q`` (internal units) at ``driver`` (default the file's), its transmission angle in
-    degrees (:func:`~.derive.fourbar_transmission`, folded into [0, 90])."""
-    from .derive import fourbar_transmission, loop_terms
+    degrees (:func:`~.steps.fourbar_transmission`, folded into [0, 90])."""
+    from .find_steps import loop_terms
+    from .steps import fourbar_transmission
 
     derivation = m.derivation
     if not derivation.fourbars:

@@ -210,7 +210,7 @@ class Mechanism:
     def derivation(self) -> Derivation:
         """The stepwise closed form derived from the loops (:mod:`.derive`), or why there
         is none (``.complete`` is False)."""
-        from .derive import derive
+        from .find_steps import derive
 
         return derive(self)
 
