@@ -16,7 +16,7 @@ from linkage.errors import InputError
 from linkage.kinematics.loading import from_text, load
 from linkage.kinematics.rates import rates_at
 from linkage.kinematics.to_joints import joints_doc
-from linkage.problems.joints import loops_text
+from linkage.problems.toml_text import loops_text
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 DRAWINGS = sorted(SAMPLES.glob("*_joints.toml"))

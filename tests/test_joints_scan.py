@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from linkage.kinematics.loading import from_text
-from linkage.problems.joints import loops_text
+from linkage.problems.toml_text import loops_text
 from linkage.scan import scan
 from test_joints_errors import SLIDER_CRANK
 

@@ -36,7 +36,8 @@ def convert(
 
     from ..files import parse_toml, read_input
     from ..kinematics.loading import parse_mechanism
-    from ..problems.joints import is_joints_doc, loops_text
+    from ..problems.joints import is_joints_doc
+    from ..problems.toml_text import loops_text
 
     if form is not None and form.lower() not in ("joints", "loops"):
         raise InputError(f"--form {form!r}: write joints or loops")

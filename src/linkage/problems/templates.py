@@ -13,7 +13,7 @@ points the way the slide grows; the inverted slider-crank's ``open`` has the roc
 pointing from its pivot towards the block (a positive travel).
 
 :func:`template` gives the joints document, :func:`joints_text` the commented file and
-:func:`text` either form (the loops form through :func:`.joints.loops_text`, so there is
+:func:`text` either form (the loops form through :func:`.toml_text.loops_text`, so there is
 one derivation)."""
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from typing import Any
 
 from ..errors import InputError
 from . import dyads
-from .joints import toml_value
+from .toml_text import toml_value
 
 Point = tuple[float, float]
 BRANCHES = ("open", "crossed")
@@ -377,13 +377,13 @@ def joints_text(doc: Mapping[str, Any], kind: str, made_by: str) -> str:
 def text(kind: str, links: Sequence[float] | None = None, angle_deg: float | None = None,
          branch: str = "open", unit: str = "mm", name: str | None = None, form: str = "joints") -> str:
     """The file ``linkage new`` writes: the joints form (commented), or with ``form`` =
-    "loops" the loops form the joints imply (:func:`.joints.loops_text`)."""
+    "loops" the loops form the joints imply (:func:`.toml_text.loops_text`)."""
     if form not in ("joints", "loops"):
         raise InputError(f"form: {form!r}: give joints or loops")
     doc = template(kind, links, angle_deg, branch, unit, name)
     made_by = command(kind, links, angle_deg, branch, unit, name, form)
     if form == "loops":
-        from .joints import loops_text
+        from .toml_text import loops_text
 
         return f"# drawn by: {made_by}\n" + loops_text(doc, f"this {kind}")
     return joints_text(doc, kind, made_by)

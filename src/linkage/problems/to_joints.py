@@ -1,5 +1,5 @@
 """A loops-form mechanism as it is drawn: ``linkage convert --form joints``, the way back
-from :func:`.joints.loops_text`. Given the loops solved at the file's driver value and
+from :func:`.toml_text.loops_text`. Given the loops solved at the file's driver value and
 their named points placed (:mod:`linkage.kinematics.to_joints` solves and places them: a
 solve is a layer above the problems), each vector tells the body it lies on:
 
@@ -27,7 +27,8 @@ from typing import Any, NamedTuple
 
 from ..errors import InputError
 from ..units import degrees
-from .joints import GROUND, toml_key, toml_value
+from .joints import GROUND
+from .toml_text import toml_key, toml_value
 
 Point = tuple[float, float]
 
