@@ -65,6 +65,9 @@ class Kind:
     """Two-way steps: one --branch word each."""
     fixed: str = ""
     """Fixed angles of the drawing (the six-bars keep their sample's), for the comments."""
+    open_brief: str = ""
+    """What ``--branch open`` draws, in a few words for ``linkage new --help`` (a six-bar's
+    dyads read as the four-bar's: none of its own)."""
 
     @property
     def signed(self) -> frozenset[str]:
@@ -178,7 +181,8 @@ KINDS: dict[str, Kind] = {
         ("O2A", "AB", "O4B", "O2O4"), (40.0, 120.0, 80.0, 100.0), 30.0,
         "the rocker turns anticlockwise from the coupler (B on the left of A -> O4)",
         ("O2", "O4"), {"crank": ["O2", "A"], "coupler": ["A", "B"], "rocker": ["O4", "B"]}, {},
-        FOURBAR_NOTES, {"crank": "the driver", "coupler": "", "rocker": ""}, _fourbar),
+        FOURBAR_NOTES, {"crank": "the driver", "coupler": "", "rocker": ""}, _fourbar,
+        open_brief="a four-bar's rocker turns anticlockwise from its coupler"),
     "slider-crank": Kind(
         "Slider-crank", "slider_crank.toml", ("crank", "coupler", "offset"),
         ("O2A", "AB", "the slider's line y = offset: any sign, 0 in line with O2"),
@@ -186,7 +190,8 @@ KINDS: dict[str, Kind] = {
         ("O2",), {"crank": ["O2", "A"], "coupler": ["A", "B"], "block": ["B"]},
         {"block": {"on": "ground", "angle": 0.0}},
         {"O2": "the crank's ground pivot", "A": "the crank pin", "B": "the block's pin, on its line"},
-        {"crank": "the driver", "coupler": "", "block": "a slider block carrying B"}, _slider_crank),
+        {"crank": "the driver", "coupler": "", "block": "a slider block carrying B"}, _slider_crank,
+        open_brief="a slider-crank's coupler points the way the slide grows"),
     "inverted-slider": Kind(
         "Inverted slider-crank", "inverted_slider_crank.toml", ("crank", "ground", "offset"),
         ("O2A", "O2O4", "the block's line from O4, across the rocker: any sign, 0 through O4"),
@@ -196,7 +201,7 @@ KINDS: dict[str, Kind] = {
         {"O2": "the crank's ground pivot", "A": "the crank pin, the block on it", "O4": "the rocker's pivot",
          "C": "a point on the rocker (crank + ground from O4): its line's direction"},
         {"crank": "the driver", "rocker": "the block slides along it", "block": "a slider block carrying A"},
-        _inverted),
+        _inverted, open_brief="an inverted slider's rocker points towards the block"),
     "watt": Kind(
         "Watt six-bar", "watt_sixbar.toml",
         ("crank", "coupler", "rocker", "ground", "O4C", "CD", "O6D", "O4O6"),
@@ -221,8 +226,30 @@ KINDS: dict[str, Kind] = {
         _stephenson, 2,
         f"C {STEPHENSON_C_DEG:g} deg ahead of AB on the coupler, O6 at {STEPHENSON_O6_DEG:g} deg from O2"),
 }
-"""The kinds, in the order --help lists them. The six-bars' --links run as their samples'
-parameters do, the four-bar's first (crank, coupler, rocker, ground), then the second dyad's."""
+"""The kinds, in the order --help lists them: the one registry ``linkage new`` reads its
+choices, help and defaults from. A new kind is an entry here (with its ``draw``) and the
+sample file its defaults are. The six-bars' --links run as their samples' parameters do,
+the four-bar's first (crank, coupler, rocker, ground), then the second dyad's."""
+
+
+def kind_names() -> str:
+    """The kinds as --help lists them: ``fourbar, slider-crank, ... or stephenson``."""
+    names = list(KINDS)
+    return ", ".join(names[:-1]) + f" or {names[-1]}" if len(names) > 1 else names[0]
+
+
+def kind_titles() -> str:
+    """The kinds' titles: ``Four-bar, Slider-crank, ... or Stephenson III six-bar``."""
+    titles = [k.title for k in KINDS.values()]
+    return ", ".join(titles[:-1]) + f" or {titles[-1]}" if len(titles) > 1 else titles[0]
+
+
+def branch_help() -> str:
+    """What --branch means for every kind, for --help."""
+    briefs = [k.open_brief for k in KINDS.values() if k.open_brief]
+    several = [key for key, k in KINDS.items() if k.dyads > 1]
+    per_dyad = (f"; {' and '.join(several)} take one word per dyad, e.g. open/crossed" if several else "")
+    return f"The assembly drawn: open ({'; '.join(briefs)}) or crossed{per_dyad}."
 
 
 def links_order(kind: str | None = None) -> str:
