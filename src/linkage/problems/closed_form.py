@@ -31,6 +31,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
+from ..units import degrees
 from .assembly import (
     fourbar_by_crank,
     fourbar_by_rocker,
@@ -216,7 +217,7 @@ def verify(m: Any) -> str | None:
         gap = abs(got - sign * claim)
         if not gap <= worst:  # NaN included
             worst = gap
-            where = ", ".join(f"{k} = {math.degrees(point[k]) if k.startswith('theta') else point[k]:.6g}"
+            where = ", ".join(f"{k} = {degrees(point[k]) if k.startswith('theta') else point[k]:.6g}"
                               for k in (m.driver.name, *(u.name for u in m.unknowns)))
     if not worst <= 1e-9 * size:
         return (f"its loop differs from the file's by {worst:.3g} {m.length_unit} at scattered positions "
@@ -303,7 +304,7 @@ def fourbar_facts(m: Any, q: Sequence[float] | None = None,
                                           "output": output},
                                 **fourbar_class(ground, inp, coupler, output)}
         if q is not None:
-            fact["transmission_deg"] = math.degrees(fourbar_transmission(view, terms, params, d, q))
+            fact["transmission_deg"] = degrees(fourbar_transmission(view, terms, params, d, q))
         out.append(fact)
     return out
 
@@ -318,8 +319,8 @@ def cos_band_arcs(c_lo: float, c_hi: float, shift: float) -> list[Arc] | None:
         return []
     if c_lo <= -1.0 and c_hi >= 1.0:
         return None
-    a_hi = math.degrees(math.acos(min(c_hi, 1.0)))  # smallest |phi|
-    a_lo = math.degrees(math.acos(max(c_lo, -1.0)))  # largest |phi|
+    a_hi = degrees(math.acos(min(c_hi, 1.0)))  # smallest |phi|
+    a_lo = degrees(math.acos(max(c_lo, -1.0)))  # largest |phi|
     if c_hi >= 1.0:
         return [(shift - a_lo, shift + a_lo)]
     if c_lo <= -1.0:

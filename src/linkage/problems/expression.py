@@ -34,6 +34,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 from ..errors import ParseError
+from ..units import RAD_PER_DEG
 from .scalar import ScalarProblem
 
 MAX_LENGTH = 2000
@@ -42,7 +43,9 @@ MAX_OPERATIONS = 2000
 
 Fn = Callable[[float], float]
 
-DEG = math.pi / 180.0
+DEG = RAD_PER_DEG
+"""pi/180 (:data:`linkage.units.RAD_PER_DEG`): the degree functions' factor and their
+derivatives' chain-rule factor."""
 EPS = 2.0**-52
 
 
@@ -56,6 +59,7 @@ FUNCTIONS: dict[str, Fn] = {
     "sinh": math.sinh, "cosh": math.cosh, "tanh": math.tanh,
     "exp": math.exp, "log": math.log, "log10": math.log10, "sqrt": math.sqrt,
     "abs": abs,
+    # the degree functions hold linkage.units' constant (no call in an equation's hot loop)
     "sind": lambda v: math.sin(v * DEG), "cosd": lambda v: math.cos(v * DEG),
     "tand": lambda v: math.tan(v * DEG),
     "asind": lambda v: math.asin(v) / DEG, "acosd": lambda v: math.acos(v) / DEG,

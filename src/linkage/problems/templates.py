@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
+from ..units import radians
 from . import dyads
 from .toml_text import toml_value
 
@@ -122,8 +123,8 @@ def _watt(r: Sequence[float], t: float, sides: Sequence[float]) -> Joints:
     O4B), and a dyad C-D-O6 (r[5], r[6]) to a third pivot O6, r[7] from O4 at 60 deg."""
     xy = _fourbar(r, t, sides)
     o4 = xy["O4"]
-    c = _polar(o4, r[4], _angle(o4, xy["B"]) + math.radians(WATT_C_DEG))
-    o6 = _polar(o4, r[7], math.radians(WATT_O6_DEG))
+    c = _polar(o4, r[4], _angle(o4, xy["B"]) + radians(WATT_C_DEG))
+    o6 = _polar(o4, r[7], radians(WATT_O6_DEG))
     d = _dyad(c, r[5], o6, r[6], sides[1], ("C", "link7's pivot O6", "link6", "link7"))
     return {**xy, "C": c, "D": d, "O6": o6}
 
@@ -133,8 +134,8 @@ def _stephenson(r: Sequence[float], t: float, sides: Sequence[float]) -> Joints:
     AB), and a dyad C-D-O6 (r[5], r[6]) to a third pivot O6, r[7] from O2 at 110 deg."""
     xy = _fourbar(r, t, sides)
     a = xy["A"]
-    c = _polar(a, r[4], _angle(a, xy["B"]) + math.radians(STEPHENSON_C_DEG))
-    o6 = _polar(xy["O2"], r[7], math.radians(STEPHENSON_O6_DEG))
+    c = _polar(a, r[4], _angle(a, xy["B"]) + radians(STEPHENSON_C_DEG))
+    o6 = _polar(xy["O2"], r[7], radians(STEPHENSON_O6_DEG))
     d = _dyad(c, r[5], o6, r[6], sides[1], ("C", "link6's pivot O6", "link5", "link6"))
     return {**xy, "C": c, "D": d, "O6": o6}
 
@@ -327,7 +328,7 @@ def template(kind: str, links: Sequence[float] | None = None, angle_deg: float |
         raise InputError(f"unit: {unit!r} is not a length unit (units: {', '.join(LENGTH_UNITS)})")
     if name is not None and (not name.strip() or not name.isprintable()):
         raise InputError("name: must be one line of printable text")
-    t = math.radians(math.remainder(angle, 360.0))  # exact: the remainder of a double is one
+    t = radians(math.remainder(angle, 360.0))  # exact: the remainder of a double is one
     try:
         joints = k.draw(lengths, t, sides)
     except _Cannot as exc:
