@@ -33,6 +33,8 @@ from typing import Any
 
 from ..units import degrees
 from .assembly import (
+    MIRROR,
+    Indeterminate,
     fourbar_by_crank,
     fourbar_by_rocker,
     is_open,
@@ -47,16 +49,6 @@ REQUIRED_NAMES = {
 }
 
 Solutions = dict[str, dict[str, float]]
-
-MIRROR = " (mirror)"
-"""With theta4 driving, the two assemblies at one theta4 (mirror images of A across the
-line O2-B) can carry the same label; the second is then keyed with this suffix, so both
-stay in the dict (and reachable): e.g. "open" and "open (mirror)"."""
-
-
-class Indeterminate(ValueError):
-    """Coincident circles: every point of the circle is a solution (a change point)."""
-
 
 def circle_points(center: complex, radius: float, other: complex, distance: float) -> list[complex]:
     """Points X with |X - center| = radius and |X - other| = distance (0, 1 or 2 of them);

@@ -32,7 +32,7 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any, NamedTuple
 
-from .assembly import TANGENT_SLACK
+from .assembly import MIRROR, TANGENT_SLACK, Indeterminate
 from .steps import (
     FourbarLoop,
     Step,
@@ -48,11 +48,6 @@ from .steps import (
     step_side,
     step_side_np,
 )
-
-
-class Indeterminate(ValueError):
-    """A step whose known vectors leave every value of an unknown a solution (coincident
-    circles, parallel slides): a change point, not a position."""
 
 
 class Derivation(NamedTuple):
@@ -427,7 +422,6 @@ class Derivation(NamedTuple):
                          f"or - per closed-form step with two roots, e.g. {'+' * count})")
 
 
-MIRROR = " (mirror)"
 _OTHER_WORD = {"open": "crossed", "crossed": "open", "+": "-", "-": "+"}
 
 
