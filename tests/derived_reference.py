@@ -18,7 +18,8 @@ import mpmath
 from mpmath import mpc, mpf
 
 from linkage.errors import InputError
-from linkage.problems.loops import Mechanism, from_text
+from linkage.kinematics.loading import from_text
+from linkage.problems.loops import Mechanism
 
 DPS = 50
 

@@ -16,7 +16,7 @@ import pytest
 
 import linkage
 from linkage.homotopy import PolySystem, solve
-from linkage.problems.loops import from_text, load
+from linkage.kinematics.loading import from_text, load
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 mpmath.mp.dps = 50

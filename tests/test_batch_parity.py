@@ -21,8 +21,8 @@ import linkage
 from linkage import rules
 from linkage.kinematics.batch import batch_sweep
 from linkage.kinematics.limits import LOCATE_TOL, solved_ranges_array
+from linkage.kinematics.loading import load, parse_mechanism
 from linkage.kinematics.sweep import driver_values, sweep
-from linkage.problems.loops import load, parse_mechanism
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 SAMPLE_NAMES = sorted(p.stem for p in SAMPLES.glob("*.toml"))

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 import linkage
+from linkage.kinematics.loading import load
 from linkage.kinematics.pose import file_branch
 from linkage.kinematics.stepwise import MEETS_NOTE
-from linkage.problems.loops import load
 
 SAMPLES = Path(__file__).resolve().parent.parent / "sample_inputs"
 CRANK_ROCKER = SAMPLES / "crank_rocker.toml"

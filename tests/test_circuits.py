@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from linkage.kinematics.circuits import circuits
-from linkage.problems.loops import load
+from linkage.kinematics.loading import load
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 

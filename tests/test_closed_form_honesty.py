@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from linkage.errors import ParseError
+from linkage.kinematics.loading import load, parse_mechanism
 from linkage.problems import assembly
 from linkage.problems.closed_form import (
     MIRROR,
@@ -27,7 +28,6 @@ from linkage.problems.closed_form import (
     transmission,
     transmission_np,
 )
-from linkage.problems.loops import load, parse_mechanism
 
 mp = pytest.importorskip("mpmath")
 

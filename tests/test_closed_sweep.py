@@ -14,9 +14,9 @@ import pytest
 import tomllib
 
 from linkage.errors import InputError
+from linkage.kinematics.loading import load
 from linkage.kinematics.stepwise import sweep as one_at_a_time
 from linkage.kinematics.sweep import sweep_mechanism
-from linkage.problems.loops import load
 from linkage.samples import sample_path
 
 CLOSED = "newton (closed form)"

@@ -417,7 +417,7 @@ def test_a_mechanism_with_its_compiled_model_still_pickles():
 
 
 def test_lu_of_two_by_two_on_scalars_equals_lu():
-    from linkage.methods._linalg import SingularMatrix, det_from_lu, lu, lu_two
+    from linkage.linalg import SingularMatrix, det_from_lu, lu, lu_two
 
     rng = random.Random(9)
     cases = [(1.0, 2.0, 1.0, 3.0), (-2.0, 1.0, 2.0, 5.0), (0.0, 1.0, 0.0, 2.0), (1.0, 2.0, 2.0, 4.0),

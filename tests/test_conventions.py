@@ -94,7 +94,7 @@ def test_draw_of_the_six_bar_writes_a_picture(cli, tmp_path):
     assert run.code == 0 and out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-# --- the transmission angle: one rule (derive.folded_transmission) in every engine -----
+# --- the transmission angle: one rule (steps.folded_transmission) in every engine -----
 
 ME581 = Path(__file__).resolve().parents[1] / "sample_inputs" / "fourbar_me581.toml"
 
@@ -115,7 +115,7 @@ def _mu_reference(theta2_deg: float) -> float:
 
 def test_the_transmission_angle_is_one_folded_rule_in_every_engine(cli, tmp_path):
     """solve and sweep printed ME581's unfolded 101.7 deg at theta2 = 65 where scan and
-    synthesize folded into 0..90: now every engine reads derive.folded_transmission,
+    synthesize folded into 0..90: now every engine reads steps.folded_transmission,
     and its column says so (``transmission angle 0..90 (deg)``)."""
     assert _mu_reference(65.0) == pytest.approx(180.0 - 101.6763, abs=1e-4)  # the issue's 101.7, folded
     doc = json.loads(cli("solve", str(ME581), "-f", "json").out)

@@ -8,7 +8,7 @@ import math
 import pytest
 
 from linkage import solve_system
-from linkage.problems.loops import from_text
+from linkage.kinematics.loading import from_text
 from test_joints_form import me581_drawing, watt_drawing
 
 

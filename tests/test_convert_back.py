@@ -13,10 +13,10 @@ import tomllib
 
 from linkage import solve_system
 from linkage.errors import InputError
+from linkage.kinematics.loading import from_text, load
 from linkage.kinematics.rates import rates_at
-from linkage.problems.joints import loops_text
-from linkage.problems.loops import from_text, load
-from linkage.problems.to_joints import joints_doc
+from linkage.kinematics.to_joints import joints_doc
+from linkage.problems.toml_text import loops_text
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 DRAWINGS = sorted(SAMPLES.glob("*_joints.toml"))
@@ -79,7 +79,7 @@ def test_loops_to_joints_places_every_joint_as_the_loops_do(path: Path) -> None:
 
 
 def _convert_text(m) -> str:
-    from linkage.problems.to_joints import joints_text
+    from linkage.kinematics.to_joints import joints_text
 
     return joints_text(m, m.source)
 

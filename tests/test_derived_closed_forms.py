@@ -21,8 +21,8 @@ import pytest
 from mpmath import mpf
 
 import derived_reference as ref
-from linkage.problems import derive, dyads
-from linkage.problems.loops import load
+from linkage.kinematics.loading import load
+from linkage.problems import derive, dyads, find_steps, steps
 from ulps import assert_ulps
 
 SAMPLES = Path(__file__).resolve().parent.parent / "sample_inputs"
@@ -657,7 +657,7 @@ def test_fourbar_view_and_transmission_under_every_driver() -> None:
             (view,) = der.fourbars
             assert (view.loop, view.input, view.coupler, view.output, view.ground) == (
                 0, t["in"], t["cp"], t["out"], t["g"])
-            terms = derive.loop_terms(m)[0]
+            terms = find_steps.loop_terms(m)[0]
             inp = ref.Inputs(m)
             for _, q in der.solutions(m.driver.value):
                 sol = {**ref.as_sol(m, q), m.driver.name: mpf(m.driver.value)}
@@ -667,7 +667,7 @@ def test_fourbar_view_and_transmission_under_every_driver() -> None:
                 b, c = inp.length(0, t["cp"]), inp.length(0, t["out"])
                 mu = mpmath.acos((b * b + c * c - abs(pa - o4) ** 2) / (2 * b * c))
                 mu = min(mu, mpmath.pi - mu)  # folded: the acute angle between the lines
-                got = derive.fourbar_transmission(view, terms, der.params, m.driver.value, q)
+                got = steps.fourbar_transmission(view, terms, der.params, m.driver.value, q)
                 worst = max(worst, float(abs(mu - got)))
     FIGURES["transmission"] = (worst, "rad, 120 four-bars")
     assert worst <= 1e-12

@@ -101,8 +101,8 @@ def test_parallel_slides_along_the_known_vectors_are_a_change_point_not_unassemb
     where the known vectors lie along them and every s (with t = r - s) closes the loop;
     solve's JSON reference was {} beside a converged Newton answer. It is a change point:
     Indeterminate, reference None; off the line there is still no solution."""
+    from linkage.kinematics.loading import load
     from linkage.problems.derive import Indeterminate
-    from linkage.problems.loops import load
 
     path = tmp_path / "slides.toml"
     path.write_text(SLIDES)

@@ -17,8 +17,8 @@ import linkage
 from linkage.errors import InputError, ParseError
 from linkage.kinematics.angles import angle_extent, closes_circle
 from linkage.kinematics.designs import CONVERGED, engine_for, solve_designs
+from linkage.kinematics.loading import from_text, load
 from linkage.problems.closed_form import grashof
-from linkage.problems.loops import from_text, load
 from linkage.scan import ScanJob, run_chunk
 from linkage.scan.request import default_branch
 

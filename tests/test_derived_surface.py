@@ -21,7 +21,7 @@ import pytest
 
 from derived_reference import XY, abcd_text
 from linkage.errors import ParseError
-from linkage.problems.loops import load, parse_mechanism
+from linkage.kinematics.loading import load, parse_mechanism
 from pty_run import run as pty
 
 ROOT = Path(__file__).resolve().parent.parent

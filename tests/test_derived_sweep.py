@@ -15,7 +15,7 @@ import pytest
 import linkage
 from derived_reference import abcd_text
 from linkage.errors import InputError
-from linkage.problems.loops import load
+from linkage.kinematics.loading import load
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 mp.mp.dps = 50

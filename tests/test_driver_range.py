@@ -8,8 +8,8 @@ import math
 
 import pytest
 
+from linkage.kinematics.loading import from_text
 from linkage.kinematics.sweep import driver_values
-from linkage.problems.loops import from_text
 from report_reading import csv_rows
 
 R2, R3, E = 40.0, 120.0, 10.0
@@ -106,7 +106,7 @@ def test_the_range_survives_convert_both_ways(cli, tmp_path) -> None:
 def test_a_range_in_radians_is_drawn_in_degrees() -> None:
     from pathlib import Path
 
-    from linkage.problems.to_joints import joints_doc
+    from linkage.kinematics.to_joints import joints_doc
 
     text = (Path(__file__).resolve().parents[1] / "sample_inputs" / "fourbar_me581.toml").read_text()
     text = text.replace("value = 65\n", "value = 1.1344640137963142\nrange = [0, 1.5]\n", 1).replace(

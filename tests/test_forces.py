@@ -16,8 +16,8 @@ import pytest
 
 from linkage.cli import run_cli
 from linkage.kinematics.forces import forces_at
+from linkage.kinematics.loading import load, parse_mechanism
 from linkage.problems.loads import Loads, Mass
-from linkage.problems.loops import load, parse_mechanism
 from linkage.problems.templates import template
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"

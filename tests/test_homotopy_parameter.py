@@ -16,7 +16,7 @@ import pytest
 from linkage.homotopy import PolySystem, solve
 from linkage.homotopy.parameter import Family, monodromy, track_parameters
 from linkage.kinematics.assemblies import assembly_system, encode
-from linkage.problems.loops import load
+from linkage.kinematics.loading import load
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 

@@ -21,7 +21,7 @@ import pytest
 import linkage
 from linkage.errors import InputError
 from linkage.kinematics.centres import CHECK_RTOL, at_driver, velocity_residual
-from linkage.problems.loops import from_text
+from linkage.kinematics.loading import from_text
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLES = ROOT / "sample_inputs"

@@ -19,9 +19,10 @@ import pytest
 import tomllib
 
 from linkage import solve_system
+from linkage.kinematics.loading import load
 from linkage.kinematics.rates import rates_at
 from linkage.problems.derive import sign_text
-from linkage.problems.loops import Mechanism, load
+from linkage.problems.loops import Mechanism
 from linkage.problems.start import start_on_branch
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"

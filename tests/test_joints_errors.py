@@ -12,7 +12,7 @@ import pytest
 import tomllib
 
 from linkage import solve_system
-from linkage.problems.loops import from_text
+from linkage.kinematics.loading import from_text
 from test_joints_form import me581_drawing, watt_drawing
 
 FOURBAR_LINKS = 'crank = ["O2", "A"]\ncoupler = ["A", "B", "P"]\nrocker = ["O4", "B"]'

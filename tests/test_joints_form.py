@@ -12,7 +12,7 @@ import pytest
 
 from linkage import solve_system
 from linkage.errors import InputError
-from linkage.problems.loops import from_text, load
+from linkage.kinematics.loading import from_text, load
 from linkage.problems.start import start_on_branch
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
@@ -208,7 +208,7 @@ def test_a_drawing_off_its_value_converts_to_loops_on_the_drawn_assembly() -> No
     the value, so the loops file solves to the drawing's joints there too."""
     from linkage.files import parse_toml
     from linkage.kinematics.rates import rates_at
-    from linkage.problems.joints import loops_text
+    from linkage.problems.toml_text import loops_text
 
     text = _mirrored(me581_drawing(driver="value = 100"))
     converted = loops_text(parse_toml(text, "<drawing>"), "<drawing>", from_text(text, "<drawing>"))

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from linkage.problems.joints import loops_text
-from linkage.problems.loops import from_text
+from linkage.kinematics.loading import from_text
+from linkage.problems.toml_text import loops_text
 from linkage.scan import scan
 from test_joints_errors import SLIDER_CRANK
 
@@ -236,7 +236,7 @@ def test_a_six_bars_third_fixed_joint_scans_as_drawings_with_it_moved_by_hand(tm
 
 def test_the_python_api_reads_coordinates_from_a_path_not_a_mechanism(tmp_path) -> None:
     from linkage.errors import InputError
-    from linkage.problems.loops import load
+    from linkage.kinematics.loading import load
 
     drawn = write(tmp_path, "drawn.toml", drawing())
     with pytest.raises(InputError, match="a joint's coordinate is read from a joints file: give its path"):

@@ -13,8 +13,8 @@ import pytest
 
 from linkage import solve_system
 from linkage.errors import InputError
+from linkage.kinematics.loading import from_text, load
 from linkage.kinematics.rates import rates_at
-from linkage.problems.loops import from_text, load
 from linkage.problems.start import start_on_branch
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"

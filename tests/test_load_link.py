@@ -12,7 +12,7 @@ import pytest
 
 import linkage
 from linkage.errors import InputError
-from linkage.problems.loops import from_text
+from linkage.kinematics.loading import from_text
 
 ROOT = Path(__file__).resolve().parents[1]
 CRANK_ROCKER = ROOT / "docs" / "crank_rocker_loads.toml"

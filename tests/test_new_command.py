@@ -14,19 +14,18 @@ import pytest
 
 from linkage import solve_system
 from linkage.files import parse_toml
+from linkage.kinematics.loading import from_text, load
 from linkage.kinematics.rates import rates_at
-from linkage.problems.loops import from_text
+from linkage.problems import templates
+from linkage.problems.loops import shown_value
 from linkage.problems.start import start_on_branch
+from linkage.samples import sample_path
 
 # lengths for which both branches assemble over a whole crank turn (the Stephenson sample's
-# dyad does not close on the four-bar's crossed branch, so it gets a longer one here)
-KINDS = {
-    "fourbar": [],
-    "slider-crank": [],
-    "inverted-slider": [],
-    "watt": [],
-    "stephenson": ["--links", "40", "120", "80", "100", "60", "140", "110", "160"],
-}
+# dyad does not close on the four-bar's crossed branch, so it gets a longer one here); every
+# other registered kind is tested with its sample's
+LONGER = {"stephenson": ["--links", "40", "120", "80", "100", "60", "140", "110", "160"]}
+KINDS = {kind: LONGER.get(kind, []) for kind in templates.KINDS}
 
 
 def made(cli, tmp_path, kind: str, *args: str) -> str:
@@ -184,6 +183,29 @@ def test_the_command_in_the_file_makes_the_file_again(cli, tmp_path) -> None:
     words = shlex.split(first.split("drawn by: ", 1)[1])
     again = cli(*words[1:])
     assert again.code == 0 and again.out == text
+
+
+@pytest.mark.parametrize("kind", list(templates.KINDS))
+def test_every_registered_kind_makes_a_file_that_solves_with_its_samples_dimensions(cli, tmp_path,
+                                                                                     kind: str) -> None:
+    """A kind is one registry entry (templates.KINDS) and its sample file: with no --links
+    the file ``linkage new KIND`` writes solves to its drawing, in both forms, and its
+    defaults are its sample's lengths and driver value."""
+    k = templates.KINDS[kind]
+    text = made(cli, tmp_path, kind)
+    drawn = {j: tuple(p) for j, p in parse_toml(text, "<new>")["joints"].items()}
+    m, r = solved(text)
+    placed = rates_at(m, r.x).joints
+    for name, xy in drawn.items():
+        assert placed[name] == pytest.approx(xy, abs=1e-9), name
+    loops = cli("new", kind, "--form", "loops")
+    assert loops.code == 0, loops.err
+    _, r2 = solved(loops.out)
+    assert list(r2.x) == pytest.approx(list(r.x), abs=1e-9)
+    sample = load(sample_path(k.sample))
+    assert shown_value(sample.driver) == pytest.approx(k.angle_deg, abs=1e-12)
+    lengths = sorted(abs(q.value) for q in sample.parameters.values() if q.kind == "length")
+    assert lengths == sorted(abs(v) for v in k.defaults)
 
 
 def test_the_defaults_are_the_samples_and_the_file_says_how_it_was_made(cli, tmp_path) -> None:

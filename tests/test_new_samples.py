@@ -15,7 +15,7 @@ import mpmath
 import pytest
 
 import linkage
-from linkage.problems.loops import load
+from linkage.kinematics.loading import load
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 INVERTED = SAMPLES / "inverted_slider_crank.toml"

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 import linkage
 from linkage.kinematics import angles
-from linkage.problems.loops import load
+from linkage.kinematics.loading import load
 from linkage.render.sweep import ranges_of
 
 ROOT = Path(__file__).resolve().parent.parent

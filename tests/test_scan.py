@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 from linkage.kinematics.designs import _sweep_engine, solve_designs
+from linkage.kinematics.loading import load
 from linkage.problems.closed_form import fourbar_class
-from linkage.problems.loops import load
 from linkage.scan.metrics import grashof_class
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -51,7 +51,7 @@ def test_the_api_and_the_command_refuse_the_same_scan_with_one_message(cli, case
 
 
 def test_a_scan_request_spells_options_as_its_asker():
-    from linkage.problems.loops import load
+    from linkage.kinematics.loading import load
     from linkage.scan.request import ScanRequest
 
     m = load(str(CRANK))

@@ -13,8 +13,8 @@ import pytest
 
 import linkage
 from linkage.errors import InputError, ParseError
+from linkage.kinematics.loading import from_text
 from linkage.problems.expression import function_of
-from linkage.problems.loops import from_text
 
 pytest.importorskip("scipy")
 

@@ -94,7 +94,7 @@ def test_offset_slider_fold_gap_and_limits_are_found_numerically():
     import random
 
     from linkage import solve_system
-    from linkage.methods._linalg import det_from_lu, lu
+    from linkage.linalg import det_from_lu, lu
 
     m = load_mechanism(SAMPLES / "offset_slider.toml")
     s = sweep(m, driver_values(0, 360, 2, None))
@@ -229,7 +229,7 @@ def test_the_lean_continuation_step_changes_no_position(name, monkeypatch):
 
     from linkage.kinematics import continuation
     from linkage.kinematics import sweep as sweep_module
-    from linkage.problems.loops import load
+    from linkage.kinematics.loading import load
 
     m = load(SAMPLES / name)
     designs = [m]

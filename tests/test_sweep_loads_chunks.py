@@ -21,9 +21,9 @@ from linkage.kinematics import force_sweeps
 from linkage.kinematics.columns import sweep_columns
 from linkage.kinematics.force_sweeps import FORCE_KEYS, load_chunks, sweep_load_columns
 from linkage.kinematics.forces import FORCE_STATUSES, PeakTracker, force_peaks
+from linkage.kinematics.loading import load
 from linkage.kinematics.sweep import sweep_mechanism
 from linkage.problems.loads import Loads
-from linkage.problems.loops import load
 
 ROOT = Path(__file__).resolve().parents[1]
 LOADED = ROOT / "docs" / "crank_rocker_loads.toml"

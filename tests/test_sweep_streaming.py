@@ -19,8 +19,8 @@ import pytest
 
 from linkage.cli import run_cli
 from linkage.kinematics import batch as batch_engine
+from linkage.kinematics.loading import load
 from linkage.kinematics.rates import rates_at
-from linkage.problems.loops import load
 
 ROOT = Path(__file__).resolve().parents[1]
 LOADED = ROOT / "docs" / "crank_rocker_loads.toml"

@@ -199,8 +199,8 @@ def _alpha_of_driver(s, theta2: float) -> float:
 
 
 def test_the_written_file_sweeps_through_the_precision_points() -> None:
+    from linkage.kinematics.loading import from_text
     from linkage.kinematics.sweep import sweep_mechanism
-    from linkage.problems.loops import from_text
     from linkage.render.synthesis import design_text, real_angles
 
     for case in DEFECT_FREE:

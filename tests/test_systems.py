@@ -12,13 +12,13 @@ from hypothesis import strategies as st
 
 from conftest import matches
 from linkage import Status, load_mechanism, solve_system
+from linkage.kinematics.loading import parse_mechanism
 from linkage.problems.closed_form import (
     Indeterminate,
     fourbar_positions,
     slider_crank_positions,
     wrap_degrees,
 )
-from linkage.problems.loops import parse_mechanism
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 ME581 = str(SAMPLES / "fourbar_me581.toml")

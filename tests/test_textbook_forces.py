@@ -25,8 +25,8 @@ from pathlib import Path
 import pytest
 
 from linkage.kinematics.forces import forces_at
+from linkage.kinematics.loading import from_text as parse_mechanism
 from linkage.problems.loads import Loads
-from linkage.problems.loops import from_text as parse_mechanism
 
 R2 = math.sqrt(2.0)
 ROOT = Path(__file__).resolve().parents[1]

@@ -12,7 +12,8 @@ import pytest
 
 from linkage import load_mechanism, solve_system
 from linkage.errors import InputError
-from linkage.problems.loops import from_text, length_factor
+from linkage.kinematics.loading import from_text
+from linkage.problems.loops import length_factor
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 

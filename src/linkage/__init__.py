@@ -32,7 +32,7 @@ _EXPORTS = {
     "coefficients_from_links": ".problems.freudenstein", "fourbar_equation": ".problems.freudenstein",
     "ScalarProblem": ".problems.scalar",
     "History": ".result", "IterationRecord": ".result", "Result": ".result", "Status": ".result",
-    "Mechanism": ".problems.loops", "load_mechanism": ".problems.loops",
+    "Mechanism": ".problems.loops", "load_mechanism": ".kinematics.loading",
     "SystemProblem": ".problems.system",
     "solve_scalar": ".solve", "solve_system": ".solve",
     "sweep": ".kinematics.sweep", "SweepResult": ".kinematics.sweep", "Position": ".kinematics.sweep",

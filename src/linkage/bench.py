@@ -85,8 +85,8 @@ def system_problem(name: str) -> dict[str, Any]:
 
     import mpmath as mp
 
+    from .kinematics.loading import load
     from .problems.catalog import BENCH_SYSTEMS
-    from .problems.loops import load
     from .samples import sample_path
     from .stress import mp_fourbar_positions
 
@@ -399,8 +399,8 @@ def sweep_times(repeats: int = 5, batch_positions: int | None = 1_000_000) -> di
     included."""
     import numpy as np
 
+    from .kinematics.loading import load
     from .kinematics.sweep import sweep_mechanism
-    from .problems.loops import load
     from .samples import sample_path
 
     m = load(sample_path("crank_rocker.toml"))
@@ -615,8 +615,8 @@ def sweep_output_targets(repeats: int = 3) -> list[tuple[str, str, float | None,
     import os
     import tempfile
 
+    from .kinematics.loading import load
     from .kinematics.sweep import sweep_mechanism
-    from .problems.loops import load
     from .samples import sample_path
 
     path = str(sample_path("crank_rocker.toml"))

@@ -433,7 +433,7 @@ def mp_fourbar_positions(
 
 def fourbar_mechanism(it: dict[str, Any]) -> Any:
     """A random four-bar of :func:`fourbar_cases` as a mechanism (metres, closed form)."""
-    from .problems.loops import parse_mechanism
+    from .kinematics.loading import parse_mechanism
 
     r1, r2, r3, r4 = it["links"]
     unit = {"unit": "m"}

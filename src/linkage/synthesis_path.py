@@ -162,9 +162,9 @@ def judge(z: np.ndarray, points: list[complex]) -> PathFourBar:
     """One real solution as a four-bar, moved through the points by the engine."""
     from .kinematics.assemblies import assemblies, same_configuration
     from .kinematics.circuits import circuits
+    from .kinematics.loading import from_text
     from .kinematics.rates import place
     from .problems.closed_form import grashof
-    from .problems.loops import from_text
 
     a, x, b, y = (complex(z[k]) for k in (ninepoint.A, ninepoint.X, ninepoint.B, ninepoint.Y))
     P0 = points[0]

@@ -49,7 +49,7 @@ def assemblies(
     """
     from ..errors import InputError
     from ..kinematics.assemblies import every_assembly
-    from ..problems.loops import load
+    from ..kinematics.loading import load
     from ..render.assemblies import assemblies_report
     from .options import choose_format, emit_report, note_closed_form, parse_assignments
 

@@ -65,7 +65,7 @@ def centres(
     Example: linkage centres sample_inputs/fourbar_me581_joints.toml --set theta_crank=80
     """
     from ..kinematics.centres import as_given, at_driver, centres_at
-    from ..problems.loops import load
+    from ..kinematics.loading import load
     from ..render.centres import centres_report
 
     out_fmt = choose_format(fmt, output)

@@ -35,8 +35,9 @@ def convert(
     import sys
 
     from ..files import parse_toml, read_input
-    from ..problems.joints import is_joints_doc, loops_text
-    from ..problems.loops import parse_mechanism
+    from ..kinematics.loading import parse_mechanism
+    from ..problems.joints import is_joints_doc
+    from ..problems.toml_text import loops_text
 
     if form is not None and form.lower() not in ("joints", "loops"):
         raise InputError(f"--form {form!r}: write joints or loops")
@@ -51,7 +52,7 @@ def convert(
     if wanted == "loops":
         text = loops_text(doc, str(file), mechanism)
     else:
-        from ..problems.to_joints import joints_text
+        from ..kinematics.to_joints import joints_text
 
         text = joints_text(mechanism, str(file))
     if target is None:

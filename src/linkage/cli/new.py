@@ -1,4 +1,5 @@
-"""linkage new."""
+"""linkage new: every kind, its help and its defaults from the one registry
+(:data:`linkage.problems.templates.KINDS`)."""
 
 from pathlib import Path
 from typing import Annotated, Optional
@@ -6,7 +7,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from ..problems.templates import KINDS, angles, links_order
+from ..problems.templates import KINDS, angles, branch_help, kind_names, kind_titles, links_order
 from .options import ForceOpt
 from .root import app
 
@@ -16,14 +17,17 @@ OPTIONS = {"links": "--links", "angle_deg": "--angle", "branch": "--branch", "un
 
 
 @app.command(
+    help=f"Start a mechanism file from its link lengths ({kind_titles()}), drawn as a commented "
+    "joints file.\n\nThe file solves and sweeps as written: the crank at --angle, each dyad closed on "
+    "--branch. Move its joints to change the design; --form loops writes the vector loops the drawing "
+    "implies instead.\n\nExample: linkage new fourbar --links 40 120 80 100 -o my_fourbar.toml",
     epilog="Examples:  linkage new fourbar --links 40 120 80 100 -o my_fourbar.toml  |  "
     "linkage new slider-crank --links 40 120 -5 --angle 90 --branch crossed  |  "
     "linkage new watt --form loops",
     context_settings={"ignore_unknown_options": True},  # a negative offset in --links
 )
 def new(
-    kind: Annotated[str, typer.Argument(metavar="KIND", help="fourbar, slider-crank, inverted-slider, "
-                    "watt or stephenson.", show_default=False)],
+    kind: Annotated[str, typer.Argument(metavar="KIND", help=f"{kind_names()}.", show_default=False)],
     lengths: Annotated[Optional[list[str]], typer.Argument(metavar="[--links LENGTH...]", help="The "
                        "lengths, in the file's unit.", show_default=False, hidden=True)] = None,
     *,
@@ -33,10 +37,7 @@ def new(
     angle: Annotated[Optional[float], typer.Option("--angle", metavar="DEG", help="The crank's angle "
                      f"in the drawing, degrees (default: the sample's: {angles()}).",
                      show_default=False)] = None,
-    branch: Annotated[str, typer.Option("--branch", help="The assembly drawn: open (a four-bar's rocker "
-                      "turns anticlockwise from its coupler; a slider-crank's coupler points the way "
-                      "the slide grows; an inverted slider's rocker points towards the block) or "
-                      "crossed; a six-bar takes one word per dyad, e.g. open/crossed.")] = "open",
+    branch: Annotated[str, typer.Option("--branch", help=branch_help())] = "open",
     unit: Annotated[str, typer.Option("--unit", help="The file's length_unit: mm, cm, m, in or ft.")] = "mm",
     name: Annotated[Optional[str], typer.Option("--name", help="The mechanism's name "
                     "(default: its kind's).", show_default=False)] = None,
@@ -46,15 +47,8 @@ def new(
                       "instead of standard output; an existing file is kept unless --force.")] = None,
     force: ForceOpt = False,
 ) -> None:
-    """Start a mechanism file from its link lengths: a four-bar, slider-crank, inverted
-    slider-crank, Watt or Stephenson six-bar, drawn as a commented joints file.
-
-    The file solves and sweeps as written: the crank at --angle, each dyad closed on
-    --branch. Move its joints to change the design; --form loops writes the vector loops
-    the drawing implies instead.
-
-    Example: linkage new fourbar --links 40 120 80 100 -o my_fourbar.toml
-    """
+    """linkage new: a file of one of the kinds of :data:`linkage.problems.templates.KINDS`
+    (its help, choices and defaults come from there)."""
     import sys
 
     from ..numbers import parse_number

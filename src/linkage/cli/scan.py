@@ -96,8 +96,8 @@ def scan(
     from ..arguments import driver_span, parse_motion
     from ..files import parse_toml, read_input
     from ..kinematics.bodies import command_loads
+    from ..kinematics.loading import from_text
     from ..kinematics.sweep import driver_values
-    from ..problems.loops import from_text
     from ..render import writers
     from ..render.scan import RecordSink, pick_spec, scan_meta, scan_report, scan_summary
     from ..scan import ScanRequest, open_scan, parse_vary, run_scan

@@ -20,8 +20,8 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
 
     from ..analysis.convergence import analyze
     from ..arguments import parse_motion
+    from ..kinematics.loading import load
     from ..problems.closed_form import fourbar_facts
-    from ..problems.loops import load
     from ..problems.start import start_on_branch
     from ..render.system import branch_label, system_report
     from ..solve import SYSTEM_METHODS, solve_system

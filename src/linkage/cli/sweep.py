@@ -92,8 +92,8 @@ def sweep(
     Example: linkage sweep --from 10 --to 160 --step 30
     """
     from ..arguments import driver_span, parse_motion
+    from ..kinematics.loading import load
     from ..kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
-    from ..problems.loops import load
     from ..render.sweep import sweep_report
     from ..render.writers import data_formats, is_data, prefetch
     from ..solve import SYSTEM_METHODS, check_criteria, check_number

@@ -83,8 +83,8 @@ def tolerance(
     """
     from ..arguments import check_scan_options, driver_span
     from ..files import parse_toml, read_input
+    from ..kinematics.loading import from_text
     from ..kinematics.sweep import driver_values
-    from ..problems.loops import from_text
     from ..render.tolerance import tolerance_report
     from ..scan.tolerance import MAX_SAMPLES, outputs_of, parse_tolerance, prepare, study
     from ..solve import check_criteria

@@ -409,7 +409,7 @@ def every_assembly(mechanism: Mechanism | str | Any, driver: float | None = None
     ``solutions`` has every path's endpoint and its steps. Every argument is checked
     first: a misuse raises :class:`~linkage.errors.InputError` naming it."""
     from ..arguments import MAX_SEED, check_number, check_whole
-    from ..problems.loops import mechanism_of
+    from .loading import mechanism_of
 
     m = mechanism_of("mechanism", mechanism)
     seed = check_whole("seed", seed, 0, MAX_SEED)

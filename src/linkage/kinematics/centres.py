@@ -22,7 +22,7 @@ and j moves relative to the other body as omega_ij x r (:func:`velocity_residual
 ``CHECK_RTOL`` of the mechanism's fastest motion.
 
 A loops-form mechanism has no bodies of its own: it is drawn as joints and links at the
-pose first, as ``linkage convert --form joints`` draws it (:mod:`..problems.to_joints`),
+pose first, as ``linkage convert --form joints`` draws it (:mod:`.to_joints`),
 and its bodies are named as that command names them.
 """
 
@@ -490,8 +490,8 @@ def joints_form(m: Any) -> tuple[Any, bool]:
     a loop that names no joints is refused with that command's message)."""
     if m.extra.get("drawing") is not None:
         return m, False
-    from ..problems.loops import parse_mechanism
-    from ..problems.to_joints import joints_doc
+    from .loading import parse_mechanism
+    from .to_joints import joints_doc
 
     return parse_mechanism(joints_doc(m), m.source), True
 
@@ -530,7 +530,7 @@ def at_driver(mechanism: Any, driver_value: Any = None, branch: Any = None) -> t
     whether it was converted from the loops form: the front door's work, shared by the
     command line."""
     from ..arguments import check_number, check_text
-    from ..problems.loops import mechanism_of
+    from .loading import mechanism_of
 
     m = mechanism_of("mechanism", mechanism)
     if driver_value is not None:
@@ -673,7 +673,7 @@ def centrodes(mechanism: Any, values: Any, body: str | None = None, *, branch: s
     each position of a sweep; points at infinity kept as directions. The public
     ``linkage.centrodes``."""
     from ..arguments import check_reals, check_text
-    from ..problems.loops import mechanism_of
+    from .loading import mechanism_of
     from .positions import MAX_POSITIONS
     from .sweep import sweep_mechanism
 

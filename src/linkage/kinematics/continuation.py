@@ -26,7 +26,7 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve, lu_two
+from ..linalg import SingularMatrix, det_from_lu, lu, lu_solve, lu_two
 from ..methods.newton_system import max_abs, newton_system_lean
 from ..problems.derive import parse_signs, read_branch
 from ..problems.loops import ANGLE_UNITS, Mechanism
@@ -83,7 +83,7 @@ class Solver:
 
     def transmission(self, q: Sequence[float], value: float) -> float | None:
         """The transmission angle (deg, folded into [0, 90]) of a mechanism whose loops include
-        four-bars (:func:`~linkage.problems.derive.fourbar_transmission`: the coupler as
+        four-bars (:func:`~linkage.problems.steps.fourbar_transmission`: the coupler as
         traversed against the output link from its pivot), at unknowns ``q`` (internal
         units) and the driver's ``value`` (display units). With several four-bar loops, the
         one farthest from 90 deg: the loop that transmits worst."""
@@ -137,7 +137,7 @@ class Solver:
         return {n: (math.degrees(v) if k == "angle" else v) for n, v, k in zip(self.names, q, self.kinds)}
 
     def det(self, p: Any, q: Sequence[float]) -> float:
-        from ..methods._linalg import SingularMatrix, det_from_lu, lu
+        from ..linalg import SingularMatrix, det_from_lu, lu
 
         try:
             return det_from_lu(lu(p.J(list(q))))

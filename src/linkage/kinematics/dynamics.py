@@ -414,8 +414,9 @@ def simulate(
     ``flywheel``: kg m^2 on a turning driver. ``samples`` output times. Every argument is
     checked first; a misuse raises InputError naming it."""
     from ..arguments import check_number, describe, finite_real
-    from ..problems.loops import ANGLE_UNITS, mechanism_of
+    from ..problems.loops import ANGLE_UNITS
     from .bodies import Frame, checked_loads
+    from .loading import mechanism_of
 
     mechanism = mechanism_of("mechanism", mechanism)
     frame = Frame.of(mechanism)

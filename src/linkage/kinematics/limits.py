@@ -11,17 +11,17 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ..methods._linalg import SingularMatrix, det_from_lu, lu, lu_solve
+from ..linalg import SingularMatrix, det_from_lu, lu, lu_solve
+from ..methods.golden import golden_min
 from ..methods.newton_system import max_abs
-from ..problems.derive import sign_text
+from ..problems.derive import Derivation, sign_text
 from ..problems.derive_limits import (
     Signs,
     assembles,
     assembles_np,
-    dip_between,
     limit_between,
     limits_between_np,
 )
@@ -30,6 +30,24 @@ from .continuation import REENTERED, Solver, predict, solver_q
 from .positions import Position
 
 LOCATE_TOL = 1e-9  # driver units (deg for angles)
+
+
+def dip_between(d: Derivation, a: float, c: float, branches: Sequence[Signs], scale: float = 1.0,
+                params: Mapping[str, float] | None = None) -> tuple[float, float] | None:
+    """Where :func:`assembles` is >= 0 at both ``a`` and ``c`` but dips below zero between
+    (an unassembled sliver narrower than the grid): its two limits, else None. Golden-section
+    search (:func:`linkage.methods.golden.golden_min`) for the smallest value, then
+    :func:`limit_between` on each side. It lives here, a layer above the margins
+    (:mod:`linkage.problems.derive_limits`), because the golden-section loop is a method."""
+    def g(x: float) -> float:
+        return assembles(d, x, branches, scale, params)
+
+    _, x1, g1, x2, g2, _ = golden_min(g, a, c, 200, lambda k: k[2] < 0.0 or k[4] < 0.0 or not k[1] < k[3])
+    inside = x1 if g1 < 0.0 else x2 if g2 < 0.0 else None
+    if inside is None:
+        return None
+    return limit_between(d, a, inside, branches, scale, params), limit_between(d, inside, c, branches,
+                                                                              scale, params)
 
 
 def solved_ranges(positions: Sequence[Position]) -> tuple[tuple[float, float], ...]:
@@ -256,7 +274,7 @@ ordinary mechanism's smallest transmission angle is far above, and costs nothing
 def _touch_det(solver: Solver, a: Position, b: Position, c: Position) -> float | None:
     """The driver value in [a, c] where the branch's J is nearest singular (golden-section
     search on hadamard_ratio, to LOCATE_TOL), if J is singular there; else None."""
-    from ..methods._linalg import hadamard_ratio
+    from ..linalg import hadamard_ratio
 
     q_b = solver_q(solver, b)
     if not hadamard_ratio(solver.problem(b.input).J(list(q_b))) <= TOUCH_CANDIDATE:

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 from operator import mul
 from typing import TYPE_CHECKING, Any, NamedTuple
 
-from ..methods._linalg import SingularMatrix, lu, lu_solve
+from ..linalg import SingularMatrix, lu, lu_solve
 from ..methods.newton_system import max_abs, newton_direction
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel
 from .labels import rate_label
@@ -705,7 +705,7 @@ def rates_at(mechanism: Any, q: Any, *, speed: float | None = None, accel: float
     is the command line's); every argument is checked first, and a misuse raises
     :class:`~linkage.errors.InputError` naming it."""
     from ..arguments import check_motion, check_number, check_reals
-    from ..problems.loops import mechanism_of
+    from .loading import mechanism_of
 
     mechanism = mechanism_of("mechanism", mechanism)
     names = [u.name for u in mechanism.unknowns]

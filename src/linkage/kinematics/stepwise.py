@@ -225,7 +225,7 @@ def classification_of(m: Mechanism) -> dict[str, Any]:
     """The Grashof class (Norton 2.8) of each loop that is a four-bar, read as written with
     the ground last: input, coupler, output (:func:`~linkage.problems.closed_form.fourbar_class`).
     One such loop: its class; several: the first's, with every loop's under ``loops``."""
-    from ..problems.derive import loop_terms
+    from ..problems.find_steps import loop_terms
 
     views = m.derivation.fourbars
     if not views:

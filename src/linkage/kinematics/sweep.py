@@ -74,8 +74,8 @@ def sweep_mechanism(
     """
     from ..arguments import check_callable, check_flag, check_motion, check_reals, check_text
     from ..errors import InputError
-    from ..problems.loops import mechanism_of
     from ..solve import check_criteria
+    from .loading import mechanism_of
 
     # the front door: every argument checked once, InputError naming it
     m = mechanism_of("mechanism", mechanism)

@@ -1,5 +1,5 @@
 """Golden-section search for the smallest value of a function unimodal on [lo, hi]: the one
-loop that the assembly-gap finder (problems.derive_limits.dip_between) and the synthesis's
+loop that the assembly-gap finder (kinematics.limits.dip_between) and the synthesis's
 error extrema (synthesis.golden_max) share."""
 
 from __future__ import annotations

@@ -23,11 +23,11 @@ from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
 from ..iterate import DIVERGE_STREAK, ROUNDING, RUNAWAY, explain, rounding_stall
+from ..linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve, pivot_ratio
 from ..problems.system import SystemProblem
 from ..result import Column, Status
 from ..rules import step_limit, step_size, system_converged
 from ._common import new_state
-from ._linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve, pivot_ratio
 
 EPS = sys.float_info.epsilon
 

@@ -28,6 +28,18 @@ from __future__ import annotations
 import math
 from typing import Any
 
+MIRROR = " (mirror)"
+"""The suffix of a second assembly of one name at a driver value: with theta4 driving, the
+two assemblies at one theta4 (mirror images of A across the line O2-B) can carry the same
+label; the second is keyed ``open (mirror)``, so both stay reachable. The closed forms
+(:mod:`.closed_form`) and the derived branch names (:mod:`.derive`) both write it."""
+
+
+class Indeterminate(ValueError):
+    """A change point, not a position: a step whose known vectors leave every value of an
+    unknown a solution (coincident circles, parallel slides)."""
+
+
 # --- circle intersection --------------------------------------------------------------------
 
 TANGENT_SLACK = 4.0 * 2.220446049250313e-16

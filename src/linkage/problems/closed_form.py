@@ -31,7 +31,10 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
+from ..units import degrees
 from .assembly import (
+    MIRROR,
+    Indeterminate,
     fourbar_by_crank,
     fourbar_by_rocker,
     is_open,
@@ -46,16 +49,6 @@ REQUIRED_NAMES = {
 }
 
 Solutions = dict[str, dict[str, float]]
-
-MIRROR = " (mirror)"
-"""With theta4 driving, the two assemblies at one theta4 (mirror images of A across the
-line O2-B) can carry the same label; the second is then keyed with this suffix, so both
-stay in the dict (and reachable): e.g. "open" and "open (mirror)"."""
-
-
-class Indeterminate(ValueError):
-    """Coincident circles: every point of the circle is a solution (a change point)."""
-
 
 def circle_points(center: complex, radius: float, other: complex, distance: float) -> list[complex]:
     """Points X with |X - center| = radius and |X - other| = distance (0, 1 or 2 of them);
@@ -126,14 +119,14 @@ def wrap_degrees(a: float) -> float:
 
 TRANSMISSION = "transmission angle 0..90"
 """The transmission angle's name in every table (its unit deg beside it): folded, see
-:func:`~.derive.folded_transmission`."""
+:func:`~.steps.folded_transmission`."""
 
 
 def transmission(t3_deg: float, t4_deg: float) -> float:
     """The transmission angle between coupler and output link (deg, in [0, 90]):
-    |theta4 - theta3| wrapped, then folded (:func:`~.derive.folded_transmission`); NaN for
+    |theta4 - theta3| wrapped, then folded (:func:`~.steps.folded_transmission`); NaN for
     a non-finite angle."""
-    from .derive import folded_transmission
+    from .steps import folded_transmission
 
     return folded_transmission(abs(wrap_degrees(t4_deg - t3_deg)))
 
@@ -143,7 +136,7 @@ def transmission_np(t3_deg: Any, t4_deg: Any) -> Any:
     import numpy as np
 
     w = np.fmod(np.asarray(t4_deg, float) - t3_deg, 360.0)
-    from .derive import folded_transmission_np
+    from .steps import folded_transmission_np
 
     w = np.where(w <= -180.0, w + 360.0, np.where(w > 180.0, w - 360.0, w))
     return folded_transmission_np(np.abs(w))
@@ -216,7 +209,7 @@ def verify(m: Any) -> str | None:
         gap = abs(got - sign * claim)
         if not gap <= worst:  # NaN included
             worst = gap
-            where = ", ".join(f"{k} = {math.degrees(point[k]) if k.startswith('theta') else point[k]:.6g}"
+            where = ", ".join(f"{k} = {degrees(point[k]) if k.startswith('theta') else point[k]:.6g}"
                               for k in (m.driver.name, *(u.name for u in m.unknowns)))
     if not worst <= 1e-9 * size:
         return (f"its loop differs from the file's by {worst:.3g} {m.length_unit} at scattered positions "
@@ -281,8 +274,9 @@ def fourbar_facts(m: Any, q: Sequence[float] | None = None,
     lengths, its Grashof class (:func:`fourbar_class`, with the loop's ground, input,
     coupler and output read as written with the ground last) and, given a configuration
     ``q`` (internal units) at ``driver`` (default the file's), its transmission angle in
-    degrees (:func:`~.derive.fourbar_transmission`, folded into [0, 90])."""
-    from .derive import fourbar_transmission, loop_terms
+    degrees (:func:`~.steps.fourbar_transmission`, folded into [0, 90])."""
+    from .find_steps import loop_terms
+    from .steps import fourbar_transmission
 
     derivation = m.derivation
     if not derivation.fourbars:
@@ -302,7 +296,7 @@ def fourbar_facts(m: Any, q: Sequence[float] | None = None,
                                           "output": output},
                                 **fourbar_class(ground, inp, coupler, output)}
         if q is not None:
-            fact["transmission_deg"] = math.degrees(fourbar_transmission(view, terms, params, d, q))
+            fact["transmission_deg"] = degrees(fourbar_transmission(view, terms, params, d, q))
         out.append(fact)
     return out
 
@@ -317,8 +311,8 @@ def cos_band_arcs(c_lo: float, c_hi: float, shift: float) -> list[Arc] | None:
         return []
     if c_lo <= -1.0 and c_hi >= 1.0:
         return None
-    a_hi = math.degrees(math.acos(min(c_hi, 1.0)))  # smallest |phi|
-    a_lo = math.degrees(math.acos(max(c_lo, -1.0)))  # largest |phi|
+    a_hi = degrees(math.acos(min(c_hi, 1.0)))  # smallest |phi|
+    a_lo = degrees(math.acos(max(c_lo, -1.0)))  # largest |phi|
     if c_hi >= 1.0:
         return [(shift - a_lo, shift + a_lo)]
     if c_lo <= -1.0:

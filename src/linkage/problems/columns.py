@@ -1,7 +1,7 @@
 """The columns of a scan's records, named from a mechanism: the one list of them.
 
 `linkage scan` (:func:`linkage.scan.columns_of`, :func:`linkage.scan.design_metrics`)
-names its columns here, and the file parser (:func:`linkage.problems.loops.parse_mechanism`)
+names its columns here, and the file parser (:func:`linkage.problems.read_loops.read_mechanism`)
 refuses a file whose names would give two columns the same name (a parameter called
 ``design`` or ``full_cycle``, an unknown ``P_x`` beside a point ``P``): one record would
 overwrite or duplicate another, or put millimetres under a (deg) heading. Every parameter

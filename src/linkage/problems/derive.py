@@ -20,7 +20,7 @@ same whichever joint drives. A slider-crank loop is open where the coupler point
 the slide grows.
 
 Everything here is symbolic until evaluated: the scalar path (:meth:`Derivation.solve`)
-and its numpy twin (:meth:`Derivation.solve_np`) share the term sums below and call the
+and its numpy twin (:meth:`Derivation.solve_np`) share the term sums of :mod:`.steps` and call the
 cases of :mod:`.dyads`, scalar and numpy side by side. Parameters are read by name at
 evaluation, so one derivation serves every design of a scan.
 """
@@ -32,128 +32,22 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any, NamedTuple
 
-from . import dyads
-from .assembly import TANGENT_SLACK
-
-DRIVER = -2
-"""The reference of the driver; an int >= 0 is an unknown, a str a parameter, a float a number."""
-
-Ref = int | str | float
-Term = tuple[float, Ref, Ref, float]
-"""(sign, length, angle, offset): the vector sign * length * e^(i (angle + offset))."""
-
-TWO_ANGLES = "two angles"
-ITS_LENGTH = "an angle and its own length"
-OTHER_LENGTH = "an angle and another vector's length"
-TWO_LENGTHS = "two lengths"
-
-
-class Indeterminate(ValueError):
-    """A step whose known vectors leave every value of an unknown a solution (coincident
-    circles, parallel slides): a change point, not a position."""
-
-
-class FourbarLoop(NamedTuple):
-    """A loop of four links of fixed length, one of them ground: the terms (indexes into
-    the loop's vectors) of the input, coupler, output and ground, in the loop's order
-    with the ground last."""
-
-    loop: int
-    input: int
-    coupler: int
-    output: int
-    ground: int
-
-
-class Step(NamedTuple):
-    """One closed-form step: ``unknowns`` from ``loops`` (one loop, or two combined with
-    ``weights``), in ``case``. ``known`` sums to K; ``first`` and ``second`` are the
-    coefficients of the two unknowns (P and Q, P and D, P and E, or E and F)."""
-
-    case: str
-    loops: tuple[int, ...]
-    weights: tuple[float, ...]
-    unknowns: tuple[int, int]
-    known: tuple[Term, ...]
-    first: tuple[Term, ...]
-    second: tuple[Term, ...]
-    word_rule: str = ""  # "fourbar" or "slider": the step's loop has a conventional name
-    word_terms: tuple[Term, Term] | None = None  # (coupler, output or slide) for the word
-
-    @property
-    def two_way(self) -> bool:
-        return self.case != TWO_LENGTHS
-
-
-def _val(ref: Ref, params: Mapping[str, Any], d: Any, q: Sequence[Any]) -> Any:
-    if ref.__class__ is int:
-        return d if ref == DRIVER else q[ref]  # type: ignore[index]
-    if ref.__class__ is str:
-        return params[ref]  # type: ignore[index]
-    return ref
-
-
-# The sums of a step's terms, written once over a namespace (math or numpy): the scalar
-# path and its numpy twin evaluate the same expressions in the same order.
-def _known_sum(terms: Sequence[Term], params: Mapping[str, Any], d: Any, q: Sequence[Any],
-               xp: Any) -> tuple[Any, Any]:
-    x = y = 0.0
-    for sign, lr, ar, off in terms:
-        r = sign * _val(lr, params, d, q)
-        t = _val(ar, params, d, q) + off if off else _val(ar, params, d, q)
-        x = x + r * xp.cos(t)
-        y = y + r * xp.sin(t)
-    return x, y
-
-
-def _angle_coefficient(terms: Sequence[Term], params: Mapping[str, Any], d: Any,
-                       q: Sequence[Any], xp: Any) -> tuple[Any, Any]:
-    """sum sign * length * e^(i offset): the coefficient of e^(i angle)."""
-    x = y = 0.0
-    for sign, lr, _, off in terms:
-        r = sign * _val(lr, params, d, q)
-        if off:
-            x = x + r * math.cos(off)
-            y = y + r * math.sin(off)
-        else:
-            x = x + r
-    return x, y
-
-
-def _length_coefficient(terms: Sequence[Term], params: Mapping[str, Any], d: Any,
-                        q: Sequence[Any], xp: Any, with_angle: bool) -> tuple[Any, Any]:
-    """sum sign * e^(i (angle + offset)) (``with_angle``) or sign * e^(i offset): the
-    coefficient of a length."""
-    x = y = 0.0
-    for sign, _, ar, off in terms:
-        if with_angle:
-            t = _val(ar, params, d, q) + off if off else _val(ar, params, d, q)
-            x = x + sign * xp.cos(t)
-            y = y + sign * xp.sin(t)
-        elif off:
-            x = x + sign * math.cos(off)
-            y = y + sign * math.sin(off)
-        else:
-            x = x + sign
-    return x, y
-
-
-def _coefficients(step: Step, params: Mapping[str, Any], d: Any, q: Sequence[Any],
-                  xp: Any) -> tuple[tuple[Any, Any], tuple[Any, Any], tuple[Any, Any]]:
-    """(first, second, K) of a step at known values."""
-    k = _known_sum(step.known, params, d, q, xp)
-    case = step.case
-    if case == TWO_ANGLES:
-        return (_angle_coefficient(step.first, params, d, q, xp),
-                _angle_coefficient(step.second, params, d, q, xp), k)
-    if case == ITS_LENGTH:
-        return (_angle_coefficient(step.first, params, d, q, xp),
-                _length_coefficient(step.second, params, d, q, xp, False), k)
-    if case == OTHER_LENGTH:
-        return (_angle_coefficient(step.first, params, d, q, xp),
-                _length_coefficient(step.second, params, d, q, xp, True), k)
-    return (_length_coefficient(step.first, params, d, q, xp, True),
-            _length_coefficient(step.second, params, d, q, xp, True), k)
+from .assembly import MIRROR, TANGENT_SLACK, Indeterminate
+from .steps import (
+    FourbarLoop,
+    Step,
+    Term,
+    coefficients,
+    fourbar_transmission,
+    is_open,
+    is_open_np,
+    solve_step,
+    solve_step_np,
+    step_margin,
+    step_margin_np,
+    step_side,
+    step_side_np,
+)
 
 
 class Derivation(NamedTuple):
@@ -237,9 +131,9 @@ class Derivation(NamedTuple):
         signs_left = iter(signs)
         for step in self.steps:
             sigma = next(signs_left) if step.two_way else 0.0
-            first, second, k = _coefficients(step, p, driver, q, math)
+            first, second, k = coefficients(step, p, driver, q, math)
             try:
-                got = _solve_step(step.case, first, second, k, sigma)
+                got = solve_step(step.case, first, second, k, sigma)
             except ZeroDivisionError as exc:
                 raise Indeterminate(f"loop {'+'.join(str(i + 1) for i in step.loops)}: {exc}") from None
             if got is None:
@@ -267,8 +161,8 @@ class Derivation(NamedTuple):
         for step in self.steps:
             if not step.two_way:
                 continue
-            first, second, k = _coefficients(step, p, driver, q, math)
-            out.append(_side(step.case, first, second, k, q[step.unknowns[0]], q[step.unknowns[1]]))
+            first, second, k = coefficients(step, p, driver, q, math)
+            out.append(step_side(step.case, first, second, k, q[step.unknowns[0]], q[step.unknowns[1]]))
         return tuple(out)
 
     def meets(self, q: Sequence[float], driver: float,
@@ -282,8 +176,8 @@ class Derivation(NamedTuple):
         out = []
         for step in self.steps:
             if step.two_way:
-                first, second, k = _coefficients(step, p, driver, q, math)
-                out.append(abs(_margin(step.case, first, second, k)) <= TANGENT_SLACK)
+                first, second, k = coefficients(step, p, driver, q, math)
+                out.append(abs(step_margin(step.case, first, second, k)) <= TANGENT_SLACK)
         return tuple(out)
 
     def meets_np(self, q: Sequence[Any], driver: Any, params: Mapping[str, Any] | None = None) -> list[Any]:
@@ -295,8 +189,8 @@ class Derivation(NamedTuple):
         with np.errstate(invalid="ignore", divide="ignore"):
             for step in self.steps:
                 if step.two_way:
-                    first, second, k = _coefficients(step, p, np.asarray(driver, float), q, np)
-                    out.append(np.abs(_margin_np(step.case, first, second, k)) <= TANGENT_SLACK)
+                    first, second, k = coefficients(step, p, np.asarray(driver, float), q, np)
+                    out.append(np.abs(step_margin_np(step.case, first, second, k)) <= TANGENT_SLACK)
         return out
 
     def on_branch(self, q: Sequence[float], driver: float, want: BranchText,
@@ -339,11 +233,11 @@ class Derivation(NamedTuple):
         signs_left = iter(signs)
         for step in self.steps:
             sigma = next(signs_left) if step.two_way else 0.0
-            first, second, k = _coefficients(step, p, driver, q, math)
+            first, second, k = coefficients(step, p, driver, q, math)
             if step.two_way:
-                out.append(_margin(step.case, first, second, k))
+                out.append(step_margin(step.case, first, second, k))
             try:
-                got = _solve_step(step.case, first, second, k, sigma)
+                got = solve_step(step.case, first, second, k, sigma)
             except ZeroDivisionError:
                 got = None
             if got is None:
@@ -375,10 +269,10 @@ class Derivation(NamedTuple):
         with np.errstate(invalid="ignore", divide="ignore"):
             for step in self.steps:
                 sigma = next(signs_left) if step.two_way else 0.0
-                first, second, k = _coefficients(step, p, d, q, np)
+                first, second, k = coefficients(step, p, d, q, np)
                 if step.two_way:
-                    out.append(_margin_np(step.case, first, second, k))
-                a, b, fine = _solve_step_np(step.case, first, second, k, sigma)
+                    out.append(step_margin_np(step.case, first, second, k))
+                a, b, fine = solve_step_np(step.case, first, second, k, sigma)
                 ok = ok & fine
                 q[step.unknowns[0]], q[step.unknowns[1]] = a, b
         shape = ok.shape
@@ -397,8 +291,8 @@ class Derivation(NamedTuple):
         with np.errstate(invalid="ignore", divide="ignore"):
             for step in self.steps:
                 if step.two_way:
-                    first, second, k = _coefficients(step, p, np.asarray(driver, float), q, np)
-                    out.append(_side_np(step.case, first, second, k, q[step.unknowns[0]],
+                    first, second, k = coefficients(step, p, np.asarray(driver, float), q, np)
+                    out.append(step_side_np(step.case, first, second, k, q[step.unknowns[0]],
                                         q[step.unknowns[1]]))
         return out
 
@@ -444,10 +338,10 @@ class Derivation(NamedTuple):
             if not step.two_way:
                 continue
             if step.word_rule:
-                out.append("open" if _is_open(step, p, driver, q) else "crossed")
+                out.append("open" if is_open(step, p, driver, q) else "crossed")
             else:  # the sign, computed only here: a sweep names every position
-                first, second, k = _coefficients(step, p, driver, q, math)
-                sigma = _side(step.case, first, second, k, q[step.unknowns[0]], q[step.unknowns[1]])
+                first, second, k = coefficients(step, p, driver, q, math)
+                sigma = step_side(step.case, first, second, k, q[step.unknowns[0]], q[step.unknowns[1]])
                 out.append("+" if sigma >= 0.0 else "-")
         return out
 
@@ -528,7 +422,6 @@ class Derivation(NamedTuple):
                          f"or - per closed-form step with two roots, e.g. {'+' * count})")
 
 
-MIRROR = " (mirror)"
 _OTHER_WORD = {"open": "crossed", "crossed": "open", "+": "-", "-": "+"}
 
 
@@ -577,262 +470,3 @@ def read_branch(der: Derivation, text: str) -> BranchText:
                          f"of its {count} two-way step{'s' if count != 1 else ''} (e.g. {'+' * count}); "
                          f"a second assembly of one name is NAME{MIRROR}")
     return BranchText(None, tuple(w in ("open", "+") for w in parts), mirrors)
-
-
-def _is_open(step: Step, params: Mapping[str, Any], d: Any, q: Sequence[Any], xp: Any = math) -> Any:
-    """The conventional open/crossed rule of a step's loop at a configuration."""
-    assert step.word_terms is not None
-    (s2, _, a2, o2), (s3, _, a3, o3) = step.word_terms
-    t2 = _val(a2, params, d, q) + o2
-    t3 = _val(a3, params, d, q) + o3
-    if step.word_rule == "fourbar":
-        # the coupler as traversed (sign s2) and the output from its ground pivot (-s3):
-        # open where the output turns anticlockwise from the coupler
-        return s2 * -s3 * xp.sin(t3 - t2) > 0.0
-    # slider: the coupler as traversed against the slide's direction of growth (-s3)
-    return s2 * -s3 * xp.cos(t3 - t2) > 0.0
-
-
-def is_open_np(step: Step, params: Mapping[str, Any], d: Any, q: Sequence[Any]) -> Any:
-    """:func:`_is_open` over arrays."""
-    import numpy as np
-
-    return _is_open(step, params, d, q, np)
-
-
-def folded_transmission(mu: float, half_turn: float = 180.0) -> float:
-    """The transmission angle, the one rule every engine reads: the angle ``mu`` in
-    [0, half_turn] between the coupler's direction and the output link's, folded into
-    [0, half_turn / 2] - the acute angle between the two links' lines, 90 deg transmitting
-    best and 0 a toggle, whichever way the linkage is assembled (Norton, Design of
-    Machinery, "the absolute value of the acute angle of the pair of angles at the
-    intersection of the two links"; Shigley and Uicker's |90 - mu| criterion reads the
-    same). The unfolded angle is theta_output - theta_coupler, in the same tables. Exact:
-    half_turn - mu is exact for mu >= half_turn / 2 (Sterbenz); NaN stays NaN."""
-    return min(mu, half_turn - mu)
-
-
-def folded_transmission_np(mu: Any, half_turn: float = 180.0) -> Any:
-    """:func:`folded_transmission` over arrays."""
-    import numpy as np
-
-    return np.minimum(mu, half_turn - mu)
-
-
-def fourbar_transmission(view: FourbarLoop, loop: Sequence[Term], params: Mapping[str, Any],
-                         d: Any, q: Sequence[Any], xp: Any = math) -> Any:
-    """The transmission angle of a four-bar loop (rad, folded into [0, pi/2] by the one rule,
-    :func:`folded_transmission`): between the coupler as traversed and the output link
-    from its ground pivot."""
-    s2, _, a2, o2 = loop[view.coupler]
-    s3, _, a3, o3 = loop[view.output]
-    t2 = _val(a2, params, d, q) + o2 + (0.0 if s2 > 0 else math.pi)
-    t3 = _val(a3, params, d, q) + o3 + (math.pi if s3 > 0 else 0.0)
-    diff = t3 - t2
-    if xp is not math:
-        return folded_transmission_np(xp.abs(xp.arctan2(xp.sin(diff), xp.cos(diff))), math.pi)
-    return folded_transmission(abs(math.atan2(math.sin(diff), math.cos(diff))), math.pi)
-
-
-def _solve_step(case: str, first: Any, second: Any, k: Any, sigma: float) -> tuple[float, float] | None:
-    if case == TWO_ANGLES:
-        return dyads.two_angles(first, second, k, sigma)
-    if case == ITS_LENGTH:
-        return dyads.angle_and_its_length(first, second, k, sigma)
-    if case == OTHER_LENGTH:
-        return dyads.angle_and_other_length(first, second, k, sigma)
-    return dyads.two_lengths(first, second, k)
-
-
-def _solve_step_np(case: str, first: Any, second: Any, k: Any, sigma: float) -> tuple[Any, Any, Any]:
-    if case == TWO_ANGLES:
-        return dyads.two_angles_np(first, second, k, sigma)
-    if case == ITS_LENGTH:
-        return dyads.angle_and_its_length_np(first, second, k, sigma)
-    if case == OTHER_LENGTH:
-        return dyads.angle_and_other_length_np(first, second, k, sigma)
-    return dyads.two_lengths_np(first, second, k)
-
-
-def _side(case: str, first: Any, second: Any, k: Any, a: float, b: float) -> float:
-    if case == TWO_ANGLES:
-        return dyads.two_angles_side(first, k, a)
-    if case == ITS_LENGTH:
-        return dyads.line_side(dyads._cdiv(first, second), b)
-    return dyads.line_side(dyads._cdiv(k, second), b)
-
-
-def _side_np(case: str, first: Any, second: Any, k: Any, a: Any, b: Any) -> Any:
-    if case == TWO_ANGLES:
-        return dyads.two_angles_side_np(first, k, a)
-    if case == ITS_LENGTH:
-        return dyads.line_side_np(dyads._cdiv(first, second), b)
-    return dyads.line_side_np(dyads._cdiv(k, second), b)
-
-
-def _margin(case: str, first: Any, second: Any, k: Any) -> float:
-    if case == TWO_ANGLES:
-        return dyads.two_angles_margin(first, second, k)
-    try:
-        if case == ITS_LENGTH:
-            return dyads.line_circle_margin(dyads._cdiv(first, second),
-                                            dyads.norm(*k) / dyads.norm(*second))
-        return dyads.line_circle_margin(dyads._cdiv(k, second), dyads.norm(*first) / dyads.norm(*second))
-    except ZeroDivisionError:
-        return math.nan
-
-
-def _margin_np(case: str, first: Any, second: Any, k: Any) -> Any:
-    if case == TWO_ANGLES:
-        return dyads.two_angles_margin_np(first, second, k)
-    norm = dyads.norm_np
-    if case == ITS_LENGTH:
-        return dyads.line_circle_margin_np(dyads._cdiv(first, second),
-                                           norm(k[0], k[1]) / norm(second[0], second[1]))
-    return dyads.line_circle_margin_np(dyads._cdiv(k, second),
-                                       norm(first[0], first[1]) / norm(second[0], second[1]))
-
-
-# --- the derivation --------------------------------------------------------------------------
-
-def loop_terms(m: Any) -> list[list[Term]]:
-    """The mechanism's loops with each name resolved: an unknown to its index, the driver
-    to DRIVER, a parameter to its name, a number to itself."""
-    index = {u.name: i for i, u in enumerate(m.unknowns)}
-
-    def ref(x: str | float) -> Ref:
-        if isinstance(x, str):
-            if x in index:
-                return index[x]
-            return DRIVER if x == m.driver.name else x
-        return float(x)
-
-    return [[(t.sign, ref(t.length), ref(t.angle), t.offset) for t in loop.vectors] for loop in m.loops]
-
-
-def _is(ref: Ref, unknown: int) -> bool:
-    """``ref`` is that unknown (not a number that equals its index: 0.0 == 0)."""
-    return ref.__class__ is int and ref == unknown
-
-
-def _key(ref: Ref) -> tuple[str, Ref]:
-    return ref.__class__.__name__, ref
-
-
-def _is_unknown(ref: Ref, known: set[int]) -> bool:
-    return ref.__class__ is int and ref != DRIVER and ref not in known  # type: ignore[operator]
-
-
-def _combine(a: Sequence[Term], b: Sequence[Term], c: float) -> list[Term]:
-    """The loop a + c b, a vector that appears in both with opposite net sign cancelled."""
-    net: dict[Any, float] = {}
-    order: dict[Any, tuple[Ref, Ref, float]] = {}
-    for w, terms in ((1.0, a), (c, b)):
-        for sign, lr, ar, off in terms:
-            key = (_key(lr), _key(ar), off)
-            order.setdefault(key, (lr, ar, off))
-            net[key] = net.get(key, 0.0) + w * sign
-    return [(net[key], *vec) for key, vec in order.items() if net[key] != 0.0]
-
-
-def _classify(terms: Sequence[Term], known: set[int], loops: tuple[int, ...],
-              weights: tuple[float, ...]) -> Step | None:
-    """The step that solves a loop (or combination) with exactly two unknowns in a
-    classical case, or None."""
-    unknown: list[int] = []
-    for _, lr, ar, _ in terms:
-        for r in (lr, ar):
-            if _is_unknown(r, known) and r not in unknown:
-                unknown.append(r)  # type: ignore[arg-type]
-    if len(unknown) != 2:
-        return None
-    angles = [u for u in unknown if any(_is(ar, u) for _, _, ar, _ in terms)]
-    lengths = [u for u in unknown if any(_is(lr, u) for _, lr, _, _ in terms)]
-    if len(angles) + len(lengths) != 2:  # an unknown is an angle or a length, never both
-        return None
-    known_terms = tuple(t for t in terms if not (_is_unknown(t[1], known) or _is_unknown(t[2], known)))
-
-    def having(pred: Any) -> tuple[Term, ...]:
-        return tuple(t for t in terms if pred(t))
-
-    if len(angles) == 2 and not lengths:
-        a, b = angles
-        return Step(TWO_ANGLES, loops, weights, (a, b), known_terms,
-                    having(lambda t: _is(t[2], a)), having(lambda t: _is(t[2], b)))
-    if len(lengths) == 2 and not angles:
-        s, t_ = lengths
-        return Step(TWO_LENGTHS, loops, weights, (s, t_), known_terms,
-                    having(lambda t: _is(t[1], s)), having(lambda t: _is(t[1], t_)))
-    if len(angles) == 1 and len(lengths) == 1 and angles[0] != lengths[0]:
-        a, s = angles[0], lengths[0]
-        with_both = having(lambda t: _is(t[1], s) and _is(t[2], a))
-        length_only = having(lambda t: _is(t[1], s) and not _is(t[2], a))
-        angle_only = having(lambda t: _is(t[2], a) and not _is(t[1], s))
-        if with_both and not length_only:
-            return Step(ITS_LENGTH, loops, weights, (a, s), known_terms, angle_only, with_both)
-        if length_only and not with_both and angle_only:
-            word = ()
-            if len(length_only) == 1 and len(angle_only) == 1 and len(loops) == 1:
-                word = (angle_only[0], length_only[0])
-            return Step(OTHER_LENGTH, loops, weights, (a, s), known_terms, angle_only, length_only,
-                        "slider" if word else "", word or None)
-    return None
-
-
-def fourbar_view(terms: Sequence[Term], loop: int) -> FourbarLoop | None:
-    """The loop as a four-bar (input, coupler, output, ground) when it is one: four links
-    of fixed length (parameters or numbers) on four distinct angles, exactly one of them
-    fixed (the ground)."""
-    if len(terms) != 4:
-        return None
-    if any(lr.__class__ is int for _, lr, _, _ in terms):
-        return None
-    angles = [ar for _, _, ar, _ in terms]
-    fixed = [i for i, ar in enumerate(angles) if ar.__class__ is not int]
-    moving = [ar for ar in angles if ar.__class__ is int]
-    if len(fixed) != 1 or len(set(moving)) != 3:
-        return None
-    g = fixed[0]
-    i, c, o = ((g + 1) % 4, (g + 2) % 4, (g + 3) % 4)
-    return FourbarLoop(loop, i, c, o, g)
-
-
-def derive(m: Any) -> Derivation:
-    """The stepwise closed form of a mechanism's loops (see the module's docstring)."""
-    loops = loop_terms(m)
-    views = tuple(v for v in (fourbar_view(t, i) for i, t in enumerate(loops)) if v is not None)
-    by_loop = {v.loop: v for v in views}
-    pool = list(range(len(loops)))
-    known: set[int] = set()
-    steps: list[Step] = []
-    n = len(m.unknowns)
-    while pool and len(known) < n:
-        step = None
-        for i in pool:
-            step = _classify(loops[i], known, (i,), (1.0,))
-            if step is not None:
-                pool.remove(i)
-                view = by_loop.get(i)
-                if view is not None and step.case == TWO_ANGLES:
-                    t = loops[i]
-                    step = Step(step.case, step.loops, step.weights, step.unknowns, step.known,
-                                step.first, step.second, "fourbar", (t[view.coupler], t[view.output]))
-                break
-        if step is None:
-            for i, j in itertools.permutations(pool, 2):
-                for c in (1.0, -1.0):
-                    step = _classify(_combine(loops[i], loops[j], c), known, (i, j), (1.0, c))
-                    if step is not None:
-                        pool.remove(j)  # i stays: the pair's second equation
-                        break
-                if step is not None:
-                    break
-        if step is None:
-            break
-        steps.append(step)
-        known.update(step.unknowns)
-    coupled = tuple((i, len({r for _, lr, ar, _ in loops[i] for r in (lr, ar) if _is_unknown(r, known)}))
-                    for i in pool) if len(known) < n else ()
-    return Derivation(tuple(steps), n, tuple(u.name for u in m.unknowns),
-                      tuple(loop.name for loop in m.loops), coupled, views,
-                      {k: q.value for k, q in m.parameters.items()}, tuple(map(tuple, loops)))

@@ -22,7 +22,6 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ..methods.golden import golden_min
 from .derive import Derivation
 
 Signs = tuple[float, ...]
@@ -97,19 +96,3 @@ def limits_between_np(d: Derivation, a: Any, b: Any, branches: Sequence[Signs], 
         good = np.where(live & ok, mid, good)
         bad = np.where(live & ~ok, mid, bad)
     return good
-
-
-def dip_between(d: Derivation, a: float, c: float, branches: Sequence[Signs], scale: float = 1.0,
-                params: Mapping[str, float] | None = None) -> tuple[float, float] | None:
-    """Where :func:`assembles` is >= 0 at both ``a`` and ``c`` but dips below zero between
-    (an unassembled sliver narrower than the grid): its two limits, else None. Golden-section
-    search for the smallest value, then :func:`limit_between` on each side."""
-    def g(x: float) -> float:
-        return assembles(d, x, branches, scale, params)
-
-    _, x1, g1, x2, g2, _ = golden_min(g, a, c, 200, lambda k: k[2] < 0.0 or k[4] < 0.0 or not k[1] < k[3])
-    inside = x1 if g1 < 0.0 else x2 if g2 < 0.0 else None
-    if inside is None:
-        return None
-    return limit_between(d, a, inside, branches, scale, params), limit_between(d, inside, c, branches,
-                                                                              scale, params)

@@ -171,7 +171,7 @@ def line_circle_margin_np(z: tuple[Any, Any], r: Any) -> Any:
         return np.where(big > 0.0, (r - np.abs(z[1])) / big, 0.0)
 
 
-def _cdiv(a: Pair, b: Pair) -> Pair:
+def cdiv(a: Pair, b: Pair) -> Pair:
     n = b[0] * b[0] + b[1] * b[1]
     x, y = _cmul_conj(a[0], a[1], b[0], b[1])
     return x / n, y / n
@@ -181,7 +181,7 @@ def angle_and_its_length(p: Pair, dd: Pair, k: Pair, sigma: float) -> tuple[floa
     """(a, s) with e^(ia) (P + s D) + K = 0; None when it cannot close. Raises
     ZeroDivisionError when D = 0, or K = 0 where it closes (then P + s D = 0 and every
     angle a is a solution: an inverted slider-crank's pin on the slide's pivot)."""
-    s = line_circle(_cdiv(p, dd), norm(*k) / norm(*dd), sigma)
+    s = line_circle(cdiv(p, dd), norm(*k) / norm(*dd), sigma)
     if s is None:
         return None
     if k[0] == 0.0 and k[1] == 0.0:
@@ -196,7 +196,7 @@ def angle_and_its_length_np(p: tuple[Any, Any], dd: tuple[Any, Any], k: tuple[An
     import numpy as np
 
     with np.errstate(invalid="ignore", divide="ignore"):
-        s, ok = line_circle_np(_cdiv(p, dd), norm_np(k[0], k[1]) / norm_np(dd[0], dd[1]), sigma)
+        s, ok = line_circle_np(cdiv(p, dd), norm_np(k[0], k[1]) / norm_np(dd[0], dd[1]), sigma)
     ok = ok & ((k[0] != 0.0) | (k[1] != 0.0))  # K = 0: the angle is indeterminate
     s = np.where(ok, s, np.nan)
     wx, wy = p[0] + s * dd[0], p[1] + s * dd[1]
@@ -207,7 +207,7 @@ def angle_and_its_length_np(p: tuple[Any, Any], dd: tuple[Any, Any], k: tuple[An
 def angle_and_other_length(p: Pair, e: Pair, k: Pair, sigma: float) -> tuple[float, float] | None:
     """(a, s) with P e^(ia) + s E + K = 0; None when it cannot close. Raises
     ZeroDivisionError when E = 0."""
-    s = line_circle(_cdiv(k, e), norm(*p) / norm(*e), sigma)
+    s = line_circle(cdiv(k, e), norm(*p) / norm(*e), sigma)
     if s is None:
         return None
     wx, wy = -(k[0] + s * e[0]), -(k[1] + s * e[1])
@@ -220,7 +220,7 @@ def angle_and_other_length_np(p: tuple[Any, Any], e: tuple[Any, Any], k: tuple[A
     import numpy as np
 
     with np.errstate(invalid="ignore", divide="ignore"):
-        s, ok = line_circle_np(_cdiv(k, e), norm_np(p[0], p[1]) / norm_np(e[0], e[1]), sigma)
+        s, ok = line_circle_np(cdiv(k, e), norm_np(p[0], p[1]) / norm_np(e[0], e[1]), sigma)
     wx, wy = -(k[0] + s * e[0]), -(k[1] + s * e[1])
     ex, ey = _cmul_conj(wx, wy, p[0], p[1])
     return np.arctan2(ey, ex), s, ok

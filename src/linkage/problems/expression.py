@@ -34,6 +34,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 from ..errors import ParseError
+from ..units import RAD_PER_DEG
 from .scalar import ScalarProblem
 
 MAX_LENGTH = 2000
@@ -42,7 +43,9 @@ MAX_OPERATIONS = 2000
 
 Fn = Callable[[float], float]
 
-DEG = math.pi / 180.0
+DEG = RAD_PER_DEG
+"""pi/180 (:data:`linkage.units.RAD_PER_DEG`): the degree functions' factor and their
+derivatives' chain-rule factor."""
 EPS = 2.0**-52
 
 
@@ -56,6 +59,7 @@ FUNCTIONS: dict[str, Fn] = {
     "sinh": math.sinh, "cosh": math.cosh, "tanh": math.tanh,
     "exp": math.exp, "log": math.log, "log10": math.log10, "sqrt": math.sqrt,
     "abs": abs,
+    # the degree functions hold linkage.units' constant (no call in an equation's hot loop)
     "sind": lambda v: math.sin(v * DEG), "cosd": lambda v: math.cos(v * DEG),
     "tand": lambda v: math.tan(v * DEG),
     "asind": lambda v: math.asin(v) / DEG, "acosd": lambda v: math.acos(v) / DEG,
@@ -333,112 +337,122 @@ def _num(v: float) -> str:
     return repr(v) if v >= 0.0 else f"({v!r})"
 
 
-def generate(ops: tuple[Op, ...], order: int) -> str:
-    """Source of ``def fn(x)`` returning the value (order 0), f' (1) or f'' (2)."""
-    lines = ["def fn(x):"]
-    v: list[str] = []          # the value's expression per op (a name or a literal)
-    d: list[str | None] = []   # first derivative (None: identically zero)
-    dd: list[str | None] = []  # second derivative
+class _Source:
+    """A generated ``fn`` being written: its lines, and per op the expression (a name or a
+    literal) of its value and of its first and second derivatives (None: identically zero)."""
 
-    def emit(name: str, expr: str) -> str:
-        lines.append(f"    {name} = {expr}")
+    def __init__(self, order: int) -> None:
+        self.order = order
+        self.lines = ["def fn(x):"]
+        self.v: list[str] = []
+        self.d: list[str | None] = []
+        self.dd: list[str | None] = []
+
+    def emit(self, name: str, expr: str) -> str:
+        self.lines.append(f"    {name} = {expr}")
         return name
 
-    def push(value: str, first: str | None, second: str | None) -> None:
-        v.append(value)
-        d.append(first)
-        dd.append(second)
+    def push(self, value: str, first: str | None, second: str | None) -> None:
+        self.v.append(value)
+        self.d.append(first)
+        self.dd.append(second)
 
+
+def generate(ops: tuple[Op, ...], order: int) -> str:
+    """Source of ``def fn(x)`` returning the value (order 0), f' (1) or f'' (2)."""
+    s = _Source(order)
     for i, op in enumerate(ops):
-        t = f"t{i}"
         if op.kind == "num":
-            push(_num(op.value), None, None)
-            continue
-        if op.kind == "x":
-            push("x", "1.0" if order else None, None)
-            continue
-        if op.kind == "var":  # another variable: held fixed by the derivatives (partial in x)
-            push(f"v{int(op.value)}", None, None)
-            continue
-        a = op.args[0]
-        va, da, dda = v[a], d[a], dd[a]
-        if op.kind == "neg":
-            v.append(emit(t, f"-{va}"))
-            d.append(emit(f"d{i}", f"-{da}") if order and da else None)
-            dd.append(emit(f"e{i}", f"-{dda}") if order > 1 and dda else None)
-            continue
-        if op.kind in FUNCTIONS:
-            vt = emit(t, f"_{op.kind}({va})")
-            v.append(vt)
-            if order and da:
-                g1 = emit(f"g{i}", _RULES[op.kind][0].format(u=va, v=vt))
-                d.append(emit(f"d{i}", f"{g1} * {da}"))
-                if order > 1:
-                    g2 = _RULES[op.kind][1].format(u=va, v=vt, g1=g1)
-                    terms = [f"({g2}) * {da} * {da}"] + ([f"{g1} * {dda}"] if dda else [])
-                    dd.append(emit(f"e{i}", " + ".join(terms)))
-                else:
-                    dd.append(None)
-            else:
-                d.append(None)
-                dd.append(None)
-            continue
-        c = op.args[1]
-        vb, db, ddb = v[c], d[c], dd[c]
-        k = op.kind
-        if k == "**":
-            const_exp = ops[c].kind == "num"
-            vt = emit(t, f"{va} * {va}" if const_exp and ops[c].value == 2.0 else f"_pow({va}, {vb})")
+            s.push(_num(op.value), None, None)
+        elif op.kind == "x":
+            s.push("x", "1.0" if order else None, None)
+        elif op.kind == "var":  # another variable: held fixed by the derivatives (partial in x)
+            s.push(f"v{int(op.value)}", None, None)
+        elif op.kind == "neg":
+            a = op.args[0]
+            va, da, dda = s.v[a], s.d[a], s.dd[a]
+            s.push(s.emit(f"t{i}", f"-{va}"), s.emit(f"d{i}", f"-{da}") if order and da else None,
+                   s.emit(f"e{i}", f"-{dda}") if order > 1 and dda else None)
+        elif op.kind in FUNCTIONS:
+            _function(s, i, op)
         else:
-            vt = emit(t, f"{va} {k} {vb}")
-        v.append(vt)
-        if not order or (da is None and db is None):
-            d.append(None)
-            dd.append(None)
-            continue
-        z = "0.0"
-        if k in "+-":
-            d.append(emit(f"d{i}", f"{da or z} {k} {db or z}"))
-            dd.append(emit(f"e{i}", f"{dda or z} {k} {ddb or z}") if order > 1 and (dda or ddb) else None)
-        elif k == "*":
-            d.append(emit(f"d{i}", f"{da or z} * {vb} + {va} * {db or z}"))
-            if order > 1:
-                dd.append(emit(f"e{i}", f"{dda or z} * {vb} + 2.0 * {da or z} * {db or z} + "
-                                        f"{va} * {ddb or z}"))
-            else:
-                dd.append(None)
-        elif k == "/":
-            di = emit(f"d{i}", f"({da or z} - {vt} * {db or z}) / {vb}")
-            d.append(di)
-            dd.append(emit(f"e{i}", f"({dda or z} - 2.0 * {di} * {db or z} - {vt} * {ddb or z}) / {vb}")
-                      if order > 1 else None)
-        elif db is None:  # a ** c, c constant
-            cv = ops[c].value
-            if cv == 2.0:
-                g1 = emit(f"g{i}", f"2.0 * {va}")
-                g2 = "2.0"
-            else:
-                g1 = emit(f"g{i}", f"{_num(cv)} * _pow({va}, {_num(cv - 1.0)})")
-                g2 = f"{_num(cv * (cv - 1.0))} * _pow({va}, {_num(cv - 2.0)})" if cv != 1.0 else "0.0"
-            d.append(emit(f"d{i}", f"{g1} * {da}"))
-            if order > 1:
-                terms = [f"({g2}) * {da} * {da}"] + ([f"{g1} * {dda}"] if dda else [])
-                dd.append(emit(f"e{i}", " + ".join(terms)))
-            else:
-                dd.append(None)
-        else:  # a ** b = exp(b log a): d = v w, w = b' log a + b a'/a
-            w = emit(f"w{i}", f"{db} * _log({va}) + {vb} * {da or z} / {va}")
-            di = emit(f"d{i}", f"{vt} * {w}")
-            d.append(di)
-            if order > 1:
-                wp = emit(f"q{i}", f"{ddb or z} * _log({va}) + 2.0 * {db} * {da or z} / {va} + "
-                                   f"{vb} * ({dda or z} * {va} - {da or z} * {da or z}) / ({va} * {va})")
-                dd.append(emit(f"e{i}", f"{di} * {w} + {vt} * {wp}"))
-            else:
-                dd.append(None)
-    result = [v, d, dd][order][-1]
-    lines.append(f"    return {result or '0.0'}")
-    return "\n".join(lines) + "\n"
+            _binary(s, i, op, ops)
+    result = [s.v, s.d, s.dd][order][-1]
+    s.lines.append(f"    return {result or '0.0'}")
+    return "\n".join(s.lines) + "\n"
+
+
+def _function(s: _Source, i: int, op: Op) -> None:
+    """A function of one argument, by the chain rule (:data:`_RULES`)."""
+    a = op.args[0]
+    va, da, dda = s.v[a], s.d[a], s.dd[a]
+    vt = s.emit(f"t{i}", f"_{op.kind}({va})")
+    if not (s.order and da):
+        s.push(vt, None, None)
+        return
+    g1 = s.emit(f"g{i}", _RULES[op.kind][0].format(u=va, v=vt))
+    first = s.emit(f"d{i}", f"{g1} * {da}")
+    second = None
+    if s.order > 1:
+        g2 = _RULES[op.kind][1].format(u=va, v=vt, g1=g1)
+        terms = [f"({g2}) * {da} * {da}"] + ([f"{g1} * {dda}"] if dda else [])
+        second = s.emit(f"e{i}", " + ".join(terms))
+    s.push(vt, first, second)
+
+
+def _binary(s: _Source, i: int, op: Op, ops: tuple[Op, ...]) -> None:
+    """a + b, a - b, a * b, a / b or a ** b, with its derivatives by the textbook rules."""
+    a, c = op.args[0], op.args[1]
+    va, da, dda = s.v[a], s.d[a], s.dd[a]
+    vb, db, ddb = s.v[c], s.d[c], s.dd[c]
+    k, t, z = op.kind, f"t{i}", "0.0"
+    if k == "**":
+        const_exp = ops[c].kind == "num"
+        vt = s.emit(t, f"{va} * {va}" if const_exp and ops[c].value == 2.0 else f"_pow({va}, {vb})")
+    else:
+        vt = s.emit(t, f"{va} {k} {vb}")
+    if not s.order or (da is None and db is None):
+        s.push(vt, None, None)
+        return
+    second_too = s.order > 1
+    if k in "+-":
+        s.push(vt, s.emit(f"d{i}", f"{da or z} {k} {db or z}"),
+               s.emit(f"e{i}", f"{dda or z} {k} {ddb or z}") if second_too and (dda or ddb) else None)
+    elif k == "*":
+        first = s.emit(f"d{i}", f"{da or z} * {vb} + {va} * {db or z}")
+        s.push(vt, first, s.emit(f"e{i}", f"{dda or z} * {vb} + 2.0 * {da or z} * {db or z} + "
+                                          f"{va} * {ddb or z}") if second_too else None)
+    elif k == "/":
+        di = s.emit(f"d{i}", f"({da or z} - {vt} * {db or z}) / {vb}")
+        s.push(vt, di, s.emit(f"e{i}", f"({dda or z} - 2.0 * {di} * {db or z} - {vt} * {ddb or z}) / {vb}")
+               if second_too else None)
+    elif db is None:  # a ** c, c constant
+        _constant_power(s, i, vt, va, da, dda, ops[c].value)
+    else:  # a ** b = exp(b log a): d = v w, w = b' log a + b a'/a
+        w = s.emit(f"w{i}", f"{db} * _log({va}) + {vb} * {da or z} / {va}")
+        di = s.emit(f"d{i}", f"{vt} * {w}")
+        second = None
+        if second_too:
+            wp = s.emit(f"q{i}", f"{ddb or z} * _log({va}) + 2.0 * {db} * {da or z} / {va} + "
+                                 f"{vb} * ({dda or z} * {va} - {da or z} * {da or z}) / ({va} * {va})")
+            second = s.emit(f"e{i}", f"{di} * {w} + {vt} * {wp}")
+        s.push(vt, di, second)
+
+
+def _constant_power(s: _Source, i: int, vt: str, va: str, da: str | None, dda: str | None, cv: float) -> None:
+    """a ** c for a constant c: d = c a^(c-1) a', d2 = c (c-1) a^(c-2) a'^2 + c a^(c-1) a''."""
+    if cv == 2.0:
+        g1 = s.emit(f"g{i}", f"2.0 * {va}")
+        g2 = "2.0"
+    else:
+        g1 = s.emit(f"g{i}", f"{_num(cv)} * _pow({va}, {_num(cv - 1.0)})")
+        g2 = f"{_num(cv * (cv - 1.0))} * _pow({va}, {_num(cv - 2.0)})" if cv != 1.0 else "0.0"
+    first = s.emit(f"d{i}", f"{g1} * {da}")
+    second = None
+    if s.order > 1:
+        terms = [f"({g2}) * {da} * {da}"] + ([f"{g1} * {dda}"] if dda else [])
+        second = s.emit(f"e{i}", " + ".join(terms))
+    s.push(vt, first, second)
 
 
 def generate_bound(ops: tuple[Op, ...]) -> str:

@@ -21,10 +21,11 @@ from collections.abc import Callable
 from typing import Any, NamedTuple
 
 from ..errors import InputError
+from ..units import RAD_PER_DEG, degrees, radians
 from .assembly import is_open, label
 from .scalar import ScalarProblem
 
-DEG = math.pi / 180.0
+DEG = RAD_PER_DEG  # held here for the hot closures below (linkage.units)
 EPS = sys.float_info.epsilon
 
 SEED_R = (5.0 / 3.0, 5.0 / 2.0, 11.0 / 6.0)
@@ -81,7 +82,7 @@ def fourbar_equation(
                              (("alpha", alpha_deg), ("R1", r1), ("R2", r2), ("R3", r3)))
     if r2 == 0.0:
         raise InputError("R2 must be non-zero (it divides in the fixed-point form)")
-    alpha = alpha_deg * DEG
+    alpha = radians(alpha_deg)
     k = r1 * math.cos(alpha) + r3
     cos, sin, acos, sqrt = math.cos, math.sin, math.acos, math.sqrt
 
@@ -152,14 +153,14 @@ def equation_roots(alpha_deg: float, r1: float, r2: float, r3: float) -> list[fl
     (R2 + cos a) cos phi + sin a sin phi = R1 cos a + R3, so
     phi = atan2(sin a, R2 + cos a) +- acos(K / |(R2 + cos a, sin a)|). [] when the
     linkage cannot be assembled at alpha; one root at a limit position."""
-    a = alpha_deg * DEG
+    a = radians(alpha_deg)
     p, q = r2 + math.cos(a), math.sin(a)
     k = r1 * math.cos(a) + r3
     size = math.hypot(p, q)
     if size == 0.0 or abs(k) > size:
         return []
     base, spread = math.atan2(q, p), math.acos(max(-1.0, min(1.0, k / size)))
-    roots = {(math.degrees(base + s * spread) + 180.0) % 360.0 - 180.0 for s in (1.0, -1.0)}
+    roots = {(degrees(base + s * spread) + 180.0) % 360.0 - 180.0 for s in (1.0, -1.0)}
     return sorted(roots)
 
 
@@ -169,33 +170,33 @@ def branch_root(alpha_deg: float, r1: float, r2: float, r3: float, sign: float) 
     :func:`equation_roots` told apart by ``sign`` (+1 or -1). A branch keeps its sign
     between limit positions, where the two roots meet (acos at 0 or pi); NaN where the
     linkage cannot be assembled."""
-    a = alpha_deg * DEG
+    a = radians(alpha_deg)
     p, q = r2 + math.cos(a), math.sin(a)
     size = math.hypot(p, q)
     k = r1 * math.cos(a) + r3
     if size == 0.0 or abs(k) > size:
         return math.nan
-    return math.degrees(math.atan2(q, p) + sign * math.acos(k / size))
+    return degrees(math.atan2(q, p) + sign * math.acos(k / size))
 
 
 def branch_root_np(alpha_deg: Any, r1: Any, r2: Any, r3: Any, sign: Any) -> Any:
     """:func:`branch_root` over arrays (broadcast): NaN where there is no assembly."""
     import numpy as np
 
-    a = np.asarray(alpha_deg, float) * DEG
+    a = radians(np.asarray(alpha_deg, float))
     p, q = r2 + np.cos(a), np.sin(a)
     size = np.hypot(p, q)
     ratio = (r1 * np.cos(a) + r3) / np.where(size == 0.0, np.nan, size)
     with np.errstate(invalid="ignore"):
         spread = np.where(np.abs(ratio) <= 1.0, np.arccos(np.clip(ratio, -1.0, 1.0)), np.nan)
-    return np.degrees(np.arctan2(q, p) + sign * spread)
+    return degrees(np.arctan2(q, p) + sign * spread)
 
 
 def branch_sign(alpha_deg: float, phi_deg: float, r1: float, r2: float, r3: float) -> float:
     """The sign (+1 or -1) of :func:`branch_root` whose root is ``phi_deg``: the side of
     atan2(sin a, R2 + cos a) the root lies on (+1 for a root at a limit position)."""
-    a = alpha_deg * DEG
-    base = math.degrees(math.atan2(math.sin(a), r2 + math.cos(a)))
+    a = radians(alpha_deg)
+    base = degrees(math.atan2(math.sin(a), r2 + math.cos(a)))
     # phi - base wrapped exactly into [-180, 180] (fmod is exact, so are the +-360 after it),
     # the same operations as the numpy twin (branch_sign_np); +-180 (acos at pi,
     # a limit position) is +1 whichever way rounding put it
@@ -208,8 +209,8 @@ def branch_sign_np(alpha_deg: Any, phi_deg: Any, r1: Any, r2: Any, r3: Any) -> A
     """:func:`branch_sign` over arrays: the same operations."""
     import numpy as np
 
-    a = np.asarray(alpha_deg, float) * DEG
-    base = np.degrees(np.arctan2(np.sin(a), r2 + np.cos(a)))
+    a = radians(np.asarray(alpha_deg, float))
+    base = degrees(np.arctan2(np.sin(a), r2 + np.cos(a)))
     d = np.fmod(phi_deg - base, 360.0)
     d = np.where(d > 180.0, d - 360.0, np.where(d < -180.0, d + 360.0, d))
     return np.where((d >= 0.0) | (d == -180.0), 1.0, -1.0)
@@ -236,7 +237,7 @@ def file_convention(alpha_deg: float, phi_deg: float,
     opposite direction, so theta2 = alpha + 180 and theta4 = phi + 180; theta3 is the
     coupler's direction from A to B. Angles in (-180, 180]."""
     a, _, c, d = links
-    t2, t4 = math.radians(alpha_deg + 180.0), math.radians(phi_deg + 180.0)
+    t2, t4 = radians(alpha_deg + 180.0), radians(phi_deg + 180.0)
     A = a * complex(math.cos(t2), math.sin(t2))
     B = d + c * complex(math.cos(t4), math.sin(t4))
     t3 = math.atan2((B - A).imag, (B - A).real)
@@ -245,5 +246,5 @@ def file_convention(alpha_deg: float, phi_deg: float,
         return (v + 180.0) % 360.0 - 180.0 if (v + 180.0) % 360.0 != 0.0 else 180.0
 
     branch = label(is_open(t3, t4))
-    return {"theta2": wrap(alpha_deg + 180.0), "theta3": wrap(math.degrees(t3)),
+    return {"theta2": wrap(alpha_deg + 180.0), "theta3": wrap(degrees(t3)),
             "theta4": wrap(phi_deg + 180.0), "branch": branch}

@@ -1,9 +1,9 @@
 """A mechanism from its drawing: joints with coordinates, links as lists of joints,
 sliders, a driver. Derives what the loops form states by hand: each link's lengths and the
 fixed angles inside it, the mobility (Gruebler-Kutzbach) and the independent loops (a
-cycle basis of the joint-link graph), and hands :func:`~.loops.parse_mechanism` the
+cycle basis of the joint-link graph), and hands :func:`~linkage.kinematics.loading.parse_mechanism` the
 equivalent loops-form document, so everything downstream works unchanged;
-:func:`loops_text` is ``linkage convert``. The shape of the file::
+:func:`.toml_text.loops_text` is ``linkage convert``. The shape of the file::
 
     name = "Offset slider-crank"
     length_unit = "mm"
@@ -29,7 +29,7 @@ with the body its line is on; its travel is measured along the line from the foo
 perpendicular from that body's first joint. The drawing gives the lengths and the
 assembly; [driver] value says where to solve (left out, the drawn angle or travel). A
 value other than the drawn one (beyond the drawing's rounding, :data:`DRIVER_TOLERANCE_DEG`)
-is solved on the drawing's branch (:func:`~.loops.parse_mechanism`), and a command says
+is solved on the drawing's branch (:func:`~linkage.kinematics.loading.parse_mechanism`), and a command says
 where the crank was drawn in a note.
 Derived names (stable: scans and scripts use them): unknowns ``theta_<link>`` and
 ``s_<slider>``; lengths ``<link>`` (first to second joint), ``<link>_<P>_<Q>``, ``ground``
@@ -42,9 +42,11 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from ..errors import ParseError
+from ..units import degrees, radians
 from .closed_form import wrap_degrees
 
 GROUND = "ground"
@@ -71,7 +73,7 @@ def _number(v: Any) -> bool:
 
 
 def _angle_deg(p: tuple[float, float], q: tuple[float, float]) -> float:
-    return math.degrees(math.atan2(q[1] - p[1], q[0] - p[0]))
+    return degrees(math.atan2(q[1] - p[1], q[0] - p[0]))
 
 
 class Slide(NamedTuple):
@@ -113,115 +115,149 @@ def loops_doc(doc: Mapping[str, Any], source: str = "<mechanism>") -> dict[str, 
         return ParseError(f"{source}: {key}: {msg}")
 
     drawing = _read(doc, fail)
-    xy, ground, links, bodies, points, sliders = drawing
     unit = doc.get("length_unit")
     dname, value = _driver(doc, drawing, fail)
+    frame, unknowns = _frames(drawing, dname)
+    slid = _slid(drawing, dname, unit, unknowns)
+    loops_needed = _loop_count(drawing)
+    if 2 * loops_needed != len(unknowns):
+        raise fail("links", f"{loops_needed} independent loop(s) give {2 * loops_needed} equations "
+                            f"for {len(unknowns)} unknowns ({', '.join(unknowns)})")
+    sliders = drawing.sliders
+    owner = {(f"s_{b}" if b in sliders else f"theta_{b}"): f"{b}'s {'travel' if b in sliders else 'angle'}"
+             for b in drawing.links}
+    w = _Vectors(drawing, unit, fail, frame, slid, {}, owner)
+    loops = _loops(w)
+    pts = {j: {"from": drawing.center(b), "vectors": [w.vector(b, drawing.center(b), j, 1)]}
+           for j, b in drawing.points.items()}
+    drv = {"name": dname, "value": float(value), "unit": unit if dname.startswith("s_") else "deg"}
+    if isinstance(doc.get("driver"), Mapping) and "range" in doc["driver"]:
+        drv["range"] = doc["driver"]["range"]  # checked as the loops form's (one rule)
+    out = {"name": doc.get("name", "mechanism"), "length_unit": unit,
+           "description": doc.get("description", ""),
+           "origin": list(drawing.xy[drawing.ground[0]]),
+           "parameters": w.params, "driver": drv, "unknowns": unknowns, "loops": loops}
+    if pts:
+        out["points"] = pts
+    return out
 
-    # each body's frame: the angle its vectors turn with (an unknown, the driver, or None
-    # for the ground) and the drawn angle of that reference (a link's first two joints)
+
+Frames = dict[str, tuple[str | None, float]]
+"""Each body's frame: the angle its vectors turn with (an unknown, the driver, or None for
+the ground) and the drawn angle of that reference (a link's first two joints)."""
+
+
+def _frames(drawing: Drawing, dname: str) -> tuple[Frames, dict[str, Any]]:
+    """Each body's frame, and the unknowns: the links' angles but the driver's."""
+    xy, links = drawing.xy, drawing.links
     base = {b: _angle_deg(xy[js[0]], xy[js[1]]) for b, js in links.items() if len(js) > 1}
-    frame: dict[str, tuple[str | None, float]] = {GROUND: (None, 0.0)}
+    frame: Frames = {GROUND: (None, 0.0)}
     unknowns: dict[str, Any] = {}
     for b in links:
-        if b not in sliders:
+        if b not in drawing.sliders:
             frame[b] = (f"theta_{b}", base[b])
             if frame[b][0] != dname:
                 unknowns[f"theta_{b}"] = {"guess": base[b], "unit": "deg"}
-    for b, slide in sliders.items():
+    for b, slide in drawing.sliders.items():
         frame[b] = frame[slide.on]
-    slid: dict[str, tuple[float, float]] = {}  # a slider's drawn travel and offset
-    for b, slide in sliders.items():
-        (jx, jy), (px, py) = xy[drawing.center(slide.on)], xy[drawing.center(b)]
-        ux, uy = math.cos(math.radians(slide.angle_deg)), math.sin(math.radians(slide.angle_deg))
+    return frame, unknowns
+
+
+def _slid(drawing: Drawing, dname: str, unit: Any,
+          unknowns: dict[str, Any]) -> dict[str, tuple[float, float]]:
+    """Each slider's drawn travel and offset from its line's joint; its travel an unknown
+    unless it is the driver's."""
+    slid: dict[str, tuple[float, float]] = {}
+    for b, slide in drawing.sliders.items():
+        (jx, jy), (px, py) = drawing.xy[drawing.center(slide.on)], drawing.xy[drawing.center(b)]
+        line = radians(slide.angle_deg)
+        ux, uy = math.cos(line), math.sin(line)
         along, across = (px - jx) * ux + (py - jy) * uy, (py - jy) * ux - (px - jx) * uy
         if abs(across) <= 4 * EPS * math.hypot(px - jx, py - jy):
             across = 0.0  # the projection's rounding: the line passes through J0
         slid[b] = (along, across)
         if f"s_{b}" != dname:
             unknowns[f"s_{b}"] = {"guess": along, "unit": unit}
-    loops_needed = _loop_count(drawing)
-    if 2 * loops_needed != len(unknowns):
-        raise fail("links", f"{loops_needed} independent loop(s) give {2 * loops_needed} equations "
-                            f"for {len(unknowns)} unknowns ({', '.join(unknowns)})")
+    return slid
 
-    params: dict[str, Any] = {}
-    owner = {(f"s_{b}" if b in sliders else f"theta_{b}"): f"{b}'s {'travel' if b in sliders else 'angle'}"
-             for b in links}
 
-    def own(name: str, what: str) -> None:
+@dataclass(frozen=True)
+class _Vectors:
+    """The loops' and points' vectors being written from a drawing: the parameters they
+    name (``params``, filled as they are written) and what owns each derived name."""
+
+    drawing: Drawing
+    unit: Any
+    fail: Any
+    frame: Frames
+    slid: dict[str, tuple[float, float]]
+    params: dict[str, Any]
+    owner: dict[str, str]
+
+    def own(self, name: str, what: str) -> None:
         """Each derived name one thing: a link named like another's derived name would
         silently share its number."""
-        if owner.setdefault(name, what) != what:
-            raise fail("links", f"the derived name {name} is {owner[name]} and {what}: rename a "
-                                "link (names: <link>, <link>_<P>_<Q>, theta_<link>, s_ and e_<slider>)")
+        if self.owner.setdefault(name, what) != what:
+            raise self.fail("links", f"the derived name {name} is {self.owner[name]} and {what}: rename a "
+                                     "link (names: <link>, <link>_<P>_<Q>, theta_<link>, s_ and e_<slider>)")
 
-    def angle(b: str, drawn_deg: float) -> dict[str, Any]:
-        ref, b0 = frame[b]
+    def angle(self, b: str, drawn_deg: float) -> dict[str, Any]:
+        ref, b0 = self.frame[b]
         if ref is None:
             return {"angle": drawn_deg}
         offset = wrap_degrees(drawn_deg - b0)
         return {"angle": ref, "offset": offset} if offset else {"angle": ref}
 
-    def vector(b: str, p: str, q: str, sign: int) -> dict[str, Any]:
+    def vector(self, b: str, p: str, q: str, sign: int) -> dict[str, Any]:
+        xy, bodies = self.drawing.xy, self.drawing.bodies
         length = math.dist(xy[p], xy[q])
         if not length > 0.0:
-            raise fail(f"links.{b}" if b != GROUND else "ground",
-                       f"joints {p} and {q} are drawn at one place")
+            raise self.fail(f"links.{b}" if b != GROUND else "ground",
+                            f"joints {p} and {q} are drawn at one place")
         first_two = len(bodies[b]) > 1 and (p, q) == (bodies[b][0], bodies[b][1])
         pname = b if first_two else f"{b}_{p}_{q}"
-        own(pname, f"the length {p} -> {q} of {b}")
-        params[pname] = {"value": length, "unit": unit}
+        self.own(pname, f"the length {p} -> {q} of {b}")
+        self.params[pname] = {"value": length, "unit": self.unit}
         if b == GROUND:  # a length and an angle parameter: a scan may move a ground joint
-            own(f"theta_{pname}", f"the ground's angle {p} -> {q}")
-            params[f"theta_{pname}"] = {"value": _angle_deg(xy[p], xy[q]), "unit": "deg"}
+            self.own(f"theta_{pname}", f"the ground's angle {p} -> {q}")
+            self.params[f"theta_{pname}"] = {"value": _angle_deg(xy[p], xy[q]), "unit": "deg"}
             return {"length": pname, "angle": f"theta_{pname}", "sign": sign}
-        return {"length": pname, **angle(b, _angle_deg(xy[p], xy[q])), "sign": sign}
+        return {"length": pname, **self.angle(b, _angle_deg(xy[p], xy[q])), "sign": sign}
 
-    def slide_vectors(b: str, forward: bool) -> tuple[list[str], list[dict[str, Any]]]:
+    def slide_vectors(self, b: str, forward: bool) -> tuple[list[str], list[dict[str, Any]]]:
         """A slider's edge J0 -> P: its offset across the line, then its travel along it."""
-        start, end = drawing.center(sliders[b].on), drawing.center(b)
-        line = sliders[b].angle_deg
-        own(f"e_{b}", f"slider {b}'s offset")
-        params[f"e_{b}"] = {"value": slid[b][1], "unit": unit, "signed": True}
-        e = {"length": f"e_{b}", **angle(sliders[b].on, wrap_degrees(line + 90.0))}
-        s = {"length": f"s_{b}", **angle(sliders[b].on, line)}
+        slide = self.drawing.sliders[b]
+        start, end = self.drawing.center(slide.on), self.drawing.center(b)
+        line = slide.angle_deg
+        self.own(f"e_{b}", f"slider {b}'s offset")
+        self.params[f"e_{b}"] = {"value": self.slid[b][1], "unit": self.unit, "signed": True}
+        e = {"length": f"e_{b}", **self.angle(slide.on, wrap_degrees(line + 90.0))}
+        s = {"length": f"s_{b}", **self.angle(slide.on, line)}
         if forward:
             return [start, ""], [{**e, "sign": 1}, {**s, "sign": 1}]
         return [end, ""], [{**s, "sign": -1}, {**e, "sign": -1}]
 
-    edges: list[tuple[str, str, str]] = []  # (body, from joint, to joint)
-    for b, js in bodies.items():
-        c = drawing.center(b)
-        edges += [(b, c, j) for j in js if j != c and j not in points]
-    edges += [(b, drawing.center(slide.on), drawing.center(b)) for b, slide in sliders.items()]
 
+def _loops(w: _Vectors) -> list[dict[str, Any]]:
+    """One loop per cycle of the joint-link graph, its vectors written by ``w``."""
+    drawing, sliders = w.drawing, w.drawing.sliders
+    edges: list[tuple[str, str, str]] = []  # (body, from joint, to joint)
+    for b, js in drawing.bodies.items():
+        c = drawing.center(b)
+        edges += [(b, c, j) for j in js if j != c and j not in drawing.points]
+    edges += [(b, drawing.center(slide.on), drawing.center(b)) for b, slide in sliders.items()]
     loops = []
-    for cycle in _placed_in_order(_cycles(edges, ground[0]), ground):
+    for cycle in _placed_in_order(_cycles(edges, drawing.ground[0]), drawing.ground):
         names, vecs = [], []
         for (b, p, q), forward in cycle:
             if b in sliders and (p, q) == (drawing.center(sliders[b].on), drawing.center(b)):
-                n, v = slide_vectors(b, forward)
+                n, v = w.slide_vectors(b, forward)
             else:
-                n, v = [p if forward else q], [vector(b, p, q, 1 if forward else -1)]
+                n, v = [p if forward else q], [w.vector(b, p, q, 1 if forward else -1)]
             names += n
             vecs += v
         loops.append({"name": "-".join(n for n in names if n), "joints": names, "vectors": vecs})
-    pts = {}
-    for j, b in points.items():
-        pts[j] = {"from": drawing.center(b), "vectors": [vector(b, drawing.center(b), j, 1)]}
-    if dname.startswith("s_"):
-        drv = {"name": dname, "value": float(value), "unit": unit}
-    else:
-        drv = {"name": dname, "value": float(value), "unit": "deg"}
-    if isinstance(doc.get("driver"), Mapping) and "range" in doc["driver"]:
-        drv["range"] = doc["driver"]["range"]  # checked as the loops form's (one rule)
-    out = {"name": doc.get("name", "mechanism"), "length_unit": unit,
-           "description": doc.get("description", ""),
-           "origin": list(xy[ground[0]]),
-           "parameters": params, "driver": drv, "unknowns": unknowns, "loops": loops}
-    if pts:
-        out["points"] = pts
-    return out
+    return loops
 
 
 EPS = 2.220446049250313e-16
@@ -268,7 +304,7 @@ def drawn_driver(d: Drawing, driver: Mapping[str, Any]) -> float:
     if "slider" in driver:
         s = driver["slider"]
         (jx, jy), (px, py) = d.xy[d.center(GROUND)], d.xy[d.center(s)]
-        t = math.radians(d.sliders[s].angle_deg)
+        t = radians(d.sliders[s].angle_deg)
         return (px - jx) * math.cos(t) + (py - jy) * math.sin(t)
     js = d.links[driver["link"]]
     return _angle_deg(d.xy[js[0]], d.xy[js[1]])
@@ -288,6 +324,38 @@ def off_drawing(d: Drawing, driver: Mapping[str, Any], value: float) -> float | 
 def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
     """The drawing's joints, ground, links, sliders and points, checked: every name known
     and used, the bodies connected, and the mobility 1."""
+    xy, ground = _joints(doc, fail)
+    links_doc, sliders_doc = doc.get("links"), doc.get("sliders", {})
+    if not isinstance(links_doc, Mapping) or not links_doc:
+        raise fail("links", "must be a table of link = [joints]")
+    if not isinstance(sliders_doc, Mapping):
+        raise fail("sliders", "must be a table of link = { on = BODY, angle = DEG } or { on, line = [P, Q] }")
+    links = _links(links_doc, sliders_doc, xy, ground, fail)
+    bodies = {GROUND: list(ground), **links}
+    sliders = _sliders(sliders_doc, bodies, xy, fail)
+    at: dict[str, list[str]] = {j: [] for j in xy}
+    for b, js in bodies.items():
+        for j in js:
+            at[j].append(b)
+    # a fixed joint on no link is a slip, unless it marks a slider's line
+    lines = {j for v in sliders_doc.values() if isinstance(v, Mapping) for j in v.get("line", [])}
+    loose = [j for j, bs in at.items() if not [b for b in bs if b != GROUND] and j not in lines]
+    if loose:
+        raise fail(f"joints.{loose[0]}", "is on no link" + (" (a fixed joint carries a link)"
+                                                           if at[loose[0]] else ""))
+    # before the mobility: a part apart from the ground has its own, which would mislead
+    _connected(bodies, at, sliders, fail)
+
+    # coupler points: a joint on one moving link and nothing else, drawn on it (a slider's
+    # first joint is its pin on the line, never a point)
+    points = {j: bs[0] for j, bs in at.items()
+              if len(bs) == 1 and bs[0] != GROUND and not (bs[0] in sliders and bodies[bs[0]][0] == j)}
+    _check_mobility(bodies, at, sliders, fail)
+    return Drawing(xy, list(ground), links, bodies, points, sliders)
+
+
+def _joints(doc: Mapping[str, Any], fail: Any) -> tuple[dict[str, tuple[float, float]], list[str]]:
+    """The file's keys, its joints (x, y) and its fixed joints, checked."""
     allowed = {"name", "description", "length_unit", "ground", "joints", "links", "sliders",
                "driver", "notes", "loads", "mass"}
     for key in doc:
@@ -317,11 +385,12 @@ def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
             raise fail("ground", f"{g!r} is not a joint (joints: {', '.join(xy)})")
     if len(set(ground)) != len(ground):
         raise fail("ground", "names a joint twice")
-    if not isinstance(links_doc, Mapping) or not links_doc:
-        raise fail("links", "must be a table of link = [joints]")
-    sliders_doc = doc.get("sliders", {})
-    if not isinstance(sliders_doc, Mapping):
-        raise fail("sliders", "must be a table of link = { on = BODY, angle = DEG } or { on, line = [P, Q] }")
+    return xy, ground
+
+
+def _links(links_doc: Mapping[str, Any], sliders_doc: Mapping[str, Any], xy: Mapping[str, Any],
+           ground: list[str], fail: Any) -> dict[str, list[str]]:
+    """``[links]``: each a list of known joints, not all fixed (a slider may have one)."""
     links: dict[str, list[str]] = {}
     for name, js in links_doc.items():
         key = f"links.{name}"
@@ -340,27 +409,13 @@ def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
         if all(j in ground for j in js):
             raise fail(key, "every joint of it is fixed: it is part of the ground")
         links[str(name)] = list(js)
-    bodies = {GROUND: list(ground), **links}
-    sliders = _sliders(sliders_doc, bodies, xy, fail)
-    at: dict[str, list[str]] = {j: [] for j in xy}
-    for b, js in bodies.items():
-        for j in js:
-            at[j].append(b)
-    # a fixed joint on no link is a slip, unless it marks a slider's line
-    lines = {j for v in sliders_doc.values() if isinstance(v, Mapping) for j in v.get("line", [])}
-    loose = [j for j, bs in at.items() if not [b for b in bs if b != GROUND] and j not in lines]
-    if loose:
-        raise fail(f"joints.{loose[0]}", "is on no link" + (" (a fixed joint carries a link)"
-                                                           if at[loose[0]] else ""))
-    # before the mobility: a part apart from the ground has its own, which would mislead
-    _connected(bodies, at, sliders, fail)
+    return links
 
-    # coupler points: a joint on one moving link and nothing else, drawn on it (a slider's
-    # first joint is its pin on the line, never a point)
-    points = {j: bs[0] for j, bs in at.items()
-              if len(bs) == 1 and bs[0] != GROUND and not (bs[0] in sliders and bodies[bs[0]][0] == j)}
-    # mobility (Gruebler-Kutzbach): 3 (n - 1) - 2 j1, a joint shared by k bodies being k - 1
-    # revolute pairs, and each slider one prismatic pair
+
+def _check_mobility(bodies: Mapping[str, list[str]], at: Mapping[str, list[str]],
+                    sliders: Mapping[str, Slide], fail: Any) -> None:
+    """Mobility 1 (Gruebler-Kutzbach): 3 (n - 1) - 2 j1, a joint shared by k bodies being
+    k - 1 revolute pairs, and each slider one prismatic pair."""
     n = len(bodies)
     revolute = sum(len(bs) - 1 for bs in at.values())
     pairs = revolute + len(sliders)
@@ -371,7 +426,6 @@ def _read(doc: Mapping[str, Any], fail: Any) -> Drawing:
         kinds = f"{revolute} revolute" + (f" and {len(sliders)} sliding" if sliders else "")
         raise fail("links", f"mobility {mobility} ({n} bodies with the ground, {kinds} pairs: "
                             f"3 x {n - 1} - 2 x {pairs}): {what}; a joints file needs mobility 1")
-    return Drawing(xy, list(ground), links, bodies, points, sliders)
 
 
 def _sliders(spec: Mapping[str, Any], bodies: Mapping[str, list[str]],
@@ -518,61 +572,3 @@ def _cycles(edges: list[tuple[str, str, str]], root: str) -> list[Cycle]:
             node = nxt
         cycles.append([(edges[k], True), *walk, *reversed(down)])
     return cycles
-
-
-def toml_value(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, (int, float)):
-        return repr(float(v)) if isinstance(v, float) else str(v)
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(v, list):
-        return "[" + ", ".join(toml_value(x) for x in v) + "]"
-    if isinstance(v, Mapping):
-        return "{ " + ", ".join(f"{toml_key(k)} = {toml_value(x)}" for k, x in v.items()) + " }"
-    raise TypeError(type(v).__name__)
-
-
-def toml_key(k: str) -> str:
-    """A key as TOML reads it back: bare when it can be, else quoted (a joint may be named
-    "B'" or "joint 1")."""
-    return k if k and all(c.isascii() and (c.isalnum() or c in "_-") for c in k) else toml_value(k)
-
-
-def loops_text(doc: Mapping[str, Any], source: str = "<mechanism>", mechanism: Any = None) -> str:
-    """The derived loops-form file of a drawing, as TOML text: each loop under a comment
-    naming its joints, so the loop-closure equations the drawing implies can be read.
-    ``mechanism``: the drawing as read (problems.loops.parse_mechanism); when its [driver]
-    value is off the drawing, its guesses (the drawing's branch there) are written."""
-    d = loops_doc(doc, source)
-    out = [f"# the vector loops of {source}, derived from its joints and links (linkage convert)",
-           f"name = {toml_value(d['name'])}"]
-    note = None if mechanism is None else mechanism.drawing_note
-    if note is not None:  # guesses on the drawing's branch at [driver] value
-        for u in mechanism.unknowns:
-            d["unknowns"][u.name]["guess"] = math.degrees(u.value) if u.kind == "angle" else u.value
-        out.insert(1, f"# {note.removeprefix(source + ': ')}: the guesses are there")
-    if d.get("description"):
-        out.append(f"description = {toml_value(d['description'])}")
-    first = d["loops"][0]["joints"][0] if d["loops"] else "the first joint"
-    out += [f"length_unit = {toml_value(d['length_unit'])}",
-            f"origin = {toml_value(d['origin'])}  # where {first} is drawn",
-            "", "[parameters]  # the drawn lengths (and the ground's angles; e_: a slider line's offset)"]
-    out += [f"{toml_key(k)} = {toml_value(v)}" for k, v in d["parameters"].items()]
-    out += ["", "[driver]"] + [f"{k} = {toml_value(v)}" for k, v in d["driver"].items()]
-    out += ["", "[unknowns]  # each moving link's angle (s_: a slider's travel), guessed from the drawing"]
-    out += [f"{toml_key(k)} = {toml_value(v)}" for k, v in d["unknowns"].items()]
-    for loop in d["loops"]:
-        names = loop["joints"]
-        shown = [n or "(foot)" for n in names]
-        out += ["", f"# {' -> '.join([*shown, shown[0]])}: the sum of these vectors is zero",
-                "[[loops]]", f"name = {toml_value(loop['name'])}", f"joints = {toml_value(names)}",
-                "vectors = ["]
-        out += [f"  {toml_value(v)},  # {a} -> {b}"
-                for v, a, b in zip(loop["vectors"], shown, [*shown[1:], shown[0]])]
-        out.append("]")
-    for name, p in d.get("points", {}).items():
-        out += ["", f"[points.{toml_key(name)}]  # on a link, nothing else attached",
-                f"from = {toml_value(p['from'])}", f"vectors = {toml_value(p['vectors'])}"]
-    return "\n".join(out) + "\n"

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import functools
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
+
+from ..units import degrees, radians
 
 Vector = Sequence[float]
 Residual = Callable[[Vector], list[float]]
@@ -52,10 +53,10 @@ class SystemProblem:
 
     def to_display(self, q: Vector) -> list[float]:
         """Internal values to interface units: radians become degrees."""
-        return [math.degrees(v) if k == "angle" else v for v, k in zip(q, self.kinds)]
+        return [degrees(v) if k == "angle" else v for v, k in zip(q, self.kinds)]
 
     def from_display(self, values: Vector) -> list[float]:
-        return [math.radians(v) if k == "angle" else v for v, k in zip(values, self.kinds)]
+        return [radians(v) if k == "angle" else v for v, k in zip(values, self.kinds)]
 
     def unit(self, i: int) -> str:
         return "deg" if self.kinds[i] == "angle" else self.length_unit

@@ -13,7 +13,7 @@ points the way the slide grows; the inverted slider-crank's ``open`` has the roc
 pointing from its pivot towards the block (a positive travel).
 
 :func:`template` gives the joints document, :func:`joints_text` the commented file and
-:func:`text` either form (the loops form through :func:`.joints.loops_text`, so there is
+:func:`text` either form (the loops form through :func:`.toml_text.loops_text`, so there is
 one derivation)."""
 
 from __future__ import annotations
@@ -24,8 +24,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
+from ..units import radians
 from . import dyads
-from .joints import toml_value
+from .toml_text import toml_value
 
 Point = tuple[float, float]
 BRANCHES = ("open", "crossed")
@@ -65,6 +66,9 @@ class Kind:
     """Two-way steps: one --branch word each."""
     fixed: str = ""
     """Fixed angles of the drawing (the six-bars keep their sample's), for the comments."""
+    open_brief: str = ""
+    """What ``--branch open`` draws, in a few words for ``linkage new --help`` (a six-bar's
+    dyads read as the four-bar's: none of its own)."""
 
     @property
     def signed(self) -> frozenset[str]:
@@ -119,8 +123,8 @@ def _watt(r: Sequence[float], t: float, sides: Sequence[float]) -> Joints:
     O4B), and a dyad C-D-O6 (r[5], r[6]) to a third pivot O6, r[7] from O4 at 60 deg."""
     xy = _fourbar(r, t, sides)
     o4 = xy["O4"]
-    c = _polar(o4, r[4], _angle(o4, xy["B"]) + math.radians(WATT_C_DEG))
-    o6 = _polar(o4, r[7], math.radians(WATT_O6_DEG))
+    c = _polar(o4, r[4], _angle(o4, xy["B"]) + radians(WATT_C_DEG))
+    o6 = _polar(o4, r[7], radians(WATT_O6_DEG))
     d = _dyad(c, r[5], o6, r[6], sides[1], ("C", "link7's pivot O6", "link6", "link7"))
     return {**xy, "C": c, "D": d, "O6": o6}
 
@@ -130,8 +134,8 @@ def _stephenson(r: Sequence[float], t: float, sides: Sequence[float]) -> Joints:
     AB), and a dyad C-D-O6 (r[5], r[6]) to a third pivot O6, r[7] from O2 at 110 deg."""
     xy = _fourbar(r, t, sides)
     a = xy["A"]
-    c = _polar(a, r[4], _angle(a, xy["B"]) + math.radians(STEPHENSON_C_DEG))
-    o6 = _polar(xy["O2"], r[7], math.radians(STEPHENSON_O6_DEG))
+    c = _polar(a, r[4], _angle(a, xy["B"]) + radians(STEPHENSON_C_DEG))
+    o6 = _polar(xy["O2"], r[7], radians(STEPHENSON_O6_DEG))
     d = _dyad(c, r[5], o6, r[6], sides[1], ("C", "link6's pivot O6", "link5", "link6"))
     return {**xy, "C": c, "D": d, "O6": o6}
 
@@ -178,7 +182,8 @@ KINDS: dict[str, Kind] = {
         ("O2A", "AB", "O4B", "O2O4"), (40.0, 120.0, 80.0, 100.0), 30.0,
         "the rocker turns anticlockwise from the coupler (B on the left of A -> O4)",
         ("O2", "O4"), {"crank": ["O2", "A"], "coupler": ["A", "B"], "rocker": ["O4", "B"]}, {},
-        FOURBAR_NOTES, {"crank": "the driver", "coupler": "", "rocker": ""}, _fourbar),
+        FOURBAR_NOTES, {"crank": "the driver", "coupler": "", "rocker": ""}, _fourbar,
+        open_brief="a four-bar's rocker turns anticlockwise from its coupler"),
     "slider-crank": Kind(
         "Slider-crank", "slider_crank.toml", ("crank", "coupler", "offset"),
         ("O2A", "AB", "the slider's line y = offset: any sign, 0 in line with O2"),
@@ -186,7 +191,8 @@ KINDS: dict[str, Kind] = {
         ("O2",), {"crank": ["O2", "A"], "coupler": ["A", "B"], "block": ["B"]},
         {"block": {"on": "ground", "angle": 0.0}},
         {"O2": "the crank's ground pivot", "A": "the crank pin", "B": "the block's pin, on its line"},
-        {"crank": "the driver", "coupler": "", "block": "a slider block carrying B"}, _slider_crank),
+        {"crank": "the driver", "coupler": "", "block": "a slider block carrying B"}, _slider_crank,
+        open_brief="a slider-crank's coupler points the way the slide grows"),
     "inverted-slider": Kind(
         "Inverted slider-crank", "inverted_slider_crank.toml", ("crank", "ground", "offset"),
         ("O2A", "O2O4", "the block's line from O4, across the rocker: any sign, 0 through O4"),
@@ -196,7 +202,7 @@ KINDS: dict[str, Kind] = {
         {"O2": "the crank's ground pivot", "A": "the crank pin, the block on it", "O4": "the rocker's pivot",
          "C": "a point on the rocker (crank + ground from O4): its line's direction"},
         {"crank": "the driver", "rocker": "the block slides along it", "block": "a slider block carrying A"},
-        _inverted),
+        _inverted, open_brief="an inverted slider's rocker points towards the block"),
     "watt": Kind(
         "Watt six-bar", "watt_sixbar.toml",
         ("crank", "coupler", "rocker", "ground", "O4C", "CD", "O6D", "O4O6"),
@@ -221,8 +227,30 @@ KINDS: dict[str, Kind] = {
         _stephenson, 2,
         f"C {STEPHENSON_C_DEG:g} deg ahead of AB on the coupler, O6 at {STEPHENSON_O6_DEG:g} deg from O2"),
 }
-"""The kinds, in the order --help lists them. The six-bars' --links run as their samples'
-parameters do, the four-bar's first (crank, coupler, rocker, ground), then the second dyad's."""
+"""The kinds, in the order --help lists them: the one registry ``linkage new`` reads its
+choices, help and defaults from. A new kind is an entry here (with its ``draw``) and the
+sample file its defaults are. The six-bars' --links run as their samples' parameters do,
+the four-bar's first (crank, coupler, rocker, ground), then the second dyad's."""
+
+
+def kind_names() -> str:
+    """The kinds as --help lists them: ``fourbar, slider-crank, ... or stephenson``."""
+    names = list(KINDS)
+    return ", ".join(names[:-1]) + f" or {names[-1]}" if len(names) > 1 else names[0]
+
+
+def kind_titles() -> str:
+    """The kinds' titles: ``Four-bar, Slider-crank, ... or Stephenson III six-bar``."""
+    titles = [k.title for k in KINDS.values()]
+    return ", ".join(titles[:-1]) + f" or {titles[-1]}" if len(titles) > 1 else titles[0]
+
+
+def branch_help() -> str:
+    """What --branch means for every kind, for --help."""
+    briefs = [k.open_brief for k in KINDS.values() if k.open_brief]
+    several = [key for key, k in KINDS.items() if k.dyads > 1]
+    per_dyad = (f"; {' and '.join(several)} take one word per dyad, e.g. open/crossed" if several else "")
+    return f"The assembly drawn: open ({'; '.join(briefs)}) or crossed{per_dyad}."
 
 
 def links_order(kind: str | None = None) -> str:
@@ -300,7 +328,7 @@ def template(kind: str, links: Sequence[float] | None = None, angle_deg: float |
         raise InputError(f"unit: {unit!r} is not a length unit (units: {', '.join(LENGTH_UNITS)})")
     if name is not None and (not name.strip() or not name.isprintable()):
         raise InputError("name: must be one line of printable text")
-    t = math.radians(math.remainder(angle, 360.0))  # exact: the remainder of a double is one
+    t = radians(math.remainder(angle, 360.0))  # exact: the remainder of a double is one
     try:
         joints = k.draw(lengths, t, sides)
     except _Cannot as exc:
@@ -377,13 +405,13 @@ def joints_text(doc: Mapping[str, Any], kind: str, made_by: str) -> str:
 def text(kind: str, links: Sequence[float] | None = None, angle_deg: float | None = None,
          branch: str = "open", unit: str = "mm", name: str | None = None, form: str = "joints") -> str:
     """The file ``linkage new`` writes: the joints form (commented), or with ``form`` =
-    "loops" the loops form the joints imply (:func:`.joints.loops_text`)."""
+    "loops" the loops form the joints imply (:func:`.toml_text.loops_text`)."""
     if form not in ("joints", "loops"):
         raise InputError(f"form: {form!r}: give joints or loops")
     doc = template(kind, links, angle_deg, branch, unit, name)
     made_by = command(kind, links, angle_deg, branch, unit, name, form)
     if form == "loops":
-        from .joints import loops_text
+        from .toml_text import loops_text
 
         return f"# drawn by: {made_by}\n" + loops_text(doc, f"this {kind}")
     return joints_text(doc, kind, made_by)

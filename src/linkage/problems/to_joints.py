@@ -1,6 +1,7 @@
 """A loops-form mechanism as it is drawn: ``linkage convert --form joints``, the way back
-from :func:`.joints.loops_text`. The loops are solved at the file's driver value and their
-named points placed; each vector then tells the body it lies on:
+from :func:`.toml_text.loops_text`. Given the loops solved at the file's driver value and
+their named points placed (:mod:`linkage.kinematics.to_joints` solves and places them: a
+solve is a layer above the problems), each vector tells the body it lies on:
 
 - a vector turning with an unknown or driver angle lies on the link of that angle;
 - a vector of constant length and angle joining two fixed points lies on the ground (a
@@ -11,23 +12,25 @@ named points placed; each vector then tells the body it lies on:
   translates: the rapier's pin D and its tip E).
 
 Links are named after their angles (``theta_crank`` -> ``crank``, ``theta3`` -> ``link3``),
-sliders after their travels (``s_block`` -> ``block``, ``s`` -> ``block_s``). The result
-is checked by deriving its loops again (:func:`.joints.loops_doc`) and solving them at
-the drawn value: a drawing that does not reproduce the placed joints is refused, never
-printed. A loop whose vectors do not name their joints cannot be drawn, and says so.
+sliders after their travels (``s_block`` -> ``block``, ``s`` -> ``block_s``). The solving
+side checks the result by deriving its loops again (:func:`.joints.loops_doc`) and solving
+them at the drawn value: a drawing that does not reproduce the placed joints is refused,
+never printed. A loop whose vectors do not name their joints cannot be drawn, and says so.
 """
 
 from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping, Sequence
 from typing import Any, NamedTuple
 
 from ..errors import InputError
-from .joints import GROUND, toml_key, toml_value
+from ..units import degrees
+from .joints import GROUND
+from .toml_text import toml_key, toml_value
 
-CHECK_TOLERANCE = 1e-9
-"""How closely the drawing's own solve must reproduce the placed joints (of the size)."""
+Point = tuple[float, float]
 
 
 class _Vector(NamedTuple):
@@ -38,6 +41,22 @@ class _Vector(NamedTuple):
     start: str  # named points ("" unnamed)
     end: str
     term: Any
+
+
+class _Moving(NamedTuple):
+    """The names that move: the unknowns' and a driver's, by kind."""
+
+    angles: frozenset[str]
+    lengths: frozenset[str]
+
+    def frame(self, t: Any) -> str:
+        return t.angle if isinstance(t.angle, str) and t.angle in self.angles else GROUND
+
+    def slides(self, t: Any) -> bool:
+        return isinstance(t.length, str) and t.length in self.lengths
+
+    def constant(self, t: Any) -> bool:
+        return self.frame(t) == GROUND and not self.slides(t)
 
 
 def link_name(angle: str) -> str:
@@ -51,44 +70,66 @@ def slider_name(length: str) -> str:
     return length[2:] if length.startswith("s_") and len(length) > 2 else f"block_{length}"
 
 
-def joints_doc(m: Any) -> dict[str, Any]:
-    """The joints-form document of the loops-form mechanism ``m`` (see the module)."""
-    from ..kinematics.rates import rates_at
-    from ..solve import solve_system
+def refusal(m: Any, msg: str) -> InputError:
+    """Why ``m`` cannot be drawn, as every step of the drawing says it."""
+    return InputError(f"{m.source}: cannot be drawn as joints and links: {msg}")
 
-    def refuse(msg: str) -> InputError:
-        return InputError(f"{m.source}: cannot be drawn as joints and links: {msg}")
 
+def check_joints_named(m: Any) -> None:
+    """A loop whose vectors do not name their joints cannot be drawn: refused first."""
     for i, loop in enumerate(m.loops):
         if not loop.joints:
-            raise refuse(f"loops[{i}] ({loop.name}) names no joints: give joints = [...], the "
-                         "start point of each vector (\"\" for an unnamed corner)")
-    result = solve_system(m.problem(), tol=1e-12)
-    if not result.converged:
-        raise refuse(f"its loops do not solve at {m.driver.name} = {_shown_driver(m)} from its "
-                     f"guesses ({result.status.value}): change the guesses or the driver value")
-    q, d = list(result.x), m.driver.value
-    placed = rates_at(m, q).joints
+            raise refusal(m, f"loops[{i}] ({loop.name}) names no joints: give joints = [...], the "
+                             "start point of each vector (\"\" for an unnamed corner)")
+
+
+def drawing_doc(m: Any, q: Sequence[float], placed: Mapping[str, Point]) -> dict[str, Any]:
+    """The joints-form document of the loops-form mechanism ``m`` (see the module), given
+    its unknowns ``q`` solved at its driver value and every named point ``placed`` there."""
+    check_joints_named(m)
+    moving = _moving(m)
+    vectors, fixed = _vectors(m, moving)
+    blocks = _blocks(m, vectors, fixed, list(q))
+    members = _members(m, vectors, fixed, blocks, moving)
+    ground = members.pop(GROUND, [])
+    first = m.loops[0].joints[0]
+    if first in ground:
+        ground.remove(first)
+        ground.insert(0, first)
+    links = _links(members, blocks, vectors, moving)
+    sliders = {s: {"on": GROUND if b["frame"] == GROUND else link_name(b["frame"]), "angle": _wrap(b["line"])}
+               for s, b in blocks.items()}
+    coords = {j: placed[j] for loop in m.loops for j in loop.joints if j} | {p: placed[p] for p in m.points}
+    driver = _driver(m, links, ground, blocks, coords)
+    used = {j for js in [ground, *links.values()] for j in js}
+    doc = {"name": m.name, "description": m.description, "length_unit": m.length_unit,
+           "ground": ground, "joints": {j: list(xy) for j, xy in coords.items() if j in used},
+           "links": links}
+    if sliders:
+        doc["sliders"] = sliders
+    doc["driver"] = driver
+    return doc
+
+
+def _moving(m: Any) -> _Moving:
     angles = {u.name for u in m.unknowns if u.kind == "angle"} | (
         {m.driver.name} if m.driver.kind == "angle" else set())
     lengths = {u.name for u in m.unknowns if u.kind == "length"} | (
         {m.driver.name} if m.driver.kind == "length" else set())
+    return _Moving(frozenset(angles), frozenset(lengths))
 
-    def frame(t: Any) -> str:
-        return t.angle if isinstance(t.angle, str) and t.angle in angles else GROUND
 
-    def constant(t: Any) -> bool:
-        return frame(t) == GROUND and not (isinstance(t.length, str) and t.length in lengths)
-
+def _vectors(m: Any, moving: _Moving) -> tuple[list[_Vector], set[str]]:
+    """Every loop vector with the body it turns with, and the named points fixed in the
+    ground (reached from a fixed one along constant vectors only)."""
     vectors: list[_Vector] = []
     fixed: set[str] = set()
     for i, loop in enumerate(m.loops):
         names, n = loop.joints, len(loop.vectors)
         for k, t in enumerate(loop.vectors):
-            slide = isinstance(t.length, str) and t.length in lengths
-            vectors.append(_Vector(i, k, frame(t), slide, names[k], names[(k + 1) % n], t))
+            vectors.append(_Vector(i, k, moving.frame(t), moving.slides(t), names[k], names[(k + 1) % n], t))
         start_fixed = i == 0 or names[0] in fixed
-        steady = [constant(t) for t in loop.vectors]
+        steady = [moving.constant(t) for t in loop.vectors]
         for k, name in enumerate(names):
             if name and start_fixed and (all(steady[:k]) or all(steady[k:])):
                 fixed.add(name)
@@ -97,12 +138,14 @@ def joints_doc(m: Any) -> dict[str, Any]:
                 continue
             before, after = vectors[-n + (k - 1) % n], vectors[-n + k]
             if not (before.frame == after.frame or before.slide or after.slide):
-                raise refuse(f"loops[{i}] ({loop.name}): the point after vector {(k - 1) % n} joins "
-                             "two links: name it in joints = [...]")
+                raise refusal(m, f"loops[{i}] ({loop.name}): the point after vector {(k - 1) % n} joins "
+                                 "two links: name it in joints = [...]")
+    return vectors, fixed
 
-    # sliders: a travel's named end not on its line's body is the pin its block carries
+
+def _blocks(m: Any, vectors: list[_Vector], fixed: set[str], q: list[float]) -> dict[str, dict[str, Any]]:
+    """The sliders: a travel's named end not on its line's body is the pin its block carries."""
     blocks: dict[str, dict[str, Any]] = {}
-    pin_of: dict[str, str] = {}
     for v in vectors:
         if not v.slide:
             continue
@@ -112,14 +155,17 @@ def joints_doc(m: Any) -> dict[str, Any]:
         pins = [j for j, w in around.items() if j and not (w.frame == v.frame and not w.slide and (
                 v.frame != GROUND or {w.start, w.end} - {""} <= fixed))]
         if len(pins) != 1:
-            raise refuse(f"loops[{v.loop}] ({m.loops[v.loop].name}): cannot tell which end of the "
-                         f"travel {v.term.length} carries the slider")
-        name = slider_name(str(v.term.length))
-        line = math.degrees(_value(m, v.term.angle, q, d) + v.term.offset)
-        blocks.setdefault(name, {"pin": pins[0], "frame": v.frame, "line": line,
-                                 "travel": v.term.length})
-        pin_of[pins[0]] = name
+            raise refusal(m, f"loops[{v.loop}] ({m.loops[v.loop].name}): cannot tell which end of the "
+                             f"travel {v.term.length} carries the slider")
+        line = degrees(_value(m, v.term.angle, q, m.driver.value) + v.term.offset)
+        blocks.setdefault(slider_name(str(v.term.length)), {"pin": pins[0], "frame": v.frame, "line": line,
+                                                            "travel": v.term.length})
+    return blocks
 
+
+def _members(m: Any, vectors: list[_Vector], fixed: set[str], blocks: dict[str, dict[str, Any]],
+             moving: _Moving) -> dict[str, list[str]]:
+    """Each body's joints (GROUND's too), in the order they are met."""
     members: dict[str, list[str]] = {}
 
     def join(body: str, *joints: str) -> None:
@@ -145,41 +191,42 @@ def joints_doc(m: Any) -> dict[str, Any]:
                 grew = True
     for v in pending:
         if v.frame == GROUND and not ({v.start, v.end} - {""}) <= fixed:
-            raise refuse(f"loops[{v.loop}] ({m.loops[v.loop].name}): vector {v.index} has a fixed "
-                         "direction but moves, and no slider carries it")
+            raise refusal(m, f"loops[{v.loop}] ({m.loops[v.loop].name}): vector {v.index} has a fixed "
+                             "direction but moves, and no slider carries it")
         join(GROUND if v.frame == GROUND else link_name(v.frame), v.start, v.end)
     for pname, (origin, terms) in m.points.items():
-        frames = {frame(t) for t in terms}
-        if len(frames) != 1 or any(isinstance(t.length, str) and t.length in lengths for t in terms):
-            raise refuse(f"points.{pname}: its vectors run over more than one link")
+        frames = {moving.frame(t) for t in terms}
+        if len(frames) != 1 or any(moving.slides(t) for t in terms):
+            raise refusal(m, f"points.{pname}: its vectors run over more than one link")
         (f,) = frames
         if f != GROUND:
             join(link_name(f), pname)
             continue
         owner = next((s for s in blocks if origin in members.get(s, [])), None)
         if owner is None:
-            raise refuse(f"points.{pname}: a point fixed in the ground: list it in a loop instead")
+            raise refusal(m, f"points.{pname}: a point fixed in the ground: list it in a loop instead")
         join(owner, pname)
+    return members
 
-    ground = members.pop(GROUND, [])
-    first = m.loops[0].joints[0]
-    if first in ground:
-        ground.remove(first)
-        ground.insert(0, first)
+
+def _links(members: dict[str, list[str]], blocks: dict[str, dict[str, Any]], vectors: list[_Vector],
+           moving: _Moving) -> dict[str, list[str]]:
+    """Each moving body's joints: a block's pin first, a link's two its angle runs between."""
     links = {}
     for body, joints in sorted(members.items(), key=lambda item: item[0] in blocks):
         if body in blocks:
             joints.remove(blocks[body]["pin"])
             links[body] = [blocks[body]["pin"], *joints]
             continue
-        angle = next(f for f in angles if link_name(f) == body)
+        angle = next(f for f in moving.angles if link_name(f) == body)
         links[body] = _ordered(joints, [v for v in vectors if v.frame == angle and not v.slide])
-    sliders = {}
-    for s, b in blocks.items():
-        on = GROUND if b["frame"] == GROUND else link_name(b["frame"])
-        sliders[s] = {"on": on, "angle": _wrap(b["line"])}
-    coords = {j: placed[j] for loop in m.loops for j in loop.joints if j} | {
-        p: placed[p] for p in m.points}
+    return links
+
+
+def _driver(m: Any, links: dict[str, list[str]], ground: list[str], blocks: dict[str, dict[str, Any]],
+            coords: Mapping[str, Point]) -> dict[str, Any]:
+    """The drawing's [driver]: the link it turns (its fixed joint first) at the drawn angle,
+    or the slider whose travel it is; its range in the drawing's unit."""
     if m.driver.kind == "angle":
         link = link_name(m.driver.name)
         js = links[link]
@@ -187,9 +234,9 @@ def joints_doc(m: Any) -> dict[str, Any]:
             if len(js) == 2 and js[1] in ground:
                 links[link] = js = [js[1], js[0]]
             else:
-                raise refuse(f"the driver {m.driver.name} turns a link with no fixed joint first")
+                raise refusal(m, f"the driver {m.driver.name} turns a link with no fixed joint first")
         (x0, y0), (x1, y1) = coords[js[0]], coords[js[1]]
-        drawn, stated = math.degrees(math.atan2(y1 - y0, x1 - x0)), math.degrees(m.driver.value)
+        drawn, stated = degrees(math.atan2(y1 - y0, x1 - x0)), degrees(m.driver.value)
         # the file's own value where the drawing agrees with it (it does but for rounding
         # when the driver's vector runs first joint -> second with no offset)
         value = stated if abs(_wrap(drawn - stated)) <= 1e-9 else drawn
@@ -197,26 +244,18 @@ def joints_doc(m: Any) -> dict[str, Any]:
     else:
         slider = next((s for s, b in blocks.items() if b["travel"] == m.driver.name), None)
         if slider is None:
-            raise refuse(f"the driver {m.driver.name} is a length but no slider's travel")
+            raise refusal(m, f"the driver {m.driver.name} is a length but no slider's travel")
         driver = {"slider": slider}
     if m.driver_range is not None:  # in the driver's unit; a drawing's is deg or its length unit
         driver["range"] = [v * _to_drawing_unit(m) for v in m.driver_range]
-    used = {j for js in [ground, *links.values()] for j in js}
-    doc = {"name": m.name, "description": m.description, "length_unit": m.length_unit,
-           "ground": ground, "joints": {j: list(xy) for j, xy in coords.items() if j in used},
-           "links": links}
-    if sliders:
-        doc["sliders"] = sliders
-    doc["driver"] = driver
-    _check(doc, coords, m, refuse)
-    return doc
+    return driver
 
 
 def _to_drawing_unit(m: Any) -> float:
     from .loops import ANGLE_UNITS, length_factor
 
     if m.driver.kind == "angle":
-        return ANGLE_UNITS[m.driver.unit] * 180.0 / math.pi if m.driver.unit != "deg" else 1.0
+        return degrees(ANGLE_UNITS[m.driver.unit]) if m.driver.unit != "deg" else 1.0
     return 1.0 if m.driver.unit == m.length_unit else length_factor(m.driver.unit, m.length_unit)
 
 
@@ -249,35 +288,14 @@ def _ordered(joints: list[str], vectors: list[_Vector]) -> list[str]:
     return joints
 
 
-def _shown_driver(m: Any) -> str:
-    v = math.degrees(m.driver.value) if m.driver.kind == "angle" else m.driver.value
+def shown_driver(m: Any) -> str:
+    """The driver's value as the user reads it (deg, or the length unit)."""
+    v = degrees(m.driver.value) if m.driver.kind == "angle" else m.driver.value
     return f"{v:g} {'deg' if m.driver.kind == 'angle' else m.length_unit}"
 
 
-def _check(doc: dict[str, Any], coords: dict[str, tuple[float, float]], m: Any, refuse: Any) -> None:
-    """The drawing's own loops, solved at the drawn value from the drawing, give back the
-    placed joints: otherwise the reading of the loops was wrong and nothing is printed."""
-    from ..errors import ParseError
-    from ..kinematics.rates import rates_at
-    from ..solve import solve_system
-    from .loops import parse_mechanism
-
-    try:
-        drawn = parse_mechanism(doc, m.source)
-    except ParseError as exc:
-        raise refuse(str(exc).removeprefix(f"{m.source}: ")) from None
-    result = solve_system(drawn.problem(), tol=1e-12)
-    size = max((math.hypot(x, y) for x, y in coords.values()), default=1.0) or 1.0
-    again = rates_at(drawn, result.x).joints if result.converged else {}
-    off = [j for j, xy in coords.items()
-           if j not in again or math.dist(again[j], xy) > CHECK_TOLERANCE * size]
-    if off:
-        raise refuse(f"the drawing read from its loops does not close at {', '.join(off[:3])}")
-
-
-def joints_text(m: Any, source: str) -> str:
-    """The joints form of ``m`` as a commented TOML file."""
-    doc = joints_doc(m)
+def drawing_text(m: Any, doc: Mapping[str, Any], source: str) -> str:
+    """The joints form ``doc`` of ``m`` (:func:`drawing_doc`) as a commented TOML file."""
     unit = doc["length_unit"]
     names: dict[str, set[str]] = {}
     for loop in m.loops:
@@ -286,7 +304,7 @@ def joints_text(m: Any, source: str) -> str:
                     u.name == t.length for u in m.unknowns) and t.length != m.driver.name:
                 names.setdefault(t.angle, set()).add(t.length)
     out = [f"# {source} drawn as joints and links (linkage convert --form joints): its loops",
-           f"# solved at {m.driver.name} = {_shown_driver(m)}, each joint where they place it",
+           f"# solved at {m.driver.name} = {shown_driver(m)}, each joint where they place it",
            f"name = {toml_value(doc['name'])}"]
     if doc["description"]:
         out.append(f"description = {toml_value(doc['description'])}")

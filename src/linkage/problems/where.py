@@ -26,6 +26,7 @@ from ..errors import ParseError
 from .expression import (
     BINOPS,
     CONSTANTS,
+    DEG,
     FUNCTIONS,
     MAX_OPERATIONS,
     call_argument,
@@ -33,14 +34,13 @@ from .expression import (
     walk_postorder,
 )
 
-_DEG = math.pi / 180.0
 NUMPY_FUNCTIONS: dict[str, Callable[[Any], Any]] = {
     "sin": np.sin, "cos": np.cos, "tan": np.tan, "asin": np.arcsin, "acos": np.arccos,
     "atan": np.arctan, "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh, "exp": np.exp,
     "log": np.log, "log10": np.log10, "sqrt": np.sqrt, "abs": np.abs,
-    "sind": lambda v: np.sin(v * _DEG), "cosd": lambda v: np.cos(v * _DEG),
-    "tand": lambda v: np.tan(v * _DEG), "asind": lambda v: np.arcsin(v) / _DEG,
-    "acosd": lambda v: np.arccos(v) / _DEG, "atand": lambda v: np.arctan(v) / _DEG,
+    "sind": lambda v: np.sin(v * DEG), "cosd": lambda v: np.cos(v * DEG),
+    "tand": lambda v: np.tan(v * DEG), "asind": lambda v: np.arcsin(v) / DEG,
+    "acosd": lambda v: np.arccos(v) / DEG, "atand": lambda v: np.arctan(v) / DEG,
 }
 assert set(NUMPY_FUNCTIONS) == set(FUNCTIONS)
 

@@ -206,8 +206,8 @@ def _drawing(mechanism: Any) -> Any:
     drawing = mechanism.extra.get("drawing")
     if drawing is not None:
         return drawing
+    from ..kinematics.to_joints import joints_doc
     from ..problems.joints import drawing_of
-    from ..problems.to_joints import joints_doc
 
     try:
         return drawing_of(joints_doc(mechanism), mechanism.source)

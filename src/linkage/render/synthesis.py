@@ -251,7 +251,7 @@ def design_text(s: Any, unit: str, made_by: str) -> str:
     the linkage generates it (synthesis.drawn_position: the file's joints give the reported
     lengths), its driver range the alpha range (in the file's convention: theta = alpha +
     180). ValueError where the linkage has no position at precision point 1."""
-    from ..problems.joints import toml_value
+    from ..problems.toml_text import toml_value
     from ..synthesis import drawn_position
 
     k = s.linkage

@@ -315,7 +315,7 @@ def scan(mechanism: Mechanism | str, vary: Mapping[str, Sequence[float]], *, sam
     """
     from ..arguments import check_flag, check_motion, check_reals, check_text, check_vary
     from ..kinematics.bodies import checked_loads
-    from ..problems.loops import mechanism_of
+    from ..kinematics.loading import mechanism_of
 
     m = mechanism_of("mechanism", mechanism)
     specs = check_vary(vary, MAX_DESIGNS)

@@ -59,7 +59,7 @@ class ScanJob:
 
 @functools.lru_cache(maxsize=8)
 def job_mechanism(text: str, source: str, overrides: tuple[tuple[str, float], ...]) -> Mechanism:
-    from ..problems.loops import from_text
+    from ..kinematics.loading import from_text
 
     return from_text(text, source).with_values(dict(overrides), {})
 

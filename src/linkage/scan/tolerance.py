@@ -552,7 +552,7 @@ def tolerance(mechanism: Mechanism | str, tolerances: Mapping[str, float],
     ``workers``). Every argument is checked first: a misuse raises InputError naming it.
     See docs/tolerance.md."""
     from ..arguments import check_reals, check_scan_options, check_text, check_whole, describe
-    from ..problems.loops import mechanism_of
+    from ..kinematics.loading import mechanism_of
     from ..solve import check_criteria
 
     m = mechanism_of("mechanism", mechanism)

@@ -1,4 +1,5 @@
-"""Small dense linear algebra in pure Python, for loop-closure systems of a few unknowns.
+"""Small dense linear algebra in pure Python, for loop-closure systems of a few unknowns (layer 0:
+every engine and the mechanism files share it).
 
 Mechanism systems have 2 to ~8 unknowns; at that size a Python LU beats numpy's
 per-call overhead, and a single solve keeps numpy out of the import graph.
