@@ -48,6 +48,7 @@ from .angles import (
 from .batch import STATUS_CODES, BatchResult, VectorLoops, solve_linear
 from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
+from .pose import implied
 from .positions import SweepResult, check_driver_values
 
 MARGIN_FLOOR = 1e-8
@@ -79,8 +80,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     # the driver's magnitude, refused as the one-at-a-time engine refuses it
     check_driver_values(m, [float(vals[0]), float(vals[-1])])
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-    solver = Solver(m, "newton", tol, max_iter)
-    signs = _followed_signs(m, solver, float(vals[0]), scale, branch)
+    signs = _followed_signs(m, tol, max_iter, float(vals[0]), scale, branch)
     if signs is None:
         return None
     kinds = tuple(u.kind for u in m.unknowns)
@@ -109,7 +109,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     closes = m.driver.kind == "angle" and closes_circle_array(vals, driver_turn(m.driver.unit))
     if _touch_candidate(closes, det, ratio):
         return None
-    shown = _display(m, solver, vals, cols, kinds, closes)
+    shown = _display(m, tol, max_iter, vals, cols, kinds, closes)
     label = "/".join(words)
     from .stepwise import classification_of
 
@@ -125,7 +125,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
                        np.ascontiguousarray(shown.T), det, iters, label, meta, 0, m, rates)
 
 
-def _followed_signs(m: Mechanism, solver: Solver, first: float, scale: float,
+def _followed_signs(m: Mechanism, tol: float, max_iter: int, first: float, scale: float,
                     branch: str | None) -> tuple[float, ...] | None:
     """The signs of the branch to follow, or None (this engine then does not apply)."""
     d = m.derivation
@@ -139,6 +139,7 @@ def _followed_signs(m: Mechanism, solver: Solver, first: float, scale: float,
     if m.driver.value / scale != first:
         starts.append(m.driver.value / scale)  # where it seeds a mechanism without the old key
     found = []
+    solver = Solver(m, "newton", tol, max_iter)
     for v in starts:
         # the one-at-a-time engine's first solve (Solver.solve: textbook Newton), on
         # compiled functions (solve_lean: the same iterates and verdict)
@@ -237,7 +238,7 @@ def _words(m: Mechanism, drv: np.ndarray, q: list[np.ndarray], signs: tuple[floa
     return out
 
 
-def _display(m: Mechanism, solver: Solver, vals: np.ndarray, cols: np.ndarray,
+def _display(m: Mechanism, tol: float, max_iter: int, vals: np.ndarray, cols: np.ndarray,
              kinds: Sequence[str], closes: bool) -> np.ndarray:
     """The unknowns in display units, each angle continuous along the cycle and anchored to
     what ``solve FILE`` gives (the rule of :mod:`.angles`, as the one-at-a-time engine)."""
@@ -253,14 +254,22 @@ def _display(m: Mechanism, solver: Solver, vals: np.ndarray, cols: np.ndarray,
     v0 = m.driver.value / scale
     near = int(anchor_index_array(vals, np.ones((1, len(vals)), dtype=bool), v0, closes, turn)[0])
     shift = np.zeros(len(angles))
-    # solve FILE's answer, as the one-at-a-time engine anchors (solve_system's damped
-    # Newton from the file's guess, on compiled functions: the same iterates and verdict)
-    got = solver.solve_lean(v0, tuple(u.value for u in m.unknowns), damped=True)
-    if got is not None:
-        ref = got[1]
+    ref = implied(m, ("closed_anchor", tol, max_iter), lambda m: _anchor(m, tol, max_iter))
+    if ref is not None:
         for a, j in enumerate(angles):
             at = continuous(float(out[j, near]), float(turns[a, near]))
             shift[a] = turn_shift(math.degrees(ref[j]), at)
     for a, j in enumerate(angles):
         out[j] = continuous(out[j], turns[a] + shift[a])
     return out
+
+
+def _anchor(m: Mechanism, tol: float, max_iter: int) -> tuple[float, ...] | None:
+    """``solve FILE``'s answer (internal units), as the one-at-a-time engine anchors its
+    angles: solve_system's damped Newton from the file's guess at its driver value, on
+    compiled functions (the same iterates and verdict); None where it does not converge.
+    Solved once per mechanism and criteria (:func:`~.pose.implied`)."""
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    got = Solver(m, "newton", tol, max_iter).solve_lean(m.driver.value / scale,
+                                                         tuple(u.value for u in m.unknowns), damped=True)
+    return None if got is None else tuple(got[1])
