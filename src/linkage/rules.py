@@ -203,23 +203,32 @@ class SystemStops:
     per position (the runaway bound's base)."""
 
     def __init__(self, tol: float, gate: Any, q0_size: Any, can_diverge: bool = True) -> None:
-        import numpy as np
-
-        q0_size = np.asarray(q0_size, dtype=float)
-        k = q0_size.shape[0]
         self.tol = tol
         self.gate = gate
         self.can_diverge = can_diverge
-        self.prev_err = np.full(k, np.inf)
-        self.growth = np.zeros(k, dtype=np.int32)
-        self.rounding_steps = np.zeros(k, dtype=np.int32)
-        self.stalls = np.zeros(k, dtype=np.int32)
-        with np.errstate(invalid="ignore", over="ignore"):
-            self.runaway = SYSTEM_RUNAWAY * (1.0 + q0_size)
+        self.q0_size = q0_size
+        self.kept: tuple[Any, Any, Any, Any, Any] | None = None  # made when first needed
+
+    def _kept(self) -> tuple[Any, Any, Any, Any, Any]:
+        """(last error, growing streak, rounding-level steps, stalls, runaway bound) per
+        position: what the scalar loop keeps between steps; made at the first step that
+        does not stop every position (a block that converges at once never pays for it)."""
+        import numpy as np
+
+        if self.kept is None:
+            q0 = np.asarray(self.q0_size, dtype=float)
+            k = q0.shape[0]
+            with np.errstate(invalid="ignore", over="ignore"):
+                runaway = SYSTEM_RUNAWAY * (1.0 + q0)
+            self.kept = (np.full(k, np.inf), np.zeros(k, dtype=np.int32), np.zeros(k, dtype=np.int32),
+                         np.zeros(k, dtype=np.int32), runaway)
+        return self.kept
 
     def judge(self, err: Any, resid: Any, singular: Any, q_size: Any, rows: Any = None) -> Any:
         """The verdict codes (int8) of one step at the positions ``rows`` (None: all),
-        ``singular`` a boolean array or None (no J singular); updates their kept state."""
+        ``singular`` a boolean array or None (no J singular), ``q_size`` max|q_new| at
+        them (or a function giving it, called only where a test reads it); updates their
+        kept state."""
         import numpy as np
 
         def at(a: Any) -> Any:
@@ -229,7 +238,7 @@ class SystemStops:
         codes = np.zeros(np.shape(err), dtype=np.int8)
         with np.errstate(invalid="ignore"):
             pending = np.ones(codes.shape, dtype=bool)
-            if singular is not None:
+            if singular is not None and singular.any():
                 within = resid <= gate
                 codes[singular] = np.where(within[singular], CONVERGED_RESIDUAL, SINGULAR)
                 pending &= ~singular
@@ -238,20 +247,25 @@ class SystemStops:
                               (CONVERGED_STEP, system_converged_array(err, resid, self.tol, gate))):
                 codes[pending & hit] = code
                 pending &= ~hit
-            prev = at(self.prev_err)
+            if not pending.any():
+                return codes  # every position stopped: nothing kept is read again
+            last, streak, rounding_steps, stalls_kept, runaway = self._kept()
+            prev = at(last)
+            if callable(q_size):
+                q_size = q_size()
             if self.can_diverge:
-                growth = np.where(err > prev, at(self.growth) + 1, 0)
-                self._put(self.growth, rows, growth)
-                hit = pending & (growth >= SYSTEM_DIVERGE_STREAK) & (q_size > at(self.runaway))
+                growth = np.where(err > prev, at(streak) + 1, 0)
+                self._put(streak, rows, growth)
+                hit = pending & (growth >= SYSTEM_DIVERGE_STREAK) & (q_size > at(runaway))
                 codes[hit] = DIVERGED
                 pending &= ~hit
             rounding = pending & (err <= SYSTEM_ROUNDING * q_size)
-            steps = at(self.rounding_steps) + rounding
-            stalls = at(self.stalls) + (rounding & (err >= prev))
-            self._put(self.rounding_steps, rows, steps)
-            self._put(self.stalls, rows, stalls)
+            steps = at(rounding_steps) + rounding
+            stalls = at(stalls_kept) + (rounding & (err >= prev))
+            self._put(rounding_steps, rows, steps)
+            self._put(stalls_kept, rows, stalls)
             codes[rounding & ((stalls >= 2) | (steps >= 6))] = PRECISION_LIMIT
-            self._put(self.prev_err, rows, err)
+            self._put(last, rows, err)
         return codes
 
     @staticmethod

@@ -20,13 +20,14 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from functools import partial
 from typing import Any
 
 import numpy as np
 
 from ..errors import InputError
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel, Mechanism
-from ..rules import residual_gate, step_scales, step_size_array, system_converged_array
+from ..rules import GOING, SystemStops, converged_codes, residual_gate, step_scales, step_size_array
 from .angles import nearest_turn, nearest_turn_array
 from .continuation import Solver, classify_gap, continue_step, solve_position, solver_q, tangent
 from .limits import solved_ranges_array
@@ -289,6 +290,21 @@ def solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[l
     return [dq[:, j] for j in range(n)], det
 
 
+def singular_of(jac: list[list[Any]], det: np.ndarray) -> np.ndarray:
+    """Where J is singular, by the single solve's test (the 2 x 2 test of
+    :func:`~linkage.methods.newton_system.newton_direction`): |det J| not above
+    SINGULAR_RATIO times |ad| + |bc| (invariant under row and column scaling), or not
+    finite. A larger J: det J zero or not finite (the scalar's equilibrated-pivot test has
+    no numpy twin yet)."""
+    from ..methods.newton_system import SINGULAR_RATIO
+
+    with np.errstate(invalid="ignore", over="ignore"):
+        if len(jac) == 2 and len(jac[0]) == 2:
+            (a, b), (c, d) = jac
+            return ~(np.abs(det) > SINGULAR_RATIO * (np.abs(a * d) + np.abs(b * c))) | ~np.isfinite(det)
+        return ~np.isfinite(det) | (det == 0.0)
+
+
 def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: str | None = None,
                 tol: float = 1e-12, max_iter: int = 50, coarse: int = 361, speed: float | None = None,
                 accel: float = 0.0, joints: bool = False) -> BatchResult:
@@ -466,9 +482,40 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     A position left "failed" goes to the one-at-a-time path. Columns are contiguous 1-D
     arrays, written into the (N, n) outputs once (reading a strided column costs
     several times more)."""
-    n, n_pos, code, take = len(kinds), len(vals), STATUS_CODES, np.take
-    # 2. warm starts: cubic Hermite interpolation between coarse neighbours that both
-    # solved, with the exact tangents dq/dv there (error ~ h^4: two Newton steps do)
+    n, code = len(kinds), STATUS_CODES
+    refs, left, usable = _warm_starts(coarse, vals, n)
+    loops = VectorLoops(model, vals * drv_scale)
+    q_all = [r * sc for r, sc in zip(refs, scale)]
+    done = _vector_newton(loops, q_all, usable, m.length_scale, kinds, tol, max_iter, iters, det_out)
+    status[done] = code["converged"]
+    cols = [c / sc for c, sc in zip(q_all, scale)]
+    # Continuity: a position must stay near its interpolated guess. Near a nearly
+    # singular configuration Newton can jump to another assembly with the same det J
+    # sign; such positions go to the one-at-a-time path.
+    moved = np.abs(cols[0] - refs[0])
+    for j in range(1, n):
+        np.maximum(moved, np.abs(cols[j] - refs[j]), out=moved)
+    status[done & (moved > np.take(coarse.allowed, left))] = code["failed"]
+    status[done & ~_on_branch_columns(m, cols, names, det_out, branch, vals * drv_scale)] = code["failed"]
+    # angles reported continuously with the guess (the one-at-a-time sweep's convention):
+    # a solution within half a turn of its guess is already the representative nearest it
+    for j, k in enumerate(kinds):
+        if k == "angle":
+            far = ~(np.abs(cols[j] - refs[j]) < 180.0)  # (NaN included)
+            if far.any():
+                cols[j][far] = nearest_turn_array(refs[j][far], cols[j][far])
+    for j in range(n):
+        shown[:, j] = cols[j]
+        ref[:, j] = refs[j]
+
+
+def _warm_starts(coarse: _Coarse, vals: np.ndarray,
+                 n: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+    """Step 2, the warm starts (display units, one array per unknown): cubic Hermite
+    interpolation between coarse neighbours that both solved, with the exact tangents
+    dq/dv there (error ~ h^4: two Newton steps do); with each position's left grid index
+    and whether its interval is usable."""
+    take = np.take
     right = np.clip(_grid_index(coarse.grid, vals), 1, len(coarse.grid) - 1)
     left = right - 1
     usable = take(coarse.pair_usable, left)
@@ -486,79 +533,58 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
         y0, y1 = take(coarse.solution[j], left), take(coarse.next_value[j], left)
         refs.append(h00 * y0 + h10 * width * take(coarse.slopes[j], left) + h01 * y1
                     + h11 * width * take(coarse.slopes[j], right))
+    return refs, left, usable
 
-    # 3. vectorised Newton on the usable positions. The first two iterations (all most
-    # positions need) evaluate every position and move only the live ones (no gathers);
-    # later ones gather the few left. Position by position the iterates do not depend on
-    # the block they are in.
-    loops = VectorLoops(model, vals * drv_scale)
-    # the single solve's stopping rule, scaled as there (linkage.rules): a length step
-    # relative to the mechanism's size, max|Phi| within tol x size
-    size = m.length_scale
-    gate, steps = residual_gate(tol, size), step_scales(kinds, size)
-    q_all = [r * sc for r, sc in zip(refs, scale)]
-    live = usable.copy()
+
+def _vector_newton(loops: VectorLoops, q_all: list[np.ndarray], live: np.ndarray, size: float,
+                   kinds: Sequence[str], tol: float, max_iter: int, iters: np.ndarray,
+                   det_out: np.ndarray) -> np.ndarray:
+    """Step 3, textbook Newton at the ``live`` positions (q_all updated in place, internal
+    units), each stopped as the single solve's loop stops it (:class:`~linkage.rules.SystemStops`,
+    with its scales: a length step relative to the mechanism's size, max|Phi| within
+    tol x size); where each converged. The first two iterations (all most positions
+    need) evaluate every position and move only the live ones (no gathers); later ones
+    gather the few left. Position by position the iterates do not depend on the block."""
+    n, n_pos = len(kinds), len(live)
+    steps = step_scales(kinds, size)
+    stops = SystemStops(tol, residual_gate(tol, size), step_size_array(q_all, None))
+    live = live.copy()
     done = np.zeros(n_pos, dtype=bool)
     it = 0
     while it < min(2, max_iter) and live.any():
         it += 1
         phi, jac = loops.evaluate(q_all, None, near=it > 1)
         dq, det = solve_linear(jac, phi, n_pos)
-        step, resid = step_size_array(dq, steps), _largest(phi)
-        finite = np.isfinite(step)
+        singular = singular_of(jac, det)
+        step = step_size_array(dq, steps)
+        moving = live & ~singular & np.isfinite(step)
         for j in range(n):
-            np.add(q_all[j], dq[j], out=q_all[j], where=live & finite)
+            np.add(q_all[j], dq[j], out=q_all[j], where=moving)
+        codes = stops.judge(step, step_size_array(phi, None), singular, partial(step_size_array, q_all, None))
         iters[live] = it
         det_out[live] = det[live]
-        finished = live & system_converged_array(step, resid, tol, gate)
-        done |= finished
-        live &= ~finished & finite
+        done |= live & converged_codes(codes)
+        live &= codes == GOING
     active = np.flatnonzero(live)
     q = [c[active] for c in q_all]
     while it < max_iter and active.size:
         it += 1
         phi, jac = loops.evaluate(q, active)
         dq, det = solve_linear(jac, phi, active.size)
-        step, resid = step_size_array(dq, steps), _largest(phi)
+        singular = singular_of(jac, det)
         for j in range(n):
-            q[j] += dq[j]
-        finished = system_converged_array(step, resid, tol, gate)
-        keep = ~finished & np.isfinite(step)
+            q[j] += np.where(singular, 0.0, dq[j])
+        codes = stops.judge(step_size_array(dq, steps), step_size_array(phi, None), singular,
+                            partial(step_size_array, q, None), active)
         for j in range(n):
             q_all[j][active] = q[j]
         iters[active] = it
         det_out[active] = det
-        done[active[finished]] = True
+        done[active[converged_codes(codes)]] = True
+        keep = codes == GOING
         active = active[keep]
         q = [c[keep] for c in q]
-    status[done] = code["converged"]
-    cols = [c / sc for c, sc in zip(q_all, scale)]
-    # Continuity: a position must stay near its interpolated guess. Near a nearly
-    # singular configuration Newton can jump to another assembly with the same det J
-    # sign; such positions go to the one-at-a-time path.
-    moved = np.abs(cols[0] - refs[0])
-    for j in range(1, n):
-        np.maximum(moved, np.abs(cols[j] - refs[j]), out=moved)
-    status[done & (moved > take(coarse.allowed, left))] = code["failed"]
-    status[done & ~_on_branch_columns(m, cols, names, det_out, branch, vals * drv_scale)] = code["failed"]
-    # angles reported continuously with the guess (the one-at-a-time sweep's convention):
-    # a solution within half a turn of its guess is already the representative nearest it
-    for j, k in enumerate(kinds):
-        if k == "angle":
-            far = ~(np.abs(cols[j] - refs[j]) < 180.0)  # (NaN included)
-            if far.any():
-                cols[j][far] = nearest_turn_array(refs[j][far], cols[j][far])
-    for j in range(n):
-        shown[:, j] = cols[j]
-        ref[:, j] = refs[j]
-
-
-def _largest(parts: Sequence[np.ndarray]) -> np.ndarray:
-    """max |part| over the parts, position by position (NaN if any part is NaN)."""
-    out = np.abs(parts[0])
-    for p in parts[1:]:
-        np.maximum(out, np.abs(p), out=out)
-    return out
+    return done
 
 
 def _have_closed(m: Mechanism, solver: Solver, value: float) -> bool:

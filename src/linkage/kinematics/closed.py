@@ -30,13 +30,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from functools import partial
 from typing import Any
 
 import numpy as np
 
 from ..problems.derive import sign_text
 from ..problems.loops import ANGLE_UNITS, Mechanism
-from ..rules import residual_gate, step_scales, step_size_array, system_converged_array
+from ..rules import GOING, SystemStops, converged_codes, residual_gate, step_scales, step_size_array
 from .angles import (
     anchor_index_array,
     closes_circle_array,
@@ -45,7 +46,7 @@ from .angles import (
     turn_shift,
     unwrap_turns_array,
 )
-from .batch import STATUS_CODES, BatchResult, VectorLoops, solve_linear
+from .batch import STATUS_CODES, BatchResult, VectorLoops, singular_of, solve_linear
 from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
 from .pose import implied
@@ -165,7 +166,9 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
     k = len(drv)
     loops = VectorLoops(m.model, drv)
     size = m.length_scale
-    gate, steps = residual_gate(tol, size), step_scales(kinds, size)
+    steps = step_scales(kinds, size)
+    # each position stopped as the single solve's loop stops it (linkage.rules)
+    stops = SystemStops(tol, residual_gate(tol, size), step_size_array(q, None))
     det = np.empty(k)
     iters = np.zeros(k, dtype=np.int32)
     ratio = np.empty(k)
@@ -179,16 +182,18 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
         sub = q if rows is None else [c[rows] for c in q]
         phi, jac = loops.evaluate(sub, rows)
         dq, dt = solve_linear(jac, phi, active.size)
-        # max |Phi| at the point the step was taken from (NaN propagates)
-        step, resid = step_size_array(dq, steps), np.max(np.abs(phi), axis=0)
-        if not np.isfinite(step).all():
-            return None
+        singular = singular_of(jac, dt)
+        moved = [s + np.where(singular, 0.0, d) for s, d in zip(sub, dq)]
+        codes = stops.judge(step_size_array(dq, steps), step_size_array(phi, None), singular,
+                            partial(step_size_array, moved, None), rows)
+        if not (converged_codes(codes) | (codes == GOING)).all():
+            return None  # a position the loop stops unconverged: the one-at-a-time engine's
         for j in range(len(q)):
-            q[j][active] = sub[j] + dq[j]
+            q[j][active] = moved[j]
         det[active] = dt
         ratio[active] = np.abs(dt) / _column_lengths(jac, active.size)
         iters[active] = it
-        active = active[~system_converged_array(step, resid, tol, gate)]
+        active = active[codes == GOING]
     if not ((det > 0).all() or (det < 0).all()):
         return None  # det J changes sign: a toggle, the one-at-a-time engine's to locate
     words = _words(m, drv, q, signs)

@@ -34,16 +34,19 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
 
-from ..methods.newton_system import SINGULAR_RATIO
 from ..problems.derive import Derivation, read_branch
 from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism, VectorTerm
 from ..rules import (
+    GOING,
+    SystemStops,
     continues_array,
     continuity_measures_array,
+    converged_codes,
     residual_gate,
     step_size_array,
     system_converged_array,
@@ -56,7 +59,7 @@ from .angles import (
     turn_shift_array,
     unwrap_turns_array,
 )
-from .batch import STATUS_CODES, VectorLoops, solve_linear
+from .batch import STATUS_CODES, VectorLoops, singular_of, solve_linear
 
 CONVERGED, NO_SOLUTION, FAILED, OFF_BRANCH = (STATUS_CODES[k] for k in
                                               ("converged", "no_solution", "failed", "off_branch"))
@@ -279,7 +282,7 @@ def _closed_form_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np
     """The derivation's closed form (:meth:`Derivation.solve_np`) for every design at every
     position at once, designs (D, 1) against positions (1, P), on each design's sign tuple
     (:func:`design_signs`); then Newton on the loops polishes every assembled position,
-    vectorised, with the single solve's stopping rule (:func:`_newton`). A position counts
+    vectorised, with the single solve's stopping rule (:func:`newton_block`). A position counts
     as solved only when Newton converges there, stays within SEED_DISTANCE of the closed
     form and lies on the branch's side of every two-way step (or where the two sides meet
     within SEED_DISTANCE: a limit position, whose side is a matter of rounding). Where the
@@ -319,7 +322,7 @@ def _closed_form_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np
     q = [np.where(ok, c, 0.0) for c in seed]
     # one loop: Cramer's rule as for every 2 x 2; more: the derivation's blocks
     linear = _stepwise_linear(der) if len(m.loops) > 1 else None
-    done, _det = _newton(loops, q, np.flatnonzero(ok), tol, size,
+    done, _det = newton_block(loops, q, np.flatnonzero(ok), tol, size,
                         [u.kind == "length" for u in m.unknowns], max_iter, linear=linear)
     moved = _distance(m, q, seed, size)
     accept = done & (moved <= SEED_DISTANCE) & ok
@@ -386,7 +389,7 @@ def _stepwise_linear(der: Derivation) -> Linear:
     hold only its two unknowns and those of earlier steps, so J is block triangular and
     every block is a 2 x 2 solved by Cramer's rule (a Watt six-bar's 4 x 4 at a fifth of
     the cost of a stacked numpy solve). J is singular where a block is, by the 2 x 2 test
-    :func:`_newton` applies to a one-loop J."""
+    :func:`newton_block` applies to a one-loop J."""
     plan = [(tuple(zip(step.loops, step.weights)), step.unknowns) for step in der.steps]
 
     def solve(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[list[Any], Any, Any]:
@@ -409,7 +412,7 @@ def _stepwise_linear(der: Derivation) -> Linear:
                         ex, ey = ex - jx[j] * d_j, ey - jy[j] * d_j
                 pa, pb, pc, pd = jx[a], jx[b], jy[a], jy[b]
                 det_s = pa * pd - pb * pc
-                singular |= ~(np.abs(det_s) > SINGULAR_RATIO * (np.abs(pa * pd) + np.abs(pb * pc)))
+                singular |= singular_of([[pa, pb], [pc, pd]], det_s)
                 dq[a], dq[b] = (ex * pd - pb * ey) / det_s, (pa * ey - pc * ex) / det_s
                 det = det * det_s
         return [np.broadcast_to(d_j, (k,)) for d_j in dq], np.broadcast_to(det, (k,)), singular
@@ -417,50 +420,41 @@ def _stepwise_linear(der: Derivation) -> Linear:
     return solve
 
 
-def _newton(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol: float, size: np.ndarray,
+def newton_block(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol: float, size: np.ndarray,
             is_length: list[bool], max_iter: int, count: bool = False, linear: Linear | None = None) -> Any:
     """Newton-Raphson at every ``active`` position at once, updating ``q_all`` in place;
-    only unconverged positions keep iterating. Returns (converged, det J), and with
-    ``count`` the iterations each took as well. ``linear``: how J dq = -Phi is solved
+    each position stops as the single solve's loop stops it (:class:`~linkage.rules.SystemStops`,
+    textbook Newton: a singular J leaves q where it is). Returns (converged, det J), and
+    with ``count`` the iterations each took as well. ``linear``: how J dq = -Phi is solved
     (default: Cramer's rule for 2 x 2, else a stacked numpy solve)."""
     n_pos = len(size)
     done = np.zeros(n_pos, dtype=bool)
     det_out = np.full(n_pos, np.nan)
     iterations = np.zeros(n_pos, dtype=np.int32)
-    gate_all = residual_gate(tol, size)
+    stops = SystemStops(tol, residual_gate(tol, size), step_size_array(q_all, None))
     q = [c[active] for c in q_all]
     for _ in range(max_iter):
         if active.size == 0:
             break
         phi, jac = loops.evaluate(q, active)
-        scale = size[active]
-        resid = np.abs(phi[0])
-        for f in phi[1:]:
-            np.maximum(resid, np.abs(f), out=resid)
         if linear is not None:
             dq, det, singular = linear(jac, phi, active.size)
         else:
             dq, det = solve_linear(jac, phi, active.size)
-            singular = ~np.isfinite(det) | (det == 0.0)
-        if linear is None and len(jac) == 2 and len(jac[0]) == 2:
-            (a, b), (c, d) = jac
-            with np.errstate(invalid="ignore"):
-                singular |= ~(np.abs(det) > SINGULAR_RATIO * (np.abs(a * d) + np.abs(b * c)))
+            singular = singular_of(jac, det)
         dq = [np.where(singular, 0.0, d_j) for d_j in dq]
         for j, d_j in enumerate(dq):
             q[j] += d_j
+        scale = size[active]
         step = step_size_array(dq, [scale if length else 1.0 for length in is_length])
-        gate = gate_all[active]
-        with np.errstate(invalid="ignore"):
-            # as a single solve: a singular J with max|Phi| already within tolerance is a
-            # root to that tolerance (a limit position); otherwise the step test decides
-            finished = np.where(singular, resid <= gate, system_converged_array(step, resid, tol, gate))
-            keep = ~finished & ~singular & np.isfinite(step)
+        codes = stops.judge(step, step_size_array(phi, None), singular, partial(step_size_array, q, None),
+                            active)
         for j in range(len(q)):
             q_all[j][active] = q[j]
         det_out[active] = det
         iterations[active] += 1
-        done[active[finished]] = True
+        done[active[converged_codes(codes)]] = True
+        keep = codes == GOING
         active = active[keep]
         q = [c[keep] for c in q]
     return (done, det_out, iterations) if count else (done, det_out)
@@ -504,7 +498,7 @@ def _continuation_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: n
     rows = np.arange(n_designs)
     loops, _ = at(v0, rows)
     seed = [np.full(n_designs, u.value) for u in m.unknowns]
-    done, _, iters = _newton(loops, seed, rows, tol, size, is_length, SEED_ITERATIONS, count=True)
+    done, _, iters = newton_block(loops, seed, rows, tol, size, is_length, SEED_ITERATIONS, count=True)
     clean &= done & (iters <= SEED_ITERATIONS)
     det0 = _det_at(loops, seed, n_designs)
     clean &= np.isfinite(det0) & (det0 != 0.0)
@@ -537,7 +531,7 @@ def _continuation_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: n
             pred = [ql + (v - v_last) * tj for ql, tj in zip(q_last, t)]
             loops_v, sub_v = at(v, live)
             q = [c.copy() for c in pred]
-            ok, _, _ = _newton(loops_v, q, np.arange(live.size), tol, size[live], is_length, 50, count=True)
+            ok, _, _ = newton_block(loops_v, q, np.arange(live.size), tol, size[live], is_length, 50, count=True)
             det = _det_at(loops_v, q, live.size)
             ok &= np.isfinite(det) & ((det > 0.0) == positive[live]) & (det != 0.0)
             dv = abs(v - v_last) * scale
