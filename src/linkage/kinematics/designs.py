@@ -49,7 +49,6 @@ from ..rules import (
     converged_codes,
     residual_gate,
     step_size_array,
-    system_converged_array,
 )
 from .angles import (
     anchor_index_array,
@@ -420,8 +419,9 @@ def _stepwise_linear(der: Derivation) -> Linear:
     return solve
 
 
-def newton_block(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol: float, size: np.ndarray,
-            is_length: list[bool], max_iter: int, count: bool = False, linear: Linear | None = None) -> Any:
+def newton_block(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol: float,
+                 size: np.ndarray, is_length: list[bool], max_iter: int, count: bool = False,
+                 linear: Linear | None = None) -> Any:
     """Newton-Raphson at every ``active`` position at once, updating ``q_all`` in place;
     each position stops as the single solve's loop stops it (:class:`~linkage.rules.SystemStops`,
     textbook Newton: a singular J leaves q where it is). Returns (converged, det J), and
@@ -531,7 +531,8 @@ def _continuation_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: n
             pred = [ql + (v - v_last) * tj for ql, tj in zip(q_last, t)]
             loops_v, sub_v = at(v, live)
             q = [c.copy() for c in pred]
-            ok, _, _ = newton_block(loops_v, q, np.arange(live.size), tol, size[live], is_length, 50, count=True)
+            ok, _, _ = newton_block(loops_v, q, np.arange(live.size), tol, size[live], is_length, 50,
+                                    count=True)
             det = _det_at(loops_v, q, live.size)
             ok &= np.isfinite(det) & ((det > 0.0) == positive[live]) & (det != 0.0)
             dv = abs(v - v_last) * scale
@@ -696,19 +697,24 @@ def _turn_references(m: Mechanism, params: Mapping[str, np.ndarray], n_designs: 
     q = [np.full(n_designs, u.value) for u in m.unknowns]
     plain = np.ones(n_designs, dtype=bool)  # every step so far the globalised solve's too
     done = np.zeros(n_designs, dtype=bool)
+    stopped = np.zeros(n_designs, dtype=bool)
+    # the globalised solve's stopping order (no divergence test: it lowers |Phi| every step)
+    stops = SystemStops(tol, gate, step_size_array(q, None), can_diverge=False)
     phi, jac = loops.evaluate(q, None)
     with np.errstate(invalid="ignore", over="ignore"):
         for _ in range(50):
-            live = plain & ~done
+            live = plain & ~done & ~stopped
             if not live.any():
                 break
             dq, _ = solve_linear(jac, phi, n_designs)
             trial = [c + d for c, d in zip(q, dq)]
             phi_t, jac_t = loops.evaluate(trial, None)
-            tiny = _largest(dq) <= 64.0 * np.finfo(float).eps * (1.0 + _largest(q))
+            tiny = step_size_array(dq, None) <= 64.0 * np.finfo(float).eps * (1.0 + step_size_array(q, None))
             plain &= ~live | (_sumsq(phi_t) <= (1.0 - 1e-4) * _sumsq(phi)) | tiny
             step = step_size_array(dq, [size if length else 1.0 for length in is_length])
-            done |= live & plain & system_converged_array(step, _largest(phi), tol, gate)
+            codes = stops.judge(step, step_size_array(phi, None), None, partial(step_size_array, trial, None))
+            done |= live & plain & converged_codes(codes)
+            stopped |= live & plain & (codes != GOING)
             q = [np.where(live, t, c) for t, c in zip(trial, q)]
             phi = [np.where(live, t, c) for t, c in zip(phi_t, phi)]
             jac = [[np.where(live, t, c) for t, c in zip(rt, rc)] for rt, rc in zip(jac_t, jac)]
@@ -728,13 +734,6 @@ def _turn_references(m: Mechanism, params: Mapping[str, np.ndarray], n_designs: 
         r = solve_system(F, tuple(u.value for u in m.unknowns), jac=J, tol=tol, record=False)
         if r.converged:
             out[d] = [math.degrees(x) if u.kind == "angle" else x for x, u in zip(r.x, m.unknowns)]
-    return out
-
-
-def _largest(parts: Sequence[Any]) -> Any:
-    out = np.abs(parts[0])
-    for p in parts[1:]:
-        out = np.maximum(out, np.abs(p))
     return out
 
 
