@@ -1,5 +1,5 @@
 """The array engines' Newton stops every position where the single solve's loop stops it:
-kinematics.designs.newton_block (the scan's engines) against solve_system's textbook
+kinematics.design_loops.newton_block (the scan's engines) against solve_system's textbook
 Newton (damped=False), one position at a time, on random driver values and random
 guesses (near the assembly, a radian off, on the line of centres where J is singular): the
 same convergence and the same iteration count, and the same root where both converge.
@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from linkage.kinematics.batch import VectorLoops
-from linkage.kinematics.designs import newton_block
+from linkage.kinematics.design_loops import newton_block
+from linkage.kinematics.vector_loops import VectorLoops
 from linkage.problems.loops import load
 from linkage.solve import solve_system
 
