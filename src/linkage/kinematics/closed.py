@@ -12,8 +12,8 @@ a sweep that stays on one branch needs no continuation:
    grid point, so each position is that branch's closed form
    (:meth:`~linkage.problems.derive.Derivation.solve_np`), for all positions at once.
 3. One vectorised Newton-Raphson step from it under the single solve's stopping rule
-   (:mod:`linkage.rules`, the batch engine's :class:`~.batch.VectorLoops` and
-   :func:`~.batch.solve_linear`): a position is converged only where the rule holds; the
+   (:mod:`linkage.rules`, the batch engine's :class:`~.vector_loops.VectorLoops` and
+   :func:`~.vector_loops.solve_linear`): a position is converged only where the rule holds; the
    few where it does not take more steps, up to ``POLISH_ITER``.
 4. The checks that make it the one-at-a-time engine's answer: det J of one sign, no
    position where that engine would search for a touch of det J = 0 between grid points
@@ -46,11 +46,12 @@ from .angles import (
     turn_shift,
     unwrap_turns_array,
 )
-from .batch import STATUS_CODES, BatchResult, VectorLoops, singular_of, solve_linear
+from .batch import STATUS_CODES, BatchResult
 from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
 from .pose import implied
 from .positions import SweepResult, check_driver_values
+from .vector_loops import VectorLoops, singular_of, solve_linear
 
 MARGIN_FLOOR = 1e-8
 """The smallest relative margin of a step at a grid point for this engine: closer to a
