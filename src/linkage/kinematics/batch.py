@@ -28,7 +28,7 @@ import numpy as np
 from ..errors import InputError
 from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism
 from ..rules import GOING, SystemStops, converged_codes, residual_gate, step_scales, step_size_array
-from ..units import RAD_PER_DEG
+from ..units import RAD_PER_DEG, degrees, radians
 from .angles import nearest_turn, nearest_turn_array
 from .continuation import Solver, classify_gap, continue_step, solve_position, solver_q, tangent
 from .limits import solved_ranges_array
@@ -76,7 +76,7 @@ class BatchResult:
         if m is None or not m.derivation.complete or not m.derivation.two_way or not len(self.values):
             return ()
         scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-        q = [np.radians(self.solution[:, j]) if u.kind == "angle" else self.solution[:, j]
+        q = [radians(self.solution[:, j]) if u.kind == "angle" else self.solution[:, j]
              for j, u in enumerate(m.unknowns)]
         meet = self.status == STATUS_CODES["converged"]
         hit = np.zeros(len(self.values), dtype=bool)
@@ -149,9 +149,9 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         if sol is None or m is None or not m.derivation.fourbars:
             return None
         scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-        q = [math.radians(sol[u.name]) if u.kind == "angle" else sol[u.name] for u in m.unknowns]
+        q = [radians(sol[u.name]) if u.kind == "angle" else sol[u.name] for u in m.unknowns]
         mu = m.derivation.transmission(q, value * scale)
-        return None if mu is None else math.degrees(mu)
+        return None if mu is None else degrees(mu)
 
     def summary(self) -> dict[str, int]:
         codes, counts = np.unique(self.batch.status, return_counts=True)
@@ -493,6 +493,6 @@ def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence
 
     want = read_branch(der, target)
     kinds = {u.name: u.kind for u in m.unknowns}
-    q = [np.radians(c) if kinds[n] == "angle" else c for n, c in zip(names, cols)]
+    q = [radians(c) if kinds[n] == "angle" else c for n, c in zip(names, cols)]
     # the derivation's one rule (a name's mirror: the continuity test has already decided)
     return np.broadcast_to(der.on_branch_np(q, drivers, want), (len(det),))

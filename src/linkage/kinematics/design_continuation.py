@@ -6,7 +6,6 @@ slider, the rapier drive): the sweep's continuation for every design at once
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from functools import partial
 from typing import Any
@@ -23,6 +22,7 @@ from ..rules import (
     residual_gate,
     step_size_array,
 )
+from ..units import degrees, radians
 from .batch import STATUS_CODES
 from .design_loops import (
     CONVERGED,
@@ -174,7 +174,7 @@ def sweep_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarra
             if p.solution is not None:
                 for j, u in enumerate(m.unknowns):
                     v = p.solution[u.name]
-                    q[j][d * k + i] = math.radians(v) if u.kind == "angle" else v
+                    q[j][d * k + i] = radians(v) if u.kind == "angle" else v
     feasible = (status == CONVERGED) | (status == OFF_BRANCH)
     return q, status, feasible, "continuation, design by design"
 
@@ -220,7 +220,7 @@ def turn_references(m: Mechanism, params: Mapping[str, np.ndarray], n_designs: i
             q = [np.where(live, t, c) for t, c in zip(trial, q)]
             phi = [np.where(live, t, c) for t, c in zip(phi_t, phi)]
             jac = [[np.where(live, t, c) for t, c in zip(rt, rc)] for rt, rc in zip(jac_t, jac)]
-    out = np.stack([np.degrees(c) if u.kind == "angle" else c for c, u in zip(q, m.unknowns)], axis=1)
+    out = np.stack([degrees(c) if u.kind == "angle" else c for c, u in zip(q, m.unknowns)], axis=1)
     out[~done] = np.nan
     rest = ~plain
     if rest.any() and m.derivation.complete:
@@ -235,7 +235,7 @@ def turn_references(m: Mechanism, params: Mapping[str, np.ndarray], n_designs: i
         F, J = LoopModel.compile(design).interpreted_functions(float(drv[d]))
         r = solve_system(F, tuple(u.value for u in m.unknowns), jac=J, tol=tol, record=False)
         if r.converged:
-            out[d] = [math.degrees(x) if u.kind == "angle" else x for x, u in zip(r.x, m.unknowns)]
+            out[d] = [degrees(x) if u.kind == "angle" else x for x, u in zip(r.x, m.unknowns)]
     return out
 
 

@@ -40,6 +40,7 @@ import numpy as np
 
 from ..problems.derive import Derivation, read_branch
 from ..problems.loops import ANGLE_UNITS, Mechanism, VectorTerm
+from ..units import degrees, radians
 from .angles import (
     anchor_index_array,
     closes_circle,
@@ -134,7 +135,7 @@ def solve_designs(m: Mechanism, params: Mapping[str, np.ndarray], values: Sequen
         q, status, feasible, engine = sweep_engine(m, params, vals, branch, tol, n_designs)
     found_paths = _paths(m, params, vals, q, status == CONVERGED) if paths else {}
     kinds = tuple(u.kind for u in m.unknowns)
-    shown = np.stack([np.degrees(c) if k == "angle" else c for c, k in zip(q, kinds)], axis=-1)
+    shown = np.stack([degrees(c) if k == "angle" else c for c, k in zip(q, kinds)], axis=-1)
     shown[status != CONVERGED] = np.nan
     shown = shown.reshape(n_designs, len(vals), len(kinds))
     _continuous(m, shown, vals, turn_references(m, params, n_designs, tol))
@@ -331,7 +332,7 @@ def meeting_counts(m: Mechanism, params: Mapping[str, np.ndarray], sol: DesignSo
         return np.zeros(len(solved), dtype=np.int64)
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     drv = (np.asarray(sol.values, dtype=float) * scale)[None, :]
-    q = [np.radians(sol.solution[:, :, j]) if kind == "angle" else sol.solution[:, :, j]
+    q = [radians(sol.solution[:, :, j]) if kind == "angle" else sol.solution[:, :, j]
          for j, kind in enumerate(sol.kinds)]
     meet = np.zeros(solved.shape, dtype=bool)
     for m_step in der.meets_np(q, drv, _param_columns(m, params)):

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..problems.loops import Mechanism
+from ..units import RAD_PER_DEG
 
 
 @dataclass(frozen=True)
@@ -152,7 +153,7 @@ def check_driver_values(m: Mechanism, values: Sequence[float]) -> list[float]:
     if not out:
         return out
     lo, hi = min(out), max(out)
-    scale = math.pi / 180.0 if m.driver.kind == "angle" else 1.0
+    scale = RAD_PER_DEG if m.driver.kind == "angle" else 1.0
     for v in (lo, hi):
         why = magnitude_problem(v * scale, m.driver.kind, m.length_unit) if math.isfinite(v) else \
             "the driver values must be finite"
