@@ -28,7 +28,6 @@ built only when it is read.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from functools import partial
 from typing import Any
@@ -38,6 +37,7 @@ import numpy as np
 from ..problems.derive import sign_text
 from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..rules import GOING, SystemStops, converged_codes, residual_gate, step_scales, step_size_array
+from ..units import degrees
 from .angles import (
     anchor_index_array,
     closes_circle_array,
@@ -49,7 +49,7 @@ from .angles import (
 from .batch import STATUS_CODES, BatchResult
 from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
-from .pose import implied
+from .pose import implied, step_words
 from .positions import SweepResult, check_driver_values
 from .vector_loops import VectorLoops, singular_of, solve_linear
 
@@ -208,6 +208,9 @@ def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray) -> bool:
     (:func:`~.limits.toggles`): a local minimum of |det J| where J is near singular, the
     neighbours taken around the circle where the grid closes it (more often than that
     engine: a candidate only sends the sweep to it)."""
+    close = ~(ratio > TOUCH_CANDIDATE)  # J near singular (NaN too): rare, so tested first
+    if not (close if closes else close[1:-1]).any():
+        return False
     a = np.abs(det)
     if closes:
         left, right, mid, near = np.roll(a, 1), np.roll(a, -1), a, ratio
@@ -230,15 +233,18 @@ def _column_lengths(jac: list[list[Any]], k: int) -> np.ndarray:
 def _words(m: Mechanism, drv: np.ndarray, q: list[np.ndarray], signs: tuple[float, ...]) -> list[str] | None:
     """Each two-way step's name for the block, by the derivation's own rule
     (:meth:`~linkage.problems.derive.Derivation.words_of_np`), or None where one changes
-    within it."""
+    within it. Where every name is a function of the signs alone
+    (:attr:`~linkage.problems.derive.Derivation.names_are_signs`), the block, all on
+    ``signs``, has its first position's names throughout."""
     d = m.derivation
+    if d.names_are_signs:
+        return d.words_of([float(c[0]) for c in q], float(drv[0]))
     out = []
-    for i, word in zip(d.two_way, d.words_of_np(q, drv)):
-        named = bool(d.steps[i].word_rule)
+    for (first, second), word in zip(step_words(m), m.derivation.words_of_np(q, drv)):
         if word.all():
-            out.append("open" if named else "+")
+            out.append(first)
         elif not word.any():
-            out.append("crossed" if named else "-")
+            out.append(second)
         else:
             return None
     return out
@@ -251,7 +257,7 @@ def _display(m: Mechanism, tol: float, max_iter: int, vals: np.ndarray, cols: np
     out = np.empty_like(cols)
     angles = [j for j, k in enumerate(kinds) if k == "angle"]
     for j, k in enumerate(kinds):
-        out[j] = np.degrees(cols[j]) if k == "angle" else cols[j]
+        out[j] = degrees(cols[j]) if k == "angle" else cols[j]
     if not angles:
         return out
     turn = driver_turn(m.driver.unit)
@@ -264,7 +270,7 @@ def _display(m: Mechanism, tol: float, max_iter: int, vals: np.ndarray, cols: np
     if ref is not None:
         for a, j in enumerate(angles):
             at = continuous(float(out[j, near]), float(turns[a, near]))
-            shift[a] = turn_shift(math.degrees(ref[j]), at)
+            shift[a] = turn_shift(degrees(ref[j]), at)
     for a, j in enumerate(angles):
         out[j] = continuous(out[j], turns[a] + shift[a])
     return out

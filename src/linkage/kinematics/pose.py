@@ -83,6 +83,15 @@ def file_pose_uncached(m: Mechanism) -> tuple[float, ...] | None:
     return tuple(r.x) if r.converged else None
 
 
+def step_words(m: Mechanism) -> list[tuple[str, str]]:
+    """Each two-way step's two names, (the first: True in
+    :meth:`~linkage.problems.derive.Derivation.words_of_np`, the second): open/crossed
+    for a four-bar or slider-crank loop (the derivation's open/crossed rule), + or - for
+    any other step (its sign). What the engines name a branch by."""
+    d = m.derivation
+    return [("open", "crossed") if d.steps[i].word_rule else ("+", "-") for i in d.two_way]
+
+
 POSE_MEETS = ("the file's pose is where its assemblies meet (to rounding: a change point or a limit): "
               "the branch its guesses solve to there is a matter of rounding; give --branch to choose")
 
