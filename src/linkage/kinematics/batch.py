@@ -66,7 +66,7 @@ class BatchResult:
         motion = self.rates if self.rates is not None and self.rates[0] is not None else None
         return SweepResult(c.mechanism, c.driver, c.driver_unit, c.names, c.units, BatchPositions(self),
                            c.feasible_ranges, c.toggles, c.branch, c.classification, c.method,
-                           motion=motion, length_unit=c.length_unit, meetings=self.meetings())
+                           motion=motion, length_unit=c.length_unit, meetings=BatchMeetings(self))
 
     def meetings(self) -> tuple[float, ...]:
         """The driver values of solved positions where two assemblies meet to rounding
@@ -83,6 +83,44 @@ class BatchResult:
         for step in m.derivation.meets_np(q, self.values * scale):
             hit |= np.broadcast_to(step, hit.shape)
         return tuple(float(v) for v in self.values[meet & hit])
+
+
+class BatchMeetings(Sequence):  # type: ignore[type-arg]
+    """A batch result's :meth:`BatchResult.meetings`, computed when first read: a sweep
+    whose meetings no one reads does not test every position for them (as its positions
+    are built only when read). Equal to, hashed, shown and pickled as the tuple."""
+
+    def __init__(self, batch: BatchResult) -> None:
+        self.batch = batch
+        self.found: tuple[float, ...] | None = None
+
+    def values(self) -> tuple[float, ...]:
+        if self.found is None:
+            self.found = self.batch.meetings()
+        return self.found
+
+    def __len__(self) -> int:
+        return len(self.values())
+
+    def __getitem__(self, i: Any) -> Any:
+        return self.values()[i]
+
+    def __iter__(self) -> Any:
+        return iter(self.values())
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, BatchMeetings):
+            other = other.values()
+        return self.values() == other
+
+    def __hash__(self) -> int:
+        return hash(self.values())
+
+    def __repr__(self) -> str:
+        return repr(self.values())
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (tuple, (self.values(),))
 
 
 RATES_CHUNK = 4096
