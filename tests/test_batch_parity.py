@@ -115,10 +115,10 @@ def test_batch_tolerances_scale_with_the_mechanism_as_one_at_a_time(scale):
 
 
 def test_design_newton_uses_the_scaled_stopping_rule():
-    """designs._newton (scans) has the batch's stopping rule, from linkage.rules: a design
+    """design_loops.newton_block (scans) has the batch's stopping rule, from linkage.rules: a design
     scaled by 1e6 takes the same iterations as the original."""
-    from linkage.kinematics.batch import VectorLoops
-    from linkage.kinematics.designs import _newton
+    from linkage.kinematics.design_loops import newton_block
+    from linkage.kinematics.vector_loops import VectorLoops
 
     counts = []
     for scale in (1e-6, 1.0, 1e6):
@@ -128,8 +128,8 @@ def test_design_newton_uses_the_scaled_stopping_rule():
         t3 = np.array([slider_crank_exact(math.degrees(v), scale=scale)[0] for v in vals])
         q = [t3 + 1e-4, np.array([slider_crank_exact(math.degrees(v), scale=scale)[1] for v in vals])
              * (1.0 + 1e-4)]
-        done, _, iters = _newton(loops, q, np.arange(len(vals)), 1e-12, np.full(len(vals), 120.0 * scale),
-                                 [False, True], 50, count=True)
+        done, _, iters = newton_block(loops, q, np.arange(len(vals)), 1e-12,
+                                      np.full(len(vals), 120.0 * scale), [False, True], 50, count=True)
         assert done.all()
         counts.append(list(iters))
     assert counts[0] == counts[1] == counts[2]

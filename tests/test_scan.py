@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from linkage.kinematics.designs import _sweep_engine, solve_designs
+from linkage.kinematics.design_continuation import sweep_engine as _sweep_engine
+from linkage.kinematics.designs import solve_designs
 from linkage.kinematics.loading import load
 from linkage.problems.closed_form import fourbar_class
 from linkage.scan.metrics import grashof_class
@@ -484,7 +485,7 @@ def test_vectorised_continuation_is_the_sweep(name, param, lo, hi, count, step, 
     """Mechanisms without a closed form: the batch continuation gives every design the
     statuses of its one-at-a-time sweep and the same solutions (designs that would need
     a halved step, a walk or a gap go through that sweep themselves)."""
-    from linkage.kinematics.designs import _continuation_engine
+    from linkage.kinematics.design_continuation import continuation_engine as _continuation_engine
 
     m = load(ROOT / "sample_inputs" / name)
     arrays = {param: np.linspace(lo, hi, count)}

@@ -298,7 +298,7 @@ def test_batch_trigonometry_after_a_small_step_is_within_a_few_ulps():
     np.cos/np.sin, and never twice in a row."""
     import numpy as np
 
-    from linkage.kinematics.batch import VectorLoops
+    from linkage.kinematics.vector_loops import VectorLoops
 
     m = load_mechanism(SAMPLES / "crank_rocker.toml")
     rng = np.random.default_rng(11)

@@ -142,3 +142,135 @@ def continuity_measures_array(q_last: Sequence[Any], pred: Sequence[Any],
     moved = np.max(np.abs(np.stack(pred) - np.stack(q_last)), axis=0)
     size = 1.0 + np.max(np.abs(np.stack(q)), axis=0)
     return correction, moved, size
+
+
+# --- the array engines' stopping order ---------------------------------------------------------
+# The numpy twin of the ordered stopping tests iterate.run applies to Newton-Raphson on a
+# system (iterate.py's module docstring lists them; methods/newton_system.newton_2x2 is the
+# same order unrolled), for the array engines (kinematics: batch, closed, designs): one
+# block function for every engine, each position judged as the scalar loop judges it.
+
+SYSTEM_DIVERGE_STREAK = 5
+"""Consecutive growing steps after which an undamped system Newton has diverged (once its
+iterate runs away): iterate.DIVERGE_STREAK, held equal by tests/test_array_stops.py."""
+
+SYSTEM_RUNAWAY = 1e8
+"""Growing steps are divergence only once max|q| exceeds this times 1 + max|q0|
+(iterate.RUNAWAY)."""
+
+SYSTEM_ROUNDING = 4.0 * 2.220446049250313e-16
+"""A step within this times max|q| is rounding noise (iterate.ROUNDING)."""
+
+(GOING, CONVERGED_STEP, CONVERGED_EXACT, CONVERGED_RESIDUAL, SINGULAR, NON_FINITE, DIVERGED,
+ PRECISION_LIMIT) = range(8)
+"""The array verdicts, one int8 per position: going on, or the scalar loop's status
+(``linkage.result.Status``) of the same name. The iteration cap is the engine's loop's."""
+
+ARRAY_STATUS = ("going", "converged_step", "converged_exact", "converged_residual", "singular_jacobian",
+                "non_finite", "diverged", "precision_limit")
+"""Each verdict code's ``Status`` value (``Status(ARRAY_STATUS[code])``)."""
+
+
+def converged_codes(codes: Any) -> Any:
+    """Where a verdict is a convergence (a step, an exact zero, or a singular J with the
+    residual already within the gate), position by position."""
+    return (codes >= CONVERGED_STEP) & (codes <= CONVERGED_RESIDUAL)
+
+
+class SystemStops:
+    """The stopping tests of Newton-Raphson on a system, in the scalar loop's order, for
+    many positions at once (a block function: :meth:`judge` after every step). Per
+    position it keeps what the scalar loop keeps between steps: the last error, the
+    growing-step streak, the rounding-level steps and stalls.
+
+    After a step from q (where max|Phi| = ``resid``, J singular or not) to q_new, with
+    ``err`` = max|dq_i| / scale_i (:func:`step_size_array`), the first that holds:
+
+    1. J singular (the step's own failure): CONVERGED_RESIDUAL where ``resid`` is within
+       the gate already (solve.system_verdict: a root to the tolerance, ill-conditioned),
+       else SINGULAR;
+    2. ``err`` or ``resid`` not finite: NON_FINITE;
+    3. ``resid`` exactly 0: CONVERGED_EXACT;
+    4. the step and the residual within tolerance (:func:`system_converged_array`):
+       CONVERGED_STEP;
+    5. (``can_diverge``: the textbook iteration) ``SYSTEM_DIVERGE_STREAK`` growing steps
+       in a row with max|q_new| past the runaway bound: DIVERGED;
+    6. a step at rounding level (``err`` <= ``SYSTEM_ROUNDING`` max|q_new|) that stopped
+       shrinking twice, or six such steps: PRECISION_LIMIT;
+
+    else GOING. ``tol`` is the step limit (rtol 0, as every engine runs), ``gate`` the
+    residual's (:func:`residual_gate`; a float, or one per position); ``q0_size``: max|q0|
+    per position (the runaway bound's base)."""
+
+    def __init__(self, tol: float, gate: Any, q0_size: Any, can_diverge: bool = True) -> None:
+        self.tol = tol
+        self.gate = gate
+        self.can_diverge = can_diverge
+        self.q0_size = q0_size
+        self.kept: tuple[Any, Any, Any, Any, Any] | None = None  # made when first needed
+
+    def _kept(self) -> tuple[Any, Any, Any, Any, Any]:
+        """(last error, growing streak, rounding-level steps, stalls, runaway bound) per
+        position: what the scalar loop keeps between steps; made at the first step that
+        does not stop every position (a block that converges at once never pays for it)."""
+        import numpy as np
+
+        if self.kept is None:
+            q0 = np.asarray(self.q0_size, dtype=float)
+            k = q0.shape[0]
+            with np.errstate(invalid="ignore", over="ignore"):
+                runaway = SYSTEM_RUNAWAY * (1.0 + q0)
+            self.kept = (np.full(k, np.inf), np.zeros(k, dtype=np.int32), np.zeros(k, dtype=np.int32),
+                         np.zeros(k, dtype=np.int32), runaway)
+        return self.kept
+
+    def judge(self, err: Any, resid: Any, singular: Any, q_size: Any, rows: Any = None) -> Any:
+        """The verdict codes (int8) of one step at the positions ``rows`` (None: all),
+        ``singular`` a boolean array or None (no J singular), ``q_size`` max|q_new| at
+        them (or a function giving it, called only where a test reads it); updates their
+        kept state."""
+        import numpy as np
+
+        def at(a: Any) -> Any:
+            return a if rows is None else a[rows]
+
+        gate = self.gate if np.ndim(self.gate) == 0 else at(self.gate)
+        codes = np.zeros(np.shape(err), dtype=np.int8)
+        with np.errstate(invalid="ignore"):
+            pending = np.ones(codes.shape, dtype=bool)
+            if singular is not None and singular.any():
+                within = resid <= gate
+                codes[singular] = np.where(within[singular], CONVERGED_RESIDUAL, SINGULAR)
+                pending &= ~singular
+            for code, hit in ((NON_FINITE, ~(np.isfinite(err) & np.isfinite(resid))),
+                              (CONVERGED_EXACT, resid == 0.0),
+                              (CONVERGED_STEP, system_converged_array(err, resid, self.tol, gate))):
+                codes[pending & hit] = code
+                pending &= ~hit
+            if not pending.any():
+                return codes  # every position stopped: nothing kept is read again
+            last, streak, rounding_steps, stalls_kept, runaway = self._kept()
+            prev = at(last)
+            if callable(q_size):
+                q_size = q_size()
+            if self.can_diverge:
+                growth = np.where(err > prev, at(streak) + 1, 0)
+                self._put(streak, rows, growth)
+                hit = pending & (growth >= SYSTEM_DIVERGE_STREAK) & (q_size > at(runaway))
+                codes[hit] = DIVERGED
+                pending &= ~hit
+            rounding = pending & (err <= SYSTEM_ROUNDING * q_size)
+            steps = at(rounding_steps) + rounding
+            stalls = at(stalls_kept) + (rounding & (err >= prev))
+            self._put(rounding_steps, rows, steps)
+            self._put(stalls_kept, rows, stalls)
+            codes[rounding & ((stalls >= 2) | (steps >= 6))] = PRECISION_LIMIT
+            self._put(last, rows, err)
+        return codes
+
+    @staticmethod
+    def _put(kept: Any, rows: Any, value: Any) -> None:
+        if rows is None:
+            kept[...] = value
+        else:
+            kept[rows] = value

@@ -20,18 +20,21 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from functools import partial
 from typing import Any
 
 import numpy as np
 
 from ..errors import InputError
-from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel, Mechanism
-from ..rules import residual_gate, step_scales, step_size_array, system_converged_array
+from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism
+from ..rules import GOING, SystemStops, converged_codes, residual_gate, step_scales, step_size_array
+from ..units import RAD_PER_DEG, degrees, radians
 from .angles import nearest_turn, nearest_turn_array
 from .continuation import Solver, classify_gap, continue_step, solve_position, solver_q, tangent
 from .limits import solved_ranges_array
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
 from .stepwise import sweep
+from .vector_loops import VectorLoops, singular_of, solve_linear
 
 STATUS_CODES = {"converged": 0, "no_solution": 1, "failed": 2, "off_branch": 3}
 CODE_STATUS = {v: k for k, v in STATUS_CODES.items()}
@@ -63,7 +66,7 @@ class BatchResult:
         motion = self.rates if self.rates is not None and self.rates[0] is not None else None
         return SweepResult(c.mechanism, c.driver, c.driver_unit, c.names, c.units, BatchPositions(self),
                            c.feasible_ranges, c.toggles, c.branch, c.classification, c.method,
-                           motion=motion, length_unit=c.length_unit, meetings=self.meetings())
+                           motion=motion, length_unit=c.length_unit, meetings=BatchMeetings(self))
 
     def meetings(self) -> tuple[float, ...]:
         """The driver values of solved positions where two assemblies meet to rounding
@@ -73,13 +76,51 @@ class BatchResult:
         if m is None or not m.derivation.complete or not m.derivation.two_way or not len(self.values):
             return ()
         scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-        q = [np.radians(self.solution[:, j]) if u.kind == "angle" else self.solution[:, j]
+        q = [radians(self.solution[:, j]) if u.kind == "angle" else self.solution[:, j]
              for j, u in enumerate(m.unknowns)]
         meet = self.status == STATUS_CODES["converged"]
         hit = np.zeros(len(self.values), dtype=bool)
         for step in m.derivation.meets_np(q, self.values * scale):
             hit |= np.broadcast_to(step, hit.shape)
         return tuple(float(v) for v in self.values[meet & hit])
+
+
+class BatchMeetings(Sequence):  # type: ignore[type-arg]
+    """A batch result's :meth:`BatchResult.meetings`, computed when first read: a sweep
+    whose meetings no one reads does not test every position for them (as its positions
+    are built only when read). Equal to, hashed, shown and pickled as the tuple."""
+
+    def __init__(self, batch: BatchResult) -> None:
+        self.batch = batch
+        self.found: tuple[float, ...] | None = None
+
+    def values(self) -> tuple[float, ...]:
+        if self.found is None:
+            self.found = self.batch.meetings()
+        return self.found
+
+    def __len__(self) -> int:
+        return len(self.values())
+
+    def __getitem__(self, i: Any) -> Any:
+        return self.values()[i]
+
+    def __iter__(self) -> Any:
+        return iter(self.values())
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, BatchMeetings):
+            other = other.values()
+        return self.values() == other
+
+    def __hash__(self) -> int:
+        return hash(self.values())
+
+    def __repr__(self) -> str:
+        return repr(self.values())
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (tuple, (self.values(),))
 
 
 RATES_CHUNK = 4096
@@ -146,9 +187,9 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         if sol is None or m is None or not m.derivation.fourbars:
             return None
         scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-        q = [math.radians(sol[u.name]) if u.kind == "angle" else sol[u.name] for u in m.unknowns]
+        q = [radians(sol[u.name]) if u.kind == "angle" else sol[u.name] for u in m.unknowns]
         mu = m.derivation.transmission(q, value * scale)
-        return None if mu is None else math.degrees(mu)
+        return None if mu is None else degrees(mu)
 
     def summary(self) -> dict[str, int]:
         codes, counts = np.unique(self.batch.status, return_counts=True)
@@ -160,133 +201,6 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         out = self.batch.solution[:, j].copy()
         out[self.batch.status != STATUS_CODES["converged"]] = np.nan
         return out
-
-
-class VectorLoops:
-    """Phi and J over arrays of positions, from the compiled loop terms.
-
-    Unknowns, residuals and Jacobian entries are kept as separate contiguous 1-D arrays
-    (column by column): strided access into (N, m, n) arrays costs several times more.
-    """
-
-    def __init__(self, model: LoopModel, drv: np.ndarray) -> None:
-        terms = [[(sign, drv if lidx == DRIVER else lc, lidx if lidx >= 0 else -1,
-                   drv if aidx == DRIVER else ac, aidx if aidx >= 0 else -1, off)
-                  for sign, lc, lidx, ac, aidx, off in loop] for loop in model.terms]
-        self.setup(terms, model.n, len(drv))
-
-    @classmethod
-    def of_terms(cls, terms: Sequence[Sequence[tuple[float, Any, int, Any, int, float]]], n: int,
-                 size: int) -> VectorLoops:
-        """Loops whose fixed lengths and angles may be arrays (one value per position):
-        each term is (sign, length, length index, angle, angle index, offset), an index
-        >= 0 naming an unknown, -1 a fixed value (a float or an array of ``size``)."""
-        self = cls.__new__(cls)
-        self.setup(terms, n, size)
-        return self
-
-    def setup(self, terms: Sequence[Sequence[tuple[float, Any, int, Any, int, float]]], n: int,
-              size: int) -> None:
-        self.n = n
-        self.m = 2 * len(terms)
-        # Terms whose length and angle are both known do not change while iterating:
-        # sum them once per position.
-        self.fixed = [np.zeros(size) for _ in range(self.m)]
-        self.moving: list[tuple[int, float, Any, int, Any, int, float]] = []
-        for li, loop in enumerate(terms):
-            for sign, r, lidx, th, aidx, off in loop:
-                if lidx < 0 and aidx < 0:
-                    self.fixed[2 * li] += sign * r * np.cos(th + off)
-                    self.fixed[2 * li + 1] += sign * r * np.sin(th + off)
-                else:
-                    self.moving.append((li, sign, r, lidx, th, aidx, off))
-
-    def evaluate(self, q: list[np.ndarray], rows: np.ndarray | None,
-                 near: bool = False) -> tuple[list[np.ndarray], list[list[Any]]]:
-        """Phi (m arrays) and J (m x n arrays or zeros) at ``rows`` (None: all positions).
-        ``near``: q is the last evaluation's q plus a Newton step (see :meth:`_trig`)."""
-        def sub(a: Any) -> Any:
-            return a if rows is None or not isinstance(a, np.ndarray) else a[rows]
-
-        phi: list[Any] = [sub(f) for f in self.fixed]  # replaced, never modified in place
-        jac: list[list[Any]] = [[0.0] * self.n for _ in range(self.m)]
-        trig: dict[tuple[int, float], tuple[Any, Any, Any, bool]] = {}
-        for li, sign, r, lidx, th, aidx, off in self.moving:
-            rr = q[lidx] if lidx >= 0 else sub(r)
-            if aidx >= 0 and rows is None:
-                c, s = self._trig(trig, aidx, off, q[aidx], near)
-            else:
-                tt = q[aidx] if aidx >= 0 else sub(th)
-                if off:
-                    tt = tt + off
-                c, s = np.cos(tt), np.sin(tt)
-            rc, rs = sign * rr * c, sign * rr * s
-            phi[2 * li] = phi[2 * li] + rc
-            phi[2 * li + 1] = phi[2 * li + 1] + rs
-            if aidx >= 0:
-                jac[2 * li][aidx] = jac[2 * li][aidx] - rs
-                jac[2 * li + 1][aidx] = jac[2 * li + 1][aidx] + rc
-            if lidx >= 0:
-                jac[2 * li][lidx] = jac[2 * li][lidx] + sign * c
-                jac[2 * li + 1][lidx] = jac[2 * li + 1][lidx] + sign * s
-        self.last_trig = trig
-        return phi, jac
-
-    SMALL_STEP = 1e-6
-    """rad: below this, cos d = 1 - d^2/2 and sin d = d to within 1.7e-19 (d^3/6)."""
-
-    def _trig(self, trig: dict[tuple[int, float], tuple[Any, Any, Any, bool]], aidx: int, off: float,
-              qa: np.ndarray, near: bool) -> tuple[Any, Any]:
-        """cos and sin of an unknown angle (plus its offset) at every position. Just after
-        a Newton step, where it moved at most SMALL_STEP, from the values computed
-        directly at the previous iterate by the angle-addition formula, within a few units in the
-        last place of np.cos and np.sin (tests/test_sweep.py) for a fraction of the time:
-        the batch's second Newton evaluation, which certifies every position, costs two
-        trigonometric calls less per angle. Never twice in a row: a value so obtained is
-        not the base of another."""
-        key = (aidx, off)
-        if key in trig:
-            return trig[key][1], trig[key][2]
-        last = getattr(self, "last_trig", {}).get(key) if near else None
-        if last is not None and last[3]:
-            d = qa - last[0]  # exact: the two iterates are within a factor of 2 of each other
-            c0, s0 = last[1], last[2]
-            cd = 1.0 - 0.5 * (d * d)
-            c, s = c0 * cd - s0 * d, s0 * cd + c0 * d
-            far = ~(np.abs(d) <= self.SMALL_STEP)  # (NaN included): those directly
-            if far.any():
-                tt = qa[far] + off if off else qa[far]
-                c[far], s[far] = np.cos(tt), np.sin(tt)
-            trig[key] = (None, c, s, False)
-            return c, s
-        tt = qa + off if off else qa
-        c, s = np.cos(tt), np.sin(tt)
-        trig[key] = (qa.copy(), c, s, True)
-        return c, s
-
-
-def solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[list[np.ndarray], np.ndarray]:
-    """dq with J dq = -Phi at every position, and det J. Cramer's rule for 2x2."""
-    if len(jac) == 2 and len(jac[0]) == 2:
-        a, b = np.broadcast_to(jac[0][0], (k,)), np.broadcast_to(jac[0][1], (k,))
-        c, d = np.broadcast_to(jac[1][0], (k,)), np.broadcast_to(jac[1][1], (k,))
-        det = a * d - b * c
-        with np.errstate(divide="ignore", invalid="ignore"):
-            inv = 1.0 / det
-            return [(b * phi[1] - d * phi[0]) * inv, (c * phi[0] - a * phi[1]) * inv], det
-    n = len(jac[0])
-    full = np.empty((k, len(jac), n))
-    for i, row in enumerate(jac):
-        for j, v in enumerate(row):
-            full[:, i, j] = v
-    with np.errstate(invalid="ignore"):  # positions not iterating hold NaN
-        det = np.linalg.det(full)
-    ok = np.isfinite(det) & (det != 0.0)
-    dq = np.full((k, n), np.nan)
-    if ok.any():
-        rhs = -np.stack(phi, axis=1)
-        dq[ok] = np.linalg.solve(full[ok], rhs[ok][..., None])[..., 0]
-    return [dq[:, j] for j in range(n)], det
 
 
 def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: str | None = None,
@@ -319,21 +233,9 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
     solver = Solver(m, "newton", tol, max_iter)
     names, kinds = solver.names, solver.kinds
     n = len(names)
-    ok_coarse = np.array([p.status == "converged" for p in rough.positions])
-    grid_arr = np.array(grid)
-    coarse_sol = np.array([[p.solution[nm] if p.solution else np.nan for nm in names]
-                           for p in rough.positions])
-
-    scale = [math.pi / 180.0 if k == "angle" else 1.0 for k in kinds]
-    slopes = np.zeros_like(coarse_sol)
-    no_tangent = np.zeros(len(grid_arr), dtype=bool)
-    for c, p in enumerate(rough.positions):
-        if p.solution is not None:
-            t = tangent(solver, p.input, solver_q(solver, p))
-            if t is None:
-                no_tangent[c] = True
-            else:
-                slopes[c] = [ti / sc for ti, sc in zip(t, scale)]
+    scale = [RAD_PER_DEG if k == "angle" else 1.0 for k in kinds]
+    coarse = _coarse_pass(solver, rough, grid, scale)
+    grid_arr = coarse.grid
     drv_scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     code = STATUS_CODES
     status = np.full(n_pos, code["failed"], dtype=np.int8)
@@ -341,7 +243,6 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
     det_out = np.full(n_pos, np.nan)
     shown = np.empty((n_pos, n))
     ref = np.empty((n_pos, n))
-    coarse = _coarse(grid_arr, ok_coarse & ~no_tangent, coarse_sol, slopes, kinds)
     # Steps 2 and 3 a block of positions at a time: every temporary array then stays in
     # the processor's cache (1,000,000 positions at once made each one 8 MB, and the
     # engine waited on memory).
@@ -352,49 +253,10 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
                 rough.branch, status[lo_i:hi_i], iters[lo_i:hi_i], det_out[lo_i:hi_i],
                 shown[lo_i:hi_i], ref[lo_i:hi_i])
 
-    # 4. everything else, one at a time: continuation from the nearer solved coarse
-    # neighbour; failing that, the status of the coarse neighbour that did not solve.
+    # 4. everything else, one at a time
     todo = np.flatnonzero(status != code["converged"])
-    right = np.full(n_pos, -1)
-    right[todo] = np.clip(np.searchsorted(grid_arr, vals[todo], side="right"), 1, len(grid_arr) - 1)
-    left = right - 1
     have_closed = _have_closed(m, solver, lo)
-    target = rough.branch
-    for i in todo:
-        v = float(vals[i])
-        near = sorted((int(left[i]), int(right[i])), key=lambda c: abs(grid_arr[c] - v))
-        pos = None
-        for c in near:
-            cp = rough.positions[c]
-            if cp.status == "converged":
-                qc = solver_q(solver, cp)
-                if have_closed:
-                    pos, _ = solve_position(solver, v, qc, cp.input, qc, target, True)
-                else:
-                    pos, _ = continue_step(solver, v, [(cp.input, qc)], target)
-                if pos.status == "converged":
-                    break
-        if pos is None or pos.status != "converged":
-            others = [rough.positions[c].status for c in near if rough.positions[c].status != "converged"]
-            if have_closed and pos is not None and pos.status in ("no_solution", "off_branch"):
-                status[i] = code[pos.status]  # solve_position read the closed form already
-                continue
-            closed = solver.problem(v).reference() if have_closed else None
-            if closed is not None and (closed == {} or target not in closed):
-                # as the one-at-a-time sweep: no assembly at all, or none with the label
-                status[i] = code["no_solution" if closed == {} else "off_branch"]
-            elif len(set(others)) > 1 and not have_closed:
-                # a boundary between two kinds of gap falls in this coarse interval
-                anchor = next((solver_q(solver, p) for p in rough.positions if p.solution), None)
-                tries = [g for g in (anchor, tuple(u.value for u in m.unknowns)) if g is not None]
-                status[i] = code[classify_gap(solver, v, tries)[0].status]
-            else:
-                status[i] = code[others[0]] if others else code["failed"]
-            continue
-        status[i] = code["converged"]
-        iters[i] = pos.iterations
-        shown[i] = [pos.solution[nm] for nm in names]
-        det_out[i] = pos.det if pos.det is not None else np.nan
+    _one_at_a_time(m, solver, rough, grid_arr, vals, todo, have_closed, status, iters, shown, det_out)
     # report angles continuously, as the one-at-a-time sweep does (where a position has
     # a guess; the blocks did the others)
     for i in todo:
@@ -408,6 +270,80 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
         # them (the coarse pass's are only as fine as its grid)
         rough = replace(rough, feasible_ranges=solved_ranges_array(vals, status == code["converged"]))
     return BatchResult(vals, status, shown, det_out, iters, rough.branch, rough, len(todo), m, rates)
+
+
+def _coarse_pass(solver: Solver, rough: SweepResult, grid: Sequence[float],
+                 scale: Sequence[float]) -> _Coarse:
+    """The coarse sweep as the blocks read it: its solutions (display units) and the exact
+    tangents dq/dv there (:func:`~.continuation.tangent`); a position without a tangent is
+    no end of a usable interval."""
+    names, kinds = solver.names, solver.kinds
+    ok_coarse = np.array([p.status == "converged" for p in rough.positions])
+    grid_arr = np.array(grid)
+    coarse_sol = np.array([[p.solution[nm] if p.solution else np.nan for nm in names]
+                           for p in rough.positions])
+    slopes = np.zeros_like(coarse_sol)
+    no_tangent = np.zeros(len(grid_arr), dtype=bool)
+    for c, p in enumerate(rough.positions):
+        if p.solution is not None:
+            t = tangent(solver, p.input, solver_q(solver, p))
+            if t is None:
+                no_tangent[c] = True
+            else:
+                slopes[c] = [ti / sc for ti, sc in zip(t, scale)]
+    return _coarse(grid_arr, ok_coarse & ~no_tangent, coarse_sol, slopes, kinds)
+
+
+def _one_at_a_time(m: Mechanism, solver: Solver, rough: SweepResult, grid_arr: np.ndarray, vals: np.ndarray,
+                   todo: np.ndarray, have_closed: bool, status: np.ndarray, iters: np.ndarray,
+                   shown: np.ndarray, det_out: np.ndarray) -> None:
+    """Step 4, in place: each position the blocks left, by continuation from the nearer
+    solved coarse neighbour; failing that, the status the one-at-a-time sweep gives it."""
+    code = STATUS_CODES
+    right = np.clip(np.searchsorted(grid_arr, vals[todo], side="right"), 1, len(grid_arr) - 1)
+    target = rough.branch
+    for i, r in zip(todo, right):
+        v = float(vals[i])
+        near = sorted((int(r) - 1, int(r)), key=lambda c: abs(grid_arr[c] - v))
+        pos = None
+        for c in near:
+            cp = rough.positions[c]
+            if cp.status == "converged":
+                qc = solver_q(solver, cp)
+                if have_closed:
+                    pos, _ = solve_position(solver, v, qc, cp.input, qc, target, True)
+                else:
+                    pos, _ = continue_step(solver, v, [(cp.input, qc)], target)
+                if pos.status == "converged":
+                    break
+        if pos is None or pos.status != "converged":
+            status[i] = code[_gap_status(m, solver, rough, near, v, pos, have_closed)]
+            continue
+        status[i] = code["converged"]
+        iters[i] = pos.iterations
+        shown[i] = [pos.solution[nm] for nm in solver.names]
+        det_out[i] = pos.det if pos.det is not None else np.nan
+
+
+def _gap_status(m: Mechanism, solver: Solver, rough: SweepResult, near: Sequence[int], v: float,
+                pos: Position | None, have_closed: bool) -> str:
+    """The status of a position that continuation did not solve, as the one-at-a-time
+    sweep gives it: the closed form's verdict where there is one, else that of the coarse
+    neighbours that did not solve (classified afresh where they differ)."""
+    target = rough.branch
+    others = [rough.positions[c].status for c in near if rough.positions[c].status != "converged"]
+    if have_closed and pos is not None and pos.status in ("no_solution", "off_branch"):
+        return pos.status  # solve_position read the closed form already
+    closed = solver.problem(v).reference() if have_closed else None
+    if closed is not None and (closed == {} or target not in closed):
+        # as the one-at-a-time sweep: no assembly at all, or none with the label
+        return "no_solution" if closed == {} else "off_branch"
+    if len(set(others)) > 1 and not have_closed:
+        # a boundary between two kinds of gap falls in this coarse interval
+        anchor = next((solver_q(solver, p) for p in rough.positions if p.solution), None)
+        tries = [g for g in (anchor, tuple(u.value for u in m.unknowns)) if g is not None]
+        return classify_gap(solver, v, tries)[0].status
+    return others[0] if others else "failed"
 
 
 def _grid_index(grid: np.ndarray, vals: np.ndarray) -> np.ndarray:
@@ -466,9 +402,40 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     A position left "failed" goes to the one-at-a-time path. Columns are contiguous 1-D
     arrays, written into the (N, n) outputs once (reading a strided column costs
     several times more)."""
-    n, n_pos, code, take = len(kinds), len(vals), STATUS_CODES, np.take
-    # 2. warm starts: cubic Hermite interpolation between coarse neighbours that both
-    # solved, with the exact tangents dq/dv there (error ~ h^4: two Newton steps do)
+    n, code = len(kinds), STATUS_CODES
+    refs, left, usable = _warm_starts(coarse, vals, n)
+    loops = VectorLoops(model, vals * drv_scale)
+    q_all = [r * sc for r, sc in zip(refs, scale)]
+    done = _vector_newton(loops, q_all, usable, m.length_scale, kinds, tol, max_iter, iters, det_out)
+    status[done] = code["converged"]
+    cols = [c / sc for c, sc in zip(q_all, scale)]
+    # Continuity: a position must stay near its interpolated guess. Near a nearly
+    # singular configuration Newton can jump to another assembly with the same det J
+    # sign; such positions go to the one-at-a-time path.
+    moved = np.abs(cols[0] - refs[0])
+    for j in range(1, n):
+        np.maximum(moved, np.abs(cols[j] - refs[j]), out=moved)
+    status[done & (moved > np.take(coarse.allowed, left))] = code["failed"]
+    status[done & ~_on_branch_columns(m, cols, names, det_out, branch, vals * drv_scale)] = code["failed"]
+    # angles reported continuously with the guess (the one-at-a-time sweep's convention):
+    # a solution within half a turn of its guess is already the representative nearest it
+    for j, k in enumerate(kinds):
+        if k == "angle":
+            far = ~(np.abs(cols[j] - refs[j]) < 180.0)  # (NaN included)
+            if far.any():
+                cols[j][far] = nearest_turn_array(refs[j][far], cols[j][far])
+    for j in range(n):
+        shown[:, j] = cols[j]
+        ref[:, j] = refs[j]
+
+
+def _warm_starts(coarse: _Coarse, vals: np.ndarray,
+                 n: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+    """Step 2, the warm starts (display units, one array per unknown): cubic Hermite
+    interpolation between coarse neighbours that both solved, with the exact tangents
+    dq/dv there (error ~ h^4: two Newton steps do); with each position's left grid index
+    and whether its interval is usable."""
+    take = np.take
     right = np.clip(_grid_index(coarse.grid, vals), 1, len(coarse.grid) - 1)
     left = right - 1
     usable = take(coarse.pair_usable, left)
@@ -486,79 +453,58 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
         y0, y1 = take(coarse.solution[j], left), take(coarse.next_value[j], left)
         refs.append(h00 * y0 + h10 * width * take(coarse.slopes[j], left) + h01 * y1
                     + h11 * width * take(coarse.slopes[j], right))
+    return refs, left, usable
 
-    # 3. vectorised Newton on the usable positions. The first two iterations (all most
-    # positions need) evaluate every position and move only the live ones (no gathers);
-    # later ones gather the few left. Position by position the iterates do not depend on
-    # the block they are in.
-    loops = VectorLoops(model, vals * drv_scale)
-    # the single solve's stopping rule, scaled as there (linkage.rules): a length step
-    # relative to the mechanism's size, max|Phi| within tol x size
-    size = m.length_scale
-    gate, steps = residual_gate(tol, size), step_scales(kinds, size)
-    q_all = [r * sc for r, sc in zip(refs, scale)]
-    live = usable.copy()
+
+def _vector_newton(loops: VectorLoops, q_all: list[np.ndarray], live: np.ndarray, size: float,
+                   kinds: Sequence[str], tol: float, max_iter: int, iters: np.ndarray,
+                   det_out: np.ndarray) -> np.ndarray:
+    """Step 3, textbook Newton at the ``live`` positions (q_all updated in place, internal
+    units), each stopped as the single solve's loop stops it (:class:`~linkage.rules.SystemStops`,
+    with its scales: a length step relative to the mechanism's size, max|Phi| within
+    tol x size); where each converged. The first two iterations (all most positions
+    need) evaluate every position and move only the live ones (no gathers); later ones
+    gather the few left. Position by position the iterates do not depend on the block."""
+    n, n_pos = len(kinds), len(live)
+    steps = step_scales(kinds, size)
+    stops = SystemStops(tol, residual_gate(tol, size), step_size_array(q_all, None))
+    live = live.copy()
     done = np.zeros(n_pos, dtype=bool)
     it = 0
     while it < min(2, max_iter) and live.any():
         it += 1
         phi, jac = loops.evaluate(q_all, None, near=it > 1)
         dq, det = solve_linear(jac, phi, n_pos)
-        step, resid = step_size_array(dq, steps), _largest(phi)
-        finite = np.isfinite(step)
+        singular = singular_of(jac, det)
+        step = step_size_array(dq, steps)
+        moving = live & ~singular & np.isfinite(step)
         for j in range(n):
-            np.add(q_all[j], dq[j], out=q_all[j], where=live & finite)
+            np.add(q_all[j], dq[j], out=q_all[j], where=moving)
+        codes = stops.judge(step, step_size_array(phi, None), singular, partial(step_size_array, q_all, None))
         iters[live] = it
         det_out[live] = det[live]
-        finished = live & system_converged_array(step, resid, tol, gate)
-        done |= finished
-        live &= ~finished & finite
+        done |= live & converged_codes(codes)
+        live &= codes == GOING
     active = np.flatnonzero(live)
     q = [c[active] for c in q_all]
     while it < max_iter and active.size:
         it += 1
         phi, jac = loops.evaluate(q, active)
         dq, det = solve_linear(jac, phi, active.size)
-        step, resid = step_size_array(dq, steps), _largest(phi)
+        singular = singular_of(jac, det)
         for j in range(n):
-            q[j] += dq[j]
-        finished = system_converged_array(step, resid, tol, gate)
-        keep = ~finished & np.isfinite(step)
+            q[j] += np.where(singular, 0.0, dq[j])
+        codes = stops.judge(step_size_array(dq, steps), step_size_array(phi, None), singular,
+                            partial(step_size_array, q, None), active)
         for j in range(n):
             q_all[j][active] = q[j]
         iters[active] = it
         det_out[active] = det
-        done[active[finished]] = True
+        done[active[converged_codes(codes)]] = True
+        keep = codes == GOING
         active = active[keep]
         q = [c[keep] for c in q]
-    status[done] = code["converged"]
-    cols = [c / sc for c, sc in zip(q_all, scale)]
-    # Continuity: a position must stay near its interpolated guess. Near a nearly
-    # singular configuration Newton can jump to another assembly with the same det J
-    # sign; such positions go to the one-at-a-time path.
-    moved = np.abs(cols[0] - refs[0])
-    for j in range(1, n):
-        np.maximum(moved, np.abs(cols[j] - refs[j]), out=moved)
-    status[done & (moved > take(coarse.allowed, left))] = code["failed"]
-    status[done & ~_on_branch_columns(m, cols, names, det_out, branch, vals * drv_scale)] = code["failed"]
-    # angles reported continuously with the guess (the one-at-a-time sweep's convention):
-    # a solution within half a turn of its guess is already the representative nearest it
-    for j, k in enumerate(kinds):
-        if k == "angle":
-            far = ~(np.abs(cols[j] - refs[j]) < 180.0)  # (NaN included)
-            if far.any():
-                cols[j][far] = nearest_turn_array(refs[j][far], cols[j][far])
-    for j in range(n):
-        shown[:, j] = cols[j]
-        ref[:, j] = refs[j]
-
-
-def _largest(parts: Sequence[np.ndarray]) -> np.ndarray:
-    """max |part| over the parts, position by position (NaN if any part is NaN)."""
-    out = np.abs(parts[0])
-    for p in parts[1:]:
-        np.maximum(out, np.abs(p), out=out)
-    return out
+    return done
 
 
 def _have_closed(m: Mechanism, solver: Solver, value: float) -> bool:
@@ -585,6 +531,6 @@ def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence
 
     want = read_branch(der, target)
     kinds = {u.name: u.kind for u in m.unknowns}
-    q = [np.radians(c) if kinds[n] == "angle" else c for n, c in zip(names, cols)]
+    q = [radians(c) if kinds[n] == "angle" else c for n, c in zip(names, cols)]
     # the derivation's one rule (a name's mirror: the continuity test has already decided)
     return np.broadcast_to(der.on_branch_np(q, drivers, want), (len(det),))

@@ -12,8 +12,8 @@ a sweep that stays on one branch needs no continuation:
    grid point, so each position is that branch's closed form
    (:meth:`~linkage.problems.derive.Derivation.solve_np`), for all positions at once.
 3. One vectorised Newton-Raphson step from it under the single solve's stopping rule
-   (:mod:`linkage.rules`, the batch engine's :class:`~.batch.VectorLoops` and
-   :func:`~.batch.solve_linear`): a position is converged only where the rule holds; the
+   (:mod:`linkage.rules`, the batch engine's :class:`~.vector_loops.VectorLoops` and
+   :func:`~.vector_loops.solve_linear`): a position is converged only where the rule holds; the
    few where it does not take more steps, up to ``POLISH_ITER``.
 4. The checks that make it the one-at-a-time engine's answer: det J of one sign, no
    position where that engine would search for a touch of det J = 0 between grid points
@@ -28,15 +28,16 @@ built only when it is read.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
+from functools import partial
 from typing import Any
 
 import numpy as np
 
 from ..problems.derive import sign_text
 from ..problems.loops import ANGLE_UNITS, Mechanism
-from ..rules import residual_gate, step_scales, step_size_array, system_converged_array
+from ..rules import GOING, SystemStops, converged_codes, residual_gate, step_scales, step_size_array
+from ..units import degrees
 from .angles import (
     anchor_index_array,
     closes_circle_array,
@@ -45,10 +46,12 @@ from .angles import (
     turn_shift,
     unwrap_turns_array,
 )
-from .batch import STATUS_CODES, BatchResult, VectorLoops, solve_linear
+from .batch import STATUS_CODES, BatchResult
 from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
+from .pose import implied, step_words
 from .positions import SweepResult, check_driver_values
+from .vector_loops import VectorLoops, singular_of, solve_linear
 
 MARGIN_FLOOR = 1e-8
 """The smallest relative margin of a step at a grid point for this engine: closer to a
@@ -79,8 +82,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     # the driver's magnitude, refused as the one-at-a-time engine refuses it
     check_driver_values(m, [float(vals[0]), float(vals[-1])])
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-    solver = Solver(m, "newton", tol, max_iter)
-    signs = _followed_signs(m, solver, float(vals[0]), scale, branch)
+    signs = _followed_signs(m, tol, max_iter, float(vals[0]), scale, branch)
     if signs is None:
         return None
     kinds = tuple(u.kind for u in m.unknowns)
@@ -109,7 +111,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     closes = m.driver.kind == "angle" and closes_circle_array(vals, driver_turn(m.driver.unit))
     if _touch_candidate(closes, det, ratio):
         return None
-    shown = _display(m, solver, vals, cols, kinds, closes)
+    shown = _display(m, tol, max_iter, vals, cols, kinds, closes)
     label = "/".join(words)
     from .stepwise import classification_of
 
@@ -125,7 +127,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
                        np.ascontiguousarray(shown.T), det, iters, label, meta, 0, m, rates)
 
 
-def _followed_signs(m: Mechanism, solver: Solver, first: float, scale: float,
+def _followed_signs(m: Mechanism, tol: float, max_iter: int, first: float, scale: float,
                     branch: str | None) -> tuple[float, ...] | None:
     """The signs of the branch to follow, or None (this engine then does not apply)."""
     d = m.derivation
@@ -139,6 +141,7 @@ def _followed_signs(m: Mechanism, solver: Solver, first: float, scale: float,
     if m.driver.value / scale != first:
         starts.append(m.driver.value / scale)  # where it seeds a mechanism without the old key
     found = []
+    solver = Solver(m, "newton", tol, max_iter)
     for v in starts:
         # the one-at-a-time engine's first solve (Solver.solve: textbook Newton), on
         # compiled functions (solve_lean: the same iterates and verdict)
@@ -164,7 +167,9 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
     k = len(drv)
     loops = VectorLoops(m.model, drv)
     size = m.length_scale
-    gate, steps = residual_gate(tol, size), step_scales(kinds, size)
+    steps = step_scales(kinds, size)
+    # each position stopped as the single solve's loop stops it (linkage.rules)
+    stops = SystemStops(tol, residual_gate(tol, size), step_size_array(q, None))
     det = np.empty(k)
     iters = np.zeros(k, dtype=np.int32)
     ratio = np.empty(k)
@@ -178,16 +183,18 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
         sub = q if rows is None else [c[rows] for c in q]
         phi, jac = loops.evaluate(sub, rows)
         dq, dt = solve_linear(jac, phi, active.size)
-        # max |Phi| at the point the step was taken from (NaN propagates)
-        step, resid = step_size_array(dq, steps), np.max(np.abs(phi), axis=0)
-        if not np.isfinite(step).all():
-            return None
+        singular = singular_of(jac, dt)
+        moved = [s + np.where(singular, 0.0, d) for s, d in zip(sub, dq)]
+        codes = stops.judge(step_size_array(dq, steps), step_size_array(phi, None), singular,
+                            partial(step_size_array, moved, None), rows)
+        if not (converged_codes(codes) | (codes == GOING)).all():
+            return None  # a position the loop stops unconverged: the one-at-a-time engine's
         for j in range(len(q)):
-            q[j][active] = sub[j] + dq[j]
+            q[j][active] = moved[j]
         det[active] = dt
         ratio[active] = np.abs(dt) / _column_lengths(jac, active.size)
         iters[active] = it
-        active = active[~system_converged_array(step, resid, tol, gate)]
+        active = active[codes == GOING]
     if not ((det > 0).all() or (det < 0).all()):
         return None  # det J changes sign: a toggle, the one-at-a-time engine's to locate
     words = _words(m, drv, q, signs)
@@ -201,6 +208,9 @@ def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray) -> bool:
     (:func:`~.limits.toggles`): a local minimum of |det J| where J is near singular, the
     neighbours taken around the circle where the grid closes it (more often than that
     engine: a candidate only sends the sweep to it)."""
+    close = ~(ratio > TOUCH_CANDIDATE)  # J near singular (NaN too): rare, so tested first
+    if not (close if closes else close[1:-1]).any():
+        return False
     a = np.abs(det)
     if closes:
         left, right, mid, near = np.roll(a, 1), np.roll(a, -1), a, ratio
@@ -223,28 +233,31 @@ def _column_lengths(jac: list[list[Any]], k: int) -> np.ndarray:
 def _words(m: Mechanism, drv: np.ndarray, q: list[np.ndarray], signs: tuple[float, ...]) -> list[str] | None:
     """Each two-way step's name for the block, by the derivation's own rule
     (:meth:`~linkage.problems.derive.Derivation.words_of_np`), or None where one changes
-    within it."""
+    within it. Where every name is a function of the signs alone
+    (:attr:`~linkage.problems.derive.Derivation.names_are_signs`), the block, all on
+    ``signs``, has its first position's names throughout."""
     d = m.derivation
+    if d.names_are_signs:
+        return d.words_of([float(c[0]) for c in q], float(drv[0]))
     out = []
-    for i, word in zip(d.two_way, d.words_of_np(q, drv)):
-        named = bool(d.steps[i].word_rule)
+    for (first, second), word in zip(step_words(m), m.derivation.words_of_np(q, drv)):
         if word.all():
-            out.append("open" if named else "+")
+            out.append(first)
         elif not word.any():
-            out.append("crossed" if named else "-")
+            out.append(second)
         else:
             return None
     return out
 
 
-def _display(m: Mechanism, solver: Solver, vals: np.ndarray, cols: np.ndarray,
+def _display(m: Mechanism, tol: float, max_iter: int, vals: np.ndarray, cols: np.ndarray,
              kinds: Sequence[str], closes: bool) -> np.ndarray:
     """The unknowns in display units, each angle continuous along the cycle and anchored to
     what ``solve FILE`` gives (the rule of :mod:`.angles`, as the one-at-a-time engine)."""
     out = np.empty_like(cols)
     angles = [j for j, k in enumerate(kinds) if k == "angle"]
     for j, k in enumerate(kinds):
-        out[j] = np.degrees(cols[j]) if k == "angle" else cols[j]
+        out[j] = degrees(cols[j]) if k == "angle" else cols[j]
     if not angles:
         return out
     turn = driver_turn(m.driver.unit)
@@ -253,14 +266,22 @@ def _display(m: Mechanism, solver: Solver, vals: np.ndarray, cols: np.ndarray,
     v0 = m.driver.value / scale
     near = int(anchor_index_array(vals, np.ones((1, len(vals)), dtype=bool), v0, closes, turn)[0])
     shift = np.zeros(len(angles))
-    # solve FILE's answer, as the one-at-a-time engine anchors (solve_system's damped
-    # Newton from the file's guess, on compiled functions: the same iterates and verdict)
-    got = solver.solve_lean(v0, tuple(u.value for u in m.unknowns), damped=True)
-    if got is not None:
-        ref = got[1]
+    ref = implied(m, ("closed_anchor", tol, max_iter), lambda m: _anchor(m, tol, max_iter))
+    if ref is not None:
         for a, j in enumerate(angles):
             at = continuous(float(out[j, near]), float(turns[a, near]))
-            shift[a] = turn_shift(math.degrees(ref[j]), at)
+            shift[a] = turn_shift(degrees(ref[j]), at)
     for a, j in enumerate(angles):
         out[j] = continuous(out[j], turns[a] + shift[a])
     return out
+
+
+def _anchor(m: Mechanism, tol: float, max_iter: int) -> tuple[float, ...] | None:
+    """``solve FILE``'s answer (internal units), as the one-at-a-time engine anchors its
+    angles: solve_system's damped Newton from the file's guess at its driver value, on
+    compiled functions (the same iterates and verdict); None where it does not converge.
+    Solved once per mechanism and criteria (:func:`~.pose.implied`)."""
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    got = Solver(m, "newton", tol, max_iter).solve_lean(m.driver.value / scale,
+                                                         tuple(u.value for u in m.unknowns), damped=True)
+    return None if got is None else tuple(got[1])

@@ -34,12 +34,10 @@ from ..problems.system import LeanProblem
 from ..result import Status
 from ..rules import continues, continuity_measures, residual_gate, step_scales
 from ..solve import system_verdict
+from ..units import DEG_PER_RAD, degrees, radians
 from .positions import Position, converged_position
 
 MAX_HALVINGS = 6
-
-
-_DEG = 180.0 / math.pi  # math.degrees(x) is x * (180 / pi), bit for bit (CPython's mathmodule)
 
 
 class Solver:
@@ -90,7 +88,7 @@ class Solver:
         if not self.m.derivation.fourbars:
             return None
         mu = self.m.derivation.transmission(q, value * self.scale, self._params)
-        return None if mu is None else mu * _DEG
+        return None if mu is None else mu * DEG_PER_RAD
 
     def solve_lean(self, value: float, guess: Sequence[float],
                    damped: bool = False) -> tuple[Any, list[float], int] | None:
@@ -133,8 +131,8 @@ class Solver:
         if self.two_angles:
             n0, n1 = self.names
             x0, x1 = q
-            return {n0: x0 * _DEG, n1: x1 * _DEG}
-        return {n: (math.degrees(v) if k == "angle" else v) for n, v, k in zip(self.names, q, self.kinds)}
+            return {n0: x0 * DEG_PER_RAD, n1: x1 * DEG_PER_RAD}
+        return {n: (degrees(v) if k == "angle" else v) for n, v, k in zip(self.names, q, self.kinds)}
 
     def det(self, p: Any, q: Sequence[float]) -> float:
         from ..linalg import SingularMatrix, det_from_lu, lu
@@ -179,7 +177,7 @@ class Solver:
 
 def solver_q(solver: Solver, pos: Position) -> tuple[float, ...]:
     assert pos.solution is not None
-    return tuple(math.radians(pos.solution[n]) if k == "angle" else pos.solution[n]
+    return tuple(radians(pos.solution[n]) if k == "angle" else pos.solution[n]
                  for n, k in zip(solver.names, solver.kinds))
 
 

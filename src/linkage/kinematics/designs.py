@@ -18,7 +18,7 @@ six-bar, any dyadic mechanism):
    numbers).
 
 Mechanisms without one (coupled loops: the offset slider, the rapier drive) follow the sweep's
-continuation for every design at once (:func:`_continuation_engine`); a design that
+continuation for every design at once (:func:`.design_continuation.continuation_engine`); a design that
 would need more than a plain step anywhere (a halved step, a gap, a fold) is swept on
 its own by :func:`~linkage.kinematics.sweep.sweep`. Either way every design gets the
 sweep's statuses (tests/test_scan.py compares them).
@@ -32,22 +32,15 @@ of the file's guess: both engines report the same numbers for the same design.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..methods.newton_system import SINGULAR_RATIO
 from ..problems.derive import Derivation, read_branch
-from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism, VectorTerm
-from ..rules import (
-    continues_array,
-    continuity_measures_array,
-    residual_gate,
-    step_size_array,
-    system_converged_array,
-)
+from ..problems.loops import ANGLE_UNITS, Mechanism, VectorTerm
+from ..units import degrees, radians
 from .angles import (
     anchor_index_array,
     closes_circle,
@@ -56,10 +49,21 @@ from .angles import (
     turn_shift_array,
     unwrap_turns_array,
 )
-from .batch import STATUS_CODES, VectorLoops, solve_linear
+from .design_continuation import continuation_engine, sweep_engine, turn_references
+from .design_loops import (
+    CONVERGED,
+    FAILED,
+    NO_SOLUTION,
+    OFF_BRANCH,
+    design_grid,
+    design_resolver,
+    design_size,
+    design_terms,
+    newton_block,
+    stepwise_linear,
+)
+from .vector_loops import VectorLoops
 
-CONVERGED, NO_SOLUTION, FAILED, OFF_BRANCH = (STATUS_CODES[k] for k in
-                                              ("converged", "no_solution", "failed", "off_branch"))
 SEED_DISTANCE = 1e-6
 """How far Newton may move a closed-form position (rad, or relative to the size) and
 still be that position: further means it went to another assembly."""
@@ -126,15 +130,15 @@ def solve_designs(m: Mechanism, params: Mapping[str, np.ndarray], values: Sequen
         q, status, feasible, engine = _closed_form_engine(m, params, vals, branch, tol, max_iter,
                                                           n_designs)
     elif which == "continuation":
-        q, status, feasible, engine = _continuation_engine(m, params, vals, tol, n_designs)
+        q, status, feasible, engine = continuation_engine(m, params, vals, tol, n_designs)
     else:
-        q, status, feasible, engine = _sweep_engine(m, params, vals, branch, tol, n_designs)
+        q, status, feasible, engine = sweep_engine(m, params, vals, branch, tol, n_designs)
     found_paths = _paths(m, params, vals, q, status == CONVERGED) if paths else {}
     kinds = tuple(u.kind for u in m.unknowns)
-    shown = np.stack([np.degrees(c) if k == "angle" else c for c, k in zip(q, kinds)], axis=-1)
+    shown = np.stack([degrees(c) if k == "angle" else c for c, k in zip(q, kinds)], axis=-1)
     shown[status != CONVERGED] = np.nan
     shown = shown.reshape(n_designs, len(vals), len(kinds))
-    _continuous(m, shown, vals, _turn_references(m, params, n_designs, tol))
+    _continuous(m, shown, vals, turn_references(m, params, n_designs, tol))
     return DesignSolutions(tuple(u.name for u in m.unknowns), kinds, vals,
                            status.reshape(n_designs, len(vals)), feasible.reshape(n_designs, len(vals)),
                            shown, branch, engine,
@@ -224,39 +228,6 @@ def design_signs(der: Derivation, text: str, drivers: np.ndarray, columns: Mappi
     return out, named
 
 
-def design_grid(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray,
-          n_designs: int) -> tuple[dict[str, Any], np.ndarray]:
-    """Every parameter (internal units) as a float or a flat array over designs x positions,
-    and the driver (internal units) flat the same way."""
-    k = len(vals)
-    out: dict[str, Any] = {}
-    for name, q in m.parameters.items():
-        if name in params:
-            a = np.asarray(params[name], dtype=float)
-            a = a * ANGLE_UNITS[q.unit] if q.kind == "angle" else a
-            out[name] = np.repeat(a, k)
-        else:
-            out[name] = q.value
-    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-    return out, np.tile(vals * scale, n_designs)
-
-
-def _size(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray) -> Any:
-    """The longest length in the loops, per position (as Mechanism.length_scale)."""
-    size: Any = 0.0
-    for name, q in m.parameters.items():
-        if q.kind == "length":
-            size = np.maximum(size, np.abs(grid[name]))
-    if m.driver.kind == "length":
-        size = np.maximum(size, np.abs(drv))
-    for loop in m.loops:
-        for t in loop.vectors:
-            if isinstance(t.length, float):
-                size = np.maximum(size, abs(t.length))
-    size = np.broadcast_to(np.asarray(size, dtype=float), drv.shape)
-    return np.where(size > 0.0, size, 1.0)
-
-
 def _apart(angles: tuple[Any, Any]) -> Any:
     """How far apart two angles are (rad, the short way round)."""
     d = angles[0] - angles[1]
@@ -279,7 +250,7 @@ def _closed_form_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np
     """The derivation's closed form (:meth:`Derivation.solve_np`) for every design at every
     position at once, designs (D, 1) against positions (1, P), on each design's sign tuple
     (:func:`design_signs`); then Newton on the loops polishes every assembled position,
-    vectorised, with the single solve's stopping rule (:func:`_newton`). A position counts
+    vectorised, with the single solve's stopping rule (:func:`.design_loops.newton_block`). A position counts
     as solved only when Newton converges there, stays within SEED_DISTANCE of the closed
     form and lies on the branch's side of every two-way step (or where the two sides meet
     within SEED_DISTANCE: a limit position, whose side is a matter of rounding). Where the
@@ -314,12 +285,12 @@ def _closed_form_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np
         for other in der.branches:
             _, good = der.solve_np(drv[miss], other, sub)
             feasible[miss] |= np.broadcast_to(good, miss.shape)
-    size = _size(m, grid, drv)
-    loops = VectorLoops.of_terms(_terms(m, grid, drv), n, len(drv))
+    size = design_size(m, grid, drv)
+    loops = VectorLoops.of_terms(design_terms(m, grid, drv), n, len(drv))
     q = [np.where(ok, c, 0.0) for c in seed]
     # one loop: Cramer's rule as for every 2 x 2; more: the derivation's blocks
-    linear = _stepwise_linear(der) if len(m.loops) > 1 else None
-    done, _det = _newton(loops, q, np.flatnonzero(ok), tol, size,
+    linear = stepwise_linear(der) if len(m.loops) > 1 else None
+    done, _det = newton_block(loops, q, np.flatnonzero(ok), tol, size,
                         [u.kind == "length" for u in m.unknowns], max_iter, linear=linear)
     moved = _distance(m, q, seed, size)
     accept = done & (moved <= SEED_DISTANCE) & ok
@@ -350,284 +321,6 @@ def _closed_form_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np
     return q, status, feasible, ENGINES["closed form"]
 
 
-def _resolver(m: Mechanism, grid: Mapping[str, Any], drv: Any,
-              q: Sequence[np.ndarray] = ()) -> tuple[dict[str, int], Any]:
-    """(each unknown's index, the value of a length or angle reference): an unknown from
-    ``q``, the driver, a parameter from ``grid`` (a float or an array), or a number."""
-    index = {u.name: i for i, u in enumerate(m.unknowns)}
-
-    def value(ref: str | float) -> Any:
-        if isinstance(ref, str):
-            if ref in index:
-                return q[index[ref]]
-            return drv if ref == m.driver.name else grid[ref]
-        return ref
-
-    return index, value
-
-
-def _terms(m: Mechanism, grid: Mapping[str, Any], drv: np.ndarray) -> list[list[tuple[Any, ...]]]:
-    """The loops' vectors with parameters and driver resolved to floats or flat arrays."""
-    index, value = _resolver(m, grid, drv)
-
-    def ref(r: str | float) -> tuple[Any, int]:
-        return (0.0, index[r]) if isinstance(r, str) and r in index else (value(r), -1)
-
-    return [[(t.sign, *ref(t.length), *ref(t.angle), t.offset) for t in loop.vectors] for loop in m.loops]
-
-
-Linear = Callable[[list[list[Any]], list[np.ndarray], int], tuple[list[Any], Any, Any]]
-"""J dq = -Phi at every position: (dq, det J, where J is singular)."""
-
-
-def _stepwise_linear(der: Derivation) -> Linear:
-    """J dq = -Phi by the derivation's steps, as the closed form solves the loops: each
-    step's two equations (its loop, or its two loops combined with the step's weights)
-    hold only its two unknowns and those of earlier steps, so J is block triangular and
-    every block is a 2 x 2 solved by Cramer's rule (a Watt six-bar's 4 x 4 at a fifth of
-    the cost of a stacked numpy solve). J is singular where a block is, by the 2 x 2 test
-    :func:`_newton` applies to a one-loop J."""
-    plan = [(tuple(zip(step.loops, step.weights)), step.unknowns) for step in der.steps]
-
-    def solve(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[list[Any], Any, Any]:
-        dq: list[Any] = [None] * len(jac[0])
-        det: Any = 1.0
-        singular = np.zeros(k, dtype=bool)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            for rows, (a, b) in plan:
-                ex: Any = 0.0
-                ey: Any = 0.0
-                jx: list[Any] = [0.0] * len(dq)
-                jy: list[Any] = [0.0] * len(dq)
-                for loop, w in rows:
-                    ex, ey = ex - w * phi[2 * loop], ey - w * phi[2 * loop + 1]
-                    for j in range(len(dq)):
-                        jx[j] = jx[j] + w * jac[2 * loop][j]
-                        jy[j] = jy[j] + w * jac[2 * loop + 1][j]
-                for j, d_j in enumerate(dq):
-                    if d_j is not None:  # an unknown of an earlier step
-                        ex, ey = ex - jx[j] * d_j, ey - jy[j] * d_j
-                pa, pb, pc, pd = jx[a], jx[b], jy[a], jy[b]
-                det_s = pa * pd - pb * pc
-                singular |= ~(np.abs(det_s) > SINGULAR_RATIO * (np.abs(pa * pd) + np.abs(pb * pc)))
-                dq[a], dq[b] = (ex * pd - pb * ey) / det_s, (pa * ey - pc * ex) / det_s
-                det = det * det_s
-        return [np.broadcast_to(d_j, (k,)) for d_j in dq], np.broadcast_to(det, (k,)), singular
-
-    return solve
-
-
-def _newton(loops: VectorLoops, q_all: list[np.ndarray], active: np.ndarray, tol: float, size: np.ndarray,
-            is_length: list[bool], max_iter: int, count: bool = False, linear: Linear | None = None) -> Any:
-    """Newton-Raphson at every ``active`` position at once, updating ``q_all`` in place;
-    only unconverged positions keep iterating. Returns (converged, det J), and with
-    ``count`` the iterations each took as well. ``linear``: how J dq = -Phi is solved
-    (default: Cramer's rule for 2 x 2, else a stacked numpy solve)."""
-    n_pos = len(size)
-    done = np.zeros(n_pos, dtype=bool)
-    det_out = np.full(n_pos, np.nan)
-    iterations = np.zeros(n_pos, dtype=np.int32)
-    gate_all = residual_gate(tol, size)
-    q = [c[active] for c in q_all]
-    for _ in range(max_iter):
-        if active.size == 0:
-            break
-        phi, jac = loops.evaluate(q, active)
-        scale = size[active]
-        resid = np.abs(phi[0])
-        for f in phi[1:]:
-            np.maximum(resid, np.abs(f), out=resid)
-        if linear is not None:
-            dq, det, singular = linear(jac, phi, active.size)
-        else:
-            dq, det = solve_linear(jac, phi, active.size)
-            singular = ~np.isfinite(det) | (det == 0.0)
-        if linear is None and len(jac) == 2 and len(jac[0]) == 2:
-            (a, b), (c, d) = jac
-            with np.errstate(invalid="ignore"):
-                singular |= ~(np.abs(det) > SINGULAR_RATIO * (np.abs(a * d) + np.abs(b * c)))
-        dq = [np.where(singular, 0.0, d_j) for d_j in dq]
-        for j, d_j in enumerate(dq):
-            q[j] += d_j
-        step = step_size_array(dq, [scale if length else 1.0 for length in is_length])
-        gate = gate_all[active]
-        with np.errstate(invalid="ignore"):
-            # as a single solve: a singular J with max|Phi| already within tolerance is a
-            # root to that tolerance (a limit position); otherwise the step test decides
-            finished = np.where(singular, resid <= gate, system_converged_array(step, resid, tol, gate))
-            keep = ~finished & ~singular & np.isfinite(step)
-        for j in range(len(q)):
-            q_all[j][active] = q[j]
-        det_out[active] = det
-        iterations[active] += 1
-        done[active[finished]] = True
-        active = active[keep]
-        q = [c[keep] for c in q]
-    return (done, det_out, iterations) if count else (done, det_out)
-
-
-# --- the continuation engines -----------------------------------------------------------------
-
-SEED_ITERATIONS = 12
-"""A design whose seed takes Newton longer than this goes through the one-at-a-time sweep
-(whose loop may stop such a run earlier, as diverged or at rounding level)."""
-
-
-def _continuation_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, tol: float,
-                         n_designs: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray, str]:
-    """The sweep's continuation for every design at once, where it is plain sailing.
-
-    The seed is Newton from the file's guess at the file's driver value (the branch: the
-    sign of det J there); the positions follow in the sweep's order, each from the last
-    by the tangent predictor and Newton, with the sweep's tests: converged, det J of the
-    same sign, and the correction within the continuity bound. A design that fails any
-    test anywhere (it would need a halved step, or reaches a gap or a fold) leaves the
-    batch and goes through :func:`~linkage.kinematics.sweep.sweep` on its own, so every
-    design gets the sweep's statuses; a design that passes them all is the sweep's
-    continuation step for step, vectorised.
-    """
-    scale = ANGLE_UNITS[m.driver.unit]
-    v0 = m.driver.value / scale
-    n, k = len(m.unknowns), len(vals)
-    is_length = [u.kind == "length" for u in m.unknowns]
-    grid, _ = design_grid(m, params, np.array([v0]), n_designs)  # one entry per design
-    size = _size(m, grid, np.full(n_designs, v0 * scale))
-    clean = np.ones(n_designs, dtype=bool)
-    q_out = [np.full((n_designs, k), np.nan) for _ in range(n)]
-
-    def at(v: float, rows: np.ndarray) -> tuple[VectorLoops, dict[str, Any]]:
-        sub = {key: (val[rows] if isinstance(val, np.ndarray) else val) for key, val in grid.items()}
-        drv = np.full(rows.size, v * scale)
-        return VectorLoops.of_terms(_terms(m, sub, drv), n, rows.size), sub
-
-    # the seed
-    rows = np.arange(n_designs)
-    loops, _ = at(v0, rows)
-    seed = [np.full(n_designs, u.value) for u in m.unknowns]
-    done, _, iters = _newton(loops, seed, rows, tol, size, is_length, SEED_ITERATIONS, count=True)
-    clean &= done & (iters <= SEED_ITERATIONS)
-    det0 = _det_at(loops, seed, n_designs)
-    clean &= np.isfinite(det0) & (det0 != 0.0)
-    positive = det0 > 0.0
-    order = np.argsort(vals, kind="stable")
-    up = [int(i) for i in order if vals[i] >= v0]
-    down = [int(i) for i in order[::-1] if vals[i] < v0]
-    full_turn = k > 0 and vals[order[-1]] - vals[order[0]] >= 360.0 - 1e-9
-    passes = [[(i, float(vals[i])) for i in up], [(i, float(vals[i])) for i in down]]
-    if full_turn:  # as the sweep: each direction carries on around the turn
-        passes[0] += [(i, float(vals[i]) + 360.0) for i in down[::-1]]
-        passes[1] += [(i, float(vals[i]) - 360.0) for i in up[::-1]]
-    reached = np.zeros((n_designs, k), dtype=bool)
-    for plan in passes:
-        live = np.flatnonzero(clean)
-        q_last = [c[live] for c in seed]
-        v_last = v0
-        here: tuple[VectorLoops, dict[str, Any]] | None = None  # the loops at v_last, while live is unchanged
-        for i, v in plan:
-            if live.size == 0:
-                break
-            if reached[live, i].all():
-                continue  # found by the other pass: the sweep skips it too
-            if abs(v - v_last) > 5.0:  # the sweep walks long intervals in smaller steps
-                clean[live] = False
-                break
-            fresh = ~reached[live, i]
-            loops_last, sub = here if here is not None else at(v_last, live)
-            t = _tangent(m, loops_last, sub, v_last * scale, q_last, scale)
-            pred = [ql + (v - v_last) * tj for ql, tj in zip(q_last, t)]
-            loops_v, sub_v = at(v, live)
-            q = [c.copy() for c in pred]
-            ok, _, _ = _newton(loops_v, q, np.arange(live.size), tol, size[live], is_length, 50, count=True)
-            det = _det_at(loops_v, q, live.size)
-            ok &= np.isfinite(det) & ((det > 0.0) == positive[live]) & (det != 0.0)
-            dv = abs(v - v_last) * scale
-            correction, moved, mag = continuity_measures_array(q_last, pred, q)
-            with np.errstate(invalid="ignore"):
-                ok &= continues_array(correction, moved, dv, mag)
-            clean[live[~ok]] = False
-            keep = ok
-            here = (loops_v, sub_v) if keep.all() else None
-            live = live[keep]
-            q = [c[keep] for c in q]
-            store = fresh[keep]
-            for j in range(n):
-                q_out[j][live[store], i] = q[j][store]
-            reached[live[store], i] = True
-            q_last, v_last = q, v
-    clean &= reached.all(axis=1)
-    status = np.full((n_designs, k), CONVERGED, dtype=np.int8)
-    q_flat = [c.reshape(-1) for c in q_out]
-    status_flat = status.reshape(-1)
-    rest = np.flatnonzero(~clean)
-    if rest.size:
-        sub = {name: np.atleast_1d(a)[rest] for name, a in params.items()}
-        q_rest, st_rest, _, _ = _sweep_engine(m, sub, vals, None, tol, rest.size)
-        idx = (rest[:, None] * k + np.arange(k)[None, :]).reshape(-1)
-        for j in range(n):
-            q_flat[j][idx] = q_rest[j]
-        status_flat[idx] = st_rest
-    feasible = (status_flat == CONVERGED) | (status_flat == OFF_BRANCH)
-    engine = "vectorised continuation" + (f" ({rest.size} designs one at a time)" if rest.size else "")
-    return q_flat, status_flat, feasible, engine
-
-
-def _det_at(loops: VectorLoops, q: list[np.ndarray], count: int) -> np.ndarray:
-    """det J at q (every entry)."""
-    _, jac = loops.evaluate(q, None)
-    zeros = [np.zeros(count) for _ in q]
-    _, det = solve_linear(jac, zeros, count)
-    return np.broadcast_to(det, (count,)).astype(float)
-
-
-def _tangent(m: Mechanism, loops: VectorLoops, grid: Mapping[str, Any], drv: float,
-             q: list[np.ndarray], scale: float) -> list[np.ndarray]:
-    """dq/dv (per display unit of the driver) from J dq/dv = -scale dPhi/dv, as
-    :func:`~linkage.kinematics.sweep.tangent`; NaN where J is singular. ``grid``: the
-    parameters of these designs."""
-    count = len(q[0])
-    _, value = _resolver(m, grid, drv, q)
-
-    rhs = []
-    for loop in m.loops:
-        dx: Any = np.zeros(count)
-        dy: Any = np.zeros(count)
-        for t in loop.vectors:
-            th = value(t.angle) + t.offset
-            if t.angle == m.driver.name:
-                r = value(t.length)
-                dx = dx - t.sign * r * np.sin(th)
-                dy = dy + t.sign * r * np.cos(th)
-            if t.length == m.driver.name:
-                dx = dx + t.sign * np.cos(th)
-                dy = dy + t.sign * np.sin(th)
-        rhs += [-scale * np.broadcast_to(dx, (count,)), -scale * np.broadcast_to(dy, (count,))]
-    _, jac = loops.evaluate(q, None)
-    # J t = rhs, i.e. J t + (-rhs) = 0: solve_linear solves J dq = -phi
-    dq, _ = solve_linear(jac, [-c for c in rhs], count)
-    return [np.asarray(c, dtype=float) for c in dq]
-
-
-def _sweep_engine(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, branch: str | None,
-                  tol: float, n_designs: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray, str]:
-    from .stepwise import sweep
-
-    n, k = len(m.unknowns), len(vals)
-    q = [np.full(n_designs * k, np.nan) for _ in range(n)]
-    status = np.empty(n_designs * k, dtype=np.int8)
-    listed = [float(v) for v in vals]
-    for d in range(n_designs):
-        design = m.with_values({name: float(np.atleast_1d(a)[d]) for name, a in params.items()}, {})
-        result = sweep(design, listed, branch=branch, tol=tol)
-        for i, p in enumerate(result.positions):
-            status[d * k + i] = STATUS_CODES[p.status]
-            if p.solution is not None:
-                for j, u in enumerate(m.unknowns):
-                    v = p.solution[u.name]
-                    q[j][d * k + i] = math.radians(v) if u.kind == "angle" else v
-    feasible = (status == CONVERGED) | (status == OFF_BRANCH)
-    return q, status, feasible, "continuation, design by design"
-
-
 def meeting_counts(m: Mechanism, params: Mapping[str, np.ndarray], sol: DesignSolutions) -> np.ndarray:
     """Per design, how many solved positions are where two assemblies of a two-way step
     meet to rounding (:meth:`~linkage.problems.derive.Derivation.meets`: a change point, s + l
@@ -639,7 +332,7 @@ def meeting_counts(m: Mechanism, params: Mapping[str, np.ndarray], sol: DesignSo
         return np.zeros(len(solved), dtype=np.int64)
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     drv = (np.asarray(sol.values, dtype=float) * scale)[None, :]
-    q = [np.radians(sol.solution[:, :, j]) if kind == "angle" else sol.solution[:, :, j]
+    q = [radians(sol.solution[:, :, j]) if kind == "angle" else sol.solution[:, :, j]
          for j, kind in enumerate(sol.kinds)]
     meet = np.zeros(solved.shape, dtype=bool)
     for m_step in der.meets_np(q, drv, _param_columns(m, params)):
@@ -655,7 +348,7 @@ def _paths(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, q: 
     LoopModel.points places them."""
     n_designs = len(solved) // max(len(vals), 1)
     grid, drv = design_grid(m, params, vals, n_designs)
-    _, value = _resolver(m, grid, drv, q)
+    _, value = design_resolver(m, grid, drv, q)
 
     def vec(t: VectorTerm) -> Any:
         return t.sign * value(t.length) * np.exp(1j * (value(t.angle) + t.offset))
@@ -682,76 +375,10 @@ def _paths(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, q: 
     return out
 
 
-def _turn_references(m: Mechanism, params: Mapping[str, np.ndarray], n_designs: int,
-                     tol: float) -> np.ndarray:
-    """What ``solve FILE`` gives each design at the file's driver value from the file's
-    guess (display units, designs x unknowns; NaN where it does not converge): the turn a
-    sweep reports its angles in (:func:`~linkage.kinematics.stepwise.sweep`). Newton from
-    the guess for every design at once; a design where some whole step would not have
-    lowered |Phi|^2 (where the single solve's globalised Newton takes another step) is
-    solved by that solve itself."""
-    from ..solve import solve_system
-
-    n = len(m.unknowns)
-    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-    grid, drv = design_grid(m, params, np.array([m.driver.value / scale]), n_designs)
-    loops = VectorLoops.of_terms(_terms(m, grid, drv), n, n_designs)
-    size = _size(m, grid, drv)
-    is_length = [u.kind == "length" for u in m.unknowns]
-    gate = residual_gate(tol, size)
-    q = [np.full(n_designs, u.value) for u in m.unknowns]
-    plain = np.ones(n_designs, dtype=bool)  # every step so far the globalised solve's too
-    done = np.zeros(n_designs, dtype=bool)
-    phi, jac = loops.evaluate(q, None)
-    with np.errstate(invalid="ignore", over="ignore"):
-        for _ in range(50):
-            live = plain & ~done
-            if not live.any():
-                break
-            dq, _ = solve_linear(jac, phi, n_designs)
-            trial = [c + d for c, d in zip(q, dq)]
-            phi_t, jac_t = loops.evaluate(trial, None)
-            tiny = _largest(dq) <= 64.0 * np.finfo(float).eps * (1.0 + _largest(q))
-            plain &= ~live | (_sumsq(phi_t) <= (1.0 - 1e-4) * _sumsq(phi)) | tiny
-            step = step_size_array(dq, [size if length else 1.0 for length in is_length])
-            done |= live & plain & system_converged_array(step, _largest(phi), tol, gate)
-            q = [np.where(live, t, c) for t, c in zip(trial, q)]
-            phi = [np.where(live, t, c) for t, c in zip(phi_t, phi)]
-            jac = [[np.where(live, t, c) for t, c in zip(rt, rc)] for rt, rc in zip(jac_t, jac)]
-    out = np.stack([np.degrees(c) if u.kind == "angle" else c for c, u in zip(q, m.unknowns)], axis=1)
-    out[~done] = np.nan
-    rest = ~plain
-    if rest.any() and m.derivation.complete:
-        # no assembly there on any branch: that solve cannot converge either
-        there = np.zeros(n_designs, dtype=bool)
-        for signs in m.derivation.branches:
-            there |= np.broadcast_to(m.derivation.solve_np(drv, signs, grid)[1], there.shape)
-        rest &= there
-    for d in np.flatnonzero(rest):
-        design = m.with_values({k: float(np.atleast_1d(a)[d]) for k, a in params.items()}, {})
-        # its loops walked, not compiled (the same Phi and J; compiling costs more than the solve)
-        F, J = LoopModel.compile(design).interpreted_functions(float(drv[d]))
-        r = solve_system(F, tuple(u.value for u in m.unknowns), jac=J, tol=tol, record=False)
-        if r.converged:
-            out[d] = [math.degrees(x) if u.kind == "angle" else x for x, u in zip(r.x, m.unknowns)]
-    return out
-
-
-def _largest(parts: Sequence[Any]) -> Any:
-    out = np.abs(parts[0])
-    for p in parts[1:]:
-        out = np.maximum(out, np.abs(p))
-    return out
-
-
-def _sumsq(parts: Sequence[Any]) -> Any:
-    return sum(p * p for p in parts)
-
-
 def _continuous(m: Mechanism, shown: np.ndarray, vals: np.ndarray, refs: np.ndarray) -> None:
     """In place: each angle continuous along the cycle by the rule of
     :mod:`linkage.kinematics.angles` (driver order around the circle), each design's curve
-    shifted by whole turns to the turn ``refs`` gives (:func:`_turn_references`: what
+    shifted by whole turns to the turn ``refs`` gives (:func:`.design_continuation.turn_references`: what
     ``solve FILE`` gives the design) at the solved position nearest the file's driver
     value, as the sweep does; not shifted where that solve does not converge."""
     if shown.size == 0:

@@ -25,6 +25,7 @@ from ..problems.derive_limits import (
     limit_between,
     limits_between_np,
 )
+from ..units import radians
 from .angles import closes_circle, driver_turn
 from .continuation import REENTERED, Solver, predict, solver_q
 from .positions import Position
@@ -96,7 +97,7 @@ def followed_branches(solver: Solver, positions: Sequence[Position], target: str
         import numpy as np
 
         # every position at once, by the numpy twin of signs_of
-        q = [np.radians([p.solution[n] for p in solved]) if k == "angle" else  # type: ignore[index]
+        q = [radians(np.array([p.solution[n] for p in solved])) if k == "angle" else  # type: ignore[index]
              np.array([p.solution[n] for p in solved]) for n, k in zip(solver.names, solver.kinds)]  # type: ignore[index]
         signs = np.stack(d.signs_of_np(q, np.array([p.input for p in solved]) * solver.scale), axis=-1)
         for row in np.unique(signs[(signs != 0.0).all(axis=-1)], axis=0)[::-1]:  # "+" first

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..problems.loops import Mechanism
+from ..units import RAD_PER_DEG
 
 
 @dataclass(frozen=True)
@@ -44,11 +45,12 @@ class SweepResult:
     motion: tuple[float, float] | None = None
     """The driver's (speed, acceleration) in internal units when rates were asked for."""
     length_unit: str = ""
-    meetings: tuple[float, ...] = ()
+    meetings: Sequence[float] = ()
     """The driver values (display units) of solved positions where two assemblies of the
     followed branch meet to rounding (a change point, s + l = p + q, or a limit exactly on
     the grid): there the branch is a matter of rounding, and each such position says so in
-    its note (:data:`~.stepwise.MEETS_NOTE`)."""
+    its note (:data:`~.stepwise.MEETS_NOTE`). A tuple, or for a batch sweep one computed
+    when first read (:class:`~.batch.BatchMeetings`, equal to the tuple)."""
     branch_note: str = ""
     """Why the followed branch is a matter of rounding, where it is (the file's pose is
     where its assemblies meet: :data:`~.pose.POSE_MEETS`); "" otherwise."""
@@ -152,7 +154,7 @@ def check_driver_values(m: Mechanism, values: Sequence[float]) -> list[float]:
     if not out:
         return out
     lo, hi = min(out), max(out)
-    scale = math.pi / 180.0 if m.driver.kind == "angle" else 1.0
+    scale = RAD_PER_DEG if m.driver.kind == "angle" else 1.0
     for v in (lo, hi):
         why = magnitude_problem(v * scale, m.driver.kind, m.length_unit) if math.isfinite(v) else \
             "the driver values must be finite"

@@ -224,7 +224,15 @@ def seed_target(solver: Solver, q: Sequence[float], v: float) -> str:
 def classification_of(m: Mechanism) -> dict[str, Any]:
     """The Grashof class (Norton 2.8) of each loop that is a four-bar, read as written with
     the ground last: input, coupler, output (:func:`~linkage.problems.closed_form.fourbar_class`).
-    One such loop: its class; several: the first's, with every loop's under ``loops``."""
+    One such loop: its class; several: the first's, with every loop's under ``loops``.
+    Computed once per mechanism (:func:`~.pose.implied`); each caller gets its own copy."""
+    from .pose import implied
+
+    c = implied(m, "classification", _classification)
+    return {k: [dict(x) for x in v] if k == "loops" else v for k, v in c.items()}
+
+
+def _classification(m: Mechanism) -> dict[str, Any]:
     from ..problems.find_steps import loop_terms
 
     views = m.derivation.fourbars

@@ -14,7 +14,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from ..problems.loops import Mechanism
-from .pose import POSE_MEETS, file_branch, pose_meets
+from .pose import POSE_MEETS, file_branch, pose_meets, step_words
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
 from .stepwise import sweep
 
@@ -150,8 +150,7 @@ def branch_choices(m: Mechanism) -> list[str]:
     from ..problems.derive import MIRROR, sign_text
 
     d = m.derivation
-    words = [("open", "crossed") if d.steps[i].word_rule else ("+", "-") for i in d.two_way]
-    names = ["/".join(w) for w in itertools.product(*words)]
+    names = ["/".join(w) for w in itertools.product(*step_words(m))]
     signs = [sign_text(b) for b in d.branches]
     return [*names, *(n + MIRROR for n in names), *(s for s in signs if s not in names)]
 

@@ -1,0 +1,154 @@
+"""Loop equations over arrays of positions (the array engines' Phi and J: :mod:`.batch`,
+:mod:`.closed`, the design engines), the linear solve J dq = -Phi at every position, and
+the single solve's test of a singular J on arrays."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ..problems.loops import DRIVER, LoopModel
+
+
+class VectorLoops:
+    """Phi and J over arrays of positions, from the compiled loop terms.
+
+    Unknowns, residuals and Jacobian entries are kept as separate contiguous 1-D arrays
+    (column by column): strided access into (N, m, n) arrays costs several times more.
+    """
+
+    def __init__(self, model: LoopModel, drv: np.ndarray) -> None:
+        terms = [[(sign, drv if lidx == DRIVER else lc, lidx if lidx >= 0 else -1,
+                   drv if aidx == DRIVER else ac, aidx if aidx >= 0 else -1, off)
+                  for sign, lc, lidx, ac, aidx, off in loop] for loop in model.terms]
+        self.setup(terms, model.n, len(drv))
+
+    @classmethod
+    def of_terms(cls, terms: Sequence[Sequence[tuple[float, Any, int, Any, int, float]]], n: int,
+                 size: int) -> VectorLoops:
+        """Loops whose fixed lengths and angles may be arrays (one value per position):
+        each term is (sign, length, length index, angle, angle index, offset), an index
+        >= 0 naming an unknown, -1 a fixed value (a float or an array of ``size``)."""
+        self = cls.__new__(cls)
+        self.setup(terms, n, size)
+        return self
+
+    def setup(self, terms: Sequence[Sequence[tuple[float, Any, int, Any, int, float]]], n: int,
+              size: int) -> None:
+        self.n = n
+        self.m = 2 * len(terms)
+        # Terms whose length and angle are both known do not change while iterating:
+        # sum them once per position.
+        self.fixed = [np.zeros(size) for _ in range(self.m)]
+        self.moving: list[tuple[int, float, Any, int, Any, int, float]] = []
+        for li, loop in enumerate(terms):
+            for sign, r, lidx, th, aidx, off in loop:
+                if lidx < 0 and aidx < 0:
+                    self.fixed[2 * li] += sign * r * np.cos(th + off)
+                    self.fixed[2 * li + 1] += sign * r * np.sin(th + off)
+                else:
+                    self.moving.append((li, sign, r, lidx, th, aidx, off))
+
+    def evaluate(self, q: list[np.ndarray], rows: np.ndarray | None,
+                 near: bool = False) -> tuple[list[np.ndarray], list[list[Any]]]:
+        """Phi (m arrays) and J (m x n arrays or zeros) at ``rows`` (None: all positions).
+        ``near``: q is the last evaluation's q plus a Newton step (see :meth:`_trig`)."""
+        def sub(a: Any) -> Any:
+            return a if rows is None or not isinstance(a, np.ndarray) else a[rows]
+
+        phi: list[Any] = [sub(f) for f in self.fixed]  # replaced, never modified in place
+        jac: list[list[Any]] = [[0.0] * self.n for _ in range(self.m)]
+        trig: dict[tuple[int, float], tuple[Any, Any, Any, bool]] = {}
+        for li, sign, r, lidx, th, aidx, off in self.moving:
+            rr = q[lidx] if lidx >= 0 else sub(r)
+            if aidx >= 0 and rows is None:
+                c, s = self._trig(trig, aidx, off, q[aidx], near)
+            else:
+                tt = q[aidx] if aidx >= 0 else sub(th)
+                if off:
+                    tt = tt + off
+                c, s = np.cos(tt), np.sin(tt)
+            rc, rs = sign * rr * c, sign * rr * s
+            phi[2 * li] = phi[2 * li] + rc
+            phi[2 * li + 1] = phi[2 * li + 1] + rs
+            if aidx >= 0:
+                jac[2 * li][aidx] = jac[2 * li][aidx] - rs
+                jac[2 * li + 1][aidx] = jac[2 * li + 1][aidx] + rc
+            if lidx >= 0:
+                jac[2 * li][lidx] = jac[2 * li][lidx] + sign * c
+                jac[2 * li + 1][lidx] = jac[2 * li + 1][lidx] + sign * s
+        self.last_trig = trig
+        return phi, jac
+
+    SMALL_STEP = 1e-6
+    """rad: below this, cos d = 1 - d^2/2 and sin d = d to within 1.7e-19 (d^3/6)."""
+
+    def _trig(self, trig: dict[tuple[int, float], tuple[Any, Any, Any, bool]], aidx: int, off: float,
+              qa: np.ndarray, near: bool) -> tuple[Any, Any]:
+        """cos and sin of an unknown angle (plus its offset) at every position. Just after
+        a Newton step, where it moved at most SMALL_STEP, from the values computed
+        directly at the previous iterate by the angle-addition formula, within a few units in the
+        last place of np.cos and np.sin (tests/test_sweep.py) for a fraction of the time:
+        the batch's second Newton evaluation, which certifies every position, costs two
+        trigonometric calls less per angle. Never twice in a row: a value so obtained is
+        not the base of another."""
+        key = (aidx, off)
+        if key in trig:
+            return trig[key][1], trig[key][2]
+        last = getattr(self, "last_trig", {}).get(key) if near else None
+        if last is not None and last[3]:
+            d = qa - last[0]  # exact: the two iterates are within a factor of 2 of each other
+            c0, s0 = last[1], last[2]
+            cd = 1.0 - 0.5 * (d * d)
+            c, s = c0 * cd - s0 * d, s0 * cd + c0 * d
+            far = ~(np.abs(d) <= self.SMALL_STEP)  # (NaN included): those directly
+            if far.any():
+                tt = qa[far] + off if off else qa[far]
+                c[far], s[far] = np.cos(tt), np.sin(tt)
+            trig[key] = (None, c, s, False)
+            return c, s
+        tt = qa + off if off else qa
+        c, s = np.cos(tt), np.sin(tt)
+        trig[key] = (qa.copy(), c, s, True)
+        return c, s
+
+
+def solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[list[np.ndarray], np.ndarray]:
+    """dq with J dq = -Phi at every position, and det J. Cramer's rule for 2x2."""
+    if len(jac) == 2 and len(jac[0]) == 2:
+        a, b = np.broadcast_to(jac[0][0], (k,)), np.broadcast_to(jac[0][1], (k,))
+        c, d = np.broadcast_to(jac[1][0], (k,)), np.broadcast_to(jac[1][1], (k,))
+        det = a * d - b * c
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = 1.0 / det
+            return [(b * phi[1] - d * phi[0]) * inv, (c * phi[0] - a * phi[1]) * inv], det
+    n = len(jac[0])
+    full = np.empty((k, len(jac), n))
+    for i, row in enumerate(jac):
+        for j, v in enumerate(row):
+            full[:, i, j] = v
+    with np.errstate(invalid="ignore"):  # positions not iterating hold NaN
+        det = np.linalg.det(full)
+    ok = np.isfinite(det) & (det != 0.0)
+    dq = np.full((k, n), np.nan)
+    if ok.any():
+        rhs = -np.stack(phi, axis=1)
+        dq[ok] = np.linalg.solve(full[ok], rhs[ok][..., None])[..., 0]
+    return [dq[:, j] for j in range(n)], det
+
+
+def singular_of(jac: list[list[Any]], det: np.ndarray) -> np.ndarray:
+    """Where J is singular, by the single solve's test (the 2 x 2 test of
+    :func:`~linkage.methods.newton_system.newton_direction`): |det J| not above
+    SINGULAR_RATIO times |ad| + |bc| (invariant under row and column scaling), or not
+    finite. A larger J: det J zero or not finite (the scalar's equilibrated-pivot test has
+    no numpy twin yet)."""
+    from ..methods.newton_system import SINGULAR_RATIO
+
+    with np.errstate(invalid="ignore", over="ignore"):
+        if len(jac) == 2 and len(jac[0]) == 2:
+            (a, b), (c, d) = jac
+            return ~(np.abs(det) > SINGULAR_RATIO * (np.abs(a * d) + np.abs(b * c))) | ~np.isfinite(det)
+        return ~np.isfinite(det) | (det == 0.0)
