@@ -104,8 +104,9 @@ def time_cluster(n: int, repeats: int) -> tuple[float, float] | None:
 def continuation(designs: int = 200, one_at_a_time: int = 20) -> None:
     """Six-bar designs (r5, r6 varied) over 0..359 deg: the vectorised continuation per
     design against the one-at-a-time sweep on the first few, and their agreement."""
-    from linkage.kinematics.designs import _continuation_engine, _sweep_engine
-    from linkage.problems.loops import load
+    from linkage.kinematics.design_continuation import continuation_engine as _continuation_engine
+    from linkage.kinematics.design_continuation import sweep_engine as _sweep_engine
+    from linkage.kinematics.loading import load
 
     m = load(ROOT / "sample_inputs" / "watt_sixbar.toml")
     arrays = {"r5": np.linspace(60, 80, designs), "r6": np.linspace(100, 120, designs)}

@@ -26,7 +26,7 @@ from pathlib import Path
 
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_inputs" / "crank_rocker.toml"
 API = ("from linkage.kinematics.sweep import sweep_mechanism\n"
-       "from linkage.problems.loops import load\n"
+       "from linkage.kinematics.loading import load\n"
        f"sweep_mechanism(load({str(SAMPLE)!r}), [k * 0.001 for k in range(360_001)])\n")
 TARGETS = {"csv": 2.0, "parquet": 1.5, "json": None, "xlsx": None}
 

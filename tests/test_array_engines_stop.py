@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from linkage.kinematics.design_loops import newton_block
+from linkage.kinematics.loading import load
 from linkage.kinematics.vector_loops import VectorLoops
-from linkage.problems.loops import load
 from linkage.solve import solve_system
 
 SAMPLES = Path(__file__).resolve().parent.parent / "sample_inputs"

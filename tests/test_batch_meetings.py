@@ -10,7 +10,7 @@ from pathlib import Path
 
 import linkage
 from linkage.kinematics.batch import BatchMeetings
-from linkage.problems.loops import load
+from linkage.kinematics.loading import load
 
 CRANK_ROCKER = Path(__file__).resolve().parent.parent / "sample_inputs" / "crank_rocker.toml"
 

@@ -15,8 +15,8 @@ import pytest
 import linkage
 from linkage.kinematics import pose
 from linkage.kinematics.closed import closed_sweep
+from linkage.kinematics.loading import load
 from linkage.kinematics.stepwise import classification_of
-from linkage.problems.loops import load
 from linkage.units import degrees
 
 SAMPLES = Path(__file__).resolve().parent.parent / "sample_inputs"

@@ -76,7 +76,8 @@ def fourbar_metrics(m: Mechanism, names: Sequence[str], designs: np.ndarray,
     of its ground, input, coupler and output as each design has them, and the extremes of
     its transmission angle over the solved positions (derive.fourbar_transmission, folded
     into [0, 90] deg)."""
-    from ..problems.derive import fourbar_transmission, loop_terms
+    from ..problems.find_steps import loop_terms
+    from ..problems.steps import fourbar_transmission
 
     views = fourbar_loops(m)
     if not views:
