@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.kinematics.rates import place, place_np
+from linkage.kinematics.placing import place, place_np
 from linkage.problems.loops import load
 from linkage.render import writers
 from linkage.render.sweep import equation_report, ranges_of, sweep_report

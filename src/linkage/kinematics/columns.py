@@ -111,7 +111,7 @@ def _array_columns(s: SweepResult, b: Any) -> SweepColumns:
             names = list(rates[int(first)].joints) if first is not None else []
             joints = {j: (RateColumn(rates, j, 0), RateColumn(rates, j, 1)) for j in names}
         elif b.rates is not None:
-            from .rates import place_np
+            from .placing import place_np
 
             placed = place_np(m.model, q, d)
             joints = {k: (np.where(solved, x, nan), np.where(solved, y, nan)) for k, (x, y) in placed.items()}

@@ -50,7 +50,8 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
     import numpy as np
 
     from ..problems.loops import LoopModel
-    from .rates import place_motion_np, solve_rates_np
+    from .placing import place_motion_np
+    from .rates import solve_rates_np
 
     frame = Frame.of(mechanism)
     d = np.asarray(d, dtype=float)

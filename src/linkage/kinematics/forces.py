@@ -352,7 +352,7 @@ def condition_np(a: Any) -> tuple[Any, Any]:
     2-norm's needs, and bounds the same error (within a factor of the matrix's size)."""
     import numpy as np
 
-    from .rates import inverse_np
+    from .rate_bounds import inverse_np
 
     inv, usable = inverse_np(a)
     cond = np.full(a.shape[:-2], np.inf)

@@ -367,7 +367,8 @@ def sensitivities(m: Mechanism, plan: Plan, values: np.ndarray, q: np.ndarray, s
                   ) -> tuple[np.ndarray, np.ndarray]:
     """(sensitivity (outputs, tolerances, positions), J invertible per position) at the
     nominal solutions ``q`` (positions, unknowns; internal units)."""
-    from .rates import place_motion_np, solve_rates_np
+    from .placing import place_motion_np
+    from .rates import solve_rates_np
 
     outs = outputs_of(m)
     k = len(values)
