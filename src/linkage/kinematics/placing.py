@@ -17,7 +17,7 @@ from typing import Any
 
 from ..problems.loops import DRIVER, LoopModel
 from .rate_bounds import Uncertainty, bounds_of, static_values
-from .vectors import EPS, FIXED, SCALAR, rate_of, term, value_of
+from .vectors import EPS, FIXED, SCALAR, rate_of, value_of
 
 
 def place(model: LoopModel, q: Any, d: float, qd: Any = None, vd: float = 0.0, qdd: Any = None,
@@ -42,7 +42,7 @@ def place_bounded(model: LoopModel, q: Any, d: Any, qd: Any, vd: Any, qdd: Any, 
     def part(t: Any, at: tuple[int, int] | None
              ) -> tuple[tuple[complex, complex, complex], tuple[float, float]]:
         if unc is None:
-            return term(t, q, d, qd, vd, qdd, vdd, xp), (0.0, 0.0)
+            return xp.term(t, q, d, qd, vd, qdd, vdd), (0.0, 0.0)
         st = (data[at[0]][at[1]] if data is not None and at is not None
               else static_values(t, q, d, qd, vd, qdd, vdd, xp))
         return st[5:8], (xp.maximum(*bounds_of(st, unc, 1)), xp.maximum(*bounds_of(st, unc, 2)))
@@ -53,8 +53,9 @@ def place_bounded(model: LoopModel, q: Any, d: Any, qd: Any, vd: Any, qdd: Any, 
         for (dp, dv, da), (cv, ca) in parts:
             p, v, a = p + sign * dp, v + sign * dv, a + sign * da
             # each addition rounds by at most an ulp of the running sum
-            bv += cv + EPS * abs(v) if unc is not None else 0.0
-            ba += ca + EPS * abs(a) if unc is not None else 0.0
+            # (not +=: a block's arrays are shared with the joint this one starts from)
+            bv = bv + (cv + EPS * abs(v) if unc is not None else 0.0)
+            ba = ba + (ca + EPS * abs(a) if unc is not None else 0.0)
         return p, v, a, bv, ba
 
     return walk(model, part, add, (complex(*m.origin), 0j, 0j, 0.0, 0.0),

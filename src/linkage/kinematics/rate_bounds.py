@@ -18,7 +18,8 @@ from typing import Any, NamedTuple
 
 from ..methods._linalg import SingularMatrix, lu, lu_solve
 from ..problems.loops import DRIVER, LoopModel
-from .vectors import EPS, SCALAR, rate_of, term, value_of
+from .block_linalg import lu_np, lu_solve_np
+from .vectors import EPS, SCALAR, rate_of, value_of
 
 SAFETY = 2.0
 """Every bound is the first-order analysis below, doubled."""
@@ -74,7 +75,7 @@ def static_values(t: Any, q: Any, d: Any, qd: Any, vd: Any, qdd: Any, vdd: Any,
     r, th = value_of(li, lc, q, d), value_of(ai, ac, q, d) + off
     r1, w = rate_of(li, qd, vd), rate_of(ai, qd, vd)
     r2, al = rate_of(li, qdd, vdd), rate_of(ai, qdd, vdd)
-    pos, vel, acc = term(t, q, d, qd, vd, qdd, vdd, xp)  # the one definition of the three
+    pos, vel, acc = xp.term(t, q, d, qd, vd, qdd, vdd)  # the one definition of the three
     co, si = abs(xp.cos(th)), abs(xp.sin(th))
     ar, aw, ar1, aal = abs(r), abs(w), abs(r1), abs(al)
     # the coefficients' own rounding: each product and sum within an ulp
@@ -243,7 +244,7 @@ def inverse_np(a: Any) -> tuple[Any, Any]:
 def abs_inverse_np(jac: list[list[Any]]) -> tuple[list[list[Any]], Any]:
     """:func:`abs_inverse` over a block (``jac`` rows of columns of arrays): (|J^-1| enlarged
     by its rounding, usable), the same tests position by position (an LU of each by numpy,
-    not :func:`lu`, beyond two unknowns)."""
+    :func:`~.block_linalg.lu_np`, ``lu``'s twin, beyond two unknowns)."""
     import numpy as np
 
     n = len(jac)
@@ -255,14 +256,16 @@ def abs_inverse_np(jac: list[list[Any]]) -> tuple[list[list[Any]], Any]:
             ok = (det != 0.0) & np.isfinite(det) & ~(EPS * size > 1e-3 * np.abs(det))
             grow = (1.0 + 4.0 * EPS * size / np.abs(det)) / np.abs(det)
             return [[np.abs(d) * grow, np.abs(b) * grow], [np.abs(c) * grow, np.abs(a) * grow]], ok
-        stack = np.stack([np.stack(np.broadcast_arrays(*row), axis=-1) for row in jac], axis=-2)
-        inv, ok = inverse_np(stack)
-        inv = np.abs(inv)
-        jrow = np.abs(stack).sum(axis=-1)
-        kappa = np.einsum("...ik,...k->...i", inv, jrow).max(axis=-1)
-        ok &= np.isfinite(kappa) & ~(EPS * kappa * n > 1e-3)
-        inv = inv * (1.0 + 8.0 * n * EPS * kappa)[..., None, None]
-        return [[inv[..., i, j] for j in range(n)] for i in range(n)], ok
+        f, perm, ok = lu_np(jac)
+        cols = [lu_solve_np(f, perm, [1.0 if i == j else 0.0 for i in range(n)]) for j in range(n)]
+        inv = [[np.abs(cols[j][i]) for j in range(n)] for i in range(n)]
+        ok &= np.logical_and.reduce([np.isfinite(v) for row in inv for v in row])
+        # Skeel's condition number, as abs_inverse bounds the inverse's error
+        jrow = [sum(np.abs(v) for v in row) for row in jac]
+        kappa = np.maximum.reduce([sum(inv[i][k] * jrow[k] for k in range(n)) for i in range(n)])
+        ok &= ~(EPS * kappa * n > 1e-3)
+        grow = 1.0 + 8.0 * n * EPS * kappa
+        return [[v * grow for v in row] for row in inv], ok
 
 
 def through_inverse_np(inv: list[list[Any]], spread: list[list[Any]], g: list[Any]

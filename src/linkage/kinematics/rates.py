@@ -30,10 +30,11 @@ from typing import TYPE_CHECKING, Any
 from ..methods.newton_system import max_abs, newton_direction
 from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel
 from ..units import radians
+from .block_linalg import direction_np
 from .labels import rate_label
 from .placing import place, place_bounded
 from .rate_bounds import SAFETY, inverse_np, rate_bounds, static_values
-from .vectors import EPS, XY, bias, value_of
+from .vectors import EPS, XY, bias, bias_np, value_of
 
 if TYPE_CHECKING:  # a solve's rates do not load the sweep's types
     from .positions import SweepResult
@@ -126,34 +127,38 @@ def rates_from_jacobian(jac: list[list[float]], dv: list[float], model: LoopMode
     return qd, qdd
 
 
-def direction_np(jac: Any, phi: Any) -> tuple[Any, Any]:
-    """newton_direction over a block: (dq with J dq = -phi, usable) for stacks ``jac``
-    (..., rows, n) and ``phi`` (..., rows). Two unknowns: its closed form and its singularity
-    test, operation for operation; more: one batched inverse (NaN where singular; the
-    rates' bounds then judge how near, :func:`~.rate_bounds.abs_inverse_np`)."""
+_COMPILED: dict[int, tuple[LoopModel, Any]] = {}
+
+
+def compiled_np(model: LoopModel, d: Any, q: Any) -> tuple[Any, Any, Any]:
+    """(Phi, J, dPhi/dv) over a block by the model's own compiled code (linkage.codegen's
+    ``source``, the scalar :attr:`LoopModel.factory`'s text) run on numpy arrays: the same
+    folded constants, the same sums in the same order, so the block's Phi and J are the
+    scalar ones' bits (where numpy's cos and sin are the C library's). Stacks (..., rows),
+    (..., rows, n), (..., rows). For a model of plain numbers (a scan's array parameters:
+    :func:`jacobian_np`)."""
     import numpy as np
 
-    from ..methods.newton_system import SINGULAR_RATIO
+    got = _COMPILED.get(id(model))
+    if got is None or got[0] is not model:
+        namespace: dict[str, Any] = {"_cos": np.cos, "_sin": np.sin, "__builtins__": {}}
+        exec(compile(model.source, "<linkage-model-numpy>", "exec"), namespace)
+        if len(_COMPILED) > 16:
+            _COMPILED.clear()
+        got = _COMPILED[id(model)] = (model, namespace["make"])
+    F, J, V = got[1](d)
+    shape = np.shape(d)
 
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        if jac.shape[-1] == 2:
-            a, b, c, d = jac[..., 0, 0], jac[..., 0, 1], jac[..., 1, 0], jac[..., 1, 1]
-            p0, p1 = phi[..., 0], phi[..., 1]
-            det = a * d - b * c
-            size = np.abs(a * d) + np.abs(b * c)
-            ok = (size > 0.0) & (np.abs(det) > SINGULAR_RATIO * size) & np.isfinite(det)
-            dq = np.stack([(b * p1 - d * p0) / det, (c * p0 - a * p1) / det], axis=-1)
-        else:
-            inv, ok = inverse_np(jac)
-            dq = -np.einsum("...ij,...j->...i", inv, phi)
-        ok &= np.isfinite(dq).all(axis=-1)
-    return np.where(ok[..., None], dq, np.nan), ok
+    def stack(values: Any, axis: int) -> Any:
+        return np.stack([np.broadcast_to(v, shape) for v in values], axis=axis)
+
+    return (stack(F(q), -1), np.stack([stack(row, -1) for row in J(q)], axis=-2), stack(V(q), -1))
 
 
 def jacobian_np(model: LoopModel, q: Any, d: Any) -> tuple[Any, Any, Any]:
     """(Phi, J, dPhi/dv) over a block of positions, from each vector's derivatives (the
-    interpreted definition the compiled model is tested against, LoopModel.interpreted_functions):
-    stacks (..., rows), (..., rows, n), (..., rows)."""
+    interpreted definition the compiled model is tested against, LoopModel.interpreted_functions),
+    for a model whose parameters may be arrays: stacks (..., rows), (..., rows, n), (..., rows)."""
     import numpy as np
 
     d = np.asarray(d, dtype=float)
@@ -186,7 +191,7 @@ def polish_np(model: LoopModel, q: Any, d: Any) -> list[Any]:
 
     d = np.asarray(d, dtype=float)
     x = np.stack([np.broadcast_to(np.asarray(c, dtype=float), d.shape) for c in q], axis=-1)
-    phi, jac, _ = jacobian_np(model, list(np.moveaxis(x, -1, 0)), d)
+    phi, jac, _ = compiled_np(model, d, list(np.moveaxis(x, -1, 0)))
     res = np.abs(phi).max(axis=-1, initial=0.0)
     last = np.full(d.shape, np.inf)
     active = res > 0.0
@@ -196,7 +201,7 @@ def polish_np(model: LoopModel, q: Any, d: Any) -> list[Any]:
         dq, ok = direction_np(jac, phi)
         size = np.abs(dq).max(axis=-1, initial=0.0)
         trial = x + dq
-        phi_t, jac_t, _ = jacobian_np(model, list(np.moveaxis(trial, -1, 0)), d)
+        phi_t, jac_t, _ = compiled_np(model, d, list(np.moveaxis(trial, -1, 0)))
         res_t = np.abs(phi_t).max(axis=-1, initial=0.0)
         step = active & ok & (size < last) & (res_t <= res)
         x = np.where(step[..., None], trial, x)
@@ -210,13 +215,13 @@ def polish_np(model: LoopModel, q: Any, d: Any) -> list[Any]:
 
 def rates_from_jacobian_np(jac: Any, dv: Any, model: LoopModel, q: Any, d: Any, speed: float,
                            accel: float) -> tuple[list[Any], list[Any], Any]:
-    """:func:`rates_from_jacobian` over a block (stacks as :func:`jacobian_np` gives them):
+    """:func:`rates_from_jacobian` over a block (stacks as :func:`compiled_np` gives them):
     (q', q'', solved), NaN where unsolved."""
     import numpy as np
 
     qd, ok = direction_np(jac, speed * dv)
     qd_list = list(np.moveaxis(qd, -1, 0))
-    rhs = accel * dv + np.stack(np.broadcast_arrays(*bias(model, q, d, qd_list, speed, np)), axis=-1)
+    rhs = accel * dv + np.stack(np.broadcast_arrays(*bias_np(model, q, d, qd_list, speed)), axis=-1)
     qdd, ok2 = direction_np(jac, rhs)
     return qd_list, list(np.moveaxis(qdd, -1, 0)), ok & ok2
 
@@ -249,7 +254,7 @@ def solve_rates_np(model: LoopModel, q: Any, d: Any, speed: float, accel: float
 
     qd = solve(speed * dv)
     qd_list = list(np.moveaxis(qd, -1, 0))
-    rhs = accel * dv + np.stack(np.broadcast_arrays(d, *bias(model, q, d, qd_list, speed, np))[1:], axis=-1)
+    rhs = accel * dv + np.stack(np.broadcast_arrays(d, *bias_np(model, q, d, qd_list, speed))[1:], axis=-1)
     qdd = solve(rhs)
     return qd_list, list(np.moveaxis(qdd, -1, 0)), solved
 
