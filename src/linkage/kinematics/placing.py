@@ -54,8 +54,8 @@ def place_bounded(model: LoopModel, q: Any, d: Any, qd: Any, vd: Any, qdd: Any, 
             p, v, a = p + sign * dp, v + sign * dv, a + sign * da
             # each addition rounds by at most an ulp of the running sum
             # (not +=: a block's arrays are shared with the joint this one starts from)
-            bv = bv + (cv + EPS * abs(v) if unc is not None else 0.0)
-            ba = ba + (ca + EPS * abs(a) if unc is not None else 0.0)
+            bv = bv + (cv + EPS * xp.hypot(v.real, v.imag) if unc is not None else 0.0)
+            ba = ba + (ca + EPS * xp.hypot(a.real, a.imag) if unc is not None else 0.0)
         return p, v, a, bv, ba
 
     return walk(model, part, add, (complex(*m.origin), 0j, 0j, 0.0, 0.0),

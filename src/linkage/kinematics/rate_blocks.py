@@ -45,9 +45,9 @@ class RateBlock:
     def __len__(self) -> int:
         return len(self.status)
 
-    def rates(self) -> list[Rates]:
+    def rates(self) -> list[Rates | None]:
         """Each position's :class:`~.rates.Rates` (plain floats, as the scalar definition
-        gives them)."""
+        gives them); None where the position is absent (unsolved, :meth:`spread`)."""
         n = len(self)
         status = self.status.tolist()
         joints = _pairs(self.joints)
@@ -59,6 +59,9 @@ class RateBlock:
         flags = [(label, where.tolist()) for label, where in self.flags]
         out = []
         for i in range(n):
+            if status[i] is None:
+                out.append(None)
+                continue
             placed = {k: (x[i], y[i]) for k, (x, y) in joints.items()}
             if status[i] == UNDEFINED:
                 out.append(Rates(placed, status=UNDEFINED))
@@ -97,6 +100,18 @@ class RateBlock:
             _each(self.velocity_bounds, put), _each(self.acceleration_bounds, put),
             _each(self.joint_velocity_bounds, put), _each(self.joint_acceleration_bounds, put),
             tuple(flags))
+
+    def rows(self, start: int, stop: int) -> RateBlock:
+        """Positions ``start:stop`` of this block."""
+        def cut(a: Any) -> Any:
+            return a[start:stop]
+
+        return RateBlock(
+            cut(self.status), _each(self.joints, cut), _each(self.velocities, cut),
+            _each(self.accelerations, cut), _each(self.joint_velocities, cut),
+            _each(self.joint_accelerations, cut), _each(self.velocity_bounds, cut),
+            _each(self.acceleration_bounds, cut), _each(self.joint_velocity_bounds, cut),
+            _each(self.joint_acceleration_bounds, cut), tuple((k, cut(v)) for k, v in self.flags))
 
     @staticmethod
     def join(blocks: list[RateBlock]) -> RateBlock:
@@ -196,8 +211,8 @@ def _judged(model: LoopModel, names: list[str], d: Any, speed: float, accel: flo
     jvb = {k: keep(SAFETY * p[3]) for k, p in pts.items()}
     jab = {k: keep(SAFETY * p[4]) for k, p in pts.items()}
     for k, (_, v, a, _, _) in pts.items():
-        judge(rate_label(k, 1, joint=True), np.abs(v), jvb[k], omega * size)
-        judge(rate_label(k, 2, joint=True), np.abs(a), jab[k], alpha * size)
+        judge(rate_label(k, 1, joint=True), np.hypot(v.real, v.imag), jvb[k], omega * size)
+        judge(rate_label(k, 2, joint=True), np.hypot(a.real, a.imag), jab[k], alpha * size)
     flagged = np.logical_or.reduce([f for _, f in flags]) if flags else np.zeros(d.shape, dtype=bool)
     status = np.where(ok, np.where(flagged, ILL, OK), UNDEFINED).astype(object)
     return RateBlock(

@@ -357,6 +357,12 @@ def rates_at(mechanism: Any, q: Any, *, speed: float | None = None, accel: float
     return position_rates(model, q, d, speed, accel)
 
 
+RATES_BLOCK_ABOVE = 1000
+"""From this many solved positions :func:`with_rates` computes their rates as one block
+(kinematics.rate_blocks: numpy, the same numbers); below, one at a time (a small sweep's
+command does not pay numpy's import)."""
+
+
 def with_rates(m: Any, result: SweepResult, speed: float | None, accel: float) -> SweepResult:
     """Joints, and with a driver speed velocities and accelerations, at every solved position."""
     from dataclasses import replace
@@ -365,14 +371,26 @@ def with_rates(m: Any, result: SweepResult, speed: float | None, accel: float) -
 
     model = m.model
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-    kinds = [u.kind for u in m.unknowns]
-    positions = []
-    for p in result.positions:
-        if p.solution is None:
-            positions.append(p)
-            continue
-        q = [radians(p.solution[u.name]) if k == "angle" else p.solution[u.name]
-             for u, k in zip(m.unknowns, kinds)]
-        positions.append(with_position_rates(p, position_rates(model, q, p.input * scale, speed, accel)))
+    solved = [p.solution is not None for p in result.positions]
+    if sum(solved) >= RATES_BLOCK_ABOVE:
+        import numpy as np
+
+        from .rate_blocks import sweep_block
+
+        sol = np.array([[p.solution[u.name] for u in m.unknowns] if p.solution is not None
+                        else [math.nan] * len(m.unknowns) for p in result.positions], dtype=float)
+        inputs = np.array([p.input for p in result.positions], dtype=float)
+        block = sweep_block(m, sol.reshape(len(solved), len(m.unknowns)), inputs, np.array(solved),
+                            speed, accel)
+        rates = block.rates()
+        positions = tuple(with_position_rates(p, r) if ok else p
+                          for p, r, ok in zip(result.positions, rates, solved))
+    else:
+        kinds = [u.kind for u in m.unknowns]
+        positions = tuple(
+            p if p.solution is None else with_position_rates(p, position_rates(
+                model, [radians(p.solution[u.name]) if k == "angle" else p.solution[u.name]
+                        for u, k in zip(m.unknowns, kinds)], p.input * scale, speed, accel))
+            for p in result.positions)
     motion = (speed, accel) if speed is not None else None
-    return replace(result, positions=tuple(positions), motion=motion)
+    return replace(result, positions=positions, motion=motion)
