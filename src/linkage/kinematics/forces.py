@@ -400,18 +400,29 @@ def forces_at(
     return judged(frame, actual, unit, loads, mechanism.source)
 
 
-def per_unit_speed(actual: Any, speed: float) -> Any:
-    """The velocities of a unit driver speed from those at ``speed`` (they are linear in
-    it, and so are their bounds): ``actual`` with its velocities and velocity bounds divided
-    by the speed, or None where there is no speed to divide by (then they are computed)."""
+def speed_usable(speed: float | None) -> bool:
+    """Whether velocities at ``speed`` can be divided by it (:func:`per_unit_speed`)."""
+    return speed is not None and 1e-100 < abs(speed) < 1e100
+
+
+def scaled_to_unit_speed(actual: Any, speed: float) -> Any:
+    """``actual`` (rates at ``speed``: one position's Rates or a block's RateBlock) with its
+    joint velocities and their bounds divided by the speed: they are linear in it."""
     from dataclasses import replace
 
-    if not 1e-100 < abs(speed) < 1e100 or actual.status == "undefined" or not actual.joint_velocities:
-        return None
     k = 1.0 / speed
     velocities = {j: (v[0] * k, v[1] * k) for j, v in actual.joint_velocities.items()}
     bounds = {j: b * abs(k) for j, b in actual.joint_velocity_bounds.items()}
     return replace(actual, joint_velocities=velocities, joint_velocity_bounds=bounds)
+
+
+def per_unit_speed(actual: Any, speed: float) -> Any:
+    """The velocities of a unit driver speed from those at ``speed``
+    (:func:`scaled_to_unit_speed`), or None where there is no speed to divide by (then they
+    are computed)."""
+    if not speed_usable(speed) or actual.status == "undefined" or not actual.joint_velocities:
+        return None
+    return scaled_to_unit_speed(actual, speed)
 
 
 def judged(frame: Frame, actual: Any, unit: Any, loads: Loads, source: str) -> Forces:
@@ -448,6 +459,21 @@ def kinematic_bound(unit: Any) -> float:
     if vmax > 0.0 and unit.joint_velocity_bounds:
         return max(unit.joint_velocity_bounds.values()) / vmax
     return 0.0
+
+
+def kinematic_bound_np(unit: Any) -> Any:
+    """:func:`kinematic_bound` of each position of a block of unit-speed rates
+    (kinematics.rate_blocks.RateBlock)."""
+    import numpy as np
+
+    n = len(unit.status)
+    speeds = [np.hypot(x, y) for x, y in unit.joint_velocities.values()]
+    vmax = np.maximum.reduce(speeds) if speeds else np.zeros(n)
+    if not unit.joint_velocity_bounds:
+        return np.zeros(n)
+    top = np.maximum.reduce(list(unit.joint_velocity_bounds.values()))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(vmax > 0.0, top / vmax, 0.0)
 
 
 def force_status(cond: float, bound: float, kinematics_ok: bool) -> str:

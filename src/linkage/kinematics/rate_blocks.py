@@ -113,6 +113,18 @@ class RateBlock:
             _each(self.acceleration_bounds, cut), _each(self.joint_velocity_bounds, cut),
             _each(self.joint_acceleration_bounds, cut), tuple((k, cut(v)) for k, v in self.flags))
 
+    def rows_at(self, index: Any) -> RateBlock:
+        """The positions at ``index`` (an integer array) of this block."""
+        def pick(a: Any) -> Any:
+            return a[index]
+
+        return RateBlock(
+            pick(self.status), _each(self.joints, pick), _each(self.velocities, pick),
+            _each(self.accelerations, pick), _each(self.joint_velocities, pick),
+            _each(self.joint_accelerations, pick), _each(self.velocity_bounds, pick),
+            _each(self.acceleration_bounds, pick), _each(self.joint_velocity_bounds, pick),
+            _each(self.joint_acceleration_bounds, pick), tuple((k, pick(v)) for k, v in self.flags))
+
     @staticmethod
     def join(blocks: list[RateBlock]) -> RateBlock:
         """Blocks one after another, as one."""
