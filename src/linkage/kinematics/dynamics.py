@@ -132,7 +132,7 @@ class Dynamics:
 
     def __init__(self, mechanism: Any, loads: Loads, friction: Friction, flywheel: float = 0.0) -> None:
         from .bodies import Frame, metre
-        from .forces import pin_pairs
+        from .load_matrix import pin_pairs
 
         self.mechanism = mechanism
         self.model = mechanism.model
@@ -213,7 +213,7 @@ class Dynamics:
     def at(self, theta: float) -> Point | None:
         """The equation's terms at driver ``theta`` (SI), or None where the mechanism is
         not assembled or its rates are undefined (J singular)."""
-        from .forces import body_motion, cg_motion
+        from .load_matrix import body_motion, cg_motion
         from .rates import place, rates_from_jacobian
 
         if self._memo is not None and self._memo[0] == theta:  # the event's call after the step's
@@ -372,7 +372,7 @@ def _checked_friction(friction: Any, drawing: Any, what: str) -> tuple[float, di
         return float(x)
 
     if isinstance(friction, Mapping):
-        from .forces import pin_pairs
+        from .load_matrix import pin_pairs
 
         pins = {j for j, _, _ in pin_pairs(drawing)}
         every, out = 0.0, {}

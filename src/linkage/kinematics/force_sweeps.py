@@ -12,16 +12,15 @@ from typing import Any, NamedTuple
 from ..problems.loads import Loads
 from .bodies import Frame, force_size, metre
 from .forces import (
-    ForceArrays,
     Forces,
     force_status_np,
     matrix_bound,
     position_forces,
     scaled_to_unit_speed,
-    solve_loads,
     speed_usable,
     undefined_forces,
 )
+from .load_matrix import ForceArrays, solve_loads
 
 
 @dataclass(frozen=True)
