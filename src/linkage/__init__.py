@@ -45,7 +45,7 @@ _EXPORTS = {
     "instant_centres": ".kinematics.centres", "InstantCentres": ".kinematics.centres",
     "centrodes": ".kinematics.centres", "Centrodes": ".kinematics.centres",
     "tolerance": ".kinematics.tolerance", "ToleranceStudy": ".kinematics.tolerance",
-    "simulate": ".kinematics.dynamics", "Simulation": ".kinematics.dynamics",
+    "simulate": ".kinematics.simulation", "Simulation": ".kinematics.simulation",
 }
 _RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",
             "scan_designs": "scan", "forces": "forces_at", "assemblies": "every_assembly"}

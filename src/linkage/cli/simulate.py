@@ -122,7 +122,7 @@ def simulate(
     """
     from ..arguments import parse_motion
     from ..kinematics.bodies import command_loads
-    from ..kinematics.dynamics import simulate as run
+    from ..kinematics.simulation import simulate as run
     from ..problems.loops import load as load_file
     from ..render.simulate import simulate_plot, simulate_report
 

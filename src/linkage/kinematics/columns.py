@@ -21,6 +21,7 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Any, NamedTuple
 
+from ..units import degrees, radians
 from .positions import SweepResult
 
 
@@ -100,7 +101,7 @@ def _array_columns(s: SweepResult, b: Any) -> SweepColumns:
     rates = None
     if m is not None:
         scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-        q = [np.radians(solution[u.name]) if u.kind == "angle" else solution[u.name] for u in m.unknowns]
+        q = [radians(solution[u.name]) if u.kind == "angle" else solution[u.name] for u in m.unknowns]
         d = np.asarray(b.values, dtype=float) * scale
         if m.derivation.fourbars:
             transmission = transmission_column(m, q, d, solved)
@@ -126,7 +127,7 @@ def transmission_column(m: Any, q: Sequence[Any], d: Any, solved: Any) -> Any:
 
     with np.errstate(invalid="ignore", divide="ignore"):
         mu = m.derivation.transmission_np(q, d)
-    return np.where(solved, np.degrees(mu), np.nan)
+    return np.where(solved, degrees(mu), np.nan)
 
 
 class RateChunks(Sequence):  # type: ignore[type-arg]
