@@ -43,7 +43,7 @@ _EXPORTS = {
     "assemblies": ".kinematics.assemblies", "Assemblies": ".kinematics.assemblies",
     "Loads": ".problems.loads", "Mass": ".problems.loads",
     "instant_centres": ".kinematics.centres", "InstantCentres": ".kinematics.centres",
-    "centrodes": ".kinematics.centres", "Centrodes": ".kinematics.centres",
+    "centrodes": ".kinematics.centrodes", "Centrodes": ".kinematics.centrodes",
     "tolerance": ".kinematics.tolerance", "ToleranceStudy": ".kinematics.tolerance",
     "simulate": ".kinematics.simulation", "Simulation": ".kinematics.simulation",
 }
