@@ -4,20 +4,27 @@ solves, the bounds, the placing rule, the ``ill_conditioned`` judgement), so a s
 rates cost what its positions do (docs/performance_loads.md). The answer,
 :class:`RateBlock`, holds one array per rate; :meth:`RateBlock.rates` gives any position's
 :class:`~.rates.Rates`, the same numbers as the scalar definition to its last bits (numpy's
-cos, sin and exp are not the C library's; tests hold the two together).
+cos and sin need not be the C library's; tests/test_rate_blocks.py holds the two
+together). :func:`with_rates` gives a sweep's positions their rates, a block at a time
+from RATES_BLOCK_ABOVE solved positions.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ..problems.loops import LoopModel
+from ..problems.loops import ANGLE_UNITS, LoopModel
+from ..units import radians
 from .labels import rate_label
 from .placing import place_bounded
 from .rate_bounds import SAFETY, rate_bounds_np, static_values
-from .rates import RATE_RTOL, Rates, compiled_np, polish_np, rates_from_jacobian_np
+from .rates import RATE_RTOL, Rates, compiled_np, polish_np, position_rates, rates_from_jacobian_np
 from .vectors import numpy_kit
+
+if TYPE_CHECKING:  # a solve's rates do not load the sweep's types
+    from .positions import SweepResult
 
 OK, ILL, UNDEFINED = "ok", "ill_conditioned", "undefined"
 
@@ -249,12 +256,45 @@ def sweep_block(m: Any, solution: Any, driver: Any, solved: Any, speed: float | 
     solved positions by :func:`block_rates`, the others absent."""
     import numpy as np
 
-    from ..problems.loops import ANGLE_UNITS
-    from ..units import radians
-
     rows = np.flatnonzero(solved)
     scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     q = [radians(solution[rows, j]) if u.kind == "angle" else solution[rows, j].astype(float)
          for j, u in enumerate(m.unknowns)]
     d = np.asarray(driver, dtype=float)[rows] * scale
     return block_rates(m.model, q, d, speed, accel).spread(rows, len(solved))
+
+
+RATES_BLOCK_ABOVE = 1000
+"""From this many solved positions :func:`with_rates` computes their rates as one block
+(kinematics.rate_blocks: numpy, the same numbers); below, one at a time (a small sweep's
+command does not pay numpy's import)."""
+
+
+def with_rates(m: Any, result: SweepResult, speed: float | None, accel: float) -> SweepResult:
+    """Joints, and with a driver speed velocities and accelerations, at every solved position."""
+    from dataclasses import replace
+
+    from .positions import with_position_rates
+
+    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    solved = [p.solution is not None for p in result.positions]
+    if sum(solved) >= RATES_BLOCK_ABOVE:
+        import numpy as np
+
+        sol = np.array([[p.solution[u.name] for u in m.unknowns] if p.solution is not None
+                        else [math.nan] * len(m.unknowns) for p in result.positions], dtype=float)
+        inputs = np.array([p.input for p in result.positions], dtype=float)
+        block = sweep_block(m, sol.reshape(len(solved), len(m.unknowns)), inputs, np.array(solved),
+                            speed, accel)
+        rates = block.rates()
+        positions = tuple(with_position_rates(p, r) if ok else p
+                          for p, r, ok in zip(result.positions, rates, solved))
+    else:
+        kinds = [u.kind for u in m.unknowns]
+        positions = tuple(
+            p if p.solution is None else with_position_rates(p, position_rates(
+                m.model, [radians(p.solution[u.name]) if k == "angle" else p.solution[u.name]
+                        for u, k in zip(m.unknowns, kinds)], p.input * scale, speed, accel))
+            for p in result.positions)
+    motion = (speed, accel) if speed is not None else None
+    return replace(result, positions=positions, motion=motion)

@@ -25,19 +25,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..methods.newton_system import max_abs, newton_direction
-from ..problems.loops import ANGLE_UNITS, DRIVER, LoopModel
-from ..units import radians
+from ..problems.loops import DRIVER, LoopModel
 from .block_linalg import direction_np
 from .labels import rate_label
 from .placing import place, place_bounded
 from .rate_bounds import SAFETY, inverse_np, rate_bounds, static_values
 from .vectors import EPS, XY, bias, bias_np, value_of
-
-if TYPE_CHECKING:  # a solve's rates do not load the sweep's types
-    from .positions import SweepResult
 
 RATE_RTOL = 1e-6
 """A rate whose error bound exceeds this, relative to the rate (or to the driver's own
@@ -355,42 +351,3 @@ def rates_at(mechanism: Any, q: Any, *, speed: float | None = None, accel: float
                          f"{gap:.3g}{unit}, more than the {allowed:.3g}{unit} (1% of the mechanism's "
                          "size) any solve's tolerance allows; solve first (solve_system)")
     return position_rates(model, q, d, speed, accel)
-
-
-RATES_BLOCK_ABOVE = 1000
-"""From this many solved positions :func:`with_rates` computes their rates as one block
-(kinematics.rate_blocks: numpy, the same numbers); below, one at a time (a small sweep's
-command does not pay numpy's import)."""
-
-
-def with_rates(m: Any, result: SweepResult, speed: float | None, accel: float) -> SweepResult:
-    """Joints, and with a driver speed velocities and accelerations, at every solved position."""
-    from dataclasses import replace
-
-    from .positions import with_position_rates
-
-    model = m.model
-    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-    solved = [p.solution is not None for p in result.positions]
-    if sum(solved) >= RATES_BLOCK_ABOVE:
-        import numpy as np
-
-        from .rate_blocks import sweep_block
-
-        sol = np.array([[p.solution[u.name] for u in m.unknowns] if p.solution is not None
-                        else [math.nan] * len(m.unknowns) for p in result.positions], dtype=float)
-        inputs = np.array([p.input for p in result.positions], dtype=float)
-        block = sweep_block(m, sol.reshape(len(solved), len(m.unknowns)), inputs, np.array(solved),
-                            speed, accel)
-        rates = block.rates()
-        positions = tuple(with_position_rates(p, r) if ok else p
-                          for p, r, ok in zip(result.positions, rates, solved))
-    else:
-        kinds = [u.kind for u in m.unknowns]
-        positions = tuple(
-            p if p.solution is None else with_position_rates(p, position_rates(
-                model, [radians(p.solution[u.name]) if k == "angle" else p.solution[u.name]
-                        for u, k in zip(m.unknowns, kinds)], p.input * scale, speed, accel))
-            for p in result.positions)
-    motion = (speed, accel) if speed is not None else None
-    return replace(result, positions=positions, motion=motion)
