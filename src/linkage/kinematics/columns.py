@@ -196,7 +196,7 @@ class RateChunks(Sequence):  # type: ignore[type-arg]
         for a in range(start - start % self.chunk, stop, self.chunk):
             got = self.chunk_block(a)
             lo, hi = max(start, a) - a, min(stop, a + self.chunk) - a
-            parts.append(got if (lo, hi) == (0, len(got)) else got.rows(lo, hi))
+            parts.append(got if (lo, hi) == (0, len(got)) else got.take(slice(lo, hi)))
         return RateBlock.join(parts)
 
     def listen(self, listener: Callable[[int, Any], None]) -> None:

@@ -176,7 +176,7 @@ def chunk_forces(mechanism: Any, frame: Frame, solved: SolvedRows, loads: Loads,
     good = np.flatnonzero(~bad)
     if not len(good):
         return ChunkForces((), undefined, None)
-    actual, unit = actual.rows_at(good), unit.rows_at(good)
+    actual, unit = actual.take(good), unit.take(good)
     k = metre(frame.length_unit)
 
     def scaled(m: Mapping[str, tuple[Any, Any]]) -> dict[str, tuple[Any, Any]]:
@@ -286,7 +286,7 @@ def chunk_loads(mechanism: Any, frame: Frame, cols: Any, loads: Loads, speed: fl
     solved = solved_columns(mechanism, cols, start, stop)
     given = None
     if speed and hasattr(cols.rates, "block"):  # the sweep's own rates (RateChunks), not again
-        given = cols.rates.block(start, stop).rows_at(solved.index - start)
+        given = cols.rates.block(start, stop).take(solved.index - start)
     cf = chunk_forces(mechanism, frame, solved, loads, speed, accel, given)
     return _chunk_columns(cf, start, stop - start, loads)
 

@@ -108,22 +108,10 @@ class RateBlock:
             _each(self.joint_velocity_bounds, put), _each(self.joint_acceleration_bounds, put),
             tuple(flags))
 
-    def rows(self, start: int, stop: int) -> RateBlock:
-        """Positions ``start:stop`` of this block."""
-        def cut(a: Any) -> Any:
-            return a[start:stop]
-
-        return RateBlock(
-            cut(self.status), _each(self.joints, cut), _each(self.velocities, cut),
-            _each(self.accelerations, cut), _each(self.joint_velocities, cut),
-            _each(self.joint_accelerations, cut), _each(self.velocity_bounds, cut),
-            _each(self.acceleration_bounds, cut), _each(self.joint_velocity_bounds, cut),
-            _each(self.joint_acceleration_bounds, cut), tuple((k, cut(v)) for k, v in self.flags))
-
-    def rows_at(self, index: Any) -> RateBlock:
-        """The positions at ``index`` (an integer array) of this block."""
+    def take(self, key: Any) -> RateBlock:
+        """The positions ``key`` (a slice or an integer array) of this block."""
         def pick(a: Any) -> Any:
-            return a[index]
+            return a[key]
 
         return RateBlock(
             pick(self.status), _each(self.joints, pick), _each(self.velocities, pick),
