@@ -109,7 +109,9 @@ def _array_columns(s: SweepResult, b: Any) -> SweepColumns:
             # computed as read, a chunk at a time (the batch's own chunks), never all held
             rates = RateChunks(s.positions)
             first = next((i for i in np.flatnonzero(solved)), None)
-            names = list(rates[int(first)].joints) if first is not None else []
+            # the joints' names from the first solved position's chunk, as arrays (no Rates built)
+            at = None if first is None else int(first) - int(first) % rates.chunk
+            names = [] if at is None else list(rates.chunk_block(at).joints)
             joints = {j: (RateColumn(rates, j, 0), RateColumn(rates, j, 1)) for j in names}
         elif b.rates is not None:
             from .placing import place_np

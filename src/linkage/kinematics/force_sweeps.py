@@ -411,7 +411,7 @@ class LoadColumns:
         """The next chunk: through the rates (which hand it to :meth:`_heard`), or here."""
         start = self.next
         if self.following:
-            self.cols.rates.load(start)
+            self.cols.rates.chunk_block(start)  # computed once, heard by _heard
         if self.next == start:  # not heard (its rates were already at hand)
             self._take(start)
 
