@@ -1,5 +1,5 @@
 """A drawing's fixed joints are reported where they were drawn, exactly (LoopModel.drawn,
-the placing rule kinematics.rates._walk): not as the sum of the ground's vectors, which
+the placing rule kinematics.placing.walk): not as the sum of the ground's vectors, which
 put a pivot drawn at x = 40.0 at 39.99999999999999."""
 
 from __future__ import annotations

@@ -527,3 +527,17 @@ def test_a_translating_coupler_reports_no_crossings(tmp_path):
                     'rocker = ["O4", "B"]\n[driver]\nlink = "crank"\nvalue = 30\n')
     cd = linkage.centrodes(str(path), [30, 60, 90, 120, 150])
     assert cd.through_infinity == ()
+
+
+def test_a_drawn_30_degrees_is_reported_as_30_not_29_999999999999996(cli) -> None:
+    """Finding: ``linkage centres -f json`` gave driver_value 29.999999999999996 for the
+    crank drawn at 30 (a radian round trip by math.degrees): the degrees read are kept."""
+    from linkage.kinematics.centres import read_degrees
+
+    r = cli("centres", str(SAMPLES / "crank_rocker_joints.toml"), "-f", "json")
+    assert json.loads(r.out)["driver_value"] == 30
+    rng = random.Random(30)
+    for _ in range(2000):
+        typed = round(rng.uniform(-720.0, 720.0), rng.randint(0, 8))
+        assert read_degrees(typed * (math.pi / 180.0), "deg") == typed
+    assert read_degrees(0.5, "rad") == math.degrees(0.5)

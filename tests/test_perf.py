@@ -50,9 +50,9 @@ def test_a_solves_rates_do_not_load_the_sweep_result_types():
 
 
 def test_with_rates_is_still_importable_from_the_sweep_module():
-    from linkage.kinematics import rates, sweep
+    from linkage.kinematics import rate_blocks, sweep
 
-    assert sweep.with_rates is rates.with_rates
+    assert sweep.with_rates is rate_blocks.with_rates
     with pytest.raises(AttributeError):
         sweep.no_such_name  # noqa: B018
 

@@ -16,7 +16,8 @@ from linkage.cli import run_cli
 from linkage.kinematics.force_sweeps import batch_forces, sweep_forces
 from linkage.kinematics.forces import FORCE_STATUSES, force_peaks
 from linkage.kinematics.loading import from_text, load
-from linkage.kinematics.rates import place_motion_np, rates_at, solve_rates_np
+from linkage.kinematics.placing import place_motion_np
+from linkage.kinematics.rates import rates_at, solve_rates_np
 from linkage.kinematics.sweep import sweep_mechanism
 from linkage.problems.loads import Loads
 from linkage.problems.loops import LoopModel

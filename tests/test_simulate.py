@@ -215,6 +215,15 @@ def test_cli_bad_input_is_one_line_exit_2(cli, args, needle):
     assert len(r.err.strip().splitlines()) == 1
 
 
+def test_a_million_second_span_is_refused_in_one_line_not_integrated_for_minutes(cli):
+    """Finding: --time 0:1e6 ran for minutes (200,000 evaluations, then integration_failed).
+    The span is projected from the run's first evaluations and refused: exit 2, one line
+    naming --time; a span within the budget still runs (the other tests)."""
+    r = cli("simulate", str(LOADED), "--time", "0:1e6", "--omega0", "10")
+    assert r.code == 2, r.err
+    assert "--time" in r.err and "evaluations" in r.err and len(r.err.strip().splitlines()) == 1
+
+
 def test_cli_a_mechanism_without_masses_is_refused(cli):
     r = cli("simulate", str(SAMPLES / "crank_rocker_joints.toml"), "--time", "0:1")
     assert r.code == 2

@@ -19,7 +19,7 @@ import pytest
 
 import linkage
 from linkage.kinematics.loading import load
-from linkage.kinematics.rates import place, place_np
+from linkage.kinematics.placing import place, place_np
 from linkage.render import cells, formats, writers
 from linkage.render.sweep import equation_report, ranges_of, sweep_report
 from ulps import assert_ulps

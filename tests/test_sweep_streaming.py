@@ -98,18 +98,18 @@ def test_the_positions_rates_are_not_all_computed_before_writing(monkeypatch, tm
     """The rates are computed as the writer takes the rows: when the first block of rows
     reaches the file, only the chunks of that block have been computed (the loads taken
     from the same chunks), not the sweep's."""
+    from linkage.kinematics.columns import RateChunks
     from linkage.render import formats
 
     monkeypatch.setattr(batch_engine, "RATES_CHUNK", 16)
     computed: list[int] = []
-    real = batch_engine.BatchPositions.__getitem__
+    real = RateChunks.chunk_block
 
-    def counted(self, i):
-        if not isinstance(i, slice) and self.batch.rates is not None and i % 16 == 0:
-            computed.append(i)
-        return real(self, i)
+    def counted(self, start):  # each chunk of rates as it is computed (or read again)
+        computed.append(start)
+        return real(self, start)
 
-    monkeypatch.setattr(batch_engine.BatchPositions, "__getitem__", counted)
+    monkeypatch.setattr(RateChunks, "chunk_block", counted)
     seen: list[tuple[int, int]] = []
     rows = formats.CsvSink.rows
 

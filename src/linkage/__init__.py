@@ -43,9 +43,9 @@ _EXPORTS = {
     "assemblies": ".kinematics.assemblies", "Assemblies": ".kinematics.assemblies",
     "Loads": ".problems.loads", "Mass": ".problems.loads",
     "instant_centres": ".kinematics.centres", "InstantCentres": ".kinematics.centres",
-    "centrodes": ".kinematics.centres", "Centrodes": ".kinematics.centres",
+    "centrodes": ".kinematics.centrodes", "Centrodes": ".kinematics.centrodes",
     "tolerance": ".scan.tolerance", "ToleranceStudy": ".scan.tolerance",
-    "simulate": ".kinematics.dynamics", "Simulation": ".kinematics.dynamics",
+    "simulate": ".kinematics.simulation", "Simulation": ".kinematics.simulation",
 }
 _RENAMED = {"load_mechanism": "load", "sweep": "sweep_mechanism", "position_rates": "rates_at",
             "scan_designs": "scan", "forces": "forces_at", "assemblies": "every_assembly"}

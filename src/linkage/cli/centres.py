@@ -81,7 +81,7 @@ def centres(
     cd = None
     if centrodes:
         from ..arguments import driver_span
-        from ..kinematics.centres import centrodes as run_centrodes
+        from ..kinematics.centrodes import centrodes as run_centrodes
         from ..kinematics.sweep import driver_values
         from ..solve import check_number
 

@@ -122,8 +122,8 @@ def simulate(
     """
     from ..arguments import parse_motion
     from ..kinematics.bodies import command_loads
-    from ..kinematics.dynamics import simulate as run
     from ..kinematics.loading import load as load_file
+    from ..kinematics.simulation import simulate as run
     from ..render.simulate import simulate_plot, simulate_report
 
     out_fmt = choose_format(fmt, output)

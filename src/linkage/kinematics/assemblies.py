@@ -328,7 +328,7 @@ def decode(m: Mechanism, x: np.ndarray) -> list[float]:
 def _joints(m: Mechanism, driver: float, q: list[float]) -> dict[str, tuple[float, float]]:
     """Every named joint and point, by the one placing rule (rates.place: a drawing's fixed
     joints where they were drawn)."""
-    from .rates import place
+    from .placing import place
 
     return {name: (p.real, p.imag) for name, (p, _, _) in place(m.model, q, driver).items()}
 

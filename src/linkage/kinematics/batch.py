@@ -161,7 +161,7 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         # memory stays bounded whatever the sweep's size
         start = i - i % RATES_CHUNK
         if self._chunk[0] != start:
-            from .rates import with_rates  # a batch without rates (a scan's) never loads them
+            from .rate_blocks import with_rates  # a batch without rates (a scan's) never loads them
 
             b = self.batch
             assert b.source is not None

@@ -7,10 +7,10 @@ the derivation's numpy twin and joints from :func:`~.rates.place_np`. The one-at
 engine's tuple of positions gives plain lists, without importing numpy (a small sweep's
 command stays numpy-free for its cold start).
 
-Rates with a driver speed stay on the scalar definition (each position's
-:class:`~.rates.Rates`, None where unsolved): ``rates`` then gives them, one per position.
-A batch result's are a :class:`RateChunks`: computed a chunk of positions at a time as
-they are read, only the last chunk held, so a table written a block at a time (a
+Rates with a driver speed: ``rates`` gives each position's :class:`~.rates.Rates` (None
+where unsolved). A batch result's are a :class:`RateChunks`: computed a chunk of positions
+at a time as one block (kinematics.rate_blocks, the one definition over arrays) as they
+are read, only the last chunk held, so a table written a block at a time (a
 sweep's positions to CSV or parquet) holds one chunk of rates whatever the sweep's length
 (docs/performance_loads.md).
 """
@@ -21,6 +21,7 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Any, NamedTuple
 
+from ..units import degrees, radians
 from .positions import SweepResult
 
 
@@ -100,7 +101,7 @@ def _array_columns(s: SweepResult, b: Any) -> SweepColumns:
     rates = None
     if m is not None:
         scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-        q = [np.radians(solution[u.name]) if u.kind == "angle" else solution[u.name] for u in m.unknowns]
+        q = [radians(solution[u.name]) if u.kind == "angle" else solution[u.name] for u in m.unknowns]
         d = np.asarray(b.values, dtype=float) * scale
         if m.derivation.fourbars:
             transmission = transmission_column(m, q, d, solved)
@@ -108,10 +109,12 @@ def _array_columns(s: SweepResult, b: Any) -> SweepColumns:
             # computed as read, a chunk at a time (the batch's own chunks), never all held
             rates = RateChunks(s.positions)
             first = next((i for i in np.flatnonzero(solved)), None)
-            names = list(rates[int(first)].joints) if first is not None else []
+            # the joints' names from the first solved position's chunk, as arrays (no Rates built)
+            at = None if first is None else int(first) - int(first) % rates.chunk
+            names = [] if at is None else list(rates.chunk_block(at).joints)
             joints = {j: (RateColumn(rates, j, 0), RateColumn(rates, j, 1)) for j in names}
         elif b.rates is not None:
-            from .rates import place_np
+            from .placing import place_np
 
             placed = place_np(m.model, q, d)
             joints = {k: (np.where(solved, x, nan), np.where(solved, y, nan)) for k, (x, y) in placed.items()}
@@ -126,24 +129,27 @@ def transmission_column(m: Any, q: Sequence[Any], d: Any, solved: Any) -> Any:
 
     with np.errstate(invalid="ignore", divide="ignore"):
         mu = m.derivation.transmission_np(q, d)
-    return np.where(solved, np.degrees(mu), np.nan)
+    return np.where(solved, degrees(mu), np.nan)
 
 
 class RateChunks(Sequence):  # type: ignore[type-arg]
     """Each position's rates of a batch sweep with a driver speed (None where unsolved),
-    read a chunk of positions at a time (kinematics.batch.RATES_CHUNK: one call of the one
-    definition, :func:`~.rates.with_rates`, per chunk, as the batch's positions compute
-    them) and only the last chunk held. :meth:`listen`: a callback given each chunk as it
-    is computed, so a second reader in step (a sweep's loads, kinematics.force_sweeps)
-    takes the same rates without computing them again."""
+    computed a chunk of positions at a time (kinematics.batch.RATES_CHUNK) as one block
+    straight from the batch's arrays (:func:`~.rate_blocks.sweep_block`, the block twin of
+    the one definition, :func:`~.rates.position_rates`), only the last chunk held.
+    :meth:`block` gives rows as arrays (a table's columns, no object per position); an
+    item, a position's :class:`~.rates.Rates`. :meth:`listen`: a callback given each chunk
+    as it is computed, so a second reader in step (a sweep's loads,
+    kinematics.force_sweeps) takes the same rates without computing them again."""
 
     def __init__(self, positions: Sequence[Any], chunk: int | None = None) -> None:
         from .batch import RATES_CHUNK
 
         self.positions = positions
+        self.batch = positions.batch  # type: ignore[attr-defined]
         self.chunk = RATES_CHUNK if chunk is None else chunk
-        self._last: tuple[int, list[Any]] = (-1, [])
-        self._listeners: list[Callable[[int, list[Any]], None]] = []
+        self._last: tuple[int, Any, list[Any] | None] = (-1, None, None)
+        self._listeners: list[Callable[[int, Any], None]] = []
 
     def __len__(self) -> int:
         return len(self.positions)
@@ -157,18 +163,46 @@ class RateChunks(Sequence):  # type: ignore[type-arg]
             raise IndexError(i)
         return self.load(i - i % self.chunk)[i % self.chunk]
 
-    def load(self, start: int) -> list[Any]:
-        """The rates of the chunk from ``start`` (a multiple of ``chunk``)."""
+    def chunk_block(self, start: int) -> Any:
+        """The rates of the chunk from ``start`` (a multiple of ``chunk``) as a
+        :class:`~.rate_blocks.RateBlock`."""
         if self._last[0] != start:
-            self._last = (-1, [])  # the last chunk let go before the next is computed
-            got = [p.rates for p in self.positions[start:start + self.chunk]]
-            self._last = (start, got)
+            from .batch import STATUS_CODES
+            from .rate_blocks import sweep_block
+
+            self._last = (-1, None, None)  # the last chunk let go before the next is computed
+            b = self.batch
+            stop = min(len(self), start + self.chunk)
+            speed, accel = b.rates
+            block = sweep_block(b.source, b.solution[start:stop], b.values[start:stop],
+                                b.status[start:stop] == STATUS_CODES["converged"], speed, accel)
+            self._last = (start, block, None)
             for listener in self._listeners:
-                listener(start, got)
+                listener(start, block)
         return self._last[1]
 
-    def listen(self, listener: Callable[[int, list[Any]], None]) -> None:
-        """Call ``listener(start, rates)`` for every chunk computed from now on."""
+    def load(self, start: int) -> list[Any]:
+        """The rates of the chunk from ``start`` (a multiple of ``chunk``), one
+        :class:`~.rates.Rates` per position (None where unsolved)."""
+        block = self.chunk_block(start)
+        if self._last[2] is None:
+            self._last = (start, block, block.rates())
+        return self._last[2]  # type: ignore[return-value]
+
+    def block(self, start: int, stop: int) -> Any:
+        """Rows ``start:stop`` as one :class:`~.rate_blocks.RateBlock` (the chunks they
+        span, in order)."""
+        from .rate_blocks import RateBlock
+
+        parts = []
+        for a in range(start - start % self.chunk, stop, self.chunk):
+            got = self.chunk_block(a)
+            lo, hi = max(start, a) - a, min(stop, a + self.chunk) - a
+            parts.append(got if (lo, hi) == (0, len(got)) else got.take(slice(lo, hi)))
+        return RateBlock.join(parts)
+
+    def listen(self, listener: Callable[[int, Any], None]) -> None:
+        """Call ``listener(start, block)`` for every chunk computed from now on."""
         self._listeners.append(listener)
 
 
@@ -191,6 +225,10 @@ class RateColumn(Sequence):  # type: ignore[type-arg]
         if isinstance(i, slice):
             import numpy as np
 
-            idx = range(*i.indices(len(self)))
+            start, stop, step = i.indices(len(self))
+            if hasattr(self.rates, "block") and step == 1 and stop > start:  # RateChunks: as arrays
+                got = self.rates.block(start, stop).joints.get(self.joint)
+                return got[self.part] if got is not None else np.full(stop - start, math.nan)
+            idx = range(start, stop, step)
             return np.fromiter((self._one(k) for k in idx), float, len(idx))
         return self._one(i if i >= 0 else i + len(self))

@@ -12,15 +12,15 @@ from typing import Any, NamedTuple
 from ..problems.loads import Loads
 from .bodies import Frame, force_size, metre
 from .forces import (
-    ForceArrays,
     Forces,
     force_status_np,
     matrix_bound,
-    per_unit_speed,
     position_forces,
-    solve_loads,
+    scaled_to_unit_speed,
+    speed_usable,
     undefined_forces,
 )
+from .load_matrix import ForceArrays, solve_loads
 
 
 @dataclass(frozen=True)
@@ -50,7 +50,8 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
     import numpy as np
 
     from ..problems.loops import LoopModel
-    from .rates import place_motion_np, solve_rates_np
+    from .placing import place_motion_np
+    from .rates import solve_rates_np
 
     frame = Frame.of(mechanism)
     d = np.asarray(d, dtype=float)
@@ -117,56 +118,76 @@ class SolvedPosition(NamedTuple):
 
 
 @dataclass(frozen=True)
+class SolvedRows:
+    """A chunk's solved positions as arrays: their indices in the sweep, the unknowns (one
+    array each) and the driver, internal units."""
+
+    index: Any
+    q: list[Any]
+    driver: Any
+
+    def __len__(self) -> int:  # the positions
+        return len(self.index)
+
+
+@dataclass(frozen=True)
 class ChunkForces:
     """The matrix method over a chunk's solved positions (:func:`chunk_forces`)."""
 
-    kept: tuple[tuple[int, Any, Any], ...]
-    """(index, rates at the driver's motion, rates at a unit speed) of each position solved."""
+    kept: tuple[int, ...]
+    """The index of each position solved (its kinematics defined)."""
     undefined: tuple[int, ...]
     """Positions whose kinematics are undefined (a toggle): no forces."""
     arrays: ForceArrays | None
     """:func:`solve_loads`' answer for ``kept``, in its order (None where none is kept)."""
+    actual: Any = None
+    """``kept``'s rates at the driver's motion (a :class:`~.rate_blocks.RateBlock`)."""
+    unit: Any = None
+    """``kept``'s rates at a unit driver speed (the virtual velocities)."""
+
+    def rates(self) -> list[tuple[int, Any, Any]]:
+        """(index, rates at the driver's motion, at a unit speed) of each kept position, as
+        :class:`~.rates.Rates`."""
+        if not self.kept:
+            return []
+        return list(zip(self.kept, self.actual.rates(), self.unit.rates()))
 
 
-def chunk_forces(mechanism: Any, frame: Frame, solved: Sequence[SolvedPosition], loads: Loads,
-                 speed: float, accel: float) -> ChunkForces:
-    """A chunk of a sweep's positions' forces: each position's rates as the sweep's own
-    (kinematics.rates: at the driver's motion where the sweep computed them, else here),
-    the matrix method for all of them in one :func:`solve_loads`."""
+def chunk_forces(mechanism: Any, frame: Frame, solved: SolvedRows, loads: Loads, speed: float | None,
+                 accel: float, given: Any = None) -> ChunkForces:
+    """A chunk of a sweep's positions' forces: the positions' rates as one block
+    (kinematics.rate_blocks, the one definition over arrays; ``given``, the sweep's own
+    block at the driver's motion for these positions, if it has one), the velocities of a
+    unit speed from them (:func:`~.forces.per_unit_speed`'s rule) or computed, and the
+    matrix method for all of them in one :func:`solve_loads`."""
     import numpy as np
 
-    from .rates import rates_at
+    from .rate_blocks import block_rates
 
+    model = mechanism.model
+    moving = speed_usable(speed)
+    actual = given if moving and given is not None else block_rates(model, solved.q, solved.driver, speed,
+                                                                    accel)
+    unit = (scaled_to_unit_speed(actual, speed) if moving and actual.velocities  # type: ignore[arg-type]
+            else block_rates(model, solved.q, solved.driver, 1.0, 0.0))
+    bad = (actual.status == "undefined") | (unit.status == "undefined")
+    index = np.asarray(solved.index)
+    undefined = tuple(index[bad].tolist())
+    good = np.flatnonzero(~bad)
+    if not len(good):
+        return ChunkForces((), undefined, None)
+    actual, unit = actual.take(good), unit.take(good)
     k = metre(frame.length_unit)
-    kept: list[tuple[int, Any, Any]] = []
-    undefined: list[int] = []
-    for p in solved:
-        given = p.rates if speed and p.rates is not None and p.rates.joint_velocities else None
-        actual = given or rates_at(mechanism, p.q, speed=speed, accel=accel, driver=p.driver)
-        unit = (per_unit_speed(actual, speed)
-                or rates_at(mechanism, p.q, speed=1.0, accel=0.0, driver=p.driver))
-        if actual.status == "undefined" or unit.status == "undefined":
-            undefined.append(p.index)
-            continue
-        kept.append((p.index, actual, unit))
-    if not kept:
-        return ChunkForces((), tuple(undefined), None)
-    names = list(kept[0][1].joints)
-    count = len(kept)
 
-    def stack(rows: Sequence[Any], get: Any) -> dict[str, tuple[Any, Any]]:
-        maps = [get(r) for r in rows]
-        return {j: (np.fromiter((m[j][0] for m in maps), float, count) * k,
-                    np.fromiter((m[j][1] for m in maps), float, count) * k) for j in names}
+    def scaled(m: Mapping[str, tuple[Any, Any]]) -> dict[str, tuple[Any, Any]]:
+        return {j: (x * k, y * k) for j, (x, y) in m.items()}
 
-    actual_rates = [a for _, a, _ in kept]
-    zero = {j: (0.0, 0.0) for j in names}
-    pos_a = stack(actual_rates, lambda r: r.joints)
-    vel_a = stack(actual_rates, lambda r: r.joint_velocities or zero)
-    acc_a = stack(actual_rates, lambda r: r.joint_accelerations or zero)
-    vstar = stack([u for _, _, u in kept], lambda r: r.joint_velocities)
-    fa = solve_loads(frame, pos_a, vel_a, acc_a, vstar, loads, mechanism.source)
-    return ChunkForces(tuple(kept), tuple(undefined), fa)
+    zero = np.zeros(len(good))
+    still = {j: (zero, zero) for j in actual.joints}
+    fa = solve_loads(frame, scaled(actual.joints), scaled(actual.joint_velocities or still),
+                     scaled(actual.joint_accelerations or still), scaled(unit.joint_velocities), loads,
+                     mechanism.source)
+    return ChunkForces(tuple(index[good].tolist()), undefined, fa, actual, unit)
 
 
 def _display_scale(mechanism: Any) -> float:
@@ -176,37 +197,38 @@ def _display_scale(mechanism: Any) -> float:
     return ANGLE_UNITS[mechanism.driver.unit] if mechanism.driver.kind == "angle" else 1.0
 
 
-def _internal(mechanism: Any, solution: Mapping[str, float]) -> list[float]:
-    return [math.radians(solution[u.name]) if u.kind == "angle" else float(solution[u.name])
-            for u in mechanism.unknowns]
-
-
-def solved_positions(mechanism: Any, positions: Sequence[Any], start: int, stop: int
-                     ) -> list[SolvedPosition]:
+def solved_positions(mechanism: Any, positions: Sequence[Any], start: int, stop: int) -> SolvedRows:
     """The solved positions among ``positions[start:stop]`` (a sweep's Position objects)."""
+    import numpy as np
+
+    from ..units import radians
+
     scale = _display_scale(mechanism)
-    out = []
-    for i in range(start, stop):
-        p = positions[i]
-        if p.status == "converged" and p.solution is not None:
-            out.append(SolvedPosition(i, _internal(mechanism, p.solution), p.input * scale, p.rates))
-    return out
+    rows = [i for i in range(start, stop)
+            if positions[i].status == "converged" and positions[i].solution is not None]
+    sols = [positions[i].solution for i in rows]
+    q = [np.array([radians(s[u.name]) if u.kind == "angle" else float(s[u.name]) for s in sols], dtype=float)
+         for u in mechanism.unknowns]
+    return SolvedRows(np.array(rows, dtype=np.intp), q,
+                      np.array([positions[i].input for i in rows], dtype=float) * scale)
 
 
-def solved_columns(mechanism: Any, cols: Any, start: int, stop: int) -> list[SolvedPosition]:
+def solved_columns(mechanism: Any, cols: Any, start: int, stop: int) -> SolvedRows:
     """The solved positions among rows ``start:stop`` of a sweep's columns
-    (:class:`~.columns.SweepColumns`: its report's, so a batch sweep's rates are not
-    computed a second time)."""
+    (:class:`~.columns.SweepColumns`), as arrays."""
+    import numpy as np
+
+    from ..units import radians
+
     scale = _display_scale(mechanism)
-    names = [u.name for u in mechanism.unknowns]
-    out = []
-    for i in range(start, stop):
-        if cols.status[i] != "converged":
-            continue
-        sol = {n: float(cols.solution[n][i]) for n in names}
-        rates = cols.rates[i] if cols.rates is not None else None
-        out.append(SolvedPosition(i, _internal(mechanism, sol), float(cols.inputs[i]) * scale, rates))
-    return out
+    status = np.asarray(cols.status[start:stop], dtype=object)
+    rows = np.flatnonzero(status == "converged")
+    q = []
+    for u in mechanism.unknowns:
+        v = np.asarray(cols.solution[u.name][start:stop], dtype=float)[rows]
+        q.append(radians(v) if u.kind == "angle" else v)
+    d = np.asarray(cols.inputs[start:stop], dtype=float)[rows] * scale
+    return SolvedRows(rows + start, q, d)
 
 
 def sweep_forces(mechanism: Any, result: Any, loads: Loads, speed: float, accel: float
@@ -224,7 +246,7 @@ def sweep_forces(mechanism: Any, result: Any, loads: Loads, speed: float, accel:
                           loads, speed, accel)
         for i in cf.undefined:
             out[i] = undefined_forces(frame, "the kinematics are undefined here")
-        for m, (i, actual, unit) in enumerate(cf.kept):
+        for m, (i, actual, unit) in enumerate(cf.rates()):
             out[i] = position_forces(cf.arrays, m, unit, actual.status, loads)  # type: ignore[arg-type]
     return out
 
@@ -261,14 +283,18 @@ def load_chunks(mechanism: Any, cols: Any, loads: Loads, speed: float, accel: fl
 def chunk_loads(mechanism: Any, frame: Frame, cols: Any, loads: Loads, speed: float, accel: float,
                 start: int, stop: int) -> LoadChunk:
     """The loads of rows ``start:stop`` of a sweep's columns (:func:`load_chunks`' chunk)."""
-    cf = chunk_forces(mechanism, frame, solved_columns(mechanism, cols, start, stop), loads, speed, accel)
+    solved = solved_columns(mechanism, cols, start, stop)
+    given = None
+    if speed and hasattr(cols.rates, "block"):  # the sweep's own rates (RateChunks), not again
+        given = cols.rates.block(start, stop).take(solved.index - start)
+    cf = chunk_forces(mechanism, frame, solved, loads, speed, accel, given)
     return _chunk_columns(cf, start, stop - start, loads)
 
 
 def _chunk_columns(cf: ChunkForces, start: int, size: int, loads: Loads) -> LoadChunk:
     import numpy as np
 
-    from .forces import FORCE_STATUSES, kinematic_bound, mechanical_advantage
+    from .forces import FORCE_STATUSES, kinematic_bound_np, mechanical_advantage
 
     status = np.full(size, -1, dtype=np.int8)
     status[[i - start for i in cf.undefined]] = FORCE_STATUSES.index("undefined")
@@ -276,11 +302,10 @@ def _chunk_columns(cf: ChunkForces, start: int, size: int, loads: Loads) -> Load
     fa = cf.arrays
     if fa is None:
         return LoadChunk(start, status, columns)
-    rows = np.array([i - start for i, _, _ in cf.kept], dtype=np.intp)
+    rows = np.array(cf.kept, dtype=np.intp) - start
     cond = fa.condition
-    bound = np.maximum(matrix_bound(cond), np.fromiter((kinematic_bound(u) for _, _, u in cf.kept), float,
-                                                       len(rows)))
-    kin_ok = np.fromiter((a.status == "ok" and u.status == "ok" for _, a, u in cf.kept), bool, len(rows))
+    bound = np.maximum(matrix_bound(cond), kinematic_bound_np(cf.unit))
+    kin_ok = (cf.actual.status == "ok") & (cf.unit.status == "ok")
     codes = force_status_np(fa.input, cond, bound, kin_ok)
     status[rows] = codes
     number = codes != FORCE_STATUSES.index("undefined")  # flagged forces keep their numbers
@@ -386,7 +411,7 @@ class LoadColumns:
         """The next chunk: through the rates (which hand it to :meth:`_heard`), or here."""
         start = self.next
         if self.following:
-            self.cols.rates.load(start)
+            self.cols.rates.chunk_block(start)  # computed once, heard by _heard
         if self.next == start:  # not heard (its rates were already at hand)
             self._take(start)
 

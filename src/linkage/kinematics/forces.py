@@ -28,8 +28,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
-from ..problems.loads import Loads, load_link
+from ..problems.loads import Loads
 from .bodies import Frame, checked_loads, metre
+from .load_matrix import ForceArrays, solve_loads
 
 EPS = sys.float_info.epsilon
 FORCE_RTOL = 1e-6
@@ -103,266 +104,6 @@ class Forces:
         return max(p.magnitude for p in self.pins)
 
 
-def _body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], acc: Mapping[str, Any]
-                 ) -> dict[str, tuple[Any, Any, Any]]:
-    """Each body's (rotation since the drawing, omega, alpha), arrays over the positions:
-    from two of its joints, a one-joint block from the body its line is on; the ground's
-    all zero."""
-    import numpy as np
-
-    d = frame.drawing
-    zero = np.zeros_like(next(iter(pos.values()))[0])
-    out: dict[str, tuple[Any, Any, Any]] = {"ground": (zero, zero, zero)}
-    pending = []
-    for body, joints in d.bodies.items():
-        if body == "ground":
-            continue
-        pair = _two_apart(d, joints)
-        if pair is None:
-            pending.append(body)
-            continue
-        j0, j1 = pair
-        rx, ry = pos[j1][0] - pos[j0][0], pos[j1][1] - pos[j0][1]
-        r2 = rx * rx + ry * ry
-        dvx, dvy = vel[j1][0] - vel[j0][0], vel[j1][1] - vel[j0][1]
-        dax, day = acc[j1][0] - acc[j0][0], acc[j1][1] - acc[j0][1]
-        drawn = math.atan2(d.xy[j1][1] - d.xy[j0][1], d.xy[j1][0] - d.xy[j0][0])
-        out[body] = (np.arctan2(ry, rx) - drawn, (rx * dvy - ry * dvx) / r2, (rx * day - ry * dax) / r2)
-    for body in pending:
-        slide = d.sliders.get(body)
-        out[body] = out.get(slide.on, out["ground"]) if slide is not None else out["ground"]
-    return out
-
-
-def cg_motion(d: Any, body: str, mass: Any, k: float, pos: Mapping[str, Any], vel: Mapping[str, Any],
-              acc: Mapping[str, Any], motion: tuple[Any, Any, Any]) -> tuple[Any, Any, Any]:
-    """The one rule for a link's centre of mass (``mass.cg``, drawn in the file's unit, ``k``
-    m per unit): its position, velocity and acceleration, each (x, y) in SI, from the
-    link's centre joint's (``pos``, ``vel``, ``acc``, m, m/s, m/s^2) and the link's
-    (rotation since the drawing, omega, alpha) (:func:`_body_motion`): r_G = r_0 + R rel,
-    v_G = v_0 + omega x rel, a_G = a_0 + alpha x rel - omega^2 rel. Floats or arrays."""
-    import numpy as np
-
-    j0 = d.center(body)
-    rot, w, al = motion
-    dx, dy = (mass.cg[0] - d.xy[j0][0]) * k, (mass.cg[1] - d.xy[j0][1]) * k
-    c, s = np.cos(rot), np.sin(rot)
-    rel = (c * dx - s * dy, s * dx + c * dy)
-    cg = (pos[j0][0] + rel[0], pos[j0][1] + rel[1])
-    vg = (vel[j0][0] - w * rel[1], vel[j0][1] + w * rel[0])
-    ag = (acc[j0][0] - al * rel[1] - w * w * rel[0], acc[j0][1] + al * rel[0] - w * w * rel[1])
-    return cg, vg, ag
-
-
-def body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], acc: Mapping[str, Any]
-                ) -> dict[str, tuple[Any, Any, Any]]:
-    """Each body's (rotation since the drawing, omega, alpha): :func:`_body_motion`, public
-    for the dynamics (kinematics.dynamics)."""
-    return _body_motion(frame, pos, vel, acc)
-
-
-def _two_apart(d: Any, joints: Sequence[str]) -> tuple[str, str] | None:
-    for i, a in enumerate(joints):
-        for b in joints[i + 1:]:
-            if d.xy[a] != d.xy[b]:
-                return a, b
-    return None
-
-
-def _cross(r: tuple[Any, Any], f: tuple[Any, Any]) -> Any:
-    return r[0] * f[1] - r[1] * f[0]
-
-
-@dataclass(frozen=True)
-class ForceArrays:
-    """The matrix method over N positions at once (arrays of shape (N,), NaN where the
-    force matrix is singular)."""
-
-    input: Any
-    input_unit: str
-    pins: tuple[tuple[str, str, str, Any, Any], ...]
-    """(joint, on, by, fx, fy) per pin force."""
-    sliders: tuple[tuple[str, str, Any, Any], ...]
-    ground: tuple[Any, Any, Any]
-    virtual_power_input: Any
-    condition: Any
-    applied: tuple[Any, Any, Any]
-
-
-def pin_pairs(d: Any) -> list[tuple[str, str, str]]:
-    """The one rule for what a pin joins: (joint, owner, link) for each link on a joint that
-    two or more bodies share, other than its owner (the ground where the pin is fixed,
-    else the first body listing it); a pin shared by k bodies is k - 1 pairs."""
-    out = []
-    for j in d.xy:
-        on = [b for b, js in d.bodies.items() if j in js]
-        if len(on) < 2:
-            continue
-        first = "ground" if "ground" in on else on[0]
-        out += [(j, first, b) for b in on if b != first]
-    return out
-
-
-def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[str, tuple[Any, Any]],
-                acc: Mapping[str, tuple[Any, Any]], vstar: Mapping[str, tuple[Any, Any]], loads: Loads,
-                source: str = "<mechanism>") -> ForceArrays:
-    """The one definition of the matrix method: every position's system assembled and solved
-    at once. ``pos``, ``vel``, ``acc``: each joint's (x, y) arrays in m, m/s, m/s^2;
-    ``vstar`` its velocity at a unit driver speed (m/s per rad/s, or per unit/s), for the
-    virtual-power answer."""
-    import numpy as np
-
-    d = frame.drawing
-    k = metre(frame.length_unit)
-    n_pos = len(next(iter(pos.values()))[0])
-    motion = _body_motion(frame, pos, vel, acc)
-    zeros = {j: (np.zeros(n_pos), np.zeros(n_pos)) for j in pos}
-    star = _body_motion(frame, pos, vstar, zeros)
-    moving = [b for b in d.bodies if b != "ground"]
-    row = {b: 3 * i for i, b in enumerate(moving)}
-    cols: list[tuple[str, Any]] = []  # what each unknown is
-    entries: list[tuple[int, int, Any]] = []
-
-    def add_force(body: str, at: tuple[Any, Any], cx: int, cy: int, sign: float = 1.0) -> None:
-        if body == "ground":
-            return
-        r = row[body]
-        entries.extend([(r, cx, sign), (r + 2, cx, -sign * at[1]),
-                        (r + 1, cy, sign), (r + 2, cy, sign * at[0])])
-
-    for j, first, b in pin_pairs(d):
-        cx, cy = len(cols), len(cols) + 1
-        cols += [("pin", (j, b, first)), ("pin_y", None)]
-        add_force(b, pos[j], cx, cy)
-        add_force(first, pos[j], cx, cy, sign=-1.0)
-    line_dirs: dict[str, tuple[Any, Any]] = {}
-    for s, slide in d.sliders.items():
-        at = pos[d.bodies[s][0]]
-        t = math.radians(slide.angle_deg) + motion[slide.on][0]
-        u = (np.cos(t), np.sin(t))
-        n = (-u[1], u[0])
-        line_dirs[s] = u
-        cn, cm = len(cols), len(cols) + 1
-        cols += [("slider", (s, slide.on)), ("slider_m", None)]
-        for body, sign in ((s, 1.0), (slide.on, -1.0)):
-            if body != "ground":
-                r = row[body]
-                entries.extend([(r, cn, sign * n[0]), (r + 1, cn, sign * n[1]),
-                                (r + 2, cn, sign * _cross(at, n)), (r + 2, cm, sign)])
-    ci = len(cols)
-    cols.append(("input", None))
-    if frame.driver_slider is not None:
-        s = frame.driver_slider
-        at, u = pos[d.bodies[s][0]], line_dirs[s]
-        for body, sign in ((s, 1.0), (d.sliders[s].on, -1.0)):
-            if body != "ground":
-                r = row[body]
-                entries.extend([(r, ci, sign * u[0]), (r + 1, ci, sign * u[1]),
-                                (r + 2, ci, sign * _cross(at, u))])
-        input_unit = "N"
-    else:
-        entries.append((row[frame.driver_link] + 2, ci, 1.0))
-        input_unit = "N m"
-    n_eq, n_un = 3 * len(moving), len(cols)
-    if n_eq != n_un:
-        raise InputError(f"{source}: {n_eq} equilibrium equations but {n_un} unknown forces: the matrix "
-                         "method needs a mobility-1 mechanism of pins and sliders")
-    a = np.zeros((n_pos, n_eq, n_un))
-    for r, c, v in entries:
-        a[:, r, c] += v
-    # the right-hand side: minus the known loads (external, gravity, inertia) on each body
-    rhs = np.zeros((n_pos, n_eq))
-    power = np.zeros(n_pos)  # the known loads' virtual power, for the independent answer
-    applied = [np.zeros(n_pos), np.zeros(n_pos), np.zeros(n_pos)]
-
-    def known(body: str, at: tuple[Any, Any], f: tuple[Any, Any], moment: Any, v_at: tuple[Any, Any]) -> None:
-        nonlocal power
-        power = power + f[0] * v_at[0] + f[1] * v_at[1] + moment * star[body][1]
-        m_at = _cross(at, f) + moment
-        applied[0] += f[0]
-        applied[1] += f[1]
-        applied[2] += m_at
-        if body != "ground":
-            r = row[body]
-            rhs[:, r] -= f[0]
-            rhs[:, r + 1] -= f[1]
-            rhs[:, r + 2] -= m_at
-
-    origin = (np.zeros(n_pos), np.zeros(n_pos))
-    for j, f in loads.forces.items():
-        known(load_link(d, j, loads.on.get(j)), pos[j], f, 0.0, vstar[j])
-    for b, t in loads.torques.items():
-        known(b, origin, (0.0, 0.0), t, origin)
-    g = loads.gravity
-    for b, mass in loads.masses.items():
-        cg, _, ag = cg_motion(d, b, mass, k, pos, acc, acc, motion[b])
-        _, vg, _ = cg_motion(d, b, mass, k, pos, vstar, vstar, star[b])
-        al = motion[b][2]
-        known(b, cg, (-mass.mass * ag[0], -mass.mass * ag[1]), -mass.inertia * al, vg)
-        if g is not None:
-            known(b, cg, (mass.mass * g[0], mass.mass * g[1]), 0.0, vg)
-    # in the mechanism's own size: moments per metre of it, torques as forces at that arm, so
-    # the condition number (the near-toggle test) is the same in mm, in m or in miles
-    size = np.broadcast_to(np.asarray(frame.size, dtype=float), (n_pos,))[:, None]
-    couples = [i for i, (kind, _) in enumerate(cols)
-               if kind == "slider_m" or (kind == "input" and frame.driver_slider is None)]
-    a[:, 2::3, :] /= size[:, :, None]
-    rhs[:, 2::3] /= size
-    a[:, :, couples] *= size[:, :, None]
-    cond, inv = condition_np(a)
-    good = np.isfinite(cond) & (cond * EPS < 0.5)
-    x = np.full((n_pos, n_un), np.nan)
-    if good.any():
-        x[good] = np.einsum("pij,pj->pi", inv[good], rhs[good])
-    x[:, couples] *= size
-    # the unit driver speed's own size: rad/s, or the length unit per second in m/s
-    vp = -power / (1.0 if frame.driver_slider is None else k)
-    pins, sliders = [], []
-    gx, gy, gm = np.zeros(n_pos), np.zeros(n_pos), np.zeros(n_pos)
-    for i, (kind, what) in enumerate(cols):
-        if kind == "pin":
-            j, on, by = what
-            fx, fy = x[:, i], x[:, i + 1]
-            pins.append((j, on, by, fx, fy))
-            if by == "ground":
-                gx, gy, gm = gx - fx, gy - fy, gm - _cross(pos[j], (fx, fy))
-        elif kind == "slider":
-            s, on = what
-            nn, mm = x[:, i], x[:, i + 1]
-            sliders.append((s, on, nn, mm))
-            if on == "ground":
-                u = line_dirs[s]
-                f = (-u[1] * nn, u[0] * nn)
-                gx, gy, gm = gx - f[0], gy - f[1], gm - _cross(pos[d.bodies[s][0]], f) - mm
-    inp = x[:, ci]
-    if frame.driver_slider is None:
-        gm = gm - inp
-    elif d.sliders[frame.driver_slider].on == "ground":
-        s = frame.driver_slider
-        u = line_dirs[s]
-        f = (u[0] * inp, u[1] * inp)
-        gx, gy, gm = gx - f[0], gy - f[1], gm - _cross(pos[d.bodies[s][0]], f)
-    return ForceArrays(inp, input_unit, tuple(pins), tuple(sliders), (gx, gy, gm), vp, cond,
-                       (applied[0], applied[1], applied[2]))
-
-
-def condition_np(a: Any) -> tuple[Any, Any]:
-    """Each matrix's condition number in the 1-norm, ||A|| ||A^-1|| (inf where A is
-    singular), and A^-1 (NaN there): an LU inverse costs a fraction of the SVD that the
-    2-norm's needs, and bounds the same error (within a factor of the matrix's size)."""
-    import numpy as np
-
-    from .rates import inverse_np
-
-    inv, usable = inverse_np(a)
-    cond = np.full(a.shape[:-2], np.inf)
-    with np.errstate(over="ignore", invalid="ignore"):
-        cond[usable] = (np.abs(a[usable]).sum(axis=-2).max(axis=-1) *
-                        np.abs(inv[usable]).sum(axis=-2).max(axis=-1))
-    cond[~np.isfinite(cond)] = np.inf
-    return cond, inv
-
-
 def _arrays(points: Mapping[str, tuple[float, float]], k: float) -> dict[str, tuple[Any, Any]]:
     import numpy as np
 
@@ -400,18 +141,29 @@ def forces_at(
     return judged(frame, actual, unit, loads, mechanism.source)
 
 
-def per_unit_speed(actual: Any, speed: float) -> Any:
-    """The velocities of a unit driver speed from those at ``speed`` (they are linear in
-    it, and so are their bounds): ``actual`` with its velocities and velocity bounds divided
-    by the speed, or None where there is no speed to divide by (then they are computed)."""
+def speed_usable(speed: float | None) -> bool:
+    """Whether velocities at ``speed`` can be divided by it (:func:`per_unit_speed`)."""
+    return speed is not None and 1e-100 < abs(speed) < 1e100
+
+
+def scaled_to_unit_speed(actual: Any, speed: float) -> Any:
+    """``actual`` (rates at ``speed``: one position's Rates or a block's RateBlock) with its
+    joint velocities and their bounds divided by the speed: they are linear in it."""
     from dataclasses import replace
 
-    if not 1e-100 < abs(speed) < 1e100 or actual.status == "undefined" or not actual.joint_velocities:
-        return None
     k = 1.0 / speed
     velocities = {j: (v[0] * k, v[1] * k) for j, v in actual.joint_velocities.items()}
     bounds = {j: b * abs(k) for j, b in actual.joint_velocity_bounds.items()}
     return replace(actual, joint_velocities=velocities, joint_velocity_bounds=bounds)
+
+
+def per_unit_speed(actual: Any, speed: float) -> Any:
+    """The velocities of a unit driver speed from those at ``speed``
+    (:func:`scaled_to_unit_speed`), or None where there is no speed to divide by (then they
+    are computed)."""
+    if not speed_usable(speed) or actual.status == "undefined" or not actual.joint_velocities:
+        return None
+    return scaled_to_unit_speed(actual, speed)
 
 
 def judged(frame: Frame, actual: Any, unit: Any, loads: Loads, source: str) -> Forces:
@@ -448,6 +200,21 @@ def kinematic_bound(unit: Any) -> float:
     if vmax > 0.0 and unit.joint_velocity_bounds:
         return max(unit.joint_velocity_bounds.values()) / vmax
     return 0.0
+
+
+def kinematic_bound_np(unit: Any) -> Any:
+    """:func:`kinematic_bound` of each position of a block of unit-speed rates
+    (kinematics.rate_blocks.RateBlock)."""
+    import numpy as np
+
+    n = len(unit.status)
+    speeds = [np.hypot(x, y) for x, y in unit.joint_velocities.values()]
+    vmax = np.maximum.reduce(speeds) if speeds else np.zeros(n)
+    if not unit.joint_velocity_bounds:
+        return np.zeros(n)
+    top = np.maximum.reduce(list(unit.joint_velocity_bounds.values()))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(vmax > 0.0, top / vmax, 0.0)
 
 
 def force_status(cond: float, bound: float, kinematics_ok: bool) -> str:

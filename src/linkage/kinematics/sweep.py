@@ -136,7 +136,7 @@ def sweep_mechanism(
                    max_iter=max_iter, progress=progress)
     if speed is None and not joints:
         return result
-    from .rates import with_rates  # here: a sweep without rates does not load them
+    from .rate_blocks import with_rates  # here: a sweep without rates does not load them
 
     return with_rates(m, result, speed, accel)
 
@@ -179,7 +179,7 @@ def check_branch(m: Mechanism, branch: str) -> None:
 
 def __getattr__(name: str) -> Any:
     if name == "with_rates":  # still importable from here, loaded when first asked for
-        from .rates import with_rates
+        from .rate_blocks import with_rates
 
         return with_rates
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

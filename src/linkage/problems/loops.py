@@ -290,7 +290,7 @@ class LoopModel:
     drawn: dict[str, tuple[float, float]] = field(default_factory=dict)
     """Joints that do not move, each exactly where it was drawn: a drawing's fixed joints,
     while the ground's lengths and angles are the drawn ones (:func:`drawn_ground`). The
-    placing rule (kinematics.rates._walk) reports them as drawn, not as the sum of
+    placing rule (kinematics.placing.walk) reports them as drawn, not as the sum of
     vectors that reaches them (a pivot drawn at 45.0 came out 44.99999999999999)."""
 
     @classmethod

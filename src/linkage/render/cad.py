@@ -154,7 +154,7 @@ def sheet(mechanism: Any, q: Sequence[float], sweep: Any = None, sweep_note: str
     """The sheet of ``mechanism`` at the unknowns ``q`` (internal units) and its file's
     driver value; ``sweep``: a sweep with joints (``linkage.sweep(..., joints=True)``)
     whose positions give the coupler curves and the sliders' travel."""
-    from ..kinematics.rates import place
+    from ..kinematics.placing import place
 
     placed = {k: (v[0].real, v[0].imag) for k, v in place(mechanism.model, q, mechanism.driver.value).items()}
     drawing = _drawing(mechanism)

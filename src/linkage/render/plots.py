@@ -276,7 +276,7 @@ def _named_points(mechanism: Any, q: Sequence[float], driver: float) -> dict[str
     """Each named point with the joint it hangs from: name -> (joint, point)."""
     if not mechanism.points:
         return {}
-    from ..kinematics.rates import place
+    from ..kinematics.placing import place
 
     placed = place(mechanism.model, q, driver)
     return {name: (placed[origin][0], placed[name][0]) for name, (origin, _) in mechanism.points.items()}

@@ -87,8 +87,11 @@ class RateCells:
         """Rows ``start:stop``, one list per column."""
         if self._last[:2] != (start, stop):
             self._last = (-1, -1, [])
-            rows = [rate_cells(self.rates[i], self.names, self.joints, True) for i in range(start, stop)]
-            cols = [list(v) for v in zip(*rows)] if rows else [[] for _ in range(self.width)]
+            if hasattr(self.rates, "block") and stop > start:  # a batch's: the cells as arrays
+                cols = rate_cells(self.rates.block(start, stop), self.names, self.joints, True)
+            else:
+                rows = [rate_cells(self.rates[i], self.names, self.joints, True) for i in range(start, stop)]
+                cols = [list(v) for v in zip(*rows)] if rows else [[] for _ in range(self.width)]
             self._last = (start, stop, cols)
         return self._last[2]
 

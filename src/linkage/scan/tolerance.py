@@ -371,7 +371,8 @@ def sensitivities(m: Mechanism, plan: Plan, values: np.ndarray, q: np.ndarray, s
                   ) -> tuple[np.ndarray, np.ndarray]:
     """(sensitivity (outputs, tolerances, positions), J invertible per position) at the
     nominal solutions ``q`` (positions, unknowns; internal units)."""
-    from ..kinematics.rates import place_motion_np, solve_rates_np
+    from ..kinematics.placing import place_motion_np
+    from ..kinematics.rates import solve_rates_np
 
     outs = outputs_of(m)
     k = len(values)

@@ -1,0 +1,345 @@
+"""The matrix method (:func:`solve_loads`): every position's equilibrium equations of
+every moving link, assembled and solved at once, over arrays of positions; and the motion
+of each body and centre of mass that the inertia loads need (:func:`body_motion`,
+:func:`cg_motion`). The method and its check by virtual power are described in
+:mod:`.forces`, which judges the answers.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+from ..errors import InputError
+from ..problems.loads import Loads, load_link
+from ..units import radians
+from .bodies import Frame, metre
+
+EPS = sys.float_info.epsilon
+
+
+def body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], acc: Mapping[str, Any]
+                 ) -> dict[str, tuple[Any, Any, Any]]:
+    """Each body's (rotation since the drawing, omega, alpha), arrays over the positions:
+    from two of its joints, a one-joint block from the body its line is on; the ground's
+    all zero."""
+    import numpy as np
+
+    d = frame.drawing
+    zero = np.zeros_like(next(iter(pos.values()))[0])
+    out: dict[str, tuple[Any, Any, Any]] = {"ground": (zero, zero, zero)}
+    pending = []
+    for body, joints in d.bodies.items():
+        if body == "ground":
+            continue
+        pair = two_apart(d, joints)
+        if pair is None:
+            pending.append(body)
+            continue
+        j0, j1 = pair
+        rx, ry = pos[j1][0] - pos[j0][0], pos[j1][1] - pos[j0][1]
+        r2 = rx * rx + ry * ry
+        dvx, dvy = vel[j1][0] - vel[j0][0], vel[j1][1] - vel[j0][1]
+        dax, day = acc[j1][0] - acc[j0][0], acc[j1][1] - acc[j0][1]
+        drawn = math.atan2(d.xy[j1][1] - d.xy[j0][1], d.xy[j1][0] - d.xy[j0][0])
+        out[body] = (np.arctan2(ry, rx) - drawn, (rx * dvy - ry * dvx) / r2, (rx * day - ry * dax) / r2)
+    for body in pending:
+        slide = d.sliders.get(body)
+        out[body] = out.get(slide.on, out["ground"]) if slide is not None else out["ground"]
+    return out
+
+
+def cg_motion(d: Any, body: str, mass: Any, k: float, pos: Mapping[str, Any], vel: Mapping[str, Any],
+              acc: Mapping[str, Any], motion: tuple[Any, Any, Any]) -> tuple[Any, Any, Any]:
+    """The one rule for a link's centre of mass (``mass.cg``, drawn in the file's unit, ``k``
+    m per unit): its position, velocity and acceleration, each (x, y) in SI, from the
+    link's centre joint's (``pos``, ``vel``, ``acc``, m, m/s, m/s^2) and the link's
+    (rotation since the drawing, omega, alpha) (:func:`body_motion`): r_G = r_0 + R rel,
+    v_G = v_0 + omega x rel, a_G = a_0 + alpha x rel - omega^2 rel. Floats or arrays."""
+    import numpy as np
+
+    j0 = d.center(body)
+    rot, w, al = motion
+    dx, dy = (mass.cg[0] - d.xy[j0][0]) * k, (mass.cg[1] - d.xy[j0][1]) * k
+    c, s = np.cos(rot), np.sin(rot)
+    rel = (c * dx - s * dy, s * dx + c * dy)
+    cg = (pos[j0][0] + rel[0], pos[j0][1] + rel[1])
+    vg = (vel[j0][0] - w * rel[1], vel[j0][1] + w * rel[0])
+    ag = (acc[j0][0] - al * rel[1] - w * w * rel[0], acc[j0][1] + al * rel[0] - w * w * rel[1])
+    return cg, vg, ag
+
+
+def two_apart(d: Any, joints: Sequence[str]) -> tuple[str, str] | None:
+    for i, a in enumerate(joints):
+        for b in joints[i + 1:]:
+            if d.xy[a] != d.xy[b]:
+                return a, b
+    return None
+
+
+def cross(r: tuple[Any, Any], f: tuple[Any, Any]) -> Any:
+    return r[0] * f[1] - r[1] * f[0]
+
+
+@dataclass(frozen=True)
+class ForceArrays:
+    """The matrix method over N positions at once (arrays of shape (N,), NaN where the
+    force matrix is singular)."""
+
+    input: Any
+    input_unit: str
+    pins: tuple[tuple[str, str, str, Any, Any], ...]
+    """(joint, on, by, fx, fy) per pin force."""
+    sliders: tuple[tuple[str, str, Any, Any], ...]
+    ground: tuple[Any, Any, Any]
+    virtual_power_input: Any
+    condition: Any
+    applied: tuple[Any, Any, Any]
+
+
+def pin_pairs(d: Any) -> list[tuple[str, str, str]]:
+    """The one rule for what a pin joins: (joint, owner, link) for each link on a joint that
+    two or more bodies share, other than its owner (the ground where the pin is fixed,
+    else the first body listing it); a pin shared by k bodies is k - 1 pairs."""
+    out = []
+    for j in d.xy:
+        on = [b for b, js in d.bodies.items() if j in js]
+        if len(on) < 2:
+            continue
+        first = "ground" if "ground" in on else on[0]
+        out += [(j, first, b) for b in on if b != first]
+    return out
+
+
+class Unknowns(NamedTuple):
+    """The matrix method's unknowns and its equilibrium matrix's entries (:func:`assemble`)."""
+
+    cols: list[tuple[str, Any]]
+    """What each unknown is: ("pin", (joint, on, by)), "pin_y", ("slider", (slider, on)),
+    "slider_m", "input"."""
+    entries: list[tuple[int, int, Any]]
+    """(row, column, value) of each entry, summed (values: numbers or arrays)."""
+    line_dirs: dict[str, tuple[Any, Any]]
+    """Each slider's line direction (cos, sin) at every position."""
+    input_col: int
+    input_unit: str
+
+
+def assemble(frame: Frame, pos: Mapping[str, tuple[Any, Any]], motion: Mapping[str, Any],
+             row: Mapping[str, int]) -> Unknowns:
+    """The equilibrium equations' left-hand side: each pin's reaction (x, y), each slider's
+    normal force and couple, and the driver's torque or force, on each moving body's three
+    rows (``row``: its first)."""
+    import numpy as np
+
+    d = frame.drawing
+    cols: list[tuple[str, Any]] = []
+    entries: list[tuple[int, int, Any]] = []
+
+    def add_force(body: str, at: tuple[Any, Any], cx: int, cy: int, sign: float = 1.0) -> None:
+        if body == "ground":
+            return
+        r = row[body]
+        entries.extend([(r, cx, sign), (r + 2, cx, -sign * at[1]),
+                        (r + 1, cy, sign), (r + 2, cy, sign * at[0])])
+
+    for j, first, b in pin_pairs(d):
+        cx, cy = len(cols), len(cols) + 1
+        cols += [("pin", (j, b, first)), ("pin_y", None)]
+        add_force(b, pos[j], cx, cy)
+        add_force(first, pos[j], cx, cy, sign=-1.0)
+    line_dirs: dict[str, tuple[Any, Any]] = {}
+    for s, slide in d.sliders.items():
+        at = pos[d.bodies[s][0]]
+        t = radians(slide.angle_deg) + motion[slide.on][0]
+        u = (np.cos(t), np.sin(t))
+        n = (-u[1], u[0])
+        line_dirs[s] = u
+        cn, cm = len(cols), len(cols) + 1
+        cols += [("slider", (s, slide.on)), ("slider_m", None)]
+        for body, sign in ((s, 1.0), (slide.on, -1.0)):
+            if body != "ground":
+                r = row[body]
+                entries.extend([(r, cn, sign * n[0]), (r + 1, cn, sign * n[1]),
+                                (r + 2, cn, sign * cross(at, n)), (r + 2, cm, sign)])
+    ci = len(cols)
+    cols.append(("input", None))
+    if frame.driver_slider is not None:
+        s = frame.driver_slider
+        at, u = pos[d.bodies[s][0]], line_dirs[s]
+        for body, sign in ((s, 1.0), (d.sliders[s].on, -1.0)):
+            if body != "ground":
+                r = row[body]
+                entries.extend([(r, ci, sign * u[0]), (r + 1, ci, sign * u[1]),
+                                (r + 2, ci, sign * cross(at, u))])
+        return Unknowns(cols, entries, line_dirs, ci, "N")
+    entries.append((row[frame.driver_link] + 2, ci, 1.0))
+    return Unknowns(cols, entries, line_dirs, ci, "N m")
+
+
+class KnownLoads(NamedTuple):
+    """The equations' right-hand side: minus the known loads (external, gravity, inertia)
+    on each body; their virtual power at a unit driver speed (the independent answer's
+    numerator); their total force x, y and moment."""
+
+    rhs: Any
+    power: Any
+    applied: tuple[Any, Any, Any]
+
+
+def known_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], acc: Mapping[str, tuple[Any, Any]],
+                vstar: Mapping[str, tuple[Any, Any]], motion: Mapping[str, Any], star: Mapping[str, Any],
+                loads: Loads, row: Mapping[str, int], n_eq: int) -> KnownLoads:
+    """Every known load at every position (d'Alembert's inertia loads at each centre of
+    mass by :func:`cg_motion`), with its virtual power at the unit-speed velocities
+    ``vstar`` (``star``: the bodies' motion at them)."""
+    import numpy as np
+
+    d = frame.drawing
+    k = metre(frame.length_unit)
+    n_pos = len(next(iter(pos.values()))[0])
+    rhs = np.zeros((n_pos, n_eq))
+    power = np.zeros(n_pos)
+    applied = [np.zeros(n_pos), np.zeros(n_pos), np.zeros(n_pos)]
+
+    def known(body: str, at: tuple[Any, Any], f: tuple[Any, Any], moment: Any, v_at: tuple[Any, Any]) -> None:
+        nonlocal power
+        power = power + f[0] * v_at[0] + f[1] * v_at[1] + moment * star[body][1]
+        m_at = cross(at, f) + moment
+        applied[0] += f[0]
+        applied[1] += f[1]
+        applied[2] += m_at
+        if body != "ground":
+            r = row[body]
+            rhs[:, r] -= f[0]
+            rhs[:, r + 1] -= f[1]
+            rhs[:, r + 2] -= m_at
+
+    origin = (np.zeros(n_pos), np.zeros(n_pos))
+    for j, f in loads.forces.items():
+        known(load_link(d, j, loads.on.get(j)), pos[j], f, 0.0, vstar[j])
+    for b, t in loads.torques.items():
+        known(b, origin, (0.0, 0.0), t, origin)
+    g = loads.gravity
+    for b, mass in loads.masses.items():
+        cg, _, ag = cg_motion(d, b, mass, k, pos, acc, acc, motion[b])
+        _, vg, _ = cg_motion(d, b, mass, k, pos, vstar, vstar, star[b])
+        al = motion[b][2]
+        known(b, cg, (-mass.mass * ag[0], -mass.mass * ag[1]), -mass.inertia * al, vg)
+        if g is not None:
+            known(b, cg, (mass.mass * g[0], mass.mass * g[1]), 0.0, vg)
+    return KnownLoads(rhs, power, (applied[0], applied[1], applied[2]))
+
+
+def solve_scaled(frame: Frame, a: Any, rhs: Any, cols: Sequence[tuple[str, Any]]) -> tuple[Any, Any]:
+    """(the unknowns, the condition number) of each position's system, solved in the
+    mechanism's own size: moments per metre of it, torques as forces at that arm, so the
+    condition number (the near-toggle test) is the same in mm, in m or in miles. NaN where
+    the matrix is singular to working precision."""
+    import numpy as np
+
+    n_pos, _, n_un = a.shape
+    size = np.broadcast_to(np.asarray(frame.size, dtype=float), (n_pos,))[:, None]
+    couples = [i for i, (kind, _) in enumerate(cols)
+               if kind == "slider_m" or (kind == "input" and frame.driver_slider is None)]
+    a[:, 2::3, :] /= size[:, :, None]
+    rhs[:, 2::3] /= size
+    a[:, :, couples] *= size[:, :, None]
+    cond, inv = condition_np(a)
+    good = np.isfinite(cond) & (cond * EPS < 0.5)
+    x = np.full((n_pos, n_un), np.nan)
+    if good.any():
+        x[good] = np.einsum("pij,pj->pi", inv[good], rhs[good])
+    x[:, couples] *= size
+    return x, cond
+
+
+def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[str, tuple[Any, Any]],
+                acc: Mapping[str, tuple[Any, Any]], vstar: Mapping[str, tuple[Any, Any]], loads: Loads,
+                source: str = "<mechanism>") -> ForceArrays:
+    """The one definition of the matrix method: every position's system assembled
+    (:func:`assemble`, :func:`known_loads`) and solved (:func:`solve_scaled`) at once.
+    ``pos``, ``vel``, ``acc``: each joint's (x, y) arrays in m, m/s, m/s^2; ``vstar`` its
+    velocity at a unit driver speed (m/s per rad/s, or per unit/s), for the virtual-power
+    answer."""
+    import numpy as np
+
+    d = frame.drawing
+    n_pos = len(next(iter(pos.values()))[0])
+    motion = body_motion(frame, pos, vel, acc)
+    zeros = {j: (np.zeros(n_pos), np.zeros(n_pos)) for j in pos}
+    star = body_motion(frame, pos, vstar, zeros)
+    moving = [b for b in d.bodies if b != "ground"]
+    row = {b: 3 * i for i, b in enumerate(moving)}
+    unknowns = assemble(frame, pos, motion, row)
+    n_eq, n_un = 3 * len(moving), len(unknowns.cols)
+    if n_eq != n_un:
+        raise InputError(f"{source}: {n_eq} equilibrium equations but {n_un} unknown forces: the matrix "
+                         "method needs a mobility-1 mechanism of pins and sliders")
+    a = np.zeros((n_pos, n_eq, n_un))
+    for r, c, v in unknowns.entries:
+        a[:, r, c] += v
+    known = known_loads(frame, pos, acc, vstar, motion, star, loads, row, n_eq)
+    x, cond = solve_scaled(frame, a, known.rhs, unknowns.cols)
+    # the unit driver speed's own size: rad/s, or the length unit per second in m/s
+    vp = -known.power / (1.0 if frame.driver_slider is None else metre(frame.length_unit))
+    pins, sliders, ground = reactions(frame, pos, unknowns, x)
+    return ForceArrays(x[:, unknowns.input_col], unknowns.input_unit, pins, sliders, ground, vp, cond,
+                       known.applied)
+
+
+def reactions(frame: Frame, pos: Mapping[str, tuple[Any, Any]], unknowns: Unknowns, x: Any
+              ) -> tuple[tuple[Any, ...], tuple[Any, ...], tuple[Any, Any, Any]]:
+    """The solved unknowns read out: each pin's force (joint, on, by, fx, fy), each slider's
+    (slider, on, normal, couple), and the force and moment on the ground (the reactions of
+    its pins, its sliders' lines and the driver's, reversed)."""
+    import numpy as np
+
+    d = frame.drawing
+    n_pos = x.shape[0]
+    pins, sliders = [], []
+    gx, gy, gm = np.zeros(n_pos), np.zeros(n_pos), np.zeros(n_pos)
+    for i, (kind, what) in enumerate(unknowns.cols):
+        if kind == "pin":
+            j, on, by = what
+            fx, fy = x[:, i], x[:, i + 1]
+            pins.append((j, on, by, fx, fy))
+            if by == "ground":
+                gx, gy, gm = gx - fx, gy - fy, gm - cross(pos[j], (fx, fy))
+        elif kind == "slider":
+            s, on = what
+            nn, mm = x[:, i], x[:, i + 1]
+            sliders.append((s, on, nn, mm))
+            if on == "ground":
+                u = unknowns.line_dirs[s]
+                f = (-u[1] * nn, u[0] * nn)
+                gx, gy, gm = gx - f[0], gy - f[1], gm - cross(pos[d.bodies[s][0]], f) - mm
+    inp = x[:, unknowns.input_col]
+    if frame.driver_slider is None:
+        gm = gm - inp
+    elif d.sliders[frame.driver_slider].on == "ground":
+        s = frame.driver_slider
+        u = unknowns.line_dirs[s]
+        f = (u[0] * inp, u[1] * inp)
+        gx, gy, gm = gx - f[0], gy - f[1], gm - cross(pos[d.bodies[s][0]], f)
+    return tuple(pins), tuple(sliders), (gx, gy, gm)
+
+
+def condition_np(a: Any) -> tuple[Any, Any]:
+    """Each matrix's condition number in the 1-norm, ||A|| ||A^-1|| (inf where A is
+    singular), and A^-1 (NaN there): an LU inverse costs a fraction of the SVD that the
+    2-norm's needs, and bounds the same error (within a factor of the matrix's size)."""
+    import numpy as np
+
+    from .rate_bounds import inverse_np
+
+    inv, usable = inverse_np(a)
+    cond = np.full(a.shape[:-2], np.inf)
+    with np.errstate(over="ignore", invalid="ignore"):
+        cond[usable] = (np.abs(a[usable]).sum(axis=-2).max(axis=-1) *
+                        np.abs(inv[usable]).sum(axis=-2).max(axis=-1))
+    cond[~np.isfinite(cond)] = np.inf
+    return cond, inv
