@@ -1,0 +1,304 @@
+"""Issue 33's speed targets, every row of its table, each a ratio of two timings taken in
+this run as interleaved pairs (:func:`.timing.interleaved_pairs`): the library through its
+public API or its command line against the same work written by hand (:mod:`.hand`).
+
+Rows whose runs take seconds (whole command-line processes, a million positions) are
+``long``: measured with ``linkage bench --full``, listed as not measured otherwise.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .processes import FLOOR, ProcessFailed, cold_commands, linkage_command, python_command, runner
+from .timing import Pairs, interleaved_pairs
+
+Target = tuple[str, str, "float | None", "bool | None"]
+"""(target, comparison, measured ratio, met): None where this run could not judge it."""
+
+
+@dataclass(frozen=True)
+class Row:
+    """One target: ``name`` as issue 33's table names the measure, met when the ratio is at
+    most ``bound`` (at least, where ``at_least``); ``part`` tells two targets of one
+    measure apart (the cold starts of solve and sweep)."""
+
+    name: str
+    comparison: str
+    bound: float
+    at_least: bool = False
+    long: bool = False
+    cold: bool = False
+    """A cold start: not measured with ``--no-cold``."""
+    part: str = ""
+
+    @property
+    def label(self) -> str:
+        part = f" ({self.part})" if self.part else ""
+        return f"{self.name}{part}: {'>=' if self.at_least else '<='} {self.bound:g}x"
+
+    def met(self, ratio: float) -> bool:
+        return ratio >= self.bound if self.at_least else ratio <= self.bound
+
+
+ROWS = (
+    Row("scalar Newton, history off / hand loop", "linkage / hand", 2.0),
+    Row("scalar Newton, history on / hand loop", "linkage / hand", 3.0),
+    Row("system Newton off / hand 2x2", "linkage / hand", 2.0),
+    Row("scipy hybr / ours", "scipy / linkage", 3.0, at_least=True),
+    Row("361-position linkage.sweep / numpy closed form", "linkage / numpy", 3.0),
+    Row("10^6 positions / the same numpy closed form, written tight", "linkage / numpy", 1.5, long=True),
+    Row("360,001 positions to CSV, CLI / API process", "cli / api", 2.0, long=True),
+    Row("the same to parquet", "cli / api", 1.5, long=True),
+    Row("36,001 positions to CSV with --speed 10 / without (rates, joint velocities)",
+        "with / without", 2.0, long=True),
+    Row("loaded scan / a hand-written numpy 9x9 batched solve", "linkage / hand", 1.5, long=True),
+    Row("synthesize --search / hand numpy, one thread", "cli / hand", 1.2, long=True),
+    Row("cold start solve, sweep / import rich.table", "linkage / import", 1.5, cold=True, part="solve"),
+    Row("cold start solve, sweep / import rich.table", "linkage / import", 1.8, cold=True, part="sweep"),
+)
+"""In the order of issue 33's table."""
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How hard to measure: ``repeats`` pairs, in-process batches of about ``budget`` s."""
+
+    repeats: int
+    budget: float
+    work: Path
+    """A scratch directory for the files the commands write."""
+
+
+class Skipped(Exception):
+    """This run cannot measure the row (an optional package is missing); the reason."""
+
+
+Measure = Callable[[Settings], Pairs]
+
+
+def tolerance() -> float:
+    """The tolerance the solver rows are compared at (issue 10's targets: 1e-12)."""
+    return 1e-12
+
+
+def scalar_newton(record: bool) -> Measure:
+    def measure(s: Settings) -> Pairs:
+        import linkage
+
+        from .hand import hand_newton
+        from .precision import scalar_problem
+
+        spec = scalar_problem("freudenstein")
+        p, x0, tol = spec["problem"], spec["x0"], tolerance()
+        return interleaved_pairs(
+            lambda: linkage.solve_scalar(p, method="newton", x0=x0, tol=tol, record=record),
+            lambda: hand_newton(p.f, p.fprime, x0, tol), s.repeats, s.budget)
+
+    return measure
+
+
+def fourbar_system() -> tuple[Any, tuple[float, ...]]:
+    from .precision import system_problem
+
+    spec = system_problem("fourbar")
+    return spec["problem"], tuple(float(v) for v in spec["x0"])
+
+
+def system_newton(s: Settings) -> Pairs:
+    """User callables F and J, as the hand loop gets them."""
+    import linkage
+
+    from .hand import hand_newton_2x2
+
+    p, x0 = fourbar_system()
+    tol = tolerance()
+    return interleaved_pairs(
+        lambda: linkage.solve_system(p.F, x0, jac=p.J, tol=tol, max_iter=100, record=False),
+        lambda: hand_newton_2x2(p.F, p.J, x0, tol), s.repeats, s.budget)
+
+
+def scipy_hybr(s: Settings) -> Pairs:
+    try:
+        from scipy.optimize import root
+    except ImportError:
+        raise Skipped("scipy is not installed") from None
+    import linkage
+
+    p, x0 = fourbar_system()
+    tol = tolerance()
+    return interleaved_pairs(
+        lambda: root(p.F, x0, jac=p.J, method="hybr", options={"xtol": tol}),
+        lambda: linkage.solve_system(p.F, x0, jac=p.J, tol=tol, max_iter=100, record=False),
+        s.repeats, s.budget)
+
+
+def crank_rocker() -> tuple[Any, tuple[float, float, float, float]]:
+    """crank_rocker.toml (the public API's Mechanism) and its links r1..r4."""
+    import linkage
+
+    from ..samples import sample_path
+
+    m = linkage.load_mechanism(sample_path("crank_rocker.toml"))
+    v = {k: q.value for k, q in m.parameters.items()}
+    return m, (v["r1"], v["r2"], v["r3"], v["r4"])
+
+
+def sweep_against_closed_form(positions: int) -> Measure:
+    """``linkage.sweep`` of crank_rocker.toml over 0..360 deg (the engine it picks) against
+    :func:`.hand.fourbar_open` on the same crank angles."""
+
+    def measure(s: Settings) -> Pairs:
+        import numpy as np
+
+        import linkage
+
+        from ..units import radians
+        from .hand import fourbar_open
+
+        m, links = crank_rocker()
+        grid = np.linspace(0.0, 360.0, positions)
+        values = grid if positions > 1_000 else [float(v) for v in grid]
+        budget = s.budget if positions <= 1_000 else 0.0
+        return interleaved_pairs(lambda: linkage.sweep(m, values),
+                                 lambda: fourbar_open(radians(grid), *links), s.repeats, budget)
+
+    return measure
+
+
+SWEEP_FILE_POSITIONS = 360_001
+"""Issue 20's output rows: crank_rocker.toml over 0..360 step 0.001."""
+
+
+def sweep_to_file(suffix: str) -> Measure:
+    """``linkage sweep crank_rocker.toml --step 0.001 --to 360 -o FILE`` against a process
+    that runs ``linkage.sweep`` of the same positions through the API (and writes nothing)."""
+
+    def measure(s: Settings) -> Pairs:
+        if suffix == "parquet":
+            try:
+                import pyarrow.parquet  # noqa: F401
+            except ImportError:
+                raise Skipped("pyarrow is not installed") from None
+        from ..samples import sample_path
+
+        path = str(sample_path("crank_rocker.toml"))
+        cli = runner(linkage_command("sweep", path, "--step", "0.001", "--to", "360",
+                                     "-o", str(s.work / f"sweep.{suffix}")))
+        api = runner(python_command(
+            f"import linkage; linkage.sweep(linkage.load_mechanism({path!r}), "
+            f"[k * 0.001 for k in range({SWEEP_FILE_POSITIONS})])"))
+        return interleaved_pairs(cli, api, s.repeats)
+
+    return measure
+
+
+def sweep_with_speed(s: Settings) -> Pairs:
+    """36,001 positions of crank_rocker.toml to CSV, with --speed 10 (rates and joint
+    velocities) and without."""
+    from ..samples import sample_path
+
+    path = str(sample_path("crank_rocker.toml"))
+
+    def command(*extra: str) -> Callable[[], None]:
+        return runner(linkage_command("sweep", path, "--step", "0.01", "--to", "360", *extra,
+                                      "-o", str(s.work / f"speed{len(extra)}.csv")))
+
+    return interleaved_pairs(command("--speed", "10"), command(), s.repeats)
+
+
+def cold_start(which: str) -> Measure:
+    """A fresh ``linkage solve`` (its default problem) or ``linkage sweep crank_rocker.toml``
+    against ``python -c "import rich.table"``."""
+
+    def measure(s: Settings) -> Pairs:
+        commands = cold_commands()
+        key = "linkage solve" if which == "solve" else "linkage sweep crank_rocker.toml"
+        return interleaved_pairs(runner(commands[key]), runner(commands[FLOOR]), max(s.repeats, 5))
+
+    return measure
+
+
+def not_yet(reason: str) -> Measure:
+    def measure(s: Settings) -> Pairs:
+        raise Skipped(reason)
+
+    return measure
+
+
+MEASURES: dict[Row, Measure] = dict(zip(ROWS, (
+    scalar_newton(False), scalar_newton(True), system_newton, scipy_hybr,
+    sweep_against_closed_form(361), sweep_against_closed_form(1_000_000),
+    sweep_to_file("csv"), sweep_to_file("parquet"), sweep_with_speed,
+    not_yet("no hand baseline yet"), not_yet("no hand baseline yet"),
+    cold_start("solve"), cold_start("sweep"),
+)))
+"""How each row is measured."""
+
+
+@dataclass(frozen=True)
+class Outcome:
+    row: Row
+    pairs: Pairs | None
+    note: str = ""
+    """Why there are no pairs: skipped (and why), or not measured (long, without --full)."""
+
+    @property
+    def target(self) -> Target:
+        if self.pairs is None:
+            return (self.row.label, f"{self.row.comparison}: {self.note}", None, None)
+        r = self.pairs.ratio
+        a, b = self.pairs.a_median, self.pairs.b_median
+        shown = f"{self.row.comparison}: {seconds(a)} / {seconds(b)}, {len(self.pairs.a)} pairs"
+        return (self.row.label, shown, r, self.row.met(r))
+
+
+def seconds(t: float) -> str:
+    """A median as a person reads it: us, ms or s, three figures."""
+    if t < 1e-3:
+        return f"{t * 1e6:.3g} us"
+    if t < 1.0:
+        return f"{t * 1e3:.3g} ms"
+    return f"{t:.3g} s"
+
+
+@contextmanager
+def settings(repeats: int, budget: float) -> Iterator[Settings]:
+    with tempfile.TemporaryDirectory(prefix="linkage-bench-") as tmp:
+        yield Settings(repeats, budget, Path(tmp))
+
+
+def run_rows(full: bool, repeats: int, budget: float, *, cold: bool = True,
+             progress: Callable[[str], None] | None = None,
+             measures: dict[Row, Measure] | None = None) -> list[Outcome]:
+    """Every row of :data:`ROWS`, measured (the long ones only when ``full``, the cold
+    starts only when ``cold``)."""
+    out = []
+    with settings(repeats, budget) as s:
+        for row, measure in (measures or MEASURES).items():
+            if progress:
+                progress(row.label)
+            if row.long and not full:
+                out.append(Outcome(row, None, "not measured (long: linkage bench --full)"))
+                continue
+            if row.cold and not cold:
+                out.append(Outcome(row, None, "not measured (--no-cold)"))
+                continue
+            try:
+                out.append(Outcome(row, measure(s)))
+            except Skipped as why:
+                out.append(Outcome(row, None, f"skipped: {why}"))
+            except ProcessFailed as failed:
+                out.append(Outcome(row, None, f"failed: {failed}"))
+    return out
+
+
+def cores() -> int:
+    """The cores this process may run on."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
