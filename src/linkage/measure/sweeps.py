@@ -23,18 +23,17 @@ def sweep_times(repeats: int = 5, scan_designs: int | None = None) -> dict[str, 
     interleaved; and the scans of :func:`scan_times` (``scan_designs`` designs; None: not
     run). Each time is of the whole call, the front door's checks and the result
     included."""
-    import linkage
-
     from ..samples import sample_path
     from ..units import radians
+    from . import api
 
-    m = linkage.load_mechanism(sample_path("crank_rocker.toml"))
-    w = linkage.load_mechanism(sample_path("watt_sixbar.toml"))
+    m = api.load_mechanism(sample_path("crank_rocker.toml"))
+    w = api.load_mechanism(sample_path("watt_sixbar.toml"))
     v = {k: q.value for k, q in m.parameters.items()}
     values = [float(k) for k in range(361)]
-    pair: dict[str, Callable[[], Any]] = {"linkage.sweep 361 positions": lambda: linkage.sweep(m, values),
-                                          WATT_CLOSED: lambda: linkage.sweep(w, values),
-                                          WATT_ONE: lambda: linkage.sweep(w, values, batch=False)}
+    pair: dict[str, Callable[[], Any]] = {"linkage.sweep 361 positions": lambda: api.sweep(m, values),
+                                          WATT_CLOSED: lambda: api.sweep(w, values),
+                                          WATT_ONE: lambda: api.sweep(w, values, batch=False)}
     if has_pylinkage():
         import pylinkage as pl
 
@@ -63,14 +62,13 @@ def scan_times(repeats: int, designs: int) -> dict[str, float]:
     """Median seconds of the same scan (r2, r3, r4 sampled; 0..359 deg; in-process, one
     chunk after another) of watt_sixbar.toml and crank_rocker.toml, taken in turn
     (benchmarks/scan.py --sixbar is the same comparison)."""
-    import linkage
-
     from ..samples import sample_path
+    from . import api
 
     vary = {"r2": (20.0, 60.0), "r3": (80.0, 160.0), "r4": (50.0, 120.0)}
     six, four = scan_keys(designs)
     runs = interleaved({
-        key: (lambda f=f: linkage.scan_designs(str(sample_path(f)), vary, samples=designs,
+        key: (lambda f=f: api.scan_designs(str(sample_path(f)), vary, samples=designs,
                                                scheduler="synchronous"))
         for key, f in ((six, "watt_sixbar.toml"), (four, "crank_rocker.toml"))}, max(3, min(5, repeats)))
     return {k: t for k, (t, _, _) in runs.items()}

@@ -90,15 +90,14 @@ def tolerance() -> float:
 
 def scalar_newton(record: bool) -> Measure:
     def measure(s: Settings) -> Pairs:
-        import linkage
-
+        from . import api
         from .hand import hand_newton
         from .precision import scalar_problem
 
         spec = scalar_problem("freudenstein")
         p, x0, tol = spec["problem"], spec["x0"], tolerance()
         return interleaved_pairs(
-            lambda: linkage.solve_scalar(p, method="newton", x0=x0, tol=tol, record=record),
+            lambda: api.solve_scalar(p, method="newton", x0=x0, tol=tol, record=record),
             lambda: hand_newton(p.f, p.fprime, x0, tol), s.repeats, s.budget)
 
     return measure
@@ -113,14 +112,13 @@ def fourbar_system() -> tuple[Any, tuple[float, ...]]:
 
 def system_newton(s: Settings) -> Pairs:
     """User callables F and J, as the hand loop gets them."""
-    import linkage
-
+    from . import api
     from .hand import hand_newton_2x2
 
     p, x0 = fourbar_system()
     tol = tolerance()
     return interleaved_pairs(
-        lambda: linkage.solve_system(p.F, x0, jac=p.J, tol=tol, max_iter=100, record=False),
+        lambda: api.solve_system(p.F, x0, jac=p.J, tol=tol, max_iter=100, record=False),
         lambda: hand_newton_2x2(p.F, p.J, x0, tol), s.repeats, s.budget)
 
 
@@ -129,23 +127,21 @@ def scipy_hybr(s: Settings) -> Pairs:
         from scipy.optimize import root
     except ImportError:
         raise Skipped("scipy is not installed") from None
-    import linkage
-
+    from . import api
     p, x0 = fourbar_system()
     tol = tolerance()
     return interleaved_pairs(
         lambda: root(p.F, x0, jac=p.J, method="hybr", options={"xtol": tol}),
-        lambda: linkage.solve_system(p.F, x0, jac=p.J, tol=tol, max_iter=100, record=False),
+        lambda: api.solve_system(p.F, x0, jac=p.J, tol=tol, max_iter=100, record=False),
         s.repeats, s.budget)
 
 
 def crank_rocker() -> tuple[Any, tuple[float, float, float, float]]:
     """crank_rocker.toml (the public API's Mechanism) and its links r1..r4."""
-    import linkage
-
     from ..samples import sample_path
+    from . import api
 
-    m = linkage.load_mechanism(sample_path("crank_rocker.toml"))
+    m = api.load_mechanism(sample_path("crank_rocker.toml"))
     v = {k: q.value for k, q in m.parameters.items()}
     return m, (v["r1"], v["r2"], v["r3"], v["r4"])
 
@@ -157,16 +153,15 @@ def sweep_against_closed_form(positions: int) -> Measure:
     def measure(s: Settings) -> Pairs:
         import numpy as np
 
-        import linkage
-
         from ..units import radians
+        from . import api
         from .hand import fourbar_open
 
         m, links = crank_rocker()
         grid = np.linspace(0.0, 360.0, positions)
         values = grid if positions > 1_000 else [float(v) for v in grid]
         budget = s.budget if positions <= 1_000 else 0.0
-        return interleaved_pairs(lambda: linkage.sweep(m, values),
+        return interleaved_pairs(lambda: api.sweep(m, values),
                                  lambda: fourbar_open(radians(grid), *links), s.repeats, budget)
 
     return measure
