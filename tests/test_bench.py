@@ -190,3 +190,54 @@ def test_the_hand_baselines_compute_what_the_library_computes():
     spec = system_problem("fourbar")
     got = hand_newton_2x2(spec["problem"].F, spec["problem"].J, spec["x0"], 1e-12)
     assert got == pytest.approx(spec["root"], abs=1e-10)
+
+
+def test_the_hand_loaded_scan_is_the_scans_forces():
+    """The loaded scan row's reference: the same designs' peak input torque, pin force and
+    ground force as linkage.scan_designs gives them (the 9x9 systems written by hand)."""
+    import numpy as np
+
+    from linkage.measure import api
+    from linkage.measure.hand import DrawnFourbar, loaded_scan
+    from linkage.samples import sample_path
+
+    loads = api.Loads(forces={"P": (0.0, -20.0)}, torques={"rocker": -2.0})
+    got = api.scan_designs(str(sample_path("crank_rocker_joints.toml")), {"O4.x": (90.0, 110.0)}, samples=12,
+                           loads=loads, scheduler="synchronous")
+    drawn = DrawnFourbar((34.64101615137755, 20.0), (145.57934415070798, 65.74590015195868), 100.0,
+                         (71.2422462637832, 67.54313782512394))
+    mine = loaded_scan(drawn, got["O4_x"], (0.0, -20.0), -2.0, np.arange(360.0))
+    for column in ("peak_input", "max_pin_force", "max_shaking_force"):
+        assert list(mine[column]) == pytest.approx(list(got[column]), rel=1e-9)
+
+
+def test_the_hand_search_keeps_what_synthesize_search_keeps(cli, tmp_path):
+    """The search row's reference: every candidate `synthesize --search` keeps is kept by
+    hand, with the same max error and smallest transmission angle (the hand search checks
+    assembly and transmission only, so it may keep a few more)."""
+    import csv
+    import math
+
+    import numpy as np
+
+    from linkage.measure.hand import function_search
+
+    out = tmp_path / "search.csv"
+    run = cli("synthesize", "--search", "--function", "log10(x)", "--x", "1:2", "--vary", "alpha0=0:350:6",
+              "--vary", "alpha_span=40:120:3", "--vary", "phi0=0:350:6", "--vary", "phi_span=60:120:3",
+              "--min-transmission", "40", "--top", "100000", "-o", str(out))
+    assert run.code == 0, run.err
+    names = ("alpha0 (deg)", "alpha_span (deg)", "phi0 (deg)", "phi_span (deg)")
+    kept = {tuple(float(r[k]) for k in names): r for r in csv.DictReader(out.open())}
+    grid = np.array([(a, da, p, dp) for a in np.linspace(0, 350, 6) for da in np.linspace(40, 120, 3)
+                     for p in np.linspace(0, 350, 6) for dp in np.linspace(60, 120, 3)])
+    xs = [1.5 - 0.5 * math.cos((2 * j - 1) * math.pi / 6) for j in (1, 2, 3)]
+    gx = np.linspace(1.0, 2.0, 2001)
+    mine = function_search(xs, [math.log10(x) for x in xs], gx, np.log10(gx), grid, 40.0)
+    assert len(kept) > 20
+    for i, c in enumerate(map(tuple, grid)):
+        if c in kept:
+            assert mine["ok"][i]
+            assert mine["max_error_deg"][i] == pytest.approx(float(kept[c]["max_error_deg"]), rel=1e-9)
+            assert mine["min_transmission_deg"][i] == pytest.approx(float(kept[c]["min_transmission_deg"]),
+                                                                    rel=1e-9)

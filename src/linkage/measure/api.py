@@ -5,8 +5,9 @@ one file to change."""
 from __future__ import annotations
 
 from ..kinematics.sweep import sweep_mechanism as sweep
+from ..problems.loads import Loads
 from ..problems.loops import load as load_mechanism
 from ..scan import scan as scan_designs
 from ..solve import solve_scalar, solve_system
 
-__all__ = ["load_mechanism", "scan_designs", "solve_scalar", "solve_system", "sweep"]
+__all__ = ["Loads", "load_mechanism", "scan_designs", "solve_scalar", "solve_system", "sweep"]

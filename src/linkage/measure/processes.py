@@ -38,16 +38,25 @@ class ProcessFailed(RuntimeError):
     """A command that failed is no measurement."""
 
 
-def runner(command: Sequence[str]) -> Callable[[], None]:
+def runner(command: Sequence[str], cpu: list[float] | None = None) -> Callable[[], None]:
     """A call that runs ``command`` to its exit (output discarded) and raises
-    :class:`ProcessFailed` with its last stderr line if it did not exit 0."""
+    :class:`ProcessFailed` with its last stderr line if it did not exit 0; ``cpu`` gets the
+    processor seconds (user and system, every thread) of each run."""
+    import tempfile
+
     env = process_env()
 
     def run() -> None:
-        done = subprocess.run(list(command), capture_output=True, check=False, env=env)
-        if done.returncode != 0:
-            last = (done.stderr.decode(errors="replace").strip().splitlines() or [""])[-1]
-            raise ProcessFailed(f"{' '.join(command[2:])}: exit {done.returncode}: {last}")
+        with tempfile.TemporaryFile() as err:
+            child = subprocess.Popen(list(command), stdout=subprocess.DEVNULL, stderr=err, env=env)
+            _, status, usage = os.wait4(child.pid, 0)
+            child.returncode = os.waitstatus_to_exitcode(status)
+            if cpu is not None:
+                cpu.append(usage.ru_utime + usage.ru_stime)
+            if child.returncode != 0:
+                err.seek(0)
+                last = (err.read().decode(errors="replace").strip().splitlines() or [""])[-1]
+                raise ProcessFailed(f"{' '.join(command[2:])}: exit {child.returncode}: {last}")
 
     return run
 

@@ -9,6 +9,7 @@ Rows whose runs take seconds (whole command-line processes, a million positions)
 from __future__ import annotations
 
 import os
+import statistics
 import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -80,7 +81,17 @@ class Skipped(Exception):
     """This run cannot measure the row (an optional package is missing); the reason."""
 
 
-Measure = Callable[[Settings], Pairs]
+@dataclass(frozen=True)
+class Measured:
+    """Pairs, and what else the row's target asks (cores used): ``detail`` says it,
+    ``also_met`` judges it."""
+
+    pairs: Pairs
+    detail: str = ""
+    also_met: bool = True
+
+
+Measure = Callable[[Settings], "Pairs | Measured"]
 
 
 def tolerance() -> float:
@@ -208,6 +219,63 @@ def sweep_with_speed(s: Settings) -> Pairs:
     return interleaved_pairs(command("--speed", "10"), command(), s.repeats)
 
 
+LOADED_DESIGNS = 200
+"""Designs of the loaded scan row (O4 moved along x), each over 0..359 deg."""
+
+
+def loaded_scan(s: Settings) -> Pairs:
+    """``linkage.scan_designs`` of crank_rocker_joints.toml with O4.x sampled in 90..110 mm,
+    a 20 N weight at the coupler point P and a -2 N m torque on the rocker (static loads),
+    with its default scheduler, against :func:`.hand.loaded_scan` of the same designs."""
+    import numpy as np
+    import tomllib
+
+    from ..samples import sample_path
+    from . import api
+    from .hand import DrawnFourbar
+    from .hand import loaded_scan as by_hand
+
+    path = sample_path("crank_rocker_joints.toml")
+    joints = tomllib.loads(path.read_text())["joints"]
+    drawn = DrawnFourbar(tuple(joints["A"]), tuple(joints["B"]), joints["O4"][0], tuple(joints["P"]))
+    weight, torque = (0.0, -20.0), -2.0
+    loads = api.Loads(forces={"P": weight}, torques={"rocker": torque})
+    vary = {"O4.x": (90.0, 110.0)}
+    o4x = api.scan_designs(str(path), vary, samples=LOADED_DESIGNS, loads=loads)["O4_x"]
+    positions = np.arange(360.0)
+    return interleaved_pairs(lambda: api.scan_designs(str(path), vary, samples=LOADED_DESIGNS, loads=loads),
+                             lambda: by_hand(drawn, o4x, weight, torque, positions), s.repeats)
+
+
+SEARCH = ("alpha0=0:350:18", "alpha_span=40:120:4", "phi0=0:350:18", "phi_span=60:120:4")
+"""The search row's grid (5,184 candidates) for y = log10(x), x 1..2, 3 Chebyshev points."""
+EVERY_CORE = 0.75
+"""Cores used (processor time over wall time) of at least this share of the cores this
+process may run on count as every core (the machine is shared)."""
+
+
+def function_search(s: Settings) -> Measured:
+    """``linkage synthesize --search`` of :data:`SEARCH` (transmission >= 40 deg, every
+    candidate kept, to CSV) against :func:`.hand.function_search` of the same candidates in
+    a process of its own, one thread; and the processor time over the wall time of the
+    command (the cores it used)."""
+    varies = [a for v in SEARCH for a in ("--vary", v)]
+    cpu: list[float] = []
+    cli = runner(linkage_command("synthesize", "--search", "--function", "log10(x)", "--x", "1:2", *varies,
+                                 "--min-transmission", "40", "--top", "100000",
+                                 "-o", str(s.work / "search.csv")), cpu)
+    grids = ", ".join(f"np.linspace({v.split('=')[1].replace(':', ', ')})" for v in SEARCH)
+    hand = runner(python_command(
+        "import math, numpy as np; from linkage.measure.hand import function_search; "
+        "xs = [1.5 - 0.5 * math.cos((2 * j - 1) * math.pi / 6) for j in (1, 2, 3)]; "
+        "gx = np.linspace(1.0, 2.0, 2001); "
+        f"c = np.stack([g.ravel() for g in np.meshgrid({grids}, indexing='ij')], axis=1); "
+        "function_search(xs, [math.log10(x) for x in xs], gx, np.log10(gx), c, 40.0)"))
+    pairs = interleaved_pairs(cli, hand, s.repeats)
+    used = statistics.median(c / w for c, w in zip(cpu[1:], pairs.a))
+    return Measured(pairs, f"{used:.2f} of {cores()} cores", used >= EVERY_CORE * cores())
+
+
 def cold_start(which: str) -> Measure:
     """A fresh ``linkage solve`` (its default problem) or ``linkage sweep crank_rocker.toml``
     against ``python -c "import rich.table"``."""
@@ -220,18 +288,11 @@ def cold_start(which: str) -> Measure:
     return measure
 
 
-def not_yet(reason: str) -> Measure:
-    def measure(s: Settings) -> Pairs:
-        raise Skipped(reason)
-
-    return measure
-
-
 MEASURES: dict[Row, Measure] = dict(zip(ROWS, (
     scalar_newton(False), scalar_newton(True), system_newton, scipy_hybr,
     sweep_against_closed_form(361), sweep_against_closed_form(1_000_000),
     sweep_to_file("csv"), sweep_to_file("parquet"), sweep_with_speed,
-    not_yet("no hand baseline yet"), not_yet("no hand baseline yet"),
+    loaded_scan, function_search,
     cold_start("solve"), cold_start("sweep"),
 )))
 """How each row is measured."""
@@ -242,7 +303,9 @@ class Outcome:
     row: Row
     pairs: Pairs | None
     note: str = ""
-    """Why there are no pairs: skipped (and why), or not measured (long, without --full)."""
+    """Why there are no pairs: skipped (and why), or not measured (long, without --full);
+    with pairs, what else was measured (cores used)."""
+    also_met: bool = True
 
     @property
     def target(self) -> Target:
@@ -251,7 +314,8 @@ class Outcome:
         r = self.pairs.ratio
         a, b = self.pairs.a_median, self.pairs.b_median
         shown = f"{self.row.comparison}: {seconds(a)} / {seconds(b)}, {len(self.pairs.a)} pairs"
-        return (self.row.label, shown, r, self.row.met(r))
+        return (self.row.label, shown + (f"; {self.note}" if self.note else ""), r,
+                self.row.met(r) and self.also_met)
 
 
 def seconds(t: float) -> str:
@@ -286,7 +350,9 @@ def run_rows(full: bool, repeats: int, budget: float, *, cold: bool = True,
                 out.append(Outcome(row, None, "not measured (--no-cold)"))
                 continue
             try:
-                out.append(Outcome(row, measure(s)))
+                got = measure(s)
+                out.append(Outcome(row, got.pairs, got.detail, got.also_met) if isinstance(got, Measured)
+                           else Outcome(row, got))
             except Skipped as why:
                 out.append(Outcome(row, None, f"skipped: {why}"))
             except ProcessFailed as failed:
