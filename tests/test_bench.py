@@ -241,3 +241,21 @@ def test_the_hand_search_keeps_what_synthesize_search_keeps(cli, tmp_path):
             assert mine["max_error_deg"][i] == pytest.approx(float(kept[c]["max_error_deg"]), rel=1e-9)
             assert mine["min_transmission_deg"][i] == pytest.approx(float(kept[c]["min_transmission_deg"]),
                                                                     rel=1e-9)
+
+
+def test_a_command_that_fails_is_no_measurement():
+    """A row whose command exits non-zero says so, with the command's last error line,
+    instead of a ratio of how fast it failed."""
+    import sys
+
+    from linkage.measure.processes import ProcessFailed, runner
+    from linkage.measure.targets import ROWS, run_rows
+    from linkage.measure.timing import interleaved_pairs
+
+    failing = runner([sys.executable, "-c", "import sys; sys.exit('no such file: x.toml')"])
+    with pytest.raises(ProcessFailed, match=r"exit 1: no such file: x\.toml"):
+        failing()
+    row = next(r for r in ROWS if r.name.startswith("360,001"))
+    (got,) = run_rows(True, 2, 0.0, measures={row: lambda s: interleaved_pairs(failing, failing, 2)})
+    assert got.pairs is None and got.target[2] is None and got.target[3] is None
+    assert "failed:" in got.target[1] and "no such file: x.toml" in got.target[1]

@@ -1,6 +1,7 @@
-"""Issue 33's speed targets, every row of its table, each a ratio of two timings taken in
-this run as interleaved pairs (:func:`.timing.interleaved_pairs`): the library through its
-public API or its command line against the same work written by hand (:mod:`.hand`).
+"""The speed targets (docs/performance.md; issue 33's table, row for row), each a ratio of
+two timings taken in this run as interleaved pairs (:func:`.timing.interleaved_pairs`): the
+library through its public API or its command line against the same work written by hand
+(:mod:`.hand`).
 
 Rows whose runs take seconds (whole command-line processes, a million positions) are
 ``long``: measured with ``linkage bench --full``, listed as not measured otherwise.
