@@ -95,6 +95,12 @@ class Measured:
 Measure = Callable[[Settings], "Pairs | Measured"]
 
 
+def short_pairs(s: Settings) -> int:
+    """Pairs of a row whose calls take microseconds to milliseconds: three times the
+    repeats, at least 9 (cheap, and a shared machine's preemptions hit a few pairs only)."""
+    return max(9, 3 * s.repeats)
+
+
 def tolerance() -> float:
     """The tolerance the solver rows are compared at (issue 10's targets: 1e-12)."""
     return 1e-12
@@ -110,7 +116,7 @@ def scalar_newton(record: bool) -> Measure:
         p, x0, tol = spec["problem"], spec["x0"], tolerance()
         return interleaved_pairs(
             lambda: api.solve_scalar(p, method="newton", x0=x0, tol=tol, record=record),
-            lambda: hand_newton(p.f, p.fprime, x0, tol), s.repeats, s.budget)
+            lambda: hand_newton(p.f, p.fprime, x0, tol), short_pairs(s), s.budget)
 
     return measure
 
@@ -131,7 +137,7 @@ def system_newton(s: Settings) -> Pairs:
     tol = tolerance()
     return interleaved_pairs(
         lambda: api.solve_system(p.F, x0, jac=p.J, tol=tol, max_iter=100, record=False),
-        lambda: hand_newton_2x2(p.F, p.J, x0, tol), s.repeats, s.budget)
+        lambda: hand_newton_2x2(p.F, p.J, x0, tol), short_pairs(s), s.budget)
 
 
 def scipy_hybr(s: Settings) -> Pairs:
@@ -145,7 +151,7 @@ def scipy_hybr(s: Settings) -> Pairs:
     return interleaved_pairs(
         lambda: root(p.F, x0, jac=p.J, method="hybr", options={"xtol": tol}),
         lambda: api.solve_system(p.F, x0, jac=p.J, tol=tol, max_iter=100, record=False),
-        s.repeats, s.budget)
+        short_pairs(s), s.budget)
 
 
 def crank_rocker() -> tuple[Any, tuple[float, float, float, float]]:
@@ -172,9 +178,9 @@ def sweep_against_closed_form(positions: int) -> Measure:
         m, links = crank_rocker()
         grid = np.linspace(0.0, 360.0, positions)
         values = grid if positions > 1_000 else [float(v) for v in grid]
-        budget = s.budget if positions <= 1_000 else 0.0
-        return interleaved_pairs(lambda: api.sweep(m, values),
-                                 lambda: fourbar_open(radians(grid), *links), s.repeats, budget)
+        short = positions <= 1_000
+        return interleaved_pairs(lambda: api.sweep(m, values), lambda: fourbar_open(radians(grid), *links),
+                                 short_pairs(s) if short else s.repeats, s.budget if short else 0.0)
 
     return measure
 

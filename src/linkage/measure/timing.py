@@ -4,6 +4,7 @@ pairs' ratios (the machine's noise then hits both sides of a pair alike)."""
 
 from __future__ import annotations
 
+import gc
 import statistics
 import time
 from collections.abc import Callable
@@ -53,7 +54,10 @@ def interleaved_pairs(a: Callable[[], Any], b: Callable[[], Any], repeats: int, 
     """``repeats`` pairs: a batch of A, then a batch of B, each batch of as many calls as take
     about ``budget`` seconds (one call when 0: a process, a big sweep), after one untimed
     call of each (a model compiles once, as in a session; numpy's first runs also pay for
-    fresh pages). Times are per call."""
+    fresh pages). Times are per call. The garbage of what ran before is collected first:
+    left behind, it made every later solve's collections slower (a scalar Newton solve
+    measured 6x slower after the work-precision run than after ``gc.collect()``)."""
+    gc.collect()
     a(), b()
     na = calls_for(a, budget, clock) if budget else 1
     nb = calls_for(b, budget, clock) if budget else 1
@@ -68,7 +72,9 @@ def interleaved_pairs(a: Callable[[], Any], b: Callable[[], Any], repeats: int, 
 
 
 def time_per_call(fn: Callable[[], Any], repeats: int, budget: float) -> tuple[float, float, float]:
-    """Median, min and max seconds per call over ``repeats`` batches of about ``budget`` s."""
+    """Median, min and max seconds per call over ``repeats`` batches of about ``budget`` s
+    (the garbage of what ran before collected first, as in :func:`interleaved_pairs`)."""
+    gc.collect()
     n = calls_for(fn, budget)
     per = []
     for _ in range(repeats):
@@ -81,7 +87,9 @@ def time_per_call(fn: Callable[[], Any], repeats: int, budget: float) -> tuple[f
 
 def interleaved(fns: dict[str, Callable[[], Any]], repeats: int) -> dict[str, tuple[float, list[float], Any]]:
     """(median seconds, the timings, the last result) of each function: one untimed run of
-    each first, then the repeats taken in turn, so that the machine's noise hits all alike."""
+    each first, then the repeats taken in turn, so that the machine's noise hits all alike
+    (the garbage of what ran before collected first, as in :func:`interleaved_pairs`)."""
+    gc.collect()
     times: dict[str, list[float]] = {k: [] for k in fns}
     last: dict[str, Any] = {}
     for rep in range(repeats + 1):
