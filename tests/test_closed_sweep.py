@@ -348,5 +348,5 @@ def test_the_sweep_targets_are_judged_from_one_runs_medians():
     # without pylinkage (or a run that did not time it) the row is there, not judged
     alone = sweep_targets({"linkage.sweep 361 positions": 0.001})
     assert alone[0][2] is None and alone[0][3] is None and alone[1][3] is None
-    labels = [r[0][:2] for r in targets([], {})]
+    labels = [r[0][:2] for r in targets({})]
     assert "3." in labels and "6." in labels

@@ -296,7 +296,7 @@ def test_the_scan_target_is_judged_at_two_thousand_designs():
     from linkage.measure.sweeps import SCAN_DESIGNS, scan_keys, targets
 
     def row(times: dict[str, float]) -> tuple:
-        return next(r for r in targets([], times) if "Watt six-bar designs" in r[0])
+        return next(r for r in targets(times) if "Watt six-bar designs" in r[0])
 
     six, four = scan_keys(SCAN_DESIGNS)
     assert row({six: 2.5, four: 1.0})[2:] == (2.5, True)

@@ -105,7 +105,7 @@ def run_targets(results: list[Any], *, quick: bool, full: bool, cold: bool, repe
         outcomes = run_rows(full, repeats, 0.005, cold=cold, progress=step)
     sweeps = sweep_times(repeats, SCAN_DESIGNS // 10 if quick else SCAN_DESIGNS)
     cold_times = cold_start(3 if quick else 5) if cold else {}
-    target_rows = [o.target for o in outcomes] + targets(results, sweeps)
+    target_rows = [o.target for o in outcomes] + targets(sweeps)
     notes = []
     if not has_scipy():
         notes.append("scipy is not installed: its rows are skipped (pip install 'linkage-kinematics[bench]')")

@@ -1,15 +1,14 @@
 """The earlier speed targets still judged beside issue 33's table (:mod:`.targets`):
-issue 10's scalar Newton against scipy's, issue 19's sweeps against pylinkage and the
-one-at-a-time engine, and its scan of Watt six-bars against the crank-rocker's. Each is
-a median of interleaved runs in this process."""
+issue 19's sweeps against pylinkage and the one-at-a-time engine, and its scan of Watt
+six-bars against the crank-rocker's. Each is a median of interleaved runs in this
+process."""
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from typing import Any
 
-from .precision import Measurement, has_pylinkage
+from .precision import has_pylinkage
 from .timing import interleaved
 
 WATT_CLOSED = "linkage.sweep watt_sixbar.toml 361 positions"
@@ -74,11 +73,6 @@ def scan_times(repeats: int, designs: int) -> dict[str, float]:
     return {k: t for k, (t, _, _) in runs.items()}
 
 
-SCIPY_NEWTON = ("1. scalar Newton at least 10x faster than scipy root_scalar newton", "scipy / linkage",
-                ("freudenstein", "scipy root_scalar newton"),
-                ("freudenstein", "linkage newton (history off)"))
-"""Issue 10's target against scipy, judged from the work-precision measurements."""
-
 Target = tuple[str, str, "float | None", "bool | None"]
 
 
@@ -87,21 +81,11 @@ def ratio_of(a: float | None, b: float | None) -> float | None:
     return a / b if a and b and a == a and b == b else None
 
 
-def targets(ms: Sequence[Measurement], sweeps: dict[str, float] | None = None) -> list[Target]:
+def targets(sweeps: dict[str, float] | None = None) -> list[Target]:
     """(target, comparison, measured ratio, met; None where this run cannot judge it) for
-    the earlier targets issue 33's table does not restate: issue 10's scalar Newton against
-    scipy (at the tolerance nearest 1e-12), issue 19's sweeps and its scan."""
-
-    def at(problem: str, contender: str) -> Measurement | None:
-        cands = [m for m in ms if m.problem == problem and m.contender == contender]
-        return min(cands, key=lambda m: abs(math.log10(m.tol) + 12), default=None)
-
-    label, comparison, num, den = SCIPY_NEWTON
-    a, b = at(*num), at(*den)
-    r = ratio_of(a.seconds if a else None, b.seconds if b else None)
-    rows: list[Target] = [(label, comparison, r, None if r is None else r >= 10.0)]
+    issue 19's sweeps and its scan (issue 10's against scipy is a row of :mod:`.targets`)."""
     sw = sweeps or {}
-    rows += sweep_targets(sw)
+    rows = sweep_targets(sw)
     six, four = scan_keys(SCAN_DESIGNS)
     r = ratio_of(sw.get(six), sw.get(four))
     if r is None and any(k.startswith("linkage.scan") for k in sw):  # --quick: fewer designs

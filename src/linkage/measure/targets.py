@@ -67,6 +67,12 @@ ROWS = (
 )
 """In the order of issue 33's table."""
 
+EARLIER = (
+    Row("issue 10: scalar Newton at least 10x faster than scipy root_scalar newton", "scipy / linkage", 10.0,
+        at_least=True),
+)
+"""The earlier targets measured the same way (the sweeps' and the scan's: :mod:`.sweeps`)."""
+
 
 @dataclass(frozen=True)
 class Settings:
@@ -96,8 +102,9 @@ Measure = Callable[[Settings], "Pairs | Measured"]
 
 
 def short_pairs(s: Settings) -> int:
-    """Pairs of a row whose calls take microseconds to milliseconds: three times the
-    repeats, at least 9 (cheap, and a shared machine's preemptions hit a few pairs only)."""
+    """Pairs of a row whose calls take microseconds to a fraction of a second (the cold
+    starts): three times the repeats, at least 9 (cheap, and a shared machine's
+    preemptions then hit a few pairs only)."""
     return max(9, 3 * s.repeats)
 
 
@@ -119,6 +126,21 @@ def scalar_newton(record: bool) -> Measure:
             lambda: hand_newton(p.f, p.fprime, x0, tol), short_pairs(s), s.budget)
 
     return measure
+
+
+def scipy_newton(s: Settings) -> Pairs:
+    try:
+        from scipy.optimize import root_scalar
+    except ImportError:
+        raise Skipped("scipy is not installed") from None
+    from . import api
+    from .precision import scalar_problem
+
+    spec = scalar_problem("freudenstein")
+    p, x0, tol = spec["problem"], spec["x0"], tolerance()
+    return interleaved_pairs(
+        lambda: root_scalar(p.f, method="newton", x0=x0, fprime=p.fprime, xtol=tol),
+        lambda: api.solve_scalar(p, method="newton", x0=x0, tol=tol, record=False), short_pairs(s), s.budget)
 
 
 def fourbar_system() -> tuple[Any, tuple[float, ...]]:
@@ -290,19 +312,19 @@ def cold_start(which: str) -> Measure:
     def measure(s: Settings) -> Pairs:
         commands = cold_commands()
         key = "linkage solve" if which == "solve" else "linkage sweep crank_rocker.toml"
-        return interleaved_pairs(runner(commands[key]), runner(commands[FLOOR]), max(s.repeats, 5))
+        return interleaved_pairs(runner(commands[key]), runner(commands[FLOOR]), short_pairs(s))
 
     return measure
 
 
-MEASURES: dict[Row, Measure] = dict(zip(ROWS, (
+MEASURES: dict[Row, Measure] = dict(zip(ROWS + EARLIER, (
     scalar_newton(False), scalar_newton(True), system_newton, scipy_hybr,
     sweep_against_closed_form(361), sweep_against_closed_form(1_000_000),
     sweep_to_file("csv"), sweep_to_file("parquet"), sweep_with_speed,
     loaded_scan, function_search,
-    cold_start("solve"), cold_start("sweep"),
+    cold_start("solve"), cold_start("sweep"), scipy_newton,
 )))
-"""How each row is measured."""
+"""How each row (issue 33's, then the earlier ones) is measured."""
 
 
 @dataclass(frozen=True)
@@ -343,8 +365,8 @@ def settings(repeats: int, budget: float) -> Iterator[Settings]:
 def run_rows(full: bool, repeats: int, budget: float, *, cold: bool = True,
              progress: Callable[[str], None] | None = None,
              measures: dict[Row, Measure] | None = None) -> list[Outcome]:
-    """Every row of :data:`ROWS`, measured (the long ones only when ``full``, the cold
-    starts only when ``cold``)."""
+    """Every row of :data:`ROWS` and :data:`EARLIER`, measured (the long ones only when
+    ``full``, the cold starts only when ``cold``)."""
     out = []
     with settings(repeats, budget) as s:
         for row, measure in (measures or MEASURES).items():
