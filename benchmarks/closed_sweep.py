@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import argparse
 
-from linkage.bench import has_pylinkage, sweep_targets, sweep_times
+from linkage.measure.precision import has_pylinkage
+from linkage.measure.sweeps import sweep_targets, sweep_times
 
 
 def main() -> None:

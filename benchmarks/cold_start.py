@@ -1,6 +1,6 @@
 """Cold starts against the floor `python -c "import rich.table"`, interleaved and repeated
 (medians of 9 by default), with the package's bytecode cached as an installed package
-has it (see :func:`linkage.bench.cold_start`); beside them, Python alone and typer alone,
+has it (see :func:`linkage.measure.processes.cold_start`); beside them, Python alone and typer alone,
 and what creating one class costs at import (a frozen dataclass, a NamedTuple):
 
     python benchmarks/cold_start.py [REPEATS]
@@ -14,7 +14,7 @@ import time
 from dataclasses import make_dataclass
 from typing import NamedTuple
 
-from linkage.bench import cold_start
+from linkage.measure.processes import cold_start
 
 
 def class_creation(repeats: int = 50) -> tuple[float, float]:

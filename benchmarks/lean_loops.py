@@ -44,7 +44,7 @@ def main() -> None:
     t = best(lambda: solve_system(F, (0.0, math.pi / 2), jac=J, tol=1e-12, record=False), 1000)
     print(f"{'four-bar F,J':13s} {t * 1e6:7.2f} us")
     try:  # the same F and J by hand and by scipy, when this checkout has them
-        from linkage.bench import hand_newton_2x2
+        from linkage.measure.hand import hand_newton_2x2
 
         hand = best(lambda: hand_newton_2x2(F, J, (0.0, math.pi / 2), 1e-12), 1000)
         print(f"{'  hand 2x2':13s} {hand * 1e6:7.2f} us  (linkage / hand {t / hand:.2f}x)")
@@ -68,7 +68,8 @@ def main() -> None:
 def parts() -> None:
     """A Newton solve split into its loop and what surrounds it (front door, checks of the
     input, the Result), beside the hand loops; for the README's account of targets 1-2."""
-    from linkage.bench import hand_newton, hand_newton_2x2, scalar_problem, system_problem
+    from linkage.measure.hand import hand_newton, hand_newton_2x2
+    from linkage.measure.precision import scalar_problem, system_problem
     from linkage.methods.newton import newton_lean
     from linkage.methods.newton_system import newton_2x2
     from linkage.problems.system import LeanProblem

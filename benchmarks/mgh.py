@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import sys
 
-from linkage.mgh_table import SOLVED_RESIDUAL, run_table, summary
+from linkage.measure.mgh_table import SOLVED_RESIDUAL, run_table, summary
 
 
 def main() -> None:

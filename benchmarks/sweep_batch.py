@@ -21,7 +21,8 @@ import numpy as np
 
 import linkage
 from linkage import load_mechanism
-from linkage.bench import interleaved, numpy_fourbar
+from linkage.measure.hand import fourbar_open
+from linkage.measure.timing import interleaved
 
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_inputs" / "crank_rocker.toml"
 
@@ -29,7 +30,7 @@ SAMPLE = Path(__file__).resolve().parents[1] / "sample_inputs" / "crank_rocker.t
 def closed_form(theta2_deg: np.ndarray, r1: float, r2: float, r3: float, r4: float) -> np.ndarray:
     """Open-branch theta3, theta4 (deg) of a four-bar for every theta2, in numpy (the same
     baseline `linkage bench` uses)."""
-    return numpy_fourbar(theta2_deg, r1, r2, r3, r4)
+    return np.stack(fourbar_open(np.radians(theta2_deg), r1, r2, r3, r4), axis=1)
 
 
 def main() -> None:

@@ -24,7 +24,8 @@ def test_bench_quick_on_one_problem(cli, tmp_path):
         if m["contender"].startswith("linkage newton") and m["tol"] <= 1e-8:
             assert m["error"] < 1e-8  # the benchmark measures errors against mpmath, not against itself
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert any(t["target"].startswith("1. scalar Newton") for t in doc["targets"])
+    assert any(t["target"].startswith("scalar Newton, history off / hand loop") for t in doc["targets"])
+    assert any(t["target"].startswith("issue 10: scalar Newton") for t in doc["targets"])
 
 
 def test_bench_without_scipy_skips_its_rows_with_a_note(cli, monkeypatch):
@@ -54,17 +55,208 @@ def test_sample_mechanisms_ship_with_the_package():
         assert sample_path(name).read_text().startswith("#")
 
 
-def test_targets_judge_the_batch_only_at_a_million_positions():
-    """--quick sweeps 100,000 positions; target 4 is stated at 1,000,000, so a quick run
-    shows its ratio under its own size and does not call it met or not."""
-    from linkage.bench import targets
+ISSUE_33_ROWS = (
+    # the measures of issue 33's table, in its order (backticks dropped)
+    "scalar Newton, history off / hand loop",
+    "scalar Newton, history on / hand loop",
+    "system Newton off / hand 2x2",
+    "scipy hybr / ours",
+    "361-position linkage.sweep / numpy closed form",
+    "10^6 positions / the same numpy closed form, written tight",
+    "360,001 positions to CSV, CLI / API process",
+    "the same to parquet",
+    "36,001 positions to CSV with --speed 10 / without (rates, joint velocities)",
+    "loaded scan / a hand-written numpy 9x9 batched solve",
+    "synthesize --search / hand numpy, one thread",
+    "cold start solve, sweep / import rich.table",
+)
 
-    def row4(sweeps):
-        return next(r for r in targets([], {}, sweeps) if r[0].startswith("4."))
 
-    full = row4({"numpy closed form 1,000,000 positions": 0.1,
-                 "linkage.sweep 1,000,000 positions (batch)": 0.18})
-    assert full[2] == pytest.approx(1.8) and full[3] is True
-    quick = row4({"numpy closed form 100,000 positions": 0.01,
-                  "linkage.sweep 100,000 positions (batch)": 0.025})
-    assert "100,000 positions" in quick[0] and quick[2] == pytest.approx(2.5) and quick[3] is None
+def test_bench_rows_are_the_rows_of_issue_33():
+    from linkage.measure.targets import EARLIER, MEASURES, ROWS
+
+    assert list(dict.fromkeys(r.name for r in ROWS)) == list(ISSUE_33_ROWS)
+    assert list(MEASURES) == [*ROWS, *EARLIER]
+    bounds = {(r.name, r.part): (r.bound, r.at_least) for r in ROWS}
+    assert bounds[("scipy hybr / ours", "")] == (3.0, True)
+    assert bounds[(ISSUE_33_ROWS[-1], "solve")] == (1.5, False)
+    assert bounds[(ISSUE_33_ROWS[-1], "sweep")] == (1.8, False)
+
+
+class FakeClock:
+    """A clock that each call of A moves by ``a`` and each call of B by ``b``; it records
+    the order of the calls."""
+
+    def __init__(self, a: list[float], b: list[float]) -> None:
+        self.now = 0.0
+        self.a, self.b = iter(a), iter(b)
+        self.calls: list[str] = []
+
+    def __call__(self) -> float:
+        return self.now
+
+    def run(self, which: str) -> None:
+        self.calls.append(which)
+        self.now += next(self.a if which == "A" else self.b)
+
+
+def test_a_ratio_is_the_median_of_interleaved_pairs():
+    """A, B, A, B, ...: each pair's ratio from the two timings taken one after the other,
+    the median of those ratios (not a ratio of two separate medians); one untimed call of
+    each first."""
+    from linkage.measure.timing import interleaved_pairs
+
+    # A drifts slower with the machine; B with it: every pair's ratio is 2 but the third
+    a = [99.0, 2.0, 4.0, 30.0, 8.0, 16.0]
+    b = [99.0, 1.0, 2.0, 3.0, 4.0, 8.0]
+    clock = FakeClock(a, b)
+    pairs = interleaved_pairs(lambda: clock.run("A"), lambda: clock.run("B"), 5, clock=clock)
+    assert clock.calls == ["A", "B"] * 6
+    assert pairs.a == (2.0, 4.0, 30.0, 8.0, 16.0) and pairs.b == (1.0, 2.0, 3.0, 4.0, 8.0)
+    assert pairs.ratio == 2.0  # the median of 2, 2, 10, 2, 2
+    assert pairs.a_median / pairs.b_median == pytest.approx(8.0 / 3.0)
+
+
+def test_a_short_call_is_timed_in_batches_and_per_call():
+    from linkage.measure.timing import interleaved_pairs
+
+    clock = FakeClock([1e-6] * 10_000, [4e-6] * 10_000)
+    pairs = interleaved_pairs(lambda: clock.run("A"), lambda: clock.run("B"), 3, budget=1e-4, clock=clock)
+    assert len(pairs.a) == 3 and pairs.a[0] == pytest.approx(1e-6) and pairs.b[0] == pytest.approx(4e-6)
+    assert pairs.ratio == pytest.approx(0.25)
+    assert clock.calls.count("A") > 3 * 50  # batches of about 1e-4 s: a hundred calls each
+
+
+def test_each_row_is_judged_from_its_pairs_and_a_row_not_run_is_not_judged():
+    """A quick run does not measure the long rows (a million positions, whole commands),
+    nor the cold starts with --no-cold; a missing package skips its row, named."""
+    from linkage.measure.targets import ROWS, Skipped, run_rows
+    from linkage.measure.timing import Pairs
+
+    def skip(_):
+        raise Skipped("scipy is not installed")
+
+    fast = Pairs((1.0, 1.0, 3.0), (1.0, 1.0, 1.0))
+    measures = {row: (skip if row.name == "scipy hybr / ours" else (lambda s: fast)) for row in ROWS}
+    quick = {o.row: o for o in run_rows(False, 3, 0.0, cold=False, measures=measures)}
+    for row, o in quick.items():
+        _, comparison, ratio, met = o.target
+        if row.long or row.cold or row.name == "scipy hybr / ours":
+            assert o.pairs is None and ratio is None and met is None
+            assert ("skipped: scipy" if row.name == "scipy hybr / ours" else "not measured") in comparison
+        else:
+            assert ratio == 1.0 and met is True and "3 pairs" in comparison
+    full = run_rows(True, 3, 0.0, measures=measures)
+    assert all(o.pairs is fast for o in full if o.row.name != "scipy hybr / ours")
+    scipy_row = next(o for o in full if o.row.name == "scipy hybr / ours")
+    assert scipy_row.target[3] is None  # at least 3x: not judged when not measured
+
+
+def test_csv_to_standard_output_is_refused_before_the_bench_runs(cli, monkeypatch):
+    from linkage.measure import precision, stress
+
+    def never(*a, **k):
+        raise AssertionError("ran before refusing")
+
+    monkeypatch.setattr(precision, "measure", never)
+    monkeypatch.setattr(stress, "run", never)
+    run = cli("bench", "--quick", "-f", "csv")
+    assert run.code == 2 and "csv holds one table" in run.err and "--table NAME" in run.err
+    run = cli("bench", "--quick", "-f", "csv", "--table", "nope")
+    assert run.code == 2 and "no such table" in run.err
+    run = cli("stress", "--quick", "-f", "csv")
+    assert run.code == 2 and "csv holds one table" in run.err and "summary, hybrid" in run.err
+
+
+def test_the_hand_baselines_compute_what_the_library_computes():
+    """The reference of each ratio does the same work: the closed form is linkage.sweep's
+    answer on crank_rocker.toml, the hand Newton loops reach linkage's roots."""
+    import numpy as np
+
+    import linkage
+    from linkage.measure.hand import fourbar_open, hand_newton, hand_newton_2x2
+    from linkage.measure.precision import scalar_problem, system_problem
+    from linkage.samples import sample_path
+    from linkage.units import radians
+
+    m = linkage.load_mechanism(sample_path("crank_rocker.toml"))
+    values = np.linspace(0.0, 360.0, 361)
+    swept = linkage.sweep(m, [float(v) for v in values])
+    t3, t4 = fourbar_open(radians(values), 100.0, 40.0, 120.0, 80.0)
+    assert [p.solution["theta3"] for p in swept.positions] == pytest.approx(list(t3), abs=1e-10)
+    assert [p.solution["theta4"] for p in swept.positions] == pytest.approx(list(t4), abs=1e-10)
+    spec = scalar_problem("freudenstein")
+    p = spec["problem"]
+    assert hand_newton(p.f, p.fprime, spec["x0"], 1e-12) == pytest.approx(spec["root"], abs=1e-10)
+    spec = system_problem("fourbar")
+    got = hand_newton_2x2(spec["problem"].F, spec["problem"].J, spec["x0"], 1e-12)
+    assert got == pytest.approx(spec["root"], abs=1e-10)
+
+
+def test_the_hand_loaded_scan_is_the_scans_forces():
+    """The loaded scan row's reference: the same designs' peak input torque, pin force and
+    ground force as linkage.scan_designs gives them (the 9x9 systems written by hand)."""
+    import numpy as np
+
+    from linkage.measure import api
+    from linkage.measure.hand import DrawnFourbar, loaded_scan
+    from linkage.samples import sample_path
+
+    loads = api.Loads(forces={"P": (0.0, -20.0)}, torques={"rocker": -2.0})
+    got = api.scan_designs(str(sample_path("crank_rocker_joints.toml")), {"O4.x": (90.0, 110.0)}, samples=12,
+                           loads=loads, scheduler="synchronous")
+    drawn = DrawnFourbar((34.64101615137755, 20.0), (145.57934415070798, 65.74590015195868), 100.0,
+                         (71.2422462637832, 67.54313782512394))
+    mine = loaded_scan(drawn, got["O4_x"], (0.0, -20.0), -2.0, np.arange(360.0))
+    for column in ("peak_input", "max_pin_force", "max_shaking_force"):
+        assert list(mine[column]) == pytest.approx(list(got[column]), rel=1e-9)
+
+
+def test_the_hand_search_keeps_what_synthesize_search_keeps(cli, tmp_path):
+    """The search row's reference: every candidate `synthesize --search` keeps is kept by
+    hand, with the same max error and smallest transmission angle (the hand search checks
+    assembly and transmission only, so it may keep a few more)."""
+    import csv
+    import math
+
+    import numpy as np
+
+    from linkage.measure.hand import function_search
+
+    out = tmp_path / "search.csv"
+    run = cli("synthesize", "--search", "--function", "log10(x)", "--x", "1:2", "--vary", "alpha0=0:350:6",
+              "--vary", "alpha_span=40:120:3", "--vary", "phi0=0:350:6", "--vary", "phi_span=60:120:3",
+              "--min-transmission", "40", "--top", "100000", "-o", str(out))
+    assert run.code == 0, run.err
+    names = ("alpha0 (deg)", "alpha_span (deg)", "phi0 (deg)", "phi_span (deg)")
+    kept = {tuple(float(r[k]) for k in names): r for r in csv.DictReader(out.open())}
+    grid = np.array([(a, da, p, dp) for a in np.linspace(0, 350, 6) for da in np.linspace(40, 120, 3)
+                     for p in np.linspace(0, 350, 6) for dp in np.linspace(60, 120, 3)])
+    xs = [1.5 - 0.5 * math.cos((2 * j - 1) * math.pi / 6) for j in (1, 2, 3)]
+    gx = np.linspace(1.0, 2.0, 2001)
+    mine = function_search(xs, [math.log10(x) for x in xs], gx, np.log10(gx), grid, 40.0)
+    assert len(kept) > 20
+    for i, c in enumerate(map(tuple, grid)):
+        if c in kept:
+            assert mine["ok"][i]
+            assert mine["max_error_deg"][i] == pytest.approx(float(kept[c]["max_error_deg"]), rel=1e-9)
+            assert mine["min_transmission_deg"][i] == pytest.approx(float(kept[c]["min_transmission_deg"]),
+                                                                    rel=1e-9)
+
+
+def test_a_command_that_fails_is_no_measurement():
+    """A row whose command exits non-zero says so, with the command's last error line,
+    instead of a ratio of how fast it failed."""
+    import sys
+
+    from linkage.measure.processes import ProcessFailed, runner
+    from linkage.measure.targets import ROWS, run_rows
+    from linkage.measure.timing import interleaved_pairs
+
+    failing = runner([sys.executable, "-c", "import sys; sys.exit('no such file: x.toml')"])
+    with pytest.raises(ProcessFailed, match=r"exit 1: no such file: x\.toml"):
+        failing()
+    row = next(r for r in ROWS if r.name.startswith("360,001"))
+    (got,) = run_rows(True, 2, 0.0, measures={row: lambda s: interleaved_pairs(failing, failing, 2)})
+    assert got.pairs is None and got.target[2] is None and got.target[3] is None
+    assert "failed:" in got.target[1] and "no such file: x.toml" in got.target[1]

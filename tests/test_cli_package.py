@@ -104,7 +104,7 @@ def test_parse_motion_lives_in_arguments_with_its_units_and_messages():
 
 
 def test_the_moved_engine_functions_are_importable_from_their_homes():
-    from linkage.bench import time_per_solve
+    from linkage.measure.timing import time_per_solve
     from linkage.problems.seed_equation import (
         applicable,
         fourbar_coefficients,

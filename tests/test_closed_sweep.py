@@ -336,7 +336,7 @@ def test_unwrap_turns_array_every_position_solved_is_the_scalar_rule():
 # --- the bench rows --------------------------------------------------------------------------
 
 def test_the_sweep_targets_are_judged_from_one_runs_medians():
-    from linkage.bench import WATT_CLOSED, WATT_ONE, sweep_targets, targets
+    from linkage.measure.sweeps import WATT_CLOSED, WATT_ONE, sweep_targets, targets
 
     rows = sweep_targets({"linkage.sweep 361 positions": 0.001, "pylinkage step_fast 361 positions": 0.0035,
                           WATT_CLOSED: 0.004, WATT_ONE: 0.1})
@@ -348,5 +348,5 @@ def test_the_sweep_targets_are_judged_from_one_runs_medians():
     # without pylinkage (or a run that did not time it) the row is there, not judged
     alone = sweep_targets({"linkage.sweep 361 positions": 0.001})
     assert alone[0][2] is None and alone[0][3] is None and alone[1][3] is None
-    labels = [r[0][:2] for r in targets([], {}, {})]
+    labels = [r[0][:2] for r in targets({})]
     assert "3." in labels and "6." in labels

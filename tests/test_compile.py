@@ -183,20 +183,20 @@ def test_lean_scalar_loops_equal_the_generic_loop_on_the_stress_battery(method):
     """With history off each of these methods runs its own tight loop; with history on,
     the generic loop. Status, root and iteration count must agree on every case."""
     from linkage import solve_scalar
-    from linkage.stress import (
-        _start,
+    from linkage.measure.stress import start_arguments
+    from linkage.measure.stress_cases import (
         bad_start_cases,
-        classic_cases,
         fourbar_equation_cases,
         non_finite_cases,
         tiny_tol_cases,
     )
+    from linkage.problems.catalog import classic_cases
 
     cases = [*classic_cases(), *fourbar_equation_cases(random.Random(0), 600), *bad_start_cases(),
              *tiny_tol_cases(), *non_finite_cases()]
     compared = 0
     for case in cases:
-        start = _start(case, method)
+        start = start_arguments(case, method)
         if start is None:
             continue
         kw = dict(method=method, fprime=case.fprime, g=case.g, tol=case.tol, rtol=case.rtol,
@@ -237,8 +237,8 @@ def test_lean_scalar_loops_equal_the_generic_loop_on_the_stress_battery(method):
 
 def test_lean_system_newton_equals_the_generic_loop_on_the_stress_battery():
     from linkage import solve_system
+    from linkage.measure.stress_cases import fourbar_cases, fourbar_mechanism
     from linkage.problems.catalog import mgh_cases
-    from linkage.stress import fourbar_cases, fourbar_mechanism
 
     for it in fourbar_cases(random.Random(0), 400):
         p = fourbar_mechanism(it).problem()
@@ -256,8 +256,8 @@ def test_the_two_unknown_front_door_equals_the_general_path():
     """solve_system on user callables of two unknowns with a tuple start takes a short
     front door; a list start takes the general path. Everything in the Result agrees."""
     from linkage import solve_system
+    from linkage.measure.stress_cases import fourbar_cases, fourbar_mechanism
     from linkage.problems.catalog import mgh_cases
-    from linkage.stress import fourbar_cases, fourbar_mechanism
 
     pairs = []
     for it in fourbar_cases(random.Random(1), 200):
@@ -281,7 +281,7 @@ def test_the_two_unknown_mechanism_front_door_equals_the_general_path():
     """A compiled problem of two angles with a tuple start (its own x0 included) takes a
     short front door when Newton converges; a list start takes the general path."""
     from linkage import solve_system
-    from linkage.stress import fourbar_cases, fourbar_mechanism
+    from linkage.measure.stress_cases import fourbar_cases, fourbar_mechanism
 
     problems = [fourbar_mechanism(it).problem() for it in fourbar_cases(random.Random(2), 200)]
     assert len(problems) == 200
@@ -300,7 +300,7 @@ def test_the_two_unknown_mechanism_front_door_equals_the_general_path():
 
 
 def _two_unknown_mechanisms():
-    from linkage.stress import fourbar_cases, fourbar_mechanism
+    from linkage.measure.stress_cases import fourbar_cases, fourbar_mechanism
 
     sample = [load_mechanism(p) for p in sorted(SAMPLES.glob("*.toml"))]
     return [m for m in sample if len(m.unknowns) == 2] + \

@@ -296,10 +296,10 @@ def test_the_second_four_bar_loop_has_suffixed_columns_that_may_not_clash():
 
 
 def test_the_scan_target_is_judged_at_two_thousand_designs():
-    from linkage.bench import SCAN_DESIGNS, scan_keys, targets
+    from linkage.measure.sweeps import SCAN_DESIGNS, scan_keys, targets
 
     def row(times: dict[str, float]) -> tuple:
-        return next(r for r in targets([], {}, times) if "Watt six-bar designs" in r[0])
+        return next(r for r in targets(times) if "Watt six-bar designs" in r[0])
 
     six, four = scan_keys(SCAN_DESIGNS)
     assert row({six: 2.5, four: 1.0})[2:] == (2.5, True)

@@ -19,7 +19,7 @@ from typing import Any
 
 import pytest
 
-from linkage import bench as bench_module
+from linkage.measure import precision, sweeps, targets, timing
 from report_reading import csv_files
 
 pq = pytest.importorskip("pyarrow.parquet")
@@ -56,13 +56,16 @@ OUTPUT_OPTION = {"samples": "--format"}  # the listing goes to standard output o
 def quick_bench(monkeypatch: pytest.MonkeyPatch) -> None:
     """bench's measurements stubbed with fixed figures: the writers are under test, and a
     timing differs from run to run."""
-    m = bench_module.Measurement
+    m = precision.Measurement
     fixed = [m("freudenstein", "linkage newton", 1e-12, 2.5e-5, (2.25e-5, 3e-5), 1e-16, 5, 6),
              m("freudenstein", "scipy brentq", 1e-12, 1e-4, (0.9e-4, 1.1e-4), 0.0, None, 9)]
-    monkeypatch.setattr(bench_module, "measure", lambda *a, **k: fixed)
-    monkeypatch.setattr(bench_module, "sweep_times", lambda *a, **k: {"a sweep": 0.25, "another": 0.5})
+    monkeypatch.setattr(precision, "measure", lambda *a, **k: fixed)
+    monkeypatch.setattr(sweeps, "sweep_times", lambda *a, **k: {"a sweep": 0.25, "another": 0.5})
+    pairs = timing.Pairs((2e-6, 3e-6), (1e-6, 1e-6))
+    monkeypatch.setattr(targets, "run_rows", lambda *a, **k: [targets.Outcome(row, pairs)
+                                                               for row in targets.ROWS])
     # solve --method all times each method: its "time per solve" column, too
-    monkeypatch.setattr(bench_module, "time_per_solve", lambda *a, **k: 2.5e-5)
+    monkeypatch.setattr(timing, "time_per_solve", lambda *a, **k: 2.5e-5)
 
 
 def run(cli: Any, tmp_path: Path, name: str, fmt: str) -> Path:

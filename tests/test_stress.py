@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from linkage import Status, fourbar_equation, solve_scalar
-from linkage.stress import run, summary_rows, totals
+from linkage.measure.stress import run, summary_rows, totals
 
 EPS = sys.float_info.epsilon
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"

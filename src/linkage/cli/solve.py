@@ -149,7 +149,7 @@ def solve(
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}, all")
 
     if method == "all":
-        from ..bench import time_per_solve
+        from ..measure.timing import time_per_solve
     runs = []
     for name in names:
         kwargs: dict[str, Any] = dict(method=name, tol=tol, rtol=rtol, ftol=ftol, max_iter=max_iter)

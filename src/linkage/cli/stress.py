@@ -5,6 +5,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
+from .early import refuse_csv_to_stdout
 from .options import FormatOpt, OutputOpt, TableOpt, check_paths, choose_format, emit_report
 from .root import app
 
@@ -31,9 +32,9 @@ def stress(
 
     Example: linkage stress --quick
     """
+    from ..measure.stress import SUMMARY_HEADERS, run, stress_tables, summary_rows, totals
     from ..methods import SCALAR_METHODS
     from ..solve import SYSTEM_METHODS
-    from ..stress import SUMMARY_HEADERS, run, summary_rows, totals
 
     known = set(SCALAR_METHODS) | set(SYSTEM_METHODS)
     for m in method or []:
@@ -41,12 +42,14 @@ def stress(
             raise InputError(f"unknown method {m!r}; choose from {', '.join(sorted(known))}")
     out_fmt = choose_format(fmt, output)
     check_paths([], [("--output", output)])
+    methods = method or None
+    refuse_csv_to_stdout(out_fmt, output, table, stress_tables(methods))
     try:
         import mpmath  # noqa: F401
     except ImportError:
         raise InputError("the stress suite needs mpmath for its references: "
                          "pip install 'linkage-kinematics[stress]'") from None
-    report = run(quick=quick, seed=seed, methods=method or None)
+    report = run(quick=quick, seed=seed, methods=methods)
     rows = summary_rows(report)
     false, crashes = totals(rows)
     from ..render.tools import stress_report

@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from .problems.catalog import mgh_cases
+from ..problems.catalog import mgh_cases
 
 SOLVED_RESIDUAL = 1e-8
 TOL = 1e-10
@@ -47,7 +47,7 @@ def _max_abs(v: Any) -> float:
 
 
 def ours(method: str, damped: bool, label: str) -> Any:
-    from .solve import solve_system
+    from ..solve import solve_system
 
     def run(case: str, system: Any, x0: tuple[float, ...]) -> Outcome:
         r = solve_system(system.F, x0, jac=system.J, method=method, damped=damped, tol=TOL, ftol=TOL,
