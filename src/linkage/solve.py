@@ -473,10 +473,12 @@ def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: b
         certify = None
         extra_evals = [0]
         if not m.bracketing:
-            def certify(s: Any, width: float) -> tuple[Status, str]:
-                fx = s.fx if s.fx is not None else _value(problem.f, s.x)
-                verdict, why, n = certify_root(problem, s.x, fx, width)
-                extra_evals[0] += n + (s.fx is None)
+            def certify(x: float, fx: Any, width: float) -> tuple[Status, str]:
+                known = fx is not None
+                if not known:
+                    fx = _value(problem.f, x)
+                verdict, why, n = certify_root(problem, x, fx, width)
+                extra_evals[0] += n + (not known)
                 return verdict, why
         if not record and hasattr(m, "run_lean"):
             # the method's own tight loop: the generic loop's outcome, without a state per step
