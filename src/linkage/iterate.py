@@ -176,6 +176,8 @@ class Loop(NamedTuple):
     residual gate) or ``minimizes`` (``system``, and a stall is a local minimum)."""
     diverge: str = ""
     """Test 6: ``""`` (a bracket cannot diverge), ``streak`` or ``runaway`` (systems)."""
+    diverge_when: str = ""
+    """An expression: test 6 runs only where it holds (``not damped``)."""
     magnitude: str = "(x if x >= 0.0 else -x)"
     limit: str = "_step_limit(tol, rtol, ax) if rtol else tol"
     failure: str = ""
@@ -253,10 +255,14 @@ def stopping_tests(loop: Loop) -> list[str]:
                                      'above the tolerance {gate:.3g}"')
     # 6. divergence
     if loop.diverge:
-        put(0, "growth = growth + 1 if err > prev_err else 0")
+        level = 0
+        if loop.diverge_when:
+            put(0, f"if {loop.diverge_when}:")
+            level = 1
+        put(level, "growth = growth + 1 if err > prev_err else 0")
         far = " and ax > runaway" if loop.diverge == "runaway" else ""
-        put(0, f"if growth >= _DIVERGE{far}:")
-        stop(1, "DIVERGED", 'f"{growth} growing steps, last {err:.3g}"')
+        put(level, f"if growth >= _DIVERGE{far}:")
+        stop(level + 1, "DIVERGED", 'f"{growth} growing steps, last {err:.3g}"')
     # 7. rounding noise that stops shrinking
     put(0, "if err <= _ROUNDING * ax:")
     put(1, "why, rounding_steps, stalls = _stall(err, prev_err, limit, rounding_steps, stalls)")

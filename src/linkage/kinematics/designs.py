@@ -38,10 +38,10 @@ from typing import Any
 
 import numpy as np
 
-from ..methods.newton_system import SINGULAR_RATIO
 from ..problems.derive import Derivation, read_branch
 from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism, VectorTerm
 from ..rules import (
+    SINGULAR_RATIO,
     continues_array,
     continuity_measures_array,
     residual_gate,
