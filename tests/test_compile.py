@@ -167,9 +167,10 @@ def _same(a, b, label):
 def _generic_newton(f, fprime, x0, tol, rtol, max_iter):
     """Newton through the generic loop (`run`), bypassing the lean one."""
     from linkage.methods import Newton
-    from linkage.solve import _problem, check_criteria, finish
+    from linkage.solve import check_criteria
+    from linkage.solve.scalar import finish, problem_of
 
-    problem = _problem(f, fprime, None)
+    problem = problem_of(f, fprime, None)
     m = Newton()
     try:
         state = m.init(problem, x0)
