@@ -68,7 +68,8 @@ class Column(NamedTuple):
 
     ``template`` uses ``{v}`` for the unknown's name (``{v}_i`` becomes ``phi_i``);
     ``kind`` decides the unit: ``x`` (unit of the unknown), ``f`` (unit of the
-    function), ``df`` (f per x), ``ratio`` (dimensionless), ``index`` and ``text``.
+    function), ``df`` (f per x), ``d2f`` (f per x^2), ``ratio`` (dimensionless), ``index``
+    and ``text``.
     """
 
     template: str
@@ -80,6 +81,7 @@ class Column(NamedTuple):
             "x": x_unit,
             "f": f_unit,
             "df": _per(f_unit, x_unit),
+            "d2f": _per(f_unit, f"{x_unit}^2" if x_unit else ""),
         }.get(self.kind, "")
         return f"{name} ({unit})" if unit else name
 
