@@ -63,6 +63,8 @@ METHODS: dict[str, MethodEntry] = {e.name: e for e in (
     MethodEntry("secant", ".secant", "Secant", "x0 x1", GOLDEN, 1, "the chord through the last two points"),
     MethodEntry("newton", ".newton", "Newton", "x0", 2.0, 2, "x - f/f'",
                 needs=(("fprime", "the derivative fprime"),)),
+    MethodEntry("halley", ".halley", "Halley", "x0", 3.0, 3, "x - 2 f f' / (2 f'^2 - f f'')",
+                needs=(("fprime", "the derivative fprime"), ("fsecond", "the second derivative fsecond"))),
     MethodEntry("fixed-point", ".fixed_point", "FixedPoint", "x0", 1.0, 1, "x = g(x)",
                 needs=(("g", "the iteration function g (x = g(x))"),), make=_evaluating_f),
 )}
