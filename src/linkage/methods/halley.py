@@ -16,7 +16,7 @@ from typing import Any, ClassVar, NamedTuple
 
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
-from ._common import new_state
+from ._common import new_state, start_stop
 
 
 class HalleyState(NamedTuple):
@@ -47,11 +47,7 @@ class Halley:
 
     def init(self, problem: ScalarProblem, x0: float) -> HalleyState:
         fx = problem.f(x0)
-        stop = None
-        if fx == 0.0:
-            stop = (Status.CONVERGED_EXACT, f"f is zero at the start {problem.var} = {x0!r}")
-        elif fx != fx or abs(fx) == float("inf"):
-            stop = (Status.NON_FINITE, f"f({problem.var}={x0:g}) = {fx!r}")
+        stop = start_stop(problem, x0, fx)
         nan = float("nan")
         return HalleyState(x0, fx, float("inf"), stop, x0, fx, nan, nan)
 

@@ -18,7 +18,7 @@ from typing import Any, ClassVar, NamedTuple
 from ..iterate import Loop, build_loop
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
-from ._common import new_state
+from ._common import new_state, start_stop
 
 
 class NewtonState(NamedTuple):
@@ -53,11 +53,7 @@ class Newton:
 
     def init(self, problem: ScalarProblem, x0: float) -> NewtonState:
         fx = problem.f(x0)
-        stop = None
-        if fx == 0.0:
-            stop = (Status.CONVERGED_EXACT, f"f is zero at the start {problem.var} = {x0!r}")
-        elif fx != fx or abs(fx) == float("inf"):
-            stop = (Status.NON_FINITE, f"f({problem.var}={x0:g}) = {fx!r}")
+        stop = start_stop(problem, x0, fx)
         return NewtonState(x0, fx, float("inf"), stop, x0, fx, float("nan"))
 
     def step(self, problem: ScalarProblem, s: NewtonState) -> NewtonState:
@@ -88,10 +84,9 @@ NEWTON_LOOP = Loop(
         f, fp = problem.f, problem.fprime
         x = x0
         fx = f(x)
-        if fx == 0.0:
-            return x, fx, _inf, _S.CONVERGED_EXACT, f"f is zero at the start {problem.var} = {x0!r}", 0
-        if fx != fx or abs(fx) == _inf:
-            return x, fx, _inf, _S.NON_FINITE, f"f({problem.var}={x0:g}) = {fx!r}", 0
+        stop = _start_stop(problem, x0, fx)
+        if stop is not None:
+            return x, fx, _inf, stop[0], stop[1], 0
         best = start = abs(fx) if isinstance(fx, float) else _inf
         err = _inf
         """,
@@ -123,4 +118,4 @@ and, when ``rows`` (an :class:`~linkage.iterate.Rows`) is given, its table row f
 max_iter, certify, rows)`` returns (x, f(x), last error, status, detail, iterations);
 ``certify(x, fx, width)`` decides a small step."""
 
-newton_lean = build_loop(NEWTON_LOOP)
+newton_lean = build_loop(NEWTON_LOOP, {"_start_stop": start_stop})
