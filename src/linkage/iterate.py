@@ -184,22 +184,38 @@ class Loop(NamedTuple):
     """When given, every stop other than convergence runs this line instead (``return None``)."""
 
 
+class _Emitter:
+    """Lines of loop source at the loop body's indentation, and a stop as ``loop`` says."""
+
+    def __init__(self, loop: Loop) -> None:
+        self.loop = loop
+        self.lines: list[str] = []
+
+    def put(self, level: int, text: str) -> None:
+        self.lines.append("    " * (level + 2) + text)
+
+    def stop(self, level: int, status: str, detail: str = '""') -> None:
+        if self.loop.failure and status not in _CONVERGED_NAMES:
+            self.put(level, self.loop.failure)
+            return
+        self.put(level, f"status, detail = _S.{status}, {detail}")
+        self.put(level, "break")
+
+
 def stopping_tests(loop: Loop) -> list[str]:
     """Tests 2-8 of the module docstring, in order, as the body of the loop after a step
     (indented for it), for ``loop``'s options."""
-    out: list[str] = []
+    out = _Emitter(loop)
+    _value_tests(out)
+    _step_test(out)
+    _growth_tests(out)
+    return out.lines
 
-    def put(level: int, text: str) -> None:
-        out.append("    " * (level + 2) + text)
 
-    def stop(level: int, status: str, detail: str = '""') -> None:
-        if loop.failure and status not in _CONVERGED_NAMES:
-            put(level, loop.failure)
-            return
-        put(level, f"status, detail = _S.{status}, {detail}")
-        put(level, "break")
-
-    # 2. a non-finite error or residual (v - v is 0.0 for a finite float, NaN otherwise)
+def _value_tests(out: _Emitter) -> None:
+    """2. a non-finite error or residual; 3. an exact zero; 4. the residual test."""
+    loop, put, stop = out.loop, out.put, out.stop
+    # v - v is 0.0 for a finite float, NaN otherwise
     put(0, "if type(err) is float and type(fx) is float:")
     put(1, "finite = err - err == 0.0 and fx - fx == 0.0")
     put(0, "else:")
@@ -209,7 +225,6 @@ def stopping_tests(loop: Loop) -> list[str]:
     stop(2, "DOMAIN_ERROR", 'f"f returned a non-real value: {fx!r}"')
     put(0, "if not finite:")
     stop(1, "NON_FINITE", 'f"error = {err!r}, residual = {fx!r}"')
-    # 3. an exact zero; 4. the residual test
     level = 0
     if loop.fx_optional:
         put(0, "if fx is not None:")
@@ -220,7 +235,11 @@ def stopping_tests(loop: Loop) -> list[str]:
         put(level, "size = fx if fx >= 0.0 else -fx")
         put(level, "if ftol is not None and size <= ftol:")
         stop(level + 1, "CONVERGED_RESIDUAL")
-    # 5. the step test, with the method's plausibility and the open methods' guard
+
+
+def _step_test(out: _Emitter) -> None:
+    """5. the step test, with the method's plausibility and the open methods' guard."""
+    loop, put, stop = out.loop, out.put, out.stop
     put(0, f"ax = {loop.magnitude}")
     put(0, f"limit = {loop.limit}")
     if loop.plausible:
@@ -253,7 +272,11 @@ def stopping_tests(loop: Loop) -> list[str]:
         if loop.step_test == "minimizes":
             stop(1, "LOCAL_MINIMUM", 'f"the least-squares residual stalls at {abs(fx or _nan):.3g}, '
                                      'above the tolerance {gate:.3g}"')
-    # 6. divergence
+
+
+def _growth_tests(out: _Emitter) -> None:
+    """6. divergence; 7. rounding noise that stops shrinking (8, the cap, is the loop's end)."""
+    loop, put, stop = out.loop, out.put, out.stop
     if loop.diverge:
         level = 0
         if loop.diverge_when:
@@ -263,13 +286,11 @@ def stopping_tests(loop: Loop) -> list[str]:
         far = " and ax > runaway" if loop.diverge == "runaway" else ""
         put(level, f"if growth >= _DIVERGE{far}:")
         stop(level + 1, "DIVERGED", 'f"{growth} growing steps, last {err:.3g}"')
-    # 7. rounding noise that stops shrinking
     put(0, "if err <= _ROUNDING * ax:")
     put(1, "why, rounding_steps, stalls = _stall(err, prev_err, limit, rounding_steps, stalls)")
     put(1, "if why is not None:")
     stop(2, "PRECISION_LIMIT", "why")
     put(0, "prev_err = err")
-    return out
 
 
 def _block(text: str, level: int) -> list[str]:

@@ -20,7 +20,7 @@ from typing import Any, ClassVar, NamedTuple
 from ..iterate import Loop, build_loop
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
-from ._common import display, new_state
+from .common import display, new_state
 
 
 class FixedPointState(NamedTuple):

@@ -16,7 +16,7 @@ from typing import Any, ClassVar, NamedTuple
 
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
-from ._common import new_state, start_stop
+from .common import new_state, start_stop
 
 
 class HalleyState(NamedTuple):

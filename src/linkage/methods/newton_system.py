@@ -27,8 +27,8 @@ from ..iterate import Loop, build_loop
 from ..problems.system import SystemProblem
 from ..result import Column, Status
 from ..rules import invertible, pivots_invertible, step_size
-from ._common import new_state
 from ._linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve, pivot_ratio
+from .common import new_state
 
 EPS = sys.float_info.epsilon
 

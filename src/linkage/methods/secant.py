@@ -18,7 +18,7 @@ from typing import Any, ClassVar, NamedTuple
 from ..iterate import Loop, build_loop
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
-from ._common import new_state
+from .common import new_state
 
 _NAN = float("nan")
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..result import Status
+
 new_state = tuple.__new__
 """Build a NamedTuple state without its Python-level ``__new__``.
 
@@ -28,8 +30,6 @@ def display(fn: Any, x: float) -> float | None:
 def start_stop(problem: Any, x0: float, fx: float) -> Any:
     """An open method's verdict on its start x0 with f(x0) = fx: (CONVERGED_EXACT or
     NON_FINITE, detail), or None to iterate."""
-    from ..result import Status
-
     if fx == 0.0:
         return (Status.CONVERGED_EXACT, f"f is zero at the start {problem.var} = {x0!r}")
     if fx != fx or abs(fx) == float("inf"):
