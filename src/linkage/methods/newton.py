@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import Loop, build_loop
+from ..iterate import HISTORY_HEAD, Loop, build_loop
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
 from .common import new_state, start_stop
@@ -81,6 +81,7 @@ NEWTON_LOOP = Loop(
     signature="newton_lean(problem, x0, tol, rtol, ftol, max_iter, certify, rows=None)",
     setup="""\
         add = rows.add if rows is not None else None
+        append = rows.append if rows is not None else None  # the first HISTORY_HEAD rows, as Rows.add
         f, fp = problem.f, problem.fprime
         x = x0
         fx = f(x)
@@ -107,7 +108,7 @@ NEWTON_LOOP = Loop(
         if err < 0.0:
             err = -err
         if add is not None:
-            add((k, x, fx, d, x1, err))
+            (append if k <= _HEAD else add)((k, x, fx, d, x1, err))
         x, fx = x1, fx1
         """,
     guard=True, step_test="certify", diverge="streak")
@@ -118,4 +119,4 @@ and, when ``rows`` (an :class:`~linkage.iterate.Rows`) is given, its table row f
 max_iter, certify, rows)`` returns (x, f(x), last error, status, detail, iterations);
 ``certify(x, fx, width)`` decides a small step."""
 
-newton_lean = build_loop(NEWTON_LOOP, {"_start_stop": start_stop})
+newton_lean = build_loop(NEWTON_LOOP, {"_start_stop": start_stop, "_HEAD": HISTORY_HEAD})

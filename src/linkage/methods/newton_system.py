@@ -436,11 +436,15 @@ NEWTON_2X2_LOOP = Loop(
     step=_dedent("""\
         (a, b), (c, d) = Jf([x0, x1])
         njev += 1
-        a0, a1 = abs(p0), abs(p1)
+        # |v| written "v if v > 0.0 else 0.0 - v": the same bits as abs (-0.0 included), no call
+        a0 = p0 if p0 > 0.0 else 0.0 - p0
+        a1 = p1 if p1 > 0.0 else 0.0 - p1
         fx = (a0 if a0 >= a1 else a1) if a0 == a0 and a1 == a1 else _nan
-        det = a * d - b * c
+        ad = a * d
+        bc = b * c
+        det = ad - bc
         refused = True
-        if _invertible(det, abs(a * d) + abs(b * c)):
+        if _invertible(det, (ad if ad > 0.0 else 0.0 - ad) + (bc if bc > 0.0 else 0.0 - bc)):
             d0, d1 = (b * p1 - d * p0) / det, (c * p0 - a * p1) / det
             t0, t1 = x0 + d0, x1 + d1
             f0, f1 = F([t0, t1])
@@ -463,11 +467,13 @@ t0, t1 = s.x
 f0, f1 = s.phi_x
 """),
     after="""\
-        e0, e1 = abs(d0), abs(d1)
+        e0 = d0 if d0 > 0.0 else 0.0 - d0
+        e1 = d1 if d1 > 0.0 else 0.0 - d1
         err = (e0 if e0 >= e1 else e1) if e0 == e0 and e1 == e1 else _nan
         x0, x1, p0, p1 = t0, t1, f0, f1
         ss = p0 * p0 + p1 * p1
-        e0, e1 = abs(x0), abs(x1)
+        e0 = x0 if x0 > 0.0 else 0.0 - x0
+        e1 = x1 if x1 > 0.0 else 0.0 - x1
         size_q = _nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
         """,
     result="[x0, x1], [p0, p1], err, status, detail, k, nfev, njev",
