@@ -293,11 +293,24 @@ def _growth_tests(out: _Emitter) -> None:
     put(0, "prev_err = err")
 
 
+def dedent(text: str) -> str:
+    """``text`` without the indentation its non-blank lines share (textwrap.dedent's
+    result for source fragments, without importing textwrap at a solve's start)."""
+    lines = text.splitlines()
+    margin = min((len(line) - len(line.lstrip()) for line in lines if line.strip()), default=0)
+    end = "\n" if text.endswith("\n") else ""
+    return "\n".join(line[margin:] if line.strip() else "" for line in lines) + end
+
+
+def indent(text: str) -> str:
+    """``text`` indented by one level (4 spaces) on its non-blank lines."""
+    end = "\n" if text.endswith("\n") else ""
+    return "\n".join("    " + line if line.strip() else "" for line in text.splitlines()) + end
+
+
 def _block(text: str, level: int) -> list[str]:
     """Dedented ``text`` re-indented to ``level`` (4 spaces each)."""
-    import textwrap
-
-    return [("    " * level + line) if line.strip() else "" for line in textwrap.dedent(text).splitlines()]
+    return [("    " * level + line) if line.strip() else "" for line in dedent(text).splitlines()]
 
 
 def loop_source(loop: Loop) -> str:

@@ -19,11 +19,10 @@ from __future__ import annotations
 import math
 import operator
 import sys
-import textwrap
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import Loop, build_loop
+from ..iterate import Loop, build_loop, dedent, indent
 from ..problems.system import SystemProblem
 from ..result import Column, Status
 from ..rules import invertible, pivots_invertible, step_size
@@ -338,14 +337,6 @@ def system_row(problem: SystemProblem, k: int, q: Any, phi: Any, dq: Any, det: f
     return tuple(row)
 
 
-def _dedent(text: str) -> str:
-    return textwrap.dedent(text)
-
-
-def _indent(text: str) -> str:
-    return textwrap.indent(text, "    ")
-
-
 _FALLBACK = """\
 njev -= 1  # the method evaluates J again
 s = _NewtonSystem("analytic", None, damped, diagnostics=False).step(problem, _State(
@@ -371,7 +362,7 @@ NEWTON_SYSTEM_LOOP = Loop(
         err = fx = _inf
         runaway = _RUNAWAY * (1.0 + _max_abs(q))
         """,
-    step=_dedent("""\
+    step=dedent("""\
         jac = Jf(q)
         njev += 1
         dq = None
@@ -396,7 +387,7 @@ NEWTON_SYSTEM_LOOP = Loop(
                 phi_t = None  # the whole step does not lower |Phi|: the method decides
                 nfev -= 1
         if phi_t is None:
-        """) + _indent(_FALLBACK.format(q="tuple(q)", phi="tuple(phi)")) + _dedent("""\
+        """) + indent(_FALLBACK.format(q="tuple(q)", phi="tuple(phi)")) + dedent("""\
             step, trial, phi_t = list(s.dq), list(s.x), list(s.phi_x)
         else:
             step = dq
@@ -433,7 +424,7 @@ NEWTON_2X2_LOOP = Loop(
         shrink = 1.0 - 1e-4
         tiny = 64.0 * _EPS
         """,
-    step=_dedent("""\
+    step=dedent("""\
         (a, b), (c, d) = Jf([x0, x1])
         njev += 1
         # |v| written "v if v > 0.0 else 0.0 - v": the same bits as abs (-0.0 included), no call
@@ -461,7 +452,7 @@ NEWTON_2X2_LOOP = Loop(
                         refused = True  # the whole step does not lower |Phi|: the method decides
                         nfev -= 1
         if refused:
-        """) + _indent(_FALLBACK.format(q="(x0, x1)", phi="(p0, p1)") + """\
+        """) + indent(_FALLBACK.format(q="(x0, x1)", phi="(p0, p1)") + """\
 d0, d1 = s.dq
 t0, t1 = s.x
 f0, f1 = s.phi_x
