@@ -167,9 +167,10 @@ def _same(a, b, label):
 def _generic_newton(f, fprime, x0, tol, rtol, max_iter):
     """Newton through the generic loop (`run`), bypassing the lean one."""
     from linkage.methods import Newton
-    from linkage.solve import _problem, check_criteria, finish
+    from linkage.solve import check_criteria
+    from linkage.solve.scalar import finish, problem_of
 
-    problem = _problem(f, fprime, None)
+    problem = problem_of(f, fprime, None)
     m = Newton()
     try:
         state = m.init(problem, x0)
@@ -312,6 +313,7 @@ def test_compiled_newton_two_equals_the_lean_loop():
     iterations and root, bit for bit, as newton_2x2 with the verdict, wherever it returns
     a result; it hands back (None) only runs that did not converge by whole steps."""
     from linkage.methods.newton_system import max_abs, newton_2x2
+    from linkage.methods.newton_two import newton_two_of
     from linkage.problems.system import LeanProblem
     from linkage.solve import system_verdict
 
@@ -335,7 +337,7 @@ def test_compiled_newton_two_equals_the_lean_loop():
             x, phi, _e, status, detail, k, _nf, _nj = newton_2x2(light, tuple(q), phi0, tol, 0.0, gate,
                                                                   50, False)
             status, _ = system_verdict(status, detail, max_abs(phi), gate)
-            got = model.newton_two(d, q[0], q[1], tol, gate, 50)
+            got = newton_two_of(model)(d, q[0], q[1], tol, gate, 50)
             if got is None:
                 handed_back += status.converged
                 continue

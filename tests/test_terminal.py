@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from linkage.methods import SCALAR_METHODS
 from pty_run import run
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
@@ -37,8 +38,7 @@ def _cells(text: str, timed: bool) -> list[str]:
         if not line.strip() or set(line.strip()) <= set("-━ "):
             continue
         words = line.split()
-        if timed and words and words[0] in ("bisection", "regula-falsi", "hybrid", "secant", "newton",
-                                             "fixed-point"):
+        if timed and words and words[0] in SCALAR_METHODS:
             words = words[:-1]
         out += [t for t in words if NUMBER.fullmatch(t) or t in STATUSES]
     return out

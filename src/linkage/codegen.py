@@ -17,6 +17,11 @@ constant angles are folded at compile time; terms with a constant length and ang
 fold into one number per equation. The source is generated from the model's numbers
 and indices only, never from user text, and can be printed (:func:`source`,
 ``LoopModel.source``) to inspect what runs.
+
+This is the model half of code generation (layer 1, beside problems/): straight-line
+residual and Jacobian code, no iteration. The loops that run on it are generated from the
+stopping rule in :mod:`linkage.iterate` (:mod:`linkage.methods.newton_two` for two
+unknowns), from the pieces :func:`model_pieces` returns.
 """
 
 from __future__ import annotations
@@ -39,11 +44,13 @@ def _angle_key(ai: int, ac: float, off: float) -> tuple[int, float]:
     return (ai, off) if ai != FIXED else (FIXED, ac + off)
 
 
-def source(terms: tuple[tuple[tuple[float, float, int, float, int, float], ...], ...], n: int,
-           newton: bool = False) -> str:
-    """The factory's source for a model's terms (see :class:`LoopModel`); ``newton``:
-    instead, for two unknowns, Newton-Raphson at one driver value as one function (see
-    :func:`_newton_two`)."""
+Terms = tuple[tuple[tuple[float, float, int, float, int, float], ...], ...]
+
+
+def model_pieces(terms: Terms, n: int) -> tuple[list[str], list[str], list[str], list[list[str]], list[str]]:
+    """The model as source pieces: (driver-only trigonometry lines for ``make(d)``,
+    unknown-angle trigonometry lines for each function, Phi's rows, J's rows (one
+    expression per entry), dPhi/d(driver)'s rows); expressions read ``q[i]`` and ``d``."""
     angles: dict[tuple[int, float], str] = {}
     pre: list[str] = []   # in make(d): driver-only trigonometry
     body: list[str] = []  # in each function: unknown-angle trigonometry
@@ -118,11 +125,14 @@ def source(terms: tuple[tuple[tuple[float, float, int, float, int, float], ...],
         return " + ".join(parts).replace("+ -", "- ") if parts else "0.0"
 
     f_rows = [total(p) for fx, fy in phi for p in (fx, fy)]
-    j_rows = ["[" + ", ".join(total(row.get(c, [])) for c in range(n)) + "]" for row in jac]
-    v_rows = [total(p) for p in dvd]
-    if newton:
-        return _newton_two(pre, body, f_rows, [[total(row.get(c, [])) for c in range(n)] for row in jac],
-                           v_rows)
+    j_entries = [[total(row.get(c, [])) for c in range(n)] for row in jac]
+    return pre, body, f_rows, j_entries, [total(p) for p in dvd]
+
+
+def source(terms: Terms, n: int) -> str:
+    """The factory's source for a model's terms (see :class:`LoopModel`)."""
+    pre, body, f_rows, j_entries, v_rows = model_pieces(terms, n)
+    j_rows = ["[" + ", ".join(row) + "]" for row in j_entries]
     lines = ["def make(d):", *pre]
     for name, rows in (("F", f_rows), ("J", j_rows), ("V", v_rows)):
         lines.append(f"    def {name}(q):")
@@ -137,93 +147,8 @@ def source(terms: tuple[tuple[tuple[float, float, int, float, int, float], ...],
     return "\n".join(lines) + "\n"
 
 
-def build(terms: Any, n: int, newton: bool = False) -> Callable[..., Any]:
-    """Compile the factory for a model's terms, or its Newton function (see :func:`source`)."""
+def build(terms: Terms, n: int) -> Callable[..., Any]:
+    """Compile the factory for a model's terms (see :func:`source`)."""
     namespace: dict[str, Any] = {"_cos": math.cos, "_sin": math.sin, "__builtins__": {}}
-    if newton:  # the stopping rules' constants, from where the other loops read them
-        from .iterate import DIVERGE_STREAK, ROUNDING, RUNAWAY, rounding_stall
-        from .methods.newton_system import SINGULAR_RATIO
-
-        namespace.update(__builtins__={"range": range}, _nan=math.nan, _inf=math.inf, _stall=rounding_stall,
-                         _RUNAWAY=RUNAWAY, _SINGULAR=SINGULAR_RATIO, _DIVERGE=DIVERGE_STREAK,
-                         _ROUNDING=ROUNDING)
-    exec(compile(source(terms, n, newton), "<linkage-model>", "exec"), namespace)
-    return namespace["newton2" if newton else "make"]  # type: ignore[no-any-return]
-
-
-# The convergence test below, "err <= tol and resid <= gate", is
-# linkage.rules.system_converged written in (the hottest loop; no call per iteration):
-# tests/test_compile.py holds this Newton equal, bit for bit, to
-# methods.newton_system.newton_2x2, which calls the rule.
-_NEWTON_TWO = """\
-def newton2(d, x0, x1, tol, gate, max_iter):
-    # Newton-Raphson on the loop equations at driver value d from (x0, x1), with damping
-    # off and recording off: the stopping rules of linkage.iterate as
-    # methods.newton_system.newton_2x2 applies them (the same operations in the same
-    # order). Returns (iterations, x0, x1, J row by row, dPhi/dv) at a root whose
-    # max|Phi| is within gate; None for any other outcome, which the caller hands to the
-    # full solver. |v| is written "v if v >= 0.0 else -v" (no call; NaN stays NaN).
-{pre}
-{point4}
-    prev_err = err = _inf
-    growth = stalls = rounding_steps = 0
-    a0 = x0 if x0 >= 0.0 else -x0
-    a1 = x1 if x1 >= 0.0 else -x1
-    runaway = _RUNAWAY * (1.0 + (_nan if a0 != a0 or a1 != a1 else (a0 if a0 >= a1 else a1)))
-    for k in range(1, max_iter + 1):
-        a0 = p0 if p0 >= 0.0 else -p0
-        a1 = p1 if p1 >= 0.0 else -p1
-        resid = (a0 if a0 >= a1 else a1) if a0 == a0 and a1 == a1 else _nan
-        ad = j00 * j11
-        bc = j01 * j10
-        det = ad - bc
-        size = (ad if ad >= 0.0 else -ad) + (bc if bc >= 0.0 else -bc)
-        if not (size > 0.0 and (det if det >= 0.0 else -det) > _SINGULAR * size and det - det == 0.0):
-            return None
-        h0 = (j01 * p1 - j11 * p0) / det
-        h1 = (j10 * p0 - j00 * p1) / det
-        x0 = x0 + h0
-        x1 = x1 + h1
-{point8}
-        e0 = h0 if h0 >= 0.0 else -h0
-        e1 = h1 if h1 >= 0.0 else -h1
-        err = (e0 if e0 >= e1 else e1) if e0 == e0 and e1 == e1 else _nan
-        if not (err - err == 0.0 and resid - resid == 0.0):
-            return None
-        if resid == 0.0 or (err <= tol and resid <= gate):
-            break
-        e0 = x0 if x0 >= 0.0 else -x0
-        e1 = x1 if x1 >= 0.0 else -x1
-        size_q = _nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
-        growth = growth + 1 if err > prev_err else 0
-        if growth >= _DIVERGE and size_q > runaway:
-            return None
-        if err <= _ROUNDING * size_q:
-            why, rounding_steps, stalls = _stall(err, prev_err, tol, rounding_steps, stalls)
-            if why is not None:
-                return None
-        prev_err = err
-    else:
-        return None
-    if not ((p0 if p0 >= 0.0 else -p0) <= gate and (p1 if p1 >= 0.0 else -p1) <= gate):
-        return None
-{velocity}
-    return k, x0, x1, j00, j01, j10, j11, w0, w1
-"""
-
-
-def _newton_two(pre: list[str], body: list[str], f_rows: list[str], j_rows: list[list[str]],
-                v_rows: list[str]) -> str:
-    """Newton for two unknowns with the model's Phi and J written in where it evaluates
-    them (each angle's trigonometry once per iterate), and dPhi/dv at the root (for the
-    continuation's next tangent)."""
-    def at(text: str) -> str:
-        return re.sub(r"q\[(\d+)\]", r"x\1", text)
-
-    values = [("p0", f_rows[0]), ("p1", f_rows[1]), ("j00", j_rows[0][0]), ("j01", j_rows[0][1]),
-              ("j10", j_rows[1][0]), ("j11", j_rows[1][1])]
-    point = [at(b.strip()) for b in body] + [f"{name} = {at(e)}" for name, e in values]
-    velocity = [f"w{i} = {at(e)}" for i, e in enumerate(v_rows)]
-    return _NEWTON_TWO.format(pre="\n".join(pre), point4="\n".join("    " + x for x in point),
-                              point8="\n".join("        " + x for x in point),
-                              velocity="\n".join("    " + x for x in velocity))
+    exec(compile(source(terms, n), "<linkage-model>", "exec"), namespace)
+    return namespace["make"]  # type: ignore[no-any-return]

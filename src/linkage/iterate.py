@@ -58,8 +58,6 @@ RUNAWAY = 1e8
 ROUNDING = 4.0 * sys.float_info.epsilon
 """Relative size of a step that is indistinguishable from rounding noise."""
 
-_isfinite = math.isfinite
-
 MAX_ITER_LIMIT = 100_000
 """The largest iteration cap accepted: a run that has not converged by then never will."""
 
@@ -135,6 +133,252 @@ def explain(exc: BaseException) -> tuple[Status, str]:
     return Status.DOMAIN_ERROR, str(exc) or type(exc).__name__
 
 
+# --- the ordered stopping rule, and the loops generated from it ----------------------------------
+#
+# Tests 2-8 above are written once, here, as source text (:func:`stopping_tests`). Every loop -
+# the generic one (:func:`run`), the methods' tight loops (Newton, the secant, fixed point,
+# bisection, Halley), the systems' Newton and the compiled models' Newton for two unknowns
+# (:mod:`linkage.methods.newton_two`) - is generated from it around the method's own step
+# (:class:`Loop`) and compiled once per process, so the order lives in one place and the tight
+# loops pay for no call per test. ``loop_source`` prints what runs.
+
+_CONVERGED_NAMES = frozenset({"CONVERGED_STEP", "CONVERGED_EXACT", "CONVERGED_RESIDUAL"})
+
+
+class Loop(NamedTuple):
+    """A method's part of a generated loop; the stopping tests are :func:`stopping_tests`'.
+
+    The step (``step``, inside the ``try`` whose arithmetic and domain errors end the run
+    as ``explain`` names them; then ``after``) leaves in ``x`` the new iterate, in ``fx``
+    its residual (``None`` when not evaluated; for a system max|Phi| at the point the step
+    was taken from) and in ``err`` the method's error measure; it may end the run itself
+    (test 1) with ``status, detail = ...; break``. ``setup`` runs before the loop and
+    must set ``x``, ``fx``, ``err`` (and ``best``, ``start`` with ``guard``, ``runaway``
+    with ``diverge == "runaway"``). A certifying loop calls ``certify(x, fx, limit)``.
+    """
+
+    signature: str
+    setup: str = ""
+    step: str = ""
+    after: str = ""
+    result: str = "x, fx, err, status, detail, k"
+    tail: str = ""
+    """Source after the loop in place of ``return result`` (which it must do itself)."""
+    fx_optional: bool = False
+    residual_test: bool = True
+    """Test 4, |f| <= ftol (scalar problems; a system's residual is part of test 5)."""
+    plausible: str = ""
+    """An expression: a small step is convergence only where it holds (test 5)."""
+    guard: bool = False
+    """The open scalar methods' guard (:func:`linkage.rules.worse_than_seen`, test 5)."""
+    step_test: str = "converged"
+    """Test 5's verdict on a small step: ``converged``, ``certify``, ``system`` (with the
+    residual gate) or ``minimizes`` (``system``, and a stall is a local minimum)."""
+    diverge: str = ""
+    """Test 6: ``""`` (a bracket cannot diverge), ``streak`` or ``runaway`` (systems)."""
+    diverge_when: str = ""
+    """An expression: test 6 runs only where it holds (``not damped``)."""
+    magnitude: str = "(x if x >= 0.0 else -x)"
+    limit: str = "_step_limit(tol, rtol, ax) if rtol else tol"
+    failure: str = ""
+    """When given, every stop other than convergence runs this line instead (``return None``)."""
+
+
+class _Emitter:
+    """Lines of loop source at the loop body's indentation, and a stop as ``loop`` says."""
+
+    def __init__(self, loop: Loop) -> None:
+        self.loop = loop
+        self.lines: list[str] = []
+
+    def put(self, level: int, text: str) -> None:
+        self.lines.append("    " * (level + 2) + text)
+
+    def stop(self, level: int, status: str, detail: str = '""') -> None:
+        if self.loop.failure and status not in _CONVERGED_NAMES:
+            self.put(level, self.loop.failure)
+            return
+        self.put(level, f"status, detail = _S.{status}, {detail}")
+        self.put(level, "break")
+
+
+def stopping_tests(loop: Loop) -> list[str]:
+    """Tests 2-8 of the module docstring, in order, as the body of the loop after a step
+    (indented for it), for ``loop``'s options."""
+    out = _Emitter(loop)
+    _value_tests(out)
+    _step_test(out)
+    _growth_tests(out)
+    return out.lines
+
+
+def _value_tests(out: _Emitter) -> None:
+    """2. a non-finite error or residual; 3. an exact zero; 4. the residual test."""
+    loop, put, stop = out.loop, out.put, out.stop
+    # v - v is 0.0 for a finite float, NaN otherwise
+    put(0, "if type(err) is float and type(fx) is float:")
+    put(1, "finite = err - err == 0.0 and fx - fx == 0.0")
+    put(0, "else:")
+    put(1, "try:")
+    put(2, "finite = _isfinite(err) and (fx is None or _isfinite(fx))")
+    put(1, "except TypeError:  # e.g. (-8) ** (1/3) in a user's function is complex in Python")
+    stop(2, "DOMAIN_ERROR", 'f"f returned a non-real value: {fx!r}"')
+    put(0, "if not finite:")
+    stop(1, "NON_FINITE", 'f"error = {err!r}, residual = {fx!r}"')
+    level = 0
+    if loop.fx_optional:
+        put(0, "if fx is not None:")
+        level = 1
+    put(level, "if fx == 0.0:")
+    stop(level + 1, "CONVERGED_EXACT")
+    if loop.residual_test:
+        put(level, "size = fx if fx >= 0.0 else -fx")
+        put(level, "if ftol is not None and size <= ftol:")
+        stop(level + 1, "CONVERGED_RESIDUAL")
+
+
+def _step_test(out: _Emitter) -> None:
+    """5. the step test, with the method's plausibility and the open methods' guard."""
+    loop, put, stop = out.loop, out.put, out.stop
+    put(0, f"ax = {loop.magnitude}")
+    put(0, f"limit = {loop.limit}")
+    if loop.plausible:
+        put(0, f"if err <= limit and not ({loop.plausible}):")
+        put(1, "limit = -1.0  # the method's own evidence says the small step is not convergence")
+    if loop.guard:
+        level = 0
+        if loop.fx_optional:
+            put(0, "if fx is not None:")
+            level = 1
+            put(1, "size = fx if fx >= 0.0 else -fx")
+        # a small step to a point worse than one already seen, still of the order of the
+        # start's |f|, is not convergence: the slope came from far away
+        put(level, "if err <= limit and _worse(size, best, start):")
+        put(level + 1, "limit = -1.0")
+        put(level, "elif size < best:")
+        put(level + 1, "best = size")
+    put(0, "if err <= limit:")
+    if loop.step_test == "converged":
+        stop(1, "CONVERGED_STEP")
+    elif loop.step_test == "certify":
+        put(1, "verdict, why = certify(x, fx, limit)")
+        put(1, "verdict, why, uncertified = _judge(verdict, why, uncertified)")
+        put(1, "if verdict is not None:")
+        put(2, "status, detail = verdict, why")
+        put(2, "break")
+    else:  # systems: the step and the residual (linkage.rules.system_converged)
+        put(1, "if fx is not None and _system_converged(err, fx, limit, gate):")
+        stop(2, "CONVERGED_STEP")
+        if loop.step_test == "minimizes":
+            stop(1, "LOCAL_MINIMUM", 'f"the least-squares residual stalls at {abs(fx or _nan):.3g}, '
+                                     'above the tolerance {gate:.3g}"')
+
+
+def _growth_tests(out: _Emitter) -> None:
+    """6. divergence; 7. rounding noise that stops shrinking (8, the cap, is the loop's end)."""
+    loop, put, stop = out.loop, out.put, out.stop
+    if loop.diverge:
+        level = 0
+        if loop.diverge_when:
+            put(0, f"if {loop.diverge_when}:")
+            level = 1
+        put(level, "growth = growth + 1 if err > prev_err else 0")
+        far = " and ax > runaway" if loop.diverge == "runaway" else ""
+        put(level, f"if growth >= _DIVERGE{far}:")
+        stop(level + 1, "DIVERGED", 'f"{growth} growing steps, last {err:.3g}"')
+    put(0, "if err <= _ROUNDING * ax:")
+    put(1, "why, rounding_steps, stalls = _stall(err, prev_err, limit, rounding_steps, stalls)")
+    put(1, "if why is not None:")
+    stop(2, "PRECISION_LIMIT", "why")
+    put(0, "prev_err = err")
+
+
+def dedent(text: str) -> str:
+    """``text`` without the indentation its non-blank lines share (textwrap.dedent's
+    result for source fragments, without importing textwrap at a solve's start)."""
+    lines = text.splitlines()
+    margin = min((len(line) - len(line.lstrip()) for line in lines if line.strip()), default=0)
+    end = "\n" if text.endswith("\n") else ""
+    return "\n".join(line[margin:] if line.strip() else "" for line in lines) + end
+
+
+def indent(text: str) -> str:
+    """``text`` indented by one level (4 spaces) on its non-blank lines."""
+    end = "\n" if text.endswith("\n") else ""
+    return "\n".join("    " + line if line.strip() else "" for line in text.splitlines()) + end
+
+
+def _block(text: str, level: int) -> list[str]:
+    """Dedented ``text`` re-indented to ``level`` (4 spaces each)."""
+    return [("    " * level + line) if line.strip() else "" for line in dedent(text).splitlines()]
+
+
+def loop_source(loop: Loop) -> str:
+    """The source of the function ``loop`` describes: its setup, then for k = 1..max_iter
+    its step and the ordered stopping tests, then test 8 (the cap) and its result."""
+    lines = [f"def {loop.signature}:", *_block(loop.setup, 1),
+             '    status, detail = _S.MAX_ITER, ""',
+             "    prev_err = _inf",
+             "    growth = uncertified = stalls = rounding_steps = k = 0",
+             "    for k in range(1, max_iter + 1):",
+             "        try:", *_block(loop.step, 3),
+             "        except (ArithmeticError, ValueError) as exc:"]
+    if loop.failure:
+        lines.append("            " + loop.failure)
+    else:
+        lines += ["            status, detail = _explain(exc)", "            k -= 1", "            break"]
+    lines += _block(loop.after, 2)
+    lines += stopping_tests(loop)
+    lines += _block(loop.tail, 1) if loop.tail else [f"    return {loop.result}"]
+    return "\n".join(lines) + "\n"
+
+
+def build_loop(loop: Loop, names: dict[str, Any] | None = None) -> Callable[..., Any]:
+    """Compile ``loop``; ``names``: what its step reads besides the stopping tests' own."""
+    namespace: dict[str, Any] = {
+        "_S": Status, "_inf": math.inf, "_nan": math.nan, "_isfinite": math.isfinite,
+        "_explain": explain, "_judge": judge_certificate, "_stall": rounding_stall,
+        "_worse": worse_than_seen, "_step_limit": step_limit, "_system_converged": system_converged,
+        "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_RUNAWAY": RUNAWAY, **(names or {})}
+    name = loop.signature.split("(", 1)[0]
+    exec(compile(loop_source(loop), f"<linkage-loop {name}>", "exec"), namespace)
+    return namespace[name]  # type: ignore[no-any-return]
+
+
+# --- the generic loop -------------------------------------------------------------------------
+
+def generic_loop(can_diverge: bool, needs_residual: bool, minimizes: bool, plausible: bool,
+                 certify: bool) -> Loop:
+    """The generic loop for a method's flags: its step is ``method.step`` on a state."""
+    return Loop(
+        signature="generic(step, row, rows, index0, problem, state, tol, rtol, ftol, gate, max_iter, "
+                  "plausible, magnitude, certify, best, start, runaway)",
+        setup="x, fx, err = state.x, state.fx, state.err",
+        step="new = step(problem, state)",
+        after="""\
+            state = new
+            if rows is not None:
+                rows.add(row(problem, state, k + index0))
+            if state.stop is not None:
+                status, detail = state.stop
+                break
+            x, fx, err = state.x, state.fx, state.err
+            """,
+        result="state, status, detail, k",
+        fx_optional=True,
+        residual_test=not needs_residual,
+        plausible="plausible(state)" if plausible else "",
+        guard=can_diverge and not needs_residual,
+        step_test=("minimizes" if minimizes else "system") if needs_residual else
+                  ("certify" if certify else "converged"),
+        diverge=("runaway" if needs_residual else "streak") if can_diverge else "",
+        magnitude="magnitude(x)",
+    )
+
+
+_GENERIC: dict[tuple[bool, ...], Callable[..., Any]] = {}
+
+
 def run(
     method: Any,
     problem: Any,
@@ -143,13 +387,14 @@ def run(
     *,
     record: bool,
     magnitude: Callable[[Any], float] = abs,
-    certify: Callable[[Any, float], tuple[Status, str]] | None = None,
+    certify: Callable[[float, Any, float], tuple[Status, str]] | None = None,
 ) -> Outcome:
     """Iterate ``method.step`` from ``state`` until a stopping test fires.
 
     States are tuples with at least the fields ``x``, ``fx`` (residual, ``None`` when
     not evaluated), ``err`` (the method's error measure, >= 0) and ``stop`` (``None`` or
-    a ``(Status, detail)`` pair set by the step).
+    a ``(Status, detail)`` pair set by the step). ``certify(x, fx, limit)`` judges an open
+    method's small step (test 5).
     """
     rows: Rows | None = None
     if record:
@@ -157,103 +402,20 @@ def run(
         first = method.initial_row(problem, state)
         if first is not None:
             rows.add(first)
-    step = method.step
-    row = method.row
-    index0 = method.first_index - 1
-    tol, rtol, ftol = crit.tol, crit.rtol, crit.ftol
     needs_residual = method.needs_residual
-    minimizes = getattr(method, "minimizes", False)
-    gate = (ftol if ftol is not None else tol) if needs_residual else math.inf
-    can_diverge = method.can_diverge
-    prev_err = math.inf
-    check_best = can_diverge and not needs_residual  # the open scalar methods
     plausible = getattr(method, "plausible", None)
+    flags = (method.can_diverge, needs_residual, getattr(method, "minimizes", False), plausible is not None,
+             certify is not None)
+    loop = _GENERIC.get(flags)
+    if loop is None:
+        loop = _GENERIC[flags] = build_loop(generic_loop(*flags))
+    ftol = crit.ftol
+    gate = (ftol if ftol is not None else crit.tol) if needs_residual else math.inf
     seen = [abs(v) for v in (state.fx, getattr(state, "fxp", None)) if isinstance(v, float) and v == v]
-    best_fx = min(seen) if seen else math.inf
-    start_fx = max(seen) if seen else math.inf
-    growth = 0
+    best = min(seen) if seen else math.inf
+    start = max(seen) if seen else math.inf
     runaway = RUNAWAY * (1.0 + magnitude(state.x))
-    uncertified = 0
-    stalls = 0
-    rounding_steps = 0
-    status = Status.MAX_ITER
-    detail = ""
-    k = 0
-    for k in range(1, crit.max_iter + 1):
-        try:
-            new = step(problem, state)
-        except (ArithmeticError, ValueError) as exc:
-            status, detail = explain(exc)
-            k -= 1
-            break
-        state = new
-        if rows is not None:
-            rows.add(row(problem, state, k + index0))
-        if state.stop is not None:
-            status, detail = state.stop
-            break
-        err = state.err
-        fx = state.fx
-        try:
-            finite = _isfinite(err) and (fx is None or _isfinite(fx))
-        except TypeError:
-            # e.g. (-8) ** (1/3) in a user's function is complex in Python
-            status, detail = Status.DOMAIN_ERROR, f"f returned a non-real value: {fx!r}"
-            break
-        if not finite:
-            status, detail = Status.NON_FINITE, f"error = {err!r}, residual = {fx!r}"
-            break
-        if fx is not None:
-            if fx == 0.0:
-                status, detail = Status.CONVERGED_EXACT, ""
-                break
-            if ftol is not None and not needs_residual and abs(fx) <= ftol:
-                status = Status.CONVERGED_RESIDUAL
-                break
-        x = state.x
-        limit = step_limit(tol, rtol, magnitude(x)) if rtol else tol
-        if err <= limit and plausible is not None and not plausible(state):
-            limit = -1.0  # the method's own evidence says the small step is not convergence
-        if check_best and fx is not None:
-            size = abs(fx)
-            if err <= limit and worse_than_seen(size, best_fx, start_fx):
-                # A small step to a point worse than one already seen, with a residual
-                # still of the order of the start's, is not convergence: the slope came
-                # from far away (a secant chord through a huge f). Differences at rounding
-                # level are allowed. Iterate on; a stall ends as precision_limit.
-                limit = -1.0
-            elif size < best_fx:
-                best_fx = size
-        if err <= limit:
-            # systems: the step and the residual (linkage.rules, the one definition)
-            if needs_residual and not (fx is not None and system_converged(err, abs(fx), limit, gate)):
-                if minimizes:
-                    status = Status.LOCAL_MINIMUM
-                    detail = (f"the least-squares residual stalls at {abs(fx or math.nan):.3g}, "
-                              f"above the tolerance {gate:.3g}")
-                    break
-            elif certify is not None:
-                stop, why, uncertified = judge_certificate(*certify(state, limit), uncertified)
-                if stop is not None:
-                    status, detail = stop, why
-                    break
-            else:
-                # The detail is formatted later from the result's fields: formatting here
-                # would cost more than a whole Newton step.
-                status = Status.CONVERGED_STEP
-                break
-        if can_diverge:
-            growth = growth + 1 if err > prev_err else 0
-            # a system's Newton may wander and recover (MGH, a mechanism far from its
-            # assembly): only iterates running away are evidence of divergence
-            if growth >= DIVERGE_STREAK and (not needs_residual or magnitude(x) > runaway):
-                status, detail = Status.DIVERGED, f"{growth} growing steps, last {err:.3g}"
-                break
-        if err <= ROUNDING * magnitude(x):
-            # Rounding noise: the error can no longer shrink in double precision.
-            why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
-            if why is not None:
-                status, detail = Status.PRECISION_LIMIT, why
-                break
-        prev_err = err
+    state, status, detail, k = loop(method.step, method.row, rows, method.first_index - 1, problem, state,
+                                    crit.tol, crit.rtol, ftol, gate, crit.max_iter, plausible, magnitude,
+                                    certify, best, start, runaway)
     return state, status, detail, k, rows

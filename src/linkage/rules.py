@@ -88,6 +88,33 @@ def system_converged_array(err: Any, resid: Any, limit: Any, gate: Any) -> Any:
     return (err <= limit) & (resid <= gate)
 
 
+# --- the singularity test -----------------------------------------------------------------------
+
+SINGULAR_RATIO = 1e-12
+"""Smallest |det J| / (|ad| + |bc|) of a 2x2 J, or smallest / largest |pivot| of an
+equilibrated LU, before a Newton step is refused as singular."""
+
+
+def invertible(det: float, size: float) -> bool:
+    """A 2x2 J = [[a, b], [c, d]] is usable for a Newton step: |det| > SINGULAR_RATIO x
+    size with size = |ad| + |bc| (invariant under row and column scaling). Since
+    |fl(ad - bc)| <= fl(|ad| + |bc|), this fails for size 0, a NaN and an overflow alike."""
+    return abs(det) > SINGULAR_RATIO * size
+
+
+def invertible_array(det: Any, size: Any) -> Any:
+    """:func:`invertible` position by position (numpy booleans)."""
+    import numpy as np
+
+    return np.abs(det) > SINGULAR_RATIO * size
+
+
+def pivots_invertible(ratio: float) -> bool:
+    """An n x n J is usable: the equilibrated LU's smallest/largest |pivot| is at least
+    SINGULAR_RATIO (NaN fails)."""
+    return ratio >= SINGULAR_RATIO
+
+
 # --- the open scalar methods' guard on a small step ---------------------------------------------
 
 FAR_SLOPE = 1e-8

@@ -18,23 +18,16 @@ from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
 from ..errors import InputError
+from ..methods import GOLDEN, METHODS
 from ..problems.scalar import ScalarProblem
 from ..result import Result
 
-GOLDEN = (1.0 + math.sqrt(5.0)) / 2.0
 ROUNDING_LEVEL = 8.0 * sys.float_info.epsilon
 """Errors below this times |x| are marked as rounding noise and left out of estimates."""
 
-THEORETICAL_ORDER: dict[str, float] = {
-    "bisection": 1.0,
-    "fixed-point": 1.0,
-    "regula-falsi": 3.0 ** (1.0 / 3.0),
-    "hybrid": 1.839,
-    "secant": GOLDEN,
-    "newton": 2.0,
-    "newton-fd": 2.0,
-    "lm": 2.0,
-}
+THEORETICAL_ORDER: dict[str, float] = {**{name: e.order for name, e in METHODS.items()},
+                                        "newton-fd": 2.0, "lm": 2.0}
+"""Each method's order near a simple root: the scalar methods' from their registry entries."""
 
 
 # A NamedTuple, not a frozen dataclass: built once per class at import, it costs
@@ -77,9 +70,9 @@ class Convergence:
         }
 
 
-ESTIMATE_COLUMN = {"regula-falsi": 5, "hybrid": 4}
-"""For these methods the bracket width jumps whenever the far end moves, so the
-estimates use |x_k - x_final| from the column of best estimates instead."""
+ESTIMATE_COLUMN = {name: e.estimate_column for name, e in METHODS.items() if e.estimate_column is not None}
+"""For these methods (their registry entries say so) the bracket width jumps whenever the
+far end moves, so the estimates use |x_k - x_final| from the column of best estimates."""
 
 
 def _errors(result: Result) -> list[tuple[Any, float]]:

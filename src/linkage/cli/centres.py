@@ -80,10 +80,9 @@ def centres(
     ic = as_given(centres_at(pose), mechanism, converted)
     cd = None
     if centrodes:
-        from ..arguments import driver_span
+        from ..arguments import check_number, driver_span
         from ..kinematics.centrodes import centrodes as run_centrodes
         from ..kinematics.sweep import driver_values
-        from ..solve import check_number
 
         a, b = driver_span(mechanism, start, stop)
         if step is not None and not check_number("--step", step) > 0:

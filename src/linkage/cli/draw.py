@@ -38,11 +38,11 @@ def draw(
 
     Example: linkage draw sample_inputs/fourbar_me581.toml --set theta2=80 -o fourbar.png
     """
-    from ..arguments import check_fps, driver_span
+    from ..arguments import check_fps, check_number, driver_span
     from ..kinematics.loading import load
     from ..kinematics.sweep import driver_values
     from ..kinematics.sweep import sweep as run_sweep
-    from ..solve import check_number, solve_system
+    from ..solve import solve_system
 
     if output is None and animate is None:
         raise InputError("give -o PATH for a drawing, --animate PATH.gif for an animation, or both")

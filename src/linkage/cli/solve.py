@@ -105,9 +105,10 @@ def solve(
     Example: linkage solve sample_inputs/fourbar_me581.toml --set theta2=80
     """
     from ..analysis.convergence import analyze
+    from ..arguments import check_number
     from ..methods import BRACKETING, SCALAR_METHODS
     from ..problems.seed_equation import applicable, fourbar_coefficients, fourbar_info, scalar_problem
-    from ..solve import check_criteria, check_number, solve_scalar
+    from ..solve import check_criteria, solve_scalar
 
     out_fmt = choose_format(fmt, output)
     check_paths([file], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})

@@ -91,12 +91,12 @@ def sweep(
 
     Example: linkage sweep --from 10 --to 160 --step 30
     """
-    from ..arguments import driver_span, parse_motion
+    from ..arguments import check_number, driver_span, parse_motion
     from ..kinematics.loading import load
     from ..kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
     from ..render.sweep import sweep_report
     from ..render.writers import data_formats, is_data, prefetch
-    from ..solve import SYSTEM_METHODS, check_criteria, check_number
+    from ..solve import SYSTEM_METHODS, check_criteria
 
     out_fmt = choose_format(fmt, output)
     check_paths([file], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})

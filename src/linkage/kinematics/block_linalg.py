@@ -92,7 +92,7 @@ def direction_np(jac: Any, phi: Any) -> tuple[Any, Any]:
     against SINGULAR_RATIO, then the LU of J as given."""
     import numpy as np
 
-    from ..methods.newton_system import SINGULAR_RATIO
+    from ..rules import SINGULAR_RATIO, invertible_array
 
     n = jac.shape[-1]
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
@@ -101,7 +101,7 @@ def direction_np(jac: Any, phi: Any) -> tuple[Any, Any]:
             p0, p1 = phi[..., 0], phi[..., 1]
             det = a * d - b * c
             size = np.abs(a * d) + np.abs(b * c)
-            ok = (size > 0.0) & (np.abs(det) > SINGULAR_RATIO * size) & np.isfinite(det)
+            ok = (size > 0.0) & invertible_array(det, size) & np.isfinite(det)
             dq = np.stack([(b * p1 - d * p0) / det, (c * p0 - a * p1) / det], axis=-1)
         else:
             rows = [[jac[..., i, j] for j in range(n)] for i in range(n)]

@@ -28,6 +28,7 @@ from typing import Any
 
 from ..linalg import SingularMatrix, det_from_lu, lu, lu_solve, lu_two
 from ..methods.newton_system import max_abs, newton_system_lean
+from ..methods.newton_two import newton_two_of
 from ..problems.derive import parse_signs, read_branch
 from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..problems.system import LeanProblem
@@ -68,7 +69,7 @@ class Solver:
         self.two = len(self.names) == 2 and self.step_scales is None and len(m.loops) == 1
         # (v, q0, q1, LU of J, dPhi/dv) where step_two last solved: the next tangent
         self.solved_at: tuple[float, float, float, Any, float, float] | None = None
-        self.newton_two = self.model.newton_two if self.two else None
+        self.newton_two = newton_two_of(self.model) if self.two else None
 
     def compiled(self, value: float) -> Any:
         """(F, J, dPhi/dv) at a driver value (display units), the last one kept: a

@@ -145,10 +145,10 @@ def singular_of(jac: list[list[Any]], det: np.ndarray) -> np.ndarray:
     SINGULAR_RATIO times |ad| + |bc| (invariant under row and column scaling), or not
     finite. A larger J: det J zero or not finite (the scalar's equilibrated-pivot test has
     no numpy twin yet)."""
-    from ..methods.newton_system import SINGULAR_RATIO
+    from ..rules import invertible_array
 
     with np.errstate(invalid="ignore", over="ignore"):
         if len(jac) == 2 and len(jac[0]) == 2:
             (a, b), (c, d) = jac
-            return ~(np.abs(det) > SINGULAR_RATIO * (np.abs(a * d) + np.abs(b * c))) | ~np.isfinite(det)
+            return ~invertible_array(det, np.abs(a * d) + np.abs(b * c)) | ~np.isfinite(det)
         return ~np.isfinite(det) | (det == 0.0)

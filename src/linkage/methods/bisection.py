@@ -13,15 +13,13 @@ c, e = (b - a) / 2.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import ROUNDING, explain, rounding_stall
+from ..iterate import Loop, build_loop
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
-from ..rules import step_limit
-from ._common import new_state, same_sign
+from .common import new_state, same_sign
 
 
 class BisectionState(NamedTuple):
@@ -105,51 +103,27 @@ class Bisection:
 
     def run_lean(self, problem: ScalarProblem, s: BisectionState, crit: Any,
                  certify: Any = None) -> tuple[BisectionState, Status, str, int]:
-        """Bisection with recording off, as one tight loop with the generic loop's stopping
-        rules for a bracketing method (:mod:`linkage.iterate`): the same outcome, without
-        a state per step (tests/test_compile.py checks it on the stress battery)."""
-        f = problem.f
-        a, fa, b, fb = s.a, s.fa, s.b, s.fb
-        x, fx, err = s.x, s.fx, s.err
-        tol, rtol, ftol = crit.tol, crit.rtol, crit.ftol
-        prev_err = math.inf
-        stalls = rounding_steps = k = 0
-        status, detail = Status.MAX_ITER, ""
-        for k in range(1, crit.max_iter + 1):
-            c = 0.5 * a + 0.5 * b
-            try:
-                fc = f(c)
-            except (ArithmeticError, ValueError) as exc:
-                status, detail = explain(exc)
-                k -= 1
-                break
-            x, fx, err = c, fc, 0.5 * (b - a)
-            if same_sign(fc, fa):
-                a, fa = c, fc
-            else:
-                b, fb = c, fc
-            try:
-                finite = math.isfinite(err) and math.isfinite(fx)
-            except TypeError:
-                status, detail = Status.DOMAIN_ERROR, f"f returned a non-real value: {fx!r}"
-                break
-            if not finite:
-                status, detail = Status.NON_FINITE, f"error = {err!r}, residual = {fx!r}"
-                break
-            if fx == 0.0:
-                status = Status.CONVERGED_EXACT
-                break
-            if ftol is not None and abs(fx) <= ftol:
-                status = Status.CONVERGED_RESIDUAL
-                break
-            limit = step_limit(tol, rtol, abs(x)) if rtol else tol
-            if err <= limit:
-                status = Status.CONVERGED_STEP
-                break
-            if err <= ROUNDING * abs(x):
-                why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
-                if why is not None:
-                    status, detail = Status.PRECISION_LIMIT, why
-                    break
-            prev_err = err
-        return (BisectionState(x, fx, err, None, a, fa, b, fb, a, fa, b, fb), status, detail, k)
+        """Bisection with recording off: :data:`BISECTION_LOOP`, the generic loop's outcome
+        without a state per step (tests/test_compile.py, tests/test_kernel.py)."""
+        return bisection_lean(problem, s.a, s.fa, s.b, s.fb, s.x, s.fx, s.err, crit.tol, crit.rtol,
+                              crit.ftol, crit.max_iter)
+
+
+BISECTION_LOOP = Loop(
+    signature="bisection_lean(problem, a, fa, b, fb, x, fx, err, tol, rtol, ftol, max_iter)",
+    setup="f = problem.f",
+    step="""\
+        c = 0.5 * a + 0.5 * b
+        fc = f(c)
+        """,
+    after="""\
+        x, fx, err = c, fc, 0.5 * (b - a)
+        if _same_sign(fc, fa):
+            a, fa = c, fc
+        else:
+            b, fb = c, fc
+        """,
+    result="_State(x, fx, err, None, a, fa, b, fb, a, fa, b, fb), status, detail, k")
+"""Bisection's loop: the stopping rule of :mod:`linkage.iterate` around halving the bracket."""
+
+bisection_lean = build_loop(BISECTION_LOOP, {"_State": BisectionState, "_same_sign": same_sign})

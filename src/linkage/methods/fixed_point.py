@@ -14,15 +14,13 @@ g'(x_i), error = x_i - x_{i+1} (signed).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import DIVERGE_STREAK, ROUNDING, explain, judge_certificate, rounding_stall
+from ..iterate import Loop, build_loop
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
-from ..rules import step_limit, worse_than_seen
-from ._common import display, new_state
+from .common import display, new_state
 
 
 class FixedPointState(NamedTuple):
@@ -71,65 +69,10 @@ class FixedPoint:
 
     def run_lean(self, problem: ScalarProblem, s: FixedPointState, crit: Any,
                  certify: Any) -> tuple[FixedPointState, Status, str, int]:
-        """Fixed-point iteration with recording off, as one tight loop with the generic
-        loop's stopping rules for an open method and the certification: the same outcome
-        (tests/test_compile.py)."""
-        f, g = problem.f, problem.g
-        evaluate_f = self.evaluate_f
-        x, fx, err, xp = s.x, s.fx, s.err, s.xp
-        tol, rtol, ftol = crit.tol, crit.rtol, crit.ftol
-        best = start = abs(fx) if isinstance(fx, float) and fx == fx else math.inf
-        prev_err = math.inf
-        growth = uncertified = stalls = rounding_steps = k = 0
-        status, detail = Status.MAX_ITER, ""
-        for k in range(1, crit.max_iter + 1):
-            try:
-                x1 = g(x)  # type: ignore[misc]
-                fx1 = f(x1) if evaluate_f else None
-            except (ArithmeticError, ValueError) as exc:
-                status, detail = explain(exc)
-                k -= 1
-                break
-            xp, x, fx, err = x, x1, fx1, abs(x - x1)
-            try:
-                finite = math.isfinite(err) and (fx is None or math.isfinite(fx))
-            except TypeError:
-                status, detail = Status.DOMAIN_ERROR, f"f returned a non-real value: {fx!r}"
-                break
-            if not finite:
-                status, detail = Status.NON_FINITE, f"error = {err!r}, residual = {fx!r}"
-                break
-            if fx is not None:
-                if fx == 0.0:
-                    status = Status.CONVERGED_EXACT
-                    break
-                if ftol is not None and abs(fx) <= ftol:
-                    status = Status.CONVERGED_RESIDUAL
-                    break
-            limit = step_limit(tol, rtol, abs(x)) if rtol else tol
-            if fx is not None:
-                size = abs(fx)
-                if err <= limit and worse_than_seen(size, best, start):
-                    limit = -1.0
-                elif size < best:
-                    best = size
-            if err <= limit:
-                verdict, why = certify(FixedPointState(x, fx, err, None, xp), limit)
-                stop, why, uncertified = judge_certificate(verdict, why, uncertified)
-                if stop is not None:
-                    status, detail = stop, why
-                    break
-            growth = growth + 1 if err > prev_err else 0
-            if growth >= DIVERGE_STREAK:
-                status, detail = Status.DIVERGED, f"{growth} growing steps, last {err:.3g}"
-                break
-            if err <= ROUNDING * abs(x):
-                why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
-                if why is not None:
-                    status, detail = Status.PRECISION_LIMIT, why
-                    break
-            prev_err = err
-        return FixedPointState(x, fx, err, None, xp), status, detail, k
+        """Fixed-point iteration with recording off: :data:`FIXED_POINT_LOOP`, the generic
+        loop's outcome (tests/test_compile.py, tests/test_kernel.py)."""
+        return fixed_point_lean(problem, s.x, s.fx, s.err, s.xp, self.evaluate_f, crit.tol, crit.rtol,
+                                crit.ftol, crit.max_iter, certify)
 
     def initial_row(self, problem: ScalarProblem, s: FixedPointState) -> None:
         return None
@@ -144,3 +87,21 @@ class FixedPoint:
             out.append(display(problem.gprime, xp))
         out.append(xp - s.x)
         return tuple(out)
+
+
+FIXED_POINT_LOOP = Loop(
+    signature="fixed_point_lean(problem, x, fx, err, xp, evaluate_f, tol, rtol, ftol, max_iter, certify)",
+    setup="""\
+        f, g = problem.f, problem.g
+        best = start = abs(fx) if isinstance(fx, float) and fx == fx else _inf
+        """,
+    step="""\
+        x1 = g(x)
+        fx1 = f(x1) if evaluate_f else None
+        """,
+    after="xp, x, fx, err = x, x1, fx1, abs(x - x1)",
+    result="_State(x, fx, err, None, xp), status, detail, k",
+    fx_optional=True, guard=True, step_test="certify", diverge="streak")
+"""Fixed-point iteration's loop: the stopping rule of :mod:`linkage.iterate` around x = g(x)."""
+
+fixed_point_lean = build_loop(FIXED_POINT_LOOP, {"_State": FixedPointState})

@@ -20,8 +20,8 @@ from typing import Any, ClassVar, NamedTuple
 
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
-from ._common import new_state
 from .bisection import init_bracket
+from .common import new_state
 
 _EPS = sys.float_info.epsilon
 

@@ -19,7 +19,7 @@ from typing import Any, ClassVar, NamedTuple
 from ..linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve
 from ..problems.system import SystemProblem
 from ..result import Column, Status
-from ._common import new_state
+from .common import new_state
 from .newton_system import (
     fd_jacobian,
     max_abs,

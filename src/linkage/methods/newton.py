@@ -12,15 +12,13 @@ Rows follow the student report (docs/worked_examples.md P2): i, x_i, f(x_i), f'(
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import DIVERGE_STREAK, ROUNDING, explain, judge_certificate, rounding_stall
+from ..iterate import HISTORY_HEAD, Loop, build_loop
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
-from ..rules import step_limit, worse_than_seen
-from ._common import new_state
+from .common import new_state, start_stop
 
 
 class NewtonState(NamedTuple):
@@ -55,11 +53,7 @@ class Newton:
 
     def init(self, problem: ScalarProblem, x0: float) -> NewtonState:
         fx = problem.f(x0)
-        stop = None
-        if fx == 0.0:
-            stop = (Status.CONVERGED_EXACT, f"f is zero at the start {problem.var} = {x0!r}")
-        elif fx != fx or abs(fx) == float("inf"):
-            stop = (Status.NON_FINITE, f"f({problem.var}={x0:g}) = {fx!r}")
+        stop = start_stop(problem, x0, fx)
         return NewtonState(x0, fx, float("inf"), stop, x0, fx, float("nan"))
 
     def step(self, problem: ScalarProblem, s: NewtonState) -> NewtonState:
@@ -83,85 +77,46 @@ class Newton:
         return (i, s.xp, s.fxp, s.dfxp, s.x, s.err)
 
 
-def newton_lean(problem: ScalarProblem, x0: float, tol: float, rtol: float, ftol: float | None,
-                max_iter: int, certify: Any,
-                rows: Any = None) -> tuple[float, float, float, Status, str, int]:
-    """Newton as one tight loop: the generic loop's stopping rules for this method
-    (:mod:`linkage.iterate`, tests 1-8, in order) written out without states or method
-    dispatch. Gives the generic loop's status, root, iteration count and, when ``rows``
-    (an :class:`~linkage.iterate.Rows`) is given, its table row for row
-    (tests/test_compile.py checks both on the stress battery; the worked examples' tables use it).
-
-    Returns (x, f(x), last error, status, detail, iterations); ``certify(x, fx, width)``
-    decides a small step as in the generic loop.
-    """
-    add = rows.add if rows is not None else None
-    f, fp = problem.f, problem.fprime
-    isfinite = math.isfinite
-    x = x0
-    fx = f(x)
-    if fx == 0.0:
-        return x, fx, math.inf, Status.CONVERGED_EXACT, f"f is zero at the start {problem.var} = {x0!r}", 0
-    if fx != fx or abs(fx) == math.inf:
-        return x, fx, math.inf, Status.NON_FINITE, f"f({problem.var}={x0:g}) = {fx!r}", 0
-    best = start = abs(fx) if isinstance(fx, float) else math.inf
-    prev_err = math.inf
-    err = math.inf
-    growth = uncertified = stalls = rounding_steps = 0
-    k = 0
-    for k in range(1, max_iter + 1):
-        try:
-            d = fp(x)  # type: ignore[misc]
-            if d == 0.0:
-                if add is not None:
-                    add((k, x, fx, d, None, None))
-                return (x, fx, math.nan, Status.ZERO_DERIVATIVE,
-                        f"f'({problem.var}) = 0 at {problem.var} = {x!r}, f = {fx:.6g}", k)
-            x1 = x - fx / d
-            fx1 = f(x1)
-        except (ArithmeticError, ValueError) as exc:
-            status, detail = explain(exc)
-            return x, fx, err, status, detail, k - 1
+NEWTON_LOOP = Loop(
+    signature="newton_lean(problem, x0, tol, rtol, ftol, max_iter, certify, rows=None)",
+    setup="""\
+        add = rows.add if rows is not None else None
+        append = rows.append if rows is not None else None  # the first HISTORY_HEAD rows, as Rows.add
+        f, fp = problem.f, problem.fprime
+        x = x0
+        fx = f(x)
+        stop = _start_stop(problem, x0, fx)
+        if stop is not None:
+            return x, fx, _inf, stop[0], stop[1], 0
+        best = start = abs(fx) if isinstance(fx, float) else _inf
+        err = _inf
+        """,
+    step="""\
+        d = fp(x)
+        if d == 0.0:
+            if add is not None:
+                add((k, x, fx, d, None, None))
+            err = _nan
+            status = _S.ZERO_DERIVATIVE
+            detail = f"f'({problem.var}) = 0 at {problem.var} = {x!r}, f = {fx:.6g}"
+            break
+        x1 = x - fx / d
+        fx1 = f(x1)
+        """,
+    after="""\
         err = x1 - x
         if err < 0.0:
             err = -err
         if add is not None:
-            add((k, x, fx, d, x1, err))
+            (append if k <= _HEAD else add)((k, x, fx, d, x1, err))
         x, fx = x1, fx1
-        # inline finiteness: v - v is 0.0 for a finite float, NaN for inf and NaN
-        if type(fx) is not float or type(err) is not float:
-            try:
-                finite = isfinite(err) and isfinite(fx)
-            except TypeError:
-                return x, fx, err, Status.DOMAIN_ERROR, f"f returned a non-real value: {fx!r}", k
-        else:
-            finite = err - err == 0.0 and fx - fx == 0.0
-        if not finite:
-            return x, fx, err, Status.NON_FINITE, f"error = {err!r}, residual = {fx!r}", k
-        if fx == 0.0:
-            return x, fx, err, Status.CONVERGED_EXACT, "", k
-        size = fx if fx > 0.0 else -fx
-        if ftol is not None and size <= ftol:
-            return x, fx, err, Status.CONVERGED_RESIDUAL, "", k
-        ax = x if x >= 0.0 else -x
-        limit = step_limit(tol, rtol, ax) if rtol else tol
-        if err <= limit:
-            if worse_than_seen(size, best, start):
-                limit = -1.0
-            else:
-                if size < best:
-                    best = size
-                stop, why, uncertified = judge_certificate(*certify(x, fx, limit), uncertified)
-                if stop is not None:
-                    return x, fx, err, stop, why, k
-        elif size < best:
-            best = size
-        growth = growth + 1 if err > prev_err else 0
-        if growth >= DIVERGE_STREAK:
-            return x, fx, err, Status.DIVERGED, f"{growth} growing steps, last {err:.3g}", k
-        if err <= ROUNDING * ax:
-            why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
-            if why is not None:
-                return x, fx, err, Status.PRECISION_LIMIT, why, k
-        prev_err = err
-    return x, fx, err, Status.MAX_ITER, "", k
+        """,
+    guard=True, step_test="certify", diverge="streak")
+"""Newton as one tight loop: the stopping rule of :mod:`linkage.iterate` around Newton's
+step, without states or method dispatch; the generic loop's status, root, iteration count
+and, when ``rows`` (an :class:`~linkage.iterate.Rows`) is given, its table row for row
+(tests/test_compile.py, tests/test_kernel.py). ``newton_lean(problem, x0, tol, rtol, ftol,
+max_iter, certify, rows)`` returns (x, f(x), last error, status, detail, iterations);
+``certify(x, fx, width)`` decides a small step."""
+
+newton_lean = build_loop(NEWTON_LOOP, {"_start_stop": start_stop, "_HEAD": HISTORY_HEAD})

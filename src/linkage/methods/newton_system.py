@@ -22,18 +22,14 @@ import sys
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import DIVERGE_STREAK, ROUNDING, RUNAWAY, explain, rounding_stall
+from ..iterate import Loop, build_loop, dedent, indent
 from ..linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve, pivot_ratio
 from ..problems.system import SystemProblem
 from ..result import Column, Status
-from ..rules import step_limit, step_size, system_converged
-from ._common import new_state
+from ..rules import invertible, pivots_invertible, step_size
+from .common import new_state
 
 EPS = sys.float_info.epsilon
-
-SINGULAR_RATIO = 1e-12
-"""Smallest |pivot| / largest |pivot| of J before a step is refused as singular."""
-
 
 def max_abs(v: Any) -> float:
     """max |v_i|, NaN if any entry is NaN (the builtin max would silently skip it)."""
@@ -107,7 +103,7 @@ def newton_direction(jac: list[list[float]], phi: list[float]) -> tuple[list[flo
         (a, b), (c, d) = jac
         det = a * d - b * c
         size = abs(a * d) + abs(b * c)  # invariant under row and column scaling
-        if size > 0.0 and abs(det) > SINGULAR_RATIO * size and math.isfinite(det):
+        if invertible(det, size):
             return [(b * phi[1] - d * phi[0]) / det, (c * phi[0] - a * phi[1]) / det], det, abs(det) / size
         return None, det, (abs(det) / size if size > 0.0 else 0.0)
     scaled, _, _ = equilibrate(jac)
@@ -117,7 +113,7 @@ def newton_direction(jac: list[list[float]], phi: list[float]) -> tuple[list[flo
     except SingularMatrix:
         return None, 0.0, 0.0
     det = det_from_lu(f)
-    if not ratio >= SINGULAR_RATIO:
+    if not pivots_invertible(ratio):
         return None, det, ratio
     # the solve itself uses J as given: equilibration decides singularity only
     return lu_solve(f, [-v for v in phi]), det, ratio
@@ -341,186 +337,145 @@ def system_row(problem: SystemProblem, k: int, q: Any, phi: Any, dq: Any, det: f
     return tuple(row)
 
 
-def newton_system_lean(problem: SystemProblem, q0: tuple[float, ...], phi0: list[float], tol: float,
-                       rtol: float, gate: float, max_iter: int, damped: bool) -> tuple[Any, ...]:
-    """Newton-Raphson with recording off, as one tight loop: the generic loop's stopping
-    rules for systems (:mod:`linkage.iterate`) written out, the whole-step path inline
-    (Cramer's rule for two unknowns). An iteration whose whole step is refused (a line
-    search, a damped or singular step) is handed to :meth:`NewtonSystem.step`, so there is
-    one implementation of globalisation; the outcome equals the generic loop's (status,
-    root, iterations; tests/test_compile.py).
+_FALLBACK = """\
+njev -= 1  # the method evaluates J again
+s = _NewtonSystem("analytic", None, damped, diagnostics=False).step(problem, _State(
+    {q}, None, err, None, (), (), (), (), _nan, _nan, 1.0, nfev, njev, {phi}))
+nfev, njev = s.nfev, s.njev
+if s.stop is not None:
+    return (list(s.x), list(s.phi_x), s.err, s.stop[0], s.stop[1], k, nfev, njev)
+"""
+"""An iteration whose whole step is refused (a line search, a damped or singular step)
+goes to :meth:`NewtonSystem.step`: one implementation of globalisation."""
 
-    Returns (x, Phi(x), last error, status, detail, iterations, nfev, njev).
-    """
-    F, Jf = problem.F, problem.J
-    scales = problem.step_scales
-    if scales is None and len(q0) == 2 and len(phi0) == 2:
-        return newton_2x2(problem, q0, phi0, tol, rtol, gate, max_iter, damped)
-    method = NewtonSystem("analytic", None, damped, diagnostics=False)
-    isfinite = math.isfinite
-    q = list(q0)
-    phi = list(phi0)
-    n = len(q)
-    nfev, njev = 1, 0
-    prev_err = err = math.inf
-    growth = stalls = rounding_steps = 0
-    runaway = RUNAWAY * (1.0 + max_abs(q))
-    k = 0
-    for k in range(1, max_iter + 1):
-        try:
-            jac = Jf(q)  # type: ignore[misc]
-            njev += 1
-            dq = None
-            if n == 2:
-                p0, p1 = phi
-                a0, a1 = abs(p0), abs(p1)
-                resid = (a0 if a0 >= a1 else a1) if a0 == a0 and a1 == a1 else math.nan
-                (a, b), (c, d) = jac
-                det = a * d - b * c
-                size = abs(a * d) + abs(b * c)
-                if size > 0.0 and abs(det) > SINGULAR_RATIO * size and isfinite(det):
-                    dq = [(b * p1 - d * p0) / det, (c * p0 - a * p1) / det]
-            else:
-                resid = max_abs(phi)
-                dq = newton_direction(jac, phi)[0]
-            phi_t = None
-            if dq is not None:
-                trial = [qi + di for qi, di in zip(q, dq)]
-                phi_t = F(trial)
-                nfev += 1
-                if damped and not _sumsq(phi_t) <= (1.0 - 1e-4) * _sumsq(phi) and \
-                        not max_abs(dq) <= 64.0 * EPS * (1.0 + max_abs(q)):
-                    phi_t = None  # the whole step does not lower |Phi|: the method decides
-                    nfev -= 1
-            if phi_t is None:
-                njev -= 1
-                s = method.step(problem, NewtonSystemState(tuple(q), None, err, None, (), (), (), (),
-                                                           math.nan, math.nan, 1.0, nfev, njev, tuple(phi)))
-                nfev, njev = s.nfev, s.njev
-                if s.stop is not None:
-                    return (list(s.x), list(s.phi_x), s.err, s.stop[0], s.stop[1], k, nfev, njev)
-                step, trial, phi_t = list(s.dq), list(s.x), list(s.phi_x)
-            else:
-                step = dq
-        except (ArithmeticError, ValueError) as exc:
-            status, detail = explain(exc)
-            return q, phi, err, status, detail, k - 1, nfev, njev
+NEWTON_SYSTEM_LOOP = Loop(
+    signature="newton_system_lean(problem, q0, phi0, tol, rtol, gate, max_iter, damped)",
+    setup="""\
+        F, Jf = problem.F, problem.J
+        scales = problem.step_scales
+        if scales is None and len(q0) == 2 and len(phi0) == 2:
+            return _newton_2x2(problem, q0, phi0, tol, rtol, gate, max_iter, damped)
+        q = list(q0)
+        phi = list(phi0)
+        n = len(q)
+        nfev, njev = 1, 0
+        err = fx = _inf
+        runaway = _RUNAWAY * (1.0 + _max_abs(q))
+        """,
+    step=dedent("""\
+        jac = Jf(q)
+        njev += 1
+        dq = None
+        if n == 2:
+            p0, p1 = phi
+            a0, a1 = abs(p0), abs(p1)
+            fx = (a0 if a0 >= a1 else a1) if a0 == a0 and a1 == a1 else _nan
+            (a, b), (c, d) = jac
+            det = a * d - b * c
+            if _invertible(det, abs(a * d) + abs(b * c)):
+                dq = [(b * p1 - d * p0) / det, (c * p0 - a * p1) / det]
+        else:
+            fx = _max_abs(phi)
+            dq = _direction(jac, phi)[0]
+        phi_t = None
+        if dq is not None:
+            trial = [qi + di for qi, di in zip(q, dq)]
+            phi_t = F(trial)
+            nfev += 1
+            if damped and not _sumsq(phi_t) <= (1.0 - 1e-4) * _sumsq(phi) and \\
+                    not _max_abs(dq) <= 64.0 * _EPS * (1.0 + _max_abs(q)):
+                phi_t = None  # the whole step does not lower |Phi|: the method decides
+                nfev -= 1
+        if phi_t is None:
+        """) + indent(_FALLBACK.format(q="tuple(q)", phi="tuple(phi)")) + dedent("""\
+            step, trial, phi_t = list(s.dq), list(s.x), list(s.phi_x)
+        else:
+            step = dq
+        """),
+    after="""\
         if scales is None and n == 2:
             e0, e1 = abs(step[0]), abs(step[1])
-            err = (e0 if e0 >= e1 else e1) if e0 == e0 and e1 == e1 else math.nan
+            err = (e0 if e0 >= e1 else e1) if e0 == e0 and e1 == e1 else _nan
         else:
-            err = step_measure(step, scales)
+            err = _step_size(step, scales)
         q, phi = trial, phi_t
-        try:
-            finite = isfinite(err) and isfinite(resid)
-        except TypeError:
-            return q, phi, err, Status.DOMAIN_ERROR, f"f returned a non-real value: {resid!r}", k, nfev, njev
-        if not finite:
-            return q, phi, err, Status.NON_FINITE, f"error = {err!r}, residual = {resid!r}", k, nfev, njev
-        if resid == 0.0:
-            return q, phi, err, Status.CONVERGED_EXACT, "", k, nfev, njev
-        size_q = max_abs(q)
-        limit = step_limit(tol, rtol, size_q) if rtol else tol
-        if system_converged(err, resid, limit, gate):
-            return q, phi, err, Status.CONVERGED_STEP, "", k, nfev, njev
-        if not damped:
-            growth = growth + 1 if err > prev_err else 0
-            if growth >= DIVERGE_STREAK and size_q > runaway:
-                return q, phi, err, Status.DIVERGED, f"{growth} growing steps, last {err:.3g}", k, nfev, njev
-        if err <= ROUNDING * size_q:
-            why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
-            if why is not None:
-                return q, phi, err, Status.PRECISION_LIMIT, why, k, nfev, njev
-        prev_err = err
-    return q, phi, err, Status.MAX_ITER, "", k, nfev, njev
+        size_q = _max_abs(q)
+        """,
+    result="q, phi, err, status, detail, k, nfev, njev",
+    residual_test=False, step_test="system", diverge="runaway", diverge_when="not damped",
+    magnitude="size_q")
+"""Newton-Raphson for a system with recording off: the stopping rule of
+:mod:`linkage.iterate` for systems around the whole Newton step (Cramer's rule for two
+unknowns), handing a refused step to :meth:`NewtonSystem.step`. The outcome equals the
+generic loop's (status, root, iterations; tests/test_compile.py). Returns (x, Phi(x),
+last error, status, detail, iterations, nfev, njev)."""
 
-
-def newton_2x2(problem: SystemProblem, q0: tuple[float, ...], phi0: list[float], tol: float, rtol: float,
-                gate: float, max_iter: int, damped: bool) -> tuple[Any, ...]:
-    """:func:`newton_system_lean` for two unknowns measured as they are (every four-bar),
-    on scalars: the same operations in the same order, so the same iterates, status and
-    counts (tests/test_compile.py), without the per-iteration lists and helper calls. A
-    refused or singular step goes to :meth:`NewtonSystem.step` exactly as there."""
-    F, Jf = problem.F, problem.J
-    nan = math.nan
-    x0, x1 = q0
-    p0, p1 = phi0
-    ss = p0 * p0 + p1 * p1  # _sumsq(phi), carried from the step that produced phi
-    nfev, njev = 1, 0
-    prev_err = err = math.inf
-    growth = stalls = rounding_steps = 0
-    a0, a1 = abs(x0), abs(x1)
-    runaway = RUNAWAY * (1.0 + (nan if a0 != a0 or a1 != a1 else (a0 if a0 >= a1 else a1)))
-    shrink = 1.0 - 1e-4
-    tiny = 64.0 * EPS
-    k = 0
-    for k in range(1, max_iter + 1):
-        try:
-            (a, b), (c, d) = Jf([x0, x1])
-            njev += 1
-            a0, a1 = abs(p0), abs(p1)
-            resid = (a0 if a0 >= a1 else a1) if a0 == a0 and a1 == a1 else nan
-            det = a * d - b * c
-            size = abs(a * d) + abs(b * c)
-            refused = True
-            if size > 0.0 and abs(det) > SINGULAR_RATIO * size and det - det == 0.0:
-                d0, d1 = (b * p1 - d * p0) / det, (c * p0 - a * p1) / det
-                t0, t1 = x0 + d0, x1 + d1
-                f0, f1 = F([t0, t1])
-                nfev += 1
-                refused = False
-                if damped:
-                    st = f0 * f0 + f1 * f1
-                    if not st <= shrink * ss:
-                        e0, e1 = abs(d0), abs(d1)
-                        step_size = nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
-                        e0, e1 = abs(x0), abs(x1)
-                        q_size = nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
-                        if not step_size <= tiny * (1.0 + q_size):
-                            refused = True  # the whole step does not lower |Phi|: the method decides
-                            nfev -= 1
-            if refused:
-                njev -= 1  # the method evaluates J again
-                method = NewtonSystem("analytic", None, damped, diagnostics=False)
-                s = method.step(problem, NewtonSystemState((x0, x1), None, err, None, (), (), (), (),
-                                                           nan, nan, 1.0, nfev, njev, (p0, p1)))
-                nfev, njev = s.nfev, s.njev
-                if s.stop is not None:
-                    return (list(s.x), list(s.phi_x), s.err, s.stop[0], s.stop[1], k, nfev, njev)
-                d0, d1 = s.dq
-                t0, t1 = s.x
-                f0, f1 = s.phi_x
-        except (ArithmeticError, ValueError) as exc:
-            status, detail = explain(exc)
-            return [x0, x1], [p0, p1], err, status, detail, k - 1, nfev, njev
-        e0, e1 = abs(d0), abs(d1)
-        err = (e0 if e0 >= e1 else e1) if e0 == e0 and e1 == e1 else nan
+NEWTON_2X2_LOOP = Loop(
+    signature="newton_2x2(problem, q0, phi0, tol, rtol, gate, max_iter, damped)",
+    setup="""\
+        F, Jf = problem.F, problem.J
+        x0, x1 = q0
+        p0, p1 = phi0
+        ss = p0 * p0 + p1 * p1  # _sumsq(phi), carried from the step that produced phi
+        nfev, njev = 1, 0
+        err = fx = _inf
+        a0, a1 = abs(x0), abs(x1)
+        runaway = _RUNAWAY * (1.0 + (_nan if a0 != a0 or a1 != a1 else (a0 if a0 >= a1 else a1)))
+        shrink = 1.0 - 1e-4
+        tiny = 64.0 * _EPS
+        """,
+    step=dedent("""\
+        (a, b), (c, d) = Jf([x0, x1])
+        njev += 1
+        # |v| written "v if v > 0.0 else 0.0 - v": the same bits as abs (-0.0 included), no call
+        a0 = p0 if p0 > 0.0 else 0.0 - p0
+        a1 = p1 if p1 > 0.0 else 0.0 - p1
+        fx = (a0 if a0 >= a1 else a1) if a0 == a0 and a1 == a1 else _nan
+        ad = a * d
+        bc = b * c
+        det = ad - bc
+        refused = True
+        if _invertible(det, (ad if ad > 0.0 else 0.0 - ad) + (bc if bc > 0.0 else 0.0 - bc)):
+            d0, d1 = (b * p1 - d * p0) / det, (c * p0 - a * p1) / det
+            t0, t1 = x0 + d0, x1 + d1
+            f0, f1 = F([t0, t1])
+            nfev += 1
+            refused = False
+            if damped:
+                st = f0 * f0 + f1 * f1
+                if not st <= shrink * ss:
+                    e0, e1 = abs(d0), abs(d1)
+                    step_size = _nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
+                    e0, e1 = abs(x0), abs(x1)
+                    q_size = _nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
+                    if not step_size <= tiny * (1.0 + q_size):
+                        refused = True  # the whole step does not lower |Phi|: the method decides
+                        nfev -= 1
+        if refused:
+        """) + indent(_FALLBACK.format(q="(x0, x1)", phi="(p0, p1)") + """\
+d0, d1 = s.dq
+t0, t1 = s.x
+f0, f1 = s.phi_x
+"""),
+    after="""\
+        e0 = d0 if d0 > 0.0 else 0.0 - d0
+        e1 = d1 if d1 > 0.0 else 0.0 - d1
+        err = (e0 if e0 >= e1 else e1) if e0 == e0 and e1 == e1 else _nan
         x0, x1, p0, p1 = t0, t1, f0, f1
         ss = p0 * p0 + p1 * p1
-        try:
-            # v - v is 0.0 for a finite number, NaN for inf and NaN (isfinite, without calls)
-            finite = err - err == 0.0 and resid - resid == 0.0
-        except TypeError:
-            return ([x0, x1], [p0, p1], err, Status.DOMAIN_ERROR, f"f returned a non-real value: {resid!r}",
-                    k, nfev, njev)
-        if not finite:
-            return [x0, x1], [p0, p1], err, Status.NON_FINITE, f"error = {err!r}, residual = {resid!r}", k, \
-                nfev, njev
-        if resid == 0.0:
-            return [x0, x1], [p0, p1], err, Status.CONVERGED_EXACT, "", k, nfev, njev
-        e0, e1 = abs(x0), abs(x1)
-        size_q = nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
-        limit = step_limit(tol, rtol, size_q) if rtol else tol
-        if system_converged(err, resid, limit, gate):
-            return [x0, x1], [p0, p1], err, Status.CONVERGED_STEP, "", k, nfev, njev
-        if not damped:
-            growth = growth + 1 if err > prev_err else 0
-            if growth >= DIVERGE_STREAK and size_q > runaway:
-                return ([x0, x1], [p0, p1], err, Status.DIVERGED, f"{growth} growing steps, last {err:.3g}",
-                        k, nfev, njev)
-        if err <= ROUNDING * size_q:
-            why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
-            if why is not None:
-                return [x0, x1], [p0, p1], err, Status.PRECISION_LIMIT, why, k, nfev, njev
-        prev_err = err
-    return [x0, x1], [p0, p1], err, Status.MAX_ITER, "", k, nfev, njev
+        e0 = x0 if x0 > 0.0 else 0.0 - x0
+        e1 = x1 if x1 > 0.0 else 0.0 - x1
+        size_q = _nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
+        """,
+    result="[x0, x1], [p0, p1], err, status, detail, k, nfev, njev",
+    residual_test=False, step_test="system", diverge="runaway", diverge_when="not damped",
+    magnitude="size_q")
+""":data:`NEWTON_SYSTEM_LOOP` for two unknowns measured as they are (every four-bar), on
+scalars: the same operations in the same order, so the same iterates, status and counts
+(tests/test_compile.py), without the per-iteration lists and helper calls."""
+
+_LOOP_NAMES = {"_NewtonSystem": NewtonSystem, "_State": NewtonSystemState, "_max_abs": max_abs,
+               "_direction": newton_direction, "_sumsq": _sumsq, "_EPS": EPS, "_invertible": invertible,
+               "_step_size": step_measure}
+newton_2x2 = build_loop(NEWTON_2X2_LOOP, _LOOP_NAMES)
+newton_system_lean = build_loop(NEWTON_SYSTEM_LOOP, {**_LOOP_NAMES, "_newton_2x2": newton_2x2})

@@ -16,8 +16,8 @@ from typing import Any, ClassVar, NamedTuple
 
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
-from ._common import new_state, same_sign
 from .bisection import init_bracket
+from .common import new_state, same_sign
 
 
 class RegulaFalsiState(NamedTuple):

@@ -12,15 +12,13 @@ x_{i+1}, |x_{i+1} - x_i|.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import DIVERGE_STREAK, ROUNDING, explain, judge_certificate, rounding_stall
+from ..iterate import Loop, build_loop
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
-from ..rules import step_limit, worse_than_seen
-from ._common import new_state
+from .common import new_state
 
 _NAN = float("nan")
 
@@ -98,81 +96,10 @@ class Secant:
 
     def run_lean(self, problem: ScalarProblem, s: SecantState, crit: Any,
                  certify: Any) -> tuple[SecantState, Status, str, int]:
-        """The secant method with recording off, as one tight loop with the generic loop's
-        stopping rules for an open method (:mod:`linkage.iterate`), its plausibility test
-        and the certification included: the same outcome (tests/test_compile.py)."""
-        f = problem.f
-        v = problem.var
-        x, fx, xp, fxp = s.x, s.fx, s.xp, s.fxp
-        slope, slope_before, err = s.slope, s.slope_before, s.err
-        tol, rtol, ftol = crit.tol, crit.rtol, crit.ftol
-        seen = [abs(t) for t in (fx, fxp) if isinstance(t, float) and t == t]
-        best = min(seen) if seen else math.inf
-        start = max(seen) if seen else math.inf
-        prev_err = math.inf
-        growth = uncertified = stalls = rounding_steps = k = 0
-        status, detail = Status.MAX_ITER, ""
-        for k in range(1, crit.max_iter + 1):
-            if x == xp:
-                detail = (f"the last two points are equal in double precision ({v} = {x!r}): "
-                          "no chord to follow")
-                return (SecantState(x, fx, _NAN, None, x, fx, _NAN, slope), Status.PRECISION_LIMIT,
-                        detail, k)
-            try:
-                new_slope = (fx - fxp) / (x - xp)
-                if new_slope == 0.0:
-                    return (SecantState(x, fx, _NAN, None, x, fx, new_slope, slope), Status.ZERO_DERIVATIVE,
-                            f"the secant slope is zero at {v} = {x!r}", k)
-                x1 = x - fx / new_slope
-                fx1 = f(x1)
-            except (ArithmeticError, ValueError) as exc:
-                status, detail = explain(exc)
-                k -= 1
-                break
-            err = abs(x1 - x)
-            xp, fxp, x, fx = x, fx, x1, fx1
-            slope_before, slope = slope, new_slope
-            try:
-                finite = math.isfinite(err) and math.isfinite(fx)
-            except TypeError:
-                status, detail = Status.DOMAIN_ERROR, f"f returned a non-real value: {fx!r}"
-                break
-            if not finite:
-                status, detail = Status.NON_FINITE, f"error = {err!r}, residual = {fx!r}"
-                break
-            if fx == 0.0:
-                status = Status.CONVERGED_EXACT
-                break
-            size = abs(fx)
-            if ftol is not None and size <= ftol:
-                status = Status.CONVERGED_RESIDUAL
-                break
-            limit = step_limit(tol, rtol, abs(x)) if rtol else tol
-            if err <= limit:
-                ratio = slope / slope_before if slope_before else _NAN
-                if not 0.5 <= ratio <= 2.0:
-                    limit = -1.0
-            if err <= limit and worse_than_seen(size, best, start):
-                limit = -1.0
-            elif size < best:
-                best = size
-            if err <= limit:
-                verdict, why = certify(SecantState(x, fx, err, None, xp, fxp, slope, slope_before), limit)
-                stop, why, uncertified = judge_certificate(verdict, why, uncertified)
-                if stop is not None:
-                    status, detail = stop, why
-                    break
-            growth = growth + 1 if err > prev_err else 0
-            if growth >= DIVERGE_STREAK:
-                status, detail = Status.DIVERGED, f"{growth} growing steps, last {err:.3g}"
-                break
-            if err <= ROUNDING * abs(x):
-                why, rounding_steps, stalls = rounding_stall(err, prev_err, limit, rounding_steps, stalls)
-                if why is not None:
-                    status, detail = Status.PRECISION_LIMIT, why
-                    break
-            prev_err = err
-        return SecantState(x, fx, err, None, xp, fxp, slope, slope_before), status, detail, k
+        """The secant method with recording off: :data:`SECANT_LOOP`, the generic loop's
+        outcome without a state per step (tests/test_compile.py, tests/test_kernel.py)."""
+        return secant_lean(problem, s.x, s.fx, s.xp, s.fxp, s.slope, s.slope_before, s.err, crit.tol,
+                           crit.rtol, crit.ftol, crit.max_iter, certify)
 
     def initial_row(self, problem: ScalarProblem, s: SecantState) -> tuple[Any, ...]:
         return (0, s.xp, s.fxp, None, None, None)
@@ -181,3 +108,40 @@ class Secant:
         if s.stop is not None:
             return (i, s.xp, s.fxp, s.slope, None, None)
         return (i, s.xp, s.fxp, s.slope, s.x, s.err)
+
+
+SECANT_LOOP = Loop(
+    signature="secant_lean(problem, x, fx, xp, fxp, slope, slope_before, err, tol, rtol, ftol, max_iter, "
+              "certify)",
+    setup="""\
+        f = problem.f
+        v = problem.var
+        seen = [abs(t) for t in (fx, fxp) if isinstance(t, float) and t == t]
+        best = min(seen) if seen else _inf
+        start = max(seen) if seen else _inf
+        """,
+    step="""\
+        if x == xp:
+            xp, fxp, err, slope_before, slope = x, fx, _nan, slope, _nan
+            status = _S.PRECISION_LIMIT
+            detail = f"the last two points are equal in double precision ({v} = {x!r}): no chord to follow"
+            break
+        new_slope = (fx - fxp) / (x - xp)
+        if new_slope == 0.0:
+            xp, fxp, err, slope_before, slope = x, fx, _nan, slope, new_slope
+            status, detail = _S.ZERO_DERIVATIVE, f"the secant slope is zero at {v} = {x!r}"
+            break
+        x1 = x - fx / new_slope
+        fx1 = f(x1)
+        """,
+    after="""\
+        err = abs(x1 - x)
+        xp, fxp, x, fx = x, fx, x1, fx1
+        slope_before, slope = slope, new_slope
+        """,
+    result="_State(x, fx, err, None, xp, fxp, slope, slope_before), status, detail, k",
+    plausible="0.5 <= (slope / slope_before if slope_before else _nan) <= 2.0",  # Secant.plausible
+    guard=True, step_test="certify", diverge="streak")
+"""The secant method's loop: the stopping rule of :mod:`linkage.iterate` around its step."""
+
+secant_lean = build_loop(SECANT_LOOP, {"_State": SecantState})

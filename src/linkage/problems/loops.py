@@ -331,14 +331,6 @@ class LoopModel:
 
         return build(self.terms, self.n)
 
-    @functools.cached_property
-    def newton_two(self) -> Any:
-        """For two unknowns: ``newton_two(d, x0, x1, tol, gate, max_iter)``, Newton-Raphson
-        at driver value d with the model written in (see :mod:`linkage.codegen`)."""
-        from ..codegen import build
-
-        return build(self.terms, self.n, newton=True)
-
     @property
     def source(self) -> str:
         """The generated code of the compiled model, for inspection."""

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..result import Status
+
 new_state = tuple.__new__
 """Build a NamedTuple state without its Python-level ``__new__``.
 
@@ -23,3 +25,13 @@ def display(fn: Any, x: float) -> float | None:
         return fn(x)
     except (ArithmeticError, ValueError, TypeError):
         return None
+
+
+def start_stop(problem: Any, x0: float, fx: float) -> Any:
+    """An open method's verdict on its start x0 with f(x0) = fx: (CONVERGED_EXACT or
+    NON_FINITE, detail), or None to iterate."""
+    if fx == 0.0:
+        return (Status.CONVERGED_EXACT, f"f is zero at the start {problem.var} = {x0!r}")
+    if fx != fx or abs(fx) == float("inf"):
+        return (Status.NON_FINITE, f"f({problem.var}={x0:g}) = {fx!r}")
+    return None

@@ -1,0 +1,323 @@
+"""``solve_system``: Phi(q) = 0 for n unknowns, validated once at the front door, with
+short front doors for two unknowns (user callables, or a compiled mechanism)."""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from typing import Any
+
+from ..arguments import check_callable, check_number, check_reals, real_vector
+from ..errors import InputError
+from ..iterate import Criteria, run
+from ..result import History, Result, Status
+from ..rules import residual_gate
+from .criteria import MAX_RELATIVE_TOL, check_criteria
+from .diagnose import names_bad_callables
+
+# The system solvers load with the first system solve, never with a scalar one
+# (python -X importtime: about 20 ms of every `linkage solve` otherwise).
+
+# --- systems ------------------------------------------------------------------------------
+
+SYSTEM_METHODS: tuple[str, ...] = ("newton", "newton-fd", "lm")
+
+@names_bad_callables
+def solve_system(
+    F: Callable[..., list[float]] | Any,
+    x0: Sequence[float] | None = None,
+    *,
+    jac: Callable[..., list[list[float]]] | None = None,
+    method: str = "newton",
+    tol: float = 1e-6,
+    rtol: float = 0.0,
+    ftol: float | None = None,
+    max_iter: int = 50,
+    record: bool = True,
+    fd_step: float | None = None,
+    damped: bool = True,
+    show_jacobian: bool = False,
+) -> Result:
+    """Solve Phi(q) = 0 for n unknowns: ``newton`` (analytic Jacobian ``jac``),
+    ``newton-fd`` (forward differences with step ``fd_step``) or ``lm``
+    (Levenberg-Marquardt on the sum of squares).
+
+    ``F`` is a callable of a sequence, or a :class:`~linkage.problems.system.SystemProblem`
+    (for instance ``linkage.load_mechanism(path).problem()``), which supplies the
+    Jacobian, names, units and a default ``x0``. ``x0`` is in internal units (radians).
+    Converges when max|dq| <= tol + rtol max|q| and max|Phi| <= ftol (ftol defaults to
+    tol), as in worked example P3, docs/worked_examples.md. For a mechanism both are relative to its size
+    (``problem.length_scale``, its longest length): Phi and length steps are compared
+    with tol times that size, so units do not change the answer, and tolerances above
+    MAX_RELATIVE_TOL are refused. ``damped`` (default) globalises Newton (see
+    :class:`~linkage.methods.newton_system.NewtonSystem`); ``damped=False`` is the
+    textbook iteration.
+    Returns a :class:`Result` with ``x`` (a tuple), ``nfev`` and ``njev``.
+    """
+    if (method == "newton" and not record and jac is not None and fd_step is None and type(x0) is tuple
+            and len(x0) == 2 and type(x0[0]) is float and type(x0[1]) is float
+            and x0[0] - x0[0] == 0.0 and x0[1] - x0[1] == 0.0 and callable(F)):
+        # the common case without the general front door: user callables, two unknowns,
+        # a finite start (the same outcome: tests/test_compile.py)
+        return _newton_two(F, jac, x0, check_criteria(tol, rtol, ftol, max_iter), damped)
+    NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system = _system_solvers()
+    if (method == "newton" and not record and jac is None and fd_step is None and type(F) is SystemProblem
+            and len(F.names) == 2 and F.J is not None and F.step_scales is None):
+        fast = _mechanism_two(F, x0, check_criteria(tol, rtol, ftol, max_iter), damped)
+        if fast is not None:
+            return fast
+    if method not in SYSTEM_METHODS:
+        raise InputError(f"unknown method {method!r} for a system; choose from {', '.join(SYSTEM_METHODS)}")
+    crit = check_criteria(tol, rtol, ftol, max_iter)
+    if fd_step is not None:
+        fd_step = check_number("fd_step", fd_step, positive=True, allow_zero=False)
+    problem, q0 = system_problem(F, x0, jac, crit, SystemProblem, generic_system)
+    if method == "newton" and problem.J is None:
+        raise InputError("newton needs the Jacobian jac; use method='newton-fd' to difference it")
+    kind = "fd" if method == "newton-fd" or problem.J is None else "analytic"
+    if method == "lm":
+        from ..methods.least_squares import LevenbergMarquardt
+
+        m: Any = LevenbergMarquardt(kind, fd_step, diagnostics=record)
+    else:
+        m = NewtonSystem(kind, fd_step, damped, diagnostics=record)
+    phi0 = residual_at_start(problem, q0)
+    gate = residual_gate(crit.ftol if crit.ftol is not None else crit.tol, problem.length_scale)
+    rows = None
+    if method == "newton" and kind == "analytic" and not record:
+        q, phi, err, status, detail, iterations, nfev, njev = newton_system_lean(
+            problem, q0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
+        x, stopped = tuple(q), status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN)
+        residual = max_abs(phi)
+    else:
+        state = m.init(problem, q0, phi0) if isinstance(m, NewtonSystem) else m.init(problem, q0)
+        run_crit = crit._replace(ftol=gate)
+        final, status, detail, iterations, rows = run(m, problem, state, run_crit, record=record,
+                                                      magnitude=max_abs)
+        x, stopped, err = tuple(final.x), final.stop is not None, final.err
+        nfev, njev = final.nfev, final.njev
+        if hasattr(final, "phi_x"):  # Newton's last trial evaluated Phi at x already
+            residual = max_abs(final.phi_x)
+        else:
+            try:
+                residual = max_abs(problem.F(list(x)))
+                nfev += 1
+            except (ArithmeticError, ValueError):
+                residual = math.nan
+    status, detail = system_verdict(status, detail, residual, gate, stopped)
+    return packaged(m, problem, crit, gate, (x, status, detail, iterations, nfev, njev, err, residual),
+                    rows, record, show_jacobian)
+
+
+def system_problem(F: Any, x0: Any, jac: Any, crit: Criteria, SystemProblem: Any,
+                   generic_system: Any) -> tuple[Any, tuple[float, ...]]:
+    """The problem to solve and its checked start (InputError naming what is wrong)."""
+    if isinstance(F, SystemProblem):
+        problem = F if jac is None else replace(F, J=jac)
+        if x0 is None:
+            x0 = problem.x0
+    else:
+        if not callable(F):
+            raise InputError(f"F must be callable or a SystemProblem, got {type(F).__name__}")
+        if x0 is None:
+            raise InputError("x0 is required for a bare residual function")
+        x0 = check_reals("x0", x0)
+        if not x0:
+            raise InputError("x0 must hold at least one value (a system of no unknowns has nothing to solve)")
+        problem = generic_system(F, len(x0), jac)
+    check_callable("jac", jac)
+    if x0 is None:
+        raise InputError(f"x0 needs {problem.n} values ({', '.join(problem.names)}), got 0")
+    checked = check_reals("x0", x0, None, problem.names)  # finite floats, each entry named
+    if len(checked) != problem.n:
+        raise InputError(f"x0 needs {problem.n} values ({', '.join(problem.names)}), got {len(checked)}")
+    if problem.length_scale != 1.0 or "length" in problem.kinds or problem.length_unit:
+        for name, value in (("tol", crit.tol), ("ftol", crit.ftol)):
+            if value is not None and value > MAX_RELATIVE_TOL:
+                raise InputError(f"{name} = {value:g} is too loose to mean anything: for a mechanism "
+                                 f"it is relative to its size ({problem.length_scale:g} "
+                                 f"{problem.length_unit}); use at most {MAX_RELATIVE_TOL:g}")
+    return problem, tuple(checked)
+
+
+def residual_at_start(problem: Any, q0: tuple[float, ...]) -> Any:
+    """Phi(q0), checked: a list of n real numbers (InputError otherwise)."""
+    try:
+        phi0 = problem.F(list(q0))
+    except (ArithmeticError, ValueError) as exc:
+        raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
+    real_vector("F", phi0, problem.n, "at x0")
+    if len(phi0) != problem.n:
+        raise InputError(f"the system has {len(phi0)} equations for {problem.n} unknowns")
+    return phi0
+
+
+def packaged(m: Any, problem: Any, crit: Criteria, gate: float, outcome: tuple[Any, ...], rows: Any,
+             record: bool, show_jacobian: bool) -> Result:
+    """The Result of a system solve from its judged outcome (x, status, detail, iterations,
+    nfev, njev, err, residual), with the closed form's verdict where it has one."""
+    x, status, detail, iterations, nfev, njev, err, residual = outcome
+    meta: dict[str, Any] = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names,
+                            "kinds": problem.kinds, "title": problem.title, **problem.meta}
+    # The closed form serves the table's true-error column and the verdict on a failed
+    # solve; a converged solve without history does not pay for it.
+    wanted = problem.reference is not None and (record or not status.converged)
+    reference = problem.reference() if wanted else None  # type: ignore[misc]
+    if reference is not None:
+        meta["reference"] = reference
+        if not reference and not status.converged:
+            reason = detail if status is Status.NO_SOLUTION else status.message
+            driver = f"{problem.meta.get('driver')} = {problem.meta.get('driver_value'):g}"
+            status, detail = (Status.NO_SOLUTION,
+                              f"the linkage cannot be assembled at {driver} "
+                              f"{problem.meta.get('driver_unit', '')} (the closed form has no real "
+                              f"solution); {m.name}: {reason}")
+    history = None
+    if rows is not None:
+        history = system_history(m, problem, rows, show_jacobian, reference, x)
+    result = Result.fast(m.name, x, status, iterations, nfev, err, residual, detail, meta)
+    if history is not None or njev:
+        result.__dict__.update(history=history, njev=njev)
+    return result
+
+
+@functools.lru_cache(maxsize=1)
+def _system_solvers() -> tuple[Any, ...]:
+    """The system solvers, imported on the first system solve (never by a scalar one;
+    Levenberg-Marquardt only when asked for)."""
+    from ..methods.newton_system import NewtonSystem, max_abs, newton_system_lean
+    from ..problems.system import SystemProblem, generic_system
+
+    return NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system
+
+
+@functools.lru_cache(maxsize=1)
+def _two_unknowns() -> tuple[Any, ...]:
+    """What :func:`_newton_two` needs, imported once (a scalar solve never pays for it)."""
+    from ..methods.newton_system import max_abs, newton_2x2
+    from ..problems.system import LeanProblem, generic_labels, generic_system
+
+    return newton_2x2, max_abs, LeanProblem, generic_labels(2), generic_system
+
+
+def system_verdict(status: Status, detail: str, residual: float, gate: float,
+                   stopped: bool = True) -> tuple[Status, str]:
+    """The verdict on a system solve from its loop's outcome and its final max|Phi|: a run
+    the method stopped (no step lowers |Phi|, or J is singular) with |Phi| already within
+    tolerance is a root to that tolerance (ill-conditioned, so the step test could not
+    pass); a converged status with |Phi| above it is not."""
+    if residual <= gate:
+        if stopped and status in _STOPPED:
+            return Status.CONVERGED_RESIDUAL, f"max|Phi| = {residual:.3g} <= {gate:.3g}; {detail}"
+        return status, detail
+    if status.converged:
+        return Status.STALLED, f"max|Phi| = {residual:.3g} at the end, above {gate:.3g}"
+    return status, detail
+
+
+_STOPPED = frozenset({Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN})
+
+
+def _two_unknown_result(problem: Any, q0: tuple[float, ...], phi0: Any, crit: Criteria, gate: float,
+                        damped: bool, meta: dict[str, Any], loaded: tuple[Any, ...]) -> Result:
+    """Newton on two unknowns by :func:`~linkage.methods.newton_system.newton_2x2`,
+    judged and packaged as :func:`solve_system` does (``loaded``: :func:`_two_unknowns`)."""
+    newton_2x2, max_abs = loaded[0], loaded[1]
+    q, phi, err, status, detail, iterations, nfev, njev = newton_2x2(
+        problem, q0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
+    residual = max_abs(phi)
+    status, detail = system_verdict(status, detail, residual, gate)
+    result = Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, meta)
+    if njev:
+        result.__dict__["njev"] = njev
+    return result
+
+
+def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float, float], crit: Criteria,
+                damped: bool) -> Result:
+    """:func:`solve_system` for ``newton`` on user callables of two unknowns, with the
+    general path's checks and packaging, but no problem object unless a step is refused."""
+    loaded = _two_unknowns()
+    _, _, LeanProblem, (names, kinds, _), generic_system = loaded
+    try:
+        phi0 = F(list(x0))
+    except (ArithmeticError, ValueError) as exc:
+        raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
+    real_vector("F", phi0, 2, "at x0")
+    if len(phi0) != 2:
+        raise InputError(f"the system has {len(phi0)} equations for 2 unknowns")
+    gate = crit.ftol if crit.ftol is not None else crit.tol
+    problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
+    meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": names, "kinds": kinds, "title": ""}
+    return _two_unknown_result(problem, x0, phi0, crit, gate, damped, meta, loaded)
+
+
+def _mechanism_two(problem: Any, x0: Any, crit: Criteria, damped: bool) -> Result | None:
+    """:func:`solve_system` for ``newton`` on a compiled problem of two unknowns measured
+    as they are (a four-bar), when it converges: the general path's checks and packaging
+    without its generality. None for anything else (a start to check, a failure for the
+    closed form to explain): the general path then runs and says what happened."""
+    q0 = problem.x0 if x0 is None else x0
+    if type(q0) is not tuple or len(q0) != 2 or not all(type(v) is float and v - v == 0.0 for v in q0):
+        return None
+    scale = problem.length_scale
+    if scale != 1.0 or "length" in problem.kinds or problem.length_unit:
+        if crit.tol > MAX_RELATIVE_TOL or (crit.ftol is not None and crit.ftol > MAX_RELATIVE_TOL):
+            return None
+    try:
+        phi0 = problem.F(list(q0))
+    except (ArithmeticError, ValueError):
+        return None
+    if len(phi0) != 2:
+        return None
+    gate = residual_gate(crit.ftol if crit.ftol is not None else crit.tol, scale)
+    meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names, "kinds": problem.kinds,
+            "title": problem.title, **problem.meta}
+    result = _two_unknown_result(problem, q0, phi0, crit, gate, damped, meta, _two_unknowns())
+    return result if result.converged else None
+
+
+def system_history(m: Any, problem: Any, rows: list[tuple[Any, ...]], show_jacobian: bool,
+                    reference: dict[str, dict[str, float]] | None, x: tuple[float, ...]) -> History:
+    from ..problems.closed_form import wrap_degrees
+
+    labels = [c.template for c in m.columns(problem, show_jacobian)]
+    kept, elided, gap = rows.finish() if hasattr(rows, "finish") else (rows, 0, 0)
+    out = []
+    for r in kept:
+        *head, jac, err = r
+        body = list(head)
+        if show_jacobian:
+            body += [v for jr in jac for v in jr] if jac else [None] * (problem.n * problem.n)
+        out.append((*body, err))
+    branch = nearest_branch(problem, reference, x)
+    if branch is not None:
+        ref = reference[branch]  # type: ignore[index]
+        labels.insert(-1, f"true error ({', '.join(sorted(set(problem.unit(i) for i in range(problem.n))))})"
+                      f" vs {branch}")
+        fixed = []
+        for r in out:
+            qd = r[1:1 + problem.n]
+            errs = [abs(wrap_degrees(v - ref[n])) if k == "angle" else abs(v - ref[n])
+                    for v, n, k in zip(qd, problem.names, problem.kinds)]
+            fixed.append((*r[:-1], max(errs), r[-1]))
+        out = fixed
+    return History(tuple(labels), tuple(out), len(labels) - 1, elided, gap if elided else 0)
+
+
+def nearest_branch(problem: Any, reference: dict[str, dict[str, float]] | None,
+                   x: Sequence[float]) -> str | None:
+    """The closed-form branch nearest to x (display units, angles compared mod 360)."""
+    if not reference:
+        return None
+    from ..problems.closed_form import wrap_degrees
+
+    shown = problem.to_display(x)
+
+    def distance(sol: dict[str, float]) -> float:
+        return max(abs(wrap_degrees(v - sol[n])) if k == "angle" else abs(v - sol[n])
+                   for v, n, k in zip(shown, problem.names, problem.kinds))
+
+    return min(reference, key=lambda b: distance(reference[b]))
