@@ -137,17 +137,11 @@ DATA_TABLES = {
 
 PENDING: set[str] = {
     'function over 80 lines: linkage.cli.synthesize.synthesize',
-    'function over 80 lines: linkage.codegen.source',
-    'function over 80 lines: linkage.iterate.run',
-    'function over 80 lines: linkage.methods.newton_system.newton_2x2',
-    'function over 80 lines: linkage.methods.newton_system.newton_system_lean',
     'function over 80 lines: linkage.render.synthesis.blocks',
     'function over 80 lines: linkage.render.synthesis.synthesis_report',
-    'function over 80 lines: linkage.solve.solve_system',
     'function over 80 lines: linkage.synthesis.evaluate_candidates',
     'function over 80 lines: linkage.synthesis.judge',
     'function over 80 lines: linkage.synthesis.remez',
-    'module over 600 lines: linkage.solve',
     'module over 600 lines: linkage.synthesis',
     'upward import: linkage.cli.root -> linkage',
     'upward import: linkage.problems.loops -> linkage.codegen',
