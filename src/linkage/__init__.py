@@ -24,6 +24,8 @@ The public API, in the order a reader meets it:
 from importlib import import_module
 from typing import Any
 
+from .version import __version__ as __version__
+
 _EXPORTS = {
     "Convergence": ".analysis.convergence", "analyze": ".analysis.convergence",
     "InputError": ".errors", "LinkageError": ".errors", "NotConvergedError": ".errors",
@@ -66,7 +68,6 @@ def __dir__() -> list[str]:
     return sorted([*globals(), *_EXPORTS])
 
 
-__version__ = "0.1.0"
 
 __all__ = [
     "Assemblies",
