@@ -145,14 +145,11 @@ def synthesize(
     desired) with its maximum, and the transmission angle. A defect (branch, grashof, order,
     transmission, no_linkage) is printed and the exit code is 1.
     """
-    import shlex
-    import sys
-
     from ..problems.loops import LENGTH_UNITS
     from ..render import writers
-    from ..render.synthesis import error_plot, synthesis_report, write_design
-    from ..synthesis import make_request
+    from ..render.synthesis import error_plot, synthesis_report
     from ..synthesis import synthesize as run
+    from ..synthesis.request import make_request
 
     design = output is not None and output.suffix.lower() == ".toml"
     report_out = None if design or output is None or str(output) == "-" else output
@@ -217,22 +214,7 @@ def synthesize(
     )
     result = run(req)
     if design:
-        if result.linkage is None:
-            typer.echo(f"note: {output} not written: there is no real linkage", err=True)
-        elif result.defects:
-            typer.echo(f"note: {output} not written: the design has defects "
-                       f"({', '.join(result.defect_names)})", err=True)
-        else:
-            made_by = (
-                " ".join(shlex.quote(w) for w in ["linkage", "synthesize", *sys.argv[2:]])
-                if len(sys.argv) > 1 and sys.argv[1] == "synthesize"
-                else "linkage synthesize"
-            )
-            said = f": linkage sweep {shlex.quote(str(output))} runs it over the alpha range"
-            why_not = write_design(result, output, unit, made_by,  # type: ignore[arg-type]
-                                   write=lambda path, text: write_mechanism(path, text, force, said=said))
-            if why_not is not None:
-                typer.echo(f"note: {output} not written: {why_not}", err=True)
+        write_chosen(result, output, unit, force)  # type: ignore[arg-type]
     if plot is not None and result.linkage is not None and result.curve:
         error_plot(result, plot)
     elif plot is not None:
@@ -241,3 +223,30 @@ def synthesize(
     if result.defects:
         raise typer.Exit(1)
 
+
+
+def write_chosen(result: object, output: Path, unit: str, force: bool) -> None:
+    """-o FILE.toml: the design as a mechanism file (the one mechanism-writing rule,
+    options.write_mechanism), or a note on stderr saying why it is not written."""
+    import shlex
+    import sys
+
+    from ..render.synthesis import write_design
+
+    if result.linkage is None:  # type: ignore[attr-defined]
+        typer.echo(f"note: {output} not written: there is no real linkage", err=True)
+        return
+    if result.defects:  # type: ignore[attr-defined]
+        typer.echo(f"note: {output} not written: the design has defects "
+                   f"({', '.join(result.defect_names)})", err=True)  # type: ignore[attr-defined]
+        return
+    made_by = (
+        " ".join(shlex.quote(w) for w in ["linkage", "synthesize", *sys.argv[2:]])
+        if len(sys.argv) > 1 and sys.argv[1] == "synthesize"
+        else "linkage synthesize"
+    )
+    said = f": linkage sweep {shlex.quote(str(output))} runs it over the alpha range"
+    why_not = write_design(result, output, unit, made_by,
+                           write=lambda path, text: write_mechanism(path, text, force, said=said))
+    if why_not is not None:
+        typer.echo(f"note: {output} not written: {why_not}", err=True)

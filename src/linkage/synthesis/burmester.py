@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InputError
-from .homotopy import PolySystem, Solutions, condition, solve
+from ..errors import InputError
+from ..homotopy import PolySystem, Solutions, condition, solve
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,7 @@ class Burmester:
 def _checked(poses: Any) -> tuple[Pose, ...]:
     """Five poses of finite real numbers (x, y, angle in degrees), each pose its own: every
     misuse an InputError naming it (arguments.check_number, the one rule for numbers)."""
-    from .arguments import check_number
+    from ..arguments import check_number
 
     if isinstance(poses, (str, bytes)) or not isinstance(poses, Sequence):
         raise InputError(f"poses must be a list of 5 poses (x, y, angle in deg), got {poses!r}")
@@ -142,8 +142,8 @@ five poses, after Newton's method on the crank equations."""
 def burmester_points(poses: Sequence[Pose | Sequence[float]], seed: int = 0) -> Burmester:
     """Every crank (centre point and circle point) that carries a body through five poses:
     each real pair, and the complex, infinite, singular and failed paths counted."""
-    from .arguments import MAX_SEED, check_whole
-    from .homotopy import polish_real
+    from ..arguments import MAX_SEED, check_whole
+    from ..homotopy import polish_real
 
     ps = _checked(poses)
     seed = check_whole("seed", seed, 0, MAX_SEED)
