@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from ..problems.closed_form import TRANSMISSION
+from ..units import radians
 from .data import Report, from_rows
 from .report import Block, Text, fmt, table
 
@@ -233,8 +234,8 @@ def design_text(s: Any, unit: str, made_by: str) -> str:
     if drawn is None:
         raise ValueError("the linkage has no position at precision point 1 to draw")
     t2, t4 = real_angles(s, *drawn)
-    a_pt = (k.a * math.cos(math.radians(t2)), k.a * math.sin(math.radians(t2)))
-    b_pt = (k.d + k.c * math.cos(math.radians(t4)), k.c * math.sin(math.radians(t4)))
+    a_pt = (k.a * math.cos(radians(t2)), k.a * math.sin(radians(t2)))
+    b_pt = (k.d + k.c * math.cos(radians(t4)), k.c * math.sin(radians(t4)))
     a0, a1 = s.alpha_range
     shift = 180.0 + k.alpha_shift()
     r0, r1 = a0 + shift, a1 + shift

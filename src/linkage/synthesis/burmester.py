@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..homotopy import PolySystem, Solutions, condition, solve
+from ..units import radians
 
 
 @dataclass(frozen=True)
@@ -105,10 +106,10 @@ def burmester_system(poses: tuple[Pose, ...]) -> PolySystem:
     centre, size = _frame(poses)
     rows = []
     d1 = (complex(poses[0].x, poses[0].y) - centre) / size
-    r1 = complex(math.cos(math.radians(poses[0].angle_deg)), math.sin(math.radians(poses[0].angle_deg)))
+    r1 = complex(math.cos(radians(poses[0].angle_deg)), math.sin(radians(poses[0].angle_deg)))
     for p in poses[1:]:
         dj = (complex(p.x, p.y) - centre) / size
-        rj = complex(math.cos(math.radians(p.angle_deg)), math.sin(math.radians(p.angle_deg)))
+        rj = complex(math.cos(radians(p.angle_deg)), math.sin(radians(p.angle_deg)))
         rows.append(_difference(dj, rj, d1, r1))
     return PolySystem(4, tuple(rows))
 
@@ -164,7 +165,7 @@ def burmester_points(poses: Sequence[Pose | Sequence[float]], seed: int = 0) -> 
         z = complex(zx, zy) * size  # body frame: the first pose's frame, scaled back
         moving = []
         for p in ps:
-            r = complex(math.cos(math.radians(p.angle_deg)), math.sin(math.radians(p.angle_deg)))
+            r = complex(math.cos(radians(p.angle_deg)), math.sin(radians(p.angle_deg)))
             moving.append(complex(p.x, p.y) + r * z)
         lengths = [abs(m - G) for m in moving]
         residual = max(abs(v - lengths[0]) for v in lengths) / size
@@ -182,6 +183,6 @@ def burmester_points(poses: Sequence[Pose | Sequence[float]], seed: int = 0) -> 
 
 def body_to_ground(p: Pose, z: tuple[float, float]) -> np.ndarray:
     """Where the body point z (body coordinates) is at pose p."""
-    r = complex(math.cos(math.radians(p.angle_deg)), math.sin(math.radians(p.angle_deg)))
+    r = complex(math.cos(radians(p.angle_deg)), math.sin(radians(p.angle_deg)))
     w = complex(p.x, p.y) + r * complex(*z)
     return np.array([w.real, w.imag])
