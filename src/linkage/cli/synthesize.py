@@ -18,7 +18,7 @@ from .root import app
 def synthesize(
     *,
     function: Annotated[
-        str,
+        Optional[str],
         typer.Option(
             "--function",
             metavar="EXPR",
@@ -27,8 +27,10 @@ def synthesize(
             "sqrt, pi, ...).",
             show_default=False,
         ),
-    ],
-    x: Annotated[str, typer.Option("--x", metavar="LO:HI", help="The range of x.", show_default=False)],
+    ] = None,
+    x: Annotated[
+        Optional[str], typer.Option("--x", metavar="LO:HI", help="The range of x.", show_default=False)
+    ] = None,
     alpha: Annotated[
         Optional[str],
         typer.Option(
@@ -134,6 +136,24 @@ def synthesize(
             help="Draw the structural error against x, the precision points marked (.png, .svg, .pdf)."
         ),
     ] = None,
+    motion: Annotated[
+        bool,
+        typer.Option("--motion", help="Motion generation: four-bars that carry a body through 5 poses "
+                     "(Burmester), each swept through them and judged (docs/motion_synthesis.md)."),
+    ] = False,
+    pose: Annotated[
+        Optional[list[str]],
+        typer.Option("--pose", metavar="X,Y,DEG", help="With --motion: a pose of the body (repeat 5 times)."),
+    ] = None,
+    poses: Annotated[
+        Optional[Path],
+        typer.Option("--poses", metavar="FILE", help="With --motion: the poses, one X,Y,DEG a line."),
+    ] = None,
+    design_number: Annotated[
+        Optional[int],
+        typer.Option("--design", metavar="K", help="With --motion and -o FILE.toml: write design K "
+                     "(default: the defect-free one with the largest least transmission angle)."),
+    ] = None,
     digits: DigitsOpt = 6,
     table: TableOpt = None,
 ) -> None:
@@ -159,6 +179,19 @@ def synthesize(
         mechanism_output(output, force)
     if unit not in LENGTH_UNITS:
         raise InputError(f"--unit {unit!r} is not a length unit (units: {', '.join(LENGTH_UNITS)})")
+    if motion:
+        from .motion import motion_command
+
+        if search or plot is not None or function is not None:
+            raise InputError("--motion takes poses (--pose, --poses): not --function, --search or --plot")
+        motion_command(pose or [], poses, min_transmission=min_transmission, design=design_number,
+                       output=output, write_file=design, force=force, unit=unit, fmt=fmt,
+                       report_out=report_out, digits=digits, table=table)
+        return
+    if pose or poses is not None or design_number is not None:
+        raise InputError("--pose, --poses and --design are options of --motion")
+    if function is None or x is None:
+        raise InputError("give --function and --x (or --motion with poses)")
     if search:
         from .search import search_command
 
@@ -166,52 +199,20 @@ def synthesize(
             raise InputError(
                 "--search lists candidates: run the best one without --search for -o FILE.toml or --plot"
             )
-        search_command(
-            function,
-            x,
-            alpha,
-            phi,
-            vary or [],
-            points=points,
-            spacing=spacing,
-            at=at,
-            ground=ground,
-            min_transmission=min_transmission,
-            samples=samples,
-            seed=seed,
-            sampling=sampling,
-            top=top,
-            scheduler=scheduler,
-            workers=workers,
-            fmt=fmt,
-            output=report_out,
-            digits=digits,
-            table=table,
-        )
+        search_command(function, x, alpha, phi, vary or [], points=points, spacing=spacing, at=at,
+                       ground=ground, min_transmission=min_transmission, samples=samples, seed=seed,
+                       sampling=sampling, top=top, scheduler=scheduler, workers=workers, fmt=fmt,
+                       output=report_out, digits=digits, table=table)
         return
-    for option, given in (
-        ("--vary", vary),
-        ("--samples", samples),
-        ("--scheduler", scheduler),
-        ("--workers", workers),
-    ):
+    searching = (("--vary", vary), ("--samples", samples), ("--scheduler", scheduler), ("--workers", workers))
+    for option, given in searching:
         if given:
             raise InputError(f"{option} is an option of --search")
     for option, given in (("--alpha", alpha), ("--phi", phi)):
         if given is None:
             raise InputError(f"give {option} (the angle range x and y map onto)")
-    req = make_request(
-        function,
-        x,
-        alpha,
-        phi,
-        points=points,
-        spacing=spacing,
-        at=at,
-        ground=ground,
-        min_transmission=min_transmission,
-        table_points=rows,
-    )
+    req = make_request(function, x, alpha, phi, points=points, spacing=spacing, at=at, ground=ground,
+                       min_transmission=min_transmission, table_points=rows)
     result = run(req)
     if design:
         write_chosen(result, output, unit, force)  # type: ignore[arg-type]

@@ -1,0 +1,69 @@
+"""linkage synthesize --motion: four-bars through five poses (its own module: the CLI's
+modules stay short; docs/motion_synthesis.md)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from ..errors import InputError
+
+
+def read_poses(pose: list[str], poses_file: Optional[Path]) -> list[tuple[float, float, float]]:
+    """--pose X,Y,DEG repeated, or --poses FILE (one pose a line: X,Y,DEG or X Y DEG; # comments)."""
+    from ..synthesis.motion import pose_list
+
+    if pose and poses_file is not None:
+        raise InputError("give the poses as --pose X,Y,DEG (repeated) or --poses FILE, not both")
+    if poses_file is None:
+        if not pose:
+            raise InputError("--motion: give 5 poses, --pose X,Y,DEG repeated (or --poses FILE)")
+        return pose_list(pose)
+    try:
+        text = poses_file.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"--poses {poses_file}: cannot read it ({exc})") from None
+    lines = [ln.split("#", 1)[0].strip() for ln in text.splitlines()]
+    return pose_list([",".join(ln.replace(",", " ").split()) for ln in lines if ln])
+
+
+def motion_command(pose: list[str], poses_file: Optional[Path], *, min_transmission: float,
+                   design: Optional[int], output: Optional[Path], write_file: bool, force: bool, unit: str,
+                   fmt: str, report_out: Optional[Path], digits: int, table: Optional[str]) -> None:
+    from ..render import writers
+    from ..render.motion_synthesis import best_design, motion_report
+    from ..synthesis.motion import synthesize_motion
+
+    poses = read_poses(pose, poses_file)
+    m = synthesize_motion(poses, min_transmission=min_transmission)
+    chosen = best_design(m)
+    if design is not None:
+        if not 1 <= design <= len(m.designs):
+            raise InputError(f"--design {design}: there are {len(m.designs)} designs (1 to {len(m.designs)})")
+        chosen = design - 1
+    writers.write(motion_report(m, digits, unit), fmt, report_out, table=table)
+    if write_file and output is not None:
+        if chosen is None:
+            typer.echo(f"note: {output} not written: no design without defects (--design K writes one)",
+                       err=True)
+        else:
+            write_motion_design(m, chosen, output, unit, force)
+    if best_design(m) is None:
+        raise typer.Exit(1)
+
+
+def write_motion_design(m: object, chosen: int, output: Path, unit: str, force: bool) -> None:
+    """-o FILE.toml: design ``chosen`` by the one mechanism-writing rule (options.write_mechanism)."""
+    import shlex
+    import sys
+
+    from ..render.motion_synthesis import motion_design_text
+    from .options import write_mechanism
+
+    made_by = (" ".join(shlex.quote(w) for w in ["linkage", *sys.argv[1:]])
+               if len(sys.argv) > 1 and sys.argv[1] == "synthesize" else "linkage synthesize --motion")
+    text = motion_design_text(m, chosen, unit, made_by)
+    write_mechanism(output, text, force, said=f" (design {chosen + 1}): linkage sweep "
+                    f"{shlex.quote(str(output))} runs it through the poses")

@@ -1,0 +1,105 @@
+"""linkage synthesize --motion: the report (Burmester's cranks, every four-bar from two of
+them with its defects) and the chosen design as a joints-form file (docs/motion_synthesis.md)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..problems.closed_form import TRANSMISSION
+from .data import Report, from_rows
+from .report import Block, Text, fmt, table
+
+CRANK_HEADERS = [
+    ("crank", "", "int"),
+    ("centre_x", "", "number"),
+    ("centre_y", "", "number"),
+    ("circle_x", "", "number"),
+    ("circle_y", "", "number"),
+    ("length", "", "number"),
+    ("residual", "", "number"),
+]
+"""Burmester's cranks: the ground pivot (centre point), the moving pivot at pose 1 (circle
+point), the crank's length and its rigidity residual (relative to the poses' size)."""
+DESIGN_HEADERS = [
+    ("design", "", "int"),
+    ("input_crank", "", "int"),
+    ("output_crank", "", "int"),
+    ("input", "", "number"),
+    ("coupler", "", "number"),
+    ("output", "", "number"),
+    ("ground", "", "number"),
+    ("grashof", "", "text"),
+    ("min_" + TRANSMISSION, "deg", "number"),
+    ("max_pose_error", "", "number"),
+    ("defects", "", "text"),
+]
+
+
+def best_design(m: Any) -> int | None:
+    """The design -o writes by default: of those without defects, the largest least
+    transmission angle (the first of equals); None without one."""
+    free = [k for k, d in enumerate(m.designs) if not d.defects]
+    return max(free, key=lambda k: (m.designs[k].min_transmission_deg or 0.0, -k)) if free else None
+
+
+def motion_report(m: Any, digits: int = 6, unit: str = "") -> Report:
+    u = f" ({unit})" if unit else ""
+    cranks = [(k + 1, *c.ground, *c.first, c.length, c.residual) for k, c in enumerate(m.burmester.cranks)]
+    designs = [
+        (k + 1, d.cranks[0] + 1, d.cranks[1] + 1, d.links["input"], d.links["coupler"], d.links["output"],
+         d.links["ground"], d.grashof, d.min_transmission_deg,
+         None if None in d.pose_error else max(d.pose_error), " ".join(d.defect_names))
+        for k, d in enumerate(m.designs)
+    ]
+    tables = (from_rows("burmester_cranks", CRANK_HEADERS, cranks),
+              from_rows("designs", DESIGN_HEADERS, designs))
+    title = f"motion generation through {len(m.poses)} poses"
+
+    def blocks() -> list[Block]:
+        b = m.burmester
+        out: list[Block] = [
+            Text(title, "bold"),
+            Text(f"{len(b.cranks)} real Burmester cranks (centre point, circle point at pose 1); "
+                 f"paths: {b.complex_count} complex, {b.infinite} at infinity, {b.singular} singular, "
+                 f"{b.failed} failed" + (f", {b.unresolved} not rigid after Newton" if b.unresolved else "")),
+            Text(""),
+            table("Burmester cranks" + u, [h for h, _, _ in CRANK_HEADERS], cranks, digits),
+            Text(""),
+            table("four-bars: input crank at O2 -> A, output crank at O4 -> B, the body the coupler" + u,
+                  [h if not un else f"{h} ({un})" for h, un, _ in DESIGN_HEADERS], designs, digits),
+        ]
+        best = best_design(m)
+        if best is None:
+            out.append(Text("defect: no four-bar from these cranks carries the body through every pose "
+                            "in order on one assembly with the transmission asked for", "red"))
+        else:
+            out.append(Text(f"best: design {best + 1} (no defects; least {TRANSMISSION} "
+                            f"{fmt(m.designs[best].min_transmission_deg, 4)} deg)", "green"))
+        return out
+
+    return Report(title, tables, blocks, None)
+
+
+def motion_design_text(m: Any, k: int, unit: str, made_by: str) -> str:
+    """Design ``k`` as a joints-form mechanism file drawn at pose 1, its driver range the
+    input's travel through the poses."""
+    from ..synthesis.motion import mechanism_text, pose_order
+
+    d = m.designs[k]
+    s, travel, _ = pose_order(d.input_deg)
+    start = d.input_deg[0]
+    poses = "; ".join(f"({p.x:.12g}, {p.y:.12g}, {p.angle_deg:.12g} deg)" for p in m.poses)
+    head = [
+        "# A motion generator through five poses (linkage synthesize --motion), made by:",
+        f"#   {made_by}",
+        f"# poses (x, y, body angle): {poses}",
+        f"# design {k + 1}: Burmester cranks {d.cranks[0] + 1} (input) and {d.cranks[1] + 1} (output); "
+        f"{d.grashof}; least {TRANSMISSION} {fmt(d.min_transmission_deg, 4)} deg; drawn at pose 1.",
+        f"# the input turns {'anticlockwise' if s > 0 else 'clockwise'} from pose 1 through the others: "
+        + ", ".join(f"{start + s * u:.6g}" for u in travel) + " deg.",
+    ]
+    if d.defects:
+        head.append("# DEFECTS: " + "; ".join(x.message for x in d.defects))
+    body = mechanism_text(d.joints, start, (start, start + s * travel[-1]),
+                          name=f"motion generator, design {k + 1}", unit=unit)
+    return "\n".join(head) + "\n" + body
