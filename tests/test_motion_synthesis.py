@@ -136,3 +136,53 @@ def test_bad_poses_are_refused_with_one_line(poses, said) -> None:
 def test_the_transmission_floor_is_checked() -> None:
     with pytest.raises(InputError, match="min_transmission"):
         synthesize_motion(FIVE, min_transmission=95)
+
+
+def cli_poses(poses) -> list[str]:
+    return [w for p in poses for w in ("--pose", ",".join(repr(float(v)) for v in p))]
+
+
+def test_the_command_writes_a_defect_free_design_that_sweeps_through_the_poses(tmp_path, capsys) -> None:
+    from linkage.cli import run_cli
+
+    o2, o4 = 0j, 4 + 0j
+    poses = poses_of(o2, o4, 1.5, 4.0, 3.5, [30.0, 80.0, 140.0, 200.0, 290.0], complex(1.0, 0.8), 10.0)
+    out = tmp_path / "design.toml"
+    args = ["synthesize", "--motion", *cli_poses(poses), "--design", "11", "-o", str(out), "-f", "json"]
+    assert run_cli(args) == 0
+    m = synthesize_motion(poses)
+    chosen = m.designs[10]
+    assert chosen.defects == () and chosen.cranks == (3, 1)  # the four-bar the poses came from
+    text = out.read_text()
+    assert "design 11" in text and "DEFECTS" not in text
+    mech = from_text(text, str(out))
+    result = sweep_mechanism(mech, [30.0, 80.0, 140.0, 200.0, 290.0], joints=True)
+    for p, pose in zip(result.positions, poses):
+        aj, bj = complex(*p.rates.joints["A"]), complex(*p.rates.joints["B"])
+        origin = aj + cmath.exp(1j * cmath.phase(bj - aj)) * complex(1.0, 0.8)
+        assert abs(origin - complex(pose[0], pose[1])) <= 1e-9
+    # the file is kept: a second run without --force is refused before any work
+    capsys.readouterr()
+    assert run_cli(["synthesize", "--motion", *cli_poses(poses), "-o", str(out)]) == 2
+    assert "exists" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args, said", [
+    (["--pose", "0,0,0"], "exactly 5 poses"),
+    (["--pose", "0,0"], "write X,Y,DEG"),
+    ([], "give 5 poses"),
+    (["--function", "x", "--pose", "0,0,0"], "--motion takes poses"),
+])
+def test_the_command_refuses_bad_poses_with_one_line(args, said, capsys) -> None:
+    from linkage.cli import run_cli
+
+    assert run_cli(["synthesize", "--motion", *args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and said in err[0]
+
+
+def test_pose_options_without_motion_are_refused(capsys) -> None:
+    from linkage.cli import run_cli
+
+    assert run_cli(["synthesize", "--function", "x", "--x", "1:2", "--pose", "0,0,0"]) == 2
+    assert "options of --motion" in capsys.readouterr().err
