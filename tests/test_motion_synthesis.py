@@ -7,6 +7,7 @@ from __future__ import annotations
 import cmath
 import math
 import random
+import re
 
 import pytest
 
@@ -121,15 +122,15 @@ FIVE = [(0, 0, 0), (1, 0.2, 10), (2, 0.5, 25), (2.8, 1.2, 40), (3.2, 2, 60)]
 
 
 @pytest.mark.parametrize("poses, said", [
-    (FIVE[:4], "exactly 5 poses"),
-    ([*FIVE, (4, 3, 70)], "exactly 5 poses"),
+    (FIVE[:4], "3 poses (with two circle points) or 5 (Burmester's points), got 4"),
+    ([*FIVE, (4, 3, 70)], "got 6"),
     ([FIVE[0], FIVE[1], FIVE[2], FIVE[3], FIVE[1]], "same pose"),
     ([FIVE[0], FIVE[1], (math.nan, 0, 0), FIVE[3], FIVE[4]], "poses[2]"),
     ([FIVE[0], FIVE[1], (1e300, 0, 0), FIVE[3], FIVE[4]], "poses[2]"),
     ("0,0,0", "list of 5 poses"),
 ])
 def test_bad_poses_are_refused_with_one_line(poses, said) -> None:
-    with pytest.raises(InputError, match=said.replace("[", r"\[").replace("]", r"\]")):
+    with pytest.raises(InputError, match=re.escape(said)):
         synthesize_motion(poses)
 
 
@@ -168,7 +169,8 @@ def test_the_command_writes_a_defect_free_design_that_sweeps_through_the_poses(t
 
 
 @pytest.mark.parametrize("args, said", [
-    (["--pose", "0,0,0"], "exactly 5 poses"),
+    (["--pose", "0,0,0"], "got 1"),
+    (["--pose", "0,0,0", "--pose", "1,0,10", "--pose", "2,1,30"], "4 free numbers"),
     (["--pose", "0,0"], "write X,Y,DEG"),
     ([], "give 5 poses"),
     (["--function", "x", "--pose", "0,0,0"], "--motion takes poses"),
@@ -186,3 +188,30 @@ def test_pose_options_without_motion_are_refused(capsys) -> None:
 
     assert run_cli(["synthesize", "--function", "x", "--x", "1:2", "--pose", "0,0,0"]) == 2
     assert "options of --motion" in capsys.readouterr().err
+
+
+def test_three_poses_and_the_circle_points_of_a_four_bar_give_it_back() -> None:
+    o2, o4 = 0.5 - 0.25j, 4.4 + 0.9j
+    a, b, c = 1.2, 4.1, 3.3
+    inputs = [40.0, 150.0, 260.0]
+    poses = poses_of(o2, o4, a, b, c, inputs, complex(-0.4, 1.1), -25.0)
+    a1 = o2 + a * cmath.exp(1j * math.radians(inputs[0]))
+    b1 = circle_meet(a1, b, o4, c, 1.0)
+    m = synthesize_motion(poses, circle_points=[(a1.real, a1.imag), (b1.real, b1.imag)])
+    assert m.burmester is None and len(m.cranks) == 2
+    design = m.designs[0]
+    assert abs(complex(*design.joints["O2"]) - o2) <= 1e-9 and abs(complex(*design.joints["O4"]) - o4) <= 1e-9
+    assert design.links == pytest.approx({"input": a, "coupler": b, "output": c, "ground": abs(o4 - o2)},
+                                         rel=1e-9)
+    assert design.defects == () and max(design.pose_error) <= 1e-9
+    check_passes_through(design, m.poses)
+
+
+def test_three_poses_say_what_is_free() -> None:
+    three = FIVE[:3]
+    with pytest.raises(InputError, match="4 free numbers, the two circle points"):
+        synthesize_motion(three)
+    with pytest.raises(InputError, match="must differ"):
+        synthesize_motion(three, circle_points=[(1, 1), (1, 1)])
+    with pytest.raises(InputError, match="five poses fix them"):
+        synthesize_motion(FIVE, circle_points=[(1, 1), (2, 1)])

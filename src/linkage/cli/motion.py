@@ -29,15 +29,36 @@ def read_poses(pose: list[str], poses_file: Optional[Path]) -> list[tuple[float,
     return pose_list([",".join(ln.replace(",", " ").split()) for ln in lines if ln])
 
 
-def motion_command(pose: list[str], poses_file: Optional[Path], *, min_transmission: float,
-                   design: Optional[int], output: Optional[Path], write_file: bool, force: bool, unit: str,
-                   fmt: str, report_out: Optional[Path], digits: int, table: Optional[str]) -> None:
+def read_circle_points(circle: list[str]) -> list[tuple[float, float]] | None:
+    """--circle X,Y (twice, with three poses): the moving pivots at pose 1."""
+    from ..numbers import parse_number
+
+    out = []
+    for k, text in enumerate(circle):
+        parts = text.split(",")
+        if len(parts) != 2:
+            raise InputError(f"--circle {text!r}: write X,Y")
+        x, y = (parse_number(f"--circle {k + 1}", v) for v in parts)
+        out.append((x, y))
+    return out or None
+
+
+def motion_command(pose: list[str], poses_file: Optional[Path], circle: list[str], *,
+                   min_transmission: float, design: Optional[int], output: Optional[Path], write_file: bool,
+                   force: bool, unit: str, fmt: str, report_out: Optional[Path], digits: int,
+                   table: Optional[str]) -> None:
     from ..render import writers
     from ..render.motion_synthesis import best_design, motion_report
-    from ..synthesis.motion import synthesize_motion
+    from ..synthesis.motion import THREE_FREE, synthesize_motion
 
     poses = read_poses(pose, poses_file)
-    m = synthesize_motion(poses, min_transmission=min_transmission)
+    points = read_circle_points(circle)
+    if len(poses) == 3 and points is None:
+        raise InputError(f"{THREE_FREE}: give them as --circle X,Y twice")
+    try:
+        m = synthesize_motion(poses, circle_points=points, min_transmission=min_transmission)
+    except InputError as exc:  # the API's argument names, as the command's options
+        raise InputError(str(exc).replace("circle_points", "--circle")) from None
     chosen = best_design(m)
     if design is not None:
         if not 1 <= design <= len(m.designs):

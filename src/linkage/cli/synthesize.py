@@ -139,15 +139,21 @@ def synthesize(
     motion: Annotated[
         bool,
         typer.Option("--motion", help="Motion generation: four-bars that carry a body through 5 poses "
-                     "(Burmester), each swept through them and judged (docs/motion_synthesis.md)."),
+                     "(Burmester) or 3 (with --circle twice), each swept through them and judged "
+                     "(docs/motion_synthesis.md)."),
     ] = False,
     pose: Annotated[
         Optional[list[str]],
-        typer.Option("--pose", metavar="X,Y,DEG", help="With --motion: a pose of the body (repeat 5 times)."),
+        typer.Option("--pose", metavar="X,Y,DEG", help="With --motion: a pose of the body (5 or 3 of them)."),
     ] = None,
     poses: Annotated[
         Optional[Path],
         typer.Option("--poses", metavar="FILE", help="With --motion: the poses, one X,Y,DEG a line."),
+    ] = None,
+    circle: Annotated[
+        Optional[list[str]],
+        typer.Option("--circle", metavar="X,Y", help="With --motion and 3 poses: a moving pivot at "
+                     "pose 1 (twice: three poses leave both free)."),
     ] = None,
     design_number: Annotated[
         Optional[int],
@@ -184,12 +190,12 @@ def synthesize(
 
         if search or plot is not None or function is not None:
             raise InputError("--motion takes poses (--pose, --poses): not --function, --search or --plot")
-        motion_command(pose or [], poses, min_transmission=min_transmission, design=design_number,
-                       output=output, write_file=design, force=force, unit=unit, fmt=fmt,
-                       report_out=report_out, digits=digits, table=table)
+        motion_command(pose or [], poses, circle or [], min_transmission=min_transmission,
+                       design=design_number, output=output, write_file=design, force=force, unit=unit,
+                       fmt=fmt, report_out=report_out, digits=digits, table=table)
         return
-    if pose or poses is not None or design_number is not None:
-        raise InputError("--pose, --poses and --design are options of --motion")
+    if pose or poses is not None or circle or design_number is not None:
+        raise InputError("--pose, --poses, --circle and --design are options of --motion")
     if function is None or x is None:
         raise InputError("give --function and --x (or --motion with poses)")
     if search:

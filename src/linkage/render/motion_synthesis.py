@@ -44,26 +44,22 @@ def best_design(m: Any) -> int | None:
 
 def motion_report(m: Any, digits: int = 6, unit: str = "") -> Report:
     u = f" ({unit})" if unit else ""
-    cranks = [(k + 1, *c.ground, *c.first, c.length, c.residual) for k, c in enumerate(m.burmester.cranks)]
+    cranks = [(k + 1, *c.ground, *c.first, c.length, c.residual) for k, c in enumerate(m.cranks)]
     designs = [
         (k + 1, d.cranks[0] + 1, d.cranks[1] + 1, d.links["input"], d.links["coupler"], d.links["output"],
          d.links["ground"], d.grashof, d.min_transmission_deg,
          None if None in d.pose_error else max(d.pose_error), " ".join(d.defect_names))
         for k, d in enumerate(m.designs)
     ]
-    tables = (from_rows("burmester_cranks", CRANK_HEADERS, cranks),
+    tables = (from_rows("cranks", CRANK_HEADERS, cranks),
               from_rows("designs", DESIGN_HEADERS, designs))
     title = f"motion generation through {len(m.poses)} poses"
 
     def blocks() -> list[Block]:
-        b = m.burmester
-        out: list[Block] = [
-            Text(title, "bold"),
-            Text(f"{len(b.cranks)} real Burmester cranks (centre point, circle point at pose 1); "
-                 f"paths: {b.complex_count} complex, {b.infinite} at infinity, {b.singular} singular, "
-                 f"{b.failed} failed" + (f", {b.unresolved} not rigid after Newton" if b.unresolved else "")),
-            Text(""),
-            table("Burmester cranks" + u, [h for h, _, _ in CRANK_HEADERS], cranks, digits),
+        out: list[Block] = [Text(title, "bold"), Text(crank_account(m)), Text(""),
+                            table(("Burmester cranks" if m.burmester else "cranks") + u,
+                                  [h for h, _, _ in CRANK_HEADERS], cranks, digits)]
+        out += [
             Text(""),
             table("four-bars: input crank at O2 -> A, output crank at O4 -> B, the body the coupler" + u,
                   [h if not un else f"{h} ({un})" for h, un, _ in DESIGN_HEADERS], designs, digits),
@@ -80,6 +76,18 @@ def motion_report(m: Any, digits: int = 6, unit: str = "") -> Report:
     return Report(title, tables, blocks, None)
 
 
+def crank_account(m: Any) -> str:
+    """Where the cranks come from: the continuation's paths by class, or three poses' free choice."""
+    from ..synthesis.motion import THREE_FREE
+
+    b = m.burmester
+    if b is None:
+        return f"{THREE_FREE}; the cranks of the circle points given:"
+    return (f"{len(b.cranks)} real Burmester cranks (centre point, circle point at pose 1); "
+            f"paths: {b.complex_count} complex, {b.infinite} at infinity, {b.singular} singular, "
+            f"{b.failed} failed" + (f", {b.unresolved} not rigid after Newton" if b.unresolved else ""))
+
+
 def motion_design_text(m: Any, k: int, unit: str, made_by: str) -> str:
     """Design ``k`` as a joints-form mechanism file drawn at pose 1, its driver range the
     input's travel through the poses."""
@@ -90,7 +98,7 @@ def motion_design_text(m: Any, k: int, unit: str, made_by: str) -> str:
     start = d.input_deg[0]
     poses = "; ".join(f"({p.x:.12g}, {p.y:.12g}, {p.angle_deg:.12g} deg)" for p in m.poses)
     head = [
-        "# A motion generator through five poses (linkage synthesize --motion), made by:",
+        f"# A motion generator through {len(m.poses)} poses (linkage synthesize --motion), made by:",
         f"#   {made_by}",
         f"# poses (x, y, body angle): {poses}",
         f"# design {k + 1}: Burmester cranks {d.cranks[0] + 1} (input) and {d.cranks[1] + 1} (output); "

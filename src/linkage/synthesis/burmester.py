@@ -60,13 +60,13 @@ class Burmester:
     unresolved: int = 0  # real roots of the polynomials that are not rigid cranks after Newton
 
 
-def _checked(poses: Any) -> tuple[Pose, ...]:
-    """Five poses of finite real numbers (x, y, angle in degrees), each pose its own: every
-    misuse an InputError naming it (arguments.check_number, the one rule for numbers)."""
+def checked_poses(poses: Any, count: int = 5) -> tuple[Pose, ...]:
+    """``count`` poses of finite real numbers (x, y, angle in degrees), each pose its own:
+    every misuse an InputError naming it (arguments.check_number, the one rule for numbers)."""
     from ..arguments import check_number
 
     if isinstance(poses, (str, bytes)) or not isinstance(poses, Sequence):
-        raise InputError(f"poses must be a list of 5 poses (x, y, angle in deg), got {poses!r}")
+        raise InputError(f"poses must be a list of {count} poses (x, y, angle in deg), got {poses!r}")
     out = []
     for k, p in enumerate(poses):
         vals = (p.x, p.y, p.angle_deg) if isinstance(p, Pose) else p
@@ -76,9 +76,10 @@ def _checked(poses: Any) -> tuple[Pose, ...]:
         if not all(abs(v) < 1e12 for v in (x, y, a)):
             raise InputError(f"poses[{k}] must be finite numbers below 1e12 in size, got {p!r}")
         out.append(Pose(x, y, a))
-    if len(out) != 5:
-        raise InputError(f"Burmester's points need exactly 5 poses, got {len(out)}")
-    for i in range(5):
+    if len(out) != count:
+        raise InputError(f"Burmester's points need exactly 5 poses, got {len(out)}" if count == 5
+                         else f"this needs exactly {count} poses, got {len(out)}")
+    for i in range(count):
         for j in range(i):
             a, b = out[i], out[j]
             if math.hypot(a.x - b.x, a.y - b.y) == 0 and math.remainder(a.angle_deg - b.angle_deg, 360) == 0:
@@ -146,7 +147,7 @@ def burmester_points(poses: Sequence[Pose | Sequence[float]], seed: int = 0) -> 
     from ..arguments import MAX_SEED, check_whole
     from ..homotopy import polish_real
 
-    ps = _checked(poses)
+    ps = checked_poses(poses)
     seed = check_whole("seed", seed, 0, MAX_SEED)
     system = burmester_system(ps)
     sols = solve(system, seed=seed)

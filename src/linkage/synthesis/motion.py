@@ -25,7 +25,7 @@ from typing import Any
 
 from ..errors import InputError
 from ..units import degrees, radians
-from .burmester import Burmester, Crank, Pose, burmester_points
+from .burmester import Burmester, Crank, Pose, burmester_points, checked_poses
 from .defects import Defect
 from .request import MIN_TRANSMISSION_DEG
 
@@ -61,36 +61,89 @@ class MotionDesign:
 
 @dataclass(frozen=True)
 class MotionSynthesis:
-    """Every Burmester crank through the poses and every four-bar from two of them."""
+    """The cranks through the poses (every Burmester crank for five poses, the two chosen
+    for three) and every four-bar from two of them."""
 
     poses: tuple[Pose, ...]
-    burmester: Burmester
+    burmester: Burmester | None
+    """Five poses: the continuation's account (paths by class); None for three."""
+    cranks: tuple[Crank, ...]
     designs: tuple[MotionDesign, ...]
     min_transmission_deg: float
 
 
-def synthesize_motion(poses: Sequence[Pose | Sequence[float]], *,
+THREE_FREE = ("three poses fix a four-bar only once both moving pivots are chosen: 4 free numbers, the "
+              "two circle points at pose 1 (the centre points are then the centres of the circles "
+              "through each circle point's three positions)")
+"""What is free with three poses (Sandor and Erdman vol. 2, ch. 3: the three-position problem)."""
+
+
+def synthesize_motion(poses: Sequence[Pose | Sequence[float]], *, circle_points: Any = None,
                       min_transmission: float = MIN_TRANSMISSION_DEG, seed: int = 0) -> MotionSynthesis:
-    """Four-bars that carry a body through five ``poses`` ((x, y, angle in deg), in order):
-    Burmester's cranks by homotopy continuation, then every pair, each swept through the
-    poses and judged. Bad input (not five poses, coincident ones, NaN or huge values) is an
+    """Four-bars that carry a body through ``poses`` ((x, y, angle in deg), in order), each
+    swept through the poses and judged. Five poses: Burmester's cranks by homotopy
+    continuation, and every pair. Three poses: the family's free choice, the two moving
+    pivots at pose 1 (``circle_points``, two (x, y)), fixes the cranks (:data:`THREE_FREE`).
+    Bad input (another number of poses, coincident ones, NaN or huge values) is an
     InputError."""
     from ..arguments import check_number
 
-    if isinstance(poses, Sequence) and not isinstance(poses, (str, bytes)) and len(poses) != 5:
-        raise InputError(f"motion synthesis takes exactly 5 poses (Burmester's points), got {len(poses)}; "
-                         "3 and 4 poses are not supported yet")
+    count = len(poses) if isinstance(poses, Sequence) and not isinstance(poses, (str, bytes)) else 5
+    if count not in (3, 5):
+        raise InputError(f"motion synthesis takes 3 poses (with two circle points) or 5 (Burmester's "
+                         f"points), got {count}" + ("; 4 poses are not supported yet" if count == 4 else ""))
     floor = check_number("min_transmission", min_transmission)
     if not 0.0 <= floor <= 90.0:
         raise InputError(f"min_transmission must be from 0 to 90 deg, got {floor:g}")
-    found = burmester_points(poses, seed=seed)
-    if len(found.cranks) < 2:
-        return MotionSynthesis(found.poses, found, (), floor)
-    designs = [
-        judge_pair(found.poses, (i, j), found.cranks[i], found.cranks[j], floor)
-        for i in range(len(found.cranks)) for j in range(len(found.cranks)) if i != j
-    ]
-    return MotionSynthesis(found.poses, found, tuple(designs), floor)
+    if count == 3:
+        ps = checked_poses(poses, 3)
+        cranks = tuple(three_pose_crank(ps, w, k) for k, w in enumerate(checked_circle_points(circle_points)))
+        found = None
+    else:
+        if circle_points is not None:
+            raise InputError("circle_points are the free choice of three poses: five poses fix them")
+        found = burmester_points(poses, seed=seed)
+        ps, cranks = found.poses, found.cranks
+    designs = [judge_pair(ps, (i, j), cranks[i], cranks[j], floor)
+               for i in range(len(cranks)) for j in range(len(cranks)) if i != j]
+    return MotionSynthesis(ps, found, cranks, tuple(designs), floor)
+
+
+def checked_circle_points(points: Any) -> list[complex]:
+    """Two moving pivots (x, y) at pose 1, finite and apart."""
+    from ..arguments import check_number
+
+    if points is None:
+        raise InputError(THREE_FREE + ": give them (circle_points, or --circle X,Y twice)")
+    if isinstance(points, (str, bytes)) or not isinstance(points, Sequence) or len(points) != 2:
+        raise InputError(f"circle_points: give two points (x, y), got {points!r}")
+    out = []
+    for k, w in enumerate(points):
+        if isinstance(w, (str, bytes)) or not isinstance(w, Sequence) or len(w) != 2:
+            raise InputError(f"circle_points[{k}] must be (x, y), got {w!r}")
+        x, y = (check_number(f"circle_points[{k}]", v) for v in w)
+        if not max(abs(x), abs(y)) < 1e12:
+            raise InputError(f"circle_points[{k}] must be finite numbers below 1e12 in size, got {w!r}")
+        out.append(complex(x, y))
+    if out[0] == out[1]:
+        raise InputError("circle_points: the two moving pivots must differ")
+    return out
+
+
+def three_pose_crank(poses: Sequence[Pose], w: complex, k: int) -> Crank:
+    """The crank of circle point ``w`` (at pose 1): its centre is the centre of the circle
+    through its three positions; an InputError where they lie on a line (no finite centre)."""
+    z = (w - complex(poses[0].x, poses[0].y)) * cmath.exp(-1j * radians(poses[0].angle_deg))
+    m1, m2, m3 = (at_pose(p, (z.real, z.imag)) for p in poses)
+    u, v = m2 - m1, m3 - m1
+    cross = u.real * v.imag - u.imag * v.real
+    if abs(cross) <= 1e-12 * max(abs(u), abs(v)) ** 2:
+        raise InputError(f"circle_points[{k}]: its three positions lie on a line (no finite centre: that "
+                         "point moves on a straight line, not a circle); choose another")
+    g = m1 - 1j * (abs(u) ** 2 * v - abs(v) ** 2 * u) / (2 * cross)
+    lengths = [abs(m - g) for m in (m1, m2, m3)]
+    residual = (max(lengths) - min(lengths)) / size_of(poses)
+    return Crank((g.real, g.imag), (z.real, z.imag), (w.real, w.imag), lengths[0], residual, math.nan)
 
 
 def size_of(poses: Sequence[Pose]) -> float:
