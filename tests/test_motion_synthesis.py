@@ -15,6 +15,7 @@ from linkage.errors import InputError
 from linkage.kinematics.sweep import sweep_mechanism
 from linkage.problems.loops import from_text
 from linkage.synthesis.motion import mechanism_text, synthesize_motion
+from linkage.synthesis.motion_curves import GRID
 
 
 def circle_meet(c1: complex, r1: float, c2: complex, r2: float, side: float) -> complex:
@@ -122,7 +123,7 @@ FIVE = [(0, 0, 0), (1, 0.2, 10), (2, 0.5, 25), (2.8, 1.2, 40), (3.2, 2, 60)]
 
 
 @pytest.mark.parametrize("poses, said", [
-    (FIVE[:4], "3 poses (with two circle points) or 5 (Burmester's points), got 4"),
+    (FIVE[:2], "got 2"),
     ([*FIVE, (4, 3, 70)], "got 6"),
     ([FIVE[0], FIVE[1], FIVE[2], FIVE[3], FIVE[1]], "same pose"),
     ([FIVE[0], FIVE[1], (math.nan, 0, 0), FIVE[3], FIVE[4]], "poses[2]"),
@@ -215,3 +216,42 @@ def test_three_poses_say_what_is_free() -> None:
         synthesize_motion(three, circle_points=[(1, 1), (1, 1)])
     with pytest.raises(InputError, match="five poses fix them"):
         synthesize_motion(FIVE, circle_points=[(1, 1), (2, 1)])
+
+
+def test_four_poses_give_centre_and_circle_point_curves_through_the_four_bars_pivots(tmp_path) -> None:
+    o2, o4 = 0.5 - 0.25j, 4.4 + 0.9j
+    a, b, c = 1.2, 4.1, 3.3
+    inputs = [40.0, 110.0, 190.0, 260.0]
+    poses = poses_of(o2, o4, a, b, c, inputs, complex(-0.4, 1.1), -25.0)
+    m = synthesize_motion(poses)
+    curves = m.curves
+    assert curves is not None and m.designs == () and len(curves.centre) > 100
+    pts = [complex(p.x, p.y) for p in m.poses]
+    size = max(abs(v - sum(pts) / 4) for v in pts)
+    # every point: its circle point, carried through the four poses (the body's frame from
+    # pose 1), stays at one distance from its centre point
+    turn = [cmath.exp(1j * math.radians(p.angle_deg)) for p in m.poses]
+    for g, w in zip(curves.centre, curves.circle):
+        z = (w - pts[0]) / turn[0]
+        lengths = [abs(d + r * z - g) for d, r in zip(pts, turn)]
+        assert max(lengths) - min(lengths) <= 1e-9 * size
+    # the four-bar's own pivots lie on the curves, to the grid's spacing
+    a1 = o2 + a * cmath.exp(1j * math.radians(inputs[0]))
+    b1 = circle_meet(a1, b, o4, c, 1.0)
+    step = (curves.box[1] - curves.box[0]) / (GRID - 1)
+    for ground, moving in ((o2, a1), (o4, b1)):
+        k = int(abs(curves.centre - ground).argmin())
+        assert abs(curves.centre[k] - ground) <= 2 * step
+        assert abs(curves.circle[k] - moving) <= 0.1 * size
+
+
+def test_the_curves_are_drawn_with_plot_and_only_for_four_poses(tmp_path, capsys) -> None:
+    from linkage.cli import run_cli
+
+    picture = tmp_path / "curves.png"
+    assert run_cli(["synthesize", "--motion", *cli_poses(FIVE[:4]), "--plot", str(picture), "-f", "csv"]) == 0
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == "centre_x,centre_y,circle_x,circle_y,spread" and len(lines) > 100
+    assert run_cli(["synthesize", "--motion", *cli_poses(FIVE), "--plot", str(tmp_path / "x.png")]) == 2
+    assert "give 4 poses" in capsys.readouterr().err and not (tmp_path / "x.png").exists()

@@ -46,13 +46,16 @@ def read_circle_points(circle: list[str]) -> list[tuple[float, float]] | None:
 def motion_command(pose: list[str], poses_file: Optional[Path], circle: list[str], *,
                    min_transmission: float, design: Optional[int], output: Optional[Path], write_file: bool,
                    force: bool, unit: str, fmt: str, report_out: Optional[Path], digits: int,
-                   table: Optional[str]) -> None:
+                   table: Optional[str], plot: Optional[Path] = None) -> None:
     from ..render import writers
     from ..render.motion_synthesis import best_design, motion_report
     from ..synthesis.motion import THREE_FREE, synthesize_motion
 
     poses = read_poses(pose, poses_file)
     points = read_circle_points(circle)
+    if plot is not None and len(poses) != 4:
+        raise InputError("--plot with --motion draws four poses' centre-point and circle-point curves: "
+                         f"give 4 poses, not {len(poses)}")
     if len(poses) == 3 and points is None:
         raise InputError(f"{THREE_FREE}: give them as --circle X,Y twice")
     try:
@@ -64,7 +67,13 @@ def motion_command(pose: list[str], poses_file: Optional[Path], circle: list[str
         if not 1 <= design <= len(m.designs):
             raise InputError(f"--design {design}: there are {len(m.designs)} designs (1 to {len(m.designs)})")
         chosen = design - 1
+    if plot is not None:
+        from ..render.motion_synthesis import curves_plot
+
+        curves_plot(m, plot, unit)
     writers.write(motion_report(m, digits, unit), fmt, report_out, table=table)
+    if m.curves is not None:
+        return
     if write_file and output is not None:
         if chosen is None:
             typer.echo(f"note: {output} not written: no design without defects (--design K writes one)",

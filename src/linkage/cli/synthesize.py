@@ -188,11 +188,11 @@ def synthesize(
     if motion:
         from .motion import motion_command
 
-        if search or plot is not None or function is not None:
-            raise InputError("--motion takes poses (--pose, --poses): not --function, --search or --plot")
+        if search or function is not None:
+            raise InputError("--motion takes poses (--pose, --poses): not --function or --search")
         motion_command(pose or [], poses, circle or [], min_transmission=min_transmission,
                        design=design_number, output=output, write_file=design, force=force, unit=unit,
-                       fmt=fmt, report_out=report_out, digits=digits, table=table)
+                       fmt=fmt, report_out=report_out, digits=digits, table=table, plot=plot)
         return
     if pose or poses is not None or circle or design_number is not None:
         raise InputError("--pose, --poses, --circle and --design are options of --motion")

@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..problems.closed_form import TRANSMISSION
+from ..units import radians
 from .data import Report, from_rows
 from .report import Block, Text, fmt, table
 
@@ -42,7 +43,74 @@ def best_design(m: Any) -> int | None:
     return max(free, key=lambda k: (m.designs[k].min_transmission_deg or 0.0, -k)) if free else None
 
 
+CURVE_HEADERS = [
+    ("centre_x", "", "number"),
+    ("centre_y", "", "number"),
+    ("circle_x", "", "number"),
+    ("circle_y", "", "number"),
+    ("spread", "", "number"),
+]
+"""Four poses: points of the centre-point curve with their circle points (at pose 1) and the
+crank's spread in length over the poses (relative to their size)."""
+FOUR_FREE = ("four poses leave one free number for each crank: its ground pivot anywhere on the "
+             "centre-point curve (a cubic), its moving pivot the matching point of the circle-point "
+             "curve; two of them make a four-bar")
+
+
+def curves_report(m: Any, digits: int = 6, unit: str = "") -> Report:
+    """Four poses: the curves' points (every one in the table; the terminal says how many)."""
+    c = m.curves
+    rows = [(g.real, g.imag, w.real, w.imag, s) for g, w, s in zip(c.centre, c.circle, c.spread)]
+    title = "motion generation through 4 poses: the centre-point and circle-point curves"
+
+    def blocks() -> list[Block]:
+        return [
+            Text(title, "bold"),
+            Text(FOUR_FREE),
+            Text(f"{len(rows)} points of the curve where it crosses a grid over x {fmt(c.box[0], 4)} to "
+                 f"{fmt(c.box[1], 4)}, y {fmt(c.box[2], 4)} to {fmt(c.box[3], 4)} {unit}; "
+                 f"largest spread of a crank's length over the poses "
+                 f"{fmt(max((r[4] for r in rows), default=0.0), 3)} of their size"),
+            Text("every point: -f csv (or json); the picture: --plot FILE.png"),
+        ]
+
+    return Report(title, (from_rows("curves", CURVE_HEADERS, rows),), blocks, None)
+
+
+def curves_plot(m: Any, path: Any, unit: str = "") -> None:
+    """The centre-point curve, the circle-point curve and the poses (a dot and a tick for each
+    body's angle), equal axes."""
+    import numpy as np
+
+    from .plots import pyplot, save_figure
+
+    plt = pyplot()
+    c = m.curves
+    fig, ax = plt.subplots(figsize=(7, 6))
+    ax.plot(c.centre.real, c.centre.imag, ".", ms=2, color="tab:blue",
+            label="centre-point curve (ground pivots)")
+    ax.plot(c.circle.real, c.circle.imag, ".", ms=2, color="tab:orange",
+            label="circle-point curve (moving pivots at pose 1)")
+    size = max(np.hypot(p.x - m.poses[0].x, p.y - m.poses[0].y) for p in m.poses) or 1.0
+    for k, p in enumerate(m.poses):
+        tip = complex(p.x, p.y) + 0.25 * size * np.exp(1j * radians(p.angle_deg))
+        ax.plot([p.x, tip.real], [p.y, tip.imag], "-", color="black", lw=1.5)
+        ax.plot([p.x], [p.y], "o", color="black", ms=4)
+        ax.annotate(str(k + 1), (p.x, p.y), textcoords="offset points", xytext=(4, 4))
+    ax.set_xlim(c.box[0], c.box[1])
+    ax.set_ylim(c.box[2], c.box[3])
+    ax.set_aspect("equal")
+    u = f" ({unit})" if unit else ""
+    ax.set_xlabel("x" + u)
+    ax.set_ylabel("y" + u)
+    ax.set_title("four poses: centre-point and circle-point curves")
+    ax.legend(loc="best", fontsize=8)
+    save_figure(fig, path)
+
+
 def motion_report(m: Any, digits: int = 6, unit: str = "") -> Report:
+    if m.curves is not None:
+        return curves_report(m, digits, unit)
     u = f" ({unit})" if unit else ""
     cranks = [(k + 1, *c.ground, *c.first, c.length, c.residual) for k, c in enumerate(m.cranks)]
     designs = [

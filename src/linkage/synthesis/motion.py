@@ -27,6 +27,7 @@ from ..errors import InputError
 from ..units import degrees, radians
 from .burmester import Burmester, Crank, Pose, burmester_points, checked_poses
 from .defects import Defect
+from .motion_curves import Curves, four_pose_curves
 from .request import MIN_TRANSMISSION_DEG
 
 POSE_TOL = 1e-9
@@ -70,6 +71,8 @@ class MotionSynthesis:
     cranks: tuple[Crank, ...]
     designs: tuple[MotionDesign, ...]
     min_transmission_deg: float
+    curves: Curves | None = None
+    """Four poses: the centre-point and circle-point curves (no cranks chosen, no designs)."""
 
 
 THREE_FREE = ("three poses fix a four-bar only once both moving pivots are chosen: 4 free numbers, the "
@@ -82,19 +85,27 @@ def synthesize_motion(poses: Sequence[Pose | Sequence[float]], *, circle_points:
                       min_transmission: float = MIN_TRANSMISSION_DEG, seed: int = 0) -> MotionSynthesis:
     """Four-bars that carry a body through ``poses`` ((x, y, angle in deg), in order), each
     swept through the poses and judged. Five poses: Burmester's cranks by homotopy
-    continuation, and every pair. Three poses: the family's free choice, the two moving
-    pivots at pose 1 (``circle_points``, two (x, y)), fixes the cranks (:data:`THREE_FREE`).
+    continuation, and every pair. Four poses: the centre-point and circle-point curves
+    (:mod:`.motion_curves`; one number along them is free for each crank). Three poses: the
+    family's free choice, the two moving pivots at pose 1 (``circle_points``, two (x, y)),
+    fixes the cranks (:data:`THREE_FREE`).
     Bad input (another number of poses, coincident ones, NaN or huge values) is an
     InputError."""
     from ..arguments import check_number
 
     count = len(poses) if isinstance(poses, Sequence) and not isinstance(poses, (str, bytes)) else 5
-    if count not in (3, 5):
-        raise InputError(f"motion synthesis takes 3 poses (with two circle points) or 5 (Burmester's "
-                         f"points), got {count}" + ("; 4 poses are not supported yet" if count == 4 else ""))
+    if count not in (3, 4, 5):
+        raise InputError(f"motion synthesis takes 3 poses (with two circle points), 4 (the centre-point "
+                         f"curve) or 5 (Burmester's points), got {count}")
     floor = check_number("min_transmission", min_transmission)
     if not 0.0 <= floor <= 90.0:
         raise InputError(f"min_transmission must be from 0 to 90 deg, got {floor:g}")
+    if count == 4:
+        if circle_points is not None:
+            raise InputError("circle_points are the free choice of three poses: with four, each crank's "
+                             "is a point of the circle-point curve")
+        ps = checked_poses(poses, 4)
+        return MotionSynthesis(ps, None, (), (), floor, four_pose_curves(ps))
     if count == 3:
         ps = checked_poses(poses, 3)
         cranks = tuple(three_pose_crank(ps, w, k) for k, w in enumerate(checked_circle_points(circle_points)))
