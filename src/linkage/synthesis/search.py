@@ -148,51 +148,33 @@ def evaluate_candidates(req: Request, a0: Any, da: Any, p0: Any, dp: Any, grid: 
     (the closed form on the branch through point 1, no continuation), with the largest
     error refined by a parabola through its grid neighbours. Columns, one entry per
     candidate. Every step is a numpy kernel on whole rows, which releases the GIL: the
-    chunks of a search run side by side on threads. Without ``judge_all`` the order and
-    transmission defects (and min_transmission_deg) are found only for rows with no
-    earlier defect: a search keeps only defect-free rows."""
+    chunks of a search run side by side on threads. Without ``judge_all`` only the rows
+    with no defect found from the precision points and the assembly rule (no_linkage,
+    branch, grashof's assembly_gap) go on to the dense grid, so their other columns (the
+    max error, order, transmission) are NaN or unjudged: a search keeps only defect-free
+    rows."""
     import numpy as np
-
-    from ..problems.freudenstein import branch_root_np
 
     a0, da, p0, dp = (np.asarray(v, float) for v in (a0, da, p0, dp))
     cand = candidate_linkages(req, a0, da, p0, dp)
     a, b, c, d = cand.lengths
     real, shift_a, shift_p = cand.real, cand.shift_a, cand.shift_p
-    gx, gt, gu = grid_of(req, grid)
-    al_g = a0[:, None] + gt[None, :] * da[:, None] + shift_a[:, None]
-    phi_g = branch_root_np(al_g, real[:, 0:1], real[:, 1:2], real[:, 2:3], cand.sign[:, None])
-    phi_g = phi_g - shift_p[:, None]
-    want = p0[:, None] + gu[None, :] * dp[:, None]
-    err = np.remainder(phi_g - want + 180.0, 360.0) - 180.0
     linkage_ok = cand.ok
-    assembles = (
-        linkage_ok
-        & np.all(np.isfinite(err), axis=-1)
-        & ~assembly_gap_np(real[:, 0], real[:, 1], real[:, 2], a0 + shift_a, a0 + da + shift_a)
-    )
+    gap = assembly_gap_np(real[:, 0], real[:, 1], real[:, 2], a0 + shift_a, a0 + da + shift_a)
     # branch: a precision point on the other assembly (the one rule, off_branch)
     branch = linkage_ok & np.any(
         off_branch_np(cand.alphas + shift_a[:, None], cand.phis + shift_p[:, None],
                       real[:, 0:1], real[:, 1:2], real[:, 2:3], cand.sign[:, None]),
         axis=-1,
     )
-    lo, hi = req.x_range
-    peak, at_x = peak_errors(err, gx, (hi - lo) / (grid - 1))
+    # the dense grid, most of the work: on every row, or (a search, which keeps only
+    # defect-free rows) on the rows still without a defect
+    rows = np.arange(len(a0)) if judge_all else np.flatnonzero(linkage_ok & ~gap & ~branch)
+    finite, peak, at_x, min_mu, order = judge_on_grid(req, cand, (a0, da, p0, dp), rows, grid)
+    assembles = linkage_ok & finite & ~gap
     max_err = np.where(assembles, peak, np.nan)
-    # order and transmission on the rows still without a defect, unless every row is to be
-    # judged: a search keeps only defect-free rows, and these two are most of the work
-    rows = slice(None) if judge_all else np.flatnonzero(assembles & ~branch)
-    fold = transmission_deg_np(a[rows, None], c[rows, None], d[rows, None], al_g[rows],
-                               phi_g[rows] + shift_p[rows, None])
-    lowest = np.min(np.where(np.isfinite(fold), fold, np.inf), axis=-1)
-    min_mu = np.full(a.shape, np.nan)
-    min_mu[rows] = np.where(linkage_ok[rows] & np.isfinite(lowest), lowest, np.nan)
-    order = np.zeros(a.shape, bool)
+    order &= assembles
     with np.errstate(invalid="ignore"):
-        # the generated output unwrapped as the scalar rule reads it: desired + error
-        gen = want[rows] + np.where(np.isfinite(err[rows]), err[rows], 0.0)
-        order[rows] = assembles[rows] & (turns_np(gen) > turns_np(want[rows]))
         low_mu = linkage_ok & (min_mu < req.min_transmission)
     defects = defect_column(
         [("no_linkage", ~linkage_ok), ("branch", branch), ("grashof", linkage_ok & ~assembles),
@@ -209,6 +191,41 @@ def evaluate_candidates(req: Request, a0: Any, da: Any, p0: Any, dp: Any, grid: 
         "defects": defects,
         "ok": defects == "",
     }
+
+
+def judge_on_grid(req: Request, cand: Candidates, ranges: tuple[Any, Any, Any, Any], rows: Any,
+                  grid: int) -> tuple[Any, Any, Any, Any, Any]:
+    """The candidates ``rows`` on the dense grid (the branch's closed form through point 1):
+    whether the output is found everywhere, the largest |error| (:func:`peak_errors`) and
+    its x, the least transmission angle (folded, deg) and whether the output turns back
+    where the function does not. Columns for every candidate: NaN or False off ``rows``."""
+    import numpy as np
+
+    from ..problems.freudenstein import branch_root_np
+
+    n = len(ranges[0])
+    a0, da, p0, dp = (v[rows] for v in ranges)
+    real, shift_a, shift_p, sign = cand.real[rows], cand.shift_a[rows], cand.shift_p[rows], cand.sign[rows]
+    a, _, c, d = (v[rows] for v in cand.lengths)
+    gx, gt, gu = grid_of(req, grid)
+    al_g = a0[:, None] + gt[None, :] * da[:, None] + shift_a[:, None]
+    phi_g = branch_root_np(al_g, real[:, 0:1], real[:, 1:2], real[:, 2:3], sign[:, None]) - shift_p[:, None]
+    want = p0[:, None] + gu[None, :] * dp[:, None]
+    err = np.remainder(phi_g - want + 180.0, 360.0) - 180.0
+    lo, hi = req.x_range
+    peak, at_x = peak_errors(err, gx, (hi - lo) / (grid - 1))
+    fold = transmission_deg_np(a[:, None], c[:, None], d[:, None], al_g, phi_g + shift_p[:, None])
+    lowest = np.min(np.where(np.isfinite(fold), fold, np.inf), axis=-1)
+    with np.errstate(invalid="ignore"):
+        # the generated output unwrapped as the scalar rule reads it: desired + error
+        gen = want + np.where(np.isfinite(err), err, 0.0)
+        turned = turns_np(gen) > turns_np(want)
+    finite, order = np.zeros(n, bool), np.zeros(n, bool)
+    full_peak, full_at, min_mu = np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan)
+    finite[rows] = np.all(np.isfinite(err), axis=-1)
+    full_peak[rows], full_at[rows], order[rows] = peak, at_x, turned
+    min_mu[rows] = np.where(cand.ok[rows] & np.isfinite(lowest), lowest, np.nan)
+    return finite, full_peak, full_at, min_mu, order
 
 
 def grashof_column(cand: Candidates) -> Any:
