@@ -159,7 +159,7 @@ BATTERY = [
     ("synthesize_function", "negative ground",
      lambda: linkage.synthesize_function("x", (1, 2), (90, 150), (0, 90), ground=-1.0), "ground"),
     ("synthesize_motion", "poses None", lambda: linkage.synthesize_motion(None), "poses"),
-    ("synthesize_motion", "four poses", lambda: linkage.synthesize_motion(POSES[:4]), "poses"),
+    ("synthesize_motion", "two poses", lambda: linkage.synthesize_motion(POSES[:2]), "poses"),
     ("synthesize_motion", "a NaN pose",
      lambda: linkage.synthesize_motion([*POSES[:4], (0, math.nan, 1)]), "poses"),
     ("synthesize_motion", "a pose twice", lambda: linkage.synthesize_motion([*POSES[:4], POSES[0]]), "poses"),
