@@ -133,18 +133,20 @@ def synthesize(
     plot: Annotated[
         Optional[Path],
         typer.Option(
-            help="Draw the structural error against x, the precision points marked (.png, .svg, .pdf)."
+            help="Draw the structural error against x, the precision points marked (.png, .svg, .pdf); "
+            "with --motion and 4 poses, the centre-point and circle-point curves."
         ),
     ] = None,
     motion: Annotated[
         bool,
         typer.Option("--motion", help="Motion generation: four-bars that carry a body through 5 poses "
-                     "(Burmester) or 3 (with --circle twice), each swept through them and judged "
-                     "(docs/motion_synthesis.md)."),
+                     "(Burmester) or 3 (with --circle twice), each swept through them and judged; "
+                     "4 poses: the centre-point and circle-point curves (docs/motion_synthesis.md)."),
     ] = False,
     pose: Annotated[
         Optional[list[str]],
-        typer.Option("--pose", metavar="X,Y,DEG", help="With --motion: a pose of the body (5 or 3 of them)."),
+        typer.Option("--pose", metavar="X,Y,DEG",
+                     help="With --motion: a pose of the body (3, 4 or 5 of them)."),
     ] = None,
     poses: Annotated[
         Optional[Path],
