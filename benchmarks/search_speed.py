@@ -132,16 +132,22 @@ def cli(vary: list[str]) -> tuple[float, float]:
 
 
 def in_process(vary: list[str], repeats: int) -> None:
-    """search() with --workers 1 against every core, interleaved, in this process."""
+    """search() with --workers 1 against every core, and its CPU against the hand search's,
+    interleaved, in this process (no start-up)."""
     from linkage.synthesis import search
+
+    c = candidates(vary)
 
     def run(workers: int | None) -> tuple[float, float]:
         t, t_cpu = time.perf_counter(), time.process_time()
         search("log10(x)", (1, 2), None, None, vary, min_transmission=MIN_MU, top=5, workers=workers)
         return time.perf_counter() - t, time.process_time() - t_cpu
 
-    one, every = [], []
+    one, every, hand = [], [], []
     for _ in range(repeats):
+        t_cpu = time.process_time()
+        hand_search(c)
+        hand.append(time.process_time() - t_cpu)
         one.append(run(1))
         every.append(run(None))
     ratios = [a[0] / b[0] for a, b in zip(one, every)]
@@ -150,6 +156,9 @@ def in_process(vary: list[str], repeats: int) -> None:
           f"({os.cpu_count()}): {statistics.median(w for w, _ in every):.2f} s, speed-up "
           f"{statistics.median(ratios):.2f}x, {statistics.median(busy):.2f} cores busy "
           f"(medians of {repeats})")
+    print(f"CPU, search with workers 1 / hand search: "
+          f"{statistics.median(s[1] / h for s, h in zip(one, hand)):.2f}x "
+          f"({statistics.median(s for _, s in one):.2f} s / {statistics.median(hand):.2f} s)")
 
 
 def main() -> None:
