@@ -79,21 +79,9 @@ def motion_command(pose: list[str], poses_file: Optional[Path], circle: list[str
             typer.echo(f"note: {output} not written: no design without defects (--design K writes one)",
                        err=True)
         else:
+            from .synthesis_output import write_motion_design
+
             write_motion_design(m, chosen, output, unit, force)
     if best_design(m) is None:
         raise typer.Exit(1)
 
-
-def write_motion_design(m: object, chosen: int, output: Path, unit: str, force: bool) -> None:
-    """-o FILE.toml: design ``chosen`` by the one mechanism-writing rule (options.write_mechanism)."""
-    import shlex
-    import sys
-
-    from ..render.motion_synthesis import motion_design_text
-    from .options import write_mechanism
-
-    made_by = (" ".join(shlex.quote(w) for w in ["linkage", *sys.argv[1:]])
-               if len(sys.argv) > 1 and sys.argv[1] == "synthesize" else "linkage synthesize --motion")
-    text = motion_design_text(m, chosen, unit, made_by)
-    write_mechanism(output, text, force, said=f" (design {chosen + 1}): linkage sweep "
-                    f"{shlex.quote(str(output))} runs it through the poses")

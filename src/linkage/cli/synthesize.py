@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import DigitsOpt, ForceOpt, TableOpt, check_paths, mechanism_output, write_mechanism
+from .options import DigitsOpt, ForceOpt, TableOpt, check_paths, mechanism_output
 from .root import app
 
 
@@ -223,6 +223,8 @@ def synthesize(
                        min_transmission=min_transmission, table_points=rows)
     result = run(req)
     if design:
+        from .synthesis_output import write_chosen
+
         write_chosen(result, output, unit, force)  # type: ignore[arg-type]
     if plot is not None and result.linkage is not None and result.curve:
         error_plot(result, plot)
@@ -233,29 +235,3 @@ def synthesize(
         raise typer.Exit(1)
 
 
-
-def write_chosen(result: object, output: Path, unit: str, force: bool) -> None:
-    """-o FILE.toml: the design as a mechanism file (the one mechanism-writing rule,
-    options.write_mechanism), or a note on stderr saying why it is not written."""
-    import shlex
-    import sys
-
-    from ..render.synthesis import write_design
-
-    if result.linkage is None:  # type: ignore[attr-defined]
-        typer.echo(f"note: {output} not written: there is no real linkage", err=True)
-        return
-    if result.defects:  # type: ignore[attr-defined]
-        typer.echo(f"note: {output} not written: the design has defects "
-                   f"({', '.join(result.defect_names)})", err=True)  # type: ignore[attr-defined]
-        return
-    made_by = (
-        " ".join(shlex.quote(w) for w in ["linkage", "synthesize", *sys.argv[2:]])
-        if len(sys.argv) > 1 and sys.argv[1] == "synthesize"
-        else "linkage synthesize"
-    )
-    said = f": linkage sweep {shlex.quote(str(output))} runs it over the alpha range"
-    why_not = write_design(result, output, unit, made_by,
-                           write=lambda path, text: write_mechanism(path, text, force, said=said))
-    if why_not is not None:
-        typer.echo(f"note: {output} not written: {why_not}", err=True)
