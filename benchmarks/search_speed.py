@@ -4,6 +4,7 @@ one thread (issue 33's row: target <= 1.2x, using every core).
     python benchmarks/search_speed.py                  # 25,920 candidates (docs/synthesis.md's grid)
     python benchmarks/search_speed.py --repeats 5 --small
     python benchmarks/search_speed.py --chunks         # in-process search: workers 1 against every core
+    python benchmarks/search_speed.py --gil            # how much of a chunk's time holds the GIL
 
 The CLI is timed as a user sees it (a fresh process, its start-up included, its default
 threads, `-f csv` to /dev/null); the hand search in-process, on one thread (the BLAS pool
@@ -161,12 +162,56 @@ def in_process(vary: list[str], repeats: int) -> None:
           f"({statistics.median(s for _, s in one):.2f} s / {statistics.median(hand):.2f} s)")
 
 
+def gil_probe() -> None:
+    """How much of a chunk's time holds the GIL: a pure-Python counting thread (it needs the
+    GIL for every loop) runs beside 20 search chunks, and beside a sleep (which holds none);
+    its loop rate beside the chunks over its rate beside the sleep is the share of time the
+    GIL was free. Machine load slows both alike."""
+    import threading
+
+    from linkage.scan import DesignPlan, parse_vary
+    from linkage.synthesis.search import SearchJob, search_chunk
+
+    plan = DesignPlan([parse_vary(v) for v in FULL], None, 0, "lhs")
+    job = SearchJob("log10(x)", (1.0, 2.0), (0.0, 40.0), (0.0, 60.0), plan.names, 3, "chebyshev", None, 1.0,
+                    MIN_MU)
+    chunks = [(i * 200, plan.chunk(i * 200, (i + 1) * 200)) for i in range(20)]
+    search_chunk(job, *chunks[0])
+
+    def rate(work: object) -> float:
+        stop, count = threading.Event(), [0]
+
+        def probe() -> None:
+            n = 0
+            while not stop.is_set():
+                n += 1
+            count[0] = n
+
+        th = threading.Thread(target=probe)
+        th.start()
+        t = time.perf_counter()
+        work()  # type: ignore[operator]
+        wall = time.perf_counter() - t
+        stop.set()
+        th.join()
+        return count[0] / wall
+
+    idle = rate(lambda: time.sleep(3.0))
+    busy = rate(lambda: [search_chunk(job, *c) for c in chunks])
+    print(f"GIL probe: a Python thread beside the search's chunks runs at {busy / idle:.2f} of its rate "
+          f"beside a sleep ({busy / 1e6:.2f} vs {idle / 1e6:.2f} M loops a second)")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--small", action="store_true", help="2,880 candidates instead of 25,920")
     ap.add_argument("--chunks", action="store_true", help="also time search() in-process by worker count")
+    ap.add_argument("--gil", action="store_true", help="only the GIL probe")
     args = ap.parse_args()
+    if args.gil:
+        gil_probe()
+        return
     vary = SMALL if args.small else FULL
     c = candidates(vary)
     kept, _ = hand_search(c)
