@@ -69,6 +69,9 @@ JM = linkage.load_mechanism(FOURBAR.parent / "fourbar_me581_joints.toml")
 JQ = [u.value for u in JM.unknowns]
 SM = linkage.load_mechanism(ROOT / "docs" / "crank_rocker_loads.toml")  # with masses, for simulate
 
+POSES = [(0, 0, 0), (1, 0.2, 10), (2, 0.5, 25), (2.8, 1.2, 40), (3.2, 2, 60)]
+"""Five poses of a body (linkage.synthesize_motion)."""
+
 BATTERY = [
     # sweep: values, rates, options
     ("sweep", "2-D values", lambda: linkage.sweep(M, np.zeros((3, 2))), "values"),
@@ -155,6 +158,14 @@ BATTERY = [
      lambda: linkage.synthesize_function("x", (1, 2), (90, 150), (0, 90), spacing="best"), "spacing"),
     ("synthesize_function", "negative ground",
      lambda: linkage.synthesize_function("x", (1, 2), (90, 150), (0, 90), ground=-1.0), "ground"),
+    ("synthesize_motion", "poses None", lambda: linkage.synthesize_motion(None), "poses"),
+    ("synthesize_motion", "two poses", lambda: linkage.synthesize_motion(POSES[:2]), "poses"),
+    ("synthesize_motion", "a NaN pose",
+     lambda: linkage.synthesize_motion([*POSES[:4], (0, math.nan, 1)]), "poses"),
+    ("synthesize_motion", "a pose twice", lambda: linkage.synthesize_motion([*POSES[:4], POSES[0]]), "poses"),
+    ("synthesize_motion", "min_transmission True",
+     lambda: linkage.synthesize_motion(POSES, min_transmission=True), "min_transmission"),
+    ("synthesize_motion", "seed -1", lambda: linkage.synthesize_motion(POSES, seed=-1), "seed"),
     ("scan_designs", "vary a list", lambda: linkage.scan_designs(M, [("r2", 1, 2, 3)], values=TWO), "vary"),
     ("scan_designs", "spec of one", lambda: linkage.scan_designs(M, {"r2": (1,)}, values=TWO), "vary"),
     ("scan_designs", "spec text", lambda: linkage.scan_designs(M, {"r2": "abc"}, values=TWO), "vary"),

@@ -18,8 +18,8 @@ import mpmath
 import numpy as np
 import pytest
 
-from linkage.burmester import Pose, burmester_points
 from linkage.errors import InputError
+from linkage.synthesis.burmester import Pose, burmester_points
 
 mpmath.mp.dps = 50
 

@@ -18,7 +18,8 @@ import pytest
 
 from linkage.cli import run_cli
 from linkage.errors import InputError
-from linkage.synthesis import chebyshev_xs, synthesize_function
+from linkage.synthesis import synthesize_function
+from linkage.synthesis.solve import chebyshev_xs
 
 GOOD = ("log10(x)", (1.0, 2.0), (90.0, 150.0), (0.0, 90.0))
 """Defect-free, both links drawn the other way (R1, R2 < 0)."""
@@ -267,7 +268,7 @@ DEFECT_CASES = {
 
 
 def test_every_defect_has_a_case() -> None:
-    from linkage.synthesis import DEFECTS
+    from linkage.synthesis.defects import DEFECTS
 
     assert set(DEFECT_CASES) == set(DEFECTS)
 
@@ -416,7 +417,7 @@ def test_numpy_twins_match_the_one_definition() -> None:
     import numpy as np
 
     from linkage.problems.freudenstein import branch_root, branch_root_np
-    from linkage.synthesis import (
+    from linkage.synthesis.solve import (
         linkage_of,
         linkage_of_np,
         solve_coefficients,
@@ -667,7 +668,8 @@ def test_points_on_different_circuits_name_branch_and_grashof() -> None:
     of the input range where the linkage cannot be assembled: synthesize named only
     grashof (the point is not reached, so it was not judged), the search's numpy twin
     branch and grashof."""
-    from linkage.synthesis import evaluate_candidates, make_request
+    from linkage.synthesis.request import make_request
+    from linkage.synthesis.search import evaluate_candidates
 
     args = ("x**2", (1, 2), (30, -90), (150, 240))
     s = synthesize_function(*args)
@@ -695,7 +697,9 @@ def test_points_on_different_circuits_name_branch_and_grashof() -> None:
 def test_numpy_defect_judgement_names_what_synthesize_names() -> None:
     """One rule: the search's judgement (numpy, on the grid) and synthesize's agree on every
     defect name, not only on which candidates have none."""
-    from linkage.synthesis import DEFECTS, evaluate_candidates, make_request
+    from linkage.synthesis.defects import DEFECTS
+    from linkage.synthesis.request import make_request
+    from linkage.synthesis.search import evaluate_candidates
 
     rng = random.Random(3)
     named = set()
@@ -728,7 +732,7 @@ def test_range_narrower_than_rounding_is_judged_by_the_rounding_it_carries() -> 
     """The bound is rounding's own (eps |x| / width, eps |y| / width of y, times the angle
     spans), checked against 40 digits: a range at ten times the bound is accepted and its
     precision points are those of exact arithmetic to that bound."""
-    from linkage.synthesis import BRANCH_TOL_DEG, make_request, rounding_deg
+    from linkage.synthesis.request import BRANCH_TOL_DEG, make_request, rounding_deg
 
     assert rounding_deg(make_request("x**2", (1, 2), (90, 150), (0, 90))) == pytest.approx(
         2.0**-52 * (2.0 / 1.0 + 4.0 / 3.0) * 90.0

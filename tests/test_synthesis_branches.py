@@ -121,7 +121,7 @@ GAP_X = (150.015, 210.015)
 
 
 def _gap_phi() -> tuple[float, float]:
-    from linkage.synthesis import make_request
+    from linkage.synthesis.request import make_request
 
     return make_request(GAP_F, GAP_X, (0, 1), (0, 1)).y_ends
 
@@ -143,7 +143,7 @@ def test_assembly_gap_against_dense_sampling() -> None:
     import random
 
     from linkage.problems.freudenstein import equation_roots
-    from linkage.synthesis import assembly_gap, assembly_gap_np
+    from linkage.synthesis.solve import assembly_gap, assembly_gap_np
 
     rng = random.Random(7)
     seen = set()

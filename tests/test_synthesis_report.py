@@ -8,7 +8,8 @@ import math
 import re
 
 from linkage.cli import run_cli
-from linkage.synthesis import dense_curve, synthesize_function
+from linkage.synthesis import synthesize_function
+from linkage.synthesis.function import dense_curve
 
 GRASHOF = ("log10(x)", (1.0, 2.0), (225.0, 315.0), (255.0, 315.0))
 """A triple rocker whose input reaches a limit position at x = 1.965, before x = 2."""

@@ -17,7 +17,8 @@ from linkage.cli import run_cli
 from linkage.files import parse_toml
 from linkage.problems.freudenstein import branch_root
 from linkage.render.synthesis import real_angles, write_design
-from linkage.synthesis import FunctionSynthesis, drawn_position, synthesize_function
+from linkage.synthesis import FunctionSynthesis, synthesize_function
+from linkage.synthesis.function import drawn_position
 from test_synthesis import random_task
 
 EPS = 2.220446049250313e-16

@@ -41,6 +41,7 @@ _EXPORTS = {
     "position_rates": ".kinematics.rates", "Rates": ".kinematics.rates",
     "scan_designs": ".scan",
     "synthesize_function": ".synthesis", "FunctionSynthesis": ".synthesis",
+    "synthesize_motion": ".synthesis.motion", "MotionSynthesis": ".synthesis.motion",
     "forces": ".kinematics.forces", "Forces": ".kinematics.forces",
     "assemblies": ".kinematics.assemblies", "Assemblies": ".kinematics.assemblies",
     "Loads": ".problems.loads", "Mass": ".problems.loads",
@@ -83,6 +84,7 @@ __all__ = [
     "Loads",
     "Mass",
     "Mechanism",
+    "MotionSynthesis",
     "NotConvergedError",
     "ParseError",
     "Position",
@@ -110,5 +112,6 @@ __all__ = [
     "solve_system",
     "sweep",
     "synthesize_function",
+    "synthesize_motion",
     "tolerance",
 ]

@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import DigitsOpt, ForceOpt, TableOpt, check_paths, mechanism_output, write_mechanism
+from .options import DigitsOpt, ForceOpt, TableOpt, check_paths, mechanism_output
 from .root import app
 
 
@@ -18,7 +18,7 @@ from .root import app
 def synthesize(
     *,
     function: Annotated[
-        str,
+        Optional[str],
         typer.Option(
             "--function",
             metavar="EXPR",
@@ -27,8 +27,10 @@ def synthesize(
             "sqrt, pi, ...).",
             show_default=False,
         ),
-    ],
-    x: Annotated[str, typer.Option("--x", metavar="LO:HI", help="The range of x.", show_default=False)],
+    ] = None,
+    x: Annotated[
+        Optional[str], typer.Option("--x", metavar="LO:HI", help="The range of x.", show_default=False)
+    ] = None,
     alpha: Annotated[
         Optional[str],
         typer.Option(
@@ -131,8 +133,34 @@ def synthesize(
     plot: Annotated[
         Optional[Path],
         typer.Option(
-            help="Draw the structural error against x, the precision points marked (.png, .svg, .pdf)."
+            help="Draw the structural error against x, the precision points marked (.png, .svg, .pdf); "
+            "with --motion and 4 poses, the centre-point and circle-point curves."
         ),
+    ] = None,
+    motion: Annotated[
+        bool,
+        typer.Option("--motion", help="Motion generation: four-bars that carry a body through 5 poses "
+                     "(Burmester) or 3 (with --circle twice), each swept through them and judged; "
+                     "4 poses: the centre-point and circle-point curves (docs/motion_synthesis.md)."),
+    ] = False,
+    pose: Annotated[
+        Optional[list[str]],
+        typer.Option("--pose", metavar="X,Y,DEG",
+                     help="With --motion: a pose of the body (3, 4 or 5 of them)."),
+    ] = None,
+    poses: Annotated[
+        Optional[Path],
+        typer.Option("--poses", metavar="FILE", help="With --motion: the poses, one X,Y,DEG a line."),
+    ] = None,
+    circle: Annotated[
+        Optional[list[str]],
+        typer.Option("--circle", metavar="X,Y", help="With --motion and 3 poses: a moving pivot at "
+                     "pose 1 (twice: three poses leave both free)."),
+    ] = None,
+    design_number: Annotated[
+        Optional[int],
+        typer.Option("--design", metavar="K", help="With --motion and -o FILE.toml: write design K "
+                     "(default: the defect-free one with the largest least transmission angle)."),
     ] = None,
     digits: DigitsOpt = 6,
     table: TableOpt = None,
@@ -145,14 +173,11 @@ def synthesize(
     desired) with its maximum, and the transmission angle. A defect (branch, grashof, order,
     transmission, no_linkage) is printed and the exit code is 1.
     """
-    import shlex
-    import sys
-
     from ..problems.loops import LENGTH_UNITS
     from ..render import writers
-    from ..render.synthesis import error_plot, synthesis_report, write_design
-    from ..synthesis import make_request
+    from ..render.synthesis import error_plot, synthesis_report
     from ..synthesis import synthesize as run
+    from ..synthesis.request import make_request
 
     design = output is not None and output.suffix.lower() == ".toml"
     report_out = None if design or output is None or str(output) == "-" else output
@@ -162,6 +187,19 @@ def synthesize(
         mechanism_output(output, force)
     if unit not in LENGTH_UNITS:
         raise InputError(f"--unit {unit!r} is not a length unit (units: {', '.join(LENGTH_UNITS)})")
+    if motion:
+        from .motion import motion_command
+
+        if search or function is not None:
+            raise InputError("--motion takes poses (--pose, --poses): not --function or --search")
+        motion_command(pose or [], poses, circle or [], min_transmission=min_transmission,
+                       design=design_number, output=output, write_file=design, force=force, unit=unit,
+                       fmt=fmt, report_out=report_out, digits=digits, table=table, plot=plot)
+        return
+    if pose or poses is not None or circle or design_number is not None:
+        raise InputError("--pose, --poses, --circle and --design are options of --motion")
+    if function is None or x is None:
+        raise InputError("give --function and --x (or --motion with poses)")
     if search:
         from .search import search_command
 
@@ -169,70 +207,25 @@ def synthesize(
             raise InputError(
                 "--search lists candidates: run the best one without --search for -o FILE.toml or --plot"
             )
-        search_command(
-            function,
-            x,
-            alpha,
-            phi,
-            vary or [],
-            points=points,
-            spacing=spacing,
-            at=at,
-            ground=ground,
-            min_transmission=min_transmission,
-            samples=samples,
-            seed=seed,
-            sampling=sampling,
-            top=top,
-            scheduler=scheduler,
-            workers=workers,
-            fmt=fmt,
-            output=report_out,
-            digits=digits,
-            table=table,
-        )
+        search_command(function, x, alpha, phi, vary or [], points=points, spacing=spacing, at=at,
+                       ground=ground, min_transmission=min_transmission, samples=samples, seed=seed,
+                       sampling=sampling, top=top, scheduler=scheduler, workers=workers, fmt=fmt,
+                       output=report_out, digits=digits, table=table)
         return
-    for option, given in (
-        ("--vary", vary),
-        ("--samples", samples),
-        ("--scheduler", scheduler),
-        ("--workers", workers),
-    ):
+    searching = (("--vary", vary), ("--samples", samples), ("--scheduler", scheduler), ("--workers", workers))
+    for option, given in searching:
         if given:
             raise InputError(f"{option} is an option of --search")
     for option, given in (("--alpha", alpha), ("--phi", phi)):
         if given is None:
             raise InputError(f"give {option} (the angle range x and y map onto)")
-    req = make_request(
-        function,
-        x,
-        alpha,
-        phi,
-        points=points,
-        spacing=spacing,
-        at=at,
-        ground=ground,
-        min_transmission=min_transmission,
-        table_points=rows,
-    )
+    req = make_request(function, x, alpha, phi, points=points, spacing=spacing, at=at, ground=ground,
+                       min_transmission=min_transmission, table_points=rows)
     result = run(req)
     if design:
-        if result.linkage is None:
-            typer.echo(f"note: {output} not written: there is no real linkage", err=True)
-        elif result.defects:
-            typer.echo(f"note: {output} not written: the design has defects "
-                       f"({', '.join(result.defect_names)})", err=True)
-        else:
-            made_by = (
-                " ".join(shlex.quote(w) for w in ["linkage", "synthesize", *sys.argv[2:]])
-                if len(sys.argv) > 1 and sys.argv[1] == "synthesize"
-                else "linkage synthesize"
-            )
-            said = f": linkage sweep {shlex.quote(str(output))} runs it over the alpha range"
-            why_not = write_design(result, output, unit, made_by,  # type: ignore[arg-type]
-                                   write=lambda path, text: write_mechanism(path, text, force, said=said))
-            if why_not is not None:
-                typer.echo(f"note: {output} not written: {why_not}", err=True)
+        from .synthesis_output import write_chosen
+
+        write_chosen(result, output, unit, force)  # type: ignore[arg-type]
     if plot is not None and result.linkage is not None and result.curve:
         error_plot(result, plot)
     elif plot is not None:
@@ -240,4 +233,5 @@ def synthesize(
     writers.write(synthesis_report(result, digits, unit), fmt, report_out, table=table)
     if result.defects:
         raise typer.Exit(1)
+
 

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from ..problems.closed_form import TRANSMISSION
+from ..units import radians
 from .data import Report, from_rows
 from .report import Block, Text, fmt, table
 
@@ -49,41 +50,41 @@ def check_command(s: Any, digits: int = 12) -> str | None:
     )
 
 
+PP_HEADERS = [
+    ("point", "", "int"),
+    ("x", "", "number"),
+    ("y", "", "number"),
+    ("alpha", "deg", "number"),
+    ("phi", "deg", "number"),
+    ("residual", "", "number"),
+]
+"""The precision points' table: name, unit, kind."""
+CURVE_HEADERS = [
+    ("x", "", "number"),
+    ("y", "", "number"),
+    ("alpha", "deg", "number"),
+    ("phi_desired", "deg", "number"),
+    ("phi_generated", "deg", "number"),
+    ("error", "deg", "number"),
+    ("error_y", "", "number"),
+    (TRANSMISSION, "deg", "number"),
+    ("status", "", "text"),
+]
+"""The structural error's table: name, unit, kind."""
+SPACING_WORDS = {
+    "at": "given (--at)",
+    "chebyshev": "Chebyshev",
+    "uniform": "uniform (ends included)",
+    "optimal": "optimal (equal ripple)",
+}
+
+
 def synthesis_report(s: Any, digits: int = 6, unit: str = "") -> Report:
-    pp_headers = [
-        ("point", "", "int"),
-        ("x", "", "number"),
-        ("y", "", "number"),
-        ("alpha", "deg", "number"),
-        ("phi", "deg", "number"),
-        ("residual", "", "number"),
-    ]
-    pp_rows = [
-        (j + 1, p.x, p.y, p.alpha_deg, p.phi_deg, p.residual) for j, p in enumerate(s.precision_points)
-    ]
-    curve_headers = [
-        ("x", "", "number"),
-        ("y", "", "number"),
-        ("alpha", "deg", "number"),
-        ("phi_desired", "deg", "number"),
-        ("phi_generated", "deg", "number"),
-        ("error", "deg", "number"),
-        ("error_y", "", "number"),
-        (TRANSMISSION, "deg", "number"),
-        ("status", "", "text"),
-    ]
+    pp_rows = [(j + 1, p.x, p.y, p.alpha_deg, p.phi_deg, p.residual)
+               for j, p in enumerate(s.precision_points)]
     curve_rows = [
-        (
-            c.x,
-            c.y,
-            c.alpha_deg,
-            c.phi_desired_deg,
-            c.phi_generated_deg,
-            c.error_deg,
-            c.error_y,
-            c.transmission_deg,
-            c.status,
-        )
+        (c.x, c.y, c.alpha_deg, c.phi_desired_deg, c.phi_generated_deg, c.error_deg, c.error_y,
+         c.transmission_deg, c.status)
         for c in s.curve
     ]
     k = s.linkage
@@ -100,111 +101,84 @@ def synthesis_report(s: Any, digits: int = 6, unit: str = "") -> Report:
         )
     )
     tables = (
-        from_rows("precision_points", pp_headers, pp_rows),
+        from_rows("precision_points", PP_HEADERS, pp_rows),
         *links,
-        from_rows("structural_error", curve_headers, curve_rows),
+        from_rows("structural_error", CURVE_HEADERS, curve_rows),
     )
 
     def blocks() -> list[Block]:
-        out: list[Block] = [
-            Text(title(s), "bold"),
-            Text(
-                f"Freudenstein's equation: {EQUATION}; alpha at O2, phi at O4, "
-                "both from the line O4 -> O2"
-            ),
-        ]
-        spaced = {
-            "at": "given (--at)",
-            "chebyshev": "Chebyshev",
-            "uniform": "uniform (ends included)",
-            "optimal": "optimal (equal ripple)",
-        }[s.spacing]
-        n = len(s.precision_points)
-        out.append(
-            Text(
-                f"{n} precision points, {spaced} spacing; "
-                + (
-                    "solved exactly"
-                    if n == 3
-                    else f"least squares (QR), residual |A R - b| = {s.fit_residual:.3g}"
-                )
-            )
-        )
-        out += [
-            Text(""),
-            table(
-                "precision points", [h if not u else f"{h} ({u})" for h, u, _ in pp_headers], pp_rows, digits
-            ),
-        ]
-        out.append(Text(f"R1 = {fmt(s.R[0], 12)}, R2 = {fmt(s.R[1], 12)}, R3 = {fmt(s.R[2], 12)}"))
-        k = s.linkage
-        if k is not None:
-            u = f" ({unit})" if unit else ""
-            out += [
-                Text(""),
-                table(
-                    f"linkage ({s.grashof}, {s.branch} assembly at point 1)",
-                    ["link", f"length{u}"],
-                    [
-                        ("input (O2 A)", k.a),
-                        ("coupler (A B)", k.b),
-                        ("output (O4 B)", k.c),
-                        ("ground (O2 O4)", k.d),
-                    ],
-                    digits,
-                ),
-            ]
-        out += [Text(f"note: {n_}", "yellow") for n_ in s.notes]
-        if s.curve:
-            out += [
-                Text(""),
-                table(
-                    "structural error (phi generated - phi desired), followed from point 1",
-                    [h if not u else f"{h} ({u})" for h, u, _ in curve_headers],
-                    curve_rows,
-                    digits,
-                ),
-            ]
-        if s.max_error_deg is not None:
-            out.append(
-                Text(
-                    f"max |error| = {fmt(s.max_error_deg, digits)} deg = {fmt(s.max_error_y, digits)} in y, "
-                    f"at x = {fmt(s.at_x, digits)}"
-                    + (
-                        ", over the part of the range reached"
-                        if any(c.status != "converged" for c in s.curve)
-                        else ""
-                    )
-                )
-            )
-        if s.chebyshev_max_error_deg is not None:
-            spread = (
-                "" if s.equioscillation is None else f"; extrema equal within {100 * s.equioscillation:.2g}%"
-            )
-            out.append(
-                Text(f"Chebyshev spacing's max |error| = {fmt(s.chebyshev_max_error_deg, digits)} "
-                     f"deg{spread}")
-            )
-        if s.transmission is not None:
-            out.append(
-                Text(
-                    f"{TRANSMISSION}: min {fmt(s.transmission[0], 4)} deg "
-                    f"(at x = {fmt(s.transmission_at_x, digits)}), max {fmt(s.transmission[1], 4)} deg"
-                )
-            )
-        cmd = check_command(s)
-        if cmd:
-            out.append(Text(f"check: {cmd}"))
-        for d in s.defects:
-            out.append(Text(f"defect: {d.message}", "red"))
-        if not s.defects:
-            out.append(Text("no defects", "green"))
-        return out
+        return design_blocks(s, digits, unit, pp_rows, curve_rows) + figure_blocks(s, digits)
 
     def document() -> dict[str, Any]:
         return document_of(s)
 
     return Report(title(s), tables, blocks, document)
+
+
+def headed(headers: list[tuple[str, str, str]]) -> list[str]:
+    """Column titles with their units: ``name (unit)``."""
+    return [h if not u else f"{h} ({u})" for h, u, _ in headers]
+
+
+def design_blocks(s: Any, digits: int, unit: str, pp_rows: list[Any], curve_rows: list[Any]) -> list[Block]:
+    """The report's text down to the structural error's table: the equation, the precision
+    points, R, the linkage, the notes and the table."""
+    n = len(s.precision_points)
+    fit = "solved exactly" if n == 3 else f"least squares (QR), residual |A R - b| = {s.fit_residual:.3g}"
+    out: list[Block] = [
+        Text(title(s), "bold"),
+        Text(f"Freudenstein's equation: {EQUATION}; alpha at O2, phi at O4, both from the line O4 -> O2"),
+        Text(f"{n} precision points, {SPACING_WORDS[s.spacing]} spacing; " + fit),
+        Text(""),
+        table("precision points", headed(PP_HEADERS), pp_rows, digits),
+        Text(f"R1 = {fmt(s.R[0], 12)}, R2 = {fmt(s.R[1], 12)}, R3 = {fmt(s.R[2], 12)}"),
+    ]
+    k = s.linkage
+    if k is not None:
+        u = f" ({unit})" if unit else ""
+        rows = [("input (O2 A)", k.a), ("coupler (A B)", k.b), ("output (O4 B)", k.c),
+                ("ground (O2 O4)", k.d)]
+        out += [
+            Text(""),
+            table(f"linkage ({s.grashof}, {s.branch} assembly at point 1)", ["link", f"length{u}"],
+                  rows, digits),
+        ]
+    out += [Text(f"note: {n_}", "yellow") for n_ in s.notes]
+    if s.curve:
+        out += [
+            Text(""),
+            table("structural error (phi generated - phi desired), followed from point 1",
+                  headed(CURVE_HEADERS), curve_rows, digits),
+        ]
+    return out
+
+
+def figure_blocks(s: Any, digits: int) -> list[Block]:
+    """The report's figures after the table: the max error, Chebyshev's for comparison, the
+    transmission angle, the check command and the defects."""
+    out: list[Block] = []
+    if s.max_error_deg is not None:
+        partly = any(c.status != "converged" for c in s.curve)
+        out.append(Text(
+            f"max |error| = {fmt(s.max_error_deg, digits)} deg = {fmt(s.max_error_y, digits)} in y, "
+            f"at x = {fmt(s.at_x, digits)}" + (", over the part of the range reached" if partly else "")
+        ))
+    if s.chebyshev_max_error_deg is not None:
+        spread = "" if s.equioscillation is None else f"; extrema equal within {100 * s.equioscillation:.2g}%"
+        out.append(Text(f"Chebyshev spacing's max |error| = {fmt(s.chebyshev_max_error_deg, digits)} "
+                        f"deg{spread}"))
+    if s.transmission is not None:
+        out.append(Text(
+            f"{TRANSMISSION}: min {fmt(s.transmission[0], 4)} deg "
+            f"(at x = {fmt(s.transmission_at_x, digits)}), max {fmt(s.transmission[1], 4)} deg"
+        ))
+    cmd = check_command(s)
+    if cmd:
+        out.append(Text(f"check: {cmd}"))
+    out += [Text(f"defect: {d.message}", "red") for d in s.defects]
+    if not s.defects:
+        out.append(Text("no defects", "green"))
+    return out
 
 
 def document_of(s: Any) -> dict[str, Any]:
@@ -252,7 +226,7 @@ def design_text(s: Any, unit: str, made_by: str) -> str:
     lengths), its driver range the alpha range (in the file's convention: theta = alpha +
     180). ValueError where the linkage has no position at precision point 1."""
     from ..problems.toml_text import toml_value
-    from ..synthesis import drawn_position
+    from ..synthesis.function import drawn_position
 
     k = s.linkage
     p = s.precision_points[0]
@@ -260,8 +234,8 @@ def design_text(s: Any, unit: str, made_by: str) -> str:
     if drawn is None:
         raise ValueError("the linkage has no position at precision point 1 to draw")
     t2, t4 = real_angles(s, *drawn)
-    a_pt = (k.a * math.cos(math.radians(t2)), k.a * math.sin(math.radians(t2)))
-    b_pt = (k.d + k.c * math.cos(math.radians(t4)), k.c * math.sin(math.radians(t4)))
+    a_pt = (k.a * math.cos(radians(t2)), k.a * math.sin(radians(t2)))
+    b_pt = (k.d + k.c * math.cos(radians(t4)), k.c * math.sin(radians(t4)))
     a0, a1 = s.alpha_range
     shift = 180.0 + k.alpha_shift()
     r0, r1 = a0 + shift, a1 + shift
@@ -315,7 +289,7 @@ def write_design(s: Any, path: Path, unit: str, made_by: str,
     not at all: ``write``, by default files.write_atomic; the command passes the one rule
     for writing mechanism files), or why not (None: written)."""
     from ..files import write_atomic
-    from ..synthesis import drawn_position
+    from ..synthesis.function import drawn_position
 
     if s.linkage is None:
         return "there is no real linkage"
@@ -336,7 +310,7 @@ def error_plot(s: Any, path: Path) -> None:
 
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.5, 4.2))
-    from ..synthesis import dense_curve
+    from ..synthesis.function import dense_curve
 
     curve = dense_curve(s)
     xs = [c.x for c in curve if c.error_deg is not None]

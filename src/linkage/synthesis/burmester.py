@@ -23,8 +23,9 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InputError
-from .homotopy import PolySystem, Solutions, condition, solve
+from ..errors import InputError
+from ..homotopy import PolySystem, Solutions, condition, solve
+from ..units import radians
 
 
 @dataclass(frozen=True)
@@ -59,13 +60,13 @@ class Burmester:
     unresolved: int = 0  # real roots of the polynomials that are not rigid cranks after Newton
 
 
-def _checked(poses: Any) -> tuple[Pose, ...]:
-    """Five poses of finite real numbers (x, y, angle in degrees), each pose its own: every
-    misuse an InputError naming it (arguments.check_number, the one rule for numbers)."""
-    from .arguments import check_number
+def checked_poses(poses: Any, count: int = 5) -> tuple[Pose, ...]:
+    """``count`` poses of finite real numbers (x, y, angle in degrees), each pose its own:
+    every misuse an InputError naming it (arguments.check_number, the one rule for numbers)."""
+    from ..arguments import check_number
 
     if isinstance(poses, (str, bytes)) or not isinstance(poses, Sequence):
-        raise InputError(f"poses must be a list of 5 poses (x, y, angle in deg), got {poses!r}")
+        raise InputError(f"poses must be a list of {count} poses (x, y, angle in deg), got {poses!r}")
     out = []
     for k, p in enumerate(poses):
         vals = (p.x, p.y, p.angle_deg) if isinstance(p, Pose) else p
@@ -75,9 +76,10 @@ def _checked(poses: Any) -> tuple[Pose, ...]:
         if not all(abs(v) < 1e12 for v in (x, y, a)):
             raise InputError(f"poses[{k}] must be finite numbers below 1e12 in size, got {p!r}")
         out.append(Pose(x, y, a))
-    if len(out) != 5:
-        raise InputError(f"Burmester's points need exactly 5 poses, got {len(out)}")
-    for i in range(5):
+    if len(out) != count:
+        raise InputError(f"Burmester's points need exactly 5 poses, got {len(out)}" if count == 5
+                         else f"this needs exactly {count} poses, got {len(out)}")
+    for i in range(count):
         for j in range(i):
             a, b = out[i], out[j]
             if math.hypot(a.x - b.x, a.y - b.y) == 0 and math.remainder(a.angle_deg - b.angle_deg, 360) == 0:
@@ -105,10 +107,10 @@ def burmester_system(poses: tuple[Pose, ...]) -> PolySystem:
     centre, size = _frame(poses)
     rows = []
     d1 = (complex(poses[0].x, poses[0].y) - centre) / size
-    r1 = complex(math.cos(math.radians(poses[0].angle_deg)), math.sin(math.radians(poses[0].angle_deg)))
+    r1 = complex(math.cos(radians(poses[0].angle_deg)), math.sin(radians(poses[0].angle_deg)))
     for p in poses[1:]:
         dj = (complex(p.x, p.y) - centre) / size
-        rj = complex(math.cos(math.radians(p.angle_deg)), math.sin(math.radians(p.angle_deg)))
+        rj = complex(math.cos(radians(p.angle_deg)), math.sin(radians(p.angle_deg)))
         rows.append(_difference(dj, rj, d1, r1))
     return PolySystem(4, tuple(rows))
 
@@ -142,10 +144,10 @@ five poses, after Newton's method on the crank equations."""
 def burmester_points(poses: Sequence[Pose | Sequence[float]], seed: int = 0) -> Burmester:
     """Every crank (centre point and circle point) that carries a body through five poses:
     each real pair, and the complex, infinite, singular and failed paths counted."""
-    from .arguments import MAX_SEED, check_whole
-    from .homotopy import polish_real
+    from ..arguments import MAX_SEED, check_whole
+    from ..homotopy import polish_real
 
-    ps = _checked(poses)
+    ps = checked_poses(poses)
     seed = check_whole("seed", seed, 0, MAX_SEED)
     system = burmester_system(ps)
     sols = solve(system, seed=seed)
@@ -164,7 +166,7 @@ def burmester_points(poses: Sequence[Pose | Sequence[float]], seed: int = 0) -> 
         z = complex(zx, zy) * size  # body frame: the first pose's frame, scaled back
         moving = []
         for p in ps:
-            r = complex(math.cos(math.radians(p.angle_deg)), math.sin(math.radians(p.angle_deg)))
+            r = complex(math.cos(radians(p.angle_deg)), math.sin(radians(p.angle_deg)))
             moving.append(complex(p.x, p.y) + r * z)
         lengths = [abs(m - G) for m in moving]
         residual = max(abs(v - lengths[0]) for v in lengths) / size
@@ -182,6 +184,6 @@ def burmester_points(poses: Sequence[Pose | Sequence[float]], seed: int = 0) -> 
 
 def body_to_ground(p: Pose, z: tuple[float, float]) -> np.ndarray:
     """Where the body point z (body coordinates) is at pose p."""
-    r = complex(math.cos(math.radians(p.angle_deg)), math.sin(math.radians(p.angle_deg)))
+    r = complex(math.cos(radians(p.angle_deg)), math.sin(radians(p.angle_deg)))
     w = complex(p.x, p.y) + r * complex(*z)
     return np.array([w.real, w.imag])
