@@ -155,7 +155,7 @@ def _grashof_crank_rocker_points(other_side: set[int], order: list[int] | None =
 
 
 def test_a_design_through_its_points_in_order_on_one_circuit_has_no_defect():
-    from linkage.synthesis_path import judge
+    from linkage.synthesis.path import judge
 
     pts, z = _grashof_crank_rocker_points(set())
     fb = judge(z, pts)
@@ -166,7 +166,7 @@ def test_a_design_through_its_points_in_order_on_one_circuit_has_no_defect():
 
 
 def test_points_on_the_other_assembly_are_a_branch_defect():
-    from linkage.synthesis_path import judge
+    from linkage.synthesis.path import judge
 
     pts, z = _grashof_crank_rocker_points({4, 5})
     d = np.array(pts[1:]) - pts[0]
@@ -175,7 +175,7 @@ def test_points_on_the_other_assembly_are_a_branch_defect():
 
 
 def test_points_met_out_of_order_are_an_order_defect():
-    from linkage.synthesis_path import judge
+    from linkage.synthesis.path import judge
 
     pts, z = _grashof_crank_rocker_points(set(), [0, 1, 2, 5, 4, 3, 6, 7, 8])
     assert judge(z, pts).defects == ("order",)
@@ -195,7 +195,7 @@ def test_points_met_out_of_order_are_an_order_defect():
 ])
 def test_bad_points_are_refused_with_one_line(bad):
     from linkage.errors import InputError
-    from linkage.synthesis_path import synthesize_path
+    from linkage.synthesis.path import synthesize_path
 
     with pytest.raises(InputError) as err:
         synthesize_path(bad)
@@ -214,7 +214,7 @@ def test_paths_tracked_as_dask_tasks_on_threads_and_a_loopback_cluster_end_where
     127.0.0.1; the endpoints are those tracked here (to 1e-8: a chunk's corrector steps
     are shared by its paths, so the last bits may differ)."""
     distributed = pytest.importorskip("distributed")
-    from linkage.synthesis_path import chunk_runner
+    from linkage.synthesis.path import chunk_runner
 
     pts = [complex(x, y) for x, y in PROBLEM_3]
     here = npt.solve_points(pts, max_routes=1, orbits=300)

@@ -157,6 +157,9 @@ def synthesize(
         typer.Option("--circle", metavar="X,Y", help="With --motion and 3 poses: a moving pivot at "
                      "pose 1 (twice: three poses leave both free)."),
     ] = None,
+    path: Annotated[bool, typer.Option("--path", help="Path generation: every four-bar whose coupler point "
+                                       "passes through 9 --point (docs/path_synthesis.md).")] = False,
+    point: Annotated[Optional[list[str]], typer.Option("--point", metavar="X,Y", help="With --path.")] = None,
     design_number: Annotated[
         Optional[int],
         typer.Option("--design", metavar="K", help="With --motion and -o FILE.toml: write design K "
@@ -190,14 +193,23 @@ def synthesize(
     if motion:
         from .motion import motion_command
 
-        if search or function is not None:
-            raise InputError("--motion takes poses (--pose, --poses): not --function or --search")
+        if search or function is not None or path:
+            raise InputError("--motion takes poses (--pose, --poses): not --function, --search or --path")
         motion_command(pose or [], poses, circle or [], min_transmission=min_transmission,
                        design=design_number, output=output, write_file=design, force=force, unit=unit,
                        fmt=fmt, report_out=report_out, digits=digits, table=table, plot=plot)
         return
-    if pose or poses is not None or circle or design_number is not None:
-        raise InputError("--pose, --poses, --circle and --design are options of --motion")
+    if path:
+        from .path import path_command
+
+        if search or function is not None or plot is not None:
+            raise InputError("--path takes nine --point X,Y: not --function, --search or --plot")
+        path_command(point or [], design=design_number, output=output, write_file=design, force=force,
+                     fmt=fmt, report_out=report_out, digits=digits, table=table, scheduler=scheduler,
+                     workers=workers)
+        return
+    if pose or poses is not None or circle or design_number is not None or point:
+        raise InputError("--pose, --poses, --circle and --design are options of --motion; --point of --path")
     if function is None or x is None:
         raise InputError("give --function and --x (or --motion with poses)")
     if search:

@@ -120,7 +120,15 @@ def prefetch(fmt: str, rows: int | None = None) -> None:
     if names:
         import threading
 
-        threading.Thread(target=import_quietly, args=(names,), name="linkage-prefetch").start()
+        thread = threading.Thread(target=import_quietly, args=(names,), name="linkage-prefetch")
+        _prefetching.append(thread)
+        thread.start()
+
+
+_prefetching: list[Any] = []
+"""Prefetch threads started: the writer waits for them before its own import, so that a
+package that fails to import fails there, in one line, and not in a race between two
+threads importing it at once (a flaky refusal, seen in tests/test_format_registry.py)."""
 
 
 def import_quietly(names: Sequence[str]) -> None:
@@ -145,6 +153,8 @@ def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None)
     to_stdout = output is None or str(output) == "-"
     spec = FORMATS[fmt]
     make: Any = spec.sink
+    while _prefetching:
+        _prefetching.pop().join()
     if spec.needs is not None:
         try:
             __import__(spec.needs[0])

@@ -24,9 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import InputError
-from .homotopy import ninepoint
-from .units import degrees
+from ..errors import InputError
+from ..homotopy import ninepoint
+from ..units import degrees
 
 POINTS = 9
 ON_POINT = 1e-9
@@ -67,7 +67,7 @@ class PathSynthesis:
 def chunk_runner(scheduler: str | None, workers: int | None):  # type: ignore[no-untyped-def]
     """The scan's chunk runner (one home for sending chunks to dask) in the form
     :func:`linkage.homotopy.ninepoint.solve_points` calls."""
-    from .scan import run_chunks
+    from ..scan import run_chunks
 
     def run(task, job, plan, size):  # type: ignore[no-untyped-def]
         return run_chunks(job, plan, size, scheduler=scheduler, workers=workers, task=task)
@@ -160,11 +160,11 @@ def _positions(z: np.ndarray, points: list[complex]) -> list[tuple[float, float,
 
 def judge(z: np.ndarray, points: list[complex]) -> PathFourBar:
     """One real solution as a four-bar, moved through the points by the engine."""
-    from .kinematics.assemblies import assemblies, same_configuration
-    from .kinematics.circuits import circuits
-    from .kinematics.loading import from_text
-    from .kinematics.rates import place
-    from .problems.closed_form import grashof
+    from ..kinematics.assemblies import assemblies, same_configuration
+    from ..kinematics.circuits import circuits
+    from ..kinematics.loading import from_text
+    from ..kinematics.rates import place
+    from ..problems.closed_form import grashof
 
     a, x, b, y = (complex(z[k]) for k in (ninepoint.A, ninepoint.X, ninepoint.B, ninepoint.Y))
     P0 = points[0]
