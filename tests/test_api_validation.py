@@ -71,6 +71,9 @@ SM = linkage.load_mechanism(ROOT / "docs" / "crank_rocker_loads.toml")  # with m
 
 POSES = [(0, 0, 0), (1, 0.2, 10), (2, 0.5, 25), (2.8, 1.2, 40), (3.2, 2, 60)]
 """Five poses of a body (linkage.synthesize_motion)."""
+NINE = [(0.25, 0), (0.52, 0.1), (0.8, 0.7), (1.2, 1), (1.4, 1.3), (1.1, 1.48), (0.7, 1.4), (0.2, 1),
+        (0.02, 0.4)]
+"""Nine points (linkage.synthesize_path): Wampler, Morgan and Sommese's Problem 3."""
 
 BATTERY = [
     # sweep: values, rates, options
@@ -158,6 +161,13 @@ BATTERY = [
      lambda: linkage.synthesize_function("x", (1, 2), (90, 150), (0, 90), spacing="best"), "spacing"),
     ("synthesize_function", "negative ground",
      lambda: linkage.synthesize_function("x", (1, 2), (90, 150), (0, 90), ground=-1.0), "ground"),
+    ("synthesize_path", "points None", lambda: linkage.synthesize_path(None), "points"),
+    ("synthesize_path", "eight points", lambda: linkage.synthesize_path(NINE[:8]), "points"),
+    ("synthesize_path", "a NaN point", lambda: linkage.synthesize_path([*NINE[:8], (math.nan, 0)]), "points"),
+    ("synthesize_path", "a point twice", lambda: linkage.synthesize_path([*NINE[:8], NINE[0]]), "points"),
+    ("synthesize_path", "seed -1", lambda: linkage.synthesize_path(NINE, seed=-1), "seed"),
+    ("synthesize_path", "workers 0", lambda: linkage.synthesize_path(NINE, workers=0), "workers"),
+    ("synthesize_path", "scheduler 3", lambda: linkage.synthesize_path(NINE, scheduler=3), "scheduler"),
     ("synthesize_motion", "poses None", lambda: linkage.synthesize_motion(None), "poses"),
     ("synthesize_motion", "two poses", lambda: linkage.synthesize_motion(POSES[:2]), "poses"),
     ("synthesize_motion", "a NaN pose",

@@ -42,6 +42,7 @@ _EXPORTS = {
     "scan_designs": ".scan",
     "synthesize_function": ".synthesis", "FunctionSynthesis": ".synthesis",
     "synthesize_motion": ".synthesis.motion", "MotionSynthesis": ".synthesis.motion",
+    "synthesize_path": ".synthesis.path", "PathSynthesis": ".synthesis.path",
     "forces": ".kinematics.forces", "Forces": ".kinematics.forces",
     "assemblies": ".kinematics.assemblies", "Assemblies": ".kinematics.assemblies",
     "Loads": ".problems.loads", "Mass": ".problems.loads",
@@ -87,6 +88,7 @@ __all__ = [
     "MotionSynthesis",
     "NotConvergedError",
     "ParseError",
+    "PathSynthesis",
     "Position",
     "Rates",
     "Result",
@@ -113,5 +115,6 @@ __all__ = [
     "sweep",
     "synthesize_function",
     "synthesize_motion",
+    "synthesize_path",
     "tolerance",
 ]

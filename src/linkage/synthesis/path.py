@@ -228,7 +228,14 @@ def synthesize_path(points: object, seed: int = 0, scheduler: str | None = None,
     by moving them (module docstring). ``points``: nine (x, y) pairs. The paths are tracked
     in chunks by the scan's runner: here, on dask's local threads or processes, or on a
     cluster (``scheduler`` tcp://HOST:PORT), ``workers`` at a time."""
+    from ..arguments import MAX_SEED, check_whole, check_workers
+
     pts = check_points(points)
+    seed = check_whole("seed", seed, 0, MAX_SEED)
+    workers = check_workers("workers", workers, scheduler)
+    if scheduler is not None and not isinstance(scheduler, str):
+        raise InputError("scheduler must be threads, processes, synchronous or tcp://HOST:PORT, "
+                         f"got {scheduler!r}")
     sols = ninepoint.solve_points(pts, seed=seed, run=chunk_runner(scheduler, workers))
     designs = []
     for z, real in zip(sols.solutions, sols.real):
