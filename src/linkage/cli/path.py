@@ -32,9 +32,10 @@ def path_command(point: list[str], *, design: Optional[int], output: Optional[Pa
     from ..render.path_synthesis import path_report, ranked
     from ..synthesis.path import check_points, synthesize_path
 
-    pts = check_points(read_points(point))
+    pairs = read_points(point)
+    check_points(pairs)  # before the workers, so a wrong count is the first thing said
     workers = check_workers("--workers", workers, scheduler)
-    result = synthesize_path(pts, scheduler=scheduler, workers=workers)
+    result = synthesize_path(pairs, scheduler=scheduler, workers=workers)
     writers.write(path_report(result, digits), fmt, report_out, table=table)
     order = ranked(result)
     clean = [i for i in order if not result.designs[i][0].defects]
