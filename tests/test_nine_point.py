@@ -226,3 +226,20 @@ def test_paths_tracked_as_dask_tasks_on_threads_and_a_loopback_cluster_end_where
                                   run=chunk_runner(cluster.scheduler_address, None))
     assert _same_sets(here.solutions, remote.solutions)
     assert remote.failed == here.failed
+
+
+@pytest.mark.parametrize(("args", "says"), [
+    (["--point", "0,0", "--point", "1,1"], "exactly 9 points"),
+    (["--point", "0;0", *["--point", "1,1"] * 8], "write X,Y"),
+    ([*[f"--point={k},{k * k}" for k in range(9)], "--plot", "x.png"], "--path takes nine --point"),
+    ([*[f"--point={k},{k * k}" for k in range(8)], "--point=0,0"], "coincide"),
+])
+def test_synthesize_path_refuses_bad_points_in_one_line(cli, args, says):
+    out = cli("synthesize", "--path", *args)
+    assert out.code == 2 and says in out.err and len(out.err.strip().splitlines()) == 1
+
+
+def test_point_is_an_option_of_path(cli):
+    out = cli("synthesize", "--function", "x", "--x", "1:2", "--alpha", "0:90", "--phi", "0:90",
+              "--point", "0,0")
+    assert out.code == 2 and "--point of --path" in out.err
