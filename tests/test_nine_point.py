@@ -243,3 +243,12 @@ def test_point_is_an_option_of_path(cli):
     out = cli("synthesize", "--function", "x", "--x", "1:2", "--alpha", "0:90", "--phi", "0:90",
               "--point", "0,0")
     assert out.code == 2 and "--point of --path" in out.err
+
+
+def test_a_low_transmission_angle_over_the_motion_is_a_transmission_defect():
+    from linkage.synthesis.path import judge
+
+    pts, z = _grashof_crank_rocker_points(set())
+    fb = judge(z, pts, min_transmission=0.0)
+    assert fb.defects == () and 0.0 < fb.transmission_min_deg < 90.0
+    assert judge(z, pts, min_transmission=fb.transmission_min_deg + 1e-6).defects == ("transmission",)

@@ -26,7 +26,7 @@ def read_points(point: list[str]) -> list[tuple[float, float]]:
 
 def path_command(point: list[str], *, design: Optional[int], output: Optional[Path], write_file: bool,
                  force: bool, fmt: str, report_out: Optional[Path], digits: int, table: Optional[str],
-                 scheduler: Optional[str], workers: Optional[int]) -> None:
+                 scheduler: Optional[str], workers: Optional[int], min_transmission: float) -> None:
     from ..arguments import check_workers
     from ..render import writers
     from ..render.path_synthesis import path_report, ranked
@@ -35,7 +35,11 @@ def path_command(point: list[str], *, design: Optional[int], output: Optional[Pa
     pairs = read_points(point)
     check_points(pairs)  # before the workers, so a wrong count is the first thing said
     workers = check_workers("--workers", workers, scheduler)
-    result = synthesize_path(pairs, scheduler=scheduler, workers=workers)
+    try:
+        result = synthesize_path(pairs, scheduler=scheduler, workers=workers,
+                                 min_transmission=min_transmission)
+    except InputError as exc:  # the API's argument names, as the command's options
+        raise InputError(str(exc).replace("min_transmission", "--min-transmission")) from None
     writers.write(path_report(result, digits), fmt, report_out, table=table)
     order = ranked(result)
     clean = [i for i in order if not result.designs[i][0].defects]

@@ -206,7 +206,7 @@ def synthesize(
             raise InputError("--path takes nine --point X,Y: not --function, --search or --plot")
         path_command(point or [], design=design_number, output=output, write_file=design, force=force,
                      fmt=fmt, report_out=report_out, digits=digits, table=table, scheduler=scheduler,
-                     workers=workers)
+                     workers=workers, min_transmission=min_transmission)
         return
     if pose or poses is not None or circle or design_number is not None or point:
         raise InputError("--pose, --poses, --circle and --design are options of --motion; --point of --path")

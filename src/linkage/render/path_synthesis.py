@@ -64,8 +64,9 @@ def path_report(result: Any, digits: int) -> Report:
         rows = list(zip(*[c.values for c in tables[0].columns]))
         out.append(table("", [c.header for c in tables[0].columns], rows, digits))
         out.append(Text("defects: branch, the points are not all on one circuit (the linkage would have "
-                        "to be taken apart); order, the circuit meets them out of order; each design's two "
-                        "Roberts cognates are in the cognates table"))
+                        "to be taken apart); order, the circuit meets them out of order; transmission, the "
+                        "least transmission angle from the first point to the last is below "
+                        "--min-transmission; each design's two Roberts cognates are in the cognates table"))
         rows = list(zip(*[c.values for c in tables[2].columns]))
         out += [Text("Routes"), table("", [c.header for c in tables[2].columns], rows, digits)]
         return out

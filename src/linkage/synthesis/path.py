@@ -13,7 +13,10 @@ coupler) and is checked as a designer would check it, by moving it:
   circuits`): the mechanism would have to be taken apart between them;
 - ``order`` defect: moving along that circuit, the points are not met in their order
   (either way round);
-- its Grashof class, and the least transmission angle at the points (folded 0..90).
+- ``transmission`` defect: the least transmission angle (folded 0..90, the one rule) over
+  the motion from the first point to the last is below ``min_transmission`` (function
+  generation's default, 30 deg);
+- its Grashof class.
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ import numpy as np
 from ..errors import InputError
 from ..homotopy import ninepoint
 from ..units import degrees
+from .request import MIN_TRANSMISSION_DEG
 
 POINTS = 9
 ON_POINT = 1e-9
@@ -158,8 +162,30 @@ def _positions(z: np.ndarray, points: list[complex]) -> list[tuple[float, float,
     return out
 
 
-def judge(z: np.ndarray, points: list[complex]) -> PathFourBar:
-    """One real solution as a four-bar, moved through the points by the engine."""
+def _transmission(t3: float, t4: float) -> float:
+    """The folded transmission angle (deg) of a configuration: the one rule
+    (problems.steps.folded_transmission) on theta4 - theta3 taken into [0, 180)."""
+    from ..problems.steps import folded_transmission
+
+    return folded_transmission(degrees(t4 - t3) % 360.0 % 180.0)
+
+
+def _along(circ, at: list[int]) -> list[tuple[float, ...]]:  # type: ignore[no-untyped-def]
+    """The traced configurations from the first point's arc position to the last's, the
+    way round that meets the points in order."""
+    n = len(circ.configurations)
+    forward = [(k - at[0]) % n for k in at]
+    step = 1 if forward == sorted(forward) else -1
+    span = ((at[-1] - at[0]) * step) % n
+    return [circ.configurations[(at[0] + step * i) % n] for i in range(span + 1)]
+
+
+def judge(z: np.ndarray, points: list[complex],
+          min_transmission: float = MIN_TRANSMISSION_DEG) -> PathFourBar:
+    """One real solution as a four-bar, moved through the points by the engine. Its least
+    transmission angle is taken over the motion from the first point to the last (on the
+    circuit, in order), or at the points where that motion does not exist; below
+    ``min_transmission`` (deg) it is a ``transmission`` defect."""
     from ..kinematics.assemblies import assemblies, same_configuration
     from ..kinematics.circuits import circuits
     from ..kinematics.loading import from_text
@@ -179,8 +205,7 @@ def judge(z: np.ndarray, points: list[complex]) -> PathFourBar:
         placed = place(m.model, q, phi)["P"][0]
         closes = max(abs(v) for v in F(q)) <= ON_POINT * size
         errors.append(abs(placed - p) if closes else math.inf)
-        mu = abs(math.remainder(t4 - t3, math.pi))
-        trans.append(min(mu, math.pi - mu))
+        trans.append(_transmission(t3, t4))
     defects: list[str] = []
     start = assemblies(m, poses[0][0])
     first = next((i for i, s in enumerate(start.real)
@@ -195,11 +220,15 @@ def judge(z: np.ndarray, points: list[complex]) -> PathFourBar:
             defects.append("branch")
         elif not _in_order([k for k in at if k is not None], len(circ.drivers)):
             defects.append("order")
+        else:
+            trans += [_transmission(q[0], q[1]) for q in _along(circ, at)]  # type: ignore[arg-type]
     max_error = max(errors) / size
     if max_error > ON_POINT:
         defects.append("positions")
+    if min(trans) < min_transmission:
+        defects.append("transmission")
     return PathFourBar(fb.ground_a, fb.ground_b, fb.pin_m, fb.pin_n, P0, grashof(*fb.lengths),
-                       tuple(defects), max(errors), degrees(min(trans)), tuple(degrees(p[0]) for p in poses))
+                       tuple(defects), max(errors), min(trans), tuple(degrees(p[0]) for p in poses))
 
 
 def _arc_index(circ, phi: float, q: tuple[float, float]) -> int | None:
@@ -223,15 +252,19 @@ def _in_order(at: list[int], n: int) -> bool:
 
 
 def synthesize_path(points: object, seed: int = 0, scheduler: str | None = None,
-                    workers: int | None = None) -> PathSynthesis:
+                    workers: int | None = None,
+                    min_transmission: float = MIN_TRANSMISSION_DEG) -> PathSynthesis:
     """Every four-bar whose coupler point passes through nine points; the real ones judged
     by moving them (module docstring). ``points``: nine (x, y) pairs. The paths are tracked
     in chunks by the scan's runner: here, on dask's local threads or processes, or on a
     cluster (``scheduler`` tcp://HOST:PORT), ``workers`` at a time."""
-    from ..arguments import MAX_SEED, check_whole, check_workers
+    from ..arguments import MAX_SEED, check_number, check_whole, check_workers
 
     pts = check_points(points)
     seed = check_whole("seed", seed, 0, MAX_SEED)
+    floor = check_number("min_transmission", min_transmission)
+    if not 0.0 <= floor <= 90.0:
+        raise InputError(f"min_transmission must be from 0 to 90 deg, got {floor:g}")
     workers = check_workers("workers", workers, scheduler)
     if scheduler is not None and not isinstance(scheduler, str):
         raise InputError("scheduler must be threads, processes, synchronous or tcp://HOST:PORT, "
@@ -242,5 +275,5 @@ def synthesize_path(points: object, seed: int = 0, scheduler: str | None = None,
         if not real:
             continue
         members = ninepoint.orbit(z)[:3]
-        designs.append(tuple(judge(mz, pts) for mz in members))
+        designs.append(tuple(judge(mz, pts, floor) for mz in members))
     return PathSynthesis(tuple(pts), tuple(designs), len(sols.solutions), sols.missing, sols)
