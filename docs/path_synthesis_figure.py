@@ -48,8 +48,9 @@ def main() -> None:
     ax.set_aspect("equal")
     ax.grid(True, alpha=0.3)
     least = ", ".join(f"{g[0].transmission_min_deg:.2g}" for g in good)
-    ax.set_title(f"Problem 3 (Wampler, Morgan, Sommese 1992): {len(good)} of {len(res.designs)} real four-bars "
-                 f"pass through\nthe points in order on one circuit (least transmission {least} deg)")
+    ax.set_title(f"Problem 3 (Wampler, Morgan, Sommese 1992): {len(good)} of {len(res.designs)} real "
+                 f"four-bars pass through\nthe points in order on one circuit (least transmission "
+                 f"{least} deg)")
     fig.savefig("docs/path_synthesis_problem3.png", dpi=110, bbox_inches="tight")
     print(f"{len(res.designs)} real, {len(good)} without defects; wrote docs/path_synthesis_problem3.png")
     for group in res.designs:
