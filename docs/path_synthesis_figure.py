@@ -52,7 +52,8 @@ def main() -> None:
                  f"four-bars pass through\nthe points in order on one circuit (least transmission "
                  f"{least} deg)")
     fig.savefig("docs/path_synthesis_problem3.png", dpi=110, bbox_inches="tight")
-    print(f"{len(res.designs)} real, {len(good)} without defects; wrote docs/path_synthesis_problem3.png")
+    print(f"{len(res.designs)} real, {len(good)} without a branch or order defect; "
+          "wrote docs/path_synthesis_problem3.png")
     for group in res.designs:
         print(group[0].grashof, group[0].defects, [g.defects for g in group[1:]])
 
