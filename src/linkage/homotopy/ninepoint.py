@@ -400,6 +400,28 @@ def polish_precisely(z: np.ndarray, d: np.ndarray, db: np.ndarray) -> np.ndarray
     return None
 
 
+def relative_residual(Z: np.ndarray, d: np.ndarray, db: np.ndarray) -> np.ndarray:
+    """max over the equations of |E_j| / (|N1 N2| + |D|^2): each equation against its own
+    terms' sizes (paths,). Works on object arrays of mpmath numbers too."""
+    col = [Z[:, k:k + 1] for k in range(8)]
+    dd = np.broadcast_to(d, (Z.shape[0], 8))
+    ddb = np.broadcast_to(db, (Z.shape[0], 8))
+    one = np.ones_like(col[A])
+    P, Pb, R = _dyad(col[A], col[X], col[AB], col[XB], dd, ddb, one)[:3]
+    Q, Qb, S = _dyad(col[B], col[Y], col[BB], col[YB], dd, ddb, one)[:3]
+    N1 = Pb * S - R * Qb
+    N2 = Q * R - P * S
+    D = P * Qb - Pb * Q
+    return np.array([max(float(abs(e) / (abs(a) + abs(b))) for e, a, b in zip(*row)) for row in
+                     zip(N1 * N2 - D * D, N1 * N2, D * D)])
+
+
+RESIDUAL = 1e-12
+"""A found solution whose residual (:func:`relative_residual`, in double arithmetic) is
+above this, or that is real, is polished at PRECISE_DIGITS and rounded: a root of
+condition near 1/eps settles in double arithmetic only to about cond eps."""
+
+
 def is_real(Z: np.ndarray) -> np.ndarray:
     scale = np.maximum(1.0, np.max(np.abs(Z), axis=1))
     return np.max(np.abs(Z[:, 4:] - np.conj(Z[:, :4])), axis=1) <= REAL * scale
@@ -527,10 +549,17 @@ def solve_points(points: list[complex] | tuple[complex, ...], seed: int = 0,
         if len(found) >= len(rows):
             break
     Z = found
-    _, J, _, _ = equations(Z, d1, db1)
-    cond = np.linalg.cond(J) if len(Z) else np.zeros(0)
     real = is_real(Z)
     Z[real, 4:] = np.conj(Z[real, :4])
+    rough = np.flatnonzero(real | (relative_residual(Z, d1, db1) > RESIDUAL)) if len(Z) else []
+    for i in rough:
+        better = polish_precisely(Z[i], d1, db1)
+        if better is not None:
+            Z[i] = better
+    real = is_real(Z)
+    Z[real, 4:] = np.conj(Z[real, :4])
+    _, J, _, _ = equations(Z, d1, db1)
+    cond = np.linalg.cond(J) if len(Z) else np.zeros(0)
     return NinePointSolutions(tuple(complex(v) for v in p), Z, real, cond, len(rows),
                               len(failed), tuple(failed), tuple(unrefined), tuple(steps),
                               time.perf_counter() - began)
