@@ -31,9 +31,9 @@ Block = Text | Table
 def fmt(v: Any, digits: int = 12) -> str:
     """One cell: integers as they are, floats to ``digits`` significant digits."""
     if isinstance(v, float):  # first: a table's usual cell (a sweep's table has thousands)
-        if v - v == 0.0:  # finite
+        if math.isfinite(v):
             return f"{v:.{digits}g}" if v != 0.0 else "0"
-        return "NaN" if v != v else "inf" if v > 0 else "-inf"
+        return "NaN" if math.isnan(v) else "inf" if v > 0 else "-inf"
     if v is None:
         return "—"
     if isinstance(v, bool):
