@@ -180,4 +180,12 @@ def main() -> None:
         if code == 0:
             typer.echo("error: cannot write to standard output", err=True)
             code = 2
+    # The objects left (every module's, the run's) are freed by the interpreter's exit as
+    # ever, but its last garbage collections no longer walk them: those walks were about a
+    # sixth of a cold ``linkage solve`` (10-13 ms of its 70, processor time). Nothing that
+    # runs at exit is skipped (atexit, finalizers, flushing); only cyclic garbage made
+    # before here is left to the exit.
+    import gc
+
+    gc.freeze()
     sys.exit(code)

@@ -129,9 +129,12 @@ def sweep(
     note_closed_form(mechanism)
     w, a_ = parse_motion(speed, accel, mechanism)
     motion = (speed, accel)
-    from ..kinematics.bodies import command_loads
+    # loads from the file or the options, or none (their engine is not imported: start-up time)
+    loads = None
+    if force or torque or gravity is not None or mechanism.extra.get("loads"):
+        from ..kinematics.bodies import command_loads
 
-    loads = command_loads(mechanism, force or [], torque or [], gravity)
+        loads = command_loads(mechanism, force or [], torque or [], gravity)
     named = check_path_names(mechanism, path, plot, file)
     if batch is None and len(values) <= BATCH_ABOVE:
         # the numpy engines (closed form, batch) cost a fresh process numpy's import, more
@@ -153,7 +156,7 @@ def sweep(
 
         cols = sweep_columns(result)  # read once: a batch sweep's rates for its table and its loads
         report = sweep_report(result, digits, joints_note=note, cols=cols)
-        if not loads.empty or loads.gravity is not None:
+        if loads is not None and (not loads.empty or loads.gravity is not None):
             from .loads import sweep_loads
 
             report = sweep_loads(report, mechanism, result, loads, w, a_, digits, torque_plot, cols)

@@ -30,22 +30,15 @@ Block = Text | Table
 
 def fmt(v: Any, digits: int = 12) -> str:
     """One cell: integers as they are, floats to ``digits`` significant digits."""
+    if isinstance(v, float):  # first: a table's usual cell (a sweep's table has thousands)
+        if math.isfinite(v):
+            return f"{v:.{digits}g}" if v != 0.0 else "0"
+        return "NaN" if math.isnan(v) else "inf" if v > 0 else "-inf"
     if v is None:
         return "—"
     if isinstance(v, bool):
         return "yes" if v else "no"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        if math.isnan(v):
-            return "NaN"
-        if math.isinf(v):
-            return "inf" if v > 0 else "-inf"
-        if v == 0.0:
-            return "0"
-        s = f"{v:.{digits}g}"
-        return s
-    return str(v)
+    return str(v)  # an integer as it is, or text
 
 
 NOISE_ULPS = 16
