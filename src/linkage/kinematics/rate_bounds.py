@@ -223,22 +223,47 @@ def through_inverse(inv: list[list[float]], spread: list[list[float]], g: list[f
 
 def inverse_np(a: Any) -> tuple[Any, Any]:
     """The inverse of each matrix of a stack (NaN where it is singular or not finite) and
-    where it exists: one batched LU, the singular ones found only when there are some."""
+    where it exists: :func:`solve_np` with no right-hand side."""
+    inv, _, usable = solve_np(a, None)
+    return inv, usable
+
+
+def solve_np(a: Any, b: Any) -> tuple[Any, Any, Any]:
+    """Each matrix of a stack ``a`` (..., n, n): its inverse, its solution for the columns
+    ``b`` (..., n, k) (None: none) and where they exist (NaN where the matrix is singular or
+    not finite). One batched LU for both (numpy's solve of [I | b]: the inverse costs n
+    columns more, not a second factorisation); the singular ones found only when there are
+    some; no copies where every matrix is usable."""
     import numpy as np
 
+    n = a.shape[-1]
+    k = 0 if b is None else b.shape[-1]
     inv = np.full(a.shape, np.nan)
+    x = np.full((*a.shape[:-1], k), np.nan)
     usable = np.isfinite(a).all(axis=(-2, -1)) if a.size else np.ones(a.shape[:-2], dtype=bool)
-    if a.shape[-1] == 0 or not usable.any():
-        return inv, usable
+    if n == 0 or not usable.any():
+        return inv, x, usable
+    eye = np.broadcast_to(np.eye(n), a.shape)
+    rhs = eye if b is None else np.concatenate([eye, np.broadcast_to(b, (*a.shape[:-1], k))], axis=-1)
+
+    def solved(rows: Any) -> Any:
+        with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+            return np.linalg.solve(a, rhs) if rows.all() else np.linalg.solve(a[rows], rhs[rows])
+
     try:
-        inv[usable] = np.linalg.inv(a[usable])
+        out = solved(usable)
     except np.linalg.LinAlgError:  # an exactly singular one: find them by their determinant
         with np.errstate(invalid="ignore", over="ignore"):
-            usable &= np.linalg.det(a) != 0.0
-        if usable.any():
-            inv[usable] = np.linalg.inv(a[usable])
+            usable &= np.linalg.det(np.where(usable[..., None, None], a, 0.0)) != 0.0
+        if not usable.any():
+            return inv, x, usable
+        out = solved(usable)
+    if usable.all():
+        inv, x = out[..., :n], out[..., n:]
+    else:
+        inv[usable], x[usable] = out[..., :n], out[..., n:]
     usable &= np.isfinite(inv).all(axis=(-2, -1))
-    return inv, usable
+    return inv, x, usable
 
 
 def abs_inverse_np(jac: list[list[Any]]) -> tuple[list[list[Any]], Any]:
