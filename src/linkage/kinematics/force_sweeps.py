@@ -43,7 +43,7 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
     """The forces at many positions at once (a scan's designs x positions, flat): ``q`` one
     array per unknown and ``d`` the driver (internal units, NaN where unsolved),
     ``values`` parameters replaced by arrays (internal units, one per position). The
-    kinematics by the numpy twins (kinematics.rates.solve_rates_np, place_motion_np), the
+    kinematics by the numpy twins (kinematics.rates.motions_rates_np, place_motion_np), the
     forces by the one matrix method (:func:`solve_loads`), judged by
     :func:`force_status_np` with the matrix's bound (no kinematic bounds here: where J is
     singular the forces are undefined)."""
@@ -51,7 +51,7 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
 
     from ..problems.loops import LoopModel
     from .placing import place_motion_np
-    from .rates import solve_rates_np
+    from .rates import motions_rates_np
 
     frame = Frame.of(mechanism)
     d = np.asarray(d, dtype=float)
@@ -67,11 +67,12 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
            for k, v in (values or {}).items()}
     model = LoopModel.compile(mechanism, sub)
     qs, ds = [c[rows] for c in q], d[rows]
-    qd1, _, ok = solve_rates_np(model, qs, ds, 1.0, 0.0)
+    motions = ((1.0, 0.0), (speed, accel)) if (speed or accel) else ((1.0, 0.0),)
+    rates, ok = motions_rates_np(model, qs, ds, motions)
+    qd1 = rates[0][0]
     unit = place_motion_np(model, qs, ds, qd1, 1.0, [np.zeros_like(ds)] * model.n, 0.0)
     if speed or accel:
-        qd, qdd, ok2 = solve_rates_np(model, qs, ds, speed, accel)
-        ok &= ok2
+        qd, qdd = rates[1]
         moving = place_motion_np(model, qs, ds, qd, speed, qdd, accel)
     else:
         moving = unit
