@@ -231,40 +231,38 @@ def inverse_np(a: Any) -> tuple[Any, Any]:
 def solve_np(a: Any, b: Any) -> tuple[Any, Any, Any]:
     """Each matrix of a stack ``a`` (..., n, n): its inverse, its solution for the columns
     ``b`` (..., n, k) (None: none) and where they exist (NaN where the matrix is singular or
-    not finite). One batched LU for both (numpy's solve of [I | b]: the inverse costs n
-    columns more, not a second factorisation); the singular ones found only when there are
-    some; no copies where every matrix is usable."""
+    not finite). One batched LU inverse, the solution through it (numpy's inverse and a
+    product cost less CPU than its solve of [I | b]); the singular ones found only when
+    there are some; no copies where every matrix is usable."""
     import numpy as np
 
     n = a.shape[-1]
     k = 0 if b is None else b.shape[-1]
-    inv = np.full(a.shape, np.nan)
-    x = np.full((*a.shape[:-1], k), np.nan)
     usable = np.isfinite(a).all(axis=(-2, -1)) if a.size else np.ones(a.shape[:-2], dtype=bool)
     if n == 0 or not usable.any():
-        return inv, x, usable
+        return np.full(a.shape, np.nan), np.full((*a.shape[:-1], k), np.nan), usable
     if n == 2:
         return solve_two_np(a, b, usable)
-    eye = np.broadcast_to(np.eye(n), a.shape)
-    rhs = eye if b is None else np.concatenate([eye, np.broadcast_to(b, (*a.shape[:-1], k))], axis=-1)
 
-    def solved(rows: Any) -> Any:
+    def inverted(rows: Any) -> Any:
         with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-            return np.linalg.solve(a, rhs) if rows.all() else np.linalg.solve(a[rows], rhs[rows])
+            if rows.all():
+                return np.linalg.inv(a)
+            inv = np.full(a.shape, np.nan)
+            inv[rows] = np.linalg.inv(a[rows])
+            return inv
 
     try:
-        out = solved(usable)
+        inv = inverted(usable)
     except np.linalg.LinAlgError:  # an exactly singular one: find them by their determinant
         with np.errstate(invalid="ignore", over="ignore"):
             usable &= np.linalg.det(np.where(usable[..., None, None], a, 0.0)) != 0.0
-        if not usable.any():
-            return inv, x, usable
-        out = solved(usable)
-    if usable.all():
-        inv, x = out[..., :n], out[..., n:]
-    else:
-        inv[usable], x[usable] = out[..., :n], out[..., n:]
+        inv = inverted(usable) if usable.any() else np.full(a.shape, np.nan)
     usable &= np.isfinite(inv).all(axis=(-2, -1))
+    if not usable.all():
+        inv = np.where(usable[..., None, None], inv, np.nan)
+    with np.errstate(invalid="ignore", over="ignore"):
+        x = np.zeros((*a.shape[:-1], 0)) if b is None else inv @ b
     return inv, x, usable
 
 
@@ -279,8 +277,7 @@ def solve_two_np(a: Any, b: Any, usable: Any) -> tuple[Any, Any, Any]:
         det = p * s - q * r
         cof = np.stack([np.stack([s, -q], axis=-1), np.stack([-r, p], axis=-1)], axis=-2)
         inv = cof / det[..., None, None]
-        x = (np.zeros((*a.shape[:-1], 0)) if b is None else
-             np.einsum("...ij,...jk->...ik", inv, np.broadcast_to(b, (*a.shape[:-1], b.shape[-1]))))
+        x = np.zeros((*a.shape[:-1], 0)) if b is None else inv @ b
     usable = usable & (det != 0.0) & np.isfinite(inv).all(axis=(-2, -1))
     where = usable[..., None, None]
     return np.where(where, inv, np.nan), np.where(where, x, np.nan), usable
