@@ -334,10 +334,11 @@ def condition_np(a: Any, rhs: Any) -> tuple[Any, Any]:
     factor of the matrix's size)."""
     import numpy as np
 
+    from ..linalg import norm1_np
     from .rate_bounds import solve_np
 
     inv, x, usable = solve_np(a, rhs[..., None])
     with np.errstate(over="ignore", invalid="ignore"):
-        cond = np.abs(a).sum(axis=-2).max(axis=-1) * np.abs(inv).sum(axis=-2).max(axis=-1)
+        cond = norm1_np(a) * norm1_np(inv)
     cond = np.where(usable & np.isfinite(cond), cond, np.inf)
     return cond, x[..., 0]
