@@ -113,6 +113,41 @@ def test_lu_and_newton_direction_twins_give_the_scalar_bits() -> None:
                 assert dq[k].tolist() == step
 
 
+def test_the_force_matrix_condition_and_solution_twins_are_the_scalar_cond1_and_lu_solve() -> None:
+    """condition_np (the loads' near-toggle test, one batched inverse) against linalg.cond1
+    and lu_solve matrix by matrix: the same 1-norm condition number and solution to the
+    rounding the condition allows, inf and NaN where the matrix is singular; solve_np's
+    2 x 2 cofactors likewise."""
+    from linkage.kinematics.load_matrix import condition_np
+    from linkage.kinematics.rate_bounds import solve_np
+    from linkage.linalg import cond1
+
+    rng = np.random.default_rng(5)
+    for n, count in ((9, 120), (2, 120)):
+        a = rng.normal(size=(count, n, n)) * rng.choice([1e-3, 1.0, 1e3], size=(count, 1, n))
+        a[:4, 1, :] = 0.0  # singular: a zero row
+        a[4:8, :, 0] = a[4:8, :, 1] * (1.0 + 1e-9)  # near singular: two columns a hair apart
+        b = rng.normal(size=(count, n))
+        cond, x = condition_np(a, b)
+        _, x2, usable = solve_np(a, b[..., None])
+        for k in range(count):
+            want = cond1(a[k].tolist())
+            if k < 4:  # a zero row: singular to both
+                assert math.isinf(want) and math.isinf(cond[k]) and np.isnan(x[k]).all() and not usable[k]
+                continue
+            if math.isinf(want) or math.isinf(cond[k]):
+                # singular to one LU and 1e16 to the other's rounding (cofactors or pivots):
+                # the same verdict, no digits (kinematics.load_matrix.solve_scaled)
+                assert min(want, cond[k]) * 2.0 ** -52 > 0.5
+                continue
+            assert usable[k] and cond[k] == pytest.approx(want, rel=1e3 * want * 2.0 ** -52)
+            sol = lu_solve(lu(a[k].tolist()), b[k].tolist())
+            scale = want * 2.0 ** -52 * 1e2 * max(map(abs, sol))
+            np.testing.assert_allclose(x[k], sol, rtol=0.0, atol=scale)
+            np.testing.assert_allclose(x2[k, :, 0], sol, rtol=0.0, atol=scale)
+        assert (cond[4:8] > 1e6).all()  # the near-singular ones are judged so
+
+
 def test_the_neumann_series_twin_stops_where_the_scalar_one_does() -> None:
     rng = np.random.default_rng(11)
     n, count = 3, 300

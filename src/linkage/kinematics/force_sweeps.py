@@ -43,7 +43,7 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
     """The forces at many positions at once (a scan's designs x positions, flat): ``q`` one
     array per unknown and ``d`` the driver (internal units, NaN where unsolved),
     ``values`` parameters replaced by arrays (internal units, one per position). The
-    kinematics by the numpy twins (kinematics.rates.solve_rates_np, place_motion_np), the
+    kinematics by the numpy twins (kinematics.rates.motions_rates_np, place_motion_np), the
     forces by the one matrix method (:func:`solve_loads`), judged by
     :func:`force_status_np` with the matrix's bound (no kinematic bounds here: where J is
     singular the forces are undefined)."""
@@ -51,7 +51,7 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
 
     from ..problems.loops import LoopModel
     from .placing import place_motion_np
-    from .rates import solve_rates_np
+    from .rates import motions_rates_np
 
     frame = Frame.of(mechanism)
     d = np.asarray(d, dtype=float)
@@ -67,24 +67,24 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
            for k, v in (values or {}).items()}
     model = LoopModel.compile(mechanism, sub)
     qs, ds = [c[rows] for c in q], d[rows]
-    qd1, _, ok = solve_rates_np(model, qs, ds, 1.0, 0.0)
-    unit = place_motion_np(model, qs, ds, qd1, 1.0, [np.zeros_like(ds)] * model.n, 0.0)
-    if speed or accel:
-        qd, qdd, ok2 = solve_rates_np(model, qs, ds, speed, accel)
-        ok &= ok2
-        moving = place_motion_np(model, qs, ds, qd, speed, qdd, accel)
-    else:
-        moving = unit
+    moves = bool(speed or accel)
+    # the velocities of a unit driver speed: those at the speed over it where it has one
+    # (forces.per_unit_speed, as one position's forces get them), else their own rates
+    by_speed = speed_usable(speed)
+    motions = ((speed, accel),) if by_speed else ((1.0, 0.0), (speed, accel)) if moves else ((1.0, 0.0),)
+    rates, ok = motions_rates_np(model, qs, ds, motions)
+    placed = [place_motion_np(model, qs, ds, qd, v, qdd, a) for (qd, qdd), (v, a) in zip(rates, motions)]
+    moving, unit = placed[-1], placed[0]
     k = metre(frame.length_unit)
 
-    def xy(which: Mapping[str, Any], part: int, scale: float) -> dict[str, tuple[Any, Any]]:
-        return {j: (v[part].real * scale, v[part].imag * scale) for j, v in which.items()}
+    def xy(which: Mapping[str, Any], part: int, per: float = 1.0) -> dict[str, tuple[Any, Any]]:
+        return {j: (v[part].real * per * k, v[part].imag * per * k) for j, v in which.items()}
 
     zero = np.zeros(len(ds))
-    pos = xy(unit, 0, k)
-    vel = xy(moving, 1, k) if (speed or accel) else {j: (zero, zero) for j in pos}
-    acc = xy(moving, 2, k) if (speed or accel) else {j: (zero, zero) for j in pos}
-    vstar = xy(unit, 1, k)
+    pos = xy(moving, 0)
+    vel = xy(moving, 1) if moves else {j: (zero, zero) for j in pos}
+    acc = xy(moving, 2) if moves else {j: (zero, zero) for j in pos}
+    vstar = xy(moving, 1, 1.0 / speed) if by_speed else xy(unit, 1)
     if sub:  # each design at its own size, as it is judged on its own
         from dataclasses import replace
 

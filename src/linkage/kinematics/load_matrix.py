@@ -241,18 +241,16 @@ def solve_scaled(frame: Frame, a: Any, rhs: Any, cols: Sequence[tuple[str, Any]]
     the matrix is singular to working precision."""
     import numpy as np
 
-    n_pos, _, n_un = a.shape
+    n_pos = a.shape[0]
     size = np.broadcast_to(np.asarray(frame.size, dtype=float), (n_pos,))[:, None]
     couples = [i for i, (kind, _) in enumerate(cols)
                if kind == "slider_m" or (kind == "input" and frame.driver_slider is None)]
     a[:, 2::3, :] /= size[:, :, None]
     rhs[:, 2::3] /= size
     a[:, :, couples] *= size[:, :, None]
-    cond, inv = condition_np(a)
+    cond, x = condition_np(a, rhs)
     good = np.isfinite(cond) & (cond * EPS < 0.5)
-    x = np.full((n_pos, n_un), np.nan)
-    if good.any():
-        x[good] = np.einsum("pij,pj->pi", inv[good], rhs[good])
+    x = np.where(good[:, None], x, np.nan)
     x[:, couples] *= size
     return x, cond
 
@@ -328,18 +326,19 @@ def reactions(frame: Frame, pos: Mapping[str, tuple[Any, Any]], unknowns: Unknow
     return tuple(pins), tuple(sliders), (gx, gy, gm)
 
 
-def condition_np(a: Any) -> tuple[Any, Any]:
+def condition_np(a: Any, rhs: Any) -> tuple[Any, Any]:
     """Each matrix's condition number in the 1-norm, ||A|| ||A^-1|| (inf where A is
-    singular), and A^-1 (NaN there): an LU inverse costs a fraction of the SVD that the
-    2-norm's needs, and bounds the same error (within a factor of the matrix's size)."""
+    singular), and its solution for ``rhs`` (..., n) (NaN there): the inverse and the
+    solution from one batched LU (:func:`~.rate_bounds.solve_np`), as an LU inverse costs
+    a fraction of the SVD that the 2-norm's needs, and bounds the same error (within a
+    factor of the matrix's size)."""
     import numpy as np
 
-    from .rate_bounds import inverse_np
+    from ..linalg import norm1_np
+    from .rate_bounds import solve_np
 
-    inv, usable = inverse_np(a)
-    cond = np.full(a.shape[:-2], np.inf)
+    inv, x, usable = solve_np(a, rhs[..., None])
     with np.errstate(over="ignore", invalid="ignore"):
-        cond[usable] = (np.abs(a[usable]).sum(axis=-2).max(axis=-1) *
-                        np.abs(inv[usable]).sum(axis=-2).max(axis=-1))
-    cond[~np.isfinite(cond)] = np.inf
-    return cond, inv
+        cond = norm1_np(a) * norm1_np(inv)
+    cond = np.where(usable & np.isfinite(cond), cond, np.inf)
+    return cond, x[..., 0]

@@ -223,22 +223,64 @@ def through_inverse(inv: list[list[float]], spread: list[list[float]], g: list[f
 
 def inverse_np(a: Any) -> tuple[Any, Any]:
     """The inverse of each matrix of a stack (NaN where it is singular or not finite) and
-    where it exists: one batched LU, the singular ones found only when there are some."""
+    where it exists: :func:`solve_np` with no right-hand side."""
+    inv, _, usable = solve_np(a, None)
+    return inv, usable
+
+
+def solve_np(a: Any, b: Any) -> tuple[Any, Any, Any]:
+    """Each matrix of a stack ``a`` (..., n, n): its inverse, its solution for the columns
+    ``b`` (..., n, k) (None: none) and where they exist (NaN where the matrix is singular or
+    not finite). One batched LU inverse, the solution through it (numpy's inverse and a
+    product cost less CPU than its solve of [I | b]); the singular ones found only when
+    there are some; no copies where every matrix is usable."""
     import numpy as np
 
-    inv = np.full(a.shape, np.nan)
+    n = a.shape[-1]
+    k = 0 if b is None else b.shape[-1]
     usable = np.isfinite(a).all(axis=(-2, -1)) if a.size else np.ones(a.shape[:-2], dtype=bool)
-    if a.shape[-1] == 0 or not usable.any():
-        return inv, usable
+    if n == 0 or not usable.any():
+        return np.full(a.shape, np.nan), np.full((*a.shape[:-1], k), np.nan), usable
+    if n == 2:
+        return solve_two_np(a, b, usable)
+
+    def inverted(rows: Any) -> Any:
+        with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+            if rows.all():
+                return np.linalg.inv(a)
+            inv = np.full(a.shape, np.nan)
+            inv[rows] = np.linalg.inv(a[rows])
+            return inv
+
     try:
-        inv[usable] = np.linalg.inv(a[usable])
+        inv = inverted(usable)
     except np.linalg.LinAlgError:  # an exactly singular one: find them by their determinant
         with np.errstate(invalid="ignore", over="ignore"):
-            usable &= np.linalg.det(a) != 0.0
-        if usable.any():
-            inv[usable] = np.linalg.inv(a[usable])
+            usable &= np.linalg.det(np.where(usable[..., None, None], a, 0.0)) != 0.0
+        inv = inverted(usable) if usable.any() else np.full(a.shape, np.nan)
     usable &= np.isfinite(inv).all(axis=(-2, -1))
-    return inv, usable
+    if not usable.all():
+        inv = np.where(usable[..., None, None], inv, np.nan)
+    with np.errstate(invalid="ignore", over="ignore"):
+        x = np.zeros((*a.shape[:-1], 0)) if b is None else inv @ b
+    return inv, x, usable
+
+
+def solve_two_np(a: Any, b: Any, usable: Any) -> tuple[Any, Any, Any]:
+    """:func:`solve_np` of a stack of 2 x 2 matrices, by cofactors: [[d, -b], [-c, a]] / det
+    (numpy's batched LU spends most of a 2 x 2's time on its per-matrix set-up), usable
+    where ``usable`` (the entries finite), det is not zero and the inverse is finite."""
+    import numpy as np
+
+    p, q, r, s = a[..., 0, 0], a[..., 0, 1], a[..., 1, 0], a[..., 1, 1]
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        det = p * s - q * r
+        cof = np.stack([np.stack([s, -q], axis=-1), np.stack([-r, p], axis=-1)], axis=-2)
+        inv = cof / det[..., None, None]
+        x = np.zeros((*a.shape[:-1], 0)) if b is None else inv @ b
+    usable = usable & (det != 0.0) & np.isfinite(inv).all(axis=(-2, -1))
+    where = usable[..., None, None]
+    return np.where(where, inv, np.nan), np.where(where, x, np.nan), usable
 
 
 def abs_inverse_np(jac: list[list[Any]]) -> tuple[list[list[Any]], Any]:

@@ -32,7 +32,7 @@ from ..problems.loops import DRIVER, LoopModel
 from .block_linalg import direction_np
 from .labels import rate_label
 from .placing import place, place_bounded
-from .rate_bounds import SAFETY, inverse_np, rate_bounds, static_values
+from .rate_bounds import SAFETY, rate_bounds, solve_np, static_values
 from .vectors import EPS, XY, bias, bias_np, value_of
 
 RATE_RTOL = 1e-6
@@ -239,20 +239,28 @@ def solve_rates_np(model: LoopModel, q: Any, d: Any, speed: float, accel: float
     dPhi/dv from each vector's derivatives and b its centripetal and Coriolis parts. NaN
     (and solved False) where J is singular. No polishing and no bound: a batch's positions
     are judged by the loads' condition number (kinematics.forces)."""
+    ((qd, qdd),), solved = motions_rates_np(model, q, d, ((speed, accel),))
+    return qd, qdd, solved
+
+
+def motions_rates_np(model: LoopModel, q: Any, d: Any, motions: Any) -> tuple[list[Any], Any]:
+    """:func:`solve_rates_np` at each driver (speed, accel) of ``motions``, J and its
+    inverse found once for all of them: [(q', q'') per motion], solved. q' is the unit
+    speed's times the speed (J q' = -(dPhi/dv) v' is linear in v')."""
     import numpy as np
 
     d = np.asarray(d, dtype=float)
     _, jac, dv = jacobian_np(model, q, d)
-    inv, solved = inverse_np(jac)
-
-    def solve(rhs: Any) -> Any:
-        return -np.einsum("...ij,...j->...i", inv, rhs)
-
-    qd = solve(speed * dv)
-    qd_list = list(np.moveaxis(qd, -1, 0))
-    rhs = accel * dv + np.stack(np.broadcast_arrays(d, *bias_np(model, q, d, qd_list, speed))[1:], axis=-1)
-    qdd = solve(rhs)
-    return qd_list, list(np.moveaxis(qdd, -1, 0)), solved
+    inv, unit, solved = solve_np(jac, dv[..., None])
+    unit = -unit[..., 0]
+    out = []
+    for speed, accel in motions:
+        qd_list = list(np.moveaxis(speed * unit, -1, 0))
+        rhs = accel * dv + np.stack(np.broadcast_arrays(d, *bias_np(model, q, d, qd_list, speed))[1:],
+                                    axis=-1)
+        qdd = -np.einsum("...ij,...j->...i", inv, rhs)
+        out.append((qd_list, list(np.moveaxis(qdd, -1, 0))))
+    return out, solved
 
 
 def _xy(c: complex) -> XY:

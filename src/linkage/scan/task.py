@@ -77,9 +77,10 @@ def run_chunk(job: ScanJob, start: int, designs: np.ndarray) -> dict[str, np.nda
     return out
 
 
-FORCE_BATCH_CELLS = 4_000_000
-"""Force-matrix numbers built at once (32 MB): a chunk's positions go through the matrix
-method in slices of this many numbers."""
+FORCE_BATCH_CELLS = 1_000_000
+"""Force-matrix numbers built at once (8 MB): a chunk's positions go through the matrix
+method in slices of this many numbers (benchmarks/loaded_scan.py: 4,000,000 took 10% more
+processor time, its arrays beyond the caches; 600,000 as much as this)."""
 
 
 def load_metrics(m: Mechanism, params: Mapping[str, np.ndarray], sol: DesignSolutions, loads: Any,
