@@ -182,6 +182,9 @@ class Loop(NamedTuple):
     limit: str = "_step_limit(tol, rtol, ax) if rtol else tol"
     failure: str = ""
     """When given, every stop other than convergence runs this line instead (``return None``)."""
+    quiet: bool = False
+    """Emit :func:`quiet_path` before the tests (needs ``tol``, ``rtol`` and ``ftol`` as
+    names, and no ``diverge_when``)."""
 
 
 class _Emitter:
@@ -206,10 +209,37 @@ def stopping_tests(loop: Loop) -> list[str]:
     """Tests 2-8 of the module docstring, in order, as the body of the loop after a step
     (indented for it), for ``loop``'s options."""
     out = _Emitter(loop)
+    if loop.quiet:
+        quiet_path(out)
     _value_tests(out)
     _step_test(out)
     _growth_tests(out)
     return out.lines
+
+
+def quiet_path(out: _Emitter) -> None:
+    """A step after which no test can fire, recognised in one condition and continued from
+    with exactly the state the tests would leave (the guard's best |f|, no growth, the
+    error as the previous one); any other step goes through tests 2-7 in order. Only
+    without ``ftol`` and ``rtol`` (the flag ``quiet`` the loop's preamble sets), with
+    floats: |f| finite and not zero (tests 2-4), the error finite and above ``tol``
+    (test 5, so neither the guard nor the plausibility nor a certificate is consulted),
+    not above the previous error (test 6 resets its streak) and above rounding (test 7)."""
+    loop, put = out.loop, out.put
+    if loop.diverge_when:
+        raise ValueError("a quiet path needs test 6 on every step")
+    put(0, "if quiet and type(err) is float and type(fx) is float:")
+    put(1, "size = fx if fx >= 0.0 else -fx")
+    put(1, f"ax = {loop.magnitude}")
+    growth = " and err <= prev_err" if loop.diverge else ""
+    put(1, f"if 0.0 < size < _inf and tol < err < _inf{growth} and err > _ROUNDING * ax:")
+    if loop.guard:
+        put(2, "if size < best:")
+        put(3, "best = size")
+    if loop.diverge:
+        put(2, "growth = 0")
+    put(2, "prev_err = err")
+    put(2, "continue")
 
 
 def _value_tests(out: _Emitter) -> None:
@@ -320,6 +350,7 @@ def loop_source(loop: Loop) -> str:
              '    status, detail = _S.MAX_ITER, ""',
              "    prev_err = _inf",
              "    growth = uncertified = stalls = rounding_steps = k = 0",
+             *(["    quiet = ftol is None and not rtol"] if loop.quiet else []),
              "    for k in range(1, max_iter + 1):",
              "        try:", *_block(loop.step, 3),
              "        except (ArithmeticError, ValueError) as exc:"]

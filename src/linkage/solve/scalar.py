@@ -148,12 +148,15 @@ _newton_loop: Any = None
 a system solve never does)."""
 
 
-def _load_newton_loop() -> Any:
-    global _newton_loop
-    from ..methods.newton import newton_lean
+_newton_recording: Any = None
 
-    _newton_loop = newton_lean
-    return newton_lean
+
+def _load_newton_loop() -> Any:
+    global _newton_loop, _newton_recording
+    from ..methods.newton import newton_lean, newton_quiet
+
+    _newton_loop, _newton_recording = newton_quiet, newton_lean
+    return newton_quiet
 
 
 def newton_result(problem: ScalarProblem, x0: float, crit: Criteria, record: bool = False) -> Result:
@@ -171,6 +174,8 @@ def newton_result(problem: ScalarProblem, x0: float, crit: Criteria, record: boo
     start = {"x0": x0}
     try:
         loop = _newton_loop or _load_newton_loop()
+        if record:
+            loop = _newton_recording
         x, fx, err, status, detail, k = loop(problem, x0, crit.tol, crit.rtol, crit.ftol, crit.max_iter,
                                              certify, rows)
     except TypeError:  # the generic path's answer to a non-real f at the start
