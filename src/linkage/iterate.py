@@ -67,24 +67,26 @@ HISTORY_TAIL = 300
 
 
 class Rows(list):  # type: ignore[type-arg]
-    """Recorded rows with a fixed ceiling: the head in the list, the tail in a ring."""
+    """Recorded rows with a fixed ceiling: the head in the list, the tail in a ring (made
+    only when a run outgrows the head: a short run pays for no ring)."""
 
-    def __init__(self) -> None:
-        super().__init__()
-        self.tail: deque[tuple[Any, ...]] = deque(maxlen=HISTORY_TAIL)
-        self.elided = 0
+    tail: deque[tuple[Any, ...]] | None = None
+    elided = 0
 
     def add(self, row: tuple[Any, ...]) -> None:
         if len(self) < HISTORY_HEAD:
             self.append(row)
             return
-        if len(self.tail) == HISTORY_TAIL:
+        tail = self.tail
+        if tail is None:
+            tail = self.tail = deque(maxlen=HISTORY_TAIL)
+        if len(tail) == HISTORY_TAIL:
             self.elided += 1
-        self.tail.append(row)
+        tail.append(row)
 
     def finish(self) -> tuple[list[tuple[Any, ...]], int, int]:
         """(rows, elided, index in rows where the gap is)."""
-        return [*self, *self.tail], self.elided, len(self)
+        return [*self, *(self.tail or ())], self.elided, len(self)
 
 
 # A NamedTuple, not a frozen dataclass: built once per class at import, it costs

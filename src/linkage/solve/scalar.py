@@ -166,11 +166,12 @@ def newton_result(problem: ScalarProblem, x0: float, crit: Criteria, record: boo
     """Newton by its generated loop (:func:`~linkage.methods.newton.newton_lean`),
     packaged exactly as :func:`finish` packages the generic loop's outcome (history
     included when ``record``)."""
-    extra = [0]
+    extra = 0  # evaluations of f the certificate made
 
     def certify(x: float, fx: float, width: float) -> tuple[Status, str]:
+        nonlocal extra
         verdict, why, n = certify_root(problem, x, fx, width)
-        extra[0] += n
+        extra += n
         return verdict, why
 
     rows = Rows() if record else None
@@ -185,7 +186,7 @@ def newton_result(problem: ScalarProblem, x0: float, crit: Criteria, record: boo
                                "f returned a non-real value")
     except (ArithmeticError, ValueError) as exc:
         return failed_at_start("newton", problem, x0, crit, record, {"x0": x0}, *explain(exc))
-    result = Result.fast("newton", x, status, k, 1 + 2 * k + extra[0], err, fx, detail,
+    result = Result.fast("newton", x, status, k, 1 + 2 * k + extra, err, fx, detail,
                          {"var": problem.var, "unit": problem.unit, "title": problem.title,
                           "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, "x0": x0})
     if rows is not None:
