@@ -185,8 +185,8 @@ class Loop(NamedTuple):
     failure: str = ""
     """When given, every stop other than convergence runs this line instead (``return None``)."""
     quiet: bool = False
-    """Emit :func:`quiet_path` before the tests (needs ``tol``, ``rtol`` and ``ftol`` as
-    names, and no ``diverge_when``)."""
+    """Emit :func:`quiet_path` before the tests (needs ``tol`` and ``rtol`` as names, and
+    ``ftol`` with ``residual_test``)."""
 
 
 class _Emitter:
@@ -223,13 +223,12 @@ def quiet_path(out: _Emitter) -> None:
     """A step after which no test can fire, recognised in one condition and continued from
     with exactly the state the tests would leave (the guard's best |f|, no growth, the
     error as the previous one); any other step goes through tests 2-7 in order. Only
-    without ``ftol`` and ``rtol`` (the flag ``quiet`` the loop's preamble sets), with
-    floats: |f| finite and not zero (tests 2-4), the error finite and above ``tol``
-    (test 5, so neither the guard nor the plausibility nor a certificate is consulted),
-    not above the previous error (test 6 resets its streak) and above rounding (test 7)."""
+    without ``rtol`` and a residual test's ``ftol`` (the flag ``quiet`` the loop's
+    preamble sets), with floats: |f| (a system's max|Phi|) finite and not zero (tests
+    2-4), the error finite and above ``tol`` (test 5, so neither the guard, the
+    plausibility, a certificate nor a system's residual gate is consulted), not above the
+    previous error (test 6 resets its streak, where it runs) and above rounding (test 7)."""
     loop, put = out.loop, out.put
-    if loop.diverge_when:
-        raise ValueError("a quiet path needs test 6 on every step")
     put(0, "if quiet and type(err) is float and type(fx) is float:")
     put(1, "size = fx if fx >= 0.0 else -fx")
     put(1, f"ax = {loop.magnitude}")
@@ -238,7 +237,10 @@ def quiet_path(out: _Emitter) -> None:
     if loop.guard:
         put(2, "if size < best:")
         put(3, "best = size")
-    if loop.diverge:
+    if loop.diverge and loop.diverge_when:
+        put(2, f"if {loop.diverge_when}:")
+        put(3, "growth = 0")
+    elif loop.diverge:
         put(2, "growth = 0")
     put(2, "prev_err = err")
     put(2, "continue")
@@ -345,6 +347,9 @@ def _block(text: str, level: int) -> list[str]:
     return [("    " * level + line) if line.strip() else "" for line in dedent(text).splitlines()]
 
 
+_QUIET_FTOL = "ftol is None and "
+
+
 def loop_source(loop: Loop) -> str:
     """The source of the function ``loop`` describes: its setup, then for k = 1..max_iter
     its step and the ordered stopping tests, then test 8 (the cap) and its result."""
@@ -352,7 +357,7 @@ def loop_source(loop: Loop) -> str:
              '    status, detail = _S.MAX_ITER, ""',
              "    prev_err = _inf",
              "    growth = uncertified = stalls = rounding_steps = k = 0",
-             *(["    quiet = ftol is None and not rtol"] if loop.quiet else []),
+             *([f"    quiet = {_QUIET_FTOL if loop.residual_test else ''}not rtol"] if loop.quiet else []),
              "    for k in range(1, max_iter + 1):",
              "        try:", *_block(loop.step, 3),
              "        except (ArithmeticError, ValueError) as exc:"]
