@@ -140,6 +140,28 @@ def test_generated_scalar_loops_equal_the_generic_loop_bit_for_bit():
         assert statuses[status] >= 5, statuses
 
 
+def test_recorded_newton_has_the_generic_loops_outcome_and_rows_bit_for_bit():
+    """Newton with history on (newton_lean) and off (newton_quiet, the quiet path) end
+    where the generic loop does, and the recorded table is the generic loop's, row for row."""
+    rng = random.Random(4242)
+    m = method_class("newton")()
+    for case in range(1_500):
+        problem, x0, _, _ = _random_problem(rng)
+        crit = _criteria(rng)
+        try:
+            state = m.init(problem, x0)
+        except (ArithmeticError, ValueError):
+            continue
+        if state.stop is not None:
+            continue
+        _, status, detail, k, rows = run(m, problem, state, crit, record=True, certify=_certify(problem))
+        on, off = newton_result(problem, x0, crit, record=True), newton_result(problem, x0, crit)
+        for r in (on, off):
+            assert (r.status, r.detail, r.iterations) == (status, detail, k), case
+        assert _bits((on.x, on.residual, on.error)) == _bits((off.x, off.residual, off.error)), case
+        assert _bits(on.history.rows) == _bits(tuple(rows.finish()[0])), case
+
+
 def _random_system(rng: random.Random, n: int) -> tuple[Any, Any, tuple[float, ...]]:
     """Phi_i(q) = sum_j A_ij q_j + c_i sin(q_i) + d_i q_i^3 - b_i, with its exact J."""
     A = [[rng.uniform(-2, 2) for _ in range(n)] for _ in range(n)]

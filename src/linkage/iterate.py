@@ -67,24 +67,26 @@ HISTORY_TAIL = 300
 
 
 class Rows(list):  # type: ignore[type-arg]
-    """Recorded rows with a fixed ceiling: the head in the list, the tail in a ring."""
+    """Recorded rows with a fixed ceiling: the head in the list, the tail in a ring (made
+    only when a run outgrows the head: a short run pays for no ring)."""
 
-    def __init__(self) -> None:
-        super().__init__()
-        self.tail: deque[tuple[Any, ...]] = deque(maxlen=HISTORY_TAIL)
-        self.elided = 0
+    tail: deque[tuple[Any, ...]] | None = None
+    elided = 0
 
     def add(self, row: tuple[Any, ...]) -> None:
         if len(self) < HISTORY_HEAD:
             self.append(row)
             return
-        if len(self.tail) == HISTORY_TAIL:
+        tail = self.tail
+        if tail is None:
+            tail = self.tail = deque(maxlen=HISTORY_TAIL)
+        if len(tail) == HISTORY_TAIL:
             self.elided += 1
-        self.tail.append(row)
+        tail.append(row)
 
     def finish(self) -> tuple[list[tuple[Any, ...]], int, int]:
         """(rows, elided, index in rows where the gap is)."""
-        return [*self, *self.tail], self.elided, len(self)
+        return [*self, *(self.tail or ())], self.elided, len(self)
 
 
 # A NamedTuple, not a frozen dataclass: built once per class at import, it costs
@@ -182,6 +184,9 @@ class Loop(NamedTuple):
     limit: str = "_step_limit(tol, rtol, ax) if rtol else tol"
     failure: str = ""
     """When given, every stop other than convergence runs this line instead (``return None``)."""
+    quiet: bool = False
+    """Emit :func:`quiet_path` before the tests (needs ``tol`` and ``rtol`` as names, and
+    ``ftol`` with ``residual_test``)."""
 
 
 class _Emitter:
@@ -206,10 +211,39 @@ def stopping_tests(loop: Loop) -> list[str]:
     """Tests 2-8 of the module docstring, in order, as the body of the loop after a step
     (indented for it), for ``loop``'s options."""
     out = _Emitter(loop)
+    if loop.quiet:
+        quiet_path(out)
     _value_tests(out)
     _step_test(out)
     _growth_tests(out)
     return out.lines
+
+
+def quiet_path(out: _Emitter) -> None:
+    """A step after which no test can fire, recognised in one condition and continued from
+    with exactly the state the tests would leave (the guard's best |f|, no growth, the
+    error as the previous one); any other step goes through tests 2-7 in order. Only
+    without ``rtol`` and a residual test's ``ftol`` (the flag ``quiet`` the loop's
+    preamble sets), with floats: |f| (a system's max|Phi|) finite and not zero (tests
+    2-4), the error finite and above ``tol`` (test 5, so neither the guard, the
+    plausibility, a certificate nor a system's residual gate is consulted), not above the
+    previous error (test 6 resets its streak, where it runs) and above rounding (test 7)."""
+    loop, put = out.loop, out.put
+    put(0, "if quiet and type(err) is float and type(fx) is float:")
+    put(1, "size = fx if fx >= 0.0 else -fx")
+    put(1, f"ax = {loop.magnitude}")
+    growth = " and err <= prev_err" if loop.diverge else ""
+    put(1, f"if 0.0 < size < _inf and tol < err < _inf{growth} and err > _ROUNDING * ax:")
+    if loop.guard:
+        put(2, "if size < best:")
+        put(3, "best = size")
+    if loop.diverge and loop.diverge_when:
+        put(2, f"if {loop.diverge_when}:")
+        put(3, "growth = 0")
+    elif loop.diverge:
+        put(2, "growth = 0")
+    put(2, "prev_err = err")
+    put(2, "continue")
 
 
 def _value_tests(out: _Emitter) -> None:
@@ -313,6 +347,9 @@ def _block(text: str, level: int) -> list[str]:
     return [("    " * level + line) if line.strip() else "" for line in dedent(text).splitlines()]
 
 
+_QUIET_FTOL = "ftol is None and "
+
+
 def loop_source(loop: Loop) -> str:
     """The source of the function ``loop`` describes: its setup, then for k = 1..max_iter
     its step and the ordered stopping tests, then test 8 (the cap) and its result."""
@@ -320,6 +357,7 @@ def loop_source(loop: Loop) -> str:
              '    status, detail = _S.MAX_ITER, ""',
              "    prev_err = _inf",
              "    growth = uncertified = stalls = rounding_steps = k = 0",
+             *([f"    quiet = {_QUIET_FTOL if loop.residual_test else ''}not rtol"] if loop.quiet else []),
              "    for k in range(1, max_iter + 1):",
              "        try:", *_block(loop.step, 3),
              "        except (ArithmeticError, ValueError) as exc:"]

@@ -111,10 +111,14 @@ class History:
     @classmethod
     def of(cls, columns: tuple[str, ...], rows: Any, error_column: int) -> History:
         """A History from the loop's rows (a list, or a ceiling-bounded ``Rows``)."""
+        elided = gap = 0
         if hasattr(rows, "finish"):
-            kept, elided, gap = rows.finish()
-            return cls(columns, tuple(kept), error_column, elided, gap if elided else 0)
-        return cls(columns, tuple(rows), error_column)
+            rows, elided, gap = rows.finish()
+        obj = _new(cls)
+        # as Result.fast: the frozen dataclass's value without its per-field __setattr__
+        _setattr(obj, "__dict__", {"columns": columns, "rows": tuple(rows), "error_column": error_column,
+                                   "elided": elided, "gap_at": gap if elided else 0})
+        return obj
 
     @property
     def note(self) -> str:

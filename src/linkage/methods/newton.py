@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import HISTORY_HEAD, Loop, build_loop
+from ..iterate import HISTORY_HEAD, Loop, build_loop, dedent
 from ..problems.scalar import ScalarProblem
 from ..result import Column, Status
 from .common import new_state, start_stop
@@ -77,41 +77,60 @@ class Newton:
         return (i, s.xp, s.fxp, s.dfxp, s.x, s.err)
 
 
-NEWTON_LOOP = Loop(
-    signature="newton_lean(problem, x0, tol, rtol, ftol, max_iter, certify, rows=None)",
-    setup="""\
-        add = rows.add if rows is not None else None
-        append = rows.append if rows is not None else None  # the first HISTORY_HEAD rows, as Rows.add
-        f, fp = problem.f, problem.fprime
-        x = x0
-        fx = f(x)
-        stop = _start_stop(problem, x0, fx)
-        if stop is not None:
-            return x, fx, _inf, stop[0], stop[1], 0
-        best = start = abs(fx) if isinstance(fx, float) else _inf
-        err = _inf
-        """,
-    step="""\
-        d = fp(x)
-        if d == 0.0:
+def _join(*parts: str) -> str:
+    """Source fragments written at one indentation, joined and dedented together."""
+    return dedent("".join(part.rstrip(" ") for part in parts))
+
+
+def newton_loop(record: bool) -> Loop:
+    """Newton's step around the ordered stopping rule, recording rows into ``rows`` (an
+    :class:`~linkage.iterate.Rows`) when ``record``; without it the loop has no row
+    bookkeeping. Both take the rule's quiet path (:func:`linkage.iterate.quiet_path`)."""
+    name = "newton_lean" if record else "newton_quiet"
+    return Loop(
+        signature=f"{name}(problem, x0, tol, rtol, ftol, max_iter, certify, rows=None)",
+        setup=_join("""\
+            add = rows.add if rows is not None else None
+            append = rows.append if rows is not None else None  # the first HISTORY_HEAD rows, as Rows.add
+            """ if record else "", """\
+            f, fp = problem.f, problem.fprime
+            x = x0
+            fx = f(x)
+            if fx == 0.0 or fx - fx != 0.0:  # the start's verdict (_start_stop) can only be a stop
+                stop = _start_stop(problem, x0, fx)
+                if stop is not None:
+                    return x, fx, _inf, stop[0], stop[1], 0
+            best = start = abs(fx) if isinstance(fx, float) else _inf
+            err = _inf
+            """),
+        step=_join("""\
+            d = fp(x)
+            if d == 0.0:
+            """, """\
+                if add is not None:
+                    add((k, x, fx, d, None, None))
+            """ if record else "", """\
+                err = _nan
+                status = _S.ZERO_DERIVATIVE
+                detail = f"f'({problem.var}) = 0 at {problem.var} = {x!r}, f = {fx:.6g}"
+                break
+            x1 = x - fx / d
+            fx1 = f(x1)
+            """),
+        after=_join("""\
+            err = x1 - x
+            if err < 0.0:
+                err = -err
+            """, """\
             if add is not None:
-                add((k, x, fx, d, None, None))
-            err = _nan
-            status = _S.ZERO_DERIVATIVE
-            detail = f"f'({problem.var}) = 0 at {problem.var} = {x!r}, f = {fx:.6g}"
-            break
-        x1 = x - fx / d
-        fx1 = f(x1)
-        """,
-    after="""\
-        err = x1 - x
-        if err < 0.0:
-            err = -err
-        if add is not None:
-            (append if k <= _HEAD else add)((k, x, fx, d, x1, err))
-        x, fx = x1, fx1
-        """,
-    guard=True, step_test="certify", diverge="streak")
+                (append if k <= _HEAD else add)((k, x, fx, d, x1, err))
+            """ if record else "", """\
+            x, fx = x1, fx1
+            """),
+        guard=True, step_test="certify", diverge="streak", quiet=True)
+
+
+NEWTON_LOOP = newton_loop(record=True)
 """Newton as one tight loop: the stopping rule of :mod:`linkage.iterate` around Newton's
 step, without states or method dispatch; the generic loop's status, root, iteration count
 and, when ``rows`` (an :class:`~linkage.iterate.Rows`) is given, its table row for row
@@ -120,3 +139,7 @@ max_iter, certify, rows)`` returns (x, f(x), last error, status, detail, iterati
 ``certify(x, fx, width)`` decides a small step."""
 
 newton_lean = build_loop(NEWTON_LOOP, {"_start_stop": start_stop, "_HEAD": HISTORY_HEAD})
+
+NEWTON_QUIET_LOOP = newton_loop(record=False)
+newton_quiet = build_loop(NEWTON_QUIET_LOOP, {"_start_stop": start_stop})
+"""``newton_lean`` without rows (its ``rows`` is ignored): the same outcome, bit for bit."""

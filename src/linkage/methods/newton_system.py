@@ -403,7 +403,7 @@ NEWTON_SYSTEM_LOOP = Loop(
         """,
     result="q, phi, err, status, detail, k, nfev, njev",
     residual_test=False, step_test="system", diverge="runaway", diverge_when="not damped",
-    magnitude="size_q")
+    magnitude="size_q", quiet=True)
 """Newton-Raphson for a system with recording off: the stopping rule of
 :mod:`linkage.iterate` for systems around the whole Newton step (Cramer's rule for two
 unknowns), handing a refused step to :meth:`NewtonSystem.step`. The outcome equals the
@@ -469,7 +469,7 @@ f0, f1 = s.phi_x
         """,
     result="[x0, x1], [p0, p1], err, status, detail, k, nfev, njev",
     residual_test=False, step_test="system", diverge="runaway", diverge_when="not damped",
-    magnitude="size_q")
+    magnitude="size_q", quiet=True)
 """:data:`NEWTON_SYSTEM_LOOP` for two unknowns measured as they are (every four-bar), on
 scalars: the same operations in the same order, so the same iterates, status and counts
 (tests/test_compile.py), without the per-iteration lists and helper calls."""

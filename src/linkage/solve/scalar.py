@@ -67,11 +67,12 @@ def solve_scalar(
     >>> round(r.root, 12), r.status.value
     (1.414213562373, 'converged_step')
     """
-    if (method == "newton" and not record and type(f) is ScalarProblem and fprime is None
+    if (method == "newton" and type(f) is ScalarProblem and fprime is None
             and type(x0) is float and x0 - x0 == 0.0 and f.fprime is not None):
         # the common case, without the general front door: a problem with its
-        # derivative and a finite start
-        return newton_result(f, x0, check_criteria(tol, rtol, ftol, max_iter))
+        # derivative and a finite start (what the front door below checks, and then
+        # the same call)
+        return newton_result(f, x0, check_criteria(tol, rtol, ftol, max_iter), record)
     entry = METHODS.get(method)
     if entry is None:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")
@@ -148,41 +149,48 @@ _newton_loop: Any = None
 a system solve never does)."""
 
 
-def _load_newton_loop() -> Any:
-    global _newton_loop
-    from ..methods.newton import newton_lean
+_newton_recording: Any = None
+_newton_method: Any = None
+"""With ``_newton_loop``: the recording loop and the method (for its table's columns)."""
 
-    _newton_loop = newton_lean
-    return newton_lean
+
+def _load_newton_loop() -> Any:
+    global _newton_loop, _newton_recording, _newton_method
+    from ..methods.newton import Newton, newton_lean, newton_quiet
+
+    _newton_loop, _newton_recording, _newton_method = newton_quiet, newton_lean, Newton()
+    return newton_quiet
 
 
 def newton_result(problem: ScalarProblem, x0: float, crit: Criteria, record: bool = False) -> Result:
     """Newton by its generated loop (:func:`~linkage.methods.newton.newton_lean`),
     packaged exactly as :func:`finish` packages the generic loop's outcome (history
     included when ``record``)."""
-    extra = [0]
+    extra = 0  # evaluations of f the certificate made
 
     def certify(x: float, fx: float, width: float) -> tuple[Status, str]:
+        nonlocal extra
         verdict, why, n = certify_root(problem, x, fx, width)
-        extra[0] += n
+        extra += n
         return verdict, why
 
     rows = Rows() if record else None
-    start = {"x0": x0}
     try:
         loop = _newton_loop or _load_newton_loop()
+        if record:
+            loop = _newton_recording
         x, fx, err, status, detail, k = loop(problem, x0, crit.tol, crit.rtol, crit.ftol, crit.max_iter,
                                              certify, rows)
     except TypeError:  # the generic path's answer to a non-real f at the start
-        return failed_at_start("newton", problem, x0, crit, record, start, Status.DOMAIN_ERROR,
+        return failed_at_start("newton", problem, x0, crit, record, {"x0": x0}, Status.DOMAIN_ERROR,
                                "f returned a non-real value")
     except (ArithmeticError, ValueError) as exc:
-        return failed_at_start("newton", problem, x0, crit, record, start, *explain(exc))
-    result = Result.fast("newton", x, status, k, 1 + 2 * k + extra[0], err, fx, detail,
+        return failed_at_start("newton", problem, x0, crit, record, {"x0": x0}, *explain(exc))
+    result = Result.fast("newton", x, status, k, 1 + 2 * k + extra, err, fx, detail,
                          {"var": problem.var, "unit": problem.unit, "title": problem.title,
                           "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, "x0": x0})
     if rows is not None:
-        labels = column_labels(method_class("newton")(), problem.var, problem.unit, problem.u is not None,
+        labels = column_labels(_newton_method, problem.var, problem.unit, problem.u is not None,
                                problem.gprime is not None)
         result.__dict__["history"] = History.of(labels, rows, len(labels) - 1)
     return result
