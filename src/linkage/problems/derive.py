@@ -263,7 +263,8 @@ class Derivation(NamedTuple):
         p = self._params(params)
         d = np.asarray(driver, float)
         q: list[Any] = [None] * self.n
-        ok = np.ones(np.broadcast_shapes(d.shape, *(np.shape(v) for v in p.values())), bool)
+        shape = np.broadcast_shapes(d.shape, *(np.shape(v) for v in p.values()))
+        ok: Any = None
         out = []
         signs_left = iter(signs)
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -273,13 +274,17 @@ class Derivation(NamedTuple):
                 if step.two_way:
                     out.append(step_margin_np(step.case, first, second, k))
                 a, b, fine = solve_step_np(step.case, first, second, k, sigma)
-                ok = ok & fine
+                ok = fine if ok is None else ok & fine
                 q[step.unknowns[0]], q[step.unknowns[1]] = a, b
-        shape = ok.shape
+        if ok is None or np.shape(ok) != shape:
+            ok = np.ones(shape, bool) if ok is None else np.broadcast_to(ok, shape).copy()
         # a step the driver does not reach (two loops whose difference drops it) has one
-        # margin for every driver: give it the drivers' shape like the other columns
-        return ([np.where(ok, np.broadcast_to(x, shape), np.nan) for x in q], ok,
-                [np.broadcast_to(x, shape).copy() for x in out])
+        # value for every driver: give it the drivers' shape like the other columns (fresh
+        # arrays, a caller's to keep); where every position assembled, NaN replaces nothing
+        every = bool(ok.all())
+        return ([(x.copy() if every else np.where(ok, x, np.nan)) if np.shape(x) == shape else
+                 np.where(ok, np.broadcast_to(x, shape), np.nan) for x in q], ok,
+                [x if np.shape(x) == shape else np.broadcast_to(x, shape).copy() for x in out])
 
     def signs_of_np(self, q: Sequence[Any], driver: Any,
                     params: Mapping[str, Any] | None = None) -> list[Any]:
