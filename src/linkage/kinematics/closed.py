@@ -220,14 +220,16 @@ def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray) -> bool:
 
 
 def _column_lengths(jac: list[list[Any]], k: int) -> np.ndarray:
-    """The product of J's columns' Euclidean lengths, position by position."""
-    out = np.ones(k)
+    """The product of J's columns' Euclidean lengths, position by position (each sum of
+    squares begun from its first term: 0 + x and 1 * x are x, so no pass adds a zero)."""
+    out: Any = None
     for j in range(len(jac[0])):
-        sq = np.zeros(k)
+        sq: Any = None
         for row in jac:
-            sq = sq + np.square(row[j])
-        out = out * np.sqrt(sq)
-    return out
+            sq = np.square(row[j]) if sq is None else sq + np.square(row[j])
+        length = np.sqrt(sq)
+        out = length if out is None else out * length
+    return np.broadcast_to(out, (k,))
 
 
 def _words(m: Mechanism, drv: np.ndarray, q: list[np.ndarray], signs: tuple[float, ...]) -> list[str] | None:
@@ -254,10 +256,13 @@ def _display(m: Mechanism, tol: float, max_iter: int, vals: np.ndarray, cols: np
              kinds: Sequence[str], closes: bool) -> np.ndarray:
     """The unknowns in display units, each angle continuous along the cycle and anchored to
     what ``solve FILE`` gives (the rule of :mod:`.angles`, as the one-at-a-time engine)."""
-    out = np.empty_like(cols)
     angles = [j for j, k in enumerate(kinds) if k == "angle"]
-    for j, k in enumerate(kinds):
-        out[j] = degrees(cols[j]) if k == "angle" else cols[j]
+    if len(angles) == len(kinds):
+        out = degrees(cols)  # every unknown an angle: one pass
+    else:
+        out = cols.copy()
+        for j in angles:
+            out[j] = degrees(cols[j])
     if not angles:
         return out
     turn = driver_turn(m.driver.unit)
@@ -271,6 +276,8 @@ def _display(m: Mechanism, tol: float, max_iter: int, vals: np.ndarray, cols: np
         for a, j in enumerate(angles):
             at = continuous(float(out[j, near]), float(turns[a, near]))
             shift[a] = turn_shift(degrees(ref[j]), at)
+    if len(angles) == len(kinds):
+        return continuous(out, turns + shift[:, None])  # elementwise: the rows' own values
     for a, j in enumerate(angles):
         out[j] = continuous(out[j], turns[a] + shift[a])
     return out
