@@ -160,10 +160,9 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
     iterations, |det J| over J's columns' lengths, the branch's words), or None where the
     engine does not apply."""
     d = m.derivation
-    q, ok, margins = d.solve_margins_np(drv, signs)
+    q, ok, margins = d.solve_margins_np(drv, signs)  # (fresh arrays, this block's own)
     if not ok.all() or not all((margin > MARGIN_FLOOR).all() for margin in margins):  # (NaN too)
         return None
-    q = [np.array(c, dtype=float) for c in q]  # own, writable copies
     k = len(drv)
     loops = VectorLoops(m.model, drv)
     size = m.length_scale
@@ -187,14 +186,18 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
         moved = [s + np.where(singular, 0.0, d) for s, d in zip(sub, dq)]
         codes = stops.judge(step_size_array(dq, steps), step_size_array(phi, None), singular,
                             partial(step_size_array, moved, None), rows)
-        if not (converged_codes(codes) | (codes == GOING)).all():
+        going = codes == GOING
+        if not (converged_codes(codes) | going).all():
             return None  # a position the loop stops unconverged: the one-at-a-time engine's
-        for j in range(len(q)):
-            q[j][active] = moved[j]
-        det[active] = dt
-        ratio[active] = np.abs(dt) / _column_lengths(jac, active.size)
-        iters[active] = it
-        active = active[codes == GOING]
+        ratio_now = np.abs(dt) / _column_lengths(jac, active.size)
+        if rows is None:  # the first step, at every position: the arrays themselves
+            q, det, ratio = moved, dt, ratio_now
+            iters[:] = it
+        else:
+            for j in range(len(q)):
+                q[j][active] = moved[j]
+            det[active], ratio[active], iters[active] = dt, ratio_now, it
+        active = active[going]
     if not ((det > 0).all() or (det < 0).all()):
         return None  # det J changes sign: a toggle, the one-at-a-time engine's to locate
     words = _words(m, drv, q, signs)
