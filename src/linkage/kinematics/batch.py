@@ -242,7 +242,7 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
     iters = np.zeros(n_pos, dtype=np.int32)
     det_out = np.full(n_pos, np.nan)
     shown = np.empty((n_pos, n))
-    ref = np.empty((n_pos, n))
+    ref = np.empty((n_pos, n))  # the guesses, written where a position is left for step 4
     # Steps 2 and 3 a block of positions at a time: every temporary array then stays in
     # the processor's cache (1,000,000 positions at once made each one 8 MB, and the
     # engine waited on memory).
@@ -426,7 +426,11 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
                 cols[j][far] = nearest_turn_array(refs[j][far], cols[j][far])
     for j in range(n):
         shown[:, j] = cols[j]
-        ref[:, j] = refs[j]
+    # the guesses, read afterwards only where the one-at-a-time path takes over
+    left_over = np.flatnonzero(status != code["converged"])
+    if left_over.size:
+        for j in range(n):
+            ref[left_over, j] = refs[j][left_over]
 
 
 def _warm_starts(coarse: _Coarse, vals: np.ndarray,
