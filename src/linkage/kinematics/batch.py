@@ -404,7 +404,8 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     several times more)."""
     n, code = len(kinds), STATUS_CODES
     refs, left, usable = _warm_starts(coarse, vals, n)
-    loops = VectorLoops(model, vals * drv_scale)
+    drivers = vals * drv_scale
+    loops = VectorLoops(model, drivers)
     q_all = [r * sc for r, sc in zip(refs, scale)]
     done = _vector_newton(loops, q_all, usable, m.length_scale, kinds, tol, max_iter, iters, det_out)
     status[done] = code["converged"]
@@ -412,16 +413,17 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     # Continuity: a position must stay near its interpolated guess. Near a nearly
     # singular configuration Newton can jump to another assembly with the same det J
     # sign; such positions go to the one-at-a-time path.
-    moved = np.abs(cols[0] - refs[0])
-    for j in range(1, n):
-        np.maximum(moved, np.abs(cols[j] - refs[j]), out=moved)
+    gaps = [np.abs(c - r) for c, r in zip(cols, refs)]  # each unknown's move from its guess
+    moved = gaps[0] if n == 1 else np.maximum(gaps[0], gaps[1])
+    for j in range(2, n):
+        np.maximum(moved, gaps[j], out=moved)
     status[done & (moved > np.take(coarse.allowed, left))] = code["failed"]
-    status[done & ~_on_branch_columns(m, cols, names, det_out, branch, vals * drv_scale)] = code["failed"]
+    status[done & ~_on_branch_columns(m, cols, names, det_out, branch, drivers)] = code["failed"]
     # angles reported continuously with the guess (the one-at-a-time sweep's convention):
     # a solution within half a turn of its guess is already the representative nearest it
     for j, k in enumerate(kinds):
         if k == "angle":
-            far = ~(np.abs(cols[j] - refs[j]) < 180.0)  # (NaN included)
+            far = ~(gaps[j] < 180.0)  # (NaN included)
             if far.any():
                 cols[j][far] = nearest_turn_array(refs[j][far], cols[j][far])
     for j in range(n):
