@@ -454,11 +454,12 @@ def _warm_starts(coarse: _Coarse, vals: np.ndarray,
     one_minus_u_sq, u_sq = (1 - u) ** 2, u * u
     h00, h10 = (1 + 2 * u) * one_minus_u_sq, u * one_minus_u_sq
     h01, h11 = u_sq * (3 - 2 * u), u_sq * (u - 1)
+    h10, h11 = h10 * width, h11 * width  # (h10 * width) * slope, as written before: the same bits
     refs = []
     for j in range(n):
         y0, y1 = take(coarse.solution[j], left), take(coarse.next_value[j], left)
-        refs.append(h00 * y0 + h10 * width * take(coarse.slopes[j], left) + h01 * y1
-                    + h11 * width * take(coarse.slopes[j], right))
+        refs.append(h00 * y0 + h10 * take(coarse.slopes[j], left) + h01 * y1
+                    + h11 * take(coarse.slopes[j], right))
     return refs, left, usable
 
 
@@ -487,8 +488,8 @@ def _vector_newton(loops: VectorLoops, q_all: list[np.ndarray], live: np.ndarray
         for j in range(n):
             np.add(q_all[j], dq[j], out=q_all[j], where=moving)
         codes = stops.judge(step, step_size_array(phi, None), singular, partial(step_size_array, q_all, None))
-        iters[live] = it
-        det_out[live] = det[live]
+        np.copyto(iters, it, where=live)  # (a masked copy: no gather of the live positions)
+        np.copyto(det_out, det, where=live)
         done |= live & converged_codes(codes)
         live &= codes == GOING
     active = np.flatnonzero(live)
