@@ -219,19 +219,27 @@ class Derivation(NamedTuple):
 
     def on_branch_np(self, q: Sequence[Any], driver: Any, want: BranchText,
                      params: Mapping[str, Any] | None = None) -> Any:
-        """:meth:`on_branch` over arrays."""
+        """:meth:`on_branch` over arrays. A step's meeting is read only where its sign or
+        word is not the one wanted (where every position has them, not at all: a sweep on
+        its branch pays nothing for the rule), with the same verdict as reading it everywhere."""
         import numpy as np
 
-        coefs = self.two_way_coefficients_np(q, driver, params)  # once, for meets and sides
-        meets = self.meets_np(q, driver, params, coefs)
-        ok: Any = True
+        coefs = None if want.signs is None else self.two_way_coefficients_np(q, driver, params)
         with np.errstate(invalid="ignore"):
             if want.signs is not None:
-                for side, sign, m in zip(self.signs_of_np(q, driver, params, coefs), want.signs, meets):
-                    ok = ok & ((side == sign) | (side == 0.0) | m)
+                sides = self.signs_of_np(q, driver, params, coefs)
+                hits = [(side == sign) | (side == 0.0) for side, sign in zip(sides, want.signs)]
             else:
-                for word, wanted, m in zip(self.words_of_np(q, driver, params, coefs), want.words, meets):
-                    ok = ok & ((word == wanted) | m)
+                words = self.words_of_np(q, driver, params)
+                hits = [word == wanted for word, wanted in zip(words, want.words)]
+        ok: Any = True
+        for hit in hits:
+            ok = ok & hit
+        if np.all(ok):
+            return ok  # every step as wanted: a meeting changes nothing
+        ok = True
+        for hit, m in zip(hits, self.meets_np(q, driver, params, coefs)):
+            ok = ok & (hit | m)
         return ok
 
     def margins(self, driver: float, signs: Sequence[float],
