@@ -244,3 +244,27 @@ def test_change_point_solves_on_either_named_branch(branch):
     named = _design(40.0, 60.0).derivation.named_solutions(0.0)
     assert set(named) == {"open", "crossed"} and named["open"] == named["crossed"]
     assert named["open"][1] == [0.0, 0.0]
+
+
+@pytest.mark.parametrize("text", ["open", "crossed", "+", "-"])
+def test_change_point_on_branch_twin_reads_meetings_as_its_scalar_rule(text):
+    """on_branch_np (which reads a step's meeting only where a sign or word differs) gives
+    on_branch's verdict position by position on both assemblies of a change-point design
+    through its cycle, the collinear pose (theta2 = 0, where they meet) included: there
+    either branch holds; elsewhere only the wanted one."""
+    from linkage.problems.derive import read_branch
+
+    m = _design(40.0, 60.0)
+    d = m.derivation
+    want = read_branch(d, text)
+    drivers = np.radians(np.array([*CYCLE, 360.0]))
+    interiors = []
+    for signs in d.branches:
+        q, ok = d.solve_np(drivers, signs)
+        assert ok.all()
+        twin = np.broadcast_to(d.on_branch_np(q, drivers, want), drivers.shape)
+        scalar = [d.on_branch([float(c[k]) for c in q], float(drivers[k]), want) for k in range(len(drivers))]
+        assert list(twin) == scalar
+        assert twin[0] and twin[-1]  # the meeting: on either branch
+        interiors.append(bool(twin[1:-1].all()) if twin[1:-1].all() or not twin[1:-1].any() else None)
+    assert sorted(interiors) == [False, True]  # elsewhere one assembly is the branch, the other not

@@ -719,3 +719,21 @@ def test_other_drivers_stepwise_closed_form_is_newton_polished() -> None:
             assert min(ref.distance(m, config, q, scale) for _, q in sols) < 1e-9, case.family
     _worst("newton_redriven", worst, f"{checked} mechanisms driven from elsewhere")
     assert checked >= 15
+
+
+def test_two_angles_margin_np_orders_by_comparisons_as_a_sort_does() -> None:
+    """two_angles_margin_np sorts its three distances by comparisons, not np.sort: the same
+    bits as the margin of the sorted distances, NaN ordered last as np.sort orders it
+    (zero lengths and NaNs mixed in), so a twin's speed-up changes no verdict."""
+    rng = np.random.default_rng(33)
+    n = 20_000
+    a = [rng.normal(size=n) * rng.choice([0.0, 1.0, 1e-8], n) for _ in range(6)]
+    for col in a:
+        col[rng.random(n) < 0.05] = np.nan
+    p, q, k = (a[0], a[1]), (a[2], a[3]), (a[4], a[5])
+    s = -np.sort(-np.stack((dyads.norm_np(*k), dyads.norm_np(*p), dyads.norm_np(*q))), axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        want = np.where(s[0] > 0.0, (s[2] - (s[0] - s[1])) / s[0], 0.0)
+    got = dyads.two_angles_margin_np(p, q, k)
+    assert np.isnan(want).any() and (want == 0.0).any()
+    assert np.array_equal(got, want, equal_nan=True)

@@ -242,7 +242,7 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
     iters = np.zeros(n_pos, dtype=np.int32)
     det_out = np.full(n_pos, np.nan)
     shown = np.empty((n_pos, n))
-    ref = np.empty((n_pos, n))
+    ref = np.empty((n_pos, n))  # the guesses, written where a position is left for step 4
     # Steps 2 and 3 a block of positions at a time: every temporary array then stays in
     # the processor's cache (1,000,000 positions at once made each one 8 MB, and the
     # engine waited on memory).
@@ -404,7 +404,8 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     several times more)."""
     n, code = len(kinds), STATUS_CODES
     refs, left, usable = _warm_starts(coarse, vals, n)
-    loops = VectorLoops(model, vals * drv_scale)
+    drivers = vals * drv_scale
+    loops = VectorLoops(model, drivers)
     q_all = [r * sc for r, sc in zip(refs, scale)]
     done = _vector_newton(loops, q_all, usable, m.length_scale, kinds, tol, max_iter, iters, det_out)
     status[done] = code["converged"]
@@ -412,21 +413,26 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     # Continuity: a position must stay near its interpolated guess. Near a nearly
     # singular configuration Newton can jump to another assembly with the same det J
     # sign; such positions go to the one-at-a-time path.
-    moved = np.abs(cols[0] - refs[0])
-    for j in range(1, n):
-        np.maximum(moved, np.abs(cols[j] - refs[j]), out=moved)
+    gaps = [np.abs(c - r) for c, r in zip(cols, refs)]  # each unknown's move from its guess
+    moved = gaps[0] if n == 1 else np.maximum(gaps[0], gaps[1])
+    for j in range(2, n):
+        np.maximum(moved, gaps[j], out=moved)
     status[done & (moved > np.take(coarse.allowed, left))] = code["failed"]
-    status[done & ~_on_branch_columns(m, cols, names, det_out, branch, vals * drv_scale)] = code["failed"]
+    status[done & ~_on_branch_columns(m, cols, names, det_out, branch, drivers)] = code["failed"]
     # angles reported continuously with the guess (the one-at-a-time sweep's convention):
     # a solution within half a turn of its guess is already the representative nearest it
     for j, k in enumerate(kinds):
         if k == "angle":
-            far = ~(np.abs(cols[j] - refs[j]) < 180.0)  # (NaN included)
+            far = ~(gaps[j] < 180.0)  # (NaN included)
             if far.any():
                 cols[j][far] = nearest_turn_array(refs[j][far], cols[j][far])
     for j in range(n):
         shown[:, j] = cols[j]
-        ref[:, j] = refs[j]
+    # the guesses, read afterwards only where the one-at-a-time path takes over
+    left_over = np.flatnonzero(status != code["converged"])
+    if left_over.size:
+        for j in range(n):
+            ref[left_over, j] = refs[j][left_over]
 
 
 def _warm_starts(coarse: _Coarse, vals: np.ndarray,
@@ -448,11 +454,12 @@ def _warm_starts(coarse: _Coarse, vals: np.ndarray,
     one_minus_u_sq, u_sq = (1 - u) ** 2, u * u
     h00, h10 = (1 + 2 * u) * one_minus_u_sq, u * one_minus_u_sq
     h01, h11 = u_sq * (3 - 2 * u), u_sq * (u - 1)
+    h10, h11 = h10 * width, h11 * width  # (h10 * width) * slope, as written before: the same bits
     refs = []
     for j in range(n):
         y0, y1 = take(coarse.solution[j], left), take(coarse.next_value[j], left)
-        refs.append(h00 * y0 + h10 * width * take(coarse.slopes[j], left) + h01 * y1
-                    + h11 * width * take(coarse.slopes[j], right))
+        refs.append(h00 * y0 + h10 * take(coarse.slopes[j], left) + h01 * y1
+                    + h11 * take(coarse.slopes[j], right))
     return refs, left, usable
 
 
@@ -481,8 +488,8 @@ def _vector_newton(loops: VectorLoops, q_all: list[np.ndarray], live: np.ndarray
         for j in range(n):
             np.add(q_all[j], dq[j], out=q_all[j], where=moving)
         codes = stops.judge(step, step_size_array(phi, None), singular, partial(step_size_array, q_all, None))
-        iters[live] = it
-        det_out[live] = det[live]
+        np.copyto(iters, it, where=live)  # (a masked copy: no gather of the live positions)
+        np.copyto(det_out, det, where=live)
         done |= live & converged_codes(codes)
         live &= codes == GOING
     active = np.flatnonzero(live)

@@ -160,10 +160,9 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
     iterations, |det J| over J's columns' lengths, the branch's words), or None where the
     engine does not apply."""
     d = m.derivation
-    q, ok, margins = d.solve_margins_np(drv, signs)
+    q, ok, margins = d.solve_margins_np(drv, signs)  # (fresh arrays, this block's own)
     if not ok.all() or not all((margin > MARGIN_FLOOR).all() for margin in margins):  # (NaN too)
         return None
-    q = [np.array(c, dtype=float) for c in q]  # own, writable copies
     k = len(drv)
     loops = VectorLoops(m.model, drv)
     size = m.length_scale
@@ -187,14 +186,18 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
         moved = [s + np.where(singular, 0.0, d) for s, d in zip(sub, dq)]
         codes = stops.judge(step_size_array(dq, steps), step_size_array(phi, None), singular,
                             partial(step_size_array, moved, None), rows)
-        if not (converged_codes(codes) | (codes == GOING)).all():
+        going = codes == GOING
+        if not (converged_codes(codes) | going).all():
             return None  # a position the loop stops unconverged: the one-at-a-time engine's
-        for j in range(len(q)):
-            q[j][active] = moved[j]
-        det[active] = dt
-        ratio[active] = np.abs(dt) / _column_lengths(jac, active.size)
-        iters[active] = it
-        active = active[codes == GOING]
+        ratio_now = np.abs(dt) / _column_lengths(jac, active.size)
+        if rows is None:  # the first step, at every position: the arrays themselves
+            q, det, ratio = moved, dt, ratio_now
+            iters[:] = it
+        else:
+            for j in range(len(q)):
+                q[j][active] = moved[j]
+            det[active], ratio[active], iters[active] = dt, ratio_now, it
+        active = active[going]
     if not ((det > 0).all() or (det < 0).all()):
         return None  # det J changes sign: a toggle, the one-at-a-time engine's to locate
     words = _words(m, drv, q, signs)
@@ -220,14 +223,16 @@ def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray) -> bool:
 
 
 def _column_lengths(jac: list[list[Any]], k: int) -> np.ndarray:
-    """The product of J's columns' Euclidean lengths, position by position."""
-    out = np.ones(k)
+    """The product of J's columns' Euclidean lengths, position by position (each sum of
+    squares begun from its first term: 0 + x and 1 * x are x, so no pass adds a zero)."""
+    out: Any = None
     for j in range(len(jac[0])):
-        sq = np.zeros(k)
+        sq: Any = None
         for row in jac:
-            sq = sq + np.square(row[j])
-        out = out * np.sqrt(sq)
-    return out
+            sq = np.square(row[j]) if sq is None else sq + np.square(row[j])
+        length = np.sqrt(sq)
+        out = length if out is None else out * length
+    return np.broadcast_to(out, (k,))
 
 
 def _words(m: Mechanism, drv: np.ndarray, q: list[np.ndarray], signs: tuple[float, ...]) -> list[str] | None:
@@ -254,10 +259,13 @@ def _display(m: Mechanism, tol: float, max_iter: int, vals: np.ndarray, cols: np
              kinds: Sequence[str], closes: bool) -> np.ndarray:
     """The unknowns in display units, each angle continuous along the cycle and anchored to
     what ``solve FILE`` gives (the rule of :mod:`.angles`, as the one-at-a-time engine)."""
-    out = np.empty_like(cols)
     angles = [j for j, k in enumerate(kinds) if k == "angle"]
-    for j, k in enumerate(kinds):
-        out[j] = degrees(cols[j]) if k == "angle" else cols[j]
+    if len(angles) == len(kinds):
+        out = degrees(cols)  # every unknown an angle: one pass
+    else:
+        out = cols.copy()
+        for j in angles:
+            out[j] = degrees(cols[j])
     if not angles:
         return out
     turn = driver_turn(m.driver.unit)
@@ -271,6 +279,8 @@ def _display(m: Mechanism, tol: float, max_iter: int, vals: np.ndarray, cols: np
         for a, j in enumerate(angles):
             at = continuous(float(out[j, near]), float(turns[a, near]))
             shift[a] = turn_shift(degrees(ref[j]), at)
+    if len(angles) == len(kinds):
+        return continuous(out, turns + shift[:, None])  # elementwise: the rows' own values
     for a, j in enumerate(angles):
         out[j] = continuous(out[j], turns[a] + shift[a])
     return out

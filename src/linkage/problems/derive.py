@@ -180,18 +180,28 @@ class Derivation(NamedTuple):
                 out.append(abs(step_margin(step.case, first, second, k)) <= TANGENT_SLACK)
         return tuple(out)
 
-    def meets_np(self, q: Sequence[Any], driver: Any, params: Mapping[str, Any] | None = None) -> list[Any]:
-        """:meth:`meets` over arrays (NaN: False)."""
+    def two_way_coefficients_np(self, q: Sequence[Any], driver: Any,
+                                params: Mapping[str, Any] | None = None) -> list[Any]:
+        """Each two-way step's (first, second, K) over arrays at a configuration: what
+        :meth:`meets_np`, :meth:`signs_of_np` and :meth:`words_of_np` read, computed once
+        where one caller asks for several (``coefs``)."""
         import numpy as np
 
         p = self._params(params)
-        out = []
+        d = np.asarray(driver, float)
         with np.errstate(invalid="ignore", divide="ignore"):
-            for step in self.steps:
-                if step.two_way:
-                    first, second, k = coefficients(step, p, np.asarray(driver, float), q, np)
-                    out.append(np.abs(step_margin_np(step.case, first, second, k)) <= TANGENT_SLACK)
-        return out
+            return [coefficients(step, p, d, q, np) for step in self.steps if step.two_way]
+
+    def meets_np(self, q: Sequence[Any], driver: Any, params: Mapping[str, Any] | None = None,
+                 coefs: list[Any] | None = None) -> list[Any]:
+        """:meth:`meets` over arrays (NaN: False)."""
+        import numpy as np
+
+        if coefs is None:
+            coefs = self.two_way_coefficients_np(q, driver, params)
+        cases = [step.case for step in self.steps if step.two_way]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return [np.abs(step_margin_np(case, *c)) <= TANGENT_SLACK for case, c in zip(cases, coefs)]
 
     def on_branch(self, q: Sequence[float], driver: float, want: BranchText,
                   params: Mapping[str, float] | None = None) -> bool:
@@ -209,18 +219,27 @@ class Derivation(NamedTuple):
 
     def on_branch_np(self, q: Sequence[Any], driver: Any, want: BranchText,
                      params: Mapping[str, Any] | None = None) -> Any:
-        """:meth:`on_branch` over arrays."""
+        """:meth:`on_branch` over arrays. A step's meeting is read only where its sign or
+        word is not the one wanted (where every position has them, not at all: a sweep on
+        its branch pays nothing for the rule), with the same verdict as reading it everywhere."""
         import numpy as np
 
-        meets = self.meets_np(q, driver, params)
-        ok: Any = True
+        coefs = None if want.signs is None else self.two_way_coefficients_np(q, driver, params)
         with np.errstate(invalid="ignore"):
             if want.signs is not None:
-                for side, sign, m in zip(self.signs_of_np(q, driver, params), want.signs, meets):
-                    ok = ok & ((side == sign) | (side == 0.0) | m)
+                sides = self.signs_of_np(q, driver, params, coefs)
+                hits = [(side == sign) | (side == 0.0) for side, sign in zip(sides, want.signs)]
             else:
-                for word, wanted, m in zip(self.words_of_np(q, driver, params), want.words, meets):
-                    ok = ok & ((word == wanted) | m)
+                words = self.words_of_np(q, driver, params)
+                hits = [word == wanted for word, wanted in zip(words, want.words)]
+        ok: Any = True
+        for hit in hits:
+            ok = ok & hit
+        if np.all(ok):
+            return ok  # every step as wanted: a meeting changes nothing
+        ok = True
+        for hit, m in zip(hits, self.meets_np(q, driver, params, coefs)):
+            ok = ok & (hit | m)
         return ok
 
     def margins(self, driver: float, signs: Sequence[float],
@@ -263,7 +282,8 @@ class Derivation(NamedTuple):
         p = self._params(params)
         d = np.asarray(driver, float)
         q: list[Any] = [None] * self.n
-        ok = np.ones(np.broadcast_shapes(d.shape, *(np.shape(v) for v in p.values())), bool)
+        shape = np.broadcast_shapes(d.shape, *(np.shape(v) for v in p.values()))
+        ok: Any = None
         out = []
         signs_left = iter(signs)
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -273,28 +293,28 @@ class Derivation(NamedTuple):
                 if step.two_way:
                     out.append(step_margin_np(step.case, first, second, k))
                 a, b, fine = solve_step_np(step.case, first, second, k, sigma)
-                ok = ok & fine
+                ok = fine if ok is None else ok & fine
                 q[step.unknowns[0]], q[step.unknowns[1]] = a, b
-        shape = ok.shape
+        if ok is None or np.shape(ok) != shape:
+            ok = np.ones(shape, bool) if ok is None else np.broadcast_to(ok, shape).copy()
         # a step the driver does not reach (two loops whose difference drops it) has one
-        # margin for every driver: give it the drivers' shape like the other columns
-        return ([np.where(ok, np.broadcast_to(x, shape), np.nan) for x in q], ok,
-                [np.broadcast_to(x, shape).copy() for x in out])
+        # value for every driver: give it the drivers' shape like the other columns (fresh
+        # arrays, a caller's to keep); where every position assembled, NaN replaces nothing
+        every = bool(ok.all())
+        return ([(x.copy() if every else np.where(ok, x, np.nan)) if np.shape(x) == shape else
+                 np.where(ok, np.broadcast_to(x, shape), np.nan) for x in q], ok,
+                [x if np.shape(x) == shape else np.broadcast_to(x, shape).copy() for x in out])
 
-    def signs_of_np(self, q: Sequence[Any], driver: Any,
-                    params: Mapping[str, Any] | None = None) -> list[Any]:
+    def signs_of_np(self, q: Sequence[Any], driver: Any, params: Mapping[str, Any] | None = None,
+                    coefs: list[Any] | None = None) -> list[Any]:
         """:meth:`signs_of` over arrays."""
         import numpy as np
 
-        p = self._params(params)
-        out = []
+        if coefs is None:
+            coefs = self.two_way_coefficients_np(q, driver, params)
+        two_way = [step for step in self.steps if step.two_way]
         with np.errstate(invalid="ignore", divide="ignore"):
-            for step in self.steps:
-                if step.two_way:
-                    first, second, k = coefficients(step, p, np.asarray(driver, float), q, np)
-                    out.append(step_side_np(step.case, first, second, k, q[step.unknowns[0]],
-                                        q[step.unknowns[1]]))
-        return out
+            return [_side_np(step, c, q) for step, c in zip(two_way, coefs)]
 
     def margins_np(self, driver: Any, signs: Sequence[float],
                    params: Mapping[str, Any] | None = None) -> list[Any]:
@@ -345,17 +365,22 @@ class Derivation(NamedTuple):
                 out.append("+" if sigma >= 0.0 else "-")
         return out
 
-    def words_of_np(self, q: Sequence[Any], d: Any, params: Mapping[str, Any] | None = None) -> list[Any]:
+    def words_of_np(self, q: Sequence[Any], d: Any, params: Mapping[str, Any] | None = None,
+                    coefs: list[Any] | None = None) -> list[Any]:
         """:meth:`words_of` over arrays: each two-way step's word as a bool, True for open
         (a four-bar or slider-crank loop) or + (the step's sign, 0 counting as +)."""
+        import numpy as np
+
         p = self._params(params)
-        sides = iter(self.signs_of_np(q, d, p))
+        two_way = [step for step in self.steps if step.two_way]
+        if all(step.word_rule for step in two_way):
+            return [is_open_np(step, p, d, q) for step in two_way]  # no side is read
+        if coefs is None:
+            coefs = self.two_way_coefficients_np(q, d, p)
         out = []
-        for step in self.steps:
-            if not step.two_way:
-                continue
-            side = next(sides)
-            out.append(is_open_np(step, p, d, q) if step.word_rule else side >= 0.0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            for step, c in zip(two_way, coefs):
+                out.append(is_open_np(step, p, d, q) if step.word_rule else _side_np(step, c, q) >= 0.0)
         return out
 
     @property
@@ -420,6 +445,11 @@ class Derivation(NamedTuple):
         where = ", ".join(named) or "none: it cannot be assembled there"
         raise ValueError(f"no {text!r} assembly here (assemblies: {where}; or their signs, one + "
                          f"or - per closed-form step with two roots, e.g. {'+' * count})")
+
+
+def _side_np(step: Step, coefs: Any, q: Sequence[Any]) -> Any:
+    """A two-way step's side (its sign) over arrays, from its coefficients."""
+    return step_side_np(step.case, *coefs, q[step.unknowns[0]], q[step.unknowns[1]])
 
 
 _OTHER_WORD = {"open": "crossed", "crossed": "open", "+": "-", "-": "+"}

@@ -129,10 +129,15 @@ def two_angles_margin(p: Pair, q: Pair, k: Pair) -> float:
 def two_angles_margin_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any]) -> Any:
     import numpy as np
 
-    s = -np.sort(-np.stack(np.broadcast_arrays(norm_np(k[0], k[1]), norm_np(p[0], p[1]),
-                                               norm_np(q[0], q[1]))), axis=0)
+    d, rp, rq = norm_np(k[0], k[1]), norm_np(p[0], p[1]), norm_np(q[0], q[1])
+    # the sorted three by comparisons (no arithmetic: the values np.sort gives, for a third
+    # of its time on a million positions); with a NaN as np.sort orders it (last): x the
+    # largest of the rest (fmax), z NaN, so the margin NaN unless x is not positive
+    lo, hi = np.minimum(d, rp), np.fmax(d, rp)
+    x, z = np.fmax(hi, rq), np.minimum(lo, rq)
+    y = np.maximum(lo, np.minimum(hi, rq))
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(s[0] > 0.0, (s[2] - (s[0] - s[1])) / s[0], 0.0)
+        return np.where(x > 0.0, (z - (x - y)) / x, 0.0)
 
 
 # --- a line and a circle ---------------------------------------------------------------------
