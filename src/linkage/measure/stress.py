@@ -39,6 +39,7 @@ from typing import Any
 from ..errors import InputError
 from ..methods import SCALAR_METHODS
 from ..problems.catalog import Case, classic_cases, mgh_cases
+from ..units import degrees
 from .stress_cases import (
     bad_start_cases,
     fourbar_cases,
@@ -183,12 +184,12 @@ def run_fourbars(items: Sequence[dict[str, Any]], methods: Sequence[str]) -> dic
             if not result.converged:
                 t.failed += 1
                 continue
-            t3, t4 = (math.degrees(v) for v in result.x)
+            t3, t4 = (degrees(v) for v in result.x)
             reference = mp_fourbar_positions(*it["links"], it["theta2"])
             errs = {
                 b: max(
-                    abs(wrap_degrees(t3 - math.degrees(s["theta3"]))),
-                    abs(wrap_degrees(t4 - math.degrees(s["theta4"]))),
+                    abs(wrap_degrees(t3 - degrees(s["theta3"]))),
+                    abs(wrap_degrees(t4 - degrees(s["theta4"]))),
                 )
                 for b, s in reference.items()
             }

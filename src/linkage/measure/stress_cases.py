@@ -12,6 +12,7 @@ from typing import Any
 
 from ..problems.catalog import Case
 from ..problems.classic import mp_root
+from ..units import degrees, radians
 
 EPS = sys.float_info.epsilon
 
@@ -44,7 +45,7 @@ def fourbar_cases(rng: random.Random, count: int) -> list[dict[str, Any]]:
                 continue
             theta2 = (b - 1e-8 if rng.random() < 0.5 else a + 1e-8) if near_limit else rng.uniform(a, b)
         try:
-            if not fourbar_positions(r1, r2, r3, r4, 0.0, theta2=math.radians(theta2)):
+            if not fourbar_positions(r1, r2, r3, r4, 0.0, theta2=radians(theta2)):
                 continue
         except Indeterminate:
             continue
@@ -60,7 +61,7 @@ def fourbar_cases(rng: random.Random, count: int) -> list[dict[str, Any]]:
                 "theta2": theta2,
                 "branch": branch,
                 "exact": exact,
-                "guess": (math.degrees(exact["theta3"]) + perturb, math.degrees(exact["theta4"]) - perturb),
+                "guess": (degrees(exact["theta3"]) + perturb, degrees(exact["theta4"]) - perturb),
                 "near_limit": near_limit,
                 "scale": scale,
             }
@@ -78,7 +79,7 @@ def fourbar_equation_cases(rng: random.Random, count: int) -> list[Case]:
     while len(out) < count:
         r1, r2 = 10 ** rng.uniform(-3, 3), 10 ** rng.uniform(-3, 3)
         alpha = rng.uniform(-180, 180)
-        a = math.radians(alpha)
+        a = radians(alpha)
         big_a, big_b = r2 + math.cos(a), math.sin(a)
         norm = math.hypot(big_a, big_b)
         if norm == 0.0:

@@ -27,6 +27,7 @@ from ..linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve, pivot_rat
 from ..problems.system import SystemProblem
 from ..result import Column, Status
 from ..rules import invertible, pivots_invertible, step_size
+from ..units import degrees
 from .common import new_state
 
 EPS = sys.float_info.epsilon
@@ -330,7 +331,7 @@ def system_row(problem: SystemProblem, k: int, q: Any, phi: Any, dq: Any, det: f
         d = dq[i] if dq else None
         row.append(d)
         if kind == "angle":
-            row.append(math.degrees(d) if d is not None else None)
+            row.append(degrees(d) if d is not None else None)
     row += [det, cond]
     row.append(jac)  # expanded (or dropped) by the solve function: see solve_system
     row.append(err)
