@@ -264,3 +264,14 @@ def test_a_low_transmission_angle_over_the_motion_is_a_transmission_defect():
     fb = judge(z, pts, min_transmission=0.0)
     assert fb.defects == () and 0.0 < fb.transmission_min_deg < 90.0
     assert judge(z, pts, min_transmission=fb.transmission_min_deg + 1e-6).defects == ("transmission",)
+
+
+@pytest.mark.parametrize("scale", [1e-6, 1e3])
+def test_four_bars_through_points_scale_with_the_points(scale):
+    """Micrometres to kilometres: the same problem at another size gives the same four-bars
+    at that size (the pivots scale with the points; the engine solves at unit size)."""
+    pts = [complex(x, y) for x, y in PROBLEM_3]
+    unit = npt.solve_points(pts, max_routes=1, orbits=200)
+    moved = npt.solve_points([p * scale + (5.0 - 2.0j) * scale for p in pts], max_routes=1, orbits=200)
+    assert len(moved.solutions) == len(unit.solutions) >= 195
+    assert _same_sets(unit.solutions, moved.solutions / scale)

@@ -471,12 +471,15 @@ def track_route(route: Route, first: int, Z: np.ndarray) -> dict[str, np.ndarray
     (settled endpoints, canonical), ``failed``, ``unsettled``, ``steps`` (counts)."""
     ok = np.ones(len(Z), bool)
     steps = 0
-    for (a, ab, b, bb), patch in zip(route.legs, route.patches):
-        Z, k, log = track_segment(ParameterSegment(a, ab, b, bb, patch), Z)
-        ok &= k
-        steps += int(log.steps.sum())
-    d1, db1 = route.target
-    Z, last, cond = polish(Z[ok], d1, db1)
+    # paths through near-degenerate points overflow on the way: the tracker judges each
+    # path by its own finite checks, so numpy's warnings would only be noise on stderr
+    with np.errstate(all="ignore"):
+        for (a, ab, b, bb), patch in zip(route.legs, route.patches):
+            Z, k, log = track_segment(ParameterSegment(a, ab, b, bb, patch), Z)
+            ok &= k
+            steps += int(log.steps.sum())
+        d1, db1 = route.target
+        Z, last, cond = polish(Z[ok], d1, db1)
     good = (last <= REFINED) & (cond <= SINGULAR)
     precise = [polish_precisely(z, d1, db1) for z in Z[~good] if np.all(np.isfinite(z))]
     settled = [z for z in precise if z is not None]
@@ -526,7 +529,10 @@ def solve_points(points: list[complex] | tuple[complex, ...], seed: int = 0,
     start = load_start()
     rows = start.solutions if orbits is None else start.solutions[:orbits]
     p = np.asarray(points, dtype=complex)
-    d1 = p[1:] - p[0]
+    # the problem is the same at every scale (the pivots scale with the points): solve it
+    # for points of size 1, as the stored instance is, and scale the four-bars back
+    size = float(np.max(np.abs(p[1:] - p[0])))
+    d1 = (p[1:] - p[0]) / size
     db1 = np.conj(d1)
     rng = np.random.default_rng(seed)
     found = np.zeros((0, 8), dtype=complex)
@@ -549,17 +555,19 @@ def solve_points(points: list[complex] | tuple[complex, ...], seed: int = 0,
         if len(found) >= len(rows):
             break
     Z = found
-    real = is_real(Z)
-    Z[real, 4:] = np.conj(Z[real, :4])
-    rough = np.flatnonzero(real | (relative_residual(Z, d1, db1) > RESIDUAL)) if len(Z) else []
-    for i in rough:
-        better = polish_precisely(Z[i], d1, db1)
-        if better is not None:
-            Z[i] = better
-    real = is_real(Z)
-    Z[real, 4:] = np.conj(Z[real, :4])
-    _, J, _, _ = equations(Z, d1, db1)
-    cond = np.linalg.cond(J) if len(Z) else np.zeros(0)
+    with np.errstate(all="ignore"):
+        real = is_real(Z)
+        Z[real, 4:] = np.conj(Z[real, :4])
+        rough = np.flatnonzero(real | (relative_residual(Z, d1, db1) > RESIDUAL)) if len(Z) else []
+        for i in rough:
+            better = polish_precisely(Z[i], d1, db1)
+            if better is not None:
+                Z[i] = better
+        real = is_real(Z)
+        Z[real, 4:] = np.conj(Z[real, :4])
+        _, J, _, _ = equations(Z, d1, db1)
+        cond = np.linalg.cond(J) if len(Z) else np.zeros(0)  # at the points' unit size
+    Z = Z * size
     return NinePointSolutions(tuple(complex(v) for v in p), Z, real, cond, len(rows),
                               len(failed), tuple(failed), tuple(unrefined), tuple(steps),
                               time.perf_counter() - began)
