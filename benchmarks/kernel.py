@@ -22,34 +22,10 @@ from collections.abc import Callable
 from typing import Any
 
 from linkage import fourbar_equation, load_mechanism, solve_scalar, solve_system
+from linkage.measure.hand import hand_newton, hand_newton_2x2
 from linkage.samples import sample_path
 
 TOL = 1e-12
-
-
-def hand_newton(f: Callable[[float], float], fp: Callable[[float], float], x: float, tol: float) -> float:
-    """The floor: Newton in ten lines of plain Python (as ``linkage bench``'s)."""
-    for _ in range(100):
-        step = f(x) / fp(x)
-        x -= step
-        if abs(step) <= tol:
-            return x
-    return x
-
-
-def hand_newton_2x2(F: Callable[..., Any], J: Callable[..., Any], q: Any, tol: float) -> tuple[float, float]:
-    """The floor for a four-bar: Newton with Cramer's rule, no checks (as ``linkage bench``'s)."""
-    a, b = q
-    for _ in range(50):
-        f1, f2 = F((a, b))
-        (j11, j12), (j21, j22) = J((a, b))
-        det = j11 * j22 - j12 * j21
-        da = (-f1 * j22 + f2 * j12) / det
-        db = (-f2 * j11 + f1 * j21) / det
-        a, b = a + da, b + db
-        if abs(da) <= tol and abs(db) <= tol:
-            break
-    return a, b
 
 
 def pairs(num: Callable[[], Any], den: Callable[[], Any], n_pairs: int,

@@ -61,14 +61,20 @@ def circuit_lines(c: Any) -> list[str]:
     return out
 
 
+TERMINAL_COLUMNS = ("circuit", "assemblies", "branches", "status", "limits", "singular_points")
+
+
 def circuits_report(c: Any, digits: int, show_paths: bool) -> Report:
     base = assemblies_report(c.assemblies, digits, show_paths)
     extra = circuits_table(c)
 
     def blocks() -> list[Block]:
-        rows = list(zip(*[col.values for col in extra.columns]))
+        # the lines above give each circuit's range and limits: the terminal's table keeps
+        # what they do not, within 80 columns (files get every column, with the steps taken)
+        shown = [col for col in extra.columns if col.name in TERMINAL_COLUMNS]
+        rows = list(zip(*[col.values for col in shown]))
         return [*base.blocks(), Text("Circuits"), *[Text(line) for line in circuit_lines(c)],
-                table("", [col.header for col in extra.columns], rows, digits)]
+                table("", [col.header for col in shown], rows, digits)]
 
     def document() -> dict[str, Any]:
         return {**base.document(), "circuits": len(c.circuits)}
