@@ -35,9 +35,13 @@ def path_command(point: list[str], *, design: Optional[int], output: Optional[Pa
     pairs = read_points(point)
     check_points(pairs)  # before the workers, so a wrong count is the first thing said
     workers = check_workers("--workers", workers, scheduler)
+    from ..homotopy.ninepoint import PATHS
+    from .progress import progress_bar
+
     try:
-        result = synthesize_path(pairs, scheduler=scheduler, workers=workers,
-                                 min_transmission=min_transmission)
+        with progress_bar(PATHS, minimum=0, label="tracking paths") as advance:
+            result = synthesize_path(pairs, scheduler=scheduler, workers=workers,
+                                     min_transmission=min_transmission, progress=advance)
     except InputError as exc:  # the API's argument names, as the command's options
         raise InputError(str(exc).replace("min_transmission", "--min-transmission")) from None
     writers.write(path_report(result, digits), fmt, report_out, table=table)

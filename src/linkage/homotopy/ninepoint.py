@@ -506,6 +506,8 @@ def _here(task, job, plan, size):  # type: ignore[no-untyped-def]
         yield task(job, a, plan.chunk(a, min(a + size, plan.total)))
 
 
+PATHS = 1442
+"""The stored instance's orbits: the paths of a route (WMS 1992's count, 8,652 / 6)."""
 CHUNK = 256
 """Paths per task: numpy blocks big enough to amortise the interpreter, small enough that
 two workers share Problem 3's 1,442 paths evenly."""
@@ -513,7 +515,7 @@ two workers share Problem 3's 1,442 paths evenly."""
 
 def solve_points(points: list[complex] | tuple[complex, ...], seed: int = 0,
                  max_routes: int = MAX_ROUTES, run=None, orbits: int | None = None,  # type: ignore[no-untyped-def]
-                 ) -> NinePointSolutions:
+                 progress=None) -> NinePointSolutions:  # type: ignore[no-untyped-def]
     """Every four-bar whose coupler point passes through nine points (complex numbers
     x + iy), by parameter homotopy from the stored generic instance (:func:`load_start`).
     The first route is the straight segment; a path that fails, or ends where Newton's
@@ -522,7 +524,8 @@ def solve_points(points: list[complex] | tuple[complex, ...], seed: int = 0,
     over routes is what is counted); routes stop when every orbit is found or at
     ``max_routes``. ``run(task, job, plan, size)`` runs the chunks of paths (default: here,
     one after another; the scan's runner sends them to dask). ``orbits``: track only the
-    first so many of the stored orbits (a quick look; the counts are then of those)."""
+    first so many of the stored orbits (a quick look; the counts are then of those).
+    ``progress(done, label)``: called as each chunk of paths ends."""
     import time
 
     began = time.perf_counter()
@@ -546,7 +549,11 @@ def solve_points(points: list[complex] | tuple[complex, ...], seed: int = 0,
             m, mb = _random_points(rng)
             legs = ((start.delta, start.deltabar, m, mb), (m, mb, d1, db1))
         job = Route(legs, tuple(random_patch(rng) for _ in legs), (d1, db1))
-        parts = list((run or _here)(track_route, job, StartRows(rows), CHUNK))
+        parts = []
+        for part in (run or _here)(track_route, job, StartRows(rows), CHUNK):
+            parts.append(part)
+            if progress is not None:
+                progress(min(len(parts) * CHUNK, len(rows)), f"tracking paths, route {route + 1}")
         failed.append(sum(int(c["failed"][0]) for c in parts))
         unrefined.append(sum(int(c["unsettled"][0]) for c in parts))
         steps.append(sum(int(c["steps"][0]) for c in parts))

@@ -55,14 +55,20 @@ def summary_lines(result: Any) -> list[str]:
     ]
 
 
+TERMINAL_COLUMNS = ("design", "grashof", "defects", "ground", "crank", "coupler", "rocker",
+                    "transmission_min", "point_error")
+
+
 def path_report(result: Any, digits: int) -> Report:
     tables = path_tables(result)
     title = "four-bars whose coupler point passes through nine points"
 
     def blocks() -> list[Block]:
         out: list[Block] = [Text(title, "bold"), *[Text(line) for line in summary_lines(result)], Text("")]
-        rows = list(zip(*[c.values for c in tables[0].columns]))
-        out.append(table("", [c.header for c in tables[0].columns], rows, digits))
+        # the pivots' coordinates go to files (-f, -o): a terminal gets the judgement
+        shown = [c for c in tables[0].columns if c.name in TERMINAL_COLUMNS]
+        rows = list(zip(*[c.values for c in shown]))
+        out.append(table("", [c.header for c in shown], rows, digits))
         out.append(Text("defects: branch, the points are not all on one circuit (the linkage would have "
                         "to be taken apart); order, the circuit meets them out of order; transmission, the "
                         "least transmission angle from the first point to the last is below "

@@ -253,11 +253,13 @@ def _in_order(at: list[int], n: int) -> bool:
 
 def synthesize_path(points: object, seed: int = 0, scheduler: str | None = None,
                     workers: int | None = None,
-                    min_transmission: float = MIN_TRANSMISSION_DEG) -> PathSynthesis:
+                    min_transmission: float = MIN_TRANSMISSION_DEG,
+                    progress=None) -> PathSynthesis:  # type: ignore[no-untyped-def]
     """Every four-bar whose coupler point passes through nine points; the real ones judged
     by moving them (module docstring). ``points``: nine (x, y) pairs. The paths are tracked
     in chunks by the scan's runner: here, on dask's local threads or processes, or on a
-    cluster (``scheduler`` tcp://HOST:PORT), ``workers`` at a time."""
+    cluster (``scheduler`` tcp://HOST:PORT), ``workers`` at a time. ``progress(done, label)``
+    is told how far it is, out of the paths of a route."""
     from ..arguments import MAX_SEED, check_number, check_whole, check_workers
 
     pts = check_points(points)
@@ -269,11 +271,12 @@ def synthesize_path(points: object, seed: int = 0, scheduler: str | None = None,
     if scheduler is not None and not isinstance(scheduler, str):
         raise InputError("scheduler must be threads, processes, synchronous or tcp://HOST:PORT, "
                          f"got {scheduler!r}")
-    sols = ninepoint.solve_points(pts, seed=seed, run=chunk_runner(scheduler, workers))
+    sols = ninepoint.solve_points(pts, seed=seed, run=chunk_runner(scheduler, workers), progress=progress)
     designs = []
-    for z, real in zip(sols.solutions, sols.real):
-        if not real:
-            continue
-        members = ninepoint.orbit(z)[:3]
+    reals = np.flatnonzero(sols.real)
+    for k, i in enumerate(reals):
+        members = ninepoint.orbit(sols.solutions[i])[:3]
         designs.append(tuple(judge(mz, pts, floor) for mz in members))
+        if progress is not None:
+            progress(sols.paths * (k + 1) // len(reals), "moving the real four-bars")
     return PathSynthesis(tuple(pts), tuple(designs), len(sols.solutions), sols.missing, sols)
