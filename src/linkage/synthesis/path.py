@@ -284,17 +284,26 @@ def synthesize_path(points: object, via: object = None, seed: int = 0, scheduler
     return solve_nine(nine.points, nine.extra, seed, run, floor, progress, orbits)
 
 
+CIRCUIT_DEFECTS = ("branch", "order")
+"""Defects of the motion, which a design's three cognates share: their motions correspond
+one to one (Roberts-Chebyshev: one coupler curve, traced by all three together)."""
+
+
 def solve_nine(points: tuple[complex, ...], extra: tuple[int, ...], seed: int, run, floor: float,  # type: ignore[no-untyped-def]
-               progress=None, orbits: int | None = None) -> PathSynthesis:  # type: ignore[no-untyped-def]
+               progress=None, orbits: int | None = None, every_cognate: bool = True) -> PathSynthesis:
     """The four-bars through nine checked points (``extra`` of them not the user's), each
-    real one and its cognates judged: :func:`synthesize_path` after its checks."""
+    real one and its cognates judged: :func:`synthesize_path` after its checks. Without
+    ``every_cognate`` (a search, which keeps only defect-free designs), a design whose first
+    cognate has a defect of CIRCUIT_DEFECTS is that cognate alone."""
     pts = list(points)
     sols = ninepoint.solve_points(pts, seed=seed, run=run, progress=progress, orbits=orbits)
     designs = []
     reals = np.flatnonzero(sols.real)
     for k, i in enumerate(reals):
         members = ninepoint.orbit(sols.solutions[i])[:3]
-        designs.append(tuple(judge(mz, pts, floor) for mz in members))
+        first = judge(members[0], pts, floor)
+        shared = not every_cognate and set(first.defects) & set(CIRCUIT_DEFECTS)
+        designs.append((first,) if shared else (first, *(judge(mz, pts, floor) for mz in members[1:])))
         if progress is not None:
             progress(sols.paths * (k + 1) // len(reals), "moving the real four-bars")
     return PathSynthesis(tuple(pts), tuple(designs), len(sols.solutions), sols.missing, sols, extra)
