@@ -33,6 +33,7 @@ def path_command(point: list[str], via: list[str], *, search: bool, samples: Opt
     from ..render.path_synthesis import path_report, ranked
     from ..synthesis.path import check_points, synthesize_path
     from ..synthesis.path_points import check_via
+    from .path_search import as_options
 
     pairs, extra = read_points(point), read_points(via, "--via")
     check_points(pairs)  # before the workers, so a wrong count is the first thing said
@@ -78,10 +79,3 @@ def path_command(point: list[str], via: list[str], *, search: bool, samples: Opt
     if result.missing or not clean:
         raise typer.Exit(1)
 
-
-def as_options(message: str) -> str:
-    """An API message with its argument names as the command's options."""
-    for name, option in (("min_transmission", "--min-transmission"), ("via:", "--via:"),
-                         ("samples", "--samples"), ("seed", "--seed")):
-        message = message.replace(name, option)
-    return message

@@ -19,7 +19,6 @@ def path_search_command(pairs: list[tuple[float, float]], samples: Optional[int]
     from ..render import writers
     from ..render.path_search import path_search_report
     from ..synthesis.path_search import search_path
-    from .path import as_options
     from .progress import progress_bar
 
     try:
@@ -45,3 +44,11 @@ def path_search_command(pairs: list[tuple[float, float]], samples: Optional[int]
                             "through the points)")
     if not found:
         raise typer.Exit(1)
+
+
+def as_options(message: str) -> str:
+    """An API message with its argument names as the command's options."""
+    for name, option in (("min_transmission", "--min-transmission"), ("via:", "--via:"),
+                         ("samples", "--samples"), ("seed", "--seed")):
+        message = message.replace(name, option)
+    return message

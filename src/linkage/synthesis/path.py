@@ -88,7 +88,7 @@ def check_points(points: object) -> list[complex]:
     if not FEWEST <= len(pts) <= POINTS:
         raise InputError(f"path synthesis takes {FEWEST} to {POINTS} points (the four-bar has 9 dimensions "
                          f"of design), got {len(pts)}")
-    check_distinct(pts, [f"point {k + 1}" for k in range(len(pts))])
+    check_distinct("points", pts, [f"point {k + 1}" for k in range(len(pts))])
     return pts
 
 

@@ -52,16 +52,17 @@ def as_points(name: str, points: object) -> list[complex]:
     return pts
 
 
-def check_distinct(pts: list[complex], labels: list[str]) -> None:
-    """InputError when two points coincide (to 1e-9 of their spread, naming both by
-    ``labels``) or the points are more than FARTHEST apart."""
+def check_distinct(name: str, pts: list[complex], labels: list[str]) -> None:
+    """InputError (its message starting with ``name``) when two points coincide (to 1e-9 of
+    their spread, naming both by ``labels``) or the points are more than FARTHEST apart."""
     size = max(abs(p - pts[0]) for p in pts)
     if size > FARTHEST or size == 0.0:
-        raise InputError("the points must be distinct and at most about 1e150 apart")
+        raise InputError(f"{name}: the points must be distinct and at most about 1e150 apart")
     for i in range(len(pts)):
         for j in range(i):
             if abs(pts[i] - pts[j]) <= 1e-9 * size:
-                raise InputError(f"{labels[j]} and {labels[i]} coincide: {pts[i].real:g}, {pts[i].imag:g}")
+                raise InputError(f"{name}: {labels[j]} and {labels[i]} coincide: "
+                                 f"{pts[i].real:g}, {pts[i].imag:g}")
 
 
 def check_via(via: object, given: list[complex]) -> list[complex]:
@@ -75,7 +76,7 @@ def check_via(via: object, given: list[complex]) -> list[complex]:
         raise InputError(f"via: {len(given)} points need {want} extra point{'s' if want != 1 else ''} "
                          f"to make nine, got {len(extra)}")
     labels = [f"point {k + 1}" for k in range(len(given))] + [f"via point {k + 1}" for k in range(len(extra))]
-    check_distinct(given + extra, labels)
+    check_distinct("via", given + extra, labels)
     return extra
 
 
@@ -164,5 +165,5 @@ def nine_points(given: list[complex], via: list[complex], seed: int, sample: int
     if len(given) == POINTS or via:
         return inserted(given, via)
     nine = sampled(given, seed, sample)
-    check_distinct(list(nine.points), [f"point {k + 1}" for k in range(POINTS)])
+    check_distinct("points", list(nine.points), [f"point {k + 1} of the nine" for k in range(POINTS)])
     return nine
