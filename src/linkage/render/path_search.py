@@ -34,8 +34,9 @@ def sample_rows(result: Any, digits: int | None = None) -> list[tuple[Any, ...]]
     for k, s in enumerate(result.samples):
         clean = sum(1 for group in s.designs for fb in group if not fb.defects)
         sol = s.solutions
-        out.append((k + 1, extra_text(s.points, s.extra, digits), s.found, s.missing, len(s.designs), clean,
-                    sol.routes, sum(sol.steps), sol.seconds))
+        # (a quick look at some orbits may find more than it tracked: routes permute them)
+        out.append((k + 1, extra_text(s.points, s.extra, digits), s.found, max(0, s.missing), len(s.designs),
+                    clean, sol.routes, sum(sol.steps), sol.seconds))
     return out
 
 
