@@ -261,3 +261,22 @@ def test_the_command_ranks_writes_the_best_and_says_none_with_exit_1(cli, curve,
     nothing = tmp_path / "none.toml"
     out = cli(*args, "--min-transmission", "89", "-o", str(nothing))
     assert out.code == 1 and not nothing.exists() and "no four-bar without defects" in out.out
+
+
+def test_nine_points_searched_rank_the_finite_set_as_six_and_three_via_do(cli, curve, solved_known):
+    pts, _ = curve
+    nine = cli("synthesize", "--path", "--search", *_args(_pairs(pts)), "-f", "csv", "--table", "designs")
+    six = cli("synthesize", "--path", "--search", *_args(_pairs([pts[i] for i in GIVEN])),
+              *_args(_pairs([pts[i] for i in VIA]), "--via"), "-f", "csv", "--table", "designs")
+    assert nine.code == six.code == 0 and nine.out == six.out and len(nine.out.splitlines()) >= 3
+
+
+def test_without_search_six_points_and_three_via_get_the_nine_point_report_naming_the_extra_ones(
+        cli, curve, solved_known):
+    pts, _ = curve
+    out = cli("synthesize", "--path", *_args(_pairs([pts[i] for i in GIVEN])),
+              *_args(_pairs([pts[i] for i in VIA]), "--via"), "-f", "plain")
+    # the stand-in solve has 4 of the 1,442 orbits: the report says so, and exits 1
+    assert out.code == 1 and "(1438 not reached)" in out.out, out.err
+    assert "through 6 given points and 3 extra points between them, points 3 (" in out.out
+    assert "the nine: each design passes through all nine in order" in out.out
