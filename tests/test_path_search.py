@@ -18,6 +18,7 @@ from linkage.homotopy import ninepoint as npt
 from linkage.synthesis.path import CIRCUIT_DEFECTS, judge
 from linkage.synthesis.path_points import curve_point, gap_counts, inserted, nine_points, sampled
 from linkage.synthesis.path_search import search_path
+from linkage.units import radians
 from test_nine_point import _grashof_crank_rocker_points
 
 GIVEN, VIA = (0, 1, 3, 4, 6, 8), (2, 5, 7)
@@ -47,7 +48,7 @@ def _through(fb, point: complex, crank_deg: float) -> float:
     (coupler) and B (rocker) meet (the nearer of the two assemblies), P rigid with MN."""
     a, b, m0, n0 = fb.ground_a, fb.ground_b, fb.pin_m, fb.pin_n
     k = (fb.coupler_point - m0) / (n0 - m0)
-    m = a + abs(m0 - a) * cmath.exp(1j * math.radians(crank_deg))
+    m = a + abs(m0 - a) * cmath.exp(1j * radians(crank_deg))
     coupler, rocker = abs(n0 - m0), abs(n0 - b)
     d = abs(b - m)
     along = (coupler * coupler - rocker * rocker + d * d) / (2 * d)
