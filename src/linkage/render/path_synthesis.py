@@ -15,7 +15,8 @@ def ranked(result: Any) -> list[int]:
                   key=lambda i: (len(designs[i][0].defects), -designs[i][0].transmission_min_deg))
 
 
-def _row(number: int, cognate: int, fb: Any) -> tuple[Any, ...]:
+def design_row(number: int, cognate: int, fb: Any) -> tuple[Any, ...]:
+    """A four-bar's row of the designs table (HEADS)."""
     r1, r2, r3, r4 = fb.lengths
     return (number, cognate, fb.grashof, " ".join(fb.defects) or "none", fb.ground_a.real,
             fb.ground_a.imag, fb.ground_b.real, fb.ground_b.imag, fb.pin_m.real, fb.pin_m.imag,
@@ -32,8 +33,9 @@ HEADS = [("design", "", "int"), ("cognate", "", "int"), ("grashof", "", "text"),
 
 def path_tables(result: Any) -> tuple[DataTable, ...]:
     order = ranked(result)
-    designs = [_row(k + 1, 1, result.designs[i][0]) for k, i in enumerate(order)]
-    cognates = [_row(k + 1, c + 1, fb) for k, i in enumerate(order) for c, fb in enumerate(result.designs[i])]
+    designs = [design_row(k + 1, 1, result.designs[i][0]) for k, i in enumerate(order)]
+    cognates = [design_row(k + 1, c + 1, fb) for k, i in enumerate(order)
+                for c, fb in enumerate(result.designs[i])]
     s = result.solutions
     routes = [(r + 1, s.paths, s.failed[r], s.unrefined[r], s.steps[r]) for r in range(s.routes)]
     return (from_rows("designs", HEADS, designs), from_rows("cognates", HEADS, cognates),
@@ -52,7 +54,18 @@ def summary_lines(result: Any) -> list[str]:
         f"{result.found} four-bars found of {s.paths}" + (f" ({result.missing} not reached)" if result.missing
                                                           else "")
         + f"; {len(result.designs)} real, {clean} without defects",
+        *extra_lines(result.points, result.extra),
     ]
+
+
+def extra_lines(points: Any, extra: Any) -> list[str]:
+    """What the nine points are when some are extra (linkage.synthesis.path_points)."""
+    if not extra:
+        return []
+    given = len(points) - len(extra)
+    where = ", ".join(f"{k + 1} ({points[k].real:.6g}, {points[k].imag:.6g})" for k in extra)
+    return [f"through {given} given points and {len(extra)} extra points between them, points {where} of "
+            "the nine: each design passes through all nine in order"]
 
 
 TERMINAL_COLUMNS = ("design", "grashof", "defects", "ground", "crank", "coupler", "rocker",

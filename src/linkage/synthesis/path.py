@@ -66,6 +66,7 @@ class PathSynthesis:
     found: int  # orbits (complex and real)
     missing: int
     solutions: ninepoint.NinePointSolutions
+    extra: tuple[int, ...] = ()  # which of the points are extra ones (path_points), not given
 
 
 def chunk_runner(scheduler: str | None, workers: int | None):  # type: ignore[no-untyped-def]
@@ -80,23 +81,14 @@ def chunk_runner(scheduler: str | None, workers: int | None):  # type: ignore[no
 
 
 def check_points(points: object) -> list[complex]:
-    """Nine finite, distinct points (pairs x, y), or InputError naming what is wrong."""
-    try:
-        pts = [complex(float(p[0]), float(p[1])) for p in points]  # type: ignore[attr-defined, index]
-    except (TypeError, ValueError, IndexError):
-        raise InputError("points must be pairs of numbers (x, y)") from None
-    if len(pts) != POINTS:
-        raise InputError(f"path synthesis takes exactly {POINTS} points (the four-bar has 9 dimensions "
+    """Five to nine finite, distinct points (pairs x, y), or InputError naming what is wrong."""
+    from .path_points import FEWEST, as_points, check_distinct
+
+    pts = as_points("points", points)
+    if not FEWEST <= len(pts) <= POINTS:
+        raise InputError(f"path synthesis takes {FEWEST} to {POINTS} points (the four-bar has 9 dimensions "
                          f"of design), got {len(pts)}")
-    if not all(math.isfinite(p.real) and math.isfinite(p.imag) for p in pts):
-        raise InputError("points must be finite numbers")
-    size = max(abs(p - pts[0]) for p in pts)
-    if size > 1e150 or size == 0.0:
-        raise InputError("the points must be distinct and at most about 1e150 apart")
-    for i in range(POINTS):
-        for j in range(i):
-            if abs(pts[i] - pts[j]) <= 1e-9 * size:
-                raise InputError(f"points {j + 1} and {i + 1} coincide: {pts[i].real:g}, {pts[i].imag:g}")
+    check_distinct("points", pts, [f"point {k + 1}" for k in range(len(pts))])
     return pts
 
 
@@ -251,18 +243,11 @@ def _in_order(at: list[int], n: int) -> bool:
     return forward == sorted(forward) or backward == sorted(backward)
 
 
-def synthesize_path(points: object, seed: int = 0, scheduler: str | None = None,
-                    workers: int | None = None,
-                    min_transmission: float = MIN_TRANSMISSION_DEG,
-                    progress=None) -> PathSynthesis:  # type: ignore[no-untyped-def]
-    """Every four-bar whose coupler point passes through nine points; the real ones judged
-    by moving them (module docstring). ``points``: nine (x, y) pairs. The paths are tracked
-    in chunks by the scan's runner: here, on dask's local threads or processes, or on a
-    cluster (``scheduler`` tcp://HOST:PORT), ``workers`` at a time. ``progress(done, label)``
-    is told how far it is, out of the paths of a route."""
+def path_options(seed: object, min_transmission: object, workers: object, scheduler: object,
+                 orbits: object) -> tuple[int, float, int | None, int | None]:
+    """The options of a path synthesis checked: (seed, min_transmission, workers, orbits)."""
     from ..arguments import MAX_SEED, check_number, check_whole, check_workers
 
-    pts = check_points(points)
     seed = check_whole("seed", seed, 0, MAX_SEED)
     floor = check_number("min_transmission", min_transmission)
     if not 0.0 <= floor <= 90.0:
@@ -271,12 +256,54 @@ def synthesize_path(points: object, seed: int = 0, scheduler: str | None = None,
     if scheduler is not None and not isinstance(scheduler, str):
         raise InputError("scheduler must be threads, processes, synchronous or tcp://HOST:PORT, "
                          f"got {scheduler!r}")
-    sols = ninepoint.solve_points(pts, seed=seed, run=chunk_runner(scheduler, workers), progress=progress)
+    if orbits is not None:
+        orbits = check_whole("orbits", orbits, 1, ninepoint.PATHS)
+    return seed, floor, workers, orbits  # type: ignore[return-value]
+
+
+def synthesize_path(points: object, via: object = None, seed: int = 0, scheduler: str | None = None,
+                    workers: int | None = None,
+                    min_transmission: float = MIN_TRANSMISSION_DEG,
+                    progress=None, orbits: int | None = None) -> PathSynthesis:  # type: ignore[no-untyped-def]
+    """Every four-bar whose coupler point passes through nine points; the real ones judged
+    by moving them (module docstring). ``points``: five to nine (x, y) pairs, in the order
+    the coupler point is to meet them. Fewer than nine are made nine by extra points
+    between them (:mod:`.path_points`): ``via``, 9 - n pairs, or else the curve's evenly
+    spaced ones. The paths are tracked in chunks by the scan's runner: here, on dask's local
+    threads or processes, or on a cluster (``scheduler`` tcp://HOST:PORT), ``workers`` at a
+    time. ``progress(done, label)`` is told how far it is, out of the paths of a route.
+    ``orbits``: track only the first so many of the stored instance's orbits (a quick look,
+    :func:`linkage.homotopy.ninepoint.solve_points`)."""
+    from .path_points import check_via, nine_points
+
+    pts = check_points(points)
+    extra = check_via(via, pts)
+    seed, floor, workers, orbits = path_options(seed, min_transmission, workers, scheduler, orbits)
+    nine = nine_points(pts, extra, seed, 0)
+    run = chunk_runner(scheduler, workers)
+    return solve_nine(nine.points, nine.extra, seed, run, floor, progress, orbits)
+
+
+CIRCUIT_DEFECTS = ("branch", "order")
+"""Defects of the motion, which a design's three cognates share: their motions correspond
+one to one (Roberts-Chebyshev: one coupler curve, traced by all three together)."""
+
+
+def solve_nine(points: tuple[complex, ...], extra: tuple[int, ...], seed: int, run, floor: float,  # type: ignore[no-untyped-def]
+               progress=None, orbits: int | None = None, every_cognate: bool = True) -> PathSynthesis:
+    """The four-bars through nine checked points (``extra`` of them not the user's), each
+    real one and its cognates judged: :func:`synthesize_path` after its checks. Without
+    ``every_cognate`` (a search, which keeps only defect-free designs), a design whose first
+    cognate has a defect of CIRCUIT_DEFECTS is that cognate alone."""
+    pts = list(points)
+    sols = ninepoint.solve_points(pts, seed=seed, run=run, progress=progress, orbits=orbits)
     designs = []
     reals = np.flatnonzero(sols.real)
     for k, i in enumerate(reals):
         members = ninepoint.orbit(sols.solutions[i])[:3]
-        designs.append(tuple(judge(mz, pts, floor) for mz in members))
+        first = judge(members[0], pts, floor)
+        shared = not every_cognate and set(first.defects) & set(CIRCUIT_DEFECTS)
+        designs.append((first,) if shared else (first, *(judge(mz, pts, floor) for mz in members[1:])))
         if progress is not None:
             progress(sols.paths * (k + 1) // len(reals), "moving the real four-bars")
-    return PathSynthesis(tuple(pts), tuple(designs), len(sols.solutions), sols.missing, sols)
+    return PathSynthesis(tuple(pts), tuple(designs), len(sols.solutions), sols.missing, sols, extra)
