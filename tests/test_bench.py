@@ -319,16 +319,17 @@ def test_the_root_check_finds_a_duplicate_a_spurious_root_and_a_residual_at_50_d
     system = PolySystem(1, ({(2,): 1 + 0j, (0,): -2 + 0j},))
     root = math.sqrt(2.0)
     clean = polynomial_certificate(system, [np.array([root]), np.array([-root])])
-    assert (clean.roots, clean.duplicates, clean.spurious, clean.met) == (2, 0, 0, True)
+    assert (clean.roots, clean.duplicates, clean.spurious, clean.above, clean.met) == (2, 0, 0, 0, True)
     assert clean.worst_residual <= 1e-16 and clean.worst_error <= 2e-16
     got = polynomial_certificate(system, [np.array([root]), np.array([root]), np.array([1.5])])
-    assert (got.roots, got.duplicates, got.spurious, got.met) == (3, 1, 1, False)
+    assert (got.roots, got.duplicates, got.spurious, got.above, got.met) == (3, 1, 1, 1, False)
     assert got.worst_residual == pytest.approx(0.25 / 4.25) and got.worst_error > 0.05
     off = -root + 1e-10
     near = polynomial_certificate(system, [np.array([off])])
     with mpmath.workdps(50):
         want = float(abs(mpmath.mpf(off) ** 2 - 2) / (mpmath.mpf(off) ** 2 + 2))
-    assert (near.duplicates, near.spurious, near.met) == (0, 0, False)  # a root, but not to 1e-12
+    # a root, but not to 1e-12
+    assert (near.duplicates, near.spurious, near.above, near.met) == (0, 0, 1, False)
     assert near.worst_residual == pytest.approx(want, rel=1e-6)
 
 
@@ -345,5 +346,5 @@ def test_the_nine_point_root_check_counts_a_cognate_as_a_duplicate():
     cognate = npt.orbit(z)[2]
     moved = z + 1e-4
     got = nine_point_certificate(np.stack([z, cognate, moved]), d, db)
-    assert (got.roots, got.duplicates, got.spurious, got.met) == (3, 1, 1, False)
+    assert (got.roots, got.duplicates, got.spurious, got.above, got.met) == (3, 1, 1, 1, False)
     assert got.worst_residual > 1e-8

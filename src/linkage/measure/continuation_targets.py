@@ -52,15 +52,16 @@ DUPLICATE = 1e-6
 
 @dataclass(frozen=True)
 class Certificate:
-    """The roots a run listed, checked at 50 digits: the worst relative residual, the
-    worst distance to the 50-digit root (relative), roots listed twice, and endpoints that
-    50-digit Newton does not confirm (spurious)."""
+    """The roots a run listed, checked at 50 digits: the worst relative residual and how
+    many are above RESIDUAL, the worst distance to the 50-digit root (relative), roots
+    listed twice, and endpoints that 50-digit Newton does not confirm (spurious)."""
 
     roots: int
     worst_residual: float
     worst_error: float
     duplicates: int
     spurious: int
+    above: int = 0
 
     @property
     def met(self) -> bool:
@@ -167,7 +168,8 @@ def certify(roots: np.ndarray, residuals: Sequence[float], exact: Sequence[Any],
               for x, e in zip(roots, exact)]
     rows, owner = members if members is not None else (roots, np.arange(len(roots)))
     return Certificate(len(roots), float(max(residuals, default=0.0)), float(max(errors, default=0.0)),
-                       duplicates(rows, owner), sum(not e <= SAME_ROOT for e in errors))
+                       duplicates(rows, owner), sum(not e <= SAME_ROOT for e in errors),
+                       sum(not r <= RESIDUAL for r in residuals))
 
 
 def polynomial_jet(system: Any) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
@@ -348,8 +350,8 @@ def cores_line() -> str:
 TIME_HEADERS = (("target", "", "text"), ("bound", "s", "number"), ("median", "s", "number"),
                 ("runs", "", "int"), ("found", "", "text"), ("met", "", "bool"))
 ROOT_HEADERS = (("target", "", "text"), ("roots", "", "int"), ("worst residual", "", "number"),
-                ("worst error", "", "number"), ("duplicates", "", "int"), ("spurious", "", "int"),
-                ("met", "", "bool"))
+                ("above 1e-12", "", "int"), ("worst error", "", "number"), ("duplicates", "", "int"),
+                ("spurious", "", "int"), ("met", "", "bool"))
 """The two tables: the times against their bounds, and the roots checked at 50 digits
 (residual relative, bound 1e-12; error: distance to the 50-digit root, relative)."""
 
@@ -364,8 +366,8 @@ def tables(outcomes: Sequence[Outcome]) -> tuple[list[tuple[Any, ...]], list[tup
         c = o.timed.found.certificate
         times.append((o.row.name, o.row.bound, o.timed.median, len(o.timed.seconds), o.timed.found.summary,
                       o.met))
-        roots.append((o.row.name, c.roots, c.worst_residual, c.worst_error, c.duplicates, c.spurious,
-                      c.met))
+        roots.append((o.row.name, c.roots, c.worst_residual, c.above, c.worst_error, c.duplicates,
+                      c.spurious, c.met))
     return times, roots
 
 
