@@ -139,8 +139,9 @@ def refined(jet: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], roots: n
 def duplicates(X: np.ndarray, owner: np.ndarray) -> int:
     """Roots listed twice: rows of ``X`` (members of each root's set: the root itself, or
     its orbit) of different owners within DUPLICATE of each other; the later owner of each
-    such pair counts. Rows are compared in the order of a fixed projection, only those
-    whose projections are within reach."""
+    such pair counts. Rows are compared in the order of a fixed projection (of norm 1), only
+    those whose projections are within reach: a row that close to row i is within
+    DUPLICATE max(|x_i|, |x_j|) <= 1.01 DUPLICATE |x_i| of it, so its projection is too."""
     if not len(X):
         return 0
     direction = np.cos(np.arange(1, X.shape[1] + 1)) + 1j * np.sin(np.arange(1, X.shape[1] + 1) ** 2)
@@ -151,7 +152,7 @@ def duplicates(X: np.ndarray, owner: np.ndarray) -> int:
     doubled: set[int] = set()
     for pos, i in enumerate(order):
         for j in order[pos + 1:]:
-            if keys[j] - keys[i] > DUPLICATE * max(scale[i], scale[j]):
+            if keys[j] - keys[i] > 1.01 * DUPLICATE * scale[i]:
                 break
             close = np.linalg.norm(X[i] - X[j]) <= DUPLICATE * max(scale[i], scale[j])
             if close and owner[i] != owner[j]:
