@@ -104,6 +104,32 @@ def test_the_stored_start_instance_has_1442_distinct_nonsingular_orbits():
     assert len(npt.distinct(members)) == 6 * 1442
 
 
+def test_the_generic_monodromy_loops_the_nine_point_problem_one_root_per_orbit():
+    """parameter.monodromy with NinePointLoops (how benchmarks/nine_point_start.py made the
+    stored instance): two seeds of one orbit are one root; every root a loop adds is a
+    solution of the seed instance (60-digit Newton from it moves it by rounding only), and
+    no two roots are of one orbit."""
+    from linkage.homotopy.parameter import monodromy
+
+    rng = np.random.default_rng(7)
+    z, d, db = npt.seed_instance(rng)
+    p = np.concatenate([d, db])
+    cognate = npt.orbit(z)[3]
+    assert np.linalg.norm(cognate - z) > 1e-3
+    seeded = monodromy(npt.NinePointLoops(), p, np.stack([z, cognate]), max_loops=0)
+    assert len(seeded.roots) == 1 and seeded.counts == ()
+    seen = []
+    found = monodromy(npt.NinePointLoops(), p, z[None, :], max_loops=3, seed=rng, on_loop=seen.append)
+    assert [loop.count for loop in seen] == list(found.counts) and len(found.roots) == found.counts[-1] > 2
+    assert sum(loop.new for loop in seen) == len(found.roots) - 1
+    for root in found.roots:
+        exact = npt.polish_precisely(root, d, db)
+        assert exact is not None
+        assert np.linalg.norm(exact - root) <= 1e-12 * max(1.0, float(np.linalg.norm(root)))
+    members = np.concatenate([npt.orbit(r) for r in found.roots])
+    assert len(npt.distinct(members)) == 6 * len(found.roots)
+
+
 def test_a_known_four_bar_is_found_among_the_solutions_through_its_points():
     pts, z = _coupler_points(np.random.default_rng(2))
     res = npt.solve_points(pts, max_routes=1)
