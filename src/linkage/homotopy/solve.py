@@ -25,9 +25,11 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
+from .alpha import Certificate, certify, has_real_structure, normalised, undistinguished
 from .polynomials import PolySystem
 from .start import start_for
 from .tracker import Homotopy, PathHomotopy, PathLog, track
@@ -106,6 +108,29 @@ class Solutions:
     @property
     def real(self) -> list[Endpoint]:
         return [e for e in self.endpoints if e.kind in ("finite", "singular") and e.real]
+
+    @cached_property
+    def certificates(self) -> tuple[Certificate | None, ...]:
+        """Smale's alpha test (:func:`.alpha.certify`, at 50 digits) at each finite endpoint,
+        None at the others; computed when first asked for (a few milliseconds an endpoint, as
+        much as the whole solve of a six-bar's assemblies)."""
+        if not any(e.kind == "finite" for e in self.endpoints):
+            return (None,) * len(self.endpoints)
+        scaled, structure = normalised(self.system), has_real_structure(self.system)
+        return tuple(certify(self.system, e.x, structure, scaled) if e.kind == "finite" and e.x is not None
+                     else None for e in self.endpoints)
+
+    @property
+    def certified(self) -> list[tuple[Endpoint, Certificate]]:
+        """The finite endpoints that the alpha test certifies, with their certificates."""
+        return [(e, c) for e, c in zip(self.endpoints, self.certificates) if c is not None and c.certified]
+
+    @property
+    def undistinguished(self) -> list[tuple[int, int]]:
+        """Pairs among :attr:`certified` (indices into it) that the alpha test cannot tell
+        apart: empty when every certified root is certainly a different root."""
+        pairs = self.certified
+        return undistinguished([e.x for e, _ in pairs], [c for _, c in pairs])  # type: ignore[misc]
 
 
 def _norm(X: np.ndarray) -> np.ndarray:

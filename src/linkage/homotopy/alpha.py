@@ -1,0 +1,264 @@
+"""Smale's alpha test: a certificate that Newton's method from a computed point converges
+to a root, that two computed points are two roots, and that a root is real.
+
+As alphaCertified does it (Hauenstein and Sottile, "Algorithm 921: alphaCertified:
+certifying solutions to polynomial systems", ACM TOMS 38(4), 2012, sec. 1-2), for a square
+system f and a point x where Df(x) is invertible:
+- beta(f, x) = ||Df(x)^-1 f(x)||, the length of Newton's step;
+- gamma(f, x) = sup_k>=2 ||Df(x)^-1 D^k f(x) / k!||^(1/(k-1)), bounded above (Shub and Smale;
+  Blum, Cucker, Shub and Smale, *Complexity and Real Computation*, Springer 1998, ch. 8 and
+  12) by mu(f, x) D^(3/2) / (2 ||(1, x)||), where D is the largest degree, mu(f, x) =
+  max(1, ||f|| ||Df(x)^-1 Delta(x)||), Delta(x) = diag(sqrt(d_i) ||(1, x)||^(d_i - 1)), and
+  ||f|| the Bombieri-Weyl norm: ||f_i||^2 = sum over terms |c_e|^2 e! (d_i - |e|)! / d_i!;
+- alpha = beta gamma. If alpha < (13 - 3 sqrt 17) / 4 = 0.1577, Newton's iterates from x
+  converge quadratically to a root xi with ||x - xi|| <= 2 beta (Smale's alpha theorem).
+- Two certified points whose distance exceeds 2 (beta_1 + beta_2) have distinct roots:
+  each root lies in its own ball of radius 2 beta.
+- If alpha(f, x) < 0.03 and ||x - y|| < 1 / (20 gamma(f, x)), then x and y are approximate
+  solutions with one associated root (Hauenstein and Sottile, sec. 2.2). A real structure
+  R (here R(x) = conj(x[conjugate]), :attr:`PolySystem.conjugate`) with f(R(x)) = A conj(f(x))
+  for a constant invertible A maps Newton's iterates to Newton's iterates, so the root of
+  R(x) is R(xi); with y = R(x) the root is its own image: real. If instead
+  ||x - R(x)|| > 4 beta, the root is not real (a real xi would be within 2 beta of both x
+  and R(x)).
+
+gamma is unchanged when the equations are multiplied by a constant invertible matrix, so
+the bound may be taken for any such rescaling: each equation is scaled to Bombieri-Weyl
+norm 1 first (the bound then does not depend on how the equations were written down).
+
+Precision, honestly: the point and the coefficients are double-precision numbers, taken
+exactly; f, Df and the linear algebra are evaluated in mpmath at :data:`DIGITS` digits,
+floating point (alphaCertified's rational mode is exact; this is not). The rounding at 50
+digits perturbs alpha relatively by about cond(Df) 10^-50, below 10^-30 at the condition
+numbers this package accepts as nonsingular (1e12 at most), and each verdict keeps a
+relative margin of :data:`SAFETY`, so rounding cannot change one. The operator norm in mu
+is bounded by the Frobenius norm (an upper bound keeps the certificate valid).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import mpmath
+import numpy as np
+
+from .polynomials import Polynomial, PolySystem
+
+DIGITS = 50
+"""mpmath's working precision for the certificate."""
+ALPHA_0 = (13 - 3 * math.sqrt(17)) / 4
+"""Smale's constant: alpha below it certifies an approximate solution (0.157671...)."""
+ALPHA_SAME = 0.03
+"""alpha below this lets a point within 1 / (20 gamma) share its root (the realness test)."""
+SAFETY = 1e-6
+"""Relative margin on every verdict, far above the 50-digit rounding (module docstring)."""
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """Smale's alpha test at one point (module docstring). ``certified``: Newton's method
+    from the point converges quadratically to a root within ``2 beta``; ``real``: that root
+    is real (only for a system with a real structure, :func:`has_real_structure`)."""
+
+    alpha: float
+    beta: float
+    gamma: float  # the Shub-Smale bound on gamma, not gamma itself
+    certified: bool
+    real: bool
+    not_real: bool = False  # the root is certified nonreal: ||x - R(x)|| > 4 beta
+
+    @property
+    def radius(self) -> float:
+        """The root lies within this of the point (2 beta), where certified."""
+        return 2.0 * self.beta
+
+
+def bombieri_weyl_squared(p: Polynomial, degree: int) -> mpmath.mpf:
+    """||p||^2 = sum |c_e|^2 e! (d - |e|)! / d!, p homogenised to degree d."""
+    total = mpmath.mpf(0)
+    for e, c in p.items():
+        weight = mpmath.mpf(math.prod(math.factorial(k) for k in e) * math.factorial(degree - sum(e)))
+        total += abs(mpmath.mpc(complex(c))) ** 2 * weight / math.factorial(degree)
+    return total
+
+
+def _powers(x: Sequence[mpmath.mpc], top: int) -> list[list[mpmath.mpc]]:
+    out = []
+    for v in x:
+        row = [mpmath.mpc(1)]
+        for _ in range(top):
+            row.append(row[-1] * v)
+        out.append(row)
+    return out
+
+
+def value_and_jacobian(system: PolySystem, x: Sequence[mpmath.mpc]
+                       ) -> tuple[list[mpmath.mpc], list[list[mpmath.mpc]]]:
+    """f(x) and Df(x) (rows) at the working precision, term by term from the coefficients."""
+    n = system.n
+    pw = _powers(x, max(system.degrees))
+    zero = mpmath.mpc(0)
+    F = [zero] * len(system.polynomials)
+    J = [[zero] * n for _ in system.polynomials]
+    for i, p in enumerate(system.polynomials):
+        row = J[i]
+        for e, c in p.items():
+            parts = [pw[v][k] for v, k in enumerate(e)]
+            term = mpmath.mpc(complex(c))
+            for part in parts:
+                term = term * part
+            F[i] += term
+            for v, k in enumerate(e):
+                if k:
+                    t = mpmath.mpc(complex(c)) * k * pw[v][k - 1]
+                    for u, part in enumerate(parts):
+                        if u != v:
+                            t = t * part
+                    row[v] += t
+    return F, J
+
+
+def solve_many(J: list[list[mpmath.mpc]], rhs: list[list[mpmath.mpc]]) -> list[list[mpmath.mpc]] | None:
+    """J^-1 [rhs] by Gaussian elimination with partial pivoting (rows of J; ``rhs`` rows of
+    the right-hand sides, one column per system); None where J is singular."""
+    n = len(J)
+    A = [list(J[i]) + list(rhs[i]) for i in range(n)]
+    width = len(A[0])
+    for k in range(n):
+        pivot = max(range(k, n), key=lambda r: abs(A[r][k]))
+        if A[pivot][k] == 0:
+            return None
+        A[k], A[pivot] = A[pivot], A[k]
+        inv = 1 / A[k][k]
+        for r in range(k + 1, n):
+            factor = A[r][k] * inv
+            if factor:
+                Ar, Ak = A[r], A[k]
+                for c in range(k + 1, width):
+                    Ar[c] -= factor * Ak[c]
+    out = [[mpmath.mpc(0)] * (width - n) for _ in range(n)]
+    for r in range(n - 1, -1, -1):
+        for c in range(width - n):
+            acc = A[r][n + c]
+            for q in range(r + 1, n):
+                acc -= A[r][q] * out[q][c]
+            out[r][c] = acc / A[r][r]
+    return out
+
+
+def normalised(system: PolySystem) -> PolySystem:
+    """Each equation divided by its Bombieri-Weyl norm (same roots, same gamma)."""
+    with mpmath.workdps(DIGITS):
+        norms = [float(mpmath.sqrt(bombieri_weyl_squared(p, d)))
+                 for p, d in zip(system.polynomials, system.degrees)]
+    return PolySystem(system.n, tuple({e: complex(c) / s for e, c in p.items()}
+                                      for p, s in zip(system.polynomials, norms)),
+                      system.names, system.groups, system.conjugate)
+
+
+def constants(system: PolySystem, x: np.ndarray, digits: int = DIGITS
+              ) -> tuple[mpmath.mpf, mpmath.mpf, mpmath.mpf] | None:
+    """(alpha, beta, the bound on gamma) of ``system`` as given (no rescaling) at the point
+    ``x``, at ``digits`` digits; None where Df(x) is singular."""
+    with mpmath.workdps(digits):
+        X = [mpmath.mpc(complex(v)) for v in x]
+        F, J = value_and_jacobian(system, X)
+        norms = [bombieri_weyl_squared(p, d) for p, d in zip(system.polynomials, system.degrees)]
+        return constants_at(F, J, X, system.degrees, norms)
+
+
+def constants_at(F: Sequence[mpmath.mpc], J: Sequence[Sequence[mpmath.mpc]], X: Sequence[mpmath.mpc],
+                 degrees: Sequence[int], norms_squared: Sequence[mpmath.mpf]
+                 ) -> tuple[mpmath.mpf, mpmath.mpf, mpmath.mpf] | None:
+    """(alpha, beta, the bound on gamma) from f(x), Df(x) (rows), x, the degrees and the
+    equations' squared Bombieri-Weyl norms, at the working precision (module docstring);
+    None where Df(x) is singular."""
+    one_x = mpmath.sqrt(1 + sum(abs(v) ** 2 for v in X))
+    n = len(degrees)
+    # right-hand sides: f(x), then the columns of Delta(x) = diag(sqrt(d_i) ||(1, x)||^(d_i - 1))
+    rhs = [[F[i]] + [mpmath.sqrt(d) * one_x ** (d - 1) if j == i else mpmath.mpc(0) for j in range(n)]
+           for i, d in enumerate(degrees)]
+    solved = solve_many([list(row) for row in J], rhs)
+    if solved is None:
+        return None
+    beta = mpmath.sqrt(sum(abs(row[0]) ** 2 for row in solved))
+    frobenius = mpmath.sqrt(sum(abs(v) ** 2 for row in solved for v in row[1:]))
+    mu = max(mpmath.mpf(1), mpmath.sqrt(mpmath.fsum(norms_squared)) * frobenius)
+    gamma = mu * mpmath.mpf(max(degrees)) ** 1.5 / (2 * one_x)
+    return beta * gamma, beta, gamma
+
+
+def has_real_structure(system: PolySystem) -> bool:
+    """Whether R(x) = conj(x[conjugate]) (an involution) maps Newton's iterates to Newton's
+    iterates, so roots to roots: each polynomial's image under R (coefficients conjugated,
+    exponents permuted) is a constant multiple of one of the polynomials, each used once
+    (then f(R(x)) = A conj(f(x)) with A constant and invertible)."""
+    mirror = system.mirror
+    used: set[int] = set()
+    for p in system.polynomials:
+        image = {tuple(e[mirror[v]] for v in range(system.n)): complex(c).conjugate() for e, c in p.items()}
+        match = next((j for j, q in enumerate(system.polynomials)
+                      if j not in used and _proportional(image, q)), None)
+        if match is None:
+            return False
+        used.add(match)
+    return True
+
+
+def _proportional(p: dict[tuple[int, ...], complex], q: Polynomial) -> bool:
+    if p.keys() != q.keys():
+        return False
+    e0 = next(iter(p))
+    ratio = complex(q[e0]) / p[e0]
+    return all(abs(complex(q[e]) - ratio * c) <= 1e-15 * abs(complex(q[e])) for e, c in p.items())
+
+
+def certify(system: PolySystem, x: np.ndarray, real_structure: bool | None = None,
+            scaled: PolySystem | None = None) -> Certificate:
+    """Smale's alpha test at ``x`` (module docstring), on the system with each equation at
+    Bombieri-Weyl norm 1 (``scaled``: that system, when the caller has it already).
+    ``real_structure``: :func:`has_real_structure` of the system, when known."""
+    scaled = normalised(system) if scaled is None else scaled
+    if real_structure is None:
+        real_structure = has_real_structure(system)
+    return verdict(constants(scaled, x), x, system.mirror if real_structure else None)
+
+
+def verdict(found: tuple[mpmath.mpf, mpmath.mpf, mpmath.mpf] | None, x: np.ndarray,
+            mirror: np.ndarray | None) -> Certificate:
+    """The certificate from (alpha, beta, gamma bound) at x (None: Df(x) singular);
+    ``mirror``: the real structure's permutation (None: no real structure, no realness)."""
+    if found is None:
+        return Certificate(math.inf, math.inf, math.inf, False, False)
+    alpha, beta, gamma = found
+    certified = alpha * (1 + SAFETY) < ALPHA_0
+    real = not_real = False
+    if certified and mirror is not None:
+        with mpmath.workdps(DIGITS):
+            X = [mpmath.mpc(complex(v)) for v in x]
+            gap = mpmath.sqrt(sum(abs(X[m] - mpmath.conj(X[v])) ** 2 for v, m in enumerate(mirror)))
+            real = alpha * (1 + SAFETY) < ALPHA_SAME and gap * (1 + SAFETY) * 20 * gamma < 1
+            not_real = gap > 4 * beta * (1 + SAFETY)
+    return Certificate(float(alpha), float(beta), float(gamma), bool(certified), bool(real), bool(not_real))
+
+
+def distinct(x1: np.ndarray, c1: Certificate, x2: np.ndarray, c2: Certificate) -> bool:
+    """Two certified points whose roots are certainly two: ||x1 - x2|| > 2 (beta1 + beta2)
+    (each root lies within 2 beta of its point)."""
+    if not (c1.certified and c2.certified):
+        return False
+    with mpmath.workdps(DIGITS):
+        gap = mpmath.sqrt(sum(abs(mpmath.mpc(complex(a)) - mpmath.mpc(complex(b))) ** 2
+                              for a, b in zip(x1, x2)))
+        return bool(gap > 2 * (mpmath.mpf(c1.beta) + mpmath.mpf(c2.beta)) * (1 + SAFETY))
+
+
+def undistinguished(points: Sequence[np.ndarray], certificates: Sequence[Certificate]
+                    ) -> list[tuple[int, int]]:
+    """Pairs of certified points that :func:`distinct` cannot tell apart (none, when every
+    certified root is certainly a different root)."""
+    idx = [i for i, c in enumerate(certificates) if c.certified]
+    return [(i, j) for a, i in enumerate(idx) for j in idx[a + 1:]
+            if not distinct(points[i], certificates[i], points[j], certificates[j])]
