@@ -147,3 +147,47 @@ def test_every_root_of_a_five_pose_burmester_problem_is_certified_and_distinct()
     assert s.undistinguished == []
     assert sum(c.real for _, c in s.certified) == len(b.cranks)
     assert all(c.real == e.real and c.not_real != e.real for e, c in s.certified)
+
+
+def test_the_nine_point_equations_multiplied_out_equal_the_factored_ones():
+    from linkage.homotopy import ninepoint as npt
+    from linkage.homotopy import ninepoint_alpha as na
+
+    rng = np.random.default_rng(4)
+    d, db = rng.normal(size=8) + 1j * rng.normal(size=8), rng.normal(size=8) + 1j * rng.normal(size=8)
+    system = na.polynomial_system(d, db)
+    assert system.degrees == (7,) * 8  # the terms of degree 8 cancel
+    z = rng.normal(size=(5, 8)) + 1j * rng.normal(size=(5, 8))
+    E, J, _, _ = npt.equations(z, d, db)
+    assert np.allclose(system.evaluate(z), E, rtol=1e-12, atol=1e-12 * np.abs(E).max())
+    assert np.allclose(system.jacobian(z), J, rtol=1e-12, atol=1e-12 * np.abs(J).max())
+    # for real points the bars' swap with conjugation is a real structure
+    assert alpha.has_real_structure(na.polynomial_system(d, np.conj(d)))
+
+
+def test_a_real_four_bar_through_nine_of_its_coupler_points_is_certified_real():
+    """A crank-rocker (ground 0 to 3, crank 1, coupler 3, rocker 2.5, coupler point at
+    0.4 + 0.6i along the coupler) placed by plane geometry at nine crank angles: the
+    four-bar (pivots relative to the first point) is a root of those points' equations."""
+    import cmath
+    import math
+
+    from linkage.homotopy import ninepoint_alpha as na
+
+    A, B, r1, L, r2, k = 0j, 3 + 0j, 1.0, 3.0, 2.5, 0.4 + 0.6j
+    pts, first = [], None
+    for phi in np.linspace(0.2, 5.8, 9):
+        M = A + r1 * cmath.exp(1j * phi)
+        d = abs(B - M)
+        along = (L * L - r2 * r2 + d * d) / (2 * d)
+        u = (B - M) / d
+        N = M + along * u + math.sqrt(L * L - along * along) * u * 1j
+        pts.append(M + (N - M) * k)
+        first = first or (M, N)
+    M, N = first
+    z = np.array([A, M, B, N]) - pts[0]
+    z = np.concatenate([z, np.conj(z)])
+    c = na.certify_rows(z[None, :], pts)[0]
+    assert c.certified and c.real and c.alpha < 1e-6
+    # a point off by 1e-3: no longer within reach of the test's bound
+    assert not na.certify_rows(z[None, :] + 1e-3, pts)[0].certified

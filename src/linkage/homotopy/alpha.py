@@ -25,6 +25,12 @@ system f and a point x where Df(x) is invertible:
 gamma is unchanged when the equations are multiplied by a constant invertible matrix, so
 the bound may be taken for any such rescaling: each equation is scaled to Bombieri-Weyl
 norm 1 first (the bound then does not depend on how the equations were written down).
+The bound is not unchanged by a change of variables, and grows as ||(1, x)||^(D - 1) with
+a large coordinate: the test is made on g(u) = f(T u), T diagonal with powers of two
+(:func:`stretch`: each variable of size about 1), whose Newton iterates are T^-1 times
+f's, exactly (u = T^-1 x is exact in binary). beta, gamma and alpha are g's at u; the root
+lies within 2 beta of u in u's norm, so within :attr:`Certificate.radius` = 2 beta max T of
+x, and R commutes with T when T is the same for a variable and its conjugate.
 
 Precision, honestly: the point and the coefficients are double-precision numbers, taken
 exactly; f, Df and the linear algebra are evaluated in mpmath at :data:`DIGITS` digits,
@@ -67,12 +73,8 @@ class Certificate:
     gamma: float  # the Shub-Smale bound on gamma, not gamma itself
     certified: bool
     real: bool
-    not_real: bool = False  # the root is certified nonreal: ||x - R(x)|| > 4 beta
-
-    @property
-    def radius(self) -> float:
-        """The root lies within this of the point (2 beta), where certified."""
-        return 2.0 * self.beta
+    not_real: bool = False  # the root is certified nonreal: ||u - R(u)|| > 4 beta
+    radius: float = math.inf  # where certified, the root is within this of the point (2 beta max T)
 
 
 def bombieri_weyl_squared(p: Polynomial, degree: int) -> mpmath.mpf:
@@ -215,21 +217,41 @@ def _proportional(p: dict[tuple[int, ...], complex], q: Polynomial) -> bool:
     return all(abs(complex(q[e]) - ratio * c) <= 1e-15 * abs(complex(q[e])) for e, c in p.items())
 
 
+def stretch(x: np.ndarray, mirror: np.ndarray) -> np.ndarray:
+    """T: for each variable the largest power of two at most max(1, |x_v|, |x_conjugate(v)|)."""
+    size = np.maximum(1.0, np.maximum(np.abs(x), np.abs(x[mirror])))
+    return np.exp2(np.floor(np.log2(size)))
+
+
+def stretched(system: PolySystem, T: np.ndarray) -> PolySystem:
+    """g(u) = f(T u): each coefficient times prod T_v^e_v (exact for powers of two)."""
+    return PolySystem(system.n, tuple({e: complex(c) * float(np.prod(T ** np.array(e))) for e, c in p.items()}
+                                      for p in system.polynomials),
+                      system.names, system.groups, system.conjugate)
+
+
 def certify(system: PolySystem, x: np.ndarray, real_structure: bool | None = None,
             scaled: PolySystem | None = None) -> Certificate:
-    """Smale's alpha test at ``x`` (module docstring), on the system with each equation at
-    Bombieri-Weyl norm 1 (``scaled``: that system, when the caller has it already).
-    ``real_structure``: :func:`has_real_structure` of the system, when known."""
-    scaled = normalised(system) if scaled is None else scaled
+    """Smale's alpha test at ``x`` (module docstring), on g(u) = f(T u) with each equation
+    at Bombieri-Weyl norm 1 (``scaled``: the system so normalised, when the caller has it
+    already; it is used where T = 1). ``real_structure``: :func:`has_real_structure` of the
+    system, when known."""
     if real_structure is None:
         real_structure = has_real_structure(system)
-    return verdict(constants(scaled, x), x, system.mirror if real_structure else None)
+    T = stretch(x, system.mirror)
+    if np.all(T == 1.0):
+        g = normalised(system) if scaled is None else scaled
+    else:
+        g = normalised(stretched(system, T))
+    u = x / T
+    return verdict(constants(g, u), u, system.mirror if real_structure else None, float(T.max()))
 
 
-def verdict(found: tuple[mpmath.mpf, mpmath.mpf, mpmath.mpf] | None, x: np.ndarray,
-            mirror: np.ndarray | None) -> Certificate:
-    """The certificate from (alpha, beta, gamma bound) at x (None: Df(x) singular);
-    ``mirror``: the real structure's permutation (None: no real structure, no realness)."""
+def verdict(found: tuple[mpmath.mpf, mpmath.mpf, mpmath.mpf] | None, u: np.ndarray,
+            mirror: np.ndarray | None, largest: float = 1.0) -> Certificate:
+    """The certificate from (alpha, beta, gamma bound) at u = T^-1 x (None: Df singular);
+    ``mirror``: the real structure's permutation (None: none, no verdict on realness);
+    ``largest``: max T (module docstring)."""
     if found is None:
         return Certificate(math.inf, math.inf, math.inf, False, False)
     alpha, beta, gamma = found
@@ -237,22 +259,24 @@ def verdict(found: tuple[mpmath.mpf, mpmath.mpf, mpmath.mpf] | None, x: np.ndarr
     real = not_real = False
     if certified and mirror is not None:
         with mpmath.workdps(DIGITS):
-            X = [mpmath.mpc(complex(v)) for v in x]
-            gap = mpmath.sqrt(sum(abs(X[m] - mpmath.conj(X[v])) ** 2 for v, m in enumerate(mirror)))
+            U = [mpmath.mpc(complex(v)) for v in u]
+            gap = mpmath.sqrt(sum(abs(U[m] - mpmath.conj(U[v])) ** 2 for v, m in enumerate(mirror)))
             real = alpha * (1 + SAFETY) < ALPHA_SAME and gap * (1 + SAFETY) * 20 * gamma < 1
             not_real = gap > 4 * beta * (1 + SAFETY)
-    return Certificate(float(alpha), float(beta), float(gamma), bool(certified), bool(real), bool(not_real))
+    radius = float(2 * beta * largest * (1 + SAFETY)) if certified else math.inf
+    return Certificate(float(alpha), float(beta), float(gamma), bool(certified), bool(real), bool(not_real),
+                       radius)
 
 
 def distinct(x1: np.ndarray, c1: Certificate, x2: np.ndarray, c2: Certificate) -> bool:
-    """Two certified points whose roots are certainly two: ||x1 - x2|| > 2 (beta1 + beta2)
-    (each root lies within 2 beta of its point)."""
+    """Two certified points whose roots are certainly two: ||x1 - x2|| > radius1 + radius2
+    (each root lies within its radius, 2 beta, of its point)."""
     if not (c1.certified and c2.certified):
         return False
     with mpmath.workdps(DIGITS):
         gap = mpmath.sqrt(sum(abs(mpmath.mpc(complex(a)) - mpmath.mpc(complex(b))) ** 2
                               for a, b in zip(x1, x2)))
-        return bool(gap > 2 * (mpmath.mpf(c1.beta) + mpmath.mpf(c2.beta)) * (1 + SAFETY))
+        return bool(gap > (mpmath.mpf(c1.radius) + mpmath.mpf(c2.radius)) * (1 + SAFETY))
 
 
 def undistinguished(points: Sequence[np.ndarray], certificates: Sequence[Certificate]
