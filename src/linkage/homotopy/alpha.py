@@ -12,8 +12,8 @@ system f and a point x where Df(x) is invertible:
   ||f|| the Bombieri-Weyl norm: ||f_i||^2 = sum over terms |c_e|^2 e! (d_i - |e|)! / d_i!;
 - alpha = beta gamma. If alpha < (13 - 3 sqrt 17) / 4 = 0.1577, Newton's iterates from x
   converge quadratically to a root xi with ||x - xi|| <= 2 beta (Smale's alpha theorem).
-- Two certified points whose distance exceeds 2 (beta_1 + beta_2) have distinct roots:
-  each root lies in its own ball of radius 2 beta.
+- Two certified points whose distance exceeds the sum of their radii (2 beta each, below)
+  have distinct roots: each root lies in its own ball.
 - If alpha(f, x) < 0.03 and ||x - y|| < 1 / (20 gamma(f, x)), then x and y are approximate
   solutions with one associated root (Hauenstein and Sottile, sec. 2.2). A real structure
   R (here R(x) = conj(x[conjugate]), :attr:`PolySystem.conjugate`) with f(R(x)) = A conj(f(x))
@@ -35,10 +35,11 @@ x, and R commutes with T when T is the same for a variable and its conjugate.
 Precision, honestly: the point and the coefficients are double-precision numbers, taken
 exactly; f, Df and the linear algebra are evaluated in mpmath at :data:`DIGITS` digits,
 floating point (alphaCertified's rational mode is exact; this is not). The rounding at 50
-digits perturbs alpha relatively by about cond(Df) 10^-50, below 10^-30 at the condition
-numbers this package accepts as nonsingular (1e12 at most), and each verdict keeps a
-relative margin of :data:`SAFETY`, so rounding cannot change one. The operator norm in mu
-is bounded by the Frobenius norm (an upper bound keeps the certificate valid).
+digits perturbs alpha relatively by about cond(Df) 10^-50 (below 10^-30 at any condition
+up to 10^20; Problem 3's worst root has 1.5e15), and each verdict keeps a relative
+margin of :data:`SAFETY`, so rounding cannot change one. The operator norm in mu is
+bounded by the Frobenius norm, and every bound used is an upper bound on the quantity the
+theorems name (alpha, gamma) or the radius they give, so the verdicts stay valid.
 """
 
 from __future__ import annotations
@@ -65,7 +66,7 @@ SAFETY = 1e-6
 @dataclass(frozen=True)
 class Certificate:
     """Smale's alpha test at one point (module docstring). ``certified``: Newton's method
-    from the point converges quadratically to a root within ``2 beta``; ``real``: that root
+    from the point converges quadratically to a root within ``radius``; ``real``: that root
     is real (only for a system with a real structure, :func:`has_real_structure`)."""
 
     alpha: float

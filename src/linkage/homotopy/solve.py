@@ -13,6 +13,9 @@ Each endpoint is one of
 - ``failed``: the tracker could not follow the path (its reason is kept). A failed path is
   retracked with smaller steps before it is reported, and never dropped.
 
+:attr:`Solutions.certificates` adds Smale's alpha test at each finite endpoint (:mod:`.alpha`),
+computed when first asked for.
+
 The Cauchy endgame (Morgan, Sommese and Wampler, "Computing singular solutions to
 nonlinear analytic systems", Numer. Math. 58, 1991): near t = 1 a path is X(s) analytic
 in s = (1 - t)^(1/c), c its cycle number; tracking t around circles |1 - t| = r until the
