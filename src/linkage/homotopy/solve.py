@@ -238,10 +238,12 @@ def weights(x: np.ndarray) -> np.ndarray:
 def equation_sizes(system: PolySystem, x: np.ndarray) -> np.ndarray:
     """Each equation's natural size at x: sum over its terms of |c| prod_v w_v^e_v, w the
     :func:`weights` (what |F_i| is measured against: rounding in evaluating F_i is about eps
-    times this)."""
+    times this). x (n,): (m,); or many points x (P, n): (P, m)."""
     form = system.homogeneous
-    W = np.concatenate([[1.0], weights(x)])[None].astype(complex)
-    return (np.abs(form.coefficients) @ form.monomials(W).real)[:, 0]
+    X = np.atleast_2d(x)
+    W = np.concatenate([np.ones((len(X), 1)), weights(X)], axis=1).astype(complex)
+    sizes = (np.abs(form.coefficients) @ form.monomials(W).real).T
+    return sizes if np.ndim(x) == 2 else sizes[0]
 
 
 def condition(system: PolySystem, x: np.ndarray) -> float:
@@ -262,6 +264,11 @@ def relative_residual(system: PolySystem, x: np.ndarray) -> float:
     """max_i |F_i(x)| / :func:`equation_sizes` (x): about eps at a root computed to rounding."""
     F = system.evaluate(x[None])[0]
     return float(np.max(np.abs(F) / equation_sizes(system, x)))
+
+
+def relative_residuals(system: PolySystem, X: np.ndarray) -> np.ndarray:
+    """:func:`relative_residual` at many points X (P, n) at once: (P,)."""
+    return np.max(np.abs(system.evaluate(X)) / equation_sizes(system, X), axis=1)
 
 
 def _refine(system: PolySystem, x: np.ndarray) -> tuple[np.ndarray, float, float]:
