@@ -283,7 +283,19 @@ def distinct(x1: np.ndarray, c1: Certificate, x2: np.ndarray, c2: Certificate) -
 def undistinguished(points: Sequence[np.ndarray], certificates: Sequence[Certificate]
                     ) -> list[tuple[int, int]]:
     """Pairs of certified points that :func:`distinct` cannot tell apart (none, when every
-    certified root is certainly a different root)."""
-    idx = [i for i, c in enumerate(certificates) if c.certified]
-    return [(i, j) for a, i in enumerate(idx) for j in idx[a + 1:]
-            if not distinct(points[i], certificates[i], points[j], certificates[j])]
+    certified root is certainly a different root). Pairs whose distance in double precision
+    is over twice the sum of their radii are apart beyond any rounding of that distance;
+    only the others are judged at 50 digits (the pairs of 1,400 points in a second)."""
+    idx = np.array([i for i, c in enumerate(certificates) if c.certified], dtype=np.intp)
+    if len(idx) < 2:
+        return []
+    X = np.array([np.asarray(points[i], dtype=complex) for i in idx])
+    r = np.array([certificates[i].radius for i in idx])
+    out = []
+    for a in range(len(idx) - 1):
+        gap = np.linalg.norm(X[a + 1:] - X[a], axis=1)
+        for b in a + 1 + np.flatnonzero(gap <= 2 * (r[a] + r[a + 1:])):
+            i, j = int(idx[a]), int(idx[b])
+            if not distinct(points[i], certificates[i], points[j], certificates[j]):
+                out.append((i, j))
+    return out
