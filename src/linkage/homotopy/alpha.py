@@ -23,8 +23,9 @@ system f and a point x where Df(x) is invertible:
   and R(x)).
 
 gamma is unchanged when the equations are multiplied by a constant invertible matrix, so
-the bound may be taken for any such rescaling: each equation is scaled to Bombieri-Weyl
-norm 1 first (the bound then does not depend on how the equations were written down).
+the bound may be taken for any such rescaling: each equation is scaled by a power of two
+(exact) to a Bombieri-Weyl norm within a factor sqrt 2 of 1 first (the bound then hardly
+depends on how the equations were written down).
 The bound is not unchanged by a change of variables, and grows as ||(1, x)||^(D - 1) with
 a large coordinate: the test is made on g(u) = f(T u), T diagonal with powers of two
 (:func:`stretch`: each variable of size about 1), whose Newton iterates are T^-1 times
@@ -152,13 +153,21 @@ def solve_many(J: list[list[mpmath.mpc]], rhs: list[list[mpmath.mpc]]) -> list[l
 
 
 def normalised(system: PolySystem) -> PolySystem:
-    """Each equation divided by its Bombieri-Weyl norm (same roots, same gamma)."""
+    """Each equation divided by the power of two nearest its Bombieri-Weyl norm (a norm
+    within a factor sqrt 2 of 1): exactly the same equations scaled, so the same roots and
+    the same gamma (a division by the norm itself would round the coefficients, and the
+    certificate would be of a system 1e-16 away)."""
     with mpmath.workdps(DIGITS):
-        norms = [float(mpmath.sqrt(bombieri_weyl_squared(p, d)))
-                 for p, d in zip(system.polynomials, system.degrees)]
-    return PolySystem(system.n, tuple({e: complex(c) / s for e, c in p.items()}
-                                      for p, s in zip(system.polynomials, norms)),
+        shifts = [round(float(mpmath.log(bombieri_weyl_squared(p, d), 2)) / 2)
+                  for p, d in zip(system.polynomials, system.degrees)]
+    return PolySystem(system.n, tuple({e: _shifted(complex(c), -k) for e, c in p.items()}
+                                      for p, k in zip(system.polynomials, shifts)),
                       system.names, system.groups, system.conjugate)
+
+
+def _shifted(c: complex, k: int) -> complex:
+    """c times 2^k, exactly."""
+    return complex(math.ldexp(c.real, k), math.ldexp(c.imag, k))
 
 
 def constants(system: PolySystem, x: np.ndarray, digits: int = DIGITS
