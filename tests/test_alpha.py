@@ -191,3 +191,19 @@ def test_a_real_four_bar_through_nine_of_its_coupler_points_is_certified_real():
     assert c.certified and c.real and c.alpha < 1e-6
     # a point off by 1e-3: no longer within reach of the test's bound
     assert not na.certify_rows(z[None, :] + 1e-3, pts)[0].certified
+
+
+def test_a_root_far_from_the_origin_is_tested_in_stretched_variables():
+    """x^2 + y^2 = 1e4, x = y at (70.7, 70.7): T = 64 for both, u = x / 64 exactly, and the
+    root is within 2 beta(u) 64 of x (the radius in x's own units)."""
+    f = PolySystem(2, ({(2, 0): 1.0, (0, 2): 1.0, (0, 0): -1e4}, {(1, 0): 1.0, (0, 1): -1.0}))
+    x = np.array([1e2 / 2 ** 0.5, 1e2 / 2 ** 0.5], dtype=complex)
+    assert list(alpha.stretch(x, f.mirror)) == [64.0, 64.0]
+    c = alpha.certify(f, x)
+    assert c.certified and c.real
+    assert c.radius == pytest.approx(2 * 64 * c.beta, rel=1e-5)
+    root = 1e2 / mpmath.sqrt(2)
+    assert float(mpmath.sqrt(2) * abs(mpmath.mpf(x[0].real) - root)) <= c.radius
+    # unstretched, the bound grows with ||(1, x)||: the same point tests worse
+    a, _, _ = alpha.constants(alpha.normalised(f), x)
+    assert a > c.alpha

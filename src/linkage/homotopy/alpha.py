@@ -235,7 +235,8 @@ def stretch(x: np.ndarray, mirror: np.ndarray) -> np.ndarray:
 
 def stretched(system: PolySystem, T: np.ndarray) -> PolySystem:
     """g(u) = f(T u): each coefficient times prod T_v^e_v (exact for powers of two)."""
-    return PolySystem(system.n, tuple({e: complex(c) * float(np.prod(T ** np.array(e))) for e, c in p.items()}
+    k = np.log2(T).astype(int)
+    return PolySystem(system.n, tuple({e: _shifted(complex(c), int(k @ np.array(e))) for e, c in p.items()}
                                       for p in system.polynomials),
                       system.names, system.groups, system.conjugate)
 
