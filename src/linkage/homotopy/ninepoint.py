@@ -401,8 +401,11 @@ def polish_precisely(z: np.ndarray, d: np.ndarray, db: np.ndarray) -> np.ndarray
 
 
 def relative_residual(Z: np.ndarray, d: np.ndarray, db: np.ndarray) -> np.ndarray:
-    """max over the equations of |E_j| / (|N1 N2| + |D|^2): each equation against its own
-    terms' sizes (paths,). Works on object arrays of mpmath numbers too."""
+    """max over the equations of |E_j| / (|N1 N2| + |D|^2) (paths,): cheap, and what decides
+    which endpoints are polished at PRECISE_DIGITS. Where N1, N2 or D is itself a near
+    cancellation (pivots far from the points) this understates the size of E_j's terms and
+    overstates the residual; :func:`.ninepoint_alpha.residuals` measures against the terms
+    multiplied out. Works on object arrays of mpmath numbers too."""
     col = [Z[:, k:k + 1] for k in range(8)]
     dd = np.broadcast_to(d, (Z.shape[0], 8))
     ddb = np.broadcast_to(db, (Z.shape[0], 8))

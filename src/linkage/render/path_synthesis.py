@@ -43,6 +43,21 @@ def path_tables(result: Any) -> tuple[DataTable, ...]:
                                  ("unsettled", "", "int"), ("steps", "", "int")], routes))
 
 
+def certified_line(result: Any) -> str:
+    """Smale's alpha test at each real four-bar (linkage.homotopy.ninepoint_alpha; tens of
+    milliseconds each): how many are certified real, and whether all are told apart."""
+    from ..homotopy.alpha import undistinguished
+    from ..homotopy.ninepoint_alpha import certify_rows
+
+    s = result.solutions
+    rows = s.solutions[s.real]
+    certs = certify_rows(rows, s.points)
+    apart = undistinguished(list(rows), certs)
+    return (f"alpha test (Smale; 50 digits): {sum(c.certified and c.real for c in certs)} of the "
+            f"{len(certs)} real four-bars certified real"
+            + (", all distinct" if not apart else f", {len(apart)} pair(s) not told apart"))
+
+
 def summary_lines(result: Any) -> list[str]:
     s = result.solutions
     clean = sum(1 for group in result.designs if not group[0].defects)
@@ -55,6 +70,7 @@ def summary_lines(result: Any) -> list[str]:
                                                           else "")
         + f"; {len(result.designs)} real, {clean} without defects",
         *extra_lines(result.points, result.extra),
+        certified_line(result),
     ]
 
 
