@@ -125,3 +125,27 @@ def test_the_twins_constants_are_the_scalar_loops():
 def test_the_codes_name_the_scalar_statuses():
     for code, name in enumerate(rules.ARRAY_STATUS[1:], start=1):
         assert Status(name).converged == bool(rules.converged_codes(np.array([code]))[0])
+
+
+def test_the_short_way_of_a_block_that_stops_at_once_is_the_ordered_tests():
+    """judge's short way (a block whose every step and residual is within the limits: one
+    full pass instead of the ordered tests) gives the ordered tests' codes, exact zeros
+    included; a block with one position outside, a NaN, an inf or a singular J takes the
+    ordered tests. The reference is the same judge with the short way turned off."""
+    rng = np.random.default_rng(5)
+    seen = set()
+    for case in range(400):
+        k = int(rng.integers(1, 40))
+        err = rng.choice([0.0, 1e-13, TOL, TOL / 2, 2 * TOL, math.nan, math.inf], k,
+                         p=[0.2, 0.3, 0.2, 0.26, 0.02, 0.01, 0.01])
+        resid = rng.choice([0.0, 1e-12, GATE, 2 * GATE, math.inf], k, p=[0.3, 0.4, 0.27, 0.02, 0.01])
+        singular = rng.random(k) < 0.01 if case % 2 else None
+        q0 = rng.uniform(0.0, 10.0, k)
+        got = rules.SystemStops(TOL, GATE, q0).judge(err, resid, singular, q0)
+        ordered = rules.SystemStops(TOL, GATE, q0)
+        ordered.bounded = False
+        want = ordered.judge(err, resid, singular, q0)
+        assert got.dtype == want.dtype and np.array_equal(got, want), (err, resid, singular)
+        seen.add(bool(rules.converged_codes(want).all()))
+    assert seen == {True, False}  # both ways were taken
+    assert not rules.SystemStops(TOL, math.inf, np.zeros(1)).bounded  # an inf limit: the ordered tests

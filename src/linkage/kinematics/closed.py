@@ -51,7 +51,7 @@ from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
 from .pose import implied, step_words
 from .positions import SweepResult, check_driver_values
-from .vector_loops import VectorLoops, singular_of, solve_linear
+from .vector_loops import VectorLoops, per_position, singular_of, solve_linear
 
 MARGIN_FLOOR = 1e-8
 """The smallest relative margin of a step at a grid point for this engine: closer to a
@@ -168,7 +168,7 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
     size = m.length_scale
     steps = step_scales(kinds, size)
     # each position stopped as the single solve's loop stops it (linkage.rules)
-    stops = SystemStops(tol, residual_gate(tol, size), step_size_array(q, None))
+    stops = SystemStops(tol, residual_gate(tol, size), partial(step_size_array, q, None))
     det = np.empty(k)
     iters = np.zeros(k, dtype=np.int32)
     ratio = np.empty(k)
@@ -183,7 +183,11 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
         phi, jac = loops.evaluate(sub, rows)
         dq, dt = solve_linear(jac, phi, active.size)
         singular = singular_of(jac, dt)
-        moved = [s + np.where(singular, 0.0, d) for s, d in zip(sub, dq)]
+        if singular.any():
+            moved = [s + np.where(singular, 0.0, d) for s, d in zip(sub, dq)]
+        else:
+            moved = [s + d for s, d in zip(sub, dq)]  # (the same sums: nothing held back)
+            singular = None
         codes = stops.judge(step_size_array(dq, steps), step_size_array(phi, None), singular,
                             partial(step_size_array, moved, None), rows)
         going = codes == GOING
@@ -232,7 +236,7 @@ def _column_lengths(jac: list[list[Any]], k: int) -> np.ndarray:
             sq = np.square(row[j]) if sq is None else sq + np.square(row[j])
         length = np.sqrt(sq)
         out = length if out is None else out * length
-    return np.broadcast_to(out, (k,))
+    return per_position(out, k)
 
 
 def _words(m: Mechanism, drv: np.ndarray, q: list[np.ndarray], signs: tuple[float, ...]) -> list[str] | None:

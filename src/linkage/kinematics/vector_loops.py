@@ -40,16 +40,19 @@ class VectorLoops:
         self.n = n
         self.m = 2 * len(terms)
         # Terms whose length and angle are both known do not change while iterating:
-        # sum them once per position.
-        self.fixed = [np.zeros(size) for _ in range(self.m)]
+        # sum them once per position, in the loop's order from 0.0 (a sum of fixed values
+        # stays one number until the first array joins it: the same additions, the same bits)
+        fixed: list[Any] = [0.0] * self.m
         self.moving: list[tuple[int, float, Any, int, Any, int, float]] = []
         for li, loop in enumerate(terms):
             for sign, r, lidx, th, aidx, off in loop:
                 if lidx < 0 and aidx < 0:
-                    self.fixed[2 * li] += sign * r * np.cos(th + off)
-                    self.fixed[2 * li + 1] += sign * r * np.sin(th + off)
+                    tt = th + off
+                    fixed[2 * li] = fixed[2 * li] + sign * r * np.cos(tt)
+                    fixed[2 * li + 1] = fixed[2 * li + 1] + sign * r * np.sin(tt)
                 else:
                     self.moving.append((li, sign, r, lidx, th, aidx, off))
+        self.fixed = [f if np.shape(f) == (size,) else np.full(size, f) for f in fixed]
 
     def evaluate(self, q: list[np.ndarray], rows: np.ndarray | None,
                  near: bool = False) -> tuple[list[np.ndarray], list[list[Any]]]:
@@ -118,8 +121,7 @@ class VectorLoops:
 def solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[list[np.ndarray], np.ndarray]:
     """dq with J dq = -Phi at every position, and det J. Cramer's rule for 2x2."""
     if len(jac) == 2 and len(jac[0]) == 2:
-        a, b = np.broadcast_to(jac[0][0], (k,)), np.broadcast_to(jac[0][1], (k,))
-        c, d = np.broadcast_to(jac[1][0], (k,)), np.broadcast_to(jac[1][1], (k,))
+        (a, b), (c, d) = ((per_position(v, k) for v in row) for row in jac)
         det = a * d - b * c
         with np.errstate(divide="ignore", invalid="ignore"):
             inv = 1.0 / det
@@ -137,6 +139,13 @@ def solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[l
         rhs = -np.stack(phi, axis=1)
         dq[ok] = np.linalg.solve(full[ok], rhs[ok][..., None])[..., 0]
     return [dq[:, j] for j in range(n)], det
+
+
+def per_position(v: Any, k: int) -> Any:
+    """An entry of J at every position: itself where it is already (a constant entry, 0.0
+    or a fixed length's cosine, broadcast; without numpy's broadcast_to where it is not
+    needed, microseconds a call)."""
+    return v if np.shape(v) == (k,) else np.broadcast_to(v, (k,))
 
 
 def singular_of(jac: list[list[Any]], det: np.ndarray) -> np.ndarray:
