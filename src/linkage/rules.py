@@ -238,6 +238,7 @@ class SystemStops:
         self.can_diverge = can_diverge
         self.q0_size = q0_size
         self.kept: tuple[Any, Any, Any, Any, Any] | None = None  # made when first needed
+        self.first: tuple[Any, Any] | None = None  # (error, rounding) of a first step of all
         # finite limits: a step and a residual within them are finite (what judge's short
         # way reads); a limit of inf leaves test 2 to the ordered tests
         self.bounded = bool(np.isfinite(tol) and np.isfinite(gate).all())
@@ -255,6 +256,9 @@ class SystemStops:
                 runaway = SYSTEM_RUNAWAY * (1.0 + q0)
             self.kept = (np.full(k, np.inf), np.zeros(k, dtype=np.int32), np.zeros(k, dtype=np.int32),
                          np.zeros(k, dtype=np.int32), runaway)
+            if self.first is not None:  # what a first step of every position left (judge)
+                self.kept[0][...], self.kept[2][...] = self.first
+                self.first = None
         return self.kept
 
     def judge(self, err: Any, resid: Any, singular: Any, q_size: Any, rows: Any = None) -> Any:
@@ -291,6 +295,16 @@ class SystemStops:
                 pending &= ~hit
             if not pending.any():
                 return codes  # every position stopped: nothing kept is read again
+            if self.kept is None and self.first is None and rows is None:
+                # the first step of every position: nothing kept yet (no last error, streak,
+                # rounding steps or stalls), so tests 5 and 6 cannot hold (a streak of 0, at
+                # most one rounding step, no stall: a step's error is finite here). What the
+                # loop keeps is this step's error and rounding, made into the arrays only if
+                # a later step does not stop every position (the usual second step does)
+                if callable(q_size):
+                    q_size = q_size()
+                self.first = (np.array(err, dtype=float), pending & (err <= SYSTEM_ROUNDING * q_size))
+                return codes
             last, streak, rounding_steps, stalls_kept, runaway = self._kept()
             prev = at(last)
             if callable(q_size):

@@ -51,7 +51,7 @@ from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
 from .pose import implied, step_words
 from .positions import SweepResult, check_driver_values
-from .vector_loops import LoopPlan, VectorLoops, per_position, singular_of, solve_linear
+from .vector_loops import VectorLoops, loop_plan, per_position, singular_of, solve_linear
 
 MARGIN_FLOOR = 1e-8
 """The smallest relative margin of a step at a grid point for this engine: closer to a
@@ -204,7 +204,7 @@ def _block(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, signs: tuple[float, 
     if not ok.all() or not all((margin > MARGIN_FLOOR).all() for margin in margins):  # (NaN too)
         return None
     k = len(drv)
-    loops = VectorLoops(implied(m, "loop_plan", lambda m: LoopPlan.of(m.model)), drv)
+    loops = VectorLoops(loop_plan(m), drv)
     steps = plan.steps
     # each position stopped as the single solve's loop stops it (linkage.rules)
     stops = SystemStops(tol, residual_gate(tol, m.length_scale), partial(step_size_array, q, None))

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ..problems.loops import DRIVER, LoopModel
+from ..problems.loops import DRIVER, LoopModel, Mechanism
 
 Term = tuple[float, Any, int, Any, int, float]
 """(sign, length, length index, angle, angle index, offset): an index >= 0 names an
@@ -40,6 +40,13 @@ class LoopPlan:
                     out.append((sign, lc, lidx, ac, aidx, off))
             loops.append(tuple(out))
         return cls(model.n, tuple(loops))
+
+
+def loop_plan(m: Mechanism) -> LoopPlan:
+    """The :class:`LoopPlan` of ``m``'s loop model, made once per mechanism (:func:`~.pose.implied`)."""
+    from .pose import implied
+
+    return implied(m, "loop_plan", lambda m: LoopPlan.of(m.model))
 
 
 class VectorLoops:
