@@ -69,17 +69,28 @@ def triangle_np(d: Any, r: Any, rho: Any) -> tuple[Any, Any, Any]:
     """:func:`triangle` over arrays: (a, h, ok), h NaN where ``ok`` is False."""
     import numpy as np
 
-    d, r, rho = np.broadcast_arrays(np.asarray(d, float), np.asarray(r, float), np.asarray(rho, float))
-    s = -np.sort(-np.stack((d, r, rho)), axis=0)
-    x, y, z = s[0], s[1], s[2]
-    gap = z - (x - y)
-    ok = (gap >= -TANGENT_SLACK * x) & (d > 0.0)
-    gap = np.maximum(gap, 0.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    d, r, rho = np.asarray(d, float), np.asarray(r, float), np.asarray(rho, float)
+    x, y, z = descending_np(d, r, rho)
+    with np.errstate(invalid="ignore", divide="ignore"):  # (inf - inf: NaN, refused)
+        gap = z - (x - y)
+        ok = (gap >= -TANGENT_SLACK * x) & (d > 0.0)
+        gap = np.maximum(gap, 0.0)
         area4 = (x + (y + z)) * gap * (z + (x - y)) * (x + (y - z))
         h = np.where(ok, np.sqrt(np.maximum(area4, 0.0)) / (2.0 * d), np.nan)
         a = ((r - rho) * (r + rho) + d * d) / (2.0 * d)
     return a, h, ok
+
+
+def descending_np(p: Any, q: Any, s: Any) -> tuple[Any, Any, Any]:
+    """The three largest first, as ``sorted((p, q, s), reverse=True)`` orders each position,
+    by comparisons alone (the same values as a sort, for a fraction of a stacked sort's
+    time, and scalars stay scalars: two link lengths order once, not once per position).
+    With a NaN among them the smallest is NaN (``np.minimum`` propagates it), which is all
+    :func:`triangle_np` reads of such a position: its gap is NaN, so ``ok`` is False."""
+    import numpy as np
+
+    lo, hi = np.minimum(p, q), np.maximum(p, q)
+    return np.maximum(hi, s), np.maximum(lo, np.minimum(hi, s)), np.minimum(lo, s)
 
 
 def _frame(x: float, y: float, t1: float) -> tuple[float, float, float]:
