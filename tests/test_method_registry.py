@@ -160,3 +160,19 @@ def test_a_method_registered_at_run_time_is_in_method_all(toy_folder):
     on_an_equation = run_with_toy(toy_folder, "solve", "--equation", "x**2 - 2", "--x0", "1",
                                   "--method", "all", "--format", "json")
     assert "steffensen" in [d["method"] for d in json.loads(on_an_equation.stdout)["runs"]]
+
+
+def test_methods_named_with_commas_are_compared_in_one_summary(cli):
+    run = cli("solve", "--method", "secant,newton", "--format", "json")
+    assert run.code == 0, run.err
+    runs = json.loads(run.out)["runs"]
+    assert [d["method"] for d in runs] == ["secant", "newton"]
+    assert all(d["seconds_per_solve"] > 0 for d in runs)
+
+
+@pytest.mark.parametrize("named,why", [("newton,nope", "unknown method 'nope'"),
+                                        ("newton,newton", "a method named twice")])
+def test_a_named_set_with_an_unknown_or_repeated_method_is_refused_in_one_line(cli, named, why):
+    run = cli("solve", "--method", named)
+    assert run.code == 2 and run.out == ""
+    assert len(run.err.strip().splitlines()) == 1 and why in run.err
