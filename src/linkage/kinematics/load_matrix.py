@@ -409,19 +409,24 @@ def eliminate_np(t: Any, y: Any) -> None:
     import numpy as np
 
     n, _, count = t.shape
+    keep = (np.empty((n, count)), np.empty(count))
     for k in range(n):
-        p = np.abs(t[k:, k]).argmax(axis=0)
-        chosen = np.bincount(p, minlength=n - k)
+        # the candidate rows: those non-zero in some system (the first largest wins, as in lu)
+        rows = np.flatnonzero(t[k:, k].any(axis=1)) + k
+        if rows.size == 0:
+            continue  # zero in every system: singular, and nothing to eliminate
+        p = rows[np.abs(t[rows, k]).argmax(axis=0)] if rows.size > 1 else np.full(count, rows[0])
+        chosen = np.bincount(p - k, minlength=n - k)
         for r in np.flatnonzero(chosen[1:]) + 1:
             other = k + r
             if chosen[r] == count:
                 t[[k, other]], y[[k, other]] = t[[other, k]], y[[other, k]]
                 continue
-            swap = p == r
-            for m in (t, y):
-                keep = m[k].copy()
+            swap = p == other
+            for m, spare in zip((t, y), keep):
+                np.copyto(spare, m[k])
                 np.copyto(m[k], m[other], where=swap)
-                np.copyto(m[other], keep, where=swap)
+                np.copyto(m[other], spare, where=swap)
         rows = np.flatnonzero(t[k + 1:, k].any(axis=1)) + k + 1
         if rows.size == 0:
             continue
