@@ -390,13 +390,17 @@ def solve_bounded_np(a: Any, rhs: Any) -> tuple[Any, Any]:
         x = np.empty_like(y)
         for k in range(n - 1, -1, -1):
             x[k] = (y[k] - np.einsum("jN,jN->N", t[k, k + 1:], x[k + 1:])) / t[k, k]
-        g, lu_norm = inverse_bound_np(np.abs(t))
+        g, lu_norm = inverse_bound_np(np.abs(t, out=t))
         safety = 1.0 + 16.0 * (n + 1) * EPS
         gamma = n * EPS / (1.0 - n * EPS)
         ge = g * gamma * lu_norm * safety
         bound = np.where(ge < 1.0, g / (1.0 - ge), np.inf)
-        # ||A||_1, the largest column sum (over the rows, axis 0: contiguous runs of N)
-        upper = np.abs(a).sum(axis=0).max(axis=0) * bound * safety
+        # ||A||_1, the largest column sum, a row at a time into t's first two rows (spent)
+        sums, row = t[0], t[-1]
+        np.abs(a[0], out=sums)
+        for i in range(1, n):
+            sums += np.abs(a[i], out=row)
+        upper = sums.max(axis=0) * bound * safety
     return x.T, upper
 
 
@@ -427,17 +431,15 @@ def eliminate_np(t: Any, y: Any) -> None:
                 np.copyto(spare, m[k])
                 np.copyto(m[k], m[other], where=swap)
                 np.copyto(m[other], spare, where=swap)
-        rows = np.flatnonzero(t[k + 1:, k].any(axis=1)) + k + 1
-        if rows.size == 0:
-            continue
-        r0, r1 = rows[0], rows[-1] + 1
-        mult = t[r0:r1, k] / t[k, k]
-        t[r0:r1, k] = mult
         cols = np.flatnonzero(t[k, k + 1:].any(axis=1)) + k + 1
-        if cols.size:
-            c0, c1 = cols[0], cols[-1] + 1
-            t[r0:r1, c0:c1] -= mult[:, None, :] * t[k, None, c0:c1]
-        y[r0:r1] -= mult * y[k]
+        c0, c1 = (cols[0], cols[-1] + 1) if cols.size else (k + 1, k + 1)
+        for i in np.flatnonzero(t[k + 1:, k].any(axis=1)) + k + 1:
+            # row by row through one scratch row: no fresh (n, n, N) temporary per step
+            mult = t[i, k]
+            np.divide(mult, t[k, k], out=mult)
+            np.multiply(mult, t[k, c0:c1], out=keep[0][:c1 - c0])
+            t[i, c0:c1] -= keep[0][:c1 - c0]
+            y[i] -= mult * y[k]
 
 
 def inverse_bound_np(lu_abs: Any) -> tuple[Any, Any]:
