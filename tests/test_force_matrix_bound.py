@@ -101,3 +101,19 @@ def test_a_scan_inverts_only_the_matrices_the_bound_does_not_pass(monkeypatch) -
             if s_one != "unsolved":
                 assert (s_one == "ok") == (code == 0)
     assert near_toggles > 0
+
+
+def test_the_bound_is_the_exact_number_for_a_diagonal_matrix_up_to_its_rounding_margin() -> None:
+    """Where g is exact (L = I, U diagonal: g = max 1/|d|), the bound is at least the
+    condition number the scalar cond1 finds, and more by no more than what it adds: the
+    factors' own error, 1 / (1 - cond gamma_9), and its rounding margin 1 + 2 (9 + 2)^2 eps."""
+    rng = np.random.default_rng(3)
+    d = 10.0 ** rng.uniform(-3, 3, size=(50, 9)) * rng.choice([-1.0, 1.0], size=(50, 9))
+    a = np.zeros((50, 9, 9))
+    a[:, range(9), range(9)] = d
+    _, upper = solve_bounded_np(np.ascontiguousarray(a.transpose(1, 2, 0)), np.ones((9, 50)))
+    for k in range(50):
+        exact = cond1(a[k].tolist())
+        eps = 2.0 ** -52
+        added = 1.0 / (1.0 - exact * 9 * eps * 1.001) * (1.0 + 2.0 * 11 ** 2 * eps) * (1.0 + 8 * eps)
+        assert exact <= upper[k] <= exact * added

@@ -378,9 +378,11 @@ def solve_bounded_np(a: Any, rhs: Any) -> tuple[Any, Any]:
     |T^-1| <= M(T)^-1 for a triangular T and its comparison matrix M(T) (theorem 8.12),
     so ||(L U)^-1||_1 <= g, the largest column sum of the non-negative M(U)^-1 M(L)^-1
     (two triangular solves), and ||A^-1||_1 <= g / (1 - g ||E||_1) where g ||E||_1 < 1.
-    (An estimate such as Hager's is a lower bound, not this.) Its own evaluation adds and
-    multiplies non-negative numbers only: at most 4n + 4 roundings of one sign, covered
-    by the factor 1 + 16 (n + 1) eps."""
+    (An estimate such as Hager's is a lower bound, not this.) Its own evaluation adds,
+    multiplies and divides non-negative numbers only, each triangular solve's relative
+    error growing by at most (j + 2) eps at its j-th unknown: n (n + 3) eps for both, n eps
+    for ||A||_1 and a few more, covered by the factor 1 + 2 (n + 2)^2 eps (barring
+    underflow: the force matrices come scaled to the mechanism's size, entries near 1)."""
     import numpy as np
 
     n = a.shape[0]
@@ -391,7 +393,7 @@ def solve_bounded_np(a: Any, rhs: Any) -> tuple[Any, Any]:
         for k in range(n - 1, -1, -1):
             x[k] = (y[k] - np.einsum("jN,jN->N", t[k, k + 1:], x[k + 1:])) / t[k, k]
         g, lu_norm = inverse_bound_np(np.abs(t, out=t))
-        safety = 1.0 + 16.0 * (n + 1) * EPS
+        safety = 1.0 + 2.0 * (n + 2) ** 2 * EPS
         gamma = n * EPS / (1.0 - n * EPS)
         ge = g * gamma * lu_norm * safety
         bound = np.where(ge < 1.0, g / (1.0 - ge), np.inf)
