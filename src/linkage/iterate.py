@@ -138,8 +138,8 @@ def explain(exc: BaseException) -> tuple[Status, str]:
 # --- the ordered stopping rule, and the loops generated from it ----------------------------------
 #
 # Tests 2-8 above are written once, here, as source text (:func:`stopping_tests`). Every loop -
-# the generic one (:func:`run`), the methods' tight loops (Newton, the secant, fixed point,
-# bisection, Halley), the systems' Newton and the compiled models' Newton for two unknowns
+# the generic one (:func:`run`), the scalar methods' tight loops (:mod:`linkage.methods`), the
+# systems' Newton and the compiled models' Newton for two unknowns
 # (:mod:`linkage.methods.newton_two`) - is generated from it around the method's own step
 # (:class:`Loop`) and compiled once per process, so the order lives in one place and the tight
 # loops pay for no call per test. ``loop_source`` prints what runs.
