@@ -215,31 +215,42 @@ def slider_crank_np(r2: Any, r3: Any, e: Any, t2: Any) -> tuple[list[tuple[Any, 
 # --- the branch rule ------------------------------------------------------------------------
 
 
+def open_rule(word: str, sign: float, coupler: Any, output: Any, xp: Any = math) -> Any:
+    """The one open/crossed rule (worked example P3, docs/worked_examples.md), of a loop whose
+    coupler points along ``coupler`` and whose output along ``output`` (rad; scalars with
+    ``xp`` = math, arrays with numpy). A four-bar (``word`` "fourbar") is open where the
+    output turns anticlockwise from the coupler, sin(output - coupler) > 0; a slider is open
+    where the coupler runs along the slide, cos(output - coupler) > 0. ``sign`` (+1 or -1,
+    exact) is the orientation the loop traverses them in. A property of the configuration,
+    whatever drives it."""
+    turn = output - coupler
+    return sign * (xp.sin(turn) if word == "fourbar" else xp.cos(turn)) > 0.0
+
+
 def is_open(t3: float, t4: float) -> bool:
-    """A four-bar configuration is open where sin(theta4 - theta3) > 0 (worked example P3,
-    docs/worked_examples.md),
-    crossed otherwise: a property of the configuration, whatever drives it (rad)."""
-    return math.sin(t4 - t3) > 0.0
+    """A four-bar configuration (coupler theta3, rocker theta4, rad) is open by
+    :func:`open_rule`: sin(theta4 - theta3) > 0, crossed otherwise."""
+    return open_rule("fourbar", 1.0, t3, t4)
 
 
 def is_open_np(t3: Any, t4: Any) -> Any:
     """:func:`is_open` over arrays (rad)."""
     import numpy as np
 
-    return np.sin(t4 - t3) > 0.0
+    return open_rule("fourbar", 1.0, t3, t4, np)
 
 
 def slider_is_open(t3: float) -> bool:
-    """A slider-crank is open where cos(theta3) > 0 (the slider on the far side of the
-    crank pivot from the coupler's turn), crossed otherwise (rad)."""
-    return math.cos(t3) > 0.0
+    """A slider-crank (coupler theta3, rad; the slide along +x) is open by :func:`open_rule`:
+    cos(theta3) > 0, the slider on the far side of the crank pivot from the coupler's turn."""
+    return open_rule("slider", 1.0, t3, 0.0)
 
 
 def slider_is_open_np(t3: Any) -> Any:
     """:func:`slider_is_open` over arrays (rad)."""
     import numpy as np
 
-    return np.cos(t3) > 0.0
+    return open_rule("slider", 1.0, t3, 0.0, np)
 
 
 def label(open_: bool) -> str:
