@@ -133,6 +133,12 @@ package that fails to import fails there, in one line, and not in a race between
 threads importing it at once (a flaky refusal, seen in tests/test_format_registry.py)."""
 
 
+def wait_for_prefetch() -> None:
+    """Wait for the prefetch threads started (their imports and warm-ups) to finish."""
+    while _prefetching:
+        _prefetching.pop().join()
+
+
 def import_quietly(names: Sequence[str], then: Callable[[], None] | None = None) -> None:
     """Import ``names``, then run ``then`` (a sink's warm-up); quietly: a failure is left to
     the writer, which meets it again and says so."""
@@ -159,8 +165,7 @@ def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None)
     to_stdout = output is None or str(output) == "-"
     spec = FORMATS[fmt]
     make: Any = spec.sink
-    while _prefetching:
-        _prefetching.pop().join()
+    wait_for_prefetch()
     if spec.needs is not None:
         try:
             __import__(spec.needs[0])
