@@ -4,7 +4,8 @@ Exit codes: 0 converged, 1 ran but did not converge (the rows are still shown),
 2 bad input (one line on stderr, never a traceback).
 
 One module per command, imported when a run names it (:mod:`.registry`); ``app`` (every
-command registered) and ``_app_for`` are loaded on first use. No module here has
+command registered), ``_app_for`` and ``run_cli`` are loaded on first use, and typer with
+them (:func:`main` imports it with the collector paused). No module here has
 postponed annotations (typer would evaluate them with ``eval()`` on every start), and
 every engine import is inside the function that needs it (start-up time).
 """
