@@ -29,8 +29,9 @@ TOL = 1e-12
 
 
 def pairs(num: Callable[[], Any], den: Callable[[], Any], n_pairs: int,
-          batch: int) -> tuple[float, float, float]:
-    """(median ratio num/den over interleaved pairs, median seconds per call of each)."""
+          batch: int) -> tuple[float, float, float, float, float]:
+    """(median ratio num/den over interleaved pairs, median seconds per call of each, and
+    the ratio's quartiles over the pairs: the spread the shared machine put on it)."""
     for _ in range(3):  # warm: a model compiles once, as in a session
         num(), den()
     ratios, tn, td = [], [], []
@@ -45,7 +46,8 @@ def pairs(num: Callable[[], Any], den: Callable[[], Any], n_pairs: int,
         ratios.append((t1 - t0) / (t2 - t1))
         tn.append((t1 - t0) / batch)
         td.append((t2 - t1) / batch)
-    return statistics.median(ratios), statistics.median(tn), statistics.median(td)
+    q1, _, q3 = statistics.quantiles(ratios, n=4)
+    return statistics.median(ratios), statistics.median(tn), statistics.median(td), q1, q3
 
 
 def contenders() -> dict[str, tuple[Callable[[], Any], Callable[[], Any], str]]:
@@ -106,10 +108,10 @@ def main() -> None:
     if args.profile:
         profile()
         return
-    print(f"{'row':<70} {'ratio':>7}  per call (us)")
+    print(f"{'row':<70} {'ratio':>7} {'quartiles':>11}  per call (us)")
     for name, (num, den, label) in contenders().items():
-        ratio, tn, td = pairs(num, den, args.pairs, args.batch)
-        print(f"{name:<70} {ratio:7.2f}  {label}: {tn * 1e6:.2f} / {td * 1e6:.2f}")
+        ratio, tn, td, q1, q3 = pairs(num, den, args.pairs, args.batch)
+        print(f"{name:<70} {ratio:7.2f} {q1:5.2f}-{q3:<5.2f}  {label}: {tn * 1e6:.2f} / {td * 1e6:.2f}")
 
 
 if __name__ == "__main__":
