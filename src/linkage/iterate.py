@@ -176,6 +176,10 @@ class Loop(NamedTuple):
     step_test: str = "converged"
     """Test 5's verdict on a small step: ``converged``, ``certify``, ``system`` (with the
     residual gate) or ``minimizes`` (``system``, and a stall is a local minimum)."""
+    counted: bool = False
+    """With ``certify``: the loop calls ``certify(problem, x, fx, limit)`` in the form of
+    :func:`linkage.solve.certify_root` (status, detail, evaluations of f it made) and adds
+    the evaluations up in ``extra`` (no closure per solve to count them)."""
     diverge: str = ""
     """Test 6: ``""`` (a bracket cannot diverge), ``streak`` or ``runaway`` (systems)."""
     diverge_when: str = ""
@@ -295,7 +299,11 @@ def _step_test(out: _Emitter) -> None:
     if loop.step_test == "converged":
         stop(1, "CONVERGED_STEP")
     elif loop.step_test == "certify":
-        put(1, "verdict, why = certify(x, fx, limit)")
+        if loop.counted:
+            put(1, "verdict, why, n = certify(problem, x, fx, limit)")
+            put(1, "extra += n")
+        else:
+            put(1, "verdict, why = certify(x, fx, limit)")
         put(1, "verdict, why, uncertified = _judge(verdict, why, uncertified)")
         put(1, "if verdict is not None:")
         put(2, "status, detail = verdict, why")
@@ -356,7 +364,7 @@ def loop_source(loop: Loop) -> str:
     lines = [f"def {loop.signature}:", *_block(loop.setup, 1),
              '    status, detail = _S.MAX_ITER, ""',
              "    prev_err = _inf",
-             "    growth = uncertified = stalls = rounding_steps = k = 0",
+             "    growth = uncertified = stalls = rounding_steps = k = " + ("extra = " * loop.counted) + "0",
              *([f"    quiet = {_QUIET_FTOL if loop.residual_test else ''}not rtol"] if loop.quiet else []),
              "    for k in range(1, max_iter + 1):",
              "        try:", *_block(loop.step, 3),

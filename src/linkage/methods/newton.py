@@ -99,7 +99,7 @@ def newton_loop(record: bool) -> Loop:
             if fx == 0.0 or fx - fx != 0.0:  # the start's verdict (_start_stop) can only be a stop
                 stop = _start_stop(problem, x0, fx)
                 if stop is not None:
-                    return x, fx, _inf, stop[0], stop[1], 0
+                    return x, fx, _inf, stop[0], stop[1], 0, 0
             best = start = abs(fx) if isinstance(fx, float) else _inf
             err = _inf
             """),
@@ -127,7 +127,8 @@ def newton_loop(record: bool) -> Loop:
             """ if record else "", """\
             x, fx = x1, fx1
             """),
-        guard=True, step_test="certify", diverge="streak", quiet=True)
+        result="x, fx, err, status, detail, k, extra",
+        guard=True, step_test="certify", counted=True, diverge="streak", quiet=True)
 
 
 NEWTON_LOOP = newton_loop(record=True)
@@ -135,8 +136,9 @@ NEWTON_LOOP = newton_loop(record=True)
 step, without states or method dispatch; the generic loop's status, root, iteration count
 and, when ``rows`` (an :class:`~linkage.iterate.Rows`) is given, its table row for row
 (tests/test_compile.py, tests/test_kernel.py). ``newton_lean(problem, x0, tol, rtol, ftol,
-max_iter, certify, rows)`` returns (x, f(x), last error, status, detail, iterations);
-``certify(x, fx, width)`` decides a small step."""
+max_iter, certify, rows)`` returns (x, f(x), last error, status, detail, iterations,
+evaluations of f the certificate made); ``certify(problem, x, fx, width)`` decides a small
+step (:func:`linkage.solve.certify_root`)."""
 
 newton_lean = build_loop(NEWTON_LOOP, {"_start_stop": start_stop, "_HEAD": HISTORY_HEAD})
 

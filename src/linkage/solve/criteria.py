@@ -22,13 +22,15 @@ def check_criteria(tol: float, rtol: float, ftol: float | None, max_iter: int) -
     value and type (True is not 1 here); values that cannot be remembered, such as a list,
     are checked afresh and refused with their message."""
     try:
-        return _checked_criteria(tol, rtol, ftol, max_iter)
+        return remembered_criteria(tol, rtol, ftol, max_iter)
     except TypeError:
         return _check_criteria(tol, rtol, ftol, max_iter)
 
 
 @functools.lru_cache(maxsize=256, typed=True)
-def _checked_criteria(tol: float, rtol: float, ftol: float | None, max_iter: int) -> Criteria:
+def remembered_criteria(tol: float, rtol: float, ftol: float | None, max_iter: int) -> Criteria:
+    """:func:`check_criteria` for hashable values, remembered: a solve's front door calls
+    it directly (TypeError for an unhashable value, which check_criteria then refuses)."""
     return _check_criteria(tol, rtol, ftol, max_iter)
 
 

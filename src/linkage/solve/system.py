@@ -12,7 +12,7 @@ from typing import Any
 from ..arguments import check_callable, check_number, check_reals, real_vector
 from ..errors import InputError
 from ..iterate import Criteria, run
-from ..result import History, Result, Status
+from ..result import History, Raw, Result, Status, given
 from ..rules import residual_gate
 from .criteria import MAX_RELATIVE_TOL, check_criteria
 from .diagnose import names_bad_callables
@@ -177,10 +177,8 @@ def packaged(m: Any, problem: Any, crit: Criteria, gate: float, outcome: tuple[A
     history = None
     if rows is not None:
         history = system_history(m, problem, rows, show_jacobian, reference, x)
-    result = Result.fast(m.name, x, status, iterations, nfev, err, residual, detail, meta)
-    if history is not None or njev:
-        result.__dict__.update(history=history, njev=njev)
-    return result
+    return Result.fast(m.name, x, status, iterations, nfev, err, residual, detail, njev, (given, meta),
+                       None if history is None else (given, history))
 
 
 @functools.lru_cache(maxsize=1)
@@ -221,7 +219,7 @@ _STOPPED = frozenset({Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN})
 
 
 def _two_unknown_result(problem: Any, q0: tuple[float, ...], phi0: Any, crit: Criteria, gate: float,
-                        damped: bool, meta: dict[str, Any], loaded: tuple[Any, ...]) -> Result:
+                        damped: bool, meta: Raw, loaded: tuple[Any, ...]) -> Result:
     """Newton on two unknowns by :func:`~linkage.methods.newton_system.newton_2x2`,
     judged and packaged as :func:`solve_system` does (``loaded``: :func:`_two_unknowns`)."""
     newton_2x2, max_abs = loaded[0], loaded[1]
@@ -229,10 +227,7 @@ def _two_unknown_result(problem: Any, q0: tuple[float, ...], phi0: Any, crit: Cr
         problem, q0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
     residual = max_abs(phi)
     status, detail = system_verdict(status, detail, residual, gate)
-    result = Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, meta)
-    if njev:
-        result.__dict__["njev"] = njev
-    return result
+    return Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, njev, meta)
 
 
 def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float, float], crit: Criteria,
@@ -250,8 +245,20 @@ def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float,
         raise InputError(f"the system has {len(phi0)} equations for 2 unknowns")
     gate = crit.ftol if crit.ftol is not None else crit.tol
     problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
-    meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": names, "kinds": kinds, "title": ""}
+    meta = (user_two_meta, crit, gate, names, kinds)
     return _two_unknown_result(problem, x0, phi0, crit, gate, damped, meta, loaded)
+
+
+def user_two_meta(crit: Criteria, gate: float, names: tuple[str, ...],
+                  kinds: tuple[str, ...]) -> dict[str, Any]:
+    """``Result.meta`` of a solve on user callables of two unknowns, built when first read."""
+    return {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": names, "kinds": kinds, "title": ""}
+
+
+def mechanism_meta(problem: Any, crit: Criteria, gate: float) -> dict[str, Any]:
+    """``Result.meta`` of a solve of a compiled problem, built when first read."""
+    return {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names, "kinds": problem.kinds,
+            "title": problem.title, **problem.meta}
 
 
 def _mechanism_two(problem: Any, x0: Any, crit: Criteria, damped: bool) -> Result | None:
@@ -273,9 +280,8 @@ def _mechanism_two(problem: Any, x0: Any, crit: Criteria, damped: bool) -> Resul
     if len(phi0) != 2:
         return None
     gate = residual_gate(crit.ftol if crit.ftol is not None else crit.tol, scale)
-    meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names, "kinds": problem.kinds,
-            "title": problem.title, **problem.meta}
-    result = _two_unknown_result(problem, q0, phi0, crit, gate, damped, meta, _two_unknowns())
+    result = _two_unknown_result(problem, q0, phi0, crit, gate, damped, (mechanism_meta, problem, crit, gate),
+                                 _two_unknowns())
     return result if result.converged else None
 
 
