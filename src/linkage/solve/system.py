@@ -14,7 +14,7 @@ from ..errors import InputError
 from ..iterate import Criteria, run
 from ..result import History, Raw, Result, Status, given
 from ..rules import residual_gate
-from .criteria import MAX_RELATIVE_TOL, check_criteria
+from .criteria import MAX_RELATIVE_TOL, check_criteria, remembered_criteria
 from .diagnose import names_bad_callables
 
 # The system solvers load with the first system solve, never with a scalar one
@@ -24,7 +24,7 @@ from .diagnose import names_bad_callables
 
 SYSTEM_METHODS: tuple[str, ...] = ("newton", "newton-fd", "lm")
 
-@names_bad_callables
+
 def solve_system(
     F: Callable[..., list[float]] | Any,
     x0: Sequence[float] | None = None,
@@ -61,7 +61,25 @@ def solve_system(
             and x0[0] - x0[0] == 0.0 and x0[1] - x0[1] == 0.0 and callable(F)):
         # the common case without the general front door: user callables, two unknowns,
         # a finite start (the same outcome: tests/test_compile.py)
-        return _newton_two(F, jac, x0, check_criteria(tol, rtol, ftol, max_iter), damped)
+        try:
+            crit = remembered_criteria(tol, rtol, ftol, max_iter)
+        except TypeError:  # an unhashable value: the general path refuses it with its message
+            crit = None
+        if crit is not None:
+            try:
+                return _newton_two(F, jac, x0, crit, damped)
+            except (TypeError, IndexError, RecursionError):
+                pass  # a user function's wrong return: the general path runs again and names it
+    return solve_general(F, x0, jac=jac, method=method, tol=tol, rtol=rtol, ftol=ftol, max_iter=max_iter,
+                         record=record, fd_step=fd_step, damped=damped, show_jacobian=show_jacobian)
+
+
+@names_bad_callables
+def solve_general(F: Any, x0: Any, *, jac: Any, method: str, tol: float, rtol: float, ftol: float | None,
+                  max_iter: int, record: bool, fd_step: float | None, damped: bool,
+                  show_jacobian: bool) -> Result:
+    """:func:`solve_system` by the general path, every argument checked; a TypeError or
+    IndexError from F or jac is named (:func:`~linkage.solve.diagnose.names_bad_callables`)."""
     NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system = _system_solvers()
     if (method == "newton" and not record and jac is None and fd_step is None and type(F) is SystemProblem
             and len(F.names) == 2 and F.J is not None and F.step_scales is None):
@@ -230,6 +248,11 @@ def _two_unknown_result(problem: Any, q0: tuple[float, ...], phi0: Any, crit: Cr
     return Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, njev, meta)
 
 
+_last_two: tuple[Any, Any, Any] = (None, None, None)
+"""The user functions (F, jac) :func:`_newton_two` last solved, with their problem: solving
+the same functions again (from another start, at other tolerances) builds none."""
+
+
 def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float, float], crit: Criteria,
                 damped: bool) -> Result:
     """:func:`solve_system` for ``newton`` on user callables of two unknowns, with the
@@ -244,7 +267,13 @@ def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float,
     if len(phi0) != 2:
         raise InputError(f"the system has {len(phi0)} equations for 2 unknowns")
     gate = crit.ftol if crit.ftol is not None else crit.tol
-    problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
+    global _last_two
+    last = _last_two
+    if last[0] is F and last[1] is jac:
+        problem = last[2]
+    else:
+        problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
+        _last_two = (F, jac, problem)
     meta = (user_two_meta, crit, gate, names, kinds)
     return _two_unknown_result(problem, x0, phi0, crit, gate, damped, meta, loaded)
 
