@@ -43,7 +43,7 @@ from collections import deque
 from collections.abc import Callable
 from typing import Any, NamedTuple
 
-from .result import Status
+from .result import STATUS_MEMBERS, Status
 from .rules import step_limit, system_converged, worse_than_seen
 
 UNCERTIFIED_LIMIT = 4
@@ -107,10 +107,10 @@ def judge_certificate(verdict: Status, why: str, uncertified: int) -> tuple[Stat
     """Test 5's certification, shared by the generic and the lean loops: after a step
     within the tolerance, (the status to stop with, or None to go on; its detail; the
     updated count of small steps without evidence)."""
-    if verdict is Status.CONVERGED_STEP:
+    if verdict is STATUS_MEMBERS.CONVERGED_STEP:
         return verdict, "", uncertified
     uncertified += 1
-    if verdict is not Status.STALLED or uncertified >= UNCERTIFIED_LIMIT:
+    if verdict is not STATUS_MEMBERS.STALLED or uncertified >= UNCERTIFIED_LIMIT:
         return verdict, why, uncertified
     return None, "", uncertified
 
@@ -382,7 +382,7 @@ def loop_source(loop: Loop) -> str:
 def build_loop(loop: Loop, names: dict[str, Any] | None = None) -> Callable[..., Any]:
     """Compile ``loop``; ``names``: what its step reads besides the stopping tests' own."""
     namespace: dict[str, Any] = {
-        "_S": Status, "_inf": math.inf, "_nan": math.nan, "_isfinite": math.isfinite,
+        "_S": STATUS_MEMBERS, "_inf": math.inf, "_nan": math.nan, "_isfinite": math.isfinite,
         "_explain": explain, "_judge": judge_certificate, "_stall": rounding_stall,
         "_worse": worse_than_seen, "_step_limit": step_limit, "_system_converged": system_converged,
         "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_RUNAWAY": RUNAWAY, **(names or {})}

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from enum import Enum
+from types import SimpleNamespace
 from typing import Any, NamedTuple
 
 from .errors import NotConvergedError
@@ -37,6 +38,11 @@ class Status(Enum):
     def message(self) -> str:
         return _MESSAGES[self]
 
+
+STATUS_MEMBERS = SimpleNamespace(**Status.__members__)
+"""The statuses as plain attributes, for the hot paths (the generated loops read them as
+``_S.MAX_ITER``): the same members, read as an instance attribute (about 10 ns) where an
+Enum class attribute costs about 150 ns on Python 3.11, several times per solve."""
 
 _CONVERGED = frozenset({Status.CONVERGED_STEP, Status.CONVERGED_RESIDUAL, Status.CONVERGED_EXACT})
 
