@@ -56,22 +56,36 @@ def solve_system(
     textbook iteration.
     Returns a :class:`Result` with ``x`` (a tuple), ``nfev`` and ``njev``.
     """
-    if (method == "newton" and not record and jac is not None and fd_step is None and type(x0) is tuple
-            and len(x0) == 2 and type(x0[0]) is float and type(x0[1]) is float
-            and x0[0] - x0[0] == 0.0 and x0[1] - x0[1] == 0.0 and callable(F)):
-        # the common case without the general front door: user callables, two unknowns,
-        # a finite start (the same outcome: tests/test_compile.py)
-        try:
-            crit = remembered_criteria(tol, rtol, ftol, max_iter)
-        except TypeError:  # an unhashable value: the general path refuses it with its message
-            crit = None
-        if crit is not None:
-            try:
-                return _newton_two(F, jac, x0, crit, damped)
-            except (TypeError, IndexError, RecursionError):
-                pass  # a user function's wrong return: the general path runs again and names it
+    if method == "newton" and not record and fd_step is None:
+        fast = fast_newton(F, x0, jac, tol, rtol, ftol, max_iter, damped)
+        if fast is not None:
+            return fast
     return solve_general(F, x0, jac=jac, method=method, tol=tol, rtol=rtol, ftol=ftol, max_iter=max_iter,
                          record=record, fd_step=fd_step, damped=damped, show_jacobian=show_jacobian)
+
+
+def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float | None, max_iter: int,
+                damped: bool) -> Result | None:
+    """Newton with recording off by a short front door, where one applies: user callables
+    of two unknowns from a finite tuple start (:func:`_newton_two`), or a compiled problem
+    of two unknowns that converges (:func:`_mechanism_two`); the same Result as the general
+    path (tests/test_compile.py). None for anything else, and where a user function
+    returned the wrong kind of value: the general path then runs and names it."""
+    try:
+        crit = remembered_criteria(tol, rtol, ftol, max_iter)
+    except TypeError:  # an unhashable value: the general path refuses it with its message
+        return None
+    try:
+        if (jac is not None and type(x0) is tuple and len(x0) == 2 and type(x0[0]) is float
+                and type(x0[1]) is float and x0[0] - x0[0] == 0.0 and x0[1] - x0[1] == 0.0 and callable(F)):
+            return _newton_two(F, jac, x0, crit, damped)
+        SystemProblem = _system_solvers()[3]
+        if (jac is None and type(F) is SystemProblem and len(F.names) == 2 and F.J is not None
+                and F.step_scales is None):
+            return _mechanism_two(F, x0, crit, damped)
+    except (TypeError, IndexError, RecursionError):
+        pass
+    return None
 
 
 @names_bad_callables
@@ -81,11 +95,6 @@ def solve_general(F: Any, x0: Any, *, jac: Any, method: str, tol: float, rtol: f
     """:func:`solve_system` by the general path, every argument checked; a TypeError or
     IndexError from F or jac is named (:func:`~linkage.solve.diagnose.names_bad_callables`)."""
     NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system = _system_solvers()
-    if (method == "newton" and not record and jac is None and fd_step is None and type(F) is SystemProblem
-            and len(F.names) == 2 and F.J is not None and F.step_scales is None):
-        fast = _mechanism_two(F, x0, check_criteria(tol, rtol, ftol, max_iter), damped)
-        if fast is not None:
-            return fast
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r} for a system; choose from {', '.join(SYSTEM_METHODS)}")
     crit = check_criteria(tol, rtol, ftol, max_iter)
