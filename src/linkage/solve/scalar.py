@@ -18,7 +18,7 @@ from ..methods import METHODS, SCALAR_METHODS, MethodEntry, method_class
 from ..problems.scalar import ScalarProblem
 from ..result import History, Result, Status
 from .certificate import certify_root, check_sign_change, final_bracket, value_or_none
-from .criteria import check_criteria, remembered_criteria
+from .criteria import RecentCriteria, check_criteria
 from .diagnose import diagnose_scalar
 
 
@@ -32,6 +32,10 @@ def problem_of(f: Callable[[float], float] | ScalarProblem, fprime: Any, g: Any)
     if not callable(f):
         raise InputError(f"f must be callable or a ScalarProblem, got {type(f).__name__}")
     return ScalarProblem(f, fprime=fprime, g=g)
+
+
+_recent = RecentCriteria()
+"""The criteria the scalar front door checked last (its fast path reads them by identity)."""
 
 
 def solve_scalar(
@@ -72,11 +76,10 @@ def solve_scalar(
         # the common case, without the general front door: a problem with its
         # derivative and a finite start (what the front door below checks, and then
         # the same call)
-        try:
-            crit = remembered_criteria(tol, rtol, ftol, max_iter)
-        except TypeError:  # an unhashable value: refused, with its message
-            crit = check_criteria(tol, rtol, ftol, max_iter)
-        return newton_result(f, x0, crit, record)
+        seen = _recent.seen
+        if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter:
+            return newton_result(f, x0, seen[4], record)
+        return newton_result(f, x0, _recent.check(tol, rtol, ftol, max_iter), record)
     entry = METHODS.get(method)
     if entry is None:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")

@@ -14,7 +14,7 @@ from ..errors import InputError
 from ..iterate import Criteria, run
 from ..result import History, Raw, Result, Status, given
 from ..rules import residual_gate
-from .criteria import MAX_RELATIVE_TOL, check_criteria, remembered_criteria
+from .criteria import MAX_RELATIVE_TOL, RecentCriteria, check_criteria
 from .diagnose import names_bad_callables
 
 # The system solvers load with the first system solve, never with a scalar one
@@ -64,6 +64,10 @@ def solve_system(
                          record=record, fd_step=fd_step, damped=damped, show_jacobian=show_jacobian)
 
 
+_recent = RecentCriteria()
+"""The criteria the system front door checked last (read by identity)."""
+
+
 def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float | None, max_iter: int,
                 damped: bool) -> Result | None:
     """Newton with recording off by a short front door, where one applies: user callables
@@ -71,10 +75,11 @@ def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float 
     of two unknowns that converges (:func:`_mechanism_two`); the same Result as the general
     path (tests/test_compile.py). None for anything else, and where a user function
     returned the wrong kind of value: the general path then runs and names it."""
-    try:
-        crit = remembered_criteria(tol, rtol, ftol, max_iter)
-    except TypeError:  # an unhashable value: the general path refuses it with its message
-        return None
+    seen = _recent.seen
+    if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter:
+        crit = seen[4]
+    else:
+        crit = _recent.check(tol, rtol, ftol, max_iter)
     try:
         if (jac is not None and type(x0) is tuple and len(x0) == 2 and type(x0[0]) is float
                 and type(x0[1]) is float and x0[0] - x0[0] == 0.0 and x0[1] - x0[1] == 0.0 and callable(F)):
