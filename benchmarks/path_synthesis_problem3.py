@@ -13,9 +13,7 @@ from __future__ import annotations
 import argparse
 
 from linkage.homotopy import ninepoint as npt
-
-PROBLEM_3 = [(0.25, 0.0), (0.52, 0.1), (0.8, 0.7), (1.2, 1.0), (1.4, 1.3), (1.1, 1.48), (0.7, 1.4),
-             (0.2, 1.0), (0.02, 0.4)]
+from linkage.synthesis.path import PROBLEM_3
 
 
 def main() -> None:

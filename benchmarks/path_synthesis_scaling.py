@@ -12,10 +12,10 @@ import statistics
 import time
 
 from linkage.homotopy import ninepoint as npt
+from linkage.synthesis import path
 from linkage.synthesis.path import chunk_runner
 
-PROBLEM_3 = [complex(x, y) for x, y in [(0.25, 0.0), (0.52, 0.1), (0.8, 0.7), (1.2, 1.0), (1.4, 1.3),
-                                        (1.1, 1.48), (0.7, 1.4), (0.2, 1.0), (0.02, 0.4)]]
+PROBLEM_3 = [complex(x, y) for x, y in path.PROBLEM_3]
 
 
 def main() -> None:

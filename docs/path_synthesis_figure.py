@@ -16,10 +16,7 @@ from linkage.kinematics.assemblies import assemblies, same_configuration
 from linkage.kinematics.circuits import circuits
 from linkage.kinematics.loading import from_text
 from linkage.kinematics.rates import place
-from linkage.synthesis.path import mechanism_text, synthesize_path
-
-PROBLEM_3 = [(0.25, 0.0), (0.52, 0.1), (0.8, 0.7), (1.2, 1.0), (1.4, 1.3), (1.1, 1.48), (0.7, 1.4),
-             (0.2, 1.0), (0.02, 0.4)]
+from linkage.synthesis.path import PROBLEM_3, mechanism_text, synthesize_path
 
 
 def main() -> None:

@@ -12,9 +12,7 @@ import numpy as np
 import pytest
 
 from linkage.homotopy import ninepoint as npt
-
-PROBLEM_3 = [(0.25, 0.0), (0.52, 0.1), (0.8, 0.7), (1.2, 1.0), (1.4, 1.3), (1.1, 1.48), (0.7, 1.4),
-             (0.2, 1.0), (0.02, 0.4)]
+from linkage.synthesis.path import PROBLEM_3
 
 
 def _coupler_points(rng: np.random.Generator) -> tuple[list[complex], np.ndarray]:
@@ -318,7 +316,9 @@ def test_problem_3s_64_real_four_bars_are_alpha_certified_real_and_distinct(prob
     certs = na.certify_rows(rows, res.points)
     assert len(certs) == 64 and all(c.certified and c.real for c in certs)
     assert alpha.undistinguished(list(rows), certs) == []
-    assert certified_line(SimpleNamespace(solutions=res)) == (
+    from linkage.synthesis.path import real_certificates
+
+    assert certified_line(SimpleNamespace(certificates=real_certificates(res))) == (
         "alpha test (Smale; 50 digits): 64 of the 64 real four-bars certified real, all distinct")
 
 

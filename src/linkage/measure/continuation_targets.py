@@ -23,9 +23,8 @@ from typing import Any
 
 import numpy as np
 
-PROBLEM_3 = ((0.25, 0.0), (0.52, 0.1), (0.8, 0.7), (1.2, 1.0), (1.4, 1.3), (1.1, 1.48), (0.7, 1.4),
-             (0.2, 1.0), (0.02, 0.4))
-"""Wampler, Morgan and Sommese's Problem 3: nine points (x, y)."""
+from ..synthesis.path import PROBLEM_3
+
 PUBLISHED_ORBITS = 1442
 PUBLISHED_REAL = 64
 FIVE_POSES = ((1.478, 2.018, 53.31), (0.7226, 2.672, 40.19), (-0.7101, 2.167, 41.29),

@@ -44,15 +44,10 @@ def path_tables(result: Any) -> tuple[DataTable, ...]:
 
 
 def certified_line(result: Any) -> str:
-    """Smale's alpha test at each real four-bar (linkage.homotopy.ninepoint_alpha; tens of
-    milliseconds each): how many are certified real, and whether all are told apart."""
-    from ..homotopy.alpha import undistinguished
-    from ..homotopy.ninepoint_alpha import certify_rows
-
-    s = result.solutions
-    rows = s.solutions[s.real]
-    certs = certify_rows(rows, s.points)
-    apart = undistinguished(list(rows), certs)
+    """The alpha test's verdict on the real four-bars (``result.certificates``,
+    :func:`linkage.synthesis.path.real_certificates`): how many are certified real, and
+    whether all are told apart."""
+    certs, apart = result.certificates
     return (f"alpha test (Smale; 50 digits): {sum(c.certified and c.real for c in certs)} of the "
             f"{len(certs)} real four-bars certified real"
             + (", all distinct" if not apart else f", {len(apart)} pair(s) not told apart"))

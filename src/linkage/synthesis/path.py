@@ -24,6 +24,8 @@ from __future__ import annotations
 import cmath
 import math
 from dataclasses import dataclass
+from functools import cached_property
+from typing import Any
 
 import numpy as np
 
@@ -33,6 +35,10 @@ from ..units import degrees
 from .request import MIN_TRANSMISSION_DEG
 
 POINTS = 9
+PROBLEM_3 = ((0.25, 0.0), (0.52, 0.1), (0.8, 0.7), (1.2, 1.0), (1.4, 1.3), (1.1, 1.48), (0.7, 1.4),
+             (0.2, 1.0), (0.02, 0.4))
+"""Wampler, Morgan and Sommese's Problem 3 (J. Mech. Des. 114(1), 1992): nine points (x, y),
+1,442 four-bars up to cognates, 64 of them real (docs/path_synthesis.md)."""
 ON_POINT = 1e-9
 """A position reaches its point when P is within this of it, relative to the linkage's size."""
 
@@ -67,6 +73,24 @@ class PathSynthesis:
     missing: int
     solutions: ninepoint.NinePointSolutions
     extra: tuple[int, ...] = ()  # which of the points are extra ones (path_points), not given
+
+    @cached_property
+    def certificates(self) -> tuple[tuple[Any, ...], list[tuple[int, int]]]:
+        """:func:`real_certificates` of the solutions, computed when first read (tens of
+        milliseconds a real four-bar)."""
+        return real_certificates(self.solutions)
+
+
+def real_certificates(solutions: ninepoint.NinePointSolutions
+                      ) -> tuple[tuple[Any, ...], list[tuple[int, int]]]:
+    """Smale's alpha test at each real four-bar (:mod:`linkage.homotopy.ninepoint_alpha`, 50
+    digits): the certificates, and the pairs of them not told apart (empty: all distinct)."""
+    from ..homotopy.alpha import undistinguished
+    from ..homotopy.ninepoint_alpha import certify_rows
+
+    rows = solutions.solutions[solutions.real]
+    certs = certify_rows(rows, solutions.points)
+    return certs, undistinguished(list(rows), certs)
 
 
 def chunk_runner(scheduler: str | None, workers: int | None):  # type: ignore[no-untyped-def]
