@@ -29,8 +29,9 @@ import numpy as np
 
 from ..errors import InputError
 from ..homotopy import ninepoint
-from ..units import degrees
+from ..units import degrees, radians
 from .request import MIN_TRANSMISSION_DEG
+from .timed_path import TimedSolutions, check_timed_points, is_timed, timed_four_bars
 
 POINTS = 9
 ON_POINT = 1e-9
@@ -51,6 +52,9 @@ class PathFourBar:
     max_point_error: float  # max |P - point| over the points, engine-placed, in lengths
     transmission_min_deg: float
     crank_deg: tuple[float, ...]  # the crank at A's angle at each point
+    timing_error_deg: float | None = None
+    """Prescribed timing: the largest gap between the crank's turn from the first point to
+    another and the prescribed one (deg); None without timing."""
 
     @property
     def lengths(self) -> tuple[float, float, float, float]:
@@ -66,6 +70,17 @@ class PathSynthesis:
     found: int  # orbits (complex and real)
     missing: int
     solutions: ninepoint.NinePointSolutions
+
+
+@dataclass(frozen=True)
+class TimedPathSynthesis:
+    """Five points with the crank's angle at each: every four-bar through them with that
+    timing (:mod:`.timed_path`), each judged (:func:`judge_four_bar`)."""
+
+    points: tuple[complex, ...]
+    crank_deg: tuple[float, ...]
+    designs: tuple[PathFourBar, ...]
+    solutions: TimedSolutions
 
 
 def chunk_runner(scheduler: str | None, workers: int | None):  # type: ignore[no-untyped-def]
@@ -182,22 +197,35 @@ def _along(circ, at: list[int]) -> list[tuple[float, ...]]:  # type: ignore[no-u
 
 def judge(z: np.ndarray, points: list[complex],
           min_transmission: float = MIN_TRANSMISSION_DEG) -> PathFourBar:
-    """One real solution as a four-bar, moved through the points by the engine. Its least
-    transmission angle is taken over the motion from the first point to the last (on the
-    circuit, in order), or at the points where that motion does not exist; below
-    ``min_transmission`` (deg) it is a ``transmission`` defect."""
+    """One real nine-point solution as a four-bar, moved through the points by the engine
+    (:func:`judge_four_bar`)."""
+    a, x, b, y = (complex(z[k]) for k in (ninepoint.A, ninepoint.X, ninepoint.B, ninepoint.Y))
+    P0 = points[0]
+    return judge_four_bar((P0 + a, P0 + b, P0 + x, P0 + y), _positions(z, points), points, min_transmission)
+
+
+def judge_four_bar(pivots: tuple[complex, complex, complex, complex],
+                   poses: list[tuple[float, float, float]], points: list[complex],
+                   min_transmission: float = MIN_TRANSMISSION_DEG,
+                   crank_deg: tuple[float, ...] | None = None) -> PathFourBar:
+    """A four-bar (ground pivots A, B, moving pivots M, N at the first point; P the first
+    point) moved through the points by the engine, from ``poses``: its (crank, coupler,
+    rocker) angles in radians at each point. Its least transmission angle is taken over
+    the motion from the first point to the last (on the circuit, in order), or at the
+    points where that motion does not exist; below ``min_transmission`` (deg) it is a
+    ``transmission`` defect. With ``crank_deg`` (prescribed crank angles, deg), a crank that
+    turns from the first point to another by other than the prescribed difference (beyond
+    :data:`ON_POINT` rad) is a ``timing`` defect."""
     from ..kinematics.assemblies import assemblies, same_configuration
     from ..kinematics.circuits import circuits
     from ..kinematics.loading import from_text
     from ..kinematics.rates import place
     from ..problems.closed_form import grashof
 
-    a, x, b, y = (complex(z[k]) for k in (ninepoint.A, ninepoint.X, ninepoint.B, ninepoint.Y))
     P0 = points[0]
-    fb = PathFourBar(P0 + a, P0 + b, P0 + x, P0 + y, P0, "", (), math.inf, math.nan, ())
+    fb = PathFourBar(*pivots, P0, "", (), math.inf, math.nan, ())
     m = from_text(mechanism_text(fb), "<path synthesis>")
     size = m.length_scale
-    poses = _positions(z, points)
     errors, trans = [], []
     for (phi, t3, t4), p in zip(poses, points):
         q = [t3, t4]
@@ -227,8 +255,19 @@ def judge(z: np.ndarray, points: list[complex],
         defects.append("positions")
     if min(trans) < min_transmission:
         defects.append("transmission")
+    timing = None if crank_deg is None else timing_error_deg([p[0] for p in poses], crank_deg)
+    if timing is not None and not radians(timing) <= ON_POINT:
+        defects.append("timing")
     return PathFourBar(fb.ground_a, fb.ground_b, fb.pin_m, fb.pin_n, P0, grashof(*fb.lengths),
-                       tuple(defects), max(errors), min(trans), tuple(degrees(p[0]) for p in poses))
+                       tuple(defects), max(errors), min(trans), tuple(degrees(p[0]) for p in poses), timing)
+
+
+def timing_error_deg(crank_rad: list[float], crank_deg: tuple[float, ...]) -> float:
+    """The largest gap (deg) between the crank's turn from the first point to each other,
+    ``crank_rad`` (its angles, rad), and the prescribed turn (``crank_deg``, its prescribed
+    angles in deg: only their differences count), modulo a turn."""
+    return max(degrees(abs(math.remainder(phi - crank_rad[0] - radians(c - crank_deg[0]), 2 * math.pi)))
+               for phi, c in zip(crank_rad, crank_deg))
 
 
 def _arc_index(circ, phi: float, q: tuple[float, float]) -> int | None:
@@ -254,19 +293,22 @@ def _in_order(at: list[int], n: int) -> bool:
 def synthesize_path(points: object, seed: int = 0, scheduler: str | None = None,
                     workers: int | None = None,
                     min_transmission: float = MIN_TRANSMISSION_DEG,
-                    progress=None) -> PathSynthesis:  # type: ignore[no-untyped-def]
+                    progress=None) -> PathSynthesis | TimedPathSynthesis:  # type: ignore[no-untyped-def]
     """Every four-bar whose coupler point passes through nine points; the real ones judged
-    by moving them (module docstring). ``points``: nine (x, y) pairs. The paths are tracked
+    by moving them (module docstring). ``points``: nine (x, y) pairs, or five (x, y, crank
+    angle in deg) for prescribed timing (:func:`synthesize_timed_path`). The paths are tracked
     in chunks by the scan's runner: here, on dask's local threads or processes, or on a
     cluster (``scheduler`` tcp://HOST:PORT), ``workers`` at a time. ``progress(done, label)``
     is told how far it is, out of the paths of a route."""
-    from ..arguments import MAX_SEED, check_number, check_whole, check_workers
+    from ..arguments import check_workers
 
+    if is_timed(points):
+        if scheduler is not None or workers is not None:
+            raise InputError("scheduler and workers are for nine points' path tracking: five timed points "
+                             "are two Burmester problems, solved here")
+        return synthesize_timed_path(points, seed, min_transmission)
     pts = check_points(points)
-    seed = check_whole("seed", seed, 0, MAX_SEED)
-    floor = check_number("min_transmission", min_transmission)
-    if not 0.0 <= floor <= 90.0:
-        raise InputError(f"min_transmission must be from 0 to 90 deg, got {floor:g}")
+    seed, floor = checked_options(seed, min_transmission)
     workers = check_workers("workers", workers, scheduler)
     if scheduler is not None and not isinstance(scheduler, str):
         raise InputError("scheduler must be threads, processes, synchronous or tcp://HOST:PORT, "
@@ -280,3 +322,29 @@ def synthesize_path(points: object, seed: int = 0, scheduler: str | None = None,
         if progress is not None:
             progress(sols.paths * (k + 1) // len(reals), "moving the real four-bars")
     return PathSynthesis(tuple(pts), tuple(designs), len(sols.solutions), sols.missing, sols)
+
+
+def checked_options(seed: object, min_transmission: object) -> tuple[int, float]:
+    """The seed (a whole number) and the transmission floor (0 to 90 deg), or InputError."""
+    from ..arguments import MAX_SEED, check_number, check_whole
+
+    whole = check_whole("seed", seed, 0, MAX_SEED)
+    floor = check_number("min_transmission", min_transmission)
+    if not 0.0 <= floor <= 90.0:
+        raise InputError(f"min_transmission must be from 0 to 90 deg, got {floor:g}")
+    return whole, floor
+
+
+def synthesize_timed_path(points: object, seed: int = 0,
+                          min_transmission: float = MIN_TRANSMISSION_DEG) -> TimedPathSynthesis:
+    """Every four-bar whose coupler point passes through five points (x, y, crank angle in
+    deg) with the crank at those angles (only their differences count: the crank's angle at
+    the first point is the design's own), each moved through the points by the engine and
+    judged (:func:`judge_four_bar`, with a ``timing`` defect). Other counts of timed points,
+    points with and without angles mixed, NaN or coincident points: InputError."""
+    check_timed_points(points)  # before the options: a wrong count is the first thing said
+    seed, floor = checked_options(seed, min_transmission)
+    found = timed_four_bars(points, seed=seed)
+    designs = tuple(judge_four_bar(fb.pivots, list(fb.configurations), list(found.points), floor,
+                                   found.crank_deg) for fb in found.four_bars)
+    return TimedPathSynthesis(found.points, found.crank_deg, designs, found)
