@@ -31,7 +31,12 @@ def path_command(point: list[str], *, design: Optional[int], output: Optional[Pa
     from ..render import writers
     from ..render.path_synthesis import path_report, ranked
     from ..synthesis.path import check_points, synthesize_path
+    from .timed_path import is_timed, timed_path_command
 
+    if is_timed(point):  # X,Y,DEG: prescribed timing, five points
+        return timed_path_command(point, design=design, output=output, write_file=write_file, force=force,
+                                  fmt=fmt, report_out=report_out, digits=digits, table=table,
+                                  scheduler=scheduler, workers=workers, min_transmission=min_transmission)
     pairs = read_points(point)
     check_points(pairs)  # before the workers, so a wrong count is the first thing said
     workers = check_workers("--workers", workers, scheduler)

@@ -158,8 +158,9 @@ def synthesize(
                      "pose 1 (twice: three poses leave both free)."),
     ] = None,
     path: Annotated[bool, typer.Option("--path", help="Path generation: every four-bar whose coupler point "
-                                       "passes through 9 --point (docs/path_synthesis.md).")] = False,
-    point: Annotated[Optional[list[str]], typer.Option("--point", metavar="X,Y", help="With --path.")] = None,
+                                       "passes through 9 --point X,Y, or 5 --point X,Y,DEG with the crank "
+                                       "at DEG (docs/path_synthesis.md).")] = False,
+    point: Annotated[Optional[list[str]], typer.Option("--point", metavar="X,Y[,DEG]", help="--path")] = None,
     design_number: Annotated[
         Optional[int],
         typer.Option("--design", metavar="K", help="With --motion and -o FILE.toml: write design K "

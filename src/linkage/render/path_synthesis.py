@@ -10,9 +10,13 @@ from .report import Block, Text, table
 
 def ranked(result: Any) -> list[int]:
     """Real designs, those without defects first, then by least transmission, largest first."""
-    designs = result.designs
+    return rank([group[0] for group in result.designs])
+
+
+def rank(designs: list[Any]) -> list[int]:
+    """Four-bars, those without defects first, then by least transmission, largest first."""
     return sorted(range(len(designs)),
-                  key=lambda i: (len(designs[i][0].defects), -designs[i][0].transmission_min_deg))
+                  key=lambda i: (len(designs[i].defects), -designs[i].transmission_min_deg))
 
 
 def _row(number: int, cognate: int, fb: Any) -> tuple[Any, ...]:
@@ -84,3 +88,57 @@ def path_report(result: Any, digits: int) -> Report:
                 "without_defects": sum(1 for g in result.designs if not g[0].defects), "seconds": s.seconds}
 
     return Report(title, tables, blocks, document)
+
+
+TIMED_HEADS = [HEADS[0], ("crank_dyad", "", "int"), ("rocker_dyad", "", "int"), *HEADS[2:],
+               ("crank_first", "deg", "number"), ("timing_error", "deg", "number")]
+"""The timed designs' columns: the untimed ones (no cognates: a cognate's crank turns as
+the coupler or the rocker does, not as prescribed), which dyads, the crank's angle at the
+first point and the timing error."""
+TIMED_TERMINAL = (*TERMINAL_COLUMNS, "timing_error")
+
+
+def timed_path_report(result: Any, digits: int) -> Report:
+    """The report of five points with prescribed crank angles (synthesis.path.TimedPathSynthesis)."""
+    order = rank(list(result.designs))
+    four_bars = result.solutions.four_bars
+    rows = [(k + 1, four_bars[i].crank + 1, four_bars[i].rocker + 1, *_row(k + 1, 1, result.designs[i])[2:],
+             result.designs[i].crank_deg[0], result.designs[i].timing_error_deg) for k, i in enumerate(order)]
+    tables = (from_rows("designs", TIMED_HEADS, rows),)
+    title = "four-bars whose coupler point passes through five points at prescribed crank angles"
+
+    def blocks() -> list[Block]:
+        out: list[Block] = [Text(title, "bold"), *[Text(line) for line in timed_summary(result)], Text("")]
+        shown = [c for c in tables[0].columns if c.name in TIMED_TERMINAL]
+        out.append(table("", [c.header for c in shown], list(zip(*[c.values for c in shown])), digits))
+        out.append(Text("defects: branch, the points are not all on one circuit; order, the circuit meets "
+                        "them out of order; transmission, the least transmission angle from the first point "
+                        "to the last is below --min-transmission; timing, the crank's turn from the first "
+                        "point is not the prescribed one"))
+        return out
+
+    def document() -> dict[str, Any]:
+        s = result.solutions
+        return {"title": title, "crank_dyads": len(s.cranks.cranks), "four_bars": len(result.designs),
+                "without_defects": sum(1 for d in result.designs if not d.defects),
+                "failed_or_unsettled": s.incomplete()}
+
+    return Report(title, tables, blocks, document)
+
+
+def timed_summary(result: Any) -> list[str]:
+    s = result.solutions
+    rockers = ", ".join("-" if r is None else str(sum(1 for f in s.four_bars if f.crank == i))
+                        for i, r in enumerate(s.rockers)) or "none"
+    clean = sum(1 for d in result.designs if not d.defects)
+    missed = s.incomplete()
+    return [
+        "prescribed timing (Sandor and Erdman's standard form): Burmester's five-pose problem for the crank "
+        "dyads (the crank turned as prescribed), then for each one's rocker dyads (the coupler turned as "
+        "that crank dyad turns it)",
+        f"crank dyads: {len(s.cranks.cranks)} real ({s.cranks.complex_count} complex, {s.cranks.infinite} at "
+        f"infinity, {s.cranks.failed} failed); rocker dyads of each: {rockers}; {len(result.designs)} "
+        f"four-bars, {clean} without defects"
+        + (f"; {missed} path{'s' if missed != 1 else ''} failed or not settled (a four-bar may be missing)"
+           if missed else ""),
+    ]

@@ -63,6 +63,11 @@ class TimedSolutions:
     problem: the coupler translates and its pins move on congruent curves)."""
     four_bars: tuple[TimedFourBar, ...]
 
+    def incomplete(self) -> int:
+        """Paths of the Burmester problems that failed, or real roots that did not settle as
+        rigid cranks: where a four-bar may be missing."""
+        return sum(b.failed + b.unresolved for b in (self.cranks, *self.rockers) if b is not None)
+
 
 def is_timed(points: Any) -> bool:
     """Whether some point carries a third number (a crank angle): the timed problem."""
