@@ -222,8 +222,8 @@ def judge_four_bar(pivots: tuple[complex, complex, complex, complex],
     from ..kinematics.rates import place
     from ..problems.closed_form import grashof
 
-    P0 = points[0]
-    fb = PathFourBar(*pivots, P0, "", (), math.inf, math.nan, ())
+    P0 = complex(points[0])
+    fb = PathFourBar(*(complex(p) for p in pivots), P0, "", (), math.inf, math.nan, ())
     m = from_text(mechanism_text(fb), "<path synthesis>")
     size = m.length_scale
     errors, trans = [], []
