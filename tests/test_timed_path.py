@@ -150,6 +150,26 @@ def test_points_given_out_of_order_are_an_order_defect():
     assert len(mine) == 1 and "order" in mine[0].defects and "branch" not in mine[0].defects
 
 
+def test_points_past_a_limit_position_of_the_crank_are_a_grashof_defect():
+    """A non-Grashof four-bar: three points on one assembly as the crank turns up to its
+    limit, two on the other as it turns back. One circuit, in order, but the crank (the
+    input, with timing) cannot drive it there: motion generation's ``grashof`` defect."""
+    import linkage
+
+    pivots, points, angles = _random_four_bar(np.random.default_rng(12), False, signs=(1, 1, 1, -1, -1))
+    back = [0, 1, 2, 4, 3]
+    result = linkage.synthesize_path(_timed([points[i] for i in back], [angles[i] for i in back]))
+    mine = [d for d in result.designs if _matches(pivots, (d.ground_a, d.ground_b, d.pin_m, d.pin_n))]
+    assert len(mine) == 1 and "grashof" in mine[0].defects
+    assert not {"branch", "order", "timing"} & set(mine[0].defects)
+    # the same four-bar with every point on the first assembly: the crank turns one way
+    same, points, angles = _random_four_bar(np.random.default_rng(12), False)
+    assert same == pivots
+    result = linkage.synthesize_path(_timed(points, angles))
+    mine = [d for d in result.designs if _matches(pivots, (d.ground_a, d.ground_b, d.pin_m, d.pin_n))]
+    assert len(mine) == 1 and not {"grashof", "branch", "order"} & set(mine[0].defects)
+
+
 def test_a_crank_that_turns_otherwise_than_prescribed_is_a_timing_defect():
     """The reference four-bar judged at its own configurations: on time with its angles, a
     ``timing`` defect (and no other new one) with one angle moved by a degree."""

@@ -17,6 +17,11 @@ coupler) and is checked as a designer would check it, by moving it:
   the motion from the first point to the last is below ``min_transmission`` (function
   generation's default, 30 deg);
 - its Grashof class.
+
+With prescribed timing (five points with the crank's angle at each, :mod:`.timed_path`),
+the crank is the input, and two more defects: ``timing``, the crank's turn from the first
+point to a point is not the prescribed one; ``grashof``, the crank cannot turn one way
+from the first point to the last (a limit position between: motion generation's name).
 """
 
 from __future__ import annotations
@@ -185,14 +190,21 @@ def _transmission(t3: float, t4: float) -> float:
     return folded_transmission(degrees(t4 - t3) % 360.0 % 180.0)
 
 
-def _along(circ, at: list[int]) -> list[tuple[float, ...]]:  # type: ignore[no-untyped-def]
-    """The traced configurations from the first point's arc position to the last's, the
+def _along(circ, at: list[int]) -> list[int]:  # type: ignore[no-untyped-def]
+    """The traced samples (indices) from the first point's arc position to the last's, the
     way round that meets the points in order."""
     n = len(circ.configurations)
     forward = [(k - at[0]) % n for k in at]
     step = 1 if forward == sorted(forward) else -1
     span = ((at[-1] - at[0]) * step) % n
-    return [circ.configurations[(at[0] + step * i) % n] for i in range(span + 1)]
+    return [(at[0] + step * i) % n for i in range(span + 1)]
+
+
+def one_way(angles: list[float]) -> bool:
+    """Whether an angle (rad, sampled along a motion) turns one way only: no limit position
+    of that link on the way (a reversal beyond rounding)."""
+    turns = np.diff(np.unwrap(np.asarray(angles, dtype=float)))
+    return bool(np.all(turns >= -1e-9) or np.all(turns <= 1e-9))
 
 
 def judge(z: np.ndarray, points: list[complex],
@@ -213,9 +225,11 @@ def judge_four_bar(pivots: tuple[complex, complex, complex, complex],
     rocker) angles in radians at each point. Its least transmission angle is taken over
     the motion from the first point to the last (on the circuit, in order), or at the
     points where that motion does not exist; below ``min_transmission`` (deg) it is a
-    ``transmission`` defect. With ``crank_deg`` (prescribed crank angles, deg), a crank that
-    turns from the first point to another by other than the prescribed difference (beyond
-    :data:`ON_POINT` rad) is a ``timing`` defect."""
+    ``transmission`` defect. With ``crank_deg`` (prescribed crank angles, deg), the crank is
+    the input: a crank that turns from the first point to another by other than the
+    prescribed difference (beyond :data:`ON_POINT` rad) is a ``timing`` defect, and one that
+    cannot turn one way from the first point to the last (a limit position of the crank
+    between them) a ``grashof`` defect, motion generation's name."""
     from ..kinematics.assemblies import assemblies, same_configuration
     from ..kinematics.circuits import circuits
     from ..kinematics.loading import from_text
@@ -249,7 +263,10 @@ def judge_four_bar(pivots: tuple[complex, complex, complex, complex],
         elif not _in_order([k for k in at if k is not None], len(circ.drivers)):
             defects.append("order")
         else:
-            trans += [_transmission(q[0], q[1]) for q in _along(circ, at)]  # type: ignore[arg-type]
+            path = _along(circ, at)
+            trans += [_transmission(circ.configurations[i][0], circ.configurations[i][1]) for i in path]
+            if crank_deg is not None and not one_way([circ.drivers[i] for i in path]):
+                defects.append("grashof")
     max_error = max(errors) / size
     if max_error > ON_POINT:
         defects.append("positions")
