@@ -122,6 +122,18 @@ def test_every_listed_four_bar_passes_through_the_points_at_the_prescribed_crank
         late = [math.remainder(c - d.crank_deg[0] - (a - angles[0]), 360.0)
                 for c, a in zip(d.crank_deg, angles)]
         assert max(map(abs, late)) <= 1e-9
+    # Roberts: the cognate whose crank at C (triangle ABC similar to MNP) stays parallel to
+    # the crank AM has the same timing, and is grouped with it
+    A, B, M, N = pivots
+    C = A + (B - A) * (points[0] - M) / (N - M)
+    size = max(abs(p - points[0]) for p in pivots)
+    mine = next(i for i, d in enumerate(result.designs)
+                if _matches(pivots, (d.ground_a, d.ground_b, d.pin_m, d.pin_n)))
+    cognate = [i for i, d in enumerate(result.designs)
+               if abs(d.ground_a - C) <= 1e-9 * size and abs(d.ground_b - B) <= 1e-9 * size]
+    group = next(g for g in result.groups if mine in g)
+    assert len(cognate) == 1 and sorted(group) == sorted([mine, *cognate])
+    assert sorted(i for g in result.groups for i in g) == list(range(len(result.designs)))
 
 
 def test_points_on_two_assemblies_are_a_branch_defect():
@@ -234,19 +246,19 @@ def test_synthesize_timed_path_refuses_bad_points_in_one_line(cli, args, says):
 
 
 def test_the_written_design_sweeps_through_the_points_at_the_prescribed_crank_angles(cli, tmp_path):
-    """synthesize --path -o FILE.toml, then linkage sweep FILE.toml from the design's crank
-    angle at the first point, in steps that land on every prescribed angle: P is on each
-    point there. The table has the timing column in every format."""
+    """synthesize --path -o FILE.toml, then linkage sweep FILE.toml over the file's range
+    (the design's crank angle at the first point through the prescribed turn), in steps that
+    land on every prescribed angle: P is on each point there."""
     A, B, r2, r3, r4, k = 0j, complex(2.5, 0.3), 1.0, 2.6, 2.2, complex(0.5, 0.7)
     points = [_place(A, B, r2, r3, r4, k, math.radians(a), 1)[2] for a in ANGLES]  # type: ignore[index]
     design = tmp_path / "timed.toml"
-    out = cli("synthesize", "--path", *_point_args(points, ANGLES), "-o", str(design), "-f", "csv")
+    out = cli("synthesize", "--path", *_point_args(points, ANGLES), "-o", str(design), "-f", "csv",
+              "--table", "designs")
     assert out.code == 0 and design.exists()
     table = list(csv.DictReader(io.StringIO(out.out)))
-    assert len(table) == 12 and all(float(r["timing_error (deg)"]) <= 1e-9 for r in table)
+    assert len(table) == 6 and all(float(r["timing_error (deg)"]) <= 1e-9 for r in table)  # 12 four-bars
     first = float(next(r for r in design.read_text().splitlines() if r.startswith("value =")).split()[-1])
-    swept = cli("sweep", str(design), "--from", repr(first), "--to", repr(first + ANGLES[-1] - ANGLES[0]),
-                "--step", "5", "-f", "csv")
+    swept = cli("sweep", str(design), "--step", "5", "-f", "csv")
     assert swept.code == 0
     rows = list(csv.DictReader(io.StringIO(swept.out)))
     reached = {round(float(r["theta2 (deg)"]) - first): complex(float(r["P.x (m)"]), float(r["P.y (m)"]))

@@ -34,7 +34,7 @@ def timed_path_command(point: list[str], *, design: Optional[int], output: Optio
                        force: bool, fmt: str, report_out: Optional[Path], digits: int, table: Optional[str],
                        scheduler: Optional[str], workers: Optional[int], min_transmission: float) -> None:
     from ..render import writers
-    from ..render.path_synthesis import rank, timed_path_report
+    from ..render.path_synthesis import timed_path_report, timed_ranked
     from ..synthesis.path import mechanism_text, synthesize_timed_path
 
     for option, given in (("--scheduler", scheduler), ("--workers", workers)):
@@ -46,8 +46,8 @@ def timed_path_command(point: list[str], *, design: Optional[int], output: Optio
     except InputError as exc:  # the API's argument names, as the command's options
         raise InputError(str(exc).replace("min_transmission", "--min-transmission")) from None
     writers.write(timed_path_report(result, digits), fmt, report_out, table=table)
-    order = rank(list(result.designs))
-    clean = [i for i in order if not result.designs[i].defects]
+    order = timed_ranked(result)  # cognate groups
+    clean = [g for g in order if not result.designs[result.groups[g][0]].defects]
     if write_file and output is not None:
         if design is not None and not 1 <= design <= len(order):
             raise InputError(f"--design {design}: there are {len(order)} designs" +
@@ -59,7 +59,11 @@ def timed_path_command(point: list[str], *, design: Optional[int], output: Optio
         else:
             from .options import write_mechanism
 
-            text = mechanism_text(result.designs[chosen], "four-bar through five timed points")
+            fb = result.designs[result.groups[chosen][0]]
+            # its driver's range: from the first point through the prescribed turn
+            turn = result.crank_deg[-1] - result.crank_deg[0]
+            text = mechanism_text(fb, "four-bar through five timed points",
+                                  (fb.crank_deg[0], fb.crank_deg[0] + turn))
             write_mechanism(output, text, force, said=" (its coupler point P passes through the points at "
                             "the prescribed crank angles, theta2)")
     if result.solutions.incomplete() or not clean:

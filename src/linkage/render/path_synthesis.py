@@ -90,21 +90,35 @@ def path_report(result: Any, digits: int) -> Report:
     return Report(title, tables, blocks, document)
 
 
-TIMED_HEADS = [HEADS[0], ("crank_dyad", "", "int"), ("rocker_dyad", "", "int"), *HEADS[2:],
+TIMED_HEADS = [*HEADS, ("crank_dyad", "", "int"), ("rocker_dyad", "", "int"),
                ("crank_first", "deg", "number"), ("timing_error", "deg", "number")]
-"""The timed designs' columns: the untimed ones (no cognates: a cognate's crank turns as
-the coupler or the rocker does, not as prescribed), which dyads, the crank's angle at the
-first point and the timing error."""
+"""The timed designs' columns: the untimed ones, which dyads (of the crank problem and of
+its rocker problem), the crank's angle at the first point and the timing error."""
 TIMED_TERMINAL = (*TERMINAL_COLUMNS, "timing_error")
+
+
+def timed_ranked(result: Any) -> list[int]:
+    """The cognate groups of a timed result, ranked by their first members."""
+    return rank([result.designs[g[0]] for g in result.groups])
+
+
+def timed_path_tables(result: Any) -> tuple[DataTable, ...]:
+    four_bars = result.solutions.four_bars
+
+    def row(number: int, cognate: int, i: int) -> tuple[Any, ...]:
+        fb = result.designs[i]
+        return (*_row(number, cognate, fb), four_bars[i].crank + 1, four_bars[i].rocker + 1, fb.crank_deg[0],
+                fb.timing_error_deg)
+
+    order = timed_ranked(result)
+    leads = [row(k + 1, 1, result.groups[g][0]) for k, g in enumerate(order)]
+    members = [row(k + 1, c + 1, i) for k, g in enumerate(order) for c, i in enumerate(result.groups[g])]
+    return from_rows("designs", TIMED_HEADS, leads), from_rows("cognates", TIMED_HEADS, members)
 
 
 def timed_path_report(result: Any, digits: int) -> Report:
     """The report of five points with prescribed crank angles (synthesis.path.TimedPathSynthesis)."""
-    order = rank(list(result.designs))
-    four_bars = result.solutions.four_bars
-    rows = [(k + 1, four_bars[i].crank + 1, four_bars[i].rocker + 1, *_row(k + 1, 1, result.designs[i])[2:],
-             result.designs[i].crank_deg[0], result.designs[i].timing_error_deg) for k, i in enumerate(order)]
-    tables = (from_rows("designs", TIMED_HEADS, rows),)
+    tables = timed_path_tables(result)
     title = "four-bars whose coupler point passes through five points at prescribed crank angles"
 
     def blocks() -> list[Block]:
@@ -113,14 +127,17 @@ def timed_path_report(result: Any, digits: int) -> Report:
         out.append(table("", [c.header for c in shown], list(zip(*[c.values for c in shown])), digits))
         out.append(Text("defects: branch, the points are not all on one circuit; order, the circuit meets "
                         "them out of order; transmission, the least transmission angle from the first point "
-                        "to the last is below --min-transmission; timing, the crank's turn from the first "
-                        "point is not the prescribed one"))
+                        "to the last is below --min-transmission; grashof, the crank cannot turn one way "
+                        "from the first point to the last; timing, the crank's turn from the first point is "
+                        "not the prescribed one. A design's Roberts cognate with the same timing is in the "
+                        "cognates table"))
         return out
 
     def document() -> dict[str, Any]:
         s = result.solutions
         return {"title": title, "crank_dyads": len(s.cranks.cranks), "four_bars": len(result.designs),
-                "without_defects": sum(1 for d in result.designs if not d.defects),
+                "designs": len(result.groups),
+                "without_defects": sum(1 for g in result.groups if not result.designs[g[0]].defects),
                 "failed_or_unsettled": s.incomplete()}
 
     return Report(title, tables, blocks, document)
@@ -130,7 +147,7 @@ def timed_summary(result: Any) -> list[str]:
     s = result.solutions
     rockers = ", ".join("-" if r is None else str(sum(1 for f in s.four_bars if f.crank == i))
                         for i, r in enumerate(s.rockers)) or "none"
-    clean = sum(1 for d in result.designs if not d.defects)
+    clean = sum(1 for g in result.groups if not result.designs[g[0]].defects)
     missed = s.incomplete()
     return [
         "prescribed timing (Sandor and Erdman's standard form): Burmester's five-pose problem for the crank "
@@ -138,7 +155,7 @@ def timed_summary(result: Any) -> list[str]:
         "that crank dyad turns it)",
         f"crank dyads: {len(s.cranks.cranks)} real ({s.cranks.complex_count} complex, {s.cranks.infinite} at "
         f"infinity, {s.cranks.failed} failed); rocker dyads of each: {rockers}; {len(result.designs)} "
-        f"four-bars, {clean} without defects"
+        f"four-bars, {len(result.groups)} up to Roberts cognates, {clean} without defects"
         + (f"; {missed} path{'s' if missed != 1 else ''} failed or not settled (a four-bar may be missing)"
            if missed else ""),
     ]

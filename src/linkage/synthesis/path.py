@@ -85,6 +85,9 @@ class TimedPathSynthesis:
     points: tuple[complex, ...]
     crank_deg: tuple[float, ...]
     designs: tuple[PathFourBar, ...]
+    """One per four-bar of ``solutions.four_bars``, in its order."""
+    groups: tuple[tuple[int, ...], ...]
+    """The designs (indices) grouped by Roberts cognates (:func:`cognate_groups`)."""
     solutions: TimedSolutions
 
 
@@ -120,9 +123,11 @@ def check_points(points: object) -> list[complex]:
     return pts
 
 
-def mechanism_text(fb: PathFourBar, name: str = "path four-bar") -> str:
+def mechanism_text(fb: PathFourBar, name: str = "path four-bar",
+                   span: tuple[float, float] | None = None) -> str:
     """The four-bar as a mechanism file (loops form): driver theta2 (the crank at A), unknowns
-    theta3 (the coupler MN) and theta4 (the rocker BN), the coupler point P."""
+    theta3 (the coupler MN) and theta4 (the rocker BN), the coupler point P; ``span``: the
+    driver's range (deg), if any."""
     r1, r2, r3, r4 = fb.lengths
     ground = degrees(cmath.phase(fb.ground_b - fb.ground_a))
     theta2 = degrees(cmath.phase(fb.pin_m - fb.ground_a))
@@ -144,7 +149,7 @@ theta1 = {{ value = {ground!r}, unit = "deg" }}
 [driver]
 name = "theta2"
 value = {theta2!r}
-unit = "deg"
+unit = "deg"{"" if span is None else f"{chr(10)}range = [{min(span)!r}, {max(span)!r}]"}
 
 [unknowns]
 theta3 = {{ guess = {theta3!r}, unit = "deg" }}
@@ -364,4 +369,55 @@ def synthesize_timed_path(points: object, seed: int = 0,
     found = timed_four_bars(points, seed=seed)
     designs = tuple(judge_four_bar(fb.pivots, list(fb.configurations), list(found.points), floor,
                                    found.crank_deg) for fb in found.four_bars)
-    return TimedPathSynthesis(found.points, found.crank_deg, designs, found)
+    return TimedPathSynthesis(found.points, found.crank_deg, designs, cognate_groups(designs), found)
+
+
+COGNATE = 1e-7
+"""Two four-bars are cognates when one's pivots are within this (of their size) of a member
+of the other's orbit."""
+
+
+def cognate_groups(designs: tuple[PathFourBar, ...]) -> tuple[tuple[int, ...], ...]:
+    """Four-bars through the same points grouped by Roberts cognates: one is a member of the
+    other's nine-point orbit (ninepoint.orbit: its three cognates, each with the dyads
+    either way round)."""
+    groups: list[list[int]] = []
+    for i, fb in enumerate(designs):
+        z = orbit_unknowns(fb)
+        size = float(np.abs(z).max())
+        mates = ninepoint.orbit(z)
+        for g in groups:
+            if np.abs(mates - orbit_unknowns(designs[g[0]])).max(axis=1).min() <= COGNATE * size:
+                g.append(i)
+                break
+        else:
+            groups.append([i])
+    return tuple(tuple(g) for g in groups)
+
+
+def orbit_unknowns(fb: PathFourBar) -> np.ndarray:
+    """The four-bar as the nine-point unknowns (isotropic, relative to its first point P)."""
+    z = np.zeros(8, dtype=complex)
+    for k, v in ((ninepoint.A, fb.ground_a), (ninepoint.X, fb.pin_m), (ninepoint.B, fb.ground_b),
+                 (ninepoint.Y, fb.pin_n)):
+        z[k] = v - fb.coupler_point
+    bars = [ninepoint.AB, ninepoint.XB, ninepoint.BB, ninepoint.YB]
+    z[bars] = np.conj(z[[ninepoint.A, ninepoint.X, ninepoint.B, ninepoint.Y]])
+    return z
+
+
+def coupler_curve(fb: PathFourBar) -> np.ndarray:
+    """P (complex) along the circuit through the four-bar's first position, as the engine
+    traces it (:mod:`linkage.kinematics.circuits`): the coupler curve a design's figure draws."""
+    from ..kinematics.assemblies import assemblies, same_configuration
+    from ..kinematics.circuits import circuits
+    from ..kinematics.loading import from_text
+    from ..kinematics.rates import place
+
+    m = from_text(mechanism_text(fb), "<coupler curve>")
+    start = assemblies(m)
+    first = next(i for i, s in enumerate(start.real)
+                 if same_configuration([m.unknowns[0].value, m.unknowns[1].value], s.q, m, 1e-6))
+    traced = circuits(m, found=start)
+    circ = traced.circuits[traced.circuit_of(first)]
+    return np.array([place(m.model, list(q), d)["P"][0] for d, q in zip(circ.drivers, circ.configurations)])
