@@ -135,6 +135,7 @@ def mechanism_text(fb: PathFourBar, name: str = "path four-bar",
     theta4 = degrees(cmath.phase(fb.pin_n - fb.ground_b))
     offset = degrees(cmath.phase((fb.coupler_point - fb.pin_m) / (fb.pin_n - fb.pin_m)))
     reach = abs(fb.coupler_point - fb.pin_m)
+    span_line = "" if span is None else f"\nrange = [{min(span)!r}, {max(span)!r}]"
     return f"""name = {name!r}
 length_unit = "m"
 origin = [{fb.ground_a.real!r}, {fb.ground_a.imag!r}]
@@ -149,7 +150,7 @@ theta1 = {{ value = {ground!r}, unit = "deg" }}
 [driver]
 name = "theta2"
 value = {theta2!r}
-unit = "deg"{"" if span is None else f"{chr(10)}range = [{min(span)!r}, {max(span)!r}]"}
+unit = "deg"{span_line}
 
 [unknowns]
 theta3 = {{ guess = {theta3!r}, unit = "deg" }}
