@@ -149,13 +149,15 @@ def timed_summary(result: Any) -> list[str]:
                         for i, r in enumerate(s.rockers)) or "none"
     clean = sum(1 for g in result.groups if not result.designs[g[0]].defects)
     missed = s.incomplete()
+    failed = sum(b.failed for b in s.problems())
     return [
         "prescribed timing (Sandor and Erdman's standard form): Burmester's five-pose problem for the crank "
         "dyads (the crank turned as prescribed), then for each one's rocker dyads (the coupler turned as "
         "that crank dyad turns it)",
         f"crank dyads: {len(s.cranks.cranks)} real ({s.cranks.complex_count} complex, {s.cranks.infinite} at "
         f"infinity, {s.cranks.failed} failed); rocker dyads of each: {rockers}; {len(result.designs)} "
-        f"four-bars, {len(result.groups)} up to Roberts cognates, {clean} without defects"
-        + (f"; {missed} path{'s' if missed != 1 else ''} failed or not settled (a four-bar may be missing)"
-           if missed else ""),
+        f"four-bars, {len(result.groups)} up to Roberts cognates, {clean} without defects",
+        f"Burmester paths failed: {failed}; "
+        + (f"{missed} root{'s' if missed != 1 else ''} not found (a four-bar may be missing)" if missed
+           else "every problem's 4 roots found (real and complex)"),
     ]

@@ -62,11 +62,32 @@ class TimedSolutions:
     """Each crank dyad's rocker problem; None where its coupler does not turn (no rocker
     problem: the coupler translates and its pins move on congruent curves)."""
     four_bars: tuple[TimedFourBar, ...]
+    unmatched: int = 0
+    """Crank dyads not found among their own rocker problem's pairs (a root missed there)."""
+
+    def problems(self) -> list[Burmester]:
+        """The Burmester problems solved: the crank problem, then each rocker problem."""
+        return [b for b in (self.cranks, *self.rockers) if b is not None]
 
     def incomplete(self) -> int:
-        """Paths of the Burmester problems that failed, or real roots that did not settle as
-        rigid cranks: where a four-bar may be missing."""
-        return sum(b.failed + b.unresolved for b in (self.cranks, *self.rockers) if b is not None)
+        """Where a four-bar may be missing: Burmester roots not found (of a problem's
+        :data:`BURMESTER_ROOTS`, while a path failed or a real root did not settle as a rigid
+        crank), and crank dyads their own rocker problem did not find."""
+        return self.unmatched + sum(missing_roots(b) for b in self.problems())
+
+
+BURMESTER_ROOTS = 4
+"""Five poses in general position have four Burmester pairs, counted in the complex: 0, 2
+or 4 of them real (Sandor and Erdman vol. 2, ch. 3; McCarthy and Soh, ch. 4). The other
+paths of the 16 of the total-degree start end at infinity."""
+
+
+def missing_roots(problem: Burmester) -> int:
+    """Burmester roots a problem did not find: none when its real and complex roots make
+    :data:`BURMESTER_ROOTS` (a failed path then was one bound for infinity); else at most the
+    paths that failed or did not settle."""
+    short = max(0, BURMESTER_ROOTS - len(problem.cranks) - problem.complex_count)
+    return min(short, problem.failed + problem.unresolved)
 
 
 def is_timed(points: Any) -> bool:
@@ -125,23 +146,48 @@ def timed_four_bars(points: Any, seed: int = 0) -> TimedSolutions:
     p, angles = check_timed_points(points)
     centre = sum(p) / len(p)
     size = max(abs(q - centre) for q in p)
-    cranks = burmester_points([(q.real, q.imag, a - angles[0]) for q, a in zip(p, angles)], seed=seed)
+    cranks = burmester([(q.real, q.imag, a - angles[0]) for q, a in zip(p, angles)], seed)
     rockers: list[Burmester | None] = []
-    four_bars = []
+    four_bars: list[TimedFourBar] = []
+    unmatched = 0
     for i, c in enumerate(cranks.cranks):
         alpha = turning(c, cranks)
         if all(abs(math.remainder(a, 360.0)) <= 1e-9 for a in alpha):
             rockers.append(None)
             continue
-        problem = burmester_points([(q.real, q.imag, a) for q, a in zip(p, alpha)], seed=seed)
+        problem = burmester([(q.real, q.imag, a) for q, a in zip(p, alpha)], seed)
         rockers.append(problem)
         A = complex(*c.ground)
         M1 = A - complex(*c.body)  # the crank pin at the first point: A + W
-        for k, r in enumerate(problem.cranks):
-            if max(abs(complex(*r.ground) - A), abs(complex(*r.first) - M1)) <= SAME_DYAD * size:
-                continue  # the crank dyad itself
-            four_bars.append(four_bar(i, k, c, r, p, alpha))
-    return TimedSolutions(p, angles, cranks, tuple(rockers), tuple(four_bars))
+        gaps = [max(abs(complex(*r.ground) - A), abs(complex(*r.first) - M1)) for r in problem.cranks]
+        itself = min(range(len(gaps)), key=gaps.__getitem__) if gaps else None
+        if itself is None or gaps[itself] > SAME_DYAD * size:
+            unmatched += 1  # a root of the rocker problem is missing: say so, keep every pair
+            itself = None
+        four_bars += [four_bar(i, k, c, r, p, alpha) for k, r in enumerate(problem.cranks) if k != itself]
+    return TimedSolutions(p, angles, cranks, tuple(rockers), tuple(four_bars), unmatched)
+
+
+RETRIES = 3
+"""Burmester's problem is solved again with another random gamma (the next seeds), up to
+this many times in all, while a root is missing (:func:`missing_roots`)."""
+
+
+def burmester(poses: list[tuple[float, float, float]], seed: int) -> Burmester:
+    """Burmester's problem with every root found if a few random gammas find them: a path
+    that failed with one gamma is another path with the next (Sommese and Wampler, *The
+    Numerical Solution of Systems of Polynomials*, the gamma trick); the try missing the
+    fewest roots is kept."""
+    from ..arguments import MAX_SEED
+
+    best = burmester_points(poses, seed=seed)
+    for k in range(1, RETRIES):
+        if not missing_roots(best):
+            break
+        again = burmester_points(poses, seed=(seed + k) % (MAX_SEED + 1))
+        if missing_roots(again) < missing_roots(best):
+            best = again
+    return best
 
 
 def turning(c: Crank, problem: Burmester) -> list[float]:
