@@ -1,13 +1,14 @@
 """Remake the stored generic instance of the nine-point problem by monodromy.
 
-    python benchmarks/nine_point_start.py [--seed 7] [--stable 3] [-o FILE]
+    python benchmarks/nine_point_start.py [--seed 7] [--stable 3] [--max-loops 60] [-o FILE]
 
 (default FILE: src/linkage/homotopy/data/nine_point_start.npz)
 
 From one random complex four-bar and points made to fit it (linkage.homotopy.ninepoint.
 seed_instance), the points are moved around random triangles back to themselves
-(monodromy_loop); each loop carries every known solution, and endpoints in new orbits
-join. It stops when `--stable` loops in a row find nothing new, and prints each loop. On
+(linkage.homotopy.parameter.monodromy, with the nine-point problem's loops:
+ninepoint.NinePointLoops); each loop carries every known solution, and endpoints in new
+orbits join. It stops when `--stable` loops in a row find nothing new, and prints each loop. On
 this machine (seed 7): 1,442 orbits after 16 loops, about 5 minutes, the published count
 (Wampler, Morgan and Sommese 1992: 8,652 = 1,442 x 6 nondegenerate solutions).
 """
@@ -20,6 +21,7 @@ import time
 import numpy as np
 
 from linkage.homotopy import ninepoint as npt
+from linkage.homotopy.parameter import Loop, monodromy
 
 
 def main() -> None:
@@ -31,15 +33,18 @@ def main() -> None:
     args = ap.parse_args()
     rng = np.random.default_rng(args.seed)
     z, d, db = npt.seed_instance(rng)
-    inst = npt.Instance(d, db, npt.canonical(z[None, :]))
-    began, quiet, loop = time.perf_counter(), 0, 0
-    while quiet < args.stable and loop < args.max_loops:
-        inst, new, failed, seconds = npt.monodromy_loop(inst, rng)
-        quiet = quiet + 1 if new == 0 else 0
-        loop += 1
-        print(f"loop {loop}: {len(inst.solutions)} orbits (+{new}), {failed} paths failed, {seconds:.1f} s",
-              flush=True)
-    Z, last, cond = npt.polish(inst.solutions, d, db)
+    began = time.perf_counter()
+
+    loops: list[Loop] = []
+
+    def show(loop: Loop) -> None:
+        loops.append(loop)
+        print(f"loop {len(loops)}: {loop.count} orbits (+{loop.new}), {loop.dropped} paths failed or "
+              f"unsettled, {loop.seconds:.1f} s", flush=True)
+
+    found = monodromy(npt.NinePointLoops(), np.concatenate([d, db]), z[None, :], stable_loops=args.stable,
+                      max_loops=args.max_loops, seed=rng, on_loop=show)
+    Z, last, cond = npt.polish(found.roots, d, db)
     print(f"{len(Z)} orbits in {time.perf_counter() - began:.0f} s; largest last Newton step "
           f"{last.max():.1e}, largest condition {cond.max():.1e}")
     np.savez(args.output, d=d, db=db, z=npt.canonical(Z))

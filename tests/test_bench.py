@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import sys
 
+import numpy as np
 import pytest
 
 
@@ -34,6 +35,12 @@ def test_bench_without_scipy_skips_its_rows_with_a_note(cli, monkeypatch):
     run = cli("bench", "--quick", "--problem", "quadratic", "--repeats", "1", "--no-cold")
     assert run.code == 0, run.err
     assert "scipy is not installed: its rows are skipped" in run.out
+    # issue 34's rows in the plain output: the quick ones measured, Problem 3 only with --full
+    from linkage.measure.continuation_targets import ROWS
+
+    assert "Issue 34's targets" in run.out and "cores" in run.out and "Their roots at 50 digits" in run.out
+    assert all(row.name in run.out for row in ROWS)
+    assert "not measured (long: linkage bench --full)" in run.out.split("Issue 34's targets")[1]
     doc = json.loads(cli("bench", "--quick", "--problem", "quadratic", "--repeats", "1", "--no-cold",
                          "--format", "json").out)
     contenders = {m["contender"] for m in doc["measurements"]}
@@ -260,3 +267,84 @@ def test_a_command_that_fails_is_no_measurement():
     (got,) = run_rows(True, 2, 0.0, measures={row: lambda s: interleaved_pairs(failing, failing, 2)})
     assert got.pairs is None and got.target[2] is None and got.target[3] is None
     assert "failed:" in got.target[1] and "no such file: x.toml" in got.target[1]
+
+
+def _timed(seconds, complete=True, residual=1e-16, duplicates=0, spurious=0):
+    from linkage.measure.continuation_targets import Certificate, Found, Timed
+
+    checked = Certificate(3, residual, 0.0, duplicates, spurious)
+    return Timed(tuple(seconds), Found("planted", complete, checked))
+
+
+def test_issue_34_rows_are_judged_from_their_median_their_counts_and_their_roots():
+    """Absolute times: met when the median run is within the bound and the run found all the
+    target asks; the roots are certified when the worst residual is at most 1e-12 with no
+    duplicate and no spurious root; Problem 3 runs only with --full (planted timings)."""
+    from linkage.measure.continuation_targets import ROWS, run_rows, tables
+
+    problem_3, burmester, sixbar = ROWS
+    assert (problem_3.bound, problem_3.long) == (600.0, True)
+    assert (burmester.bound, burmester.long) == (0.1, False) and (sixbar.bound, sixbar.long) == (0.05, False)
+    assert burmester.met(_timed([0.09, 0.5, 0.01])) is True  # the median, not the mean nor the worst
+    assert burmester.met(_timed([0.2, 0.11, 0.05])) is False
+    assert burmester.met(_timed([0.01], complete=False)) is False  # fast, but a path failed
+    planted = {problem_3: lambda r: _timed([30.0]), burmester: lambda r: _timed([0.06] * r),
+               sixbar: lambda r: _timed([0.07] * r, residual=2e-12)}
+    quick = run_rows(False, 3, measures=planted)
+    assert quick[0].timed is None and quick[0].met is None and quick[0].certified is None
+    assert "--full" in quick[0].note
+    assert (quick[1].met, quick[1].certified) == (True, True)
+    assert (quick[2].met, quick[2].certified) == (False, False)
+    times, roots = tables(quick)
+    assert times[0][2] is None and times[1][2:4] == (0.06, 3) and [r[0] for r in roots] == [burmester.name,
+                                                                                          sixbar.name]
+    full = run_rows(True, 3, measures=planted)
+    assert full[0].met is True and len(tables(full)[1]) == 3
+    for bad in (dict(duplicates=1), dict(spurious=1), dict(residual=1.1e-12)):
+        assert _timed([1.0], **bad).found.certificate.met is False
+
+
+def test_the_root_check_finds_a_duplicate_a_spurious_root_and_a_residual_at_50_digits():
+    """x^2 - 2: sqrt(2) twice (a duplicate), 1.5 (50-digit Newton goes to sqrt(2), far from
+    it: spurious); -sqrt(2) off by 1e-10 is confirmed (its root is that near), but its
+    residual against the terms' size, |x^2 - 2| / (x^2 + 2), computed here at 50 digits, is
+    above 1e-12."""
+    import math
+
+    import mpmath
+
+    from linkage.homotopy import PolySystem
+    from linkage.measure.continuation_targets import polynomial_certificate
+
+    system = PolySystem(1, ({(2,): 1 + 0j, (0,): -2 + 0j},))
+    root = math.sqrt(2.0)
+    clean = polynomial_certificate(system, [np.array([root]), np.array([-root])])
+    assert (clean.roots, clean.duplicates, clean.spurious, clean.above, clean.met) == (2, 0, 0, 0, True)
+    assert clean.worst_residual <= 1e-16 and clean.worst_error <= 2e-16
+    got = polynomial_certificate(system, [np.array([root]), np.array([root]), np.array([1.5])])
+    assert (got.roots, got.duplicates, got.spurious, got.above, got.met) == (3, 1, 1, 1, False)
+    assert got.worst_residual == pytest.approx(0.25 / 4.25) and got.worst_error > 0.05
+    off = -root + 1e-10
+    near = polynomial_certificate(system, [np.array([off])])
+    with mpmath.workdps(50):
+        want = float(abs(mpmath.mpf(off) ** 2 - 2) / (mpmath.mpf(off) ** 2 + 2))
+    # a root, but not to 1e-12
+    assert (near.duplicates, near.spurious, near.above, near.met) == (0, 0, 1, False)
+    assert near.worst_residual == pytest.approx(want, rel=1e-6)
+
+
+def test_the_nine_point_root_check_counts_a_cognate_as_a_duplicate():
+    """A seed instance's four-bar is certified; its Roberts cognate listed beside it is the
+    same four-bar up to the orbit (a duplicate); the four-bar moved by 1e-4 is spurious and
+    its residual is far above 1e-12."""
+    from linkage.homotopy import ninepoint as npt
+    from linkage.measure.continuation_targets import nine_point_certificate
+
+    z, d, db = npt.seed_instance(np.random.default_rng(11))
+    alone = nine_point_certificate(z[None, :], d, db)
+    assert alone.met and alone.worst_residual <= 1e-13 and alone.worst_error <= 1e-13
+    cognate = npt.orbit(z)[2]
+    moved = z + 1e-4
+    got = nine_point_certificate(np.stack([z, cognate, moved]), d, db)
+    assert (got.roots, got.duplicates, got.spurious, got.above, got.met) == (3, 1, 1, 1, False)
+    assert got.worst_residual > 1e-8

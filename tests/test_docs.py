@@ -129,8 +129,10 @@ def test_quick_start_is_two_commands_and_ci_runs_them_verbatim():
 
 
 def test_the_readme_is_a_short_guide_that_links_every_docs_page():
-    """The README was 1,695 lines mixing usage, test names, benchmarks and fix history."""
-    assert len(README.splitlines()) <= 400
+    """The README was 1,695 lines mixing usage, test names, benchmarks and fix history. A
+    tour of every command with one example each (and a picture for the synthesis and
+    continuation commands: issue 34) fits in 450."""
+    assert len(README.splitlines()) <= 450
     for page in PAGES[1:]:
         if page.name.endswith(".md"):
             assert f"docs/{page.name}" in README, f"the README does not link docs/{page.name}"

@@ -19,7 +19,7 @@ from typing import Any
 
 import pytest
 
-from linkage.measure import precision, sweeps, targets, timing
+from linkage.measure import continuation_targets, precision, sweeps, targets, timing
 from report_reading import csv_files
 
 pq = pytest.importorskip("pyarrow.parquet")
@@ -64,6 +64,12 @@ def quick_bench(monkeypatch: pytest.MonkeyPatch) -> None:
     pairs = timing.Pairs((2e-6, 3e-6), (1e-6, 1e-6))
     monkeypatch.setattr(targets, "run_rows", lambda *a, **k: [targets.Outcome(row, pairs)
                                                                for row in targets.ROWS])
+    ct = continuation_targets
+    checked = ct.Certificate(4, 6.25e-17, 1.5e-16, 0, 0)
+    timed = ct.Timed((0.0625, 0.0625), ct.Found("4 real cranks", True, checked))
+    monkeypatch.setattr(ct, "run_rows", lambda *a, **k: [ct.Outcome(row, None if row.long else timed,
+                                                                     "not measured" if row.long else "")
+                                                          for row in ct.ROWS])
     # solve --method all times each method: its "time per solve" column, too
     monkeypatch.setattr(timing, "time_per_solve", lambda *a, **k: 2.5e-5)
 

@@ -49,6 +49,17 @@ def test_roots_of_a_number_by_parameter_homotopy_and_monodromy(d):
     assert _matched(found.roots, start, 1e-12)
 
 
+def test_each_monodromy_loop_is_reported_as_it_ends():
+    """on_loop sees each loop's record as it ends: the count after it, what it added and
+    dropped; the records add up to the result's counts, roots and dropped paths."""
+    family = Family(1, 1, ({(4, 0): 1 + 0j, (0, 1): -1 + 0j},))
+    seen = []
+    found = monodromy(family, [2.0 + 1.0j], [[complex(2.0 + 1.0j) ** 0.25]], seed=5, on_loop=seen.append)
+    assert tuple(seen) == found.loops and [r.count for r in seen] == list(found.counts)
+    assert sum(r.new for r in seen) == len(found.roots) - 1 == 3
+    assert sum(r.dropped for r in seen) == found.dropped
+
+
 def _six_bar_family(seed: int) -> Family:
     """Two loops on four angles in isotropic coordinates, sum_k a_jk z_k + p_j = 0 and its
     conjugate-structured twin sum_k conj(a_jk) w_k + q_j = 0, z_k w_k = 1: the loops'

@@ -240,7 +240,7 @@ def _point_args(points, angles) -> list[str]:  # type: ignore[no-untyped-def]
     ([*[f"--point={x},{y},{a}" for x, y, a in FIVE[:4]], "--point=2,2"], "or none"),
     ([*[f"--point={x},{y},{a}" for x, y, a in FIVE[:4]], "--point=2,2,nan"], "--point 5"),
     ([*[f"--point={x},{y},{a}" for x, y, a in FIVE[:4]], "--point=1,0.2,150"], "coincide"),
-    ([*[f"--point={x},{y},{a}" for x, y, a in FIVE], "--workers", "2"], "--workers is for nine points"),
+    ([*[f"--point={x},{y},{a}" for x, y, a in FIVE], "--workers", "2"], "--workers is for untimed points"),
 ])
 def test_synthesize_timed_path_refuses_bad_points_in_one_line(cli, args, says):
     out = cli("synthesize", "--path", *args)

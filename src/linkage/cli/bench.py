@@ -11,8 +11,9 @@ from .options import PICTURES, FormatOpt, OutputOpt, TableOpt, check_paths, choo
 from .progress import progress_bar
 from .root import app
 
-BENCH_TABLES = ("measurements", "sweeps", "cold_start", "targets")
-"""The tables of bench's report (render.tools.bench_report), known before it runs."""
+BENCH_TABLES = ("measurements", "sweeps", "cold_start", "targets", "continuation", "certified")
+"""The tables of bench's report (render.tools.bench_report, then issue 34's:
+measure.continuation_targets), known before it runs."""
 
 
 @app.command(
@@ -24,8 +25,8 @@ def bench(
     quick: Annotated[bool, typer.Option("--quick", help="Two problems, three tolerances, short "
                      "timings (about 20 seconds).")] = False,
     full: Annotated[bool, typer.Option("--full", help="Also the long targets: whole command-line "
-                    "sweeps of 36,001 and 360,001 positions, a million positions in process "
-                    "(minutes).")] = False,
+                    "sweeps of 36,001 and 360,001 positions, a million positions in process, "
+                    "nine-point Problem 3 and its 1,442 roots checked at 50 digits (minutes).")] = False,
     problem: Annotated[Optional[list[str]], typer.Option(help="freudenstein, quadratic, fourbar, rapier "
                        "(repeatable; default: all, or freudenstein and fourbar with --quick).")] = None,
     repeats: Annotated[Optional[int], typer.Option(help="Timed batches per measurement, and pairs "
@@ -39,7 +40,8 @@ def bench(
     table: TableOpt = None,
 ) -> None:
     """Run time against achieved error for every method, beside scipy and a hand-written loop,
-    and every speed target, each a ratio of interleaved pairs timed in this run.
+    and every speed target, each a ratio of interleaved pairs timed in this run; then issue
+    34's targets, seconds against their bounds, with their roots checked at 50 digits.
 
     Example: linkage bench --quick --plot wp.png
     """
@@ -87,14 +89,16 @@ def work_precision(names: list[str], quick: bool, repeats: int) -> list[Any]:
 
 
 def run_targets(results: list[Any], *, quick: bool, full: bool, cold: bool, repeats: int) -> Any:
-    """Issue 33's rows, the earlier targets, the sweeps and the cold starts, as the report."""
+    """Issue 33's rows, the earlier targets, the sweeps and the cold starts, then issue 34's
+    rows, as the report."""
+    from ..measure import continuation_targets as continuation
     from ..measure.precision import has_pylinkage, has_scipy, measurement_rows
     from ..measure.processes import cold_start
     from ..measure.sweeps import SCAN_DESIGNS, sweep_times, targets
     from ..measure.targets import ROWS, run_rows
     from ..render.tools import bench_report
 
-    with progress_bar(len(ROWS), minimum=1, label="targets") as advance:
+    with progress_bar(len(ROWS) + len(continuation.ROWS), minimum=1, label="targets") as advance:
         done = [0]
 
         def step(_: str) -> None:
@@ -103,6 +107,7 @@ def run_targets(results: list[Any], *, quick: bool, full: bool, cold: bool, repe
                 advance(done[0])
 
         outcomes = run_rows(full, repeats, 0.005, cold=cold, progress=step)
+        found = continuation.run_rows(full, repeats, progress=step)
     sweeps = sweep_times(repeats, SCAN_DESIGNS // 10 if quick else SCAN_DESIGNS)
     cold_times = cold_start(3 if quick else 5) if cold else {}
     target_rows = [o.target for o in outcomes] + targets(sweeps)
@@ -114,5 +119,6 @@ def run_targets(results: list[Any], *, quick: bool, full: bool, cold: bool, repe
                      "(pip install 'pylinkage==1.3.0')")
     if not full:
         notes.append("the long targets are measured with --full")
-    return bench_report(measurement_rows(results), sweeps, cold_times, target_rows, repeats, notes,
-                        has_scipy())
+    report = bench_report(measurement_rows(results), sweeps, cold_times, target_rows, repeats, notes,
+                          has_scipy())
+    return continuation.with_continuation(report, found)

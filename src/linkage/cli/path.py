@@ -11,44 +11,61 @@ import typer
 from ..errors import InputError
 
 
-def read_points(point: list[str]) -> list[tuple[float, float]]:
-    """--point X,Y repeated: the nine points."""
+def read_points(point: list[str], option: str = "--point") -> list[tuple[float, float]]:
+    """--point X,Y (or ``option``) repeated: the points."""
     from ..numbers import parse_number
 
     out = []
     for k, text in enumerate(point):
         parts = text.split(",")
         if len(parts) != 2:
-            raise InputError(f"--point {text!r}: write X,Y")
-        out.append(tuple(parse_number(f"--point {k + 1}", v) for v in parts))
+            raise InputError(f"{option} {text!r}: write X,Y")
+        out.append(tuple(parse_number(f"{option} {k + 1}", v) for v in parts))
     return out  # type: ignore[return-value]
 
 
-def path_command(point: list[str], *, design: Optional[int], output: Optional[Path], write_file: bool,
+def path_command(point: list[str], via: list[str], *, search: bool, samples: Optional[int], seed: int,
+                 design: Optional[int], output: Optional[Path], write_file: bool,
                  force: bool, fmt: str, report_out: Optional[Path], digits: int, table: Optional[str],
                  scheduler: Optional[str], workers: Optional[int], min_transmission: float) -> None:
     from ..arguments import check_workers
     from ..render import writers
     from ..render.path_synthesis import path_report, ranked
     from ..synthesis.path import check_points, synthesize_path
+    from ..synthesis.path_points import check_via
+    from .path_search import as_options
     from .timed_path import is_timed, timed_path_command
 
     if is_timed(point):  # X,Y,DEG: prescribed timing, five points
-        return timed_path_command(point, design=design, output=output, write_file=write_file, force=force,
-                                  fmt=fmt, report_out=report_out, digits=digits, table=table,
-                                  scheduler=scheduler, workers=workers, min_transmission=min_transmission)
-    pairs = read_points(point)
+        return timed_path_command(point, via, search=search, samples=samples, seed=seed, design=design,
+                                  output=output, write_file=write_file, force=force, fmt=fmt,
+                                  report_out=report_out, digits=digits, table=table, scheduler=scheduler,
+                                  workers=workers, min_transmission=min_transmission)
+    pairs, extra = read_points(point), read_points(via, "--via")
     check_points(pairs)  # before the workers, so a wrong count is the first thing said
+    try:
+        check_via(extra, [complex(*p) for p in pairs])
+    except InputError as exc:
+        raise InputError(as_options(str(exc))) from None
     workers = check_workers("--workers", workers, scheduler)
+    options = {"via": extra, "seed": seed, "scheduler": scheduler, "workers": workers,
+               "min_transmission": min_transmission}
+    if search:
+        from .path_search import path_search_command
+
+        path_search_command(pairs, samples, options, design=design, output=output, write_file=write_file,
+                            force=force, fmt=fmt, report_out=report_out, digits=digits, table=table)
+        return
+    if samples is not None:
+        raise InputError("--samples is an option of --search")
     from ..homotopy.ninepoint import PATHS
     from .progress import progress_bar
 
     try:
         with progress_bar(PATHS, minimum=0, label="tracking paths") as advance:
-            result = synthesize_path(pairs, scheduler=scheduler, workers=workers,
-                                     min_transmission=min_transmission, progress=advance)
-    except InputError as exc:  # the API's argument names, as the command's options
-        raise InputError(str(exc).replace("min_transmission", "--min-transmission")) from None
+            result = synthesize_path(pairs, progress=advance, **options)  # type: ignore[arg-type]
+    except InputError as exc:
+        raise InputError(as_options(str(exc))) from None
     writers.write(path_report(result, digits), fmt, report_out, table=table)
     order = ranked(result)
     clean = [i for i in order if not result.designs[i][0].defects]
@@ -63,7 +80,8 @@ def path_command(point: list[str], *, design: Optional[int], output: Optional[Pa
             from ..synthesis.path import mechanism_text
             from .options import write_mechanism
 
-            text = mechanism_text(result.designs[chosen][0], "four-bar through nine points")
+            text = mechanism_text(result.designs[chosen][0], f"four-bar through {len(pairs)} points")
             write_mechanism(output, text, force, said=" (its coupler point P passes through the points)")
     if result.missing or not clean:
         raise typer.Exit(1)
+

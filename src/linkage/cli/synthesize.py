@@ -17,17 +17,9 @@ from .root import app
 )
 def synthesize(
     *,
-    function: Annotated[
-        Optional[str],
-        typer.Option(
-            "--function",
-            metavar="EXPR",
-            help="The function y = f(x) to "
-            "generate, in x (the --equation parser: + - * / **, sin, cos, exp, log, log10, "
-            "sqrt, pi, ...).",
-            show_default=False,
-        ),
-    ] = None,
+    function: Annotated[Optional[str], typer.Option(
+        "--function", metavar="EXPR", show_default=False, help="The function y = f(x) to generate, in x (the "
+        "--equation parser: + - * / **, sin, cos, exp, log, log10, sqrt, pi, ...).")] = None,
     x: Annotated[
         Optional[str], typer.Option("--x", metavar="LO:HI", help="The range of x.", show_default=False)
     ] = None,
@@ -158,9 +150,13 @@ def synthesize(
                      "pose 1 (twice: three poses leave both free)."),
     ] = None,
     path: Annotated[bool, typer.Option("--path", help="Path generation: every four-bar whose coupler point "
-                                       "passes through 9 --point X,Y, or 5 --point X,Y,DEG with the crank "
-                                       "at DEG (docs/path_synthesis.md).")] = False,
+                                       "passes through 5 to 9 --point X,Y, or 5 --point X,Y,DEG with the "
+                                       "crank at DEG (docs/path_synthesis.md); with --search, the "
+                                       "defect-free ones ranked.")] = False,
     point: Annotated[Optional[list[str]], typer.Option("--point", metavar="X,Y[,DEG]", help="--path")] = None,
+    via: Annotated[Optional[list[str]], typer.Option(
+        "--via", metavar="X,Y", help="With --path and n < 9 points: the 9 - n extra points (default: on a "
+        "curve through the points; --search --samples K draws K sets).")] = None,
     design_number: Annotated[
         Optional[int],
         typer.Option("--design", metavar="K", help="With --motion and -o FILE.toml: write design K "
@@ -203,14 +199,16 @@ def synthesize(
     if path:
         from .path import path_command
 
-        if search or function is not None or plot is not None:
-            raise InputError("--path takes nine --point X,Y: not --function, --search or --plot")
-        path_command(point or [], design=design_number, output=output, write_file=design, force=force,
-                     fmt=fmt, report_out=report_out, digits=digits, table=table, scheduler=scheduler,
-                     workers=workers, min_transmission=min_transmission)
+        if function is not None or plot is not None:
+            raise InputError("--path takes 5 to 9 --point X,Y: not --function or --plot")
+        path_command(point or [], via or [], search=search, samples=samples, seed=seed, design=design_number,
+                     output=output, write_file=design, force=force, fmt=fmt, report_out=report_out,
+                     digits=digits, table=table, scheduler=scheduler, workers=workers,
+                     min_transmission=min_transmission)
         return
-    if pose or poses is not None or circle or design_number is not None or point:
-        raise InputError("--pose, --poses, --circle and --design are options of --motion; --point of --path")
+    if pose or poses is not None or circle or design_number is not None or point or via:
+        raise InputError("--pose, --poses, --circle and --design are options of --motion; --point of --path "
+                         "(and --via)")
     if function is None or x is None:
         raise InputError("give --function and --x (or --motion with poses)")
     if search:

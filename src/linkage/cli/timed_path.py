@@ -30,19 +30,22 @@ def read_timed_points(point: list[str]) -> list[tuple[float, ...]]:
     return out
 
 
-def timed_path_command(point: list[str], *, design: Optional[int], output: Optional[Path], write_file: bool,
-                       force: bool, fmt: str, report_out: Optional[Path], digits: int, table: Optional[str],
+def timed_path_command(point: list[str], via: list[str], *, search: bool, samples: Optional[int], seed: int,
+                       design: Optional[int], output: Optional[Path], write_file: bool, force: bool, fmt: str,
+                       report_out: Optional[Path], digits: int, table: Optional[str],
                        scheduler: Optional[str], workers: Optional[int], min_transmission: float) -> None:
     from ..render import writers
     from ..render.path_synthesis import timed_path_report, timed_ranked
     from ..synthesis.path import mechanism_text, synthesize_timed_path
 
-    for option, given in (("--scheduler", scheduler), ("--workers", workers)):
+    untimed = (("--via", via or None), ("--search", search or None), ("--samples", samples),
+               ("--scheduler", scheduler), ("--workers", workers))
+    for option, given in untimed:
         if given is not None:
-            raise InputError(f"{option} is for nine points' path tracking: five timed points are two "
-                             "Burmester problems, solved here")
+            raise InputError(f"{option} is for untimed points (X,Y): five timed points are two Burmester "
+                             "problems, solved here")
     try:
-        result = synthesize_timed_path(read_timed_points(point), min_transmission=min_transmission)
+        result = synthesize_timed_path(read_timed_points(point), seed=seed, min_transmission=min_transmission)
     except InputError as exc:  # the API's argument names, as the command's options
         raise InputError(str(exc).replace("min_transmission", "--min-transmission")) from None
     writers.write(timed_path_report(result, digits), fmt, report_out, table=table)

@@ -303,39 +303,39 @@ def _random_points(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     return (rng.normal(size=8) + 1j * rng.normal(size=8), rng.normal(size=8) + 1j * rng.normal(size=8))
 
 
-def monodromy_loop(instance: Instance, rng: np.random.Generator, max_step: float = MAX_STEP
-                   ) -> tuple[Instance, int, int, float]:
-    """Move the points around a random triangle back to themselves, carrying every known
-    solution; endpoints that are new orbits join. Returns (instance, new orbits, failed
-    paths, seconds)."""
-    import time
+@dataclass(frozen=True)
+class NinePointLoops:
+    """The nine-point problem as :func:`.parameter.monodromy` loops it: the parameters are
+    the points, (delta, deltabar) as one vector of 16; a corner of a loop is random complex
+    points of unit size, as the stored instance's are; a leg is :func:`track_segment` on its
+    own random patch; a root is one solution per orbit of six, in its canonical form
+    (:func:`canonical`), polished at the instance (:func:`polish`; one that does not settle
+    is dropped), so that an endpoint is new only as a new orbit (:func:`distinct`)."""
 
-    began = time.perf_counter()
-    d1, db1 = _random_points(rng)
-    d2, db2 = _random_points(rng)
-    d0, db0 = instance.delta, instance.deltabar
-    Z = instance.solutions
-    ok_all = np.ones(len(Z), bool)
-    for (a, ab), (b, bb) in (((d0, db0), (d1, db1)), ((d1, db1), (d2, db2)), ((d2, db2), (d0, db0))):
-        Z, ok, _log = track_segment(ParameterSegment(a, ab, b, bb, random_patch(rng)), Z, max_step)
-        ok_all &= ok
-    Z = Z[ok_all]
-    # polish at the instance, then keep the orbits not yet known
-    for _ in range(3):
-        E, J, _, _ = equations(Z, d0, db0)
-        Z = Z - np.linalg.solve(J, E[..., None])[..., 0]
-    Z = canonical(Z[np.all(np.isfinite(Z), axis=1)])
-    both = np.vstack([instance.solutions, Z])
-    fresh = [i - len(instance.solutions) for i in distinct(both) if i >= len(instance.solutions)]
-    kept = [Z[i] for i in fresh]
-    solutions = np.vstack([instance.solutions, *[k[None, :] for k in kept]]) if kept else instance.solutions
-    return (Instance(d0, db0, solutions), len(kept), int((~ok_all).sum()),
-            time.perf_counter() - began)
+    max_step: float = MAX_STEP
+    n: int = 8
+
+    def turn(self, p: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        return np.concatenate(_random_points(rng))
+
+    def leg(self, a: np.ndarray, b: np.ndarray, roots: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        segment = ParameterSegment(a[:8], a[8:], b[:8], b[8:], random_patch(rng))
+        Z, ok, _log = track_segment(segment, roots, self.max_step)
+        return Z[ok]
+
+    def settle(self, roots: np.ndarray, p: np.ndarray) -> np.ndarray:
+        with np.errstate(all="ignore"):
+            Z, last, _ = polish(roots, p[:8], p[8:])
+        return canonical(Z[last <= REFINED])
+
+    def fresh(self, known: np.ndarray, roots: np.ndarray) -> list[int]:
+        return [i - len(known) for i in distinct(np.vstack([known, roots])) if i >= len(known)]
 
 
 START = "data/nine_point_start.npz"
 """A generic complex instance with one solution of each of its 1,442 orbits, made by
-:func:`monodromy_loop` from one seed (benchmarks/nine_point_start.py remakes it)."""
+:func:`.parameter.monodromy` with :class:`NinePointLoops` from one seed
+(benchmarks/nine_point_start.py remakes it)."""
 POLISH_STEPS = 8
 REFINED = 1e-10
 """An endpoint is a solution when Newton's steps at the target fall below this, relative."""
@@ -401,8 +401,11 @@ def polish_precisely(z: np.ndarray, d: np.ndarray, db: np.ndarray) -> np.ndarray
 
 
 def relative_residual(Z: np.ndarray, d: np.ndarray, db: np.ndarray) -> np.ndarray:
-    """max over the equations of |E_j| / (|N1 N2| + |D|^2): each equation against its own
-    terms' sizes (paths,). Works on object arrays of mpmath numbers too."""
+    """max over the equations of |E_j| / (|N1 N2| + |D|^2) (paths,): cheap, and what decides
+    which endpoints are polished at PRECISE_DIGITS. Where N1, N2 or D is itself a near
+    cancellation (pivots far from the points) this understates the size of E_j's terms and
+    overstates the residual; :func:`.ninepoint_alpha.residuals` measures against the terms
+    multiplied out. Works on object arrays of mpmath numbers too."""
     col = [Z[:, k:k + 1] for k in range(8)]
     dd = np.broadcast_to(d, (Z.shape[0], 8))
     ddb = np.broadcast_to(db, (Z.shape[0], 8))

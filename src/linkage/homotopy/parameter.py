@@ -23,7 +23,7 @@ how many loops it was stable for, and tests compare it with counts known otherwi
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from itertools import pairwise
@@ -168,6 +168,80 @@ GOOD_RESIDUAL = 1e-11
 residual (:class:`.solve.Endpoint`) is at most this."""
 
 
+class Loops(Protocol):
+    """What :func:`monodromy` needs of a problem to carry its roots around a loop of
+    parameters: :class:`FamilyLoops` for a :class:`Family`, or a problem's own (the
+    nine-point problem's, which keeps one root per orbit of its symmetries:
+    :class:`.ninepoint.NinePointLoops`)."""
+
+    @property
+    def n(self) -> int: ...
+
+    def turn(self, p: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """A random complex parameter point, a corner of a loop from ``p``."""
+        ...
+
+    def leg(self, a: np.ndarray, b: np.ndarray, roots: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """``roots`` (roots at ``a``, one a row) tracked to ``b``: the endpoints that are good
+        roots there (the others are dropped)."""
+        ...
+
+    def settle(self, roots: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """A loop's endpoints, back at ``p``, in the form the root set keeps (those that do
+        not settle are dropped)."""
+        ...
+
+    def fresh(self, known: np.ndarray, roots: np.ndarray) -> list[int]:
+        """Indices of the rows of ``roots`` that are in neither ``known`` nor an earlier row."""
+        ...
+
+
+@dataclass(frozen=True)
+class FamilyLoops:
+    """A family's loops: corners at the scale of ``p``, legs by :func:`track_parameters`
+    (an endpoint is kept as a finite root of residual at most GOOD_RESIDUAL), roots equal
+    to SAME."""
+
+    family: ParameterFamily
+
+    @property
+    def n(self) -> int:
+        return self.family.n
+
+    def turn(self, p: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        k = self.family.k
+        scale = max(1.0, float(np.linalg.norm(p)) / np.sqrt(max(1, k)))
+        return scale * (rng.normal(size=k) + 1j * rng.normal(size=k))
+
+    def leg(self, a: np.ndarray, b: np.ndarray, roots: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        ends = track_parameters(self.family, a, b, roots, seed=int(rng.integers(2**31)))
+        good = [e.x for e in ends.endpoints if e.kind == "finite" and e.residual <= GOOD_RESIDUAL]
+        return np.array(good).reshape(-1, self.n)
+
+    def settle(self, roots: np.ndarray, p: np.ndarray) -> np.ndarray:
+        return roots  # track_parameters refined them at p
+
+    def fresh(self, known: np.ndarray, roots: np.ndarray) -> list[int]:
+        seen = list(known)
+        out = []
+        for i, x in enumerate(roots):
+            size = max(1.0, float(np.linalg.norm(x)))
+            if all(np.linalg.norm(x - y) > SAME * size for y in seen):
+                seen.append(x)
+                out.append(i)
+        return out
+
+
+@dataclass(frozen=True)
+class Loop:
+    """One monodromy loop: the count after it, the roots it added, the paths it dropped."""
+
+    count: int
+    new: int
+    dropped: int
+    seconds: float
+
+
 @dataclass(frozen=True)
 class Monodromy:
     """The roots of F(x; p) found from the seeds, and how the count grew."""
@@ -179,46 +253,48 @@ class Monodromy:
     paths: int  # paths tracked, over every leg of every loop
     dropped: int  # paths that did not end at a good root on some leg (that loop lost them)
     seconds: float
+    loops: tuple[Loop, ...] = ()
 
 
-def _is_new(x: np.ndarray, known: list[np.ndarray]) -> bool:
-    size = max(1.0, float(np.linalg.norm(x)))
-    return all(np.linalg.norm(x - y) > SAME * size for y in known)
-
-
-def monodromy(family: ParameterFamily, p: Parameters, seeds: np.ndarray, stable_loops: int = 5,
-              max_loops: int = 200, seed: int = 0, max_seconds: float = np.inf) -> Monodromy:
+def monodromy(family: ParameterFamily | Loops, p: Parameters, seeds: np.ndarray, stable_loops: int = 5,
+              max_loops: int = 200, seed: int | np.random.Generator = 0, max_seconds: float = np.inf,
+              on_loop: Callable[[Loop], None] | None = None) -> Monodromy:
     """Loops p -> p1 -> p2 -> p through random complex parameters, each tracking every known
     root, until ``stable_loops`` loops in a row add none, or after ``max_loops`` loops, or
-    the first loop to end past ``max_seconds`` (then ``stable`` says how settled it was)."""
+    the first loop to end past ``max_seconds`` (then ``stable`` says how settled it was).
+    ``family``: a family (:class:`FamilyLoops` loops it) or a problem's own :class:`Loops`
+    (the seeds are settled by it first, as each loop's endpoints are).
+    ``seed``: an int, or a generator to draw from (a caller's stream goes on). ``on_loop``
+    is called with each loop's record as it ends."""
     began = time.perf_counter()
+    loops: Loops = family if hasattr(family, "leg") else FamilyLoops(family)  # type: ignore[assignment]
     rng = np.random.default_rng(seed)
     p = np.asarray(p, dtype=complex)
-    known: list[np.ndarray] = []
-    for x in np.asarray(seeds, dtype=complex).reshape(-1, family.n):
-        if _is_new(x, known):
-            known.append(x)
-    scale = max(1.0, float(np.linalg.norm(p)) / np.sqrt(max(1, family.k)))
-    counts: list[int] = []
+    seeds = loops.settle(np.asarray(seeds, dtype=complex).reshape(-1, loops.n), p)
+    known = seeds[loops.fresh(np.zeros((0, loops.n), dtype=complex), seeds)]
+    records: list[Loop] = []
     stable = paths = dropped = 0
     for _ in range(max_loops):
-        before = len(known)
-        turns = [scale * (rng.normal(size=family.k) + 1j * rng.normal(size=family.k)) for _ in range(2)]
-        current = np.array(known)
+        t0, before, lost = time.perf_counter(), len(known), 0
+        turns = [loops.turn(p, rng) for _ in range(2)]
+        current = known
         for a, b in pairwise([p, *turns, p]):
-            ends = track_parameters(family, a, b, current, seed=int(rng.integers(2**31)))
+            good = loops.leg(a, b, current, rng)
             paths += len(current)
-            good = [e.x for e in ends.endpoints if e.kind == "finite" and e.residual <= GOOD_RESIDUAL]
-            dropped += len(current) - len(good)
-            if not good:
+            lost += len(current) - len(good)
+            current = good
+            if not len(good):
                 break
-            current = np.array(good)
         else:
-            for x in current:
-                if _is_new(x, known):
-                    known.append(x)
-        counts.append(len(known))
+            settled = loops.settle(current, p)
+            lost += len(current) - len(settled)
+            known = np.vstack([known, settled[loops.fresh(known, settled)]])
+        dropped += lost
+        records.append(Loop(len(known), len(known) - before, lost, time.perf_counter() - t0))
+        if on_loop is not None:
+            on_loop(records[-1])
         stable = 0 if len(known) > before else stable + 1
         if stable >= stable_loops or time.perf_counter() - began > max_seconds:
             break
-    return Monodromy(p, np.array(known), tuple(counts), stable, paths, dropped, time.perf_counter() - began)
+    return Monodromy(p, known, tuple(r.count for r in records), stable, paths, dropped,
+                     time.perf_counter() - began, tuple(records))

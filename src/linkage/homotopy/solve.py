@@ -13,6 +13,9 @@ Each endpoint is one of
 - ``failed``: the tracker could not follow the path (its reason is kept). A failed path is
   retracked with smaller steps before it is reported, and never dropped.
 
+:attr:`Solutions.certificates` adds Smale's alpha test at each finite endpoint (:mod:`.alpha`),
+computed when first asked for.
+
 The Cauchy endgame (Morgan, Sommese and Wampler, "Computing singular solutions to
 nonlinear analytic systems", Numer. Math. 58, 1991): near t = 1 a path is X(s) analytic
 in s = (1 - t)^(1/c), c its cycle number; tracking t around circles |1 - t| = r until the
@@ -25,9 +28,11 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
+from .alpha import Certificate, certify, has_real_structure, normalised, undistinguished
 from .polynomials import PolySystem
 from .start import start_for
 from .tracker import Homotopy, PathHomotopy, PathLog, track
@@ -106,6 +111,29 @@ class Solutions:
     @property
     def real(self) -> list[Endpoint]:
         return [e for e in self.endpoints if e.kind in ("finite", "singular") and e.real]
+
+    @cached_property
+    def certificates(self) -> tuple[Certificate | None, ...]:
+        """Smale's alpha test (:func:`.alpha.certify`, at 50 digits) at each finite endpoint,
+        None at the others; computed when first asked for (a few milliseconds an endpoint, as
+        much as the whole solve of a six-bar's assemblies)."""
+        if not any(e.kind == "finite" for e in self.endpoints):
+            return (None,) * len(self.endpoints)
+        scaled, structure = normalised(self.system), has_real_structure(self.system)
+        return tuple(certify(self.system, e.x, structure, scaled) if e.kind == "finite" and e.x is not None
+                     else None for e in self.endpoints)
+
+    @property
+    def certified(self) -> list[tuple[Endpoint, Certificate]]:
+        """The finite endpoints that the alpha test certifies, with their certificates."""
+        return [(e, c) for e, c in zip(self.endpoints, self.certificates) if c is not None and c.certified]
+
+    @property
+    def undistinguished(self) -> list[tuple[int, int]]:
+        """Pairs among :attr:`certified` (indices into it) that the alpha test cannot tell
+        apart: empty when every certified root is certainly a different root."""
+        pairs = self.certified
+        return undistinguished([e.x for e, _ in pairs], [c for _, c in pairs])  # type: ignore[misc]
 
 
 def _norm(X: np.ndarray) -> np.ndarray:
@@ -210,10 +238,12 @@ def weights(x: np.ndarray) -> np.ndarray:
 def equation_sizes(system: PolySystem, x: np.ndarray) -> np.ndarray:
     """Each equation's natural size at x: sum over its terms of |c| prod_v w_v^e_v, w the
     :func:`weights` (what |F_i| is measured against: rounding in evaluating F_i is about eps
-    times this)."""
+    times this). x (n,): (m,); or many points x (P, n): (P, m)."""
     form = system.homogeneous
-    W = np.concatenate([[1.0], weights(x)])[None].astype(complex)
-    return (np.abs(form.coefficients) @ form.monomials(W).real)[:, 0]
+    X = np.atleast_2d(x)
+    W = np.concatenate([np.ones((len(X), 1)), weights(X)], axis=1).astype(complex)
+    sizes = (np.abs(form.coefficients) @ form.monomials(W).real).T
+    return sizes if np.ndim(x) == 2 else sizes[0]
 
 
 def condition(system: PolySystem, x: np.ndarray) -> float:
@@ -234,6 +264,11 @@ def relative_residual(system: PolySystem, x: np.ndarray) -> float:
     """max_i |F_i(x)| / :func:`equation_sizes` (x): about eps at a root computed to rounding."""
     F = system.evaluate(x[None])[0]
     return float(np.max(np.abs(F) / equation_sizes(system, x)))
+
+
+def relative_residuals(system: PolySystem, X: np.ndarray) -> np.ndarray:
+    """:func:`relative_residual` at many points X (P, n) at once: (P,)."""
+    return np.max(np.abs(system.evaluate(X)) / equation_sizes(system, X), axis=1)
 
 
 def _refine(system: PolySystem, x: np.ndarray) -> tuple[np.ndarray, float, float]:

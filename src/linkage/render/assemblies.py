@@ -28,7 +28,8 @@ def assemblies_tables(a: Any) -> tuple[DataTable, ...]:
     joints = [(i + 1, name, x, y) for i, s in enumerate(a.real) for name, (x, y) in s.joints.items()]
     paths = [(k + 1, e.kind, e.real if e.kind in ("finite", "singular") else None, e.cycle, e.steps,
               e.rejected, e.newton, e.smallest_step if math.isfinite(e.smallest_step) else None,
-              e.retracked, e.endgame, e.note) for k, e in enumerate(a.solutions.endpoints)]
+              e.retracked, e.endgame, None if c is None else c.certified, None if c is None else c.alpha,
+              e.note) for k, (e, c) in enumerate(zip(a.solutions.endpoints, a.solutions.certificates))]
     return (
         from_rows("assemblies", heads, rows),
         from_rows("joints", [("assembly", "", "int"), ("joint", "", "text"), ("x", m.length_unit, "number"),
@@ -36,7 +37,8 @@ def assemblies_tables(a: Any) -> tuple[DataTable, ...]:
         from_rows("paths", [("path", "", "int"), ("endpoint", "", "text"), ("real", "", "bool"),
                             ("cycle", "", "int"), ("steps", "", "int"), ("rejected", "", "int"),
                             ("newton", "", "int"), ("smallest_step", "", "number"), ("retracked", "", "bool"),
-                            ("endgame", "", "bool"), ("note", "", "text")], paths),
+                            ("endgame", "", "bool"), ("certified", "", "bool"), ("alpha", "", "number"),
+                            ("note", "", "text")], paths),
     )
 
 
@@ -77,8 +79,20 @@ def summary_lines(a: Any) -> list[str]:
         f"{'y' if len(a.real) == 1 else 'ies'}, {a.complex_count} complex, {a.infinite} at infinity, "
         f"{a.failed} failed" + (f" ({retracked} retracked)" if retracked else "")
         + f"; {sum(e.steps for e in s.endpoints)} steps in {s.seconds:.2f} s",
+        certified_line(s),
         *extra,
     ]
+
+
+def certified_line(s: Any) -> str:
+    """How many finite roots Smale's alpha test certifies (linkage.homotopy.alpha)."""
+    finite = s.count("finite")
+    pairs = s.certified
+    apart = s.undistinguished
+    real = sum(c.real for _, c in pairs)
+    return (f"alpha test (Smale; 50 digits): {len(pairs)} of {finite} nonsingular root"
+            f"{'s' if finite != 1 else ''} certified, {real} of them real"
+            + (", all distinct" if not apart else f", {len(apart)} pair(s) not told apart"))
 
 
 def _bound_text(s: Any, lengths: bool) -> str:
@@ -128,6 +142,9 @@ def assemblies_report(a: Any, digits: int, show_paths: bool) -> Report:
                 "paths": len(s.endpoints), "real": len(a.real),
                 "complex": a.complex_count, "infinite": a.infinite, "failed": a.failed,
                 "unresolved": a.unresolved, "continuum": a.continuum,
+                "alpha_certified": len(s.certified),
+                "alpha_certified_real": sum(c.real for _, c in s.certified),
+                "alpha_undistinguished": len(s.undistinguished),
                 "degrees": list(s.system.degrees), "seconds": s.seconds}
 
     return Report(title_of(a), tables, blocks, document)

@@ -7,6 +7,7 @@ from typing import Any
 
 from ..problems.closed_form import TRANSMISSION
 from ..units import radians
+from .assemblies import certified_line
 from .data import Report, from_rows
 from .report import Block, Text, fmt, table
 
@@ -124,7 +125,10 @@ def motion_report(m: Any, digits: int = 6, unit: str = "") -> Report:
     title = f"motion generation through {len(m.poses)} poses"
 
     def blocks() -> list[Block]:
-        out: list[Block] = [Text(title, "bold"), Text(crank_account(m)), Text(""),
+        account = [Text(crank_account(m))]
+        if m.burmester is not None:
+            account.append(Text(certified_line(m.burmester.solutions)))
+        out: list[Block] = [Text(title, "bold"), *account, Text(""),
                             table(("Burmester cranks" if m.burmester else "cranks") + u,
                                   [h for h, _, _ in CRANK_HEADERS], cranks, digits)]
         out += [

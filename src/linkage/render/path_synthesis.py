@@ -19,7 +19,8 @@ def rank(designs: list[Any]) -> list[int]:
                   key=lambda i: (len(designs[i].defects), -designs[i].transmission_min_deg))
 
 
-def _row(number: int, cognate: int, fb: Any) -> tuple[Any, ...]:
+def design_row(number: int, cognate: int, fb: Any) -> tuple[Any, ...]:
+    """A four-bar's row of the designs table (HEADS)."""
     r1, r2, r3, r4 = fb.lengths
     return (number, cognate, fb.grashof, " ".join(fb.defects) or "none", fb.ground_a.real,
             fb.ground_a.imag, fb.ground_b.real, fb.ground_b.imag, fb.pin_m.real, fb.pin_m.imag,
@@ -36,13 +37,29 @@ HEADS = [("design", "", "int"), ("cognate", "", "int"), ("grashof", "", "text"),
 
 def path_tables(result: Any) -> tuple[DataTable, ...]:
     order = ranked(result)
-    designs = [_row(k + 1, 1, result.designs[i][0]) for k, i in enumerate(order)]
-    cognates = [_row(k + 1, c + 1, fb) for k, i in enumerate(order) for c, fb in enumerate(result.designs[i])]
+    designs = [design_row(k + 1, 1, result.designs[i][0]) for k, i in enumerate(order)]
+    cognates = [design_row(k + 1, c + 1, fb) for k, i in enumerate(order)
+                for c, fb in enumerate(result.designs[i])]
     s = result.solutions
     routes = [(r + 1, s.paths, s.failed[r], s.unrefined[r], s.steps[r]) for r in range(s.routes)]
     return (from_rows("designs", HEADS, designs), from_rows("cognates", HEADS, cognates),
             from_rows("routes", [("route", "", "int"), ("paths", "", "int"), ("failed", "", "int"),
                                  ("unsettled", "", "int"), ("steps", "", "int")], routes))
+
+
+def certified_line(result: Any) -> str:
+    """Smale's alpha test at each real four-bar (linkage.homotopy.ninepoint_alpha; tens of
+    milliseconds each): how many are certified real, and whether all are told apart."""
+    from ..homotopy.alpha import undistinguished
+    from ..homotopy.ninepoint_alpha import certify_rows
+
+    s = result.solutions
+    rows = s.solutions[s.real]
+    certs = certify_rows(rows, s.points)
+    apart = undistinguished(list(rows), certs)
+    return (f"alpha test (Smale; 50 digits): {sum(c.certified and c.real for c in certs)} of the "
+            f"{len(certs)} real four-bars certified real"
+            + (", all distinct" if not apart else f", {len(apart)} pair(s) not told apart"))
 
 
 def summary_lines(result: Any) -> list[str]:
@@ -56,7 +73,19 @@ def summary_lines(result: Any) -> list[str]:
         f"{result.found} four-bars found of {s.paths}" + (f" ({result.missing} not reached)" if result.missing
                                                           else "")
         + f"; {len(result.designs)} real, {clean} without defects",
+        *extra_lines(result.points, result.extra),
+        certified_line(result),
     ]
+
+
+def extra_lines(points: Any, extra: Any) -> list[str]:
+    """What the nine points are when some are extra (linkage.synthesis.path_points)."""
+    if not extra:
+        return []
+    given = len(points) - len(extra)
+    where = ", ".join(f"{k + 1} ({points[k].real:.6g}, {points[k].imag:.6g})" for k in extra)
+    return [f"through {given} given points and {len(extra)} extra points between them, points {where} of "
+            "the nine: each design passes through all nine in order"]
 
 
 TERMINAL_COLUMNS = ("design", "grashof", "defects", "ground", "crank", "coupler", "rocker",
@@ -107,8 +136,8 @@ def timed_path_tables(result: Any) -> tuple[DataTable, ...]:
 
     def row(number: int, cognate: int, i: int) -> tuple[Any, ...]:
         fb = result.designs[i]
-        return (*_row(number, cognate, fb), four_bars[i].crank + 1, four_bars[i].rocker + 1, fb.crank_deg[0],
-                fb.timing_error_deg)
+        return (*design_row(number, cognate, fb), four_bars[i].crank + 1, four_bars[i].rocker + 1,
+                fb.crank_deg[0], fb.timing_error_deg)
 
     order = timed_ranked(result)
     leads = [row(k + 1, 1, result.groups[g][0]) for k, g in enumerate(order)]

@@ -75,6 +75,7 @@ class PathSynthesis:
     found: int  # orbits (complex and real)
     missing: int
     solutions: ninepoint.NinePointSolutions
+    extra: tuple[int, ...] = ()  # which of the points are extra ones (path_points), not given
 
 
 @dataclass(frozen=True)
@@ -103,23 +104,14 @@ def chunk_runner(scheduler: str | None, workers: int | None):  # type: ignore[no
 
 
 def check_points(points: object) -> list[complex]:
-    """Nine finite, distinct points (pairs x, y), or InputError naming what is wrong."""
-    try:
-        pts = [complex(float(p[0]), float(p[1])) for p in points]  # type: ignore[attr-defined, index]
-    except (TypeError, ValueError, IndexError):
-        raise InputError("points must be pairs of numbers (x, y)") from None
-    if len(pts) != POINTS:
-        raise InputError(f"path synthesis takes exactly {POINTS} points (the four-bar has 9 dimensions "
+    """Five to nine finite, distinct points (pairs x, y), or InputError naming what is wrong."""
+    from .path_points import FEWEST, as_points, check_distinct
+
+    pts = as_points("points", points)
+    if not FEWEST <= len(pts) <= POINTS:
+        raise InputError(f"path synthesis takes {FEWEST} to {POINTS} points (the four-bar has 9 dimensions "
                          f"of design), got {len(pts)}")
-    if not all(math.isfinite(p.real) and math.isfinite(p.imag) for p in pts):
-        raise InputError("points must be finite numbers")
-    size = max(abs(p - pts[0]) for p in pts)
-    if size > 1e150 or size == 0.0:
-        raise InputError("the points must be distinct and at most about 1e150 apart")
-    for i in range(POINTS):
-        for j in range(i):
-            if abs(pts[i] - pts[j]) <= 1e-9 * size:
-                raise InputError(f"points {j + 1} and {i + 1} coincide: {pts[i].real:g}, {pts[i].imag:g}")
+    check_distinct("points", pts, [f"point {k + 1}" for k in range(len(pts))])
     return pts
 
 
@@ -313,49 +305,80 @@ def _in_order(at: list[int], n: int) -> bool:
     return forward == sorted(forward) or backward == sorted(backward)
 
 
-def synthesize_path(points: object, seed: int = 0, scheduler: str | None = None,
-                    workers: int | None = None,
-                    min_transmission: float = MIN_TRANSMISSION_DEG,
-                    progress=None) -> PathSynthesis | TimedPathSynthesis:  # type: ignore[no-untyped-def]
-    """Every four-bar whose coupler point passes through nine points; the real ones judged
-    by moving them (module docstring). ``points``: nine (x, y) pairs, or five (x, y, crank
-    angle in deg) for prescribed timing (:func:`synthesize_timed_path`). The paths are tracked
-    in chunks by the scan's runner: here, on dask's local threads or processes, or on a
-    cluster (``scheduler`` tcp://HOST:PORT), ``workers`` at a time. ``progress(done, label)``
-    is told how far it is, out of the paths of a route."""
-    from ..arguments import check_workers
+def path_options(seed: object, min_transmission: object, workers: object, scheduler: object,
+                 orbits: object) -> tuple[int, float, int | None, int | None]:
+    """The options of a path synthesis checked: (seed, min_transmission, workers, orbits)."""
+    from ..arguments import MAX_SEED, check_number, check_whole, check_workers
 
-    if is_timed(points):
-        if scheduler is not None or workers is not None:
-            raise InputError("scheduler and workers are for nine points' path tracking: five timed points "
-                             "are two Burmester problems, solved here")
-        return synthesize_timed_path(points, seed, min_transmission)
-    pts = check_points(points)
-    seed, floor = checked_options(seed, min_transmission)
+    seed = check_whole("seed", seed, 0, MAX_SEED)
+    floor = check_number("min_transmission", min_transmission)
+    if not 0.0 <= floor <= 90.0:
+        raise InputError(f"min_transmission must be from 0 to 90 deg, got {floor:g}")
     workers = check_workers("workers", workers, scheduler)
     if scheduler is not None and not isinstance(scheduler, str):
         raise InputError("scheduler must be threads, processes, synchronous or tcp://HOST:PORT, "
                          f"got {scheduler!r}")
-    sols = ninepoint.solve_points(pts, seed=seed, run=chunk_runner(scheduler, workers), progress=progress)
+    if orbits is not None:
+        orbits = check_whole("orbits", orbits, 1, ninepoint.PATHS)
+    return seed, floor, workers, orbits  # type: ignore[return-value]
+
+
+def synthesize_path(points: object, via: object = None, seed: int = 0, scheduler: str | None = None,
+                    workers: int | None = None,
+                    min_transmission: float = MIN_TRANSMISSION_DEG,
+                    progress=None, orbits: int | None = None,
+                    ) -> PathSynthesis | TimedPathSynthesis:  # type: ignore[no-untyped-def]
+    """Every four-bar whose coupler point passes through nine points; the real ones judged
+    by moving them (module docstring). ``points``: five to nine (x, y) pairs, in the order
+    the coupler point is to meet them; or five (x, y, crank angle in deg) for prescribed
+    timing (:func:`synthesize_timed_path`, which takes ``seed`` and ``min_transmission``).
+    Fewer than nine untimed points are made nine by extra points between them
+    (:mod:`.path_points`): ``via``, 9 - n pairs, or else the curve's evenly spaced ones.
+    The paths are tracked in chunks by the scan's runner: here, on dask's local
+    threads or processes, or on a cluster (``scheduler`` tcp://HOST:PORT), ``workers`` at a
+    time. ``progress(done, label)`` is told how far it is, out of the paths of a route.
+    ``orbits``: track only the first so many of the stored instance's orbits (a quick look,
+    :func:`linkage.homotopy.ninepoint.solve_points`)."""
+    from .path_points import check_via, nine_points
+
+    if is_timed(points):
+        options = (("via", via), ("scheduler", scheduler), ("workers", workers), ("orbits", orbits))
+        given = [k for k, v in options if v is not None]
+        if given:
+            raise InputError(f"{', '.join(given)}: for untimed points' path tracking; five timed points "
+                             "are two Burmester problems, solved here")
+        return synthesize_timed_path(points, seed, min_transmission)
+    pts = check_points(points)
+    extra = check_via(via, pts)
+    seed, floor, workers, orbits = path_options(seed, min_transmission, workers, scheduler, orbits)
+    nine = nine_points(pts, extra, seed, 0)
+    run = chunk_runner(scheduler, workers)
+    return solve_nine(nine.points, nine.extra, seed, run, floor, progress, orbits)
+
+
+CIRCUIT_DEFECTS = ("branch", "order")
+"""Defects of the motion, which a design's three cognates share: their motions correspond
+one to one (Roberts-Chebyshev: one coupler curve, traced by all three together)."""
+
+
+def solve_nine(points: tuple[complex, ...], extra: tuple[int, ...], seed: int, run, floor: float,  # type: ignore[no-untyped-def]
+               progress=None, orbits: int | None = None, every_cognate: bool = True) -> PathSynthesis:
+    """The four-bars through nine checked points (``extra`` of them not the user's), each
+    real one and its cognates judged: :func:`synthesize_path` after its checks. Without
+    ``every_cognate`` (a search, which keeps only defect-free designs), a design whose first
+    cognate has a defect of CIRCUIT_DEFECTS is that cognate alone."""
+    pts = list(points)
+    sols = ninepoint.solve_points(pts, seed=seed, run=run, progress=progress, orbits=orbits)
     designs = []
     reals = np.flatnonzero(sols.real)
     for k, i in enumerate(reals):
         members = ninepoint.orbit(sols.solutions[i])[:3]
-        designs.append(tuple(judge(mz, pts, floor) for mz in members))
+        first = judge(members[0], pts, floor)
+        shared = not every_cognate and set(first.defects) & set(CIRCUIT_DEFECTS)
+        designs.append((first,) if shared else (first, *(judge(mz, pts, floor) for mz in members[1:])))
         if progress is not None:
             progress(sols.paths * (k + 1) // len(reals), "moving the real four-bars")
-    return PathSynthesis(tuple(pts), tuple(designs), len(sols.solutions), sols.missing, sols)
-
-
-def checked_options(seed: object, min_transmission: object) -> tuple[int, float]:
-    """The seed (a whole number) and the transmission floor (0 to 90 deg), or InputError."""
-    from ..arguments import MAX_SEED, check_number, check_whole
-
-    whole = check_whole("seed", seed, 0, MAX_SEED)
-    floor = check_number("min_transmission", min_transmission)
-    if not 0.0 <= floor <= 90.0:
-        raise InputError(f"min_transmission must be from 0 to 90 deg, got {floor:g}")
-    return whole, floor
+    return PathSynthesis(tuple(pts), tuple(designs), len(sols.solutions), sols.missing, sols, extra)
 
 
 def synthesize_timed_path(points: object, seed: int = 0,
@@ -366,7 +389,7 @@ def synthesize_timed_path(points: object, seed: int = 0,
     judged (:func:`judge_four_bar`, with a ``timing`` defect). Other counts of timed points,
     points with and without angles mixed, NaN or coincident points: InputError."""
     check_timed_points(points)  # before the options: a wrong count is the first thing said
-    seed, floor = checked_options(seed, min_transmission)
+    seed, floor, _, _ = path_options(seed, min_transmission, None, None, None)
     found = timed_four_bars(points, seed=seed)
     designs = tuple(judge_four_bar(fb.pivots, list(fb.configurations), list(found.points), floor,
                                    found.crank_deg) for fb in found.four_bars)

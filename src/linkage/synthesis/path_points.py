@@ -1,0 +1,169 @@
+"""The nine points of a path synthesis through fewer (docs/path_synthesis.md, "Five to eight
+points").
+
+A four-bar has nine dimensions of design, so the four-bars whose coupler point passes
+through n < 9 points form a (9 - n)-dimensional family. Each choice of 9 - n extra points
+picks the finitely many of them that also pass through those: the nine-point problem
+(:mod:`linkage.homotopy.ninepoint`). So every design found passes through the given
+points, and sampling the extra points samples the family.
+
+The extra points go between consecutive given points, never before the first or after the
+last: a design is judged over its motion from the first point to the last, in order
+(:func:`linkage.synthesis.path.judge`), and an extra point on the way is met in order by a
+design that follows the path. They are placed on a smooth closed curve through the given
+points in their order, a centripetal Catmull-Rom spline (Yuksel, Schaefer and Keyser,
+"Parameterization and applications of Catmull-Rom curves", Computer-Aided Design 43(7),
+2011: no cusps or self-intersections within a segment), in the widest gaps. Sample 0 takes
+them evenly spaced along the curve; each later sample moves each one along the curve and
+across it by a seeded random offset.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+
+POINTS = 9
+"""A four-bar's dimensions of design: nine points fix finitely many."""
+FEWEST = 5
+"""Fewer given points leave a family of five or more dimensions to sample: the issue's range."""
+ALONG = 0.3
+"""A sampled extra point moves along the curve by up to this fraction of its share of the gap
+(so the extra points of one gap keep their order and stay inside it)."""
+ACROSS = 0.15
+"""...and across the gap by up to this fraction of the gap's chord."""
+FARTHEST = 1e150
+"""Points at most about this far apart (their squares stay finite in double precision)."""
+
+
+def as_points(name: str, points: object) -> list[complex]:
+    """Pairs (x, y) of finite numbers as complex numbers x + iy, or InputError naming ``name``."""
+    try:
+        pts = [complex(float(p[0]), float(p[1])) for p in points]  # type: ignore[attr-defined, index]
+    except (TypeError, ValueError, IndexError):
+        raise InputError(f"{name} must be pairs of numbers (x, y)") from None
+    if not all(math.isfinite(p.real) and math.isfinite(p.imag) for p in pts):
+        raise InputError(f"{name} must be finite numbers")
+    return pts
+
+
+def check_distinct(name: str, pts: list[complex], labels: list[str]) -> None:
+    """InputError (its message starting with ``name``) when two points coincide (to 1e-9 of
+    their spread, naming both by ``labels``) or the points are more than FARTHEST apart."""
+    size = max(abs(p - pts[0]) for p in pts)
+    if size > FARTHEST or size == 0.0:
+        raise InputError(f"{name}: the points must be distinct and at most about 1e150 apart")
+    for i in range(len(pts)):
+        for j in range(i):
+            if abs(pts[i] - pts[j]) <= 1e-9 * size:
+                raise InputError(f"{name}: {labels[j]} and {labels[i]} coincide: "
+                                 f"{pts[i].real:g}, {pts[i].imag:g}")
+
+
+def check_via(via: object, given: list[complex]) -> list[complex]:
+    """The extra points a user gives (``via``): 9 - len(given) finite pairs, distinct from
+    the given points and each other, or InputError."""
+    if via is None:
+        return []
+    extra = as_points("via", via)
+    want = POINTS - len(given)
+    if extra and len(extra) != want:
+        raise InputError(f"via: {len(given)} points need {want} extra point{'s' if want != 1 else ''} "
+                         f"to make nine, got {len(extra)}")
+    labels = [f"point {k + 1}" for k in range(len(given))] + [f"via point {k + 1}" for k in range(len(extra))]
+    check_distinct("via", given + extra, labels)
+    return extra
+
+
+@dataclass(frozen=True)
+class NinePoints:
+    """The nine points solved: the given points in their order with the extra points
+    between them, ``extra`` the positions of the extra ones."""
+
+    points: tuple[complex, ...]
+    extra: tuple[int, ...]
+
+    @property
+    def given(self) -> tuple[complex, ...]:
+        return tuple(p for k, p in enumerate(self.points) if k not in self.extra)
+
+
+def curve_point(pts: list[complex], k: int, s: float) -> complex:
+    """The closed centripetal Catmull-Rom curve through ``pts`` (in order, the last joined
+    to the first) at fraction ``s`` of the way from point k to point k + 1 (Barry and
+    Goldman's pyramid of linear interpolations, knots spaced by the square root of the
+    chords)."""
+    n = len(pts)
+    p0, p1, p2, p3 = (pts[(k + i) % n] for i in (-1, 0, 1, 2))
+    t1 = abs(p1 - p0) ** 0.5
+    t2 = t1 + abs(p2 - p1) ** 0.5
+    t3 = t2 + abs(p3 - p2) ** 0.5
+    t = t1 + s * (t2 - t1)
+
+    def mix(a: complex, b: complex, ta: float, tb: float) -> complex:
+        return a * (tb - t) / (tb - ta) + b * (t - ta) / (tb - ta)
+
+    a1, a2, a3 = mix(p0, p1, 0.0, t1), mix(p1, p2, t1, t2), mix(p2, p3, t2, t3)
+    return mix(mix(a1, a2, 0.0, t2), mix(a2, a3, t1, t3), t1, t2)
+
+
+def gap_counts(pts: list[complex], count: int) -> list[int]:
+    """How many of ``count`` extra points go in each gap between consecutive points: one
+    at a time to the gap whose chord, shared among its extra points, is widest (the first
+    such gap on a tie)."""
+    chords = [abs(b - a) for a, b in itertools.pairwise(pts)]
+    counts = [0] * len(chords)
+    for _ in range(count):
+        k = max(range(len(chords)), key=lambda i: chords[i] / (counts[i] + 1))
+        counts[k] += 1
+    return counts
+
+
+def sampled(pts: list[complex], seed: int, sample: int) -> NinePoints:
+    """The given points and 9 - n extra points on the curve through them (module
+    docstring): sample 0 evenly spaced, later ones moved by the random numbers of
+    (``seed``, ``sample``)."""
+    rng = np.random.default_rng([seed, sample])
+    out: list[complex] = []
+    extra: list[int] = []
+    for k, m in enumerate([*gap_counts(pts, POINTS - len(pts)), 0]):
+        out.append(pts[k])
+        if not m:
+            continue
+        a, b = pts[k], pts[k + 1]
+        across = 1j * (b - a)  # the chord turned a quarter turn
+        for j in range(m):
+            along, side = (rng.uniform(-ALONG, ALONG), rng.uniform(-ACROSS, ACROSS)) if sample else (0.0, 0.0)
+            extra.append(len(out))
+            out.append(curve_point(pts, k, (j + 1 + along) / (m + 1)) + side * across)
+    return NinePoints(tuple(out), tuple(extra))
+
+
+def inserted(pts: list[complex], via: list[complex]) -> NinePoints:
+    """The given points with each extra point of ``via`` (in turn) put into the gap between
+    consecutive points where it lengthens the polyline least (cheapest insertion)."""
+    out = list(pts)
+    marks = [False] * len(pts)
+    for v in via:
+        def detour(i: int, v: complex = v) -> float:
+            return abs(out[i] - v) + abs(v - out[i + 1]) - abs(out[i + 1] - out[i])
+
+        k = min(range(len(out) - 1), key=detour)
+        out.insert(k + 1, v)
+        marks.insert(k + 1, True)
+    return NinePoints(tuple(out), tuple(k for k, m in enumerate(marks) if m))
+
+
+def nine_points(given: list[complex], via: list[complex], seed: int, sample: int) -> NinePoints:
+    """The nine points solved for ``given`` (checked, 5 to 9): the user's extra points
+    ``via`` when given, else sample ``sample`` of the curve's."""
+    if len(given) == POINTS or via:
+        return inserted(given, via)
+    nine = sampled(given, seed, sample)
+    check_distinct("points", list(nine.points), [f"point {k + 1} of the nine" for k in range(POINTS)])
+    return nine
