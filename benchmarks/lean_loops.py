@@ -70,7 +70,7 @@ def parts() -> None:
     input, the Result), beside the hand loops; for the README's account of targets 1-2."""
     from linkage.measure.hand import hand_newton, hand_newton_2x2
     from linkage.measure.precision import scalar_problem, system_problem
-    from linkage.methods.newton import newton_lean
+    from linkage.methods.newton import newton_quiet
     from linkage.methods.newton_system import newton_2x2
     from linkage.problems.system import LeanProblem
     from linkage.solve import certify_root
@@ -79,11 +79,8 @@ def parts() -> None:
     p, x0 = spec["problem"], spec["x0"]
     r = solve_scalar(p, method="newton", x0=x0, tol=1e-12, record=False)
 
-    def certify(x, fx, width):
-        return certify_root(p, x, fx, width)[:2]
-
     whole = best(lambda: solve_scalar(p, method="newton", x0=x0, tol=1e-12, record=False), 20000)
-    loop = best(lambda: newton_lean(p, x0, 1e-12, 0.0, None, 100, certify, None), 20000)
+    loop = best(lambda: newton_quiet(p, x0, 1e-12, 0.0, None, 100, certify_root), 20000)
     hand = best(lambda: hand_newton(p.f, p.fprime, x0, 1e-12), 20000)
     print(f"Freudenstein Newton ({r.iterations} iterations): solve {whole * 1e6:.2f} us = loop "
           f"{loop * 1e6:.2f} us + front door and Result {(whole - loop) * 1e6:.2f} us; hand loop "

@@ -87,7 +87,9 @@ def _scalar(q0: float, script: list[tuple[float, float, float, bool]], can_diver
 
 
 def _array(q0s: list[float], scripts: list[list[tuple[float, float, float, bool]]],
-           can_diverge: bool) -> list[tuple[str, int]]:
+           can_diverge: bool, whole: bool = False) -> list[tuple[str, int]]:
+    """The twin on the scripts; ``whole``: a step at every position passes rows=None (the
+    engines' first steps), else the rows always."""
     arr = np.array(scripts, dtype=float)  # (cases, steps, 4)
     stops = rules.SystemStops(TOL, GATE, np.array(q0s), can_diverge)
     out: list[tuple[str, int]] = [("max_iter", MAX_ITER)] * len(scripts)
@@ -96,7 +98,8 @@ def _array(q0s: list[float], scripts: list[list[tuple[float, float, float, bool]
         if not active.size:
             break
         err, resid, size, singular = (arr[active, k - 1, j] for j in range(4))
-        codes = stops.judge(err, resid, singular.astype(bool), size, rows=active)
+        rows = None if whole and active.size == len(scripts) else active
+        codes = stops.judge(err, resid, singular.astype(bool), size, rows=rows)
         for i, c in zip(active[codes != rules.GOING], codes[codes != rules.GOING]):
             out[i] = (rules.ARRAY_STATUS[c], k)
         active = active[codes == rules.GOING]
@@ -110,10 +113,25 @@ def test_the_array_stops_are_the_scalar_loops_on_random_runs(can_diverge):
     got = _array([q for q, _ in cases], [s for _, s in cases], can_diverge)
     want = [_scalar(q, s, can_diverge) for q, s in cases]
     assert got == want
+    # a first step of every position judged as a whole (rows=None: what is kept is made
+    # only when a later step needs it) is the same
+    assert _array([q for q, _ in cases], [s for _, s in cases], can_diverge, whole=True) == want
     seen = {status for status, _ in want}
     # every verdict the twin knows was met (the undamped run's divergence included)
     expected = set(rules.ARRAY_STATUS[1:]) | {"max_iter"}
     assert seen == (expected if can_diverge else expected - {"diverged"})
+
+
+def test_a_first_step_at_rounding_level_counts_toward_the_precision_limit():
+    """Six shrinking steps at rounding level with the residual above the gate: the sixth
+    is the precision limit only if the first counted, on every way of judging it."""
+    shrinking = [(e, 1e-6, 1e3, False) for e in (4e-13, 3e-13, 2e-13, 1e-13, 5e-14, 2e-14)]
+    script = shrinking + [(1e-14, 1e-6, 1e3, False)] * (MAX_ITER - len(shrinking))
+    loose = [(1e-3, 1e-6, 1e3, False)] * MAX_ITER  # a second position that goes on
+    want = [_scalar(1e3, script, True), _scalar(1e3, loose, True)]
+    assert want[0] == ("precision_limit", 6)
+    for whole in (False, True):
+        assert _array([1e3, 1e3], [script, loose], True, whole) == want
 
 
 def test_the_twins_constants_are_the_scalar_loops():
@@ -125,3 +143,27 @@ def test_the_twins_constants_are_the_scalar_loops():
 def test_the_codes_name_the_scalar_statuses():
     for code, name in enumerate(rules.ARRAY_STATUS[1:], start=1):
         assert Status(name).converged == bool(rules.converged_codes(np.array([code]))[0])
+
+
+def test_the_short_way_of_a_block_that_stops_at_once_is_the_ordered_tests():
+    """judge's short way (a block whose every step and residual is within the limits: one
+    full pass instead of the ordered tests) gives the ordered tests' codes, exact zeros
+    included; a block with one position outside, a NaN, an inf or a singular J takes the
+    ordered tests. The reference is the same judge with the short way turned off."""
+    rng = np.random.default_rng(5)
+    seen = set()
+    for case in range(400):
+        k = int(rng.integers(1, 40))
+        err = rng.choice([0.0, 1e-13, TOL, TOL / 2, 2 * TOL, math.nan, math.inf], k,
+                         p=[0.2, 0.3, 0.2, 0.26, 0.02, 0.01, 0.01])
+        resid = rng.choice([0.0, 1e-12, GATE, 2 * GATE, math.inf], k, p=[0.3, 0.4, 0.27, 0.02, 0.01])
+        singular = rng.random(k) < 0.01 if case % 2 else None
+        q0 = rng.uniform(0.0, 10.0, k)
+        got = rules.SystemStops(TOL, GATE, q0).judge(err, resid, singular, q0)
+        ordered = rules.SystemStops(TOL, GATE, q0)
+        ordered.bounded = False
+        want = ordered.judge(err, resid, singular, q0)
+        assert got.dtype == want.dtype and np.array_equal(got, want), (err, resid, singular)
+        seen.add(bool(rules.converged_codes(want).all()))
+    assert seen == {True, False}  # both ways were taken
+    assert not rules.SystemStops(TOL, math.inf, np.zeros(1)).bounded  # an inf limit: the ordered tests

@@ -135,6 +135,27 @@ def test_design_newton_uses_the_scaled_stopping_rule():
     assert counts[0] == counts[1] == counts[2]
 
 
+@pytest.mark.parametrize("name", SAMPLE_NAMES)
+def test_loops_from_a_plan_are_the_loops_from_their_terms(name):
+    """VectorLoops from a LoopPlan (fixed terms reduced to numbers once per model) give Phi
+    and J bit for bit as from the model's own terms, each fixed term's cosine and sine taken
+    where it is summed (VectorLoops.of_terms, the design engines' way)."""
+    from linkage.kinematics.vector_loops import DRIVER, LoopPlan, VectorLoops
+
+    m = load(SAMPLES / f"{name}.toml")
+    rng = np.random.default_rng(7)
+    drv = rng.uniform(-7.0, 7.0, 53)
+    terms = [[(sign, drv if li == DRIVER else lc, li if li >= 0 else -1, drv if ai == DRIVER else ac,
+               ai if ai >= 0 else -1, off) for sign, lc, li, ac, ai, off in loop] for loop in m.model.terms]
+    q = [rng.uniform(-3.0, 3.0, 53) * (1.0 if u.kind == "angle" else m.length_scale) for u in m.unknowns]
+    want = VectorLoops.of_terms(terms, m.model.n, 53).evaluate(q, None)
+    for loops in (VectorLoops(m.model, drv), VectorLoops(LoopPlan.of(m.model), drv)):
+        got = loops.evaluate(q, None)
+        assert all(np.array_equal(a, b) for a, b in zip(got[0], want[0]))
+        assert all(np.array_equal(np.broadcast_to(a, (53,)), np.broadcast_to(b, (53,)))
+                   for ra, rb in zip(got[1], want[1]) for a, b in zip(ra, rb))
+
+
 # --- finding: batch sweeps drop rates -------------------------------------------------------------
 
 def _csv(text: str) -> tuple[list[str], list[list[str]]]:

@@ -133,8 +133,16 @@ def test_method_all_lists_every_method(cli):
 
 def test_method_all_on_an_equation_runs_only_what_applies(cli):
     run = cli("solve", "--equation", "x**2 - 2", "--x0", "1", "--method", "all", "--format", "json")
-    # an equation has exact f' and f'': from --x0 alone, Newton and Halley apply
-    assert [d["method"] for d in json.loads(run.out)["runs"]] == ["newton", "halley"]
+    # from --x0 alone: every registered method that starts from x0 and needs only what an
+    # equation has (its exact derivatives; no g without --g), in the registry's order
+    from linkage import equation_problem
+    from linkage.methods import METHODS
+
+    problem = equation_problem("x**2 - 2")
+    expected = [name for name, e in METHODS.items()
+                if e.starts == "x0" and all(getattr(problem, attr) is not None for attr, _ in e.needs)]
+    assert "newton" in expected and "fixed-point" not in expected and "secant" not in expected
+    assert [d["method"] for d in json.loads(run.out)["runs"]] == expected
 
 
 @pytest.mark.parametrize("fmt", ["table", "plain", "github", "grid", "latex"])

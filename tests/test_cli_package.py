@@ -124,3 +124,37 @@ def test_the_moved_engine_functions_are_importable_from_their_homes():
     problem = scalar_problem(None, None, 40.0, None, None, None, ("2", "7", "9", "6"))
     for root in _roots_deg(40.0, *rs):
         assert abs(problem.f(root)) < 1e-12
+
+
+def test_the_collector_paused_for_start_up_runs_again_while_the_command_works():
+    """linkage.cli.main pauses the cyclic collector while the command line starts (a cold
+    start's cost, docs/performance.md) and must resume it before the command works: a long
+    sweep's cyclic garbage is collected as ever. What start-up made is frozen (never walked
+    again), and an in-process run_cli (the tests' own) leaves the collector alone."""
+    from conftest import run_process
+
+    code = """
+import gc, sys
+import linkage.render.writers as writers
+seen = []
+real = writers.write
+def write(*args, **kwargs):
+    seen.append((gc.isenabled(), gc.get_freeze_count() > 0))
+    return real(*args, **kwargs)
+writers.write = write
+sys.argv = ["linkage", "solve"]
+from linkage.cli import main
+try:
+    main()
+except SystemExit as stop:
+    print(seen, gc.isenabled(), stop.code, file=sys.stderr)
+"""
+    run = run_process(code=code)
+    assert run.stderr.strip().splitlines()[-1] == "[(True, True)] True 0", run.stderr
+    import gc
+
+    from linkage.cli import run_cli
+
+    frozen = gc.get_freeze_count()
+    assert run_cli(["samples"]) == 0
+    assert gc.isenabled() and gc.get_freeze_count() == frozen

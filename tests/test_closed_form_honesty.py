@@ -434,6 +434,29 @@ def test_the_circle_intersection_twin_is_its_scalar_rule():
             assert got == (a[i], h[i])
 
 
+def test_the_circle_intersection_twin_orders_by_comparisons_as_sorted_does():
+    """triangle_np orders its three distances by comparisons (descending_np), not a sort:
+    the same values as sorted(..., reverse=True) wherever there is no NaN (ties, zeros,
+    infinities, scalars beside arrays), and with a NaN the twin still refuses the
+    position as the scalar rule does."""
+    rng = np.random.default_rng(3)
+    pool = np.array([0.0, 1.0, 2.0, 3.0, 1e-300, 1e300, np.inf, 0.5])
+    p, q, s = (pool[rng.integers(0, len(pool), 5000)] for _ in range(3))
+    got = np.stack(assembly.descending_np(p, q, s))
+    assert np.array_equal(got, -np.sort(-np.stack((p, q, s)), axis=0))
+    x, y, z = assembly.descending_np(np.array([2.0, 5.0, 0.5]), 3.0, 1.0)  # two scalars
+    assert [list(v) for v in (x, y, z)] == [[3.0, 5.0, 3.0], [2.0, 3.0, 1.0], [1.0, 1.0, 0.5]]
+    for bad in ([np.nan, 1.0, 1.0], [1.0, np.nan, 1.0], [1.0, 1.0, np.nan], [np.nan] * 3,
+                [np.inf, 1.0, 1.0], [1.0, np.inf, np.inf], [1.0, 1.0, 0.0], [1.0, 0.0, 0.0]):
+        a, h, ok = assembly.triangle_np(*(np.array([v]) for v in bad))
+        want = assembly.triangle(*bad)
+        assert bool(ok[0]) == (want is not None), bad
+        if want is None:
+            assert np.isnan(h[0]), bad
+        else:
+            assert np.array_equal([a[0], h[0]], want, equal_nan=True), bad
+
+
 @pytest.mark.parametrize("kind", ["crank", "rocker", "slider"])
 def test_the_closed_form_position_twins_are_their_scalar_rules(kind):
     """Same operations; numpy's sin/cos/atan2 may differ from the C library's by an ulp,

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import random
 from pathlib import Path
+from typing import Any
 
 import mpmath as mp
 import pytest
@@ -253,6 +254,11 @@ def test_lean_system_newton_equals_the_generic_loop_on_the_stress_battery():
                   solve_system(s.F, s.start(factor), record=True, **kw), label)
 
 
+def seen(result: Any) -> dict[str, Any]:
+    """A Result's fields as a reader sees them (a fast solve keeps some raw until read)."""
+    return {name: getattr(result, name) for name in result.__dataclass_fields__}
+
+
 def test_the_two_unknown_front_door_equals_the_general_path():
     """solve_system on user callables of two unknowns with a tuple start takes a short
     front door; a list start takes the general path. Everything in the Result agrees."""
@@ -274,7 +280,7 @@ def test_the_two_unknown_front_door_equals_the_general_path():
             for kw in (dict(tol=1e-10), dict(tol=1e-12, ftol=1e-9, max_iter=7), dict(tol=1e-8, rtol=1e-6)):
                 fast = solve_system(F, x0, jac=J, record=False, damped=damped, **kw)
                 full = solve_system(F, list(x0), jac=J, record=False, damped=damped, **kw)
-                assert vars(fast) == vars(full) or repr(vars(fast)) == repr(vars(full)), (label, kw)
+                assert seen(fast) == seen(full) or repr(seen(fast)) == repr(seen(full)), (label, kw)
 
 
 
@@ -293,9 +299,9 @@ def test_the_two_unknown_mechanism_front_door_equals_the_general_path():
             for kw in (dict(tol=1e-10), dict(tol=1e-12, ftol=1e-9, max_iter=7), dict(tol=1e-8, rtol=1e-6)):
                 fast = solve_system(p, x0, record=False, damped=damped, **kw)
                 full = solve_system(p, list(x0), record=False, damped=damped, **kw)
-                assert repr(vars(fast)) == repr(vars(full)), kw
+                assert repr(seen(fast)) == repr(seen(full)), kw
                 fast = solve_system(p, record=False, damped=damped, **kw)  # its own x0
-                assert repr(vars(fast)) == repr(vars(full)), kw
+                assert repr(seen(fast)) == repr(seen(full)), kw
                 converged += fast.converged
     assert converged > 300
 

@@ -162,6 +162,22 @@ def test_recorded_newton_has_the_generic_loops_outcome_and_rows_bit_for_bit():
         assert _bits(on.history.rows) == _bits(tuple(rows.finish()[0])), case
 
 
+def test_a_long_recorded_newton_keeps_the_generic_loops_head_and_tail():
+    """Past the history's head (HISTORY_HEAD rows) the recorded loop hands rows to the
+    ring: a cycling Newton (x^3 - 2x + 2 from 0) of 700 steps has the generic loop's table."""
+    from linkage.iterate import HISTORY_HEAD
+
+    problem = ScalarProblem(lambda x: x ** 3 - 2.0 * x + 2.0, fprime=lambda x: 3.0 * x * x - 2.0)
+    m = method_class("newton")()
+    crit = Criteria(1e-12, 0.0, None, 700)
+    _, status, detail, k, rows = run(m, problem, m.init(problem, 0.0), crit, record=True,
+                                     certify=_certify(problem))
+    on = newton_result(problem, 0.0, crit, record=True)
+    assert (on.status, on.detail, on.iterations) == (status, detail, k) == (Status.MAX_ITER, "", 700)
+    assert on.history.elided > 0 and on.history.gap_at == HISTORY_HEAD
+    assert _bits(on.history.rows) == _bits(tuple(rows.finish()[0]))
+
+
 def _random_system(rng: random.Random, n: int) -> tuple[Any, Any, tuple[float, ...]]:
     """Phi_i(q) = sum_j A_ij q_j + c_i sin(q_i) + d_i q_i^3 - b_i, with its exact J."""
     A = [[rng.uniform(-2, 2) for _ in range(n)] for _ in range(n)]

@@ -43,7 +43,7 @@ from collections import deque
 from collections.abc import Callable
 from typing import Any, NamedTuple
 
-from .result import Status
+from .result import STATUS_MEMBERS, Status
 from .rules import step_limit, system_converged, worse_than_seen
 
 UNCERTIFIED_LIMIT = 4
@@ -107,10 +107,10 @@ def judge_certificate(verdict: Status, why: str, uncertified: int) -> tuple[Stat
     """Test 5's certification, shared by the generic and the lean loops: after a step
     within the tolerance, (the status to stop with, or None to go on; its detail; the
     updated count of small steps without evidence)."""
-    if verdict is Status.CONVERGED_STEP:
+    if verdict is STATUS_MEMBERS.CONVERGED_STEP:
         return verdict, "", uncertified
     uncertified += 1
-    if verdict is not Status.STALLED or uncertified >= UNCERTIFIED_LIMIT:
+    if verdict is not STATUS_MEMBERS.STALLED or uncertified >= UNCERTIFIED_LIMIT:
         return verdict, why, uncertified
     return None, "", uncertified
 
@@ -138,8 +138,8 @@ def explain(exc: BaseException) -> tuple[Status, str]:
 # --- the ordered stopping rule, and the loops generated from it ----------------------------------
 #
 # Tests 2-8 above are written once, here, as source text (:func:`stopping_tests`). Every loop -
-# the generic one (:func:`run`), the methods' tight loops (Newton, the secant, fixed point,
-# bisection, Halley), the systems' Newton and the compiled models' Newton for two unknowns
+# the generic one (:func:`run`), the scalar methods' tight loops (:mod:`linkage.methods`), the
+# systems' Newton and the compiled models' Newton for two unknowns
 # (:mod:`linkage.methods.newton_two`) - is generated from it around the method's own step
 # (:class:`Loop`) and compiled once per process, so the order lives in one place and the tight
 # loops pay for no call per test. ``loop_source`` prints what runs.
@@ -176,6 +176,10 @@ class Loop(NamedTuple):
     step_test: str = "converged"
     """Test 5's verdict on a small step: ``converged``, ``certify``, ``system`` (with the
     residual gate) or ``minimizes`` (``system``, and a stall is a local minimum)."""
+    counted: bool = False
+    """With ``certify``: the loop calls ``certify(problem, x, fx, limit)`` in the form of
+    :func:`linkage.solve.certify_root` (status, detail, evaluations of f it made) and adds
+    the evaluations up in ``extra`` (no closure per solve to count them)."""
     diverge: str = ""
     """Test 6: ``""`` (a bracket cannot diverge), ``streak`` or ``runaway`` (systems)."""
     diverge_when: str = ""
@@ -295,7 +299,11 @@ def _step_test(out: _Emitter) -> None:
     if loop.step_test == "converged":
         stop(1, "CONVERGED_STEP")
     elif loop.step_test == "certify":
-        put(1, "verdict, why = certify(x, fx, limit)")
+        if loop.counted:
+            put(1, "verdict, why, n = certify(problem, x, fx, limit)")
+            put(1, "extra += n")
+        else:
+            put(1, "verdict, why = certify(x, fx, limit)")
         put(1, "verdict, why, uncertified = _judge(verdict, why, uncertified)")
         put(1, "if verdict is not None:")
         put(2, "status, detail = verdict, why")
@@ -356,7 +364,7 @@ def loop_source(loop: Loop) -> str:
     lines = [f"def {loop.signature}:", *_block(loop.setup, 1),
              '    status, detail = _S.MAX_ITER, ""',
              "    prev_err = _inf",
-             "    growth = uncertified = stalls = rounding_steps = k = 0",
+             "    growth = uncertified = stalls = rounding_steps = k = " + ("extra = " * loop.counted) + "0",
              *([f"    quiet = {_QUIET_FTOL if loop.residual_test else ''}not rtol"] if loop.quiet else []),
              "    for k in range(1, max_iter + 1):",
              "        try:", *_block(loop.step, 3),
@@ -374,7 +382,7 @@ def loop_source(loop: Loop) -> str:
 def build_loop(loop: Loop, names: dict[str, Any] | None = None) -> Callable[..., Any]:
     """Compile ``loop``; ``names``: what its step reads besides the stopping tests' own."""
     namespace: dict[str, Any] = {
-        "_S": Status, "_inf": math.inf, "_nan": math.nan, "_isfinite": math.isfinite,
+        "_S": STATUS_MEMBERS, "_inf": math.inf, "_nan": math.nan, "_isfinite": math.isfinite,
         "_explain": explain, "_judge": judge_certificate, "_stall": rounding_stall,
         "_worse": worse_than_seen, "_step_limit": step_limit, "_system_converged": system_converged,
         "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_RUNAWAY": RUNAWAY, **(names or {})}

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from enum import Enum
+from types import SimpleNamespace
 from typing import Any, NamedTuple
 
 from .errors import NotConvergedError
@@ -37,6 +38,11 @@ class Status(Enum):
     def message(self) -> str:
         return _MESSAGES[self]
 
+
+STATUS_MEMBERS = SimpleNamespace(**Status.__members__)
+"""The statuses as plain attributes, for the hot paths (the generated loops read them as
+``_S.MAX_ITER``): the same members, read as an instance attribute (about 10 ns) where an
+Enum class attribute costs about 150 ns on Python 3.11, several times per solve."""
 
 _CONVERGED = frozenset({Status.CONVERGED_STEP, Status.CONVERGED_RESIDUAL, Status.CONVERGED_EXACT})
 
@@ -168,15 +174,22 @@ class Result:
 
     @classmethod
     def fast(cls, method: str, x: Any, status: Status, iterations: int, nfev: int, error: float,
-             residual: Any, detail: str, meta: dict[str, Any]) -> Result:
-        """The same value as ``Result(...)`` without the frozen dataclass's per-field
-        ``object.__setattr__`` (about 1.5 us of a 5 us solve): for the lean loops."""
+             residual: Any, detail: str, njev: int, meta: Raw, history: Raw | None = None) -> Result:
+        """The same value as ``Result(...)``, made for a solve's hot path: without the frozen
+        dataclass's per-field ``object.__setattr__`` (about 1.5 us of a 5 us solve), and with
+        ``meta`` and ``history`` kept raw, each as ``(builder, *arguments)``, to be built on
+        their first read (:class:`Built`): most callers never read them."""
         obj = _new(cls)
         # one dict literal set as the instance's namespace: no keyword dict to merge
         _setattr(obj, "__dict__", {"method": method, "x": x, "status": status, "iterations": iterations,
                                    "nfev": nfev, "error": error, "residual": residual, "detail": detail,
-                                   "history": None, "njev": 0, "meta": meta})
+                                   "njev": njev, "raw_meta": meta, "raw_history": history})
         return obj
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The fields as values (a raw record holds the solve's callables, which need not
+        pickle): a copy or a pickle is the Result as every reader sees it."""
+        return {name: getattr(self, name) for name in self.__dataclass_fields__}
 
     @property
     def root(self) -> Any:
@@ -217,6 +230,40 @@ class Result:
 
 _new = object.__new__
 _setattr = object.__setattr__
+
+Raw = tuple
+"""A field kept raw: ``(builder, *arguments)``, the value being ``builder(*arguments)``."""
+
+
+class Built:
+    """A :class:`Result` field that :meth:`Result.fast` keeps raw (as ``raw_<name>`` in the
+    instance's namespace) and that is built on its first read, then kept (as
+    ``functools.cached_property`` does). A Result made the ordinary way holds the value
+    itself, which is read first: a non-data descriptor yields to the instance's namespace."""
+
+    __slots__ = ("default", "name", "raw")
+
+    def __init__(self, name: str, default: Any) -> None:
+        self.name, self.raw, self.default = name, f"raw_{name}", default
+
+    def __get__(self, obj: Any, owner: Any = None) -> Any:
+        if obj is None:
+            return self.default
+        namespace = obj.__dict__
+        raw = namespace.get(self.raw)
+        value = self.default if raw is None else raw[0](*raw[1:])
+        namespace[self.name] = value
+        return value
+
+
+def given(value: Any) -> Any:
+    """The builder of a raw field whose value is already made: ``(given, value)``."""
+    return value
+
+
+# after the dataclass is made: its __init__ keeps the defaults, the class the builders
+Result.meta = Built("meta", None)  # type: ignore[assignment]
+Result.history = Built("history", None)  # type: ignore[assignment]
 
 
 def _magnitude(v: Any) -> float:

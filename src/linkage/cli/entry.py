@@ -56,9 +56,28 @@ def _for_stderr(line: str) -> str:
                                     break_on_hyphens=False)) if len(line) > width else line
 
 
+PAUSED: list[bool] = []
+"""True while the collector is paused for start-up (:func:`linkage.cli.main`)."""
+
+
+def resume_collector() -> None:
+    """Start-up is over (the command's module is loaded): if :func:`main` paused the
+    collector, what start-up made is frozen (it lives until exit; no collection walks it
+    again) and collection resumes for the command's own work. A run in a process of its
+    own only: frozen objects are never freed."""
+    if PAUSED:
+        import gc
+
+        PAUSED.clear()
+        gc.freeze()
+        gc.enable()
+
+
 def _run_command(args: list[str]) -> int:
     try:
-        rv = app_for(args)(args=args, prog_name="linkage", standalone_mode=False)
+        app = app_for(args)
+        resume_collector()
+        rv = app(args=args, prog_name="linkage", standalone_mode=False)
     except typer.Exit as exc:
         return exc.exit_code
     except typer.Abort:
@@ -163,13 +182,18 @@ class _ClosedStdout:
         return False
 
 
-def main() -> None:
+def main(paused_collector: bool = False) -> None:
+    """One command run in a process of its own (``linkage.cli.main``, which pauses the
+    collector for start-up: ``paused_collector``), then the process exits with its code."""
     import signal
 
+    if paused_collector:
+        PAUSED.append(True)
     _standard_streams()
     with contextlib.suppress(ValueError, OSError):  # not the main thread, or no signals
         signal.signal(signal.SIGTERM, _on_sigterm)
     code = run_cli()
+    resume_collector()  # start-up failed (an import): resumed here
     try:
         sys.stdout.flush()
     except OSError:

@@ -6,6 +6,7 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import InputError
+from ..methods import METHODS
 from .options import (
     PICTURES,
     AccelOpt,
@@ -37,9 +38,8 @@ def solve(
         metavar="[FILE]", help="A mechanism file (TOML, see sample_inputs/; - reads standard input): "
         "solve its loop-closure equations.", show_default=False)] = None,
     *,
-    method: Annotated[str, typer.Option("--method", "-m", help="bisection, regula-falsi, "
-                      "hybrid, secant, newton, fixed-point, or all; with FILE: newton, "
-                      "newton-fd, lm.")] = "newton",
+    method: Annotated[str, typer.Option("--method", "-m", help=f"{', '.join(METHODS)}, several "
+                      "of them separated by commas, or all; with FILE: newton, newton-fd, lm.")] = "newton",
     alpha: Annotated[Optional[float], typer.Option(help="Four-bar input angle alpha (deg); "
                      "default 70.")] = None,
     r1: Annotated[Optional[str], typer.Option("--r1", help="R1 (default 5/3).")] = None,
@@ -139,17 +139,20 @@ def solve(
         check_number("bracket start", bracket[0])
         check_number("bracket end", bracket[1])
     problem = scalar_problem(equation, g, alpha, r1, r2, r3, links)
+    summary = method == "all" or "," in method  # several methods: one summary row each
     if method == "all":
         names = [m for m in SCALAR_METHODS if applicable(m, problem, equation, x0, x1, bracket)]
         if not names:
             raise InputError("no method applies: give --x0 (newton), --x0 and --x1 (secant), "
                              "--bracket (bracketing) or --g with --x0 (fixed-point)")
-    elif method in SCALAR_METHODS:
-        names = [method]
     else:
-        raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}, all")
+        names = [m.strip() for m in method.split(",")]
+        unknown = [m for m in names if m not in SCALAR_METHODS]
+        if unknown or len(set(names)) < len(names):
+            why = f"unknown method {unknown[0]!r}" if unknown else f"a method named twice in {method!r}"
+            raise InputError(f"{why}; choose from {', '.join(SCALAR_METHODS)}, all")
 
-    if method == "all":
+    if summary:
         from ..measure.timing import time_per_solve
     runs = []
     for name in names:
@@ -162,18 +165,18 @@ def solve(
         if result.status.value == "invalid_bracket" and len(names) == 1:
             raise InputError(result.detail)
         conv = analyze(result, problem)
-        seconds = time_per_solve(problem, kwargs) if method == "all" else None
+        seconds = time_per_solve(problem, kwargs) if summary else None
         runs.append((result, conv, seconds))
 
     from ..render.scalar import scalar_report, summary_report
 
     fourbar = None
-    if equation is None and method != "all":
+    if equation is None and not summary:
         fourbar = fourbar_info(alpha, r1, r2, r3, links, runs[0][0])
     elif equation is None:  # the summary's title: alpha and R1, R2, R3
         fourbar = {"alpha": 70.0 if alpha is None else alpha,
                    "R": list(fourbar_coefficients(r1, r2, r3, links)[0])}
-    report = scalar_report(problem, *runs[0][:2], digits, fourbar) if method != "all" else \
+    report = scalar_report(problem, *runs[0][:2], digits, fourbar) if not summary else \
         summary_report(problem, runs, digits, fourbar)
     emit_report(report, out_fmt, output, columns=columns, table=table)
     if plot is not None:

@@ -34,7 +34,7 @@ from .continuation import Solver, classify_gap, continue_step, solve_position, s
 from .limits import solved_ranges_array
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
 from .stepwise import sweep
-from .vector_loops import VectorLoops, singular_of, solve_linear
+from .vector_loops import VectorLoops, loop_plan, singular_of, solve_linear
 
 STATUS_CODES = {"converged": 0, "no_solution": 1, "failed": 2, "off_branch": 3}
 CODE_STATUS = {v: k for k, v in STATUS_CODES.items()}
@@ -405,7 +405,7 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     n, code = len(kinds), STATUS_CODES
     refs, left, usable = _warm_starts(coarse, vals, n)
     drivers = vals * drv_scale
-    loops = VectorLoops(model, drivers)
+    loops = VectorLoops(loop_plan(m) if model is m.model else model, drivers)
     q_all = [r * sc for r, sc in zip(refs, scale)]
     done = _vector_newton(loops, q_all, usable, m.length_scale, kinds, tol, max_iter, iters, det_out)
     status[done] = code["converged"]

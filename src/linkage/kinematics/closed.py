@@ -28,7 +28,7 @@ built only when it is read.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from dataclasses import dataclass
 from functools import partial
 from typing import Any
 
@@ -51,7 +51,7 @@ from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
 from .pose import implied, step_words
 from .positions import SweepResult, check_driver_values
-from .vector_loops import VectorLoops, singular_of, solve_linear
+from .vector_loops import VectorLoops, loop_plan, per_position, singular_of, solve_linear
 
 MARGIN_FLOOR = 1e-8
 """The smallest relative margin of a step at a grid point for this engine: closer to a
@@ -65,6 +65,47 @@ BLOCK = 65_536
 """Positions per block (the temporaries stay small for a million positions)."""
 
 
+@dataclass(frozen=True)
+class ClosedPlan:
+    """What this engine reads of a mechanism, whatever the values: derived once per
+    mechanism (:func:`~.pose.implied`; a Mechanism is frozen), not on every sweep."""
+
+    applies: bool
+    """The loops solve stepwise in closed form with a choice of sign, on an angle or length driver."""
+    scale: float
+    """Internal units per display unit of the driver (rad per deg, or 1)."""
+    turn: float
+    """The driver's full turn in its display unit (an angle driver)."""
+    kinds: tuple[str, ...]
+    angles: tuple[int, ...]
+    """The unknowns that are angles (their indexes)."""
+    steps: tuple[float, ...] | None
+    """The step scales (:func:`~linkage.rules.step_scales`)."""
+    names_are_signs: bool
+    """:attr:`~linkage.problems.derive.Derivation.names_are_signs`."""
+    words: tuple[tuple[str, str], ...]
+    """Each two-way step's two names (:func:`~.pose.step_words`)."""
+    units: tuple[str, ...]
+    """Each unknown's display unit."""
+
+
+def closed_plan(m: Mechanism) -> ClosedPlan:
+    """``m``'s :class:`ClosedPlan`, derived once per mechanism."""
+    return implied(m, "closed_plan", _closed_plan)
+
+
+def _closed_plan(m: Mechanism) -> ClosedPlan:
+    d = m.derivation
+    applies = bool(d.complete and d.two_way and m.driver.kind in ("angle", "length"))
+    kinds = tuple(u.kind for u in m.unknowns)
+    angles = tuple(j for j, k in enumerate(kinds) if k == "angle")
+    return ClosedPlan(applies, ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0,
+                      driver_turn(m.driver.unit), kinds, angles,
+                      step_scales(kinds, m.length_scale), bool(applies and d.names_are_signs),
+                      tuple(step_words(m)) if applies else (),
+                      tuple("deg" if k == "angle" else m.length_unit for k in kinds))
+
+
 def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: float = 1e-12,
                  max_iter: int = 50, speed: float | None = None, accel: float = 0.0,
                  joints: bool = False) -> BatchResult | None:
@@ -72,8 +113,8 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     door leaves them; this engine takes them strictly ascending) by its closed form, or
     None where this engine does not apply (see the module). The other arguments are
     :func:`~.sweep.sweep_mechanism`'s, checked there."""
-    d = m.derivation
-    if not d.complete or not d.two_way or m.driver.kind not in ("angle", "length"):
+    plan = closed_plan(m)
+    if not plan.applies:
         return None
     vals = np.asarray(values, dtype=float)
     n_pos = len(vals)
@@ -81,11 +122,11 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
         return None
     # the driver's magnitude, refused as the one-at-a-time engine refuses it
     check_driver_values(m, [float(vals[0]), float(vals[-1])])
-    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+    scale = plan.scale
     signs = _followed_signs(m, tol, max_iter, float(vals[0]), scale, branch)
     if signs is None:
         return None
-    kinds = tuple(u.kind for u in m.unknowns)
+    kinds = plan.kinds
     n = len(kinds)
     cols = np.empty((n, n_pos))
     det = np.empty(n_pos)
@@ -94,7 +135,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     words: list[str] | None = None
     det_sign = 0.0
     for lo in range(0, n_pos, BLOCK):
-        got = _block(m, vals[lo:lo + BLOCK] * scale, signs, kinds, tol, min(max_iter, POLISH_ITER))
+        got = _block(m, plan, vals[lo:lo + BLOCK] * scale, signs, tol, min(max_iter, POLISH_ITER))
         if got is None:
             return None
         q, dt, it, rt, w = got
@@ -108,20 +149,19 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
         iters[lo:lo + BLOCK] = it
         ratio[lo:lo + BLOCK] = rt
     assert words is not None
-    closes = m.driver.kind == "angle" and closes_circle_array(vals, driver_turn(m.driver.unit))
+    closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn)
     if _touch_candidate(closes, det, ratio):
         return None
-    shown = _display(m, tol, max_iter, vals, cols, kinds, closes)
+    shown = _display(m, plan, tol, max_iter, vals, cols, closes)
     label = "/".join(words)
     from .stepwise import classification_of
 
     # the followed branch as the one-at-a-time engine reports it: its name where each name
     # is one sign branch, else its signs (each position still carries its name)
-    followed = label if m.derivation.names_are_signs else sign_text(signs)
+    followed = label if plan.names_are_signs else sign_text(signs)
     meta = SweepResult(m.name, m.driver.name, m.driver.unit, tuple(u.name for u in m.unknowns),
-                       tuple("deg" if k == "angle" else m.length_unit for k in kinds), (),
-                       ((float(vals[0]), float(vals[-1])),), (), followed, classification_of(m),
-                       "newton (closed form)", length_unit=m.length_unit)
+                       plan.units, (), ((float(vals[0]), float(vals[-1])),), (), followed,
+                       classification_of(m), "newton (closed form)", length_unit=m.length_unit)
     rates = (speed, accel) if speed is not None or joints else None
     return BatchResult(vals, np.full(n_pos, STATUS_CODES["converged"], dtype=np.int8),
                        np.ascontiguousarray(shown.T), det, iters, label, meta, 0, m, rates)
@@ -154,7 +194,7 @@ def _followed_signs(m: Mechanism, tol: float, max_iter: int, first: float, scale
     return found[0]
 
 
-def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Sequence[str], tol: float,
+def _block(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, signs: tuple[float, ...], tol: float,
            max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[str]] | None:
     """One block of driver values (internal units): (unknowns (n, k) internal, det J,
     iterations, |det J| over J's columns' lengths, the branch's words), or None where the
@@ -164,11 +204,10 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
     if not ok.all() or not all((margin > MARGIN_FLOOR).all() for margin in margins):  # (NaN too)
         return None
     k = len(drv)
-    loops = VectorLoops(m.model, drv)
-    size = m.length_scale
-    steps = step_scales(kinds, size)
+    loops = VectorLoops(loop_plan(m), drv)
+    steps = plan.steps
     # each position stopped as the single solve's loop stops it (linkage.rules)
-    stops = SystemStops(tol, residual_gate(tol, size), step_size_array(q, None))
+    stops = SystemStops(tol, residual_gate(tol, m.length_scale), partial(step_size_array, q, None))
     det = np.empty(k)
     iters = np.zeros(k, dtype=np.int32)
     ratio = np.empty(k)
@@ -183,7 +222,11 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
         phi, jac = loops.evaluate(sub, rows)
         dq, dt = solve_linear(jac, phi, active.size)
         singular = singular_of(jac, dt)
-        moved = [s + np.where(singular, 0.0, d) for s, d in zip(sub, dq)]
+        if singular.any():
+            moved = [s + np.where(singular, 0.0, d) for s, d in zip(sub, dq)]
+        else:
+            moved = [s + d for s, d in zip(sub, dq)]  # (the same sums: nothing held back)
+            singular = None
         codes = stops.judge(step_size_array(dq, steps), step_size_array(phi, None), singular,
                             partial(step_size_array, moved, None), rows)
         going = codes == GOING
@@ -200,7 +243,7 @@ def _block(m: Mechanism, drv: np.ndarray, signs: tuple[float, ...], kinds: Seque
         active = active[going]
     if not ((det > 0).all() or (det < 0).all()):
         return None  # det J changes sign: a toggle, the one-at-a-time engine's to locate
-    words = _words(m, drv, q, signs)
+    words = _words(m, plan, drv, q)
     if words is None:
         return None
     return np.array(q), det, iters, ratio, words
@@ -232,20 +275,20 @@ def _column_lengths(jac: list[list[Any]], k: int) -> np.ndarray:
             sq = np.square(row[j]) if sq is None else sq + np.square(row[j])
         length = np.sqrt(sq)
         out = length if out is None else out * length
-    return np.broadcast_to(out, (k,))
+    return per_position(out, k)
 
 
-def _words(m: Mechanism, drv: np.ndarray, q: list[np.ndarray], signs: tuple[float, ...]) -> list[str] | None:
+def _words(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, q: list[np.ndarray]) -> list[str] | None:
     """Each two-way step's name for the block, by the derivation's own rule
     (:meth:`~linkage.problems.derive.Derivation.words_of_np`), or None where one changes
     within it. Where every name is a function of the signs alone
     (:attr:`~linkage.problems.derive.Derivation.names_are_signs`), the block, all on
     ``signs``, has its first position's names throughout."""
     d = m.derivation
-    if d.names_are_signs:
+    if plan.names_are_signs:
         return d.words_of([float(c[0]) for c in q], float(drv[0]))
     out = []
-    for (first, second), word in zip(step_words(m), m.derivation.words_of_np(q, drv)):
+    for (first, second), word in zip(plan.words, d.words_of_np(q, drv)):
         if word.all():
             out.append(first)
         elif not word.any():
@@ -255,11 +298,11 @@ def _words(m: Mechanism, drv: np.ndarray, q: list[np.ndarray], signs: tuple[floa
     return out
 
 
-def _display(m: Mechanism, tol: float, max_iter: int, vals: np.ndarray, cols: np.ndarray,
-             kinds: Sequence[str], closes: bool) -> np.ndarray:
+def _display(m: Mechanism, plan: ClosedPlan, tol: float, max_iter: int, vals: np.ndarray, cols: np.ndarray,
+             closes: bool) -> np.ndarray:
     """The unknowns in display units, each angle continuous along the cycle and anchored to
     what ``solve FILE`` gives (the rule of :mod:`.angles`, as the one-at-a-time engine)."""
-    angles = [j for j, k in enumerate(kinds) if k == "angle"]
+    kinds, angles = plan.kinds, list(plan.angles)
     if len(angles) == len(kinds):
         out = degrees(cols)  # every unknown an angle: one pass
     else:
@@ -268,11 +311,9 @@ def _display(m: Mechanism, tol: float, max_iter: int, vals: np.ndarray, cols: np
             out[j] = degrees(cols[j])
     if not angles:
         return out
-    turn = driver_turn(m.driver.unit)
     turns = unwrap_turns_array(out[angles], closes)
-    scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-    v0 = m.driver.value / scale
-    near = int(anchor_index_array(vals, np.ones((1, len(vals)), dtype=bool), v0, closes, turn)[0])
+    # (every position solved: the anchor is the grid point nearest the file's driver value)
+    near = int(anchor_index_array(vals, True, m.driver.value / plan.scale, closes, plan.turn)[0])
     shift = np.zeros(len(angles))
     ref = implied(m, ("closed_anchor", tol, max_iter), lambda m: _anchor(m, tol, max_iter))
     if ref is not None:

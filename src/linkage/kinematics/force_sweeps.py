@@ -12,6 +12,7 @@ from typing import Any, NamedTuple
 from ..problems.loads import Loads
 from .bodies import Frame, force_size, metre
 from .forces import (
+    TOGGLE_COND,
     Forces,
     force_status_np,
     matrix_bound,
@@ -44,7 +45,8 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
     array per unknown and ``d`` the driver (internal units, NaN where unsolved),
     ``values`` parameters replaced by arrays (internal units, one per position). The
     kinematics by the numpy twins (kinematics.rates.motions_rates_np, place_motion_np), the
-    forces by the one matrix method (:func:`solve_loads`), judged by
+    forces by the one matrix method (:func:`solve_loads`, screened: ``arrays.condition`` is
+    a certified upper bound where that is below TOGGLE_COND), judged by
     :func:`force_status_np` with the matrix's bound (no kinematic bounds here: where J is
     singular the forces are undefined)."""
     import numpy as np
@@ -89,7 +91,9 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
         from dataclasses import replace
 
         frame = replace(frame, size=np.broadcast_to(force_size(mechanism, sub), ds.shape))
-    fa = solve_loads(frame, pos, vel, acc, vstar, loads, mechanism.source)
+    # a scan needs each position's verdict, not its condition number: a certified bound below
+    # TOGGLE_COND passes it as ok (as the exact number would) without the inverse
+    fa = solve_loads(frame, pos, vel, acc, vstar, loads, mechanism.source, screen_below=TOGGLE_COND)
     got = np.where(ok, fa.input, np.nan)
     status[rows] = force_status_np(got, fa.condition, matrix_bound(fa.condition), ok)
     inp[rows] = got

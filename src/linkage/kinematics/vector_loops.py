@@ -5,11 +5,48 @@ the single solve's test of a singular J on arrays."""
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..problems.loops import DRIVER, LoopModel
+from ..problems.loops import DRIVER, LoopModel, Mechanism
+
+Term = tuple[float, Any, int, Any, int, float]
+"""(sign, length, length index, angle, angle index, offset): an index >= 0 names an
+unknown, -1 a fixed value, DRIVER the driver."""
+
+
+@dataclass(frozen=True)
+class LoopPlan:
+    """A loop model's terms as :class:`VectorLoops` reads them, sorted once per model
+    (``model.terms`` with the driver's places marked): each loop's terms whose length and
+    angle are both fixed numbers are reduced to their x and y (their cosine and sine taken
+    once, not on every sweep), the others kept in the loop's order."""
+
+    n: int
+    loops: tuple[tuple[tuple[Any, Any] | Term, ...], ...]
+
+    @classmethod
+    def of(cls, model: LoopModel) -> LoopPlan:
+        loops = []
+        for loop in model.terms:
+            out: list[tuple[Any, Any] | Term] = []
+            for sign, lc, lidx, ac, aidx, off in loop:
+                if lidx < 0 and aidx < 0 and DRIVER not in (lidx, aidx):  # two fixed numbers
+                    tt = ac + off
+                    out.append((sign * lc * np.cos(tt), sign * lc * np.sin(tt)))
+                else:
+                    out.append((sign, lc, lidx, ac, aidx, off))
+            loops.append(tuple(out))
+        return cls(model.n, tuple(loops))
+
+
+def loop_plan(m: Mechanism) -> LoopPlan:
+    """The :class:`LoopPlan` of ``m``'s loop model, made once per mechanism (:func:`~.pose.implied`)."""
+    from .pose import implied
+
+    return implied(m, "loop_plan", lambda m: LoopPlan.of(m.model))
 
 
 class VectorLoops:
@@ -19,15 +56,17 @@ class VectorLoops:
     (column by column): strided access into (N, m, n) arrays costs several times more.
     """
 
-    def __init__(self, model: LoopModel, drv: np.ndarray) -> None:
-        terms = [[(sign, drv if lidx == DRIVER else lc, lidx if lidx >= 0 else -1,
-                   drv if aidx == DRIVER else ac, aidx if aidx >= 0 else -1, off)
-                  for sign, lc, lidx, ac, aidx, off in loop] for loop in model.terms]
-        self.setup(terms, model.n, len(drv))
+    def __init__(self, model: LoopModel | LoopPlan, drv: np.ndarray) -> None:
+        """The loops of ``model`` at the driver values ``drv``; a :class:`LoopPlan` of it
+        (kept by a caller that sweeps the same model again) gives the same loops."""
+        plan = model if isinstance(model, LoopPlan) else LoopPlan.of(model)
+        terms = [[t if len(t) == 2 else (t[0], drv if t[2] == DRIVER else t[1], t[2] if t[2] >= 0 else -1,
+                                         drv if t[4] == DRIVER else t[3], t[4] if t[4] >= 0 else -1, t[5])
+                  for t in loop] for loop in plan.loops]
+        self.setup(terms, plan.n, len(drv))
 
     @classmethod
-    def of_terms(cls, terms: Sequence[Sequence[tuple[float, Any, int, Any, int, float]]], n: int,
-                 size: int) -> VectorLoops:
+    def of_terms(cls, terms: Sequence[Sequence[Term]], n: int, size: int) -> VectorLoops:
         """Loops whose fixed lengths and angles may be arrays (one value per position):
         each term is (sign, length, length index, angle, angle index, offset), an index
         >= 0 naming an unknown, -1 a fixed value (a float or an array of ``size``)."""
@@ -35,21 +74,30 @@ class VectorLoops:
         self.setup(terms, n, size)
         return self
 
-    def setup(self, terms: Sequence[Sequence[tuple[float, Any, int, Any, int, float]]], n: int,
-              size: int) -> None:
+    def setup(self, terms: Sequence[Sequence[tuple[Any, Any] | Term]], n: int, size: int) -> None:
+        """``terms``: each loop's terms (:data:`Term`, no DRIVER index left), or for a term
+        with nothing unknown its x and y already (:class:`LoopPlan`)."""
         self.n = n
         self.m = 2 * len(terms)
         # Terms whose length and angle are both known do not change while iterating:
-        # sum them once per position.
-        self.fixed = [np.zeros(size) for _ in range(self.m)]
+        # sum them once per position, in the loop's order from 0.0 (a sum of fixed values
+        # stays one number until the first array joins it: the same additions, the same bits)
+        fixed: list[Any] = [0.0] * self.m
         self.moving: list[tuple[int, float, Any, int, Any, int, float]] = []
         for li, loop in enumerate(terms):
-            for sign, r, lidx, th, aidx, off in loop:
-                if lidx < 0 and aidx < 0:
-                    self.fixed[2 * li] += sign * r * np.cos(th + off)
-                    self.fixed[2 * li + 1] += sign * r * np.sin(th + off)
+            for term in loop:
+                if len(term) == 2:
+                    x, y = term
+                elif term[2] < 0 and term[4] < 0:
+                    sign, r, _, th, _, off = term
+                    tt = th + off
+                    x, y = sign * r * np.cos(tt), sign * r * np.sin(tt)
                 else:
-                    self.moving.append((li, sign, r, lidx, th, aidx, off))
+                    self.moving.append((li, *term))  # type: ignore[arg-type]
+                    continue
+                fixed[2 * li] = fixed[2 * li] + x
+                fixed[2 * li + 1] = fixed[2 * li + 1] + y
+        self.fixed = [f if np.shape(f) == (size,) else np.full(size, f) for f in fixed]
 
     def evaluate(self, q: list[np.ndarray], rows: np.ndarray | None,
                  near: bool = False) -> tuple[list[np.ndarray], list[list[Any]]]:
@@ -118,8 +166,7 @@ class VectorLoops:
 def solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[list[np.ndarray], np.ndarray]:
     """dq with J dq = -Phi at every position, and det J. Cramer's rule for 2x2."""
     if len(jac) == 2 and len(jac[0]) == 2:
-        a, b = np.broadcast_to(jac[0][0], (k,)), np.broadcast_to(jac[0][1], (k,))
-        c, d = np.broadcast_to(jac[1][0], (k,)), np.broadcast_to(jac[1][1], (k,))
+        (a, b), (c, d) = ((per_position(v, k) for v in row) for row in jac)
         det = a * d - b * c
         with np.errstate(divide="ignore", invalid="ignore"):
             inv = 1.0 / det
@@ -137,6 +184,13 @@ def solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[l
         rhs = -np.stack(phi, axis=1)
         dq[ok] = np.linalg.solve(full[ok], rhs[ok][..., None])[..., 0]
     return [dq[:, j] for j in range(n)], det
+
+
+def per_position(v: Any, k: int) -> Any:
+    """An entry of J at every position: itself where it is already (a constant entry, 0.0
+    or a fixed length's cosine, broadcast; without numpy's broadcast_to where it is not
+    needed, microseconds a call)."""
+    return v if np.shape(v) == (k,) else np.broadcast_to(v, (k,))
 
 
 def singular_of(jac: list[list[Any]], det: np.ndarray) -> np.ndarray:

@@ -215,11 +215,12 @@ def nine_point_certificate(Z: np.ndarray, d: np.ndarray, db: np.ndarray) -> Cert
     """Four-bars through nine points, one per orbit (rows of ``Z``: a, x, b, y and their
     bars, :mod:`linkage.homotopy.ninepoint`; ``d``, ``db``: the points less the first, and
     their bars), checked at 50 digits on the nine-point equations: the residual as
-    :func:`linkage.homotopy.ninepoint.relative_residual` defines it; a duplicate is two
+    :func:`linkage.homotopy.ninepoint_alpha.residuals` defines it; a duplicate is two
     listed four-bars of one orbit (any of the six members)."""
     import mpmath
 
     from ..homotopy import ninepoint as npt
+    from ..homotopy import ninepoint_alpha as npa
 
     Z = np.asarray(Z, dtype=complex).reshape(-1, 8)
     with mpmath.workdps(DIGITS):
@@ -230,8 +231,9 @@ def nine_point_certificate(Z: np.ndarray, d: np.ndarray, db: np.ndarray) -> Cert
             E, J, _, _ = npt.equations(X, dd, ddb)
             return E, J
 
-        mp = np.array([[mpmath.mpc(complex(v)) for v in z] for z in Z], dtype=object).reshape(Z.shape)
-        residuals = [float(r) for r in npt.relative_residual(mp, dd, ddb)] if len(Z) else []
+    # the residual against the equations' terms multiplied out, as every polynomial
+    # system's is measured (ninepoint_alpha.residuals says why not the factored form's)
+    residuals = [float(r) for r in npa.residuals(npa.polynomial_system(d, db), Z, d, db)] if len(Z) else []
     with np.errstate(all="ignore"):
         orbits = [npt.orbit(z) for z in Z]
     members = np.concatenate(orbits) if orbits else np.zeros((0, 8), complex)

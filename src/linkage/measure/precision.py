@@ -3,10 +3,11 @@
 For each problem and each tolerance, every contender solves the same problem many
 times: the median time per solve over several timed batches (and their spread), the
 achieved error against a 40-digit mpmath reference, iterations and evaluations.
-Contenders: linkage's methods with history recording on and off; scipy.optimize
-(root_scalar's bisect, brentq, ridder, toms748, newton, secant, halley; root's hybr
-and lm; fsolve) when scipy is installed; and a plain hand-written Newton loop
-(:mod:`.hand`), the floor any library pays over.
+Contenders: linkage's methods (the registry, :data:`linkage.methods.METHODS`) with history
+recording on and off; scipy.optimize when scipy is installed (root_scalar's counterpart of
+each registered method that has one, and its bracketing methods that have none; root's
+hybr and lm; fsolve); and a plain hand-written Newton loop (:mod:`.hand`), the floor any
+library pays over.
 """
 
 from __future__ import annotations
@@ -22,6 +23,10 @@ from .timing import time_per_call
 QUICK_TOLERANCES = (1e-3, 1e-8, 1e-13)
 FULL_TOLERANCES = (1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14)
 PROBLEMS = ("freudenstein", "quadratic", "fourbar", "rapier")
+SCIPY_BRACKETING = ("brentq", "ridder", "toms748")
+"""root_scalar's bracketing methods that no registered method runs (the registry's ``scipy``)."""
+SCIPY_KEYWORDS = {"fprime": "fprime", "fsecond": "fprime2"}
+"""root_scalar's keyword for each problem function a registered method needs."""
 
 
 @dataclass(frozen=True)
@@ -100,23 +105,22 @@ def scalar_contenders(
     spec: dict[str, Any], tol: float
 ) -> list[tuple[str, Callable[[], Any], Callable[[Any], Any]]]:
     """(name, call, summarise) where summarise turns the call's value into (x, iters, nfev)."""
-    from ..methods import BRACKETING, SCALAR_METHODS
+    from ..methods import METHODS
     from ..solve import solve_scalar
 
     p = spec["problem"]
+    # the registered methods whose needs the problem supplies (a g for fixed point, say)
+    entries = [e for e in METHODS.values() if all(getattr(p, attr) is not None for attr, _ in e.needs)]
     out: list[tuple[str, Callable[[], Any], Callable[[Any], Any]]] = []
-    for m in SCALAR_METHODS:
-        if m == "fixed-point" and p.g is None:
-            continue
+    for e in entries:
         kw: dict[str, Any] = (
-            {"bracket": spec["bracket"]} if m in BRACKETING else {"x0": spec["x0"], "x1": spec["x1"]}
+            {"bracket": spec["bracket"]} if e.bracketing else {"x0": spec["x0"], "x1": spec["x1"]}
         )
         for record in (False, True):
-            name = f"linkage {m} (history {'on' if record else 'off'})"
             out.append(
                 (
-                    name,
-                    lambda m=m, kw=kw, record=record: solve_scalar(
+                    f"linkage {e.name} (history {'on' if record else 'off'})",
+                    lambda m=e.name, kw=kw, record=record: solve_scalar(
                         p, method=m, tol=tol, max_iter=2000, record=record, **kw
                     ),
                     lambda r: (r.x, r.iterations, r.nfev),
@@ -134,40 +138,36 @@ def scalar_contenders(
         from scipy.optimize import root_scalar
     except ImportError:
         return out
-    fpp = p.fsecond
-    a, b = spec["bracket"]
-    for method in ("bisect", "brentq", "ridder", "toms748"):
+    scipy_runs = [(e.scipy, scipy_keywords(e, spec)) for e in entries if e.scipy is not None]
+    scipy_runs += [(method, scipy_bracket(spec)) for method in SCIPY_BRACKETING]
+    for method, kw in scipy_runs:
         out.append(
             (
                 f"scipy root_scalar {method}",
-                lambda method=method: root_scalar(
-                    f, method=method, bracket=(a, b), xtol=tol, rtol=4 * sys.float_info.epsilon
-                ),
+                lambda method=method, kw=kw: root_scalar(f, method=method, xtol=tol, **kw),
                 lambda r: (r.root, r.iterations, r.function_calls),
             )
         )
-    out.append(
-        (
-            "scipy root_scalar newton",
-            lambda: root_scalar(f, method="newton", x0=spec["x0"], fprime=fp, xtol=tol),
-            lambda r: (r.root, r.iterations, r.function_calls),
-        )
-    )
-    out.append(
-        (
-            "scipy root_scalar secant",
-            lambda: root_scalar(f, method="secant", x0=spec["x0"], x1=spec["x1"], xtol=tol),
-            lambda r: (r.root, r.iterations, r.function_calls),
-        )
-    )
-    out.append(
-        (
-            "scipy root_scalar halley",
-            lambda: root_scalar(f, method="halley", x0=spec["x0"], fprime=fp, fprime2=fpp, xtol=tol),
-            lambda r: (r.root, r.iterations, r.function_calls),
-        )
-    )
     return out
+
+
+def scipy_bracket(spec: dict[str, Any]) -> dict[str, Any]:
+    """root_scalar's keywords for a bracketing method: the bracket, and the relative
+    tolerance at scipy's own default for brentq, 4 eps."""
+    return {"bracket": spec["bracket"], "rtol": 4 * sys.float_info.epsilon}
+
+
+def scipy_keywords(entry: Any, spec: dict[str, Any]) -> dict[str, Any]:
+    """root_scalar's start and functions for the registered method ``entry``, from its
+    ``starts`` and ``needs``."""
+    if entry.bracketing:
+        return scipy_bracket(spec)
+    kw: dict[str, Any] = {"x0": spec["x0"]}
+    if entry.starts == "x0 x1":
+        kw["x1"] = spec["x1"]
+    p = spec["problem"]
+    kw.update({SCIPY_KEYWORDS[attr]: getattr(p, attr) for attr, _ in entry.needs})
+    return kw
 
 
 def system_contenders(

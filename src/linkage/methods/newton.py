@@ -84,14 +84,14 @@ def _join(*parts: str) -> str:
 
 def newton_loop(record: bool) -> Loop:
     """Newton's step around the ordered stopping rule, recording rows into ``rows`` (an
-    :class:`~linkage.iterate.Rows`) when ``record``; without it the loop has no row
-    bookkeeping. Both take the rule's quiet path (:func:`linkage.iterate.quiet_path`)."""
+    :class:`~linkage.iterate.Rows`, required) when ``record``; without it the loop has no row
+    bookkeeping (and ignores ``rows``). Both take the rule's quiet path
+    (:func:`linkage.iterate.quiet_path`)."""
     name = "newton_lean" if record else "newton_quiet"
     return Loop(
         signature=f"{name}(problem, x0, tol, rtol, ftol, max_iter, certify, rows=None)",
         setup=_join("""\
-            add = rows.add if rows is not None else None
-            append = rows.append if rows is not None else None  # the first HISTORY_HEAD rows, as Rows.add
+            append = rows.append  # the first HISTORY_HEAD rows, as Rows.add
             """ if record else "", """\
             f, fp = problem.f, problem.fprime
             x = x0
@@ -99,7 +99,7 @@ def newton_loop(record: bool) -> Loop:
             if fx == 0.0 or fx - fx != 0.0:  # the start's verdict (_start_stop) can only be a stop
                 stop = _start_stop(problem, x0, fx)
                 if stop is not None:
-                    return x, fx, _inf, stop[0], stop[1], 0
+                    return x, fx, _inf, stop[0], stop[1], 0, 0
             best = start = abs(fx) if isinstance(fx, float) else _inf
             err = _inf
             """),
@@ -107,8 +107,7 @@ def newton_loop(record: bool) -> Loop:
             d = fp(x)
             if d == 0.0:
             """, """\
-                if add is not None:
-                    add((k, x, fx, d, None, None))
+                rows.add((k, x, fx, d, None, None))
             """ if record else "", """\
                 err = _nan
                 status = _S.ZERO_DERIVATIVE
@@ -122,21 +121,25 @@ def newton_loop(record: bool) -> Loop:
             if err < 0.0:
                 err = -err
             """, """\
-            if add is not None:
-                (append if k <= _HEAD else add)((k, x, fx, d, x1, err))
+            if k <= _HEAD:
+                append((k, x, fx, d, x1, err))
+            else:
+                rows.add((k, x, fx, d, x1, err))
             """ if record else "", """\
             x, fx = x1, fx1
             """),
-        guard=True, step_test="certify", diverge="streak", quiet=True)
+        result="x, fx, err, status, detail, k, extra",
+        guard=True, step_test="certify", counted=True, diverge="streak", quiet=True)
 
 
 NEWTON_LOOP = newton_loop(record=True)
 """Newton as one tight loop: the stopping rule of :mod:`linkage.iterate` around Newton's
 step, without states or method dispatch; the generic loop's status, root, iteration count
-and, when ``rows`` (an :class:`~linkage.iterate.Rows`) is given, its table row for row
+and, into ``rows`` (an :class:`~linkage.iterate.Rows`), its table row for row
 (tests/test_compile.py, tests/test_kernel.py). ``newton_lean(problem, x0, tol, rtol, ftol,
-max_iter, certify, rows)`` returns (x, f(x), last error, status, detail, iterations);
-``certify(x, fx, width)`` decides a small step."""
+max_iter, certify, rows)`` returns (x, f(x), last error, status, detail, iterations,
+evaluations of f the certificate made); ``certify(problem, x, fx, width)`` decides a small
+step (:func:`linkage.solve.certify_root`)."""
 
 newton_lean = build_loop(NEWTON_LOOP, {"_start_stop": start_stop, "_HEAD": HISTORY_HEAD})
 

@@ -417,7 +417,7 @@ NEWTON_2X2_LOOP = Loop(
         F, Jf = problem.F, problem.J
         x0, x1 = q0
         p0, p1 = phi0
-        ss = p0 * p0 + p1 * p1  # _sumsq(phi), carried from the step that produced phi
+        ss = st = p0 * p0 + p1 * p1  # _sumsq(phi), carried from the step that produced phi
         nfev, njev = 1, 0
         err = fx = _inf
         a0, a1 = abs(x0), abs(x1)
@@ -457,13 +457,14 @@ NEWTON_2X2_LOOP = Loop(
 d0, d1 = s.dq
 t0, t1 = s.x
 f0, f1 = s.phi_x
+st = f0 * f0 + f1 * f1
 """),
     after="""\
         e0 = d0 if d0 > 0.0 else 0.0 - d0
         e1 = d1 if d1 > 0.0 else 0.0 - d1
         err = (e0 if e0 >= e1 else e1) if e0 == e0 and e1 == e1 else _nan
         x0, x1, p0, p1 = t0, t1, f0, f1
-        ss = p0 * p0 + p1 * p1
+        ss = st  # the new phi's sum of squares, as the step computed it (read only when damped)
         e0 = x0 if x0 > 0.0 else 0.0 - x0
         e1 = x1 if x1 > 0.0 else 0.0 - x1
         size_q = _nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)

@@ -69,17 +69,28 @@ def triangle_np(d: Any, r: Any, rho: Any) -> tuple[Any, Any, Any]:
     """:func:`triangle` over arrays: (a, h, ok), h NaN where ``ok`` is False."""
     import numpy as np
 
-    d, r, rho = np.broadcast_arrays(np.asarray(d, float), np.asarray(r, float), np.asarray(rho, float))
-    s = -np.sort(-np.stack((d, r, rho)), axis=0)
-    x, y, z = s[0], s[1], s[2]
-    gap = z - (x - y)
-    ok = (gap >= -TANGENT_SLACK * x) & (d > 0.0)
-    gap = np.maximum(gap, 0.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    d, r, rho = np.asarray(d, float), np.asarray(r, float), np.asarray(rho, float)
+    x, y, z = descending_np(d, r, rho)
+    with np.errstate(invalid="ignore", divide="ignore"):  # (inf - inf: NaN, refused)
+        gap = z - (x - y)
+        ok = (gap >= -TANGENT_SLACK * x) & (d > 0.0)
+        gap = np.maximum(gap, 0.0)
         area4 = (x + (y + z)) * gap * (z + (x - y)) * (x + (y - z))
         h = np.where(ok, np.sqrt(np.maximum(area4, 0.0)) / (2.0 * d), np.nan)
         a = ((r - rho) * (r + rho) + d * d) / (2.0 * d)
     return a, h, ok
+
+
+def descending_np(p: Any, q: Any, s: Any) -> tuple[Any, Any, Any]:
+    """The three largest first, as ``sorted((p, q, s), reverse=True)`` orders each position,
+    by comparisons alone (the same values as a sort, for a fraction of a stacked sort's
+    time, and scalars stay scalars: two link lengths order once, not once per position).
+    With a NaN among them the smallest is NaN (``np.minimum`` propagates it), which is all
+    :func:`triangle_np` reads of such a position: its gap is NaN, so ``ok`` is False."""
+    import numpy as np
+
+    lo, hi = np.minimum(p, q), np.maximum(p, q)
+    return np.maximum(hi, s), np.maximum(lo, np.minimum(hi, s)), np.minimum(lo, s)
 
 
 def _frame(x: float, y: float, t1: float) -> tuple[float, float, float]:
@@ -204,31 +215,42 @@ def slider_crank_np(r2: Any, r3: Any, e: Any, t2: Any) -> tuple[list[tuple[Any, 
 # --- the branch rule ------------------------------------------------------------------------
 
 
+def open_rule(word: str, sign: float, coupler: Any, output: Any, xp: Any = math) -> Any:
+    """The one open/crossed rule (worked example P3, docs/worked_examples.md), of a loop whose
+    coupler points along ``coupler`` and whose output along ``output`` (rad; scalars with
+    ``xp`` = math, arrays with numpy). A four-bar (``word`` "fourbar") is open where the
+    output turns anticlockwise from the coupler, sin(output - coupler) > 0; a slider is open
+    where the coupler runs along the slide, cos(output - coupler) > 0. ``sign`` (+1 or -1,
+    exact) is the orientation the loop traverses them in. A property of the configuration,
+    whatever drives it."""
+    turn = output - coupler
+    return sign * (xp.sin(turn) if word == "fourbar" else xp.cos(turn)) > 0.0
+
+
 def is_open(t3: float, t4: float) -> bool:
-    """A four-bar configuration is open where sin(theta4 - theta3) > 0 (worked example P3,
-    docs/worked_examples.md),
-    crossed otherwise: a property of the configuration, whatever drives it (rad)."""
-    return math.sin(t4 - t3) > 0.0
+    """A four-bar configuration (coupler theta3, rocker theta4, rad) is open by
+    :func:`open_rule`: sin(theta4 - theta3) > 0, crossed otherwise."""
+    return open_rule("fourbar", 1.0, t3, t4)
 
 
 def is_open_np(t3: Any, t4: Any) -> Any:
     """:func:`is_open` over arrays (rad)."""
     import numpy as np
 
-    return np.sin(t4 - t3) > 0.0
+    return open_rule("fourbar", 1.0, t3, t4, np)
 
 
 def slider_is_open(t3: float) -> bool:
-    """A slider-crank is open where cos(theta3) > 0 (the slider on the far side of the
-    crank pivot from the coupler's turn), crossed otherwise (rad)."""
-    return math.cos(t3) > 0.0
+    """A slider-crank (coupler theta3, rad; the slide along +x) is open by :func:`open_rule`:
+    cos(theta3) > 0, the slider on the far side of the crank pivot from the coupler's turn."""
+    return open_rule("slider", 1.0, t3, 0.0)
 
 
 def slider_is_open_np(t3: Any) -> Any:
     """:func:`slider_is_open` over arrays (rad)."""
     import numpy as np
 
-    return np.cos(t3) > 0.0
+    return open_rule("slider", 1.0, t3, 0.0, np)
 
 
 def label(open_: bool) -> str:

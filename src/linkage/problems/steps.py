@@ -9,7 +9,7 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any, NamedTuple
 
-from . import dyads
+from . import assembly, dyads
 
 DRIVER = -2
 """The reference of the driver; an int >= 0 is an unknown, a str a parameter, a float a number."""
@@ -133,12 +133,9 @@ def is_open(step: Step, params: Mapping[str, Any], d: Any, q: Sequence[Any], xp:
     (s2, _, a2, o2), (s3, _, a3, o3) = step.word_terms
     t2 = ref_value(a2, params, d, q) + o2
     t3 = ref_value(a3, params, d, q) + o3
-    if step.word_rule == "fourbar":
-        # the coupler as traversed (sign s2) and the output from its ground pivot (-s3):
-        # open where the output turns anticlockwise from the coupler
-        return s2 * -s3 * xp.sin(t3 - t2) > 0.0
-    # slider: the coupler as traversed against the slide's direction of growth (-s3)
-    return s2 * -s3 * xp.cos(t3 - t2) > 0.0
+    # the coupler as traversed (sign s2) and the output from its ground pivot, or the
+    # slide's direction of growth (-s3)
+    return assembly.open_rule(step.word_rule, s2 * -s3, t2, t3, xp)
 
 
 def is_open_np(step: Step, params: Mapping[str, Any], d: Any, q: Sequence[Any]) -> Any:

@@ -54,8 +54,19 @@ class CsvSink(Sink):
 
     @classmethod
     def modules(cls, rows: int | None) -> tuple[str, ...]:
-        # the block path, from FAST_CELLS cells (every table has two columns at least)
-        return ("pyarrow.csv",) if rows is not None and 2 * rows >= cells.FAST_CELLS else ()
+        # the block path, from FAST_CELLS cells (every table has two columns at least),
+        # its slices formatted on a thread pool (cells.csv_slices)
+        return ("pyarrow.csv", "concurrent.futures") if cls.blocks(rows) else ()
+
+    @classmethod
+    def blocks(cls, rows: int | None) -> bool:
+        """A table of ``rows`` rows may go through pyarrow's CSV writer (:meth:`rows`)."""
+        return rows is not None and 2 * rows >= cells.FAST_CELLS
+
+    @classmethod
+    def warm(cls, rows: int | None) -> None:
+        if cls.blocks(rows):
+            cells.warm_arrow()
 
     def rows(self, values: Sequence[Any]) -> None:
         n = len(values[0]) if values else 0
@@ -139,6 +150,10 @@ class ParquetSink(Sink):
     @classmethod
     def modules(cls, rows: int | None) -> tuple[str, ...]:
         return ("pyarrow.parquet",)
+
+    @classmethod
+    def warm(cls, rows: int | None) -> None:
+        cells.warm_arrow()  # its blocks' conversions are arrow_table's
 
     def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
         super().__init__(out, path, meta)

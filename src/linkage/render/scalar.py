@@ -111,7 +111,7 @@ def summary_blocks(problem: ScalarProblem, runs: Sequence[tuple[Result, Converge
                      r.residual, c.order if c else None, s * 1e6 if s is not None else None))
     blocks: list[Block] = [
         Text(scalar_title(problem, digits, fourbar), "bold"),
-        Text("every applicable method, side by side (time: median per solve, history off)"),
+        Text("one row per method, side by side (time: median per solve, history off)"),
         Text(""),
         table("", headers, [(*row[:5], fmt(row[5], 3), fmt(row[6], 3), fmt(row[7], 4),
                              fmt(row[8], 4)) for row in rows], digits),

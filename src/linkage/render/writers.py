@@ -116,11 +116,13 @@ def prefetch(fmt: str, rows: int | None = None) -> None:
     own import then finds them loaded, or waits for them. An import that fails here is
     left to fail where the writer needs it (:func:`open_sink` says so in one line)."""
     spec = FORMATS.get(fmt)
-    names = [m for m in (spec.sink.modules(rows) if spec and spec.sink else ()) if m not in sys.modules]
-    if names:
+    sink = spec.sink if spec else None
+    names = [m for m in (sink.modules(rows) if sink else ()) if m not in sys.modules]
+    if names and sink is not None:
         import threading
 
-        thread = threading.Thread(target=import_quietly, args=(names,), name="linkage-prefetch")
+        thread = threading.Thread(target=import_quietly, args=(names, lambda: sink.warm(rows)),
+                                  name="linkage-prefetch")
         _prefetching.append(thread)
         thread.start()
 
@@ -131,12 +133,22 @@ package that fails to import fails there, in one line, and not in a race between
 threads importing it at once (a flaky refusal, seen in tests/test_format_registry.py)."""
 
 
-def import_quietly(names: Sequence[str]) -> None:
-    for name in names:
-        try:
+def wait_for_prefetch() -> None:
+    """Wait for the prefetch threads started (their imports and warm-ups) to finish."""
+    while _prefetching:
+        _prefetching.pop().join()
+
+
+def import_quietly(names: Sequence[str], then: Callable[[], None] | None = None) -> None:
+    """Import ``names``, then run ``then`` (a sink's warm-up); quietly: a failure is left to
+    the writer, which meets it again and says so."""
+    try:
+        for name in names:
             __import__(name)
-        except Exception:
-            return
+        if then is not None:
+            then()
+    except Exception:
+        return
 
 
 def sidecar_name(output: Path | str, table: str) -> str:
@@ -153,8 +165,7 @@ def open_sink(fmt: str, output: Path | None, meta: dict[str, Any] | None = None)
     to_stdout = output is None or str(output) == "-"
     spec = FORMATS[fmt]
     make: Any = spec.sink
-    while _prefetching:
-        _prefetching.pop().join()
+    wait_for_prefetch()
     if spec.needs is not None:
         try:
             __import__(spec.needs[0])

@@ -10,7 +10,7 @@ from collections.abc import Callable
 from typing import Any
 
 from ..problems.scalar import ScalarProblem
-from ..result import Status
+from ..result import STATUS_MEMBERS, Status
 
 
 def check_sign_change(problem: ScalarProblem, x: float, fx: float | None, lo: float, hi: float,
@@ -147,11 +147,11 @@ def certify_root(problem: ScalarProblem, x: float, fx: float | None, width: floa
     if not isinstance(fx, (int, float)) or not math.isfinite(fx):
         return Status.STALLED, f"f = {fx!r} at the last iterate", 0
     if fx == 0.0:
-        return Status.CONVERGED_STEP, "", 0
+        return STATUS_MEMBERS.CONVERGED_STEP, "", 0
     if problem.fbound is not None:
         bound = value_or_none(problem.fbound, x)
         if bound is not None and abs(fx) <= bound:
-            return Status.CONVERGED_STEP, "", 0
+            return STATUS_MEMBERS.CONVERGED_STEP, "", 0
     lo, hi = max(x - width, -_BIG), min(x + width, _BIG)
     flo, fhi = value_or_none(problem.f, lo), value_or_none(problem.f, hi)
     evals = 2

@@ -18,7 +18,7 @@ from ..methods import METHODS, SCALAR_METHODS, MethodEntry, method_class
 from ..problems.scalar import ScalarProblem
 from ..result import History, Result, Status
 from .certificate import certify_root, check_sign_change, final_bracket, value_or_none
-from .criteria import check_criteria
+from .criteria import RecentCriteria, check_criteria
 from .diagnose import diagnose_scalar
 
 
@@ -32,6 +32,10 @@ def problem_of(f: Callable[[float], float] | ScalarProblem, fprime: Any, g: Any)
     if not callable(f):
         raise InputError(f"f must be callable or a ScalarProblem, got {type(f).__name__}")
     return ScalarProblem(f, fprime=fprime, g=g)
+
+
+_recent = RecentCriteria()
+"""The criteria the scalar front door checked last (its fast path reads them by identity)."""
 
 
 def solve_scalar(
@@ -72,7 +76,10 @@ def solve_scalar(
         # the common case, without the general front door: a problem with its
         # derivative and a finite start (what the front door below checks, and then
         # the same call)
-        return newton_result(f, x0, check_criteria(tol, rtol, ftol, max_iter), record)
+        seen = _recent.seen
+        if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter:
+            return newton_result(f, x0, seen[4], record)
+        return newton_result(f, x0, _recent.check(tol, rtol, ftol, max_iter), record)
     entry = METHODS.get(method)
     if entry is None:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")
@@ -166,34 +173,39 @@ def newton_result(problem: ScalarProblem, x0: float, crit: Criteria, record: boo
     """Newton by its generated loop (:func:`~linkage.methods.newton.newton_lean`),
     packaged exactly as :func:`finish` packages the generic loop's outcome (history
     included when ``record``)."""
-    extra = 0  # evaluations of f the certificate made
-
-    def certify(x: float, fx: float, width: float) -> tuple[Status, str]:
-        nonlocal extra
-        verdict, why, n = certify_root(problem, x, fx, width)
-        extra += n
-        return verdict, why
-
     rows = Rows() if record else None
     try:
         loop = _newton_loop or _load_newton_loop()
         if record:
             loop = _newton_recording
-        x, fx, err, status, detail, k = loop(problem, x0, crit.tol, crit.rtol, crit.ftol, crit.max_iter,
-                                             certify, rows)
+        x, fx, err, status, detail, k, extra = loop(problem, x0, crit.tol, crit.rtol, crit.ftol,
+                                                    crit.max_iter, certify_root, rows)
     except TypeError:  # the generic path's answer to a non-real f at the start
         return failed_at_start("newton", problem, x0, crit, record, {"x0": x0}, Status.DOMAIN_ERROR,
                                "f returned a non-real value")
     except (ArithmeticError, ValueError) as exc:
         return failed_at_start("newton", problem, x0, crit, record, {"x0": x0}, *explain(exc))
-    result = Result.fast("newton", x, status, k, 1 + 2 * k + extra, err, fx, detail,
-                         {"var": problem.var, "unit": problem.unit, "title": problem.title,
-                          "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, "x0": x0})
-    if rows is not None:
-        labels = column_labels(_newton_method, problem.var, problem.unit, problem.u is not None,
-                               problem.gprime is not None)
-        result.__dict__["history"] = History.of(labels, rows, len(labels) - 1)
-    return result
+    return Result.fast("newton", x, status, k, 1 + 2 * k + extra, err, fx, detail, 0,
+                       (newton_meta, problem, crit, x0),
+                       None if rows is None else (history_of, _newton_method, problem, rows))
+
+
+def newton_meta(problem: ScalarProblem, crit: Criteria, x0: float) -> dict[str, Any]:
+    """A Newton solve's ``Result.meta``, built when first read."""
+    return {"var": problem.var, "unit": problem.unit, "title": problem.title,
+            "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, "x0": x0}
+
+
+def scalar_meta(problem: ScalarProblem, crit: Criteria, start: dict[str, Any]) -> dict[str, Any]:
+    """A scalar solve's ``Result.meta`` (the start as ``start`` names it), built when first read."""
+    return {"var": problem.var, "unit": problem.unit, "title": problem.title,
+            "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, **start}
+
+
+def history_of(m: Any, problem: ScalarProblem, rows: Rows) -> History:
+    """A scalar solve's ``Result.history`` from its loop's rows, built when first read."""
+    labels = column_labels(m, problem.var, problem.unit, problem.u is not None, problem.gprime is not None)
+    return History.of(labels, rows, len(labels) - 1)
 
 
 @functools.lru_cache(maxsize=128)
@@ -246,11 +258,6 @@ def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: b
         lo, hi = final_bracket(final)
         status, detail, more = check_sign_change(problem, x, residual, lo, hi, start["f_ends"], detail)
         nfev += more
-    result = Result.fast(m.name, x, status, iterations, nfev, final.err, residual, detail,
-                         {"var": problem.var, "unit": problem.unit, "title": problem.title,
-                          "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, **start})
-    if rows is not None:
-        labels = column_labels(m, problem.var, problem.unit, problem.u is not None,
-                               problem.gprime is not None)
-        result.__dict__["history"] = History.of(labels, rows, len(labels) - 1)
-    return result
+    return Result.fast(m.name, x, status, iterations, nfev, final.err, residual, detail, 0,
+                       (scalar_meta, problem, crit, start),
+                       None if rows is None else (history_of, m, problem, rows))

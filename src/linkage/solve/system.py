@@ -12,9 +12,9 @@ from typing import Any
 from ..arguments import check_callable, check_number, check_reals, real_vector
 from ..errors import InputError
 from ..iterate import Criteria, run
-from ..result import History, Result, Status
+from ..result import History, Raw, Result, Status, given
 from ..rules import residual_gate
-from .criteria import MAX_RELATIVE_TOL, check_criteria
+from .criteria import MAX_RELATIVE_TOL, RecentCriteria, check_criteria
 from .diagnose import names_bad_callables
 
 # The system solvers load with the first system solve, never with a scalar one
@@ -24,7 +24,7 @@ from .diagnose import names_bad_callables
 
 SYSTEM_METHODS: tuple[str, ...] = ("newton", "newton-fd", "lm")
 
-@names_bad_callables
+
 def solve_system(
     F: Callable[..., list[float]] | Any,
     x0: Sequence[float] | None = None,
@@ -56,18 +56,50 @@ def solve_system(
     textbook iteration.
     Returns a :class:`Result` with ``x`` (a tuple), ``nfev`` and ``njev``.
     """
-    if (method == "newton" and not record and jac is not None and fd_step is None and type(x0) is tuple
-            and len(x0) == 2 and type(x0[0]) is float and type(x0[1]) is float
-            and x0[0] - x0[0] == 0.0 and x0[1] - x0[1] == 0.0 and callable(F)):
-        # the common case without the general front door: user callables, two unknowns,
-        # a finite start (the same outcome: tests/test_compile.py)
-        return _newton_two(F, jac, x0, check_criteria(tol, rtol, ftol, max_iter), damped)
-    NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system = _system_solvers()
-    if (method == "newton" and not record and jac is None and fd_step is None and type(F) is SystemProblem
-            and len(F.names) == 2 and F.J is not None and F.step_scales is None):
-        fast = _mechanism_two(F, x0, check_criteria(tol, rtol, ftol, max_iter), damped)
+    if method == "newton" and not record and fd_step is None:
+        fast = fast_newton(F, x0, jac, tol, rtol, ftol, max_iter, damped)
         if fast is not None:
             return fast
+    return solve_general(F, x0, jac=jac, method=method, tol=tol, rtol=rtol, ftol=ftol, max_iter=max_iter,
+                         record=record, fd_step=fd_step, damped=damped, show_jacobian=show_jacobian)
+
+
+_recent = RecentCriteria()
+"""The criteria the system front door checked last (read by identity)."""
+
+
+def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float | None, max_iter: int,
+                damped: bool) -> Result | None:
+    """Newton with recording off by a short front door, where one applies: user callables
+    of two unknowns from a finite tuple start (:func:`_newton_two`), or a compiled problem
+    of two unknowns that converges (:func:`_mechanism_two`); the same Result as the general
+    path (tests/test_compile.py). None for anything else, and where a user function
+    returned the wrong kind of value: the general path then runs and names it."""
+    seen = _recent.seen
+    if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter:
+        crit = seen[4]
+    else:
+        crit = _recent.check(tol, rtol, ftol, max_iter)
+    try:
+        if (jac is not None and type(x0) is tuple and len(x0) == 2 and type(x0[0]) is float
+                and type(x0[1]) is float and x0[0] - x0[0] == 0.0 and x0[1] - x0[1] == 0.0 and callable(F)):
+            return _newton_two(F, jac, x0, crit, damped)
+        SystemProblem = _system_solvers()[3]
+        if (jac is None and type(F) is SystemProblem and len(F.names) == 2 and F.J is not None
+                and F.step_scales is None):
+            return _mechanism_two(F, x0, crit, damped)
+    except (TypeError, IndexError, RecursionError):
+        pass
+    return None
+
+
+@names_bad_callables
+def solve_general(F: Any, x0: Any, *, jac: Any, method: str, tol: float, rtol: float, ftol: float | None,
+                  max_iter: int, record: bool, fd_step: float | None, damped: bool,
+                  show_jacobian: bool) -> Result:
+    """:func:`solve_system` by the general path, every argument checked; a TypeError or
+    IndexError from F or jac is named (:func:`~linkage.solve.diagnose.names_bad_callables`)."""
+    NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system = _system_solvers()
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r} for a system; choose from {', '.join(SYSTEM_METHODS)}")
     crit = check_criteria(tol, rtol, ftol, max_iter)
@@ -177,10 +209,8 @@ def packaged(m: Any, problem: Any, crit: Criteria, gate: float, outcome: tuple[A
     history = None
     if rows is not None:
         history = system_history(m, problem, rows, show_jacobian, reference, x)
-    result = Result.fast(m.name, x, status, iterations, nfev, err, residual, detail, meta)
-    if history is not None or njev:
-        result.__dict__.update(history=history, njev=njev)
-    return result
+    return Result.fast(m.name, x, status, iterations, nfev, err, residual, detail, njev, (given, meta),
+                       None if history is None else (given, history))
 
 
 @functools.lru_cache(maxsize=1)
@@ -221,7 +251,7 @@ _STOPPED = frozenset({Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN})
 
 
 def _two_unknown_result(problem: Any, q0: tuple[float, ...], phi0: Any, crit: Criteria, gate: float,
-                        damped: bool, meta: dict[str, Any], loaded: tuple[Any, ...]) -> Result:
+                        damped: bool, meta: Raw, loaded: tuple[Any, ...]) -> Result:
     """Newton on two unknowns by :func:`~linkage.methods.newton_system.newton_2x2`,
     judged and packaged as :func:`solve_system` does (``loaded``: :func:`_two_unknowns`)."""
     newton_2x2, max_abs = loaded[0], loaded[1]
@@ -229,10 +259,12 @@ def _two_unknown_result(problem: Any, q0: tuple[float, ...], phi0: Any, crit: Cr
         problem, q0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
     residual = max_abs(phi)
     status, detail = system_verdict(status, detail, residual, gate)
-    result = Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, meta)
-    if njev:
-        result.__dict__["njev"] = njev
-    return result
+    return Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, njev, meta)
+
+
+_last_two: tuple[Any, Any, Any] = (None, None, None)
+"""The user functions (F, jac) :func:`_newton_two` last solved, with their problem: solving
+the same functions again (from another start, at other tolerances) builds none."""
 
 
 def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float, float], crit: Criteria,
@@ -249,9 +281,27 @@ def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float,
     if len(phi0) != 2:
         raise InputError(f"the system has {len(phi0)} equations for 2 unknowns")
     gate = crit.ftol if crit.ftol is not None else crit.tol
-    problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
-    meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": names, "kinds": kinds, "title": ""}
+    global _last_two
+    last = _last_two
+    if last[0] is F and last[1] is jac:
+        problem = last[2]
+    else:
+        problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
+        _last_two = (F, jac, problem)
+    meta = (user_two_meta, crit, gate, names, kinds)
     return _two_unknown_result(problem, x0, phi0, crit, gate, damped, meta, loaded)
+
+
+def user_two_meta(crit: Criteria, gate: float, names: tuple[str, ...],
+                  kinds: tuple[str, ...]) -> dict[str, Any]:
+    """``Result.meta`` of a solve on user callables of two unknowns, built when first read."""
+    return {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": names, "kinds": kinds, "title": ""}
+
+
+def mechanism_meta(problem: Any, crit: Criteria, gate: float) -> dict[str, Any]:
+    """``Result.meta`` of a solve of a compiled problem, built when first read."""
+    return {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names, "kinds": problem.kinds,
+            "title": problem.title, **problem.meta}
 
 
 def _mechanism_two(problem: Any, x0: Any, crit: Criteria, damped: bool) -> Result | None:
@@ -273,9 +323,8 @@ def _mechanism_two(problem: Any, x0: Any, crit: Criteria, damped: bool) -> Resul
     if len(phi0) != 2:
         return None
     gate = residual_gate(crit.ftol if crit.ftol is not None else crit.tol, scale)
-    meta = {"tol": crit.tol, "rtol": crit.rtol, "ftol": gate, "names": problem.names, "kinds": problem.kinds,
-            "title": problem.title, **problem.meta}
-    result = _two_unknown_result(problem, q0, phi0, crit, gate, damped, meta, _two_unknowns())
+    result = _two_unknown_result(problem, q0, phi0, crit, gate, damped, (mechanism_meta, problem, crit, gate),
+                                 _two_unknowns())
     return result if result.converged else None
 
 

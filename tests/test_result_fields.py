@@ -1,0 +1,64 @@
+"""A Result made on a solve's hot path keeps its meta and history raw and builds them on
+first read: every reader (attributes, equality, replace, copy, pickle) sees the Result an
+ordinary construction gives."""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import pickle
+
+from linkage import fourbar_equation, solve_scalar, solve_system
+from linkage.result import Result
+
+
+def _ordinary(r: Result) -> Result:
+    return Result(**{name: getattr(r, name) for name in r.__dataclass_fields__})
+
+
+def test_a_fast_results_fields_read_as_an_ordinary_results():
+    p = fourbar_equation(70.0)
+    for record in (False, True):
+        for method, start in (("newton", {"x0": 50.0}), ("secant", {"x0": 50.0, "x1": 60.0}),
+                              ("bisection", {"bracket": (40.0, 60.0)})):
+            r = solve_scalar(p, method=method, tol=1e-12, record=record, **start)
+            assert "meta" not in vars(r)  # kept raw until read
+            expected = {"var": "phi", "unit": "deg", "title": p.title, "tol": 1e-12, "rtol": 0.0,
+                        "ftol": None, **start}
+            assert {k: r.meta[k] for k in expected} == expected
+            assert (r.history is not None) == record
+            if record:
+                assert len(r.records) == len(r.history.rows) > 0
+            plain = _ordinary(r)
+            assert plain == r and repr(plain) == repr(r)
+            assert dataclasses.replace(r, detail="x").meta == r.meta
+
+
+def test_a_fast_result_copies_and_pickles_as_its_fields():
+    r = solve_scalar(fourbar_equation(70.0), method="newton", x0=50.0, tol=1e-12, record=True)
+    for twin in (copy.copy(r), copy.deepcopy(r), pickle.loads(pickle.dumps(r))):
+        assert twin == r and twin.history == r.history and twin.meta == r.meta
+        assert not any(name.startswith("raw_") for name in vars(twin))
+
+
+def test_a_system_solves_meta_is_built_on_read():
+    def F(q: list[float]) -> list[float]:
+        return [q[0] * q[0] + q[1] * q[1] - 4.0, q[0] - q[1]]
+
+    def J(q: list[float]) -> list[list[float]]:
+        return [[2.0 * q[0], 2.0 * q[1]], [1.0, -1.0]]
+
+    fast = solve_system(F, (1.0, 2.0), jac=J, tol=1e-12, record=False)
+    full = solve_system(F, [1.0, 2.0], jac=J, tol=1e-12, record=False)
+    assert fast.converged and "meta" not in vars(fast)
+    assert fast.meta == full.meta == {"tol": 1e-12, "rtol": 0.0, "ftol": 1e-12, "names": ("x1", "x2"),
+                                      "kinds": ("", ""), "title": ""}
+    assert fast == full and fast.njev == full.njev > 0
+
+
+def test_an_ordinary_result_holds_its_own_fields():
+    from linkage.result import Status
+
+    r = Result("newton", 1.0, Status.CONVERGED_STEP, 1, 3, 0.0, 0.0, meta={"tol": 1.0})
+    assert r.meta == {"tol": 1.0} and r.history is None
+    assert Result("newton", 1.0, Status.CONVERGED_STEP, 1, 3, 0.0, 0.0).meta is None
