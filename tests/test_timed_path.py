@@ -220,6 +220,7 @@ FIVE = [(0.0, 0.0, 0.0), (1.0, 0.2, 20.0), (1.5, 1.0, 45.0), (1.0, 2.0, 80.0), (
     ([*FIVE[:4], (2.0, 2.0, 1e300)], "points[4]"),
     ([*FIVE[:4], (1.0, 0.2, 150.0)], "coincide"),
     ([(x, y, 30.0) for x, y, _ in FIVE], "does not turn"),
+    ([*FIVE[:4], (2.0, 2.0, 360.0)], "points 1 and 5 have the same crank angle"),
 ])
 def test_bad_timed_points_are_refused_with_one_line(bad, says):
     import linkage
@@ -295,3 +296,11 @@ def test_a_burmester_root_one_gamma_misses_is_found_with_the_next():
     found = timed_four_bars(_timed(points, angles))
     assert found.incomplete() == 0
     assert sum(_matches(pivots, fb.pivots) for fb in found.four_bars) == 1
+
+
+def test_collinear_timed_points_say_their_roots_went_to_infinity_not_that_all_were_found(cli):
+    """Five collinear points: Burmester's problems have fewer than four finite roots (one
+    goes to infinity); the summary says so, and does not claim all four were found."""
+    out = cli("synthesize", "--path", *[f"--point={k},0,{10 * k}" for k in range(5)])
+    assert "fewer than 4 finite roots" in out.out and "every problem's 4 roots found" not in out.out
+    assert out.code == 1  # no design without defects

@@ -186,7 +186,20 @@ def timed_summary(result: Any) -> list[str]:
         f"crank dyads: {len(s.cranks.cranks)} real ({s.cranks.complex_count} complex, {s.cranks.infinite} at "
         f"infinity, {s.cranks.failed} failed); rocker dyads of each: {rockers}; {len(result.designs)} "
         f"four-bars, {len(result.groups)} up to Roberts cognates, {clean} without defects",
-        f"Burmester paths failed: {failed}; "
-        + (f"{missed} root{'s' if missed != 1 else ''} not found (a four-bar may be missing)" if missed
-           else "every problem's 4 roots found (real and complex)"),
+        f"Burmester paths failed: {failed}; " + roots_line(s.problems(), missed),
     ]
+
+
+def roots_line(problems: list[Any], missed: int) -> str:
+    """What the Burmester problems' roots say: all four found in each, some not found (a
+    four-bar may be missing), or fewer finite (the others at infinity: points in special
+    position)."""
+    from ..synthesis.timed_path import BURMESTER_ROOTS
+
+    if missed:
+        return f"{missed} root{'s' if missed != 1 else ''} not found (a four-bar may be missing)"
+    few = sum(1 for b in problems if len(b.cranks) + b.complex_count < BURMESTER_ROOTS)
+    if few:
+        return (f"{few} of the {len(problems)} problems have fewer than {BURMESTER_ROOTS} finite roots "
+                "(the others at infinity: points in special position)")
+    return f"every problem's {BURMESTER_ROOTS} roots found (real and complex)"

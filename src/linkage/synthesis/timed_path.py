@@ -100,7 +100,8 @@ def is_timed(points: Any) -> bool:
 def free_choices(count: int) -> str:
     """What is free with ``count`` timed points (fewer than five)."""
     free = TIMED_POINTS - count
-    return (f"with timing, give exactly {TIMED_POINTS} points: {count} timed points leave {free} free "
+    return (f"with timing, give exactly {TIMED_POINTS} points: {count} timed point"
+            f"{'s leave' if count != 1 else ' leaves'} {free} free "
             f"number{'s' if free != 1 else ''} for each dyad ({2 * free} for the four-bar), a family, "
             "not a finite set")
 
@@ -137,6 +138,11 @@ def check_timed_points(points: Any) -> tuple[tuple[complex, ...], tuple[float, .
                 raise InputError(f"points {j + 1} and {i + 1} coincide: {pts[i].real:g}, {pts[i].imag:g}")
     if all(math.remainder(a - angles[0], 360) == 0 for a in angles):
         raise InputError("points: the crank does not turn between them (every crank angle the same)")
+    for i in range(TIMED_POINTS):
+        for j in range(i):
+            if math.remainder(angles[i] - angles[j], 360) == 0:
+                raise InputError(f"points {j + 1} and {i + 1} have the same crank angle (mod 360 deg): the "
+                                 "crank, the input, cannot put the coupler point in two places at one angle")
     return pts, angles
 
 
