@@ -12,11 +12,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from linkage.kinematics.assemblies import assemblies, same_configuration
-from linkage.kinematics.circuits import circuits
-from linkage.kinematics.loading import from_text
-from linkage.kinematics.rates import place
-from linkage.synthesis.path import PROBLEM_3, mechanism_text, synthesize_path
+from linkage.synthesis.path import PROBLEM_3, coupler_curve, synthesize_path
 
 
 def main() -> None:
@@ -24,19 +20,8 @@ def main() -> None:
     good = [group for group in res.designs if not {"branch", "order"} & set(group[0].defects)]
     fig, ax = plt.subplots(figsize=(7, 7))
     for group in good:
-        fb = group[0]
-        m = from_text(mechanism_text(fb), "<figure>")
-        start = assemblies(m)
-        first = next(i for i, s in enumerate(start.real)
-                     if same_configuration([m.unknowns[0].value, m.unknowns[1].value], s.q, m, 1e-6))
-        traced = circuits(m, found=start)
-        circ = traced.circuits[traced.circuit_of(first)]
-        xs, ys = [], []
-        for d, q in zip(circ.drivers, circ.configurations):
-            p = place(m.model, list(q), d)["P"][0]
-            xs.append(p.real)
-            ys.append(p.imag)
-        ax.plot(xs, ys, lw=0.8)
+        curve = coupler_curve(group[0])
+        ax.plot(curve.real, curve.imag, lw=0.8)
     ax.plot([x for x, _ in PROBLEM_3], [y for _, y in PROBLEM_3], "ko", ms=6, zorder=5)
     for k, (x, y) in enumerate(PROBLEM_3):
         ax.annotate(str(k + 1), (x, y), textcoords="offset points", xytext=(5, 5))

@@ -74,6 +74,8 @@ POSES = [(0, 0, 0), (1, 0.2, 10), (2, 0.5, 25), (2.8, 1.2, 40), (3.2, 2, 60)]
 NINE = [(0.25, 0), (0.52, 0.1), (0.8, 0.7), (1.2, 1), (1.4, 1.3), (1.1, 1.48), (0.7, 1.4), (0.2, 1),
         (0.02, 0.4)]
 """Nine points (linkage.synthesize_path): Wampler, Morgan and Sommese's Problem 3."""
+TIMED = [(0.0, 0.0, 0.0), (1.0, 0.2, 20.0), (1.5, 1.0, 45.0), (1.0, 2.0, 80.0), (0.0, 2.2, 120.0)]
+"""Five points with the crank's angle at each (linkage.synthesize_path, prescribed timing)."""
 
 BATTERY = [
     # sweep: values, rates, options
@@ -187,6 +189,18 @@ BATTERY = [
     ("synthesize_path", "seed -1", lambda: linkage.synthesize_path(NINE, seed=-1), "seed"),
     ("synthesize_path", "workers 0", lambda: linkage.synthesize_path(NINE, workers=0), "workers"),
     ("synthesize_path", "scheduler 3", lambda: linkage.synthesize_path(NINE, scheduler=3), "scheduler"),
+    ("synthesize_path", "six timed points", lambda: linkage.synthesize_path([*TIMED, (3, 3, 150)]), "points"),
+    ("synthesize_path", "four timed points", lambda: linkage.synthesize_path(TIMED[:4]), "points"),
+    ("synthesize_path", "timed and untimed points", lambda: linkage.synthesize_path([*TIMED[:4], (3, 3)]),
+     "points"),
+    ("synthesize_path", "a NaN crank angle", lambda: linkage.synthesize_path([*TIMED[:4], (3, 3, math.nan)]),
+     "points"),
+    ("synthesize_path", "a text crank angle", lambda: linkage.synthesize_path([*TIMED[:4], (3, 3, "x")]),
+     "points"),
+    ("synthesize_path", "timed, workers 2", lambda: linkage.synthesize_path(TIMED, workers=2), "workers"),
+    ("synthesize_path", "timed, seed -1", lambda: linkage.synthesize_path(TIMED, seed=-1), "seed"),
+    ("synthesize_path", "timed, min_transmission 100",
+     lambda: linkage.synthesize_path(TIMED, min_transmission=100), "min_transmission"),
     ("synthesize_motion", "poses None", lambda: linkage.synthesize_motion(None), "poses"),
     ("synthesize_motion", "two poses", lambda: linkage.synthesize_motion(POSES[:2]), "poses"),
     ("synthesize_motion", "a NaN pose",

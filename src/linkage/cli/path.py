@@ -34,7 +34,13 @@ def path_command(point: list[str], via: list[str], *, search: bool, samples: Opt
     from ..synthesis.path import check_points, synthesize_path
     from ..synthesis.path_points import check_via
     from .path_search import as_options
+    from .timed_path import is_timed, timed_path_command
 
+    if is_timed(point):  # X,Y,DEG: prescribed timing, five points
+        return timed_path_command(point, via, search=search, samples=samples, seed=seed, design=design,
+                                  output=output, write_file=write_file, force=force, fmt=fmt,
+                                  report_out=report_out, digits=digits, table=table, scheduler=scheduler,
+                                  workers=workers, min_transmission=min_transmission)
     pairs, extra = read_points(point), read_points(via, "--via")
     check_points(pairs)  # before the workers, so a wrong count is the first thing said
     try:

@@ -150,9 +150,10 @@ def synthesize(
                      "pose 1 (twice: three poses leave both free)."),
     ] = None,
     path: Annotated[bool, typer.Option("--path", help="Path generation: every four-bar whose coupler point "
-                                       "passes through 5 to 9 --point (docs/path_synthesis.md); with "
-                                       "--search, the defect-free ones ranked.")] = False,
-    point: Annotated[Optional[list[str]], typer.Option("--point", metavar="X,Y", help="With --path.")] = None,
+                                       "passes through 5 to 9 --point X,Y, or 5 --point X,Y,DEG with the "
+                                       "crank at DEG (docs/path_synthesis.md); with --search, the "
+                                       "defect-free ones ranked.")] = False,
+    point: Annotated[Optional[list[str]], typer.Option("--point", metavar="X,Y[,DEG]", help="--path")] = None,
     via: Annotated[Optional[list[str]], typer.Option(
         "--via", metavar="X,Y", help="With --path and n < 9 points: the 9 - n extra points (default: on a "
         "curve through the points; --search --samples K draws K sets).")] = None,

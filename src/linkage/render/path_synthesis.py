@@ -10,9 +10,13 @@ from .report import Block, Text, table
 
 def ranked(result: Any) -> list[int]:
     """Real designs, those without defects first, then by least transmission, largest first."""
-    designs = result.designs
+    return rank([group[0] for group in result.designs])
+
+
+def rank(designs: list[Any]) -> list[int]:
+    """Four-bars, those without defects first, then by least transmission, largest first."""
     return sorted(range(len(designs)),
-                  key=lambda i: (len(designs[i][0].defects), -designs[i][0].transmission_min_deg))
+                  key=lambda i: (len(designs[i].defects), -designs[i].transmission_min_deg))
 
 
 def design_row(number: int, cognate: int, fb: Any) -> tuple[Any, ...]:
@@ -108,3 +112,89 @@ def path_report(result: Any, digits: int) -> Report:
                 "without_defects": sum(1 for g in result.designs if not g[0].defects), "seconds": s.seconds}
 
     return Report(title, tables, blocks, document)
+
+
+TIMED_HEADS = [*HEADS, ("crank_dyad", "", "int"), ("rocker_dyad", "", "int"),
+               ("crank_first", "deg", "number"), ("timing_error", "deg", "number")]
+"""The timed designs' columns: the untimed ones, which dyads (of the crank problem and of
+its rocker problem), the crank's angle at the first point and the timing error."""
+TIMED_TERMINAL = (*TERMINAL_COLUMNS, "timing_error")
+
+
+def timed_ranked(result: Any) -> list[int]:
+    """The cognate groups of a timed result, ranked by their first members."""
+    return rank([result.designs[g[0]] for g in result.groups])
+
+
+def timed_path_tables(result: Any) -> tuple[DataTable, ...]:
+    four_bars = result.solutions.four_bars
+
+    def row(number: int, cognate: int, i: int) -> tuple[Any, ...]:
+        fb = result.designs[i]
+        return (*design_row(number, cognate, fb), four_bars[i].crank + 1, four_bars[i].rocker + 1,
+                fb.crank_deg[0], fb.timing_error_deg)
+
+    order = timed_ranked(result)
+    leads = [row(k + 1, 1, result.groups[g][0]) for k, g in enumerate(order)]
+    members = [row(k + 1, c + 1, i) for k, g in enumerate(order) for c, i in enumerate(result.groups[g])]
+    return from_rows("designs", TIMED_HEADS, leads), from_rows("cognates", TIMED_HEADS, members)
+
+
+def timed_path_report(result: Any, digits: int) -> Report:
+    """The report of five points with prescribed crank angles (synthesis.path.TimedPathSynthesis)."""
+    tables = timed_path_tables(result)
+    title = "four-bars whose coupler point passes through five points at prescribed crank angles"
+
+    def blocks() -> list[Block]:
+        out: list[Block] = [Text(title, "bold"), *[Text(line) for line in timed_summary(result)], Text("")]
+        shown = [c for c in tables[0].columns if c.name in TIMED_TERMINAL]
+        out.append(table("", [c.header for c in shown], list(zip(*[c.values for c in shown])), digits))
+        out.append(Text("defects: branch, the points are not all on one circuit; order, the circuit meets "
+                        "them out of order; transmission, the least transmission angle from the first point "
+                        "to the last is below --min-transmission; grashof, the crank cannot turn one way "
+                        "from the first point to the last; timing, the crank's turn from the first point is "
+                        "not the prescribed one. A design's Roberts cognate with the same timing is in the "
+                        "cognates table"))
+        return out
+
+    def document() -> dict[str, Any]:
+        s = result.solutions
+        return {"title": title, "crank_dyads": len(s.cranks.cranks), "four_bars": len(result.designs),
+                "designs": len(result.groups),
+                "without_defects": sum(1 for g in result.groups if not result.designs[g[0]].defects),
+                "failed_or_unsettled": s.incomplete()}
+
+    return Report(title, tables, blocks, document)
+
+
+def timed_summary(result: Any) -> list[str]:
+    s = result.solutions
+    rockers = ", ".join("-" if r is None else str(sum(1 for f in s.four_bars if f.crank == i))
+                        for i, r in enumerate(s.rockers)) or "none"
+    clean = sum(1 for g in result.groups if not result.designs[g[0]].defects)
+    missed = s.incomplete()
+    failed = sum(b.failed for b in s.problems())
+    return [
+        "prescribed timing (Sandor and Erdman's standard form): Burmester's five-pose problem for the crank "
+        "dyads (the crank turned as prescribed), then for each one's rocker dyads (the coupler turned as "
+        "that crank dyad turns it)",
+        f"crank dyads: {len(s.cranks.cranks)} real ({s.cranks.complex_count} complex, {s.cranks.infinite} at "
+        f"infinity, {s.cranks.failed} failed); rocker dyads of each: {rockers}; {len(result.designs)} "
+        f"four-bars, {len(result.groups)} up to Roberts cognates, {clean} without defects",
+        f"Burmester paths failed: {failed}; " + roots_line(s.problems(), missed),
+    ]
+
+
+def roots_line(problems: list[Any], missed: int) -> str:
+    """What the Burmester problems' roots say: all four found in each, some not found (a
+    four-bar may be missing), or fewer finite (the others at infinity: points in special
+    position)."""
+    from ..synthesis.timed_path import BURMESTER_ROOTS
+
+    if missed:
+        return f"{missed} root{'s' if missed != 1 else ''} not found (a four-bar may be missing)"
+    few = sum(1 for b in problems if len(b.cranks) + b.complex_count < BURMESTER_ROOTS)
+    if few:
+        return (f"{few} of the {len(problems)} problems have fewer than {BURMESTER_ROOTS} finite roots "
+                "(the others at infinity: points in special position)")
+    return f"every problem's {BURMESTER_ROOTS} roots found (real and complex)"
