@@ -90,3 +90,46 @@ def test_help_of_synthesize_at_80_columns_says_what_point_search_and_samples_do_
     samples = text[text.index("--samples <int>"):text.index("--sampling")]
     assert "with --path" in samples, samples
     assert "--motion and --path" in text
+
+
+TIMED = ["--point=0.1579,2.4375,20", "--point=0.3675,3.0987,60", "--point=-0.1131,3.2206,100",
+         "--point=-0.7817,2.8793,140", "--point=-1.3129,2.2146,180"]
+
+
+def test_timed_path_designs_at_80_columns_keep_the_judgement_in_the_first_part():
+    """The designs table (too wide for 80 columns) stacked the least transmission angle, the
+    ranking's key that the defects name, in the second part, away from the defects."""
+    seen = run([sys.executable, "-m", "linkage", "synthesize", "--path", *TIMED], 80)
+    assert fits(seen)
+    assert parts(seen) == [2, 2], parts(seen)
+    first = seen[seen.index("(columns part 1 of 2)"):seen.index("(columns part 2 of 2)")]
+    for head in ("design", "grashof", "defects", "transmission_min", "(deg)"):
+        assert head in first, first
+    second = seen[seen.index("(columns part 2 of 2)"):seen.index("defects: branch")]
+    assert "point_error" in second and "timing_error" in second and "transmission_min" not in second
+
+
+def test_path_reports_put_the_transmission_angle_beside_the_design_and_files_keep_every_column():
+    """The nine-point, timed and search reports' terminal tables: the judgement first, the
+    links after; the designs table (files) keeps its own order and the pivots."""
+    from linkage.render.data import from_rows
+    from linkage.render.path_search import SEARCH_HEADS
+    from linkage.render.path_search import TERMINAL_COLUMNS as SEARCH
+    from linkage.render.path_synthesis import (
+        HEADS,
+        TERMINAL_COLUMNS,
+        TIMED_HEADS,
+        TIMED_TERMINAL,
+        terminal_table,
+    )
+
+    def headers(heads: list[tuple[str, str, str]], names: tuple[str, ...]) -> list[str]:
+        row = tuple(1 if kind == "int" else "x" if kind == "text" else 0.5 for _, _, kind in heads)
+        return list(terminal_table(from_rows("designs", heads, [row]), names, 4).headers)
+
+    for heads, names in ((HEADS, TERMINAL_COLUMNS), (TIMED_HEADS, TIMED_TERMINAL), (SEARCH_HEADS, SEARCH)):
+        shown = headers(heads, names)
+        k = shown.index("transmission_min (deg)")
+        assert k < shown.index("ground") and "design" == shown[0], shown
+        assert "Ax" not in shown and "Ax" in [h for h, _, _ in heads]
+    assert [h for h, _, _ in HEADS].index("transmission_min") > [h for h, _, _ in HEADS].index("ground")
