@@ -59,7 +59,8 @@ def test_quiet_columns_keep_a_double_assembly_and_a_path_note():
 def test_motion_at_80_columns_fits_the_cranks_and_stacks_the_four_bars_in_two_parts():
     """The cranks table stacked a second part holding only ``residual`` (relative, under a
     "(mm)" title), and the four-bars table a third holding only ``defects``: its input and
-    output lengths are its cranks' lengths, in the table above."""
+    output lengths are its cranks' lengths, in the table above. Its max_pose_error (relative,
+    or rad) stood unexplained under the "(mm)" title."""
     seen = run([sys.executable, "-m", "linkage", "synthesize", "--motion", "--poses", POSES], 80)
     assert "best: design 1" in seen, seen
     assert fits(seen)
@@ -67,6 +68,8 @@ def test_motion_at_80_columns_fits_the_cranks_and_stacks_the_four_bars_in_two_pa
     assert re.search(r"rigidity residual \(relative to the poses' size\) at most \d", seen), seen
     crank_lines = seen[seen.index("Burmester cranks (mm)"):seen.index("four-bars (mm)")]
     assert "residual" not in crank_lines and "length" in crank_lines
+    # the four-bars table's title gives the lengths' unit: the pose error says it is none
+    assert "max_pose_error: the largest distance from a pose" in " ".join(seen.split())
 
 
 def test_files_of_motion_keep_the_residual_and_the_input_and_output_lengths(cli):

@@ -37,6 +37,11 @@ DESIGN_HEADERS = [
 ]
 
 
+POSE_ERROR = ("max_pose_error: the largest distance from a pose, a position's over the poses' size or an "
+              "angle's in rad (not a length)")
+"""What max_pose_error is, below the table whose title gives the lengths' unit."""
+
+
 def best_design(m: Any) -> int | None:
     """The design -o writes by default: of those without defects, the largest least
     transmission angle (the first of equals); None without one."""
@@ -136,7 +141,8 @@ def motion_report(m: Any, digits: int = 6, unit: str = "") -> Report:
                             shown_table(("Burmester cranks" if m.burmester else "cranks") + u,
                                         CRANK_HEADERS, cranks, digits, ("residual",))]
         four_bars = f"four-bars{u}: input crank O2 -> A, output crank O4 -> B, the body the coupler"
-        out += [Text(""), shown_table(four_bars, DESIGN_HEADERS, designs, digits, ("input", "output"))]
+        out += [Text(""), shown_table(four_bars, DESIGN_HEADERS, designs, digits, ("input", "output")),
+                Text(POSE_ERROR)]
         best = best_design(m)
         if best is None:
             out.append(Text("defect: no four-bar from these cranks carries the body through every pose "
