@@ -112,6 +112,16 @@ def test_timed_path_designs_at_80_columns_keep_the_judgement_in_the_first_part()
     assert "point_error" in second and "timing_error" in second and "transmission_min" not in second
 
 
+def test_path_reports_say_how_to_get_the_cognates_table_they_point_to(cli):
+    """"... is in the cognates table": a terminal shows no such table, and --table needs a
+    file format. The hint is the command that prints it."""
+    seen = run([sys.executable, "-m", "linkage", "synthesize", "--path", *TIMED], 80)
+    assert "cognates table (--table cognates -f csv)" in " ".join(seen.split()), seen
+    r = cli("synthesize", "--path", *TIMED, "--table", "cognates", "-f", "csv")
+    assert r.code == 0 and r.out.startswith("design,cognate,"), r.err
+    assert len(r.out.splitlines()) == 1 + 12  # the 12 four-bars, each cognate a row
+
+
 def test_path_reports_put_the_transmission_angle_beside_the_design_and_files_keep_every_column():
     """The nine-point, timed and search reports' terminal tables: the judgement first, the
     links after; the designs table (files) keeps its own order and the pivots."""

@@ -109,7 +109,8 @@ def path_report(result: Any, digits: int) -> Report:
         out.append(Text("defects: branch, the points are not all on one circuit (the linkage would have "
                         "to be taken apart); order, the circuit meets them out of order; transmission, the "
                         "least transmission angle from the first point to the last is below "
-                        "--min-transmission; each design's two Roberts cognates are in the cognates table"))
+                        "--min-transmission; each design's two Roberts cognates are in the cognates table "
+                        "(--table cognates -f csv)"))
         rows = list(zip(*[c.values for c in tables[2].columns]))
         out += [Text("Routes"), table("", [c.header for c in tables[2].columns], rows, digits)]
         return out
@@ -162,7 +163,7 @@ def timed_path_report(result: Any, digits: int) -> Report:
                         "to the last is below --min-transmission; grashof, the crank cannot turn one way "
                         "from the first point to the last; timing, the crank's turn from the first point is "
                         "not the prescribed one. A design's Roberts cognate with the same timing is in the "
-                        "cognates table"))
+                        "cognates table (--table cognates -f csv)"))
         return out
 
     def document() -> dict[str, Any]:
