@@ -146,3 +146,14 @@ def test_path_reports_put_the_transmission_angle_beside_the_design_and_files_kee
         assert k < shown.index("ground") and "design" == shown[0], shown
         assert "Ax" not in shown and "Ax" in [h for h, _, _ in heads]
     assert [h for h, _, _ in HEADS].index("transmission_min") > [h for h, _, _ in HEADS].index("ground")
+
+
+def test_the_double_assemblies_line_names_what_it_counts(cli):
+    """"1 of them double" followed the alpha test's line ("0 of 0 nonsingular roots
+    certified, 0 of them real"), so it read as one of those roots. At a change point the
+    terminal keeps the multiplicity column: the line says how many, the column which."""
+    crank_rocker = str(ROOT / "sample_inputs" / "crank_rocker.toml")
+    r = cli("assemblies", crank_rocker, "--set", "r2=40", "--set", "r4=60", "--set", "theta2=0", "-f", "plain")
+    assert r.code == 0, r.err
+    assert "1 of the real assemblies double (two assemblies that meet here" in r.out, r.out
+    assert "of them double" not in r.out and "multiplicity" in r.out

@@ -62,8 +62,9 @@ def summary_lines(a: Any) -> list[str]:
     extra = []
     doubles = sum(k > 1 for k in a.multiplicity)
     if doubles:
-        extra.append(f"{doubles} of them double (two assemblies that meet here, to rounding: a limit "
-                     "position or a change point)")
+        # named, not "of them": the line above counts the certified roots, not the real assemblies
+        extra.append(f"{doubles} of the real assemblies double (two assemblies that meet here, to "
+                     "rounding: a limit position or a change point)")
     if a.continuum:
         extra.append("not isolated: the loops close all along a curve here (the mechanism can move "
                      "with its driver held)")
