@@ -153,7 +153,8 @@ def test_the_double_assemblies_line_names_what_it_counts(cli):
     certified, 0 of them real"), so it read as one of those roots. At a change point the
     terminal keeps the multiplicity column: the line says how many, the column which."""
     crank_rocker = str(ROOT / "sample_inputs" / "crank_rocker.toml")
-    r = cli("assemblies", crank_rocker, "--set", "r2=40", "--set", "r4=60", "--set", "theta2=0", "-f", "plain")
+    at_change_point = ("--set", "r2=40", "--set", "r4=60", "--set", "theta2=0")
+    r = cli("assemblies", crank_rocker, *at_change_point, "-f", "plain")
     assert r.code == 0, r.err
     assert "1 of the real assemblies double (two assemblies that meet here" in r.out, r.out
     assert "of them double" not in r.out and "multiplicity" in r.out
