@@ -62,8 +62,9 @@ def summary_lines(a: Any) -> list[str]:
     extra = []
     doubles = sum(k > 1 for k in a.multiplicity)
     if doubles:
-        extra.append(f"{doubles} of them double (two assemblies that meet here, to rounding: a limit "
-                     "position or a change point)")
+        # named, not "of them": the line above counts the certified roots, not the real assemblies
+        extra.append(f"{doubles} of the real assemblies double (two assemblies that meet here, to "
+                     "rounding: a limit position or a change point)")
     if a.continuum:
         extra.append("not isolated: the loops close all along a curve here (the mechanism can move "
                      "with its driver held)")
@@ -106,12 +107,23 @@ def _bound_text(s: Any, lengths: bool) -> str:
     return f"{s.bound} paths (Bezout's bound, the total degree)"
 
 
-def _display(t: DataTable, digits: int, scale: float = 0.0) -> Block:
-    """A table as the terminal shows it; with ``scale``, numbers within rounding of zero at
-    that scale (a joint at the origin computed as 2e-14) shown as 0."""
-    rows = [tuple(denoise(v, scale) if scale else v for v in row)
-            for row in zip(*[c.values for c in t.columns])]
-    return table("", [c.header for c in t.columns], rows, digits)
+def _display(t: DataTable, digits: int, scale: float = 0.0, hide: tuple[str, ...] = ()) -> Block:
+    """A table as the terminal shows it, without the columns ``hide`` names (files keep
+    them); with ``scale``, numbers within rounding of zero at that scale (a joint at the
+    origin computed as 2e-14) shown as 0."""
+    shown = [c for c in t.columns if c.name not in hide]
+    rows = [tuple(denoise(v, scale) if scale else v for v in row) for row in zip(*[c.values for c in shown])]
+    return table("", [c.header for c in shown], rows, digits)
+
+
+def quiet_columns(a: Any) -> tuple[str, ...]:
+    """Columns the terminal leaves out because they say nothing the lines above do not: the
+    multiplicity when every assembly is simple (the summary counts the double ones) and the
+    paths' note when no path has one. At 80 columns each would otherwise stack a table of
+    its own."""
+    simple = ("multiplicity",) if all(k == 1 for k in a.multiplicity) else ()
+    silent = ("note",) if not any(e.note for e in a.solutions.endpoints) else ()
+    return simple + silent
 
 
 def assemblies_report(a: Any, digits: int, show_paths: bool) -> Report:
@@ -120,7 +132,7 @@ def assemblies_report(a: Any, digits: int, show_paths: bool) -> Report:
     def blocks() -> list[Block]:
         out: list[Block] = [Text(title_of(a), "bold"), *[Text(line) for line in summary_lines(a)], Text("")]
         if tables[0].row_count:
-            out.append(_display(tables[0], digits))
+            out.append(_display(tables[0], digits, hide=quiet_columns(a)))
         else:
             out.append(Text("no real assembly: the mechanism cannot be assembled here"))
         if any(s.singular for s in a.real):
@@ -130,7 +142,7 @@ def assemblies_report(a: Any, digits: int, show_paths: bool) -> Report:
             size = max((abs(v) for s in a.real for xy in s.joints.values() for v in xy), default=0.0)
             out += [Text("Joints"), _display(tables[1], digits, size)]
         if show_paths:
-            out += [Text("Paths"), _display(tables[2], digits)]
+            out += [Text("Paths"), _display(tables[2], digits, hide=quiet_columns(a))]
         for e in a.solutions.endpoints:
             if e.kind == "failed":
                 out.append(Text(f"failed path: {e.note}"))

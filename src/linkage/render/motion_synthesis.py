@@ -37,6 +37,11 @@ DESIGN_HEADERS = [
 ]
 
 
+POSE_ERROR = ("max_pose_error: the largest distance from a pose, a position's over the poses' size or an "
+              "angle's in rad (not a length)")
+"""What max_pose_error is, below the table whose title gives the lengths' unit."""
+
+
 def best_design(m: Any) -> int | None:
     """The design -o writes by default: of those without defects, the largest least
     transmission angle (the first of equals); None without one."""
@@ -128,14 +133,16 @@ def motion_report(m: Any, digits: int = 6, unit: str = "") -> Report:
         account = [Text(crank_account(m))]
         if m.burmester is not None:
             account.append(Text(certified_line(m.burmester.solutions)))
+        if m.cranks:
+            largest = fmt(max(c.residual for c in m.cranks), 3)
+            account.append(Text("each crank's rigidity residual (relative to the poses' size) at most "
+                                f"{largest}; a four-bar's input and output links are its two cranks"))
         out: list[Block] = [Text(title, "bold"), *account, Text(""),
-                            table(("Burmester cranks" if m.burmester else "cranks") + u,
-                                  [h for h, _, _ in CRANK_HEADERS], cranks, digits)]
-        out += [
-            Text(""),
-            table("four-bars: input crank at O2 -> A, output crank at O4 -> B, the body the coupler" + u,
-                  [h if not un else f"{h} ({un})" for h, un, _ in DESIGN_HEADERS], designs, digits),
-        ]
+                            shown_table(("Burmester cranks" if m.burmester else "cranks") + u,
+                                        CRANK_HEADERS, cranks, digits, ("residual",))]
+        four_bars = f"four-bars{u}: input crank O2 -> A, output crank O4 -> B, the body the coupler"
+        out += [Text(""), shown_table(four_bars, DESIGN_HEADERS, designs, digits, ("input", "output")),
+                Text(POSE_ERROR)]
         best = best_design(m)
         if best is None:
             out.append(Text("defect: no four-bar from these cranks carries the body through every pose "
@@ -146,6 +153,17 @@ def motion_report(m: Any, digits: int = 6, unit: str = "") -> Report:
         return out
 
     return Report(title, tables, blocks, None)
+
+
+def shown_table(title: str, heads: list[tuple[str, str, str]], rows: list[tuple[Any, ...]], digits: int,
+                hide: tuple[str, ...]) -> Block:
+    """A table as a person reads it, without the columns ``hide`` names: what the lines above
+    it say (the cranks' residuals, the input and output cranks' lengths, which are the cranks
+    table's). Files (-f, -o) keep every column. At 80 columns the cranks table then fits
+    and the four-bars table stacks in two parts, not three."""
+    keep = [j for j, (h, _, _) in enumerate(heads) if h not in hide]
+    return table(title, [heads[j][0] if not heads[j][1] else f"{heads[j][0]} ({heads[j][1]})" for j in keep],
+                 [tuple(r[j] for j in keep) for r in rows], digits)
 
 
 def crank_account(m: Any) -> str:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from .data import Report, from_rows
-from .path_synthesis import HEADS, design_row
+from .path_synthesis import HEADS, design_row, terminal_table
 from .report import Block, Text, table
 
 SEARCH_HEADS = [HEADS[0], ("sample", "", "int"), *HEADS[1:]]
@@ -17,8 +17,10 @@ SAMPLE_HEADS = [("sample", "", "int"), ("extra", "", "text"), ("found", "", "int
                 ("steps", "", "int"), ("seconds", "s", "number")]
 """A sample: its extra points (X,Y each, as --via takes them), the orbits found and not
 reached, its real designs (cognate groups), its defect-free cognates, and the tracking."""
-TERMINAL_COLUMNS = ("design", "sample", "cognate", "grashof", "ground", "crank", "coupler", "rocker",
-                    "transmission_min", "point_error")
+TERMINAL_COLUMNS = ("design", "sample", "cognate", "grashof", "transmission_min", "ground", "crank",
+                    "coupler", "rocker", "point_error")
+"""The terminal's columns, the ranking's key (the least transmission angle) beside the rank
+(path_synthesis.TERMINAL_COLUMNS)."""
 
 
 def extra_text(points: Any, extra: Any, digits: int | None = None) -> str:
@@ -61,9 +63,7 @@ def path_search_report(result: Any, digits: int) -> Report:
     def blocks() -> list[Block]:
         out: list[Block] = [Text(title, "bold"), Text(summary_line(result)), Text("")]
         if designs:
-            shown = [c for c in tables[0].columns if c.name in TERMINAL_COLUMNS]
-            rows = list(zip(*[c.values for c in shown]))
-            out.append(table("", [c.header for c in shown], rows, digits))
+            out.append(terminal_table(tables[0], TERMINAL_COLUMNS, digits))
             out.append(Text("ranked by the least transmission angle over the motion from the first point to "
                             "the last, largest first; the pivots are in the designs table (-f, -o); -o "
                             "FILE.toml writes design 1 (--design K writes design K)"))

@@ -83,8 +83,20 @@ def extra_lines(points: Any, extra: Any) -> list[str]:
             "the nine: each design passes through all nine in order"]
 
 
-TERMINAL_COLUMNS = ("design", "grashof", "defects", "ground", "crank", "coupler", "rocker",
-                    "transmission_min", "point_error")
+TERMINAL_COLUMNS = ("design", "grashof", "defects", "transmission_min", "ground", "crank", "coupler",
+                    "rocker", "point_error")
+"""The designs table's columns on a terminal, in this order: the judgement beside the design's
+number (the rank is by the least transmission angle), then its links, then the check. Too
+wide for 80 columns, rich stacks them in parts (report.column_groups): the first then holds
+what a person chooses by."""
+
+
+def terminal_table(t: DataTable, names: tuple[str, ...], digits: int) -> Block:
+    """The columns ``names`` of table ``t``, in that order: the pivots' coordinates go to
+    files (-f, -o), a terminal gets the judgement."""
+    by_name = {c.name: c for c in t.columns}
+    shown = [by_name[n] for n in names]
+    return table("", [c.header for c in shown], list(zip(*[c.values for c in shown])), digits)
 
 
 def path_report(result: Any, digits: int) -> Report:
@@ -93,14 +105,12 @@ def path_report(result: Any, digits: int) -> Report:
 
     def blocks() -> list[Block]:
         out: list[Block] = [Text(title, "bold"), *[Text(line) for line in summary_lines(result)], Text("")]
-        # the pivots' coordinates go to files (-f, -o): a terminal gets the judgement
-        shown = [c for c in tables[0].columns if c.name in TERMINAL_COLUMNS]
-        rows = list(zip(*[c.values for c in shown]))
-        out.append(table("", [c.header for c in shown], rows, digits))
+        out.append(terminal_table(tables[0], TERMINAL_COLUMNS, digits))
         out.append(Text("defects: branch, the points are not all on one circuit (the linkage would have "
                         "to be taken apart); order, the circuit meets them out of order; transmission, the "
                         "least transmission angle from the first point to the last is below "
-                        "--min-transmission; each design's two Roberts cognates are in the cognates table"))
+                        "--min-transmission; each design's two Roberts cognates are in the cognates table "
+                        "(--table cognates -f csv)"))
         rows = list(zip(*[c.values for c in tables[2].columns]))
         out += [Text("Routes"), table("", [c.header for c in tables[2].columns], rows, digits)]
         return out
@@ -147,14 +157,13 @@ def timed_path_report(result: Any, digits: int) -> Report:
 
     def blocks() -> list[Block]:
         out: list[Block] = [Text(title, "bold"), *[Text(line) for line in timed_summary(result)], Text("")]
-        shown = [c for c in tables[0].columns if c.name in TIMED_TERMINAL]
-        out.append(table("", [c.header for c in shown], list(zip(*[c.values for c in shown])), digits))
+        out.append(terminal_table(tables[0], TIMED_TERMINAL, digits))
         out.append(Text("defects: branch, the points are not all on one circuit; order, the circuit meets "
                         "them out of order; transmission, the least transmission angle from the first point "
                         "to the last is below --min-transmission; grashof, the crank cannot turn one way "
                         "from the first point to the last; timing, the crank's turn from the first point is "
                         "not the prescribed one. A design's Roberts cognate with the same timing is in the "
-                        "cognates table"))
+                        "cognates table (--table cognates -f csv)"))
         return out
 
     def document() -> dict[str, Any]:
