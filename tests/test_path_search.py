@@ -242,7 +242,7 @@ def solved_known(monkeypatch, curve, known):
         assert list(points) == list(pts)
         return small
 
-    monkeypatch.setattr(npt, "solve_points", solve)
+    monkeypatch.setattr(nt, "solve_points", solve)
     return known.designs[0]
 
 
