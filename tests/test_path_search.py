@@ -235,8 +235,11 @@ def solved_known(monkeypatch, curve, known):
     reals = np.flatnonzero(sols.real)
     best = known.designs[0].group
     keep = [reals[best], *[reals[k] for k in range(len(reals)) if k != best][:3]]
+    kept = {int(k): n for n, k in enumerate(keep)}  # the paths' four-bars, renumbered
+    record = dataclasses.replace(sols.record, four_bar=np.array([kept.get(int(f), -1)
+                                                                 for f in sols.record.four_bar]))
     small = dataclasses.replace(sols, solutions=sols.solutions[keep], real=sols.real[keep],
-                                condition=sols.condition[keep])
+                                condition=sols.condition[keep], record=record)
 
     def solve(points, **_):
         assert list(points) == list(pts)
