@@ -21,6 +21,7 @@ import time
 import numpy as np
 
 from linkage.homotopy import ninepoint as npt
+from linkage.homotopy import ninepoint_track as nt
 from linkage.homotopy.parameter import Loop, monodromy
 
 
@@ -42,7 +43,7 @@ def main() -> None:
         print(f"loop {len(loops)}: {loop.count} orbits (+{loop.new}), {loop.dropped} paths failed or "
               f"unsettled, {loop.seconds:.1f} s", flush=True)
 
-    found = monodromy(npt.NinePointLoops(), np.concatenate([d, db]), z[None, :], stable_loops=args.stable,
+    found = monodromy(nt.NinePointLoops(), np.concatenate([d, db]), z[None, :], stable_loops=args.stable,
                       max_loops=args.max_loops, seed=rng, on_loop=show)
     Z, last, cond = npt.polish(found.roots, d, db)
     print(f"{len(Z)} orbits in {time.perf_counter() - began:.0f} s; largest last Newton step "

@@ -12,16 +12,16 @@ from __future__ import annotations
 
 import argparse
 
-from linkage.homotopy import ninepoint as npt
+from linkage.homotopy import ninepoint_track as nt
 from linkage.synthesis.path import PROBLEM_3
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--routes", type=int, default=npt.MAX_ROUTES)
+    ap.add_argument("--routes", type=int, default=nt.MAX_ROUTES)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
-    res = npt.solve_points([complex(x, y) for x, y in PROBLEM_3], seed=args.seed, max_routes=args.routes)
+    res = nt.solve_points([complex(x, y) for x, y in PROBLEM_3], seed=args.seed, max_routes=args.routes)
     print(f"{res.seconds:.1f} s, {res.routes} route(s) of {res.paths} paths; failed per route {res.failed}, "
           f"not settled {res.unrefined}; steps {res.steps}")
     print(f"orbits found: {len(res.solutions)} of {res.paths} (missing {res.missing}); "

@@ -11,7 +11,7 @@ import argparse
 import statistics
 import time
 
-from linkage.homotopy import ninepoint as npt
+from linkage.homotopy import ninepoint_track as nt
 from linkage.synthesis import path
 from linkage.synthesis.path import chunk_runner
 
@@ -32,7 +32,7 @@ def main() -> None:
         for _ in range(args.repeats):
             for n, cluster in clusters.items():
                 began = time.perf_counter()
-                res = npt.solve_points(PROBLEM_3, max_routes=1, orbits=args.orbits,
+                res = nt.solve_points(PROBLEM_3, max_routes=1, orbits=args.orbits,
                                        run=chunk_runner(cluster.scheduler_address, None))
                 times[n].append(time.perf_counter() - began)
         one, two = statistics.median(times[1]), statistics.median(times[2])

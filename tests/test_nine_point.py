@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from linkage.homotopy import ninepoint as npt
+from linkage.homotopy import ninepoint_track as nt
 from linkage.synthesis.path import PROBLEM_3
 
 
@@ -114,10 +115,10 @@ def test_the_generic_monodromy_loops_the_nine_point_problem_one_root_per_orbit()
     p = np.concatenate([d, db])
     cognate = npt.orbit(z)[3]
     assert np.linalg.norm(cognate - z) > 1e-3
-    seeded = monodromy(npt.NinePointLoops(), p, np.stack([z, cognate]), max_loops=0)
+    seeded = monodromy(nt.NinePointLoops(), p, np.stack([z, cognate]), max_loops=0)
     assert len(seeded.roots) == 1 and seeded.counts == ()
     seen = []
-    found = monodromy(npt.NinePointLoops(), p, z[None, :], max_loops=3, seed=rng, on_loop=seen.append)
+    found = monodromy(nt.NinePointLoops(), p, z[None, :], max_loops=3, seed=rng, on_loop=seen.append)
     assert [loop.count for loop in seen] == list(found.counts) and len(found.roots) == found.counts[-1] > 2
     assert sum(loop.new for loop in seen) == len(found.roots) - 1
     for root in found.roots:
@@ -130,7 +131,7 @@ def test_the_generic_monodromy_loops_the_nine_point_problem_one_root_per_orbit()
 
 def test_a_known_four_bar_is_found_among_the_solutions_through_its_points():
     pts, z = _coupler_points(np.random.default_rng(2))
-    res = npt.solve_points(pts, max_routes=1)
+    res = nt.solve_points(pts, max_routes=1)
     assert res.paths == 1442
     want = npt.canonical(z[None, :])[0]
     gaps = np.linalg.norm(res.solutions - want, axis=1)
@@ -140,7 +141,7 @@ def test_a_known_four_bar_is_found_among_the_solutions_through_its_points():
 
 @pytest.fixture(scope="module")
 def problem_3():
-    return npt.solve_points([complex(x, y) for x, y in PROBLEM_3])
+    return nt.solve_points([complex(x, y) for x, y in PROBLEM_3])
 
 
 def test_problem_3_has_the_published_64_real_four_bars(problem_3):
@@ -253,12 +254,12 @@ def test_paths_tracked_as_dask_tasks_on_threads_and_a_loopback_cluster_end_where
     from linkage.synthesis.path import chunk_runner
 
     pts = [complex(x, y) for x, y in PROBLEM_3]
-    here = npt.solve_points(pts, max_routes=1, orbits=300)
-    threads = npt.solve_points(pts, max_routes=1, orbits=300, run=chunk_runner("threads", 2))
+    here = nt.solve_points(pts, max_routes=1, orbits=300)
+    threads = nt.solve_points(pts, max_routes=1, orbits=300, run=chunk_runner("threads", 2))
     assert len(here.solutions) >= 290 and _same_sets(here.solutions, threads.solutions)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                                   dashboard_address=None) as cluster:
-        remote = npt.solve_points(pts, max_routes=1, orbits=300,
+        remote = nt.solve_points(pts, max_routes=1, orbits=300,
                                   run=chunk_runner(cluster.scheduler_address, None))
     assert _same_sets(here.solutions, remote.solutions)
     assert remote.failed == here.failed
@@ -295,8 +296,8 @@ def test_four_bars_through_points_scale_with_the_points(scale):
     """Micrometres to kilometres: the same problem at another size gives the same four-bars
     at that size (the pivots scale with the points; the engine solves at unit size)."""
     pts = [complex(x, y) for x, y in PROBLEM_3]
-    unit = npt.solve_points(pts, max_routes=1, orbits=200)
-    moved = npt.solve_points([p * scale + (5.0 - 2.0j) * scale for p in pts], max_routes=1, orbits=200)
+    unit = nt.solve_points(pts, max_routes=1, orbits=200)
+    moved = nt.solve_points([p * scale + (5.0 - 2.0j) * scale for p in pts], max_routes=1, orbits=200)
     assert len(moved.solutions) == len(unit.solutions) >= 195
     assert _same_sets(unit.solutions, moved.solutions / scale)
 

@@ -15,6 +15,7 @@ import pytest
 
 from linkage.errors import InputError
 from linkage.homotopy import ninepoint as npt
+from linkage.homotopy import ninepoint_track as nt
 from linkage.synthesis.path import CIRCUIT_DEFECTS, judge
 from linkage.synthesis.path_points import curve_point, gap_counts, inserted, nine_points, sampled
 from linkage.synthesis.path_search import search_path
@@ -69,7 +70,7 @@ def test_the_via_points_go_into_their_gaps_and_make_the_curves_nine_points(curve
 def test_a_known_four_bar_through_six_of_its_coupler_points_is_among_the_ranked_designs(curve, known):
     pts, z = curve
     sample = known.samples[0]
-    assert sample.found == npt.PATHS and sample.missing == 0
+    assert sample.found == nt.PATHS and sample.missing == 0
     members = npt.orbit(z)[:, :4] + pts[0]  # the four-bar and its cognates: a, x, b, y in the plane
     scale = float(np.abs(members).max())
     found = [d for d in known.designs
@@ -226,7 +227,7 @@ def test_synthesize_path_search_refuses_bad_input_in_one_line(cli, args, says):
 
 @pytest.fixture()
 def solved_known(monkeypatch, curve, known):
-    """``linkage.homotopy.ninepoint.solve_points`` answering the known curve's nine points
+    """``linkage.homotopy.ninepoint_track.solve_points`` answering the known curve's nine points
     with the fixture's solutions (the known four-bar's group and three others), so that
     the command's plumbing is tested without tracking the paths again."""
     pts, _ = curve
@@ -234,14 +235,17 @@ def solved_known(monkeypatch, curve, known):
     reals = np.flatnonzero(sols.real)
     best = known.designs[0].group
     keep = [reals[best], *[reals[k] for k in range(len(reals)) if k != best][:3]]
+    kept = {int(k): n for n, k in enumerate(keep)}  # the paths' four-bars, renumbered
+    record = dataclasses.replace(sols.record, four_bar=np.array([kept.get(int(f), -1)
+                                                                 for f in sols.record.four_bar]))
     small = dataclasses.replace(sols, solutions=sols.solutions[keep], real=sols.real[keep],
-                                condition=sols.condition[keep])
+                                condition=sols.condition[keep], record=record)
 
     def solve(points, **_):
         assert list(points) == list(pts)
         return small
 
-    monkeypatch.setattr(npt, "solve_points", solve)
+    monkeypatch.setattr(nt, "solve_points", solve)
     return known.designs[0]
 
 

@@ -58,7 +58,7 @@ def path_command(point: list[str], via: list[str], *, search: bool, samples: Opt
         return
     if samples is not None:
         raise InputError("--samples is an option of --search")
-    from ..homotopy.ninepoint import PATHS
+    from ..homotopy.ninepoint_track import PATHS
     from .progress import progress_bar
 
     try:

@@ -15,7 +15,7 @@ from ..errors import InputError
 def path_search_command(pairs: list[tuple[float, float]], samples: Optional[int], options: dict[str, Any], *,
                         design: Optional[int], output: Optional[Path], write_file: bool, force: bool,
                         fmt: str, report_out: Optional[Path], digits: int, table: Optional[str]) -> None:
-    from ..homotopy.ninepoint import PATHS
+    from ..homotopy.ninepoint_track import PATHS
     from ..render import writers
     from ..render.path_search import path_search_report
     from ..synthesis.path_search import search_path

@@ -35,12 +35,8 @@ of six is enough to track (:func:`orbit`):
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from .tracker import PathLog
 
 A, X, B, Y, AB, XB, BB, YB = range(8)
 """Columns of an unknown vector: a, x, b, y, abar, xbar, bbar, ybar."""
@@ -144,58 +140,6 @@ def orbit(z: np.ndarray) -> np.ndarray:
     return np.concatenate([three, swap(three)])
 
 
-@dataclass(frozen=True)
-class ParameterSegment:
-    """The points moving on a straight line, delta(t) = (1 - t) start + t end, for all
-    paths at once; an instance of the homotopy protocol of :func:`.tracker.track`
-    (``residual_and_jacobians`` and ``velocity``). Points are projective, (z, w) with z/w
-    the unknowns, on the random patch ``patch`` . (z, w) = 1, so that a solution that is
-    large at an instance (a nearly degenerate four-bar: pivots far away) stays bounded."""
-
-    d0: np.ndarray  # (8,) delta at t = 0
-    db0: np.ndarray
-    d1: np.ndarray  # (8,) at t = 1
-    db1: np.ndarray
-    patch: np.ndarray  # (9,)
-
-    def at(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        t = np.asarray(t)[:, None]
-        return (1 - t) * self.d0 + t * self.d1, (1 - t) * self.db0 + t * self.db1
-
-    def residual_and_jacobians(self, Z: np.ndarray, t: np.ndarray
-                               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        d, db = self.at(t)
-        E, J, Ed, Edb = equations(Z[:, :8], d, db, Z[:, 8])
-        Ht = Ed * (self.d1 - self.d0) + Edb * (self.db1 - self.db0)
-        n = len(Z)
-        patch = np.broadcast_to(self.patch, (n, 1, 9))
-        return (np.concatenate([E, (Z @ self.patch - 1.0)[:, None]], axis=1),
-                np.concatenate([J, patch], axis=1),
-                np.concatenate([Ht, np.zeros((n, 1), dtype=complex)], axis=1))
-
-    def velocity(self, Z: np.ndarray, t: np.ndarray, dt: np.ndarray) -> np.ndarray:
-        from .tracker import velocity
-
-        return velocity(self, Z, t, dt)
-
-
-def random_patch(rng: np.random.Generator) -> np.ndarray:
-    patch = rng.normal(size=9) + 1j * rng.normal(size=9)
-    return patch / np.linalg.norm(patch)
-
-
-def lift(z: np.ndarray, patch: np.ndarray) -> np.ndarray:
-    """Affine solutions (paths, 8) to projective points on the patch."""
-    Z = np.concatenate([z, np.ones((len(z), 1), dtype=complex)], axis=1)
-    return Z / (Z @ patch)[:, None]
-
-
-def affine(Z: np.ndarray) -> np.ndarray:
-    """Projective points back to affine solutions (inf where w is 0)."""
-    with np.errstate(all="ignore"):
-        return Z[:, :8] / Z[:, 8:9]
-
-
 def seed_instance(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A random complex instance with one solution known: random unknowns z and random
     delta_j, then each deltabar_j a root of E_j (a cubic in deltabar_j, fitted exactly
@@ -220,28 +164,8 @@ def seed_instance(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.
     return z, d, db
 
 
-MAX_STEP = 0.05
-"""Largest step in t along a parameter segment."""
-CORRECTOR_TOL = 1e-9
-"""The tracker's corrector tolerance here (relative): the equations are of degree 8 and a
-path's Jacobian has a condition number up to about 1e6 along the way, so Newton's method
-in double precision stalls near 1e-11 (measured); the endpoints are refined at the end."""
 SAME = 1e-8
 """Two solutions closer than this (relative to their size) are one."""
-
-
-def track_segment(segment: ParameterSegment, Z: np.ndarray, max_step: float = MAX_STEP
-                  ) -> tuple[np.ndarray, np.ndarray, PathLog]:
-    """Every row of ``Z`` (affine solutions at t = 0) tracked to t = 1 in projective
-    coordinates: (affine Z at 1, ok, the log)."""
-    from .tracker import PathLog, track
-
-    n = len(Z)
-    log = PathLog.empty(n)
-    Z1, ok, _ = track(segment, lift(Z, segment.patch), np.zeros(n), np.ones(n), lambda t: t, np.ones_like,
-                      log, np.arange(n), np.full(n, max_step / 4.0), max_step, CORRECTOR_TOL)
-    z1 = affine(Z1)
-    return z1, ok & np.all(np.isfinite(z1), axis=1), log
 
 
 KEY = np.array([0.3141592653589793 + 0.2718281828459045j, -0.5772156649015329 + 0.1618033988749895j,
@@ -268,25 +192,35 @@ def canonical(Z: np.ndarray) -> np.ndarray:
 
 def distinct(Z: np.ndarray) -> np.ndarray:
     """Indices of the rows of ``Z`` that no earlier row equals (to SAME, relative): of
-    rows that are one solution, the first. Rows are sorted by key, and only rows whose keys
-    are within reach are compared (|key difference| <= |difference| |KEY|)."""
+    rows that are one solution, the first (:func:`owners`)."""
+    return np.flatnonzero(owners(Z) == np.arange(len(Z)))
+
+
+def owners(Z: np.ndarray) -> np.ndarray:
+    """For each row of ``Z``, the first row of the solution it is (to SAME, relative): itself
+    when no earlier row equals it. Rows are sorted by key, and only rows whose keys are
+    within reach are compared (|key difference| <= |difference| |KEY|); a row equal to an
+    earlier one takes that one's owner, so rows that are one solution share one owner."""
     keys = (Z @ KEY).real
     order = np.argsort(keys, kind="stable")
     scale = np.maximum(1.0, np.linalg.norm(Z, axis=1))
     reach = SAME * scale * float(np.linalg.norm(KEY)) * 1.01
-    keep = np.ones(len(Z), bool)
+    equal = np.arange(len(Z))
     for pos, i in enumerate(order):
         for direction in (-1, 1):
             q = pos + direction
             while 0 <= q < len(order) and abs(keys[order[q]] - keys[i]) <= reach[i]:
                 j = order[q]
                 if j < i and np.linalg.norm(Z[i] - Z[j]) <= SAME * scale[i]:
-                    keep[i] = False
+                    equal[i] = j
                     break
                 q += direction
-            if not keep[i]:
+            if equal[i] != i:
                 break
-    return np.flatnonzero(keep)
+    owner = equal.copy()
+    for i in range(len(Z)):  # an earlier row's owner is settled before a later row's
+        owner[i] = owner[equal[i]]
+    return owner
 
 
 @dataclass(frozen=True)
@@ -299,42 +233,13 @@ class Instance:
     solutions: np.ndarray  # (orbits, 8)
 
 
-def _random_points(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+def random_points(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     return (rng.normal(size=8) + 1j * rng.normal(size=8), rng.normal(size=8) + 1j * rng.normal(size=8))
-
-
-@dataclass(frozen=True)
-class NinePointLoops:
-    """The nine-point problem as :func:`.parameter.monodromy` loops it: the parameters are
-    the points, (delta, deltabar) as one vector of 16; a corner of a loop is random complex
-    points of unit size, as the stored instance's are; a leg is :func:`track_segment` on its
-    own random patch; a root is one solution per orbit of six, in its canonical form
-    (:func:`canonical`), polished at the instance (:func:`polish`; one that does not settle
-    is dropped), so that an endpoint is new only as a new orbit (:func:`distinct`)."""
-
-    max_step: float = MAX_STEP
-    n: int = 8
-
-    def turn(self, p: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-        return np.concatenate(_random_points(rng))
-
-    def leg(self, a: np.ndarray, b: np.ndarray, roots: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-        segment = ParameterSegment(a[:8], a[8:], b[:8], b[8:], random_patch(rng))
-        Z, ok, _log = track_segment(segment, roots, self.max_step)
-        return Z[ok]
-
-    def settle(self, roots: np.ndarray, p: np.ndarray) -> np.ndarray:
-        with np.errstate(all="ignore"):
-            Z, last, _ = polish(roots, p[:8], p[8:])
-        return canonical(Z[last <= REFINED])
-
-    def fresh(self, known: np.ndarray, roots: np.ndarray) -> list[int]:
-        return [i - len(known) for i in distinct(np.vstack([known, roots])) if i >= len(known)]
 
 
 START = "data/nine_point_start.npz"
 """A generic complex instance with one solution of each of its 1,442 orbits, made by
-:func:`.parameter.monodromy` with :class:`NinePointLoops` from one seed
+:func:`.parameter.monodromy` with :class:`.ninepoint_track.NinePointLoops` from one seed
 (benchmarks/nine_point_start.py remakes it)."""
 POLISH_STEPS = 8
 REFINED = 1e-10
@@ -430,154 +335,5 @@ def is_real(Z: np.ndarray) -> np.ndarray:
     return np.max(np.abs(Z[:, 4:] - np.conj(Z[:, :4])), axis=1) <= REAL * scale
 
 
-@dataclass(frozen=True)
-class NinePointSolutions:
-    """The four-bars through nine points, one per orbit (cognates and dyad order), and how
-    they were found."""
-
-    points: tuple[complex, ...]  # P_0..P_8
-    solutions: np.ndarray  # (orbits found, 8): a, x, b, y, bars; P_0 at the origin
-    real: np.ndarray  # (orbits found,) bool
-    condition: np.ndarray  # (orbits found,)
-    paths: int  # tracked per route (the start instance's orbits)
-    routes: int  # straight, then through random complex points, until every orbit is found
-    failed: tuple[int, ...]  # per route
-    unrefined: tuple[int, ...]  # per route: ended where Newton's method does not settle
-    steps: tuple[int, ...]  # per route, total
-    seconds: float
-
-    @property
-    def missing(self) -> int:
-        """Orbits of the start instance whose endpoint no route reached."""
-        return self.paths - len(self.solutions)
-
-
-MAX_ROUTES = 4
 SINGULAR = 1e12
 """An endpoint whose Jacobian's condition exceeds this is not counted as a solution."""
-
-
-@dataclass(frozen=True)
-class Route:
-    """One way from the stored instance to the target: its legs (points at each end) and
-    each leg's projective patch. A value, so that a chunk of paths can be sent to a worker."""
-
-    legs: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], ...]
-    patches: tuple[np.ndarray, ...]
-    target: tuple[np.ndarray, np.ndarray]
-
-
-def track_route(route: Route, first: int, Z: np.ndarray) -> dict[str, np.ndarray]:
-    """Paths ``Z`` (start solutions; ``first`` is the index of the first, for the caller's
-    order) along every leg of ``route``, polished at the target; endpoints that will not
-    settle in double precision polished at PRECISE_DIGITS. A chunk's records: ``z``
-    (settled endpoints, canonical), ``failed``, ``unsettled``, ``steps`` (counts)."""
-    ok = np.ones(len(Z), bool)
-    steps = 0
-    # paths through near-degenerate points overflow on the way: the tracker judges each
-    # path by its own finite checks, so numpy's warnings would only be noise on stderr
-    with np.errstate(all="ignore"):
-        for (a, ab, b, bb), patch in zip(route.legs, route.patches):
-            Z, k, log = track_segment(ParameterSegment(a, ab, b, bb, patch), Z)
-            ok &= k
-            steps += int(log.steps.sum())
-        d1, db1 = route.target
-        Z, last, cond = polish(Z[ok], d1, db1)
-    good = (last <= REFINED) & (cond <= SINGULAR)
-    precise = [polish_precisely(z, d1, db1) for z in Z[~good] if np.all(np.isfinite(z))]
-    settled = [z for z in precise if z is not None]
-    Z = canonical(np.vstack([Z[good], *[z[None, :] for z in settled]]))
-    return {"z": Z, "failed": np.array([int((~ok).sum())]), "steps": np.array([steps]),
-            "unsettled": np.array([int((~good).sum()) - len(settled)])}
-
-
-class StartRows:
-    """The stored instance's solutions as a plan of chunks (``total``, ``chunk(a, b)``),
-    the shape the scan's chunk runner takes."""
-
-    def __init__(self, solutions: np.ndarray) -> None:
-        self.solutions = solutions
-        self.total = len(solutions)
-
-    def chunk(self, a: int, b: int) -> np.ndarray:
-        return self.solutions[a:b]
-
-
-def _here(task, job, plan, size):  # type: ignore[no-untyped-def]
-    """Chunks one after another, in this process (the default runner)."""
-    for a in range(0, plan.total, size):
-        yield task(job, a, plan.chunk(a, min(a + size, plan.total)))
-
-
-PATHS = 1442
-"""The stored instance's orbits: the paths of a route (WMS 1992's count, 8,652 / 6)."""
-CHUNK = 256
-"""Paths per task: numpy blocks big enough to amortise the interpreter, small enough that
-two workers share Problem 3's 1,442 paths evenly."""
-
-
-def solve_points(points: list[complex] | tuple[complex, ...], seed: int = 0,
-                 max_routes: int = MAX_ROUTES, run=None, orbits: int | None = None,  # type: ignore[no-untyped-def]
-                 progress=None) -> NinePointSolutions:  # type: ignore[no-untyped-def]
-    """Every four-bar whose coupler point passes through nine points (complex numbers
-    x + iy), by parameter homotopy from the stored generic instance (:func:`load_start`).
-    The first route is the straight segment; a path that fails, or ends where Newton's
-    method does not settle, leaves its endpoint to another route, through a random complex
-    instance, which carries every path again (a route permutes the endpoints, so the union
-    over routes is what is counted); routes stop when every orbit is found or at
-    ``max_routes``. ``run(task, job, plan, size)`` runs the chunks of paths (default: here,
-    one after another; the scan's runner sends them to dask). ``orbits``: track only the
-    first so many of the stored orbits (a quick look; the counts are then of those).
-    ``progress(done, label)``: called as each chunk of paths ends."""
-    import time
-
-    began = time.perf_counter()
-    start = load_start()
-    rows = start.solutions if orbits is None else start.solutions[:orbits]
-    p = np.asarray(points, dtype=complex)
-    # the problem is the same at every scale (the pivots scale with the points): solve it
-    # for points of size 1, as the stored instance is, and scale the four-bars back
-    size = float(np.max(np.abs(p[1:] - p[0])))
-    d1 = (p[1:] - p[0]) / size
-    db1 = np.conj(d1)
-    rng = np.random.default_rng(seed)
-    found = np.zeros((0, 8), dtype=complex)
-    failed: list[int] = []
-    unrefined: list[int] = []
-    steps: list[int] = []
-    for route in range(max_routes):
-        if route == 0:
-            legs = ((start.delta, start.deltabar, d1, db1),)
-        else:
-            m, mb = _random_points(rng)
-            legs = ((start.delta, start.deltabar, m, mb), (m, mb, d1, db1))
-        job = Route(legs, tuple(random_patch(rng) for _ in legs), (d1, db1))
-        parts = []
-        for part in (run or _here)(track_route, job, StartRows(rows), CHUNK):
-            parts.append(part)
-            if progress is not None:
-                progress(min(len(parts) * CHUNK, len(rows)), f"tracking paths, route {route + 1}")
-        failed.append(sum(int(c["failed"][0]) for c in parts))
-        unrefined.append(sum(int(c["unsettled"][0]) for c in parts))
-        steps.append(sum(int(c["steps"][0]) for c in parts))
-        both = np.vstack([found, *[c["z"] for c in parts]])
-        found = both[distinct(both)]
-        if len(found) >= len(rows):
-            break
-    Z = found
-    with np.errstate(all="ignore"):
-        real = is_real(Z)
-        Z[real, 4:] = np.conj(Z[real, :4])
-        rough = np.flatnonzero(real | (relative_residual(Z, d1, db1) > RESIDUAL)) if len(Z) else []
-        for i in rough:
-            better = polish_precisely(Z[i], d1, db1)
-            if better is not None:
-                Z[i] = better
-        real = is_real(Z)
-        Z[real, 4:] = np.conj(Z[real, :4])
-        _, J, _, _ = equations(Z, d1, db1)
-        cond = np.linalg.cond(J) if len(Z) else np.zeros(0)  # at the points' unit size
-    Z = Z * size
-    return NinePointSolutions(tuple(complex(v) for v in p), Z, real, cond, len(rows),
-                              len(failed), tuple(failed), tuple(unrefined), tuple(steps),
-                              time.perf_counter() - began)

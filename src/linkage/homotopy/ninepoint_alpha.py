@@ -144,7 +144,7 @@ def residuals(system: PolySystem, Z: np.ndarray, d: np.ndarray, db: np.ndarray) 
 def certify_rows(Z: np.ndarray, points: tuple[complex, ...] | np.ndarray,
                  progress: Callable[[int], None] | None = None) -> tuple[Certificate, ...]:
     """The certificate of each row of ``Z`` (solutions of the nine ``points``, P_0 at the
-    origin, as :class:`.ninepoint.NinePointSolutions` has them)."""
+    origin, as :class:`.ninepoint_track.NinePointSolutions` has them)."""
     p = np.asarray(points, dtype=complex)
     d = p[1:] - p[0]
     db = np.conj(d)

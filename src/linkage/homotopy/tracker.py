@@ -28,6 +28,9 @@ CORRECTOR_STEPS = 3
 MIN_STEP = 1e-13
 MAX_STEPS = 20_000
 """Steps a path may take before it is called failed (a path wandering near a singularity)."""
+UNDERFLOW, TOO_MANY_STEPS = 1, 2
+"""A failed path's cause in :attr:`PathLog.cause` (0: it has not failed here): its step
+size fell below MIN_STEP, or it took MAX_STEPS steps."""
 
 
 class PathHomotopy(Protocol):
@@ -78,18 +81,20 @@ class Homotopy:
 
 @dataclass
 class PathLog:
-    """What each path did: counts per path (arrays), and why a failed one failed."""
+    """What each path did: counts per path (arrays), and why a failed one failed (in words,
+    and as a code, UNDERFLOW or TOO_MANY_STEPS, for callers that keep arrays)."""
 
     steps: np.ndarray
     rejected: np.ndarray
     newton: np.ndarray
-    smallest_step: np.ndarray
+    smallest_step: np.ndarray  # of the step sizes chosen for accepted steps (inf: none accepted)
     failure: list[str] = field(default_factory=list)
+    cause: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int8))
 
     @classmethod
     def empty(cls, paths: int) -> PathLog:
         return cls(np.zeros(paths, int), np.zeros(paths, int), np.zeros(paths, int),
-                   np.full(paths, np.inf), [""] * paths)
+                   np.full(paths, np.inf), [""] * paths, np.zeros(paths, np.int8))
 
 
 def solve_batched(J: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -164,7 +169,9 @@ def track(h: PathHomotopy, X: np.ndarray, tau: np.ndarray, tau_end: np.ndarray,
         X[acc] = Xp[accept]
         tau[acc] = np.where(tau_end[acc] - (ta[accept] + ha[accept]) <= 1e-15 * np.abs(tau_end[acc]),
                             tau_end[acc], ta[accept] + ha[accept])
-        log.smallest_step[index[acc]] = np.minimum(log.smallest_step[index[acc]], ha[accept])
+        # the step size chosen, not the step cut short to end at tau_end: a last step of the
+        # rounding left over (1e-15) is no sign of a hard path
+        log.smallest_step[index[acc]] = np.minimum(log.smallest_step[index[acc]], step[acc])
         good[acc] += 1
         grow = acc[good[acc] >= 3]
         step[grow] = np.minimum(2.0 * step[grow], max_step)
@@ -176,9 +183,11 @@ def track(h: PathHomotopy, X: np.ndarray, tau: np.ndarray, tau_end: np.ndarray,
             ok[i] = False
             where = complex(t_of(tau[i:i + 1])[0])
             log.failure[index[i]] = f"step size below {MIN_STEP:g} at t = {where:.6g}"
+            log.cause[index[i]] = UNDERFLOW
         for i in a[log.steps[index[a]] >= MAX_STEPS]:
             if ok[i]:
                 ok[i] = False
                 log.failure[index[i]] = f"more than {MAX_STEPS} steps"
+                log.cause[index[i]] = TOO_MANY_STEPS
         active = ok & (tau < tau_end)
     return X, ok, step

@@ -259,7 +259,7 @@ def runs(fn: Callable[[], Any], repeats: int, warm: bool = True) -> tuple[tuple[
 def problem_3(repeats: int) -> Timed:
     """``synthesize --path``'s engine on Problem 3 from the stored start instance, once (a
     run is half a minute; the first call loads the instance, as a command does)."""
-    from ..homotopy.ninepoint import solve_points
+    from ..homotopy.ninepoint_track import solve_points
 
     seconds, res = runs(lambda: solve_points([complex(x, y) for x, y in PROBLEM_3]), 1, warm=False)
     real = int(np.sum(res.real))

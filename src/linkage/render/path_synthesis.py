@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
-from .data import DataTable, Report, from_rows
+from .data import DataTable, Report, column, from_rows
 from .report import Block, Text, table
 
 
@@ -44,7 +45,47 @@ def path_tables(result: Any) -> tuple[DataTable, ...]:
     routes = [(r + 1, s.paths, s.failed[r], s.unrefined[r], s.steps[r]) for r in range(s.routes)]
     return (from_rows("designs", HEADS, designs), from_rows("cognates", HEADS, cognates),
             from_rows("routes", [("route", "", "int"), ("paths", "", "int"), ("failed", "", "int"),
-                                 ("unsettled", "", "int"), ("steps", "", "int")], routes))
+                                 ("unsettled", "", "int"), ("steps", "", "int")], routes),
+            outcomes_table(s), paths_table(result, order))
+
+
+def outcomes_table(s: Any) -> DataTable:
+    """Each route's paths counted by outcome class (linkage.homotopy.ninepoint_track.OUTCOMES),
+    and how many of the settled ones settled only at 60 digits."""
+    from ..homotopy.ninepoint_track import OUTCOMES
+
+    counts = s.record.counts(s.routes)
+    precise = [int(s.record.precise[s.record.route == r + 1].sum()) for r in range(s.routes)]
+    rows = [(r + 1, s.paths, *map(int, counts[r]), precise[r]) for r in range(s.routes)]
+    heads = [("route", "", "int"), ("paths", "", "int"), *[(name, "", "int") for name in OUTCOMES],
+             ("polished_60_digits", "", "int")]
+    return from_rows("outcomes", heads, rows)
+
+
+PATH_HEADS = [("route", "", "int"), ("orbit", "", "int"), ("steps", "", "int"), ("rejected", "", "int"),
+              ("newton", "", "int"), ("smallest_step", "", "number"), ("outcome", "", "text"),
+              ("polished_60_digits", "", "bool"), ("stopped_on_leg", "", "int"), ("four_bar", "", "int"),
+              ("real", "", "bool"), ("design", "", "int")]
+"""The paths table: one row per path per route (NinePointSolutions.record); orbit is the
+start instance's orbit (1-based), smallest_step the smallest accepted step in t, four_bar
+the found four-bar's number (1-based, in the order found; real ones have a design number,
+the designs table's)."""
+
+
+def paths_table(result: Any, order: list[int]) -> DataTable:
+    from ..homotopy.ninepoint_track import OUTCOMES
+
+    s = result.solutions
+    rec = s.record
+    reals = [i for i, r in enumerate(s.real) if r]
+    design = {reals[k]: pos + 1 for pos, k in enumerate(order)}
+    fbs = [int(fb) for fb in rec.four_bar]
+    values = [rec.route.tolist(), (rec.path + 1).tolist(), rec.steps.tolist(), rec.rejected.tolist(),
+              rec.newton.tolist(), [v if math.isfinite(v) else None for v in rec.smallest_step.tolist()],
+              [OUTCOMES[k] for k in rec.outcome], rec.precise.tolist(), [k or None for k in rec.leg.tolist()],
+              [fb + 1 if fb >= 0 else None for fb in fbs],
+              [bool(s.real[fb]) if fb >= 0 else None for fb in fbs], [design.get(fb) for fb in fbs]]
+    return DataTable("paths", tuple(column(n, u, v, k) for (n, u, k), v in zip(PATH_HEADS, values)))
 
 
 def certified_line(result: Any) -> str:
@@ -113,6 +154,7 @@ def path_report(result: Any, digits: int) -> Report:
                         "(--table cognates -f csv)"))
         rows = list(zip(*[c.values for c in tables[2].columns]))
         out += [Text("Routes"), table("", [c.header for c in tables[2].columns], rows, digits)]
+        out += outcome_blocks(tables[3], digits)
         return out
 
     def document() -> dict[str, Any]:
@@ -122,6 +164,19 @@ def path_report(result: Any, digits: int) -> Report:
                 "without_defects": sum(1 for g in result.designs if not g[0].defects), "seconds": s.seconds}
 
     return Report(title, tables, blocks, document)
+
+
+def outcome_blocks(outcomes: DataTable, digits: int) -> list[Block]:
+    """The outcomes table as the terminal shows it, and where every path's record is."""
+    rows = list(zip(*[c.values for c in outcomes.columns]))
+    return [Text("Paths by outcome"), table("", [c.header for c in outcomes.columns], rows, digits),
+            Text("outcomes: reached, a four-bar no path had reached; reached_again, one an earlier route "
+                 "found; duplicate, one another path of the route reached first; unsettled, Newton's method "
+                 "did not settle at the points (in double precision nor at 60 digits); step_underflow, "
+                 "too_many_steps, infinite, the tracker gave the path up; polished_60_digits, of the "
+                 "settled, those that settled only at 60 digits. Every path's steps, rejected steps, "
+                 "corrector iterations and smallest step: --table paths with -f csv or json "
+                 "(docs/path_synthesis.md)")]
 
 
 TIMED_HEADS = [*HEADS, ("crank_dyad", "", "int"), ("rocker_dyad", "", "int"),

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ..homotopy import ninepoint
+from ..homotopy import ninepoint, ninepoint_track
 from ..units import degrees, radians
 from .request import MIN_TRANSMISSION_DEG
 from .timed_path import TimedSolutions, check_timed_points, is_timed, timed_four_bars
@@ -80,7 +80,7 @@ class PathSynthesis:
     designs: tuple[tuple[PathFourBar, ...], ...]  # per real orbit: its three cognates
     found: int  # orbits (complex and real)
     missing: int
-    solutions: ninepoint.NinePointSolutions
+    solutions: ninepoint_track.NinePointSolutions
     extra: tuple[int, ...] = ()  # which of the points are extra ones (path_points), not given
 
     @cached_property
@@ -90,7 +90,7 @@ class PathSynthesis:
         return real_certificates(self.solutions)
 
 
-def real_certificates(solutions: ninepoint.NinePointSolutions
+def real_certificates(solutions: ninepoint_track.NinePointSolutions
                       ) -> tuple[tuple[Any, ...], list[tuple[int, int]]]:
     """Smale's alpha test at each real four-bar (:mod:`linkage.homotopy.ninepoint_alpha`, 50
     digits): the certificates, and the pairs of them not told apart (empty: all distinct)."""
@@ -118,7 +118,7 @@ class TimedPathSynthesis:
 
 def chunk_runner(scheduler: str | None, workers: int | None):  # type: ignore[no-untyped-def]
     """The scan's chunk runner (one home for sending chunks to dask) in the form
-    :func:`linkage.homotopy.ninepoint.solve_points` calls."""
+    :func:`linkage.homotopy.ninepoint_track.solve_points` calls."""
     from ..scan import run_chunks
 
     def run(task, job, plan, size):  # type: ignore[no-untyped-def]
@@ -343,7 +343,7 @@ def path_options(seed: object, min_transmission: object, workers: object, schedu
         raise InputError("scheduler must be threads, processes, synchronous or tcp://HOST:PORT, "
                          f"got {scheduler!r}")
     if orbits is not None:
-        orbits = check_whole("orbits", orbits, 1, ninepoint.PATHS)
+        orbits = check_whole("orbits", orbits, 1, ninepoint_track.PATHS)
     return seed, floor, workers, orbits  # type: ignore[return-value]
 
 
@@ -362,7 +362,7 @@ def synthesize_path(points: object, via: object = None, seed: int = 0, scheduler
     threads or processes, or on a cluster (``scheduler`` tcp://HOST:PORT), ``workers`` at a
     time. ``progress(done, label)`` is told how far it is, out of the paths of a route.
     ``orbits``: track only the first so many of the stored instance's orbits (a quick look,
-    :func:`linkage.homotopy.ninepoint.solve_points`)."""
+    :func:`linkage.homotopy.ninepoint_track.solve_points`)."""
     from .path_points import check_via, nine_points
 
     if is_timed(points):
@@ -392,7 +392,7 @@ def solve_nine(points: tuple[complex, ...], extra: tuple[int, ...], seed: int, r
     ``every_cognate`` (a search, which keeps only defect-free designs), a design whose first
     cognate has a defect of CIRCUIT_DEFECTS is that cognate alone."""
     pts = list(points)
-    sols = ninepoint.solve_points(pts, seed=seed, run=run, progress=progress, orbits=orbits)
+    sols = ninepoint_track.solve_points(pts, seed=seed, run=run, progress=progress, orbits=orbits)
     designs = []
     reals = np.flatnonzero(sols.real)
     for k, i in enumerate(reals):

@@ -89,7 +89,7 @@ def search_path(points: object, samples: int | None = None, via: object = None, 
 def _sample_progress(progress: Callable[[int, str], None], k: int, total: int) -> Callable[[int, str], None]:
     """A sample's progress(done, label) as the whole search's: paths of the samples before
     it added, the sample named."""
-    from ..homotopy.ninepoint import PATHS
+    from ..homotopy.ninepoint_track import PATHS
 
     def told(done: int, label: str) -> None:
         progress(k * PATHS + done, f"sample {k + 1} of {total}: {label}" if total > 1 else label)
