@@ -42,6 +42,7 @@ from .steps import (
     is_open,
     is_open_np,
     solve_step,
+    solve_step_margin_np,
     solve_step_np,
     step_margin,
     step_margin_np,
@@ -282,7 +283,10 @@ class Derivation(NamedTuple):
         p = self._params(params)
         d = np.asarray(driver, float)
         q: list[Any] = [None] * self.n
-        shape = np.broadcast_shapes(d.shape, *(np.shape(v) for v in p.values()))
+        # a float parameter broadcasts to anything: only arrays (a scan's designs) are
+        # asked (np.broadcast_shapes costs microseconds a call, a sweep's every call)
+        shapes = [np.shape(v) for v in p.values() if v.__class__ is not float]
+        shape = np.broadcast_shapes(d.shape, *shapes) if shapes else d.shape
         ok: Any = None
         out = []
         signs_left = iter(signs)
@@ -291,8 +295,10 @@ class Derivation(NamedTuple):
                 sigma = next(signs_left) if step.two_way else 0.0
                 first, second, k = coefficients(step, p, d, q, np)
                 if step.two_way:
-                    out.append(step_margin_np(step.case, first, second, k))
-                a, b, fine = solve_step_np(step.case, first, second, k, sigma)
+                    a, b, fine, margin = solve_step_margin_np(step.case, first, second, k, sigma)
+                    out.append(margin)
+                else:
+                    a, b, fine = solve_step_np(step.case, first, second, k, sigma)
                 ok = fine if ok is None else ok & fine
                 q[step.unknowns[0]], q[step.unknowns[1]] = a, b
         if ok is None or np.shape(ok) != shape:
