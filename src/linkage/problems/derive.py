@@ -274,14 +274,17 @@ class Derivation(NamedTuple):
         q, ok, _ = self.solve_margins_np(driver, signs, params)
         return q, ok
 
-    def solve_margins_np(self, driver: Any, signs: Sequence[float],
-                         params: Mapping[str, Any] | None = None) -> tuple[list[Any], Any, list[Any]]:
+    def solve_margins_np(self, driver: Any, signs: Sequence[float], params: Mapping[str, Any] | None = None,
+                         driver_trig: tuple[Any, Any] | None = None) -> tuple[list[Any], Any, list[Any]]:
         """:meth:`solve_np` and :meth:`margins_np` in one pass (a sweep needs both):
-        (unknowns, ok, margins)."""
+        (unknowns, ok, margins). ``driver_trig``: np.cos and np.sin of ``driver`` (an angle,
+        a float array), where the caller takes them for its own use too (the closed-form
+        sweep's loop equations); taken here when not given."""
         import numpy as np
 
         p = self._params(params)
         d = np.asarray(driver, float)
+        xp: Any = np if driver_trig is None else GivenTrig(d, *driver_trig)
         q: list[Any] = [None] * self.n
         # a float parameter broadcasts to anything: only arrays (a scan's designs) are
         # asked (np.broadcast_shapes costs microseconds a call, a sweep's every call)
@@ -293,7 +296,7 @@ class Derivation(NamedTuple):
         with np.errstate(invalid="ignore", divide="ignore"):
             for step in self.steps:
                 sigma = next(signs_left) if step.two_way else 0.0
-                first, second, k = coefficients(step, p, d, q, np)
+                first, second, k = coefficients(step, p, d, q, xp)
                 if step.two_way:
                     a, b, fine, margin = solve_step_margin_np(step.case, first, second, k, sigma)
                     out.append(margin)
@@ -451,6 +454,32 @@ class Derivation(NamedTuple):
         where = ", ".join(named) or "none: it cannot be assembled there"
         raise ValueError(f"no {text!r} assembly here (assemblies: {where}; or their signs, one + "
                          f"or - per closed-form step with two roots, e.g. {'+' * count})")
+
+
+class GivenTrig:
+    """numpy as :func:`~.steps.coefficients` reads it (``xp``), with the cosine and sine of
+    one array as a caller already took them (np.cos and np.sin of that very array: the
+    same bits); np.cos and np.sin of anything else."""
+
+    __slots__ = ("c", "of", "s")
+
+    def __init__(self, of: Any, c: Any, s: Any) -> None:
+        self.of, self.c, self.s = of, c, s
+
+    def cos(self, t: Any) -> Any:
+        import numpy as np
+
+        return self.c if t is self.of else np.cos(t)
+
+    def sin(self, t: Any) -> Any:
+        import numpy as np
+
+        return self.s if t is self.of else np.sin(t)
+
+    def __getattr__(self, name: str) -> Any:
+        import numpy as np
+
+        return getattr(np, name)
 
 
 def _side_np(step: Step, coefs: Any, q: Sequence[Any]) -> Any:
