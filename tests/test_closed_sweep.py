@@ -312,6 +312,23 @@ def test_closes_circle_array_is_its_scalar(grid):
 
     assert closes_circle_array(np.array(grid)) == closes_circle(grid)
     assert closes_circle_array(np.array(grid), 2 * math.pi) == closes_circle(grid, 2 * math.pi)
+    # with the grid's np.diff given (the closed-form engine takes it once): the same verdict
+    diff = np.diff(np.array(grid, dtype=float))
+    assert closes_circle_array(np.array(grid), 360.0, diff) == closes_circle(grid)
+
+
+def test_anchor_index_array_every_position_solved_is_the_masked_rule():
+    """anchor_index_array with solved=True (the closed-form engine: no masked copy) gives
+    what the masked path gives with every position solved, ties to the first, and the
+    scalar rule's index."""
+    from linkage.kinematics.angles import anchor_index, anchor_index_array
+
+    grid = np.arange(0.0, 360.0, 0.5)
+    for v0, closes in ((30.0, True), (359.9, True), (359.9, False), (-45.25, True), (90.25, False)):
+        got = anchor_index_array(grid, True, v0, closes)
+        masked = anchor_index_array(grid, np.ones((1, len(grid)), bool), v0, closes)
+        assert got.shape == (1,) and got[0] == masked[0]
+        assert got[0] == anchor_index(list(grid), [True] * len(grid), v0, closes)
 
 
 def test_unwrap_turns_array_every_position_solved_is_the_scalar_rule():
