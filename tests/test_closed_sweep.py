@@ -281,6 +281,31 @@ def test_the_crank_rockers_angles_read_as_solve_file_gives_them():
 # --- the numpy twins it reads ----------------------------------------------------------------
 
 @pytest.mark.parametrize("name", ["crank_rocker.toml", "slider_crank.toml", "watt_sixbar.toml",
+                                  "fourbar_me581.toml", "fourbar_me581_theta4.toml"])
+def test_the_driver_trig_given_changes_no_bit(name):
+    """The closed-form engine takes the driver's cosine and sine once and gives them to
+    solve_margins_np and VectorLoops (driver_trig): the same bits as each taking its own,
+    -0.0 among the drivers included (sin(-0.0) keeps the sign; the sums begin at 0.0)."""
+    from linkage.kinematics.vector_loops import VectorLoops, loop_plan
+
+    m = load(sample_path(name))
+    d = m.derivation
+    drv = np.radians(np.arange(-180.0, 180.0, 0.7))
+    drv[0] = -0.0
+    trig = (np.cos(drv), np.sin(drv))
+    q_pos = [np.full(len(drv), u.value) for u in m.unknowns]
+    for signs in d.branches:
+        own, given = d.solve_margins_np(drv, signs), d.solve_margins_np(drv, signs, driver_trig=trig)
+        for a, b in zip([*own[0], own[1], *own[2]], [*given[0], given[1], *given[2]]):
+            assert np.array_equal(a, b, equal_nan=True)
+            assert np.array_equal(np.signbit(a), np.signbit(b))
+    (phi, jac), (phi2, jac2) = (VectorLoops(loop_plan(m), drv, t).evaluate(q_pos, None) for t in (None, trig))
+    for x, y in zip([*phi, *(v for row in jac for v in row)], [*phi2, *(v for row in jac2 for v in row)]):
+        x, y = np.broadcast_to(x, drv.shape), np.broadcast_to(y, drv.shape)
+        assert np.array_equal(x, y) and np.array_equal(np.signbit(x), np.signbit(y))
+
+
+@pytest.mark.parametrize("name", ["crank_rocker.toml", "slider_crank.toml", "watt_sixbar.toml",
                                   "fourbar_me581.toml"])
 def test_solve_margins_np_equals_the_scalar_path(name):
     m = load(sample_path(name))
