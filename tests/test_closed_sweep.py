@@ -283,8 +283,9 @@ def test_the_crank_rockers_angles_read_as_solve_file_gives_them():
 @pytest.mark.parametrize("name", ["crank_rocker.toml", "slider_crank.toml", "watt_sixbar.toml",
                                   "fourbar_me581.toml", "fourbar_me581_theta4.toml"])
 def test_the_driver_trig_given_changes_no_bit(name):
-    """The closed-form engine takes the driver's cosine and sine once and gives them to
-    solve_margins_np and VectorLoops (driver_trig): the same bits as each taking its own,
+    """The closed-form and batch engines take the driver's cosine and sine once and give them
+    to solve_margins_np, on_branch_np and VectorLoops (driver_trig): the same bits as each
+    taking its own,
     -0.0 among the drivers included (sin(-0.0) keeps the sign; the sums begin at 0.0)."""
     from linkage.kinematics.vector_loops import VectorLoops, loop_plan
 
@@ -299,6 +300,19 @@ def test_the_driver_trig_given_changes_no_bit(name):
         for a, b in zip([*own[0], own[1], *own[2]], [*given[0], given[1], *given[2]]):
             assert np.array_equal(a, b, equal_nan=True)
             assert np.array_equal(np.signbit(a), np.signbit(b))
+    from linkage.problems.derive import read_branch
+
+    for signs in d.branches:  # the batch engine's branch rule, read with signs: the same verdicts
+        q, ok, _ = d.solve_margins_np(drv, signs)
+        q = [np.where(ok, c, 0.3) for c in q]
+        want = read_branch(d, "".join("+" if x > 0 else "-" for x in signs))
+        assert np.array_equal(d.on_branch_np(q, drv, want), d.on_branch_np(q, drv, want, driver_trig=trig))
+        coefs = zip(d.two_way_coefficients_np(q, drv), d.two_way_coefficients_np(q, drv, None, trig))
+        for own, given in coefs:
+            for x, y in zip([v for pair in own for v in pair], [v for pair in given for v in pair]):
+                x, y = np.broadcast_to(x, drv.shape), np.broadcast_to(y, drv.shape)
+                assert np.array_equal(x, y, equal_nan=True) and np.array_equal(np.signbit(x), np.signbit(y))
+    assert loop_plan(m).driver_angle
     (phi, jac), (phi2, jac2) = (VectorLoops(loop_plan(m), drv, t).evaluate(q_pos, None) for t in (None, trig))
     for x, y in zip([*phi, *(v for row in jac for v in row)], [*phi2, *(v for row in jac2 for v in row)]):
         x, y = np.broadcast_to(x, drv.shape), np.broadcast_to(y, drv.shape)

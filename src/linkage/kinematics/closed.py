@@ -204,12 +204,13 @@ def _block(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, signs: tuple[float, 
     engine does not apply."""
     d = m.derivation
     # the driver's cosine and sine, taken once for the closed form and the loop equations
-    trig = (np.cos(drv), np.sin(drv)) if m.driver.kind == "angle" else None
+    plan_loops = loop_plan(m)
+    trig = (np.cos(drv), np.sin(drv)) if plan_loops.driver_angle else None
     q, ok, margins = d.solve_margins_np(drv, signs, driver_trig=trig)  # (fresh arrays, this block's own)
     if not ok.all() or not all((margin > MARGIN_FLOOR).all() for margin in margins):  # (NaN too)
         return None
     k = len(drv)
-    loops = VectorLoops(loop_plan(m), drv, trig)
+    loops = VectorLoops(plan_loops, drv, trig)
     steps = plan.steps
     # each position stopped as the single solve's loop stops it (linkage.rules)
     stops = SystemStops(tol, residual_gate(tol, m.length_scale), partial(step_size_array, q, None))

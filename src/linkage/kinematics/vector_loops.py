@@ -27,6 +27,12 @@ class LoopPlan:
     n: int
     loops: tuple[tuple[tuple[Any, Any] | Term, ...], ...]
 
+    @property
+    def driver_angle(self) -> bool:
+        """Whether a term's angle is the driver itself (no offset): where the cosine and sine
+        of the driver values are worth taking once for several readers (``driver_trig``)."""
+        return any(len(t) == 6 and t[4] == DRIVER and t[5] == 0.0 for loop in self.loops for t in loop)
+
     @classmethod
     def of(cls, model: LoopModel) -> LoopPlan:
         loops = []

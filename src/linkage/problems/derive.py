@@ -181,17 +181,19 @@ class Derivation(NamedTuple):
                 out.append(abs(step_margin(step.case, first, second, k)) <= TANGENT_SLACK)
         return tuple(out)
 
-    def two_way_coefficients_np(self, q: Sequence[Any], driver: Any,
-                                params: Mapping[str, Any] | None = None) -> list[Any]:
+    def two_way_coefficients_np(self, q: Sequence[Any], driver: Any, params: Mapping[str, Any] | None = None,
+                                driver_trig: tuple[Any, Any] | None = None) -> list[Any]:
         """Each two-way step's (first, second, K) over arrays at a configuration: what
         :meth:`meets_np`, :meth:`signs_of_np` and :meth:`words_of_np` read, computed once
-        where one caller asks for several (``coefs``)."""
+        where one caller asks for several (``coefs``). ``driver_trig`` as for
+        :meth:`solve_margins_np`."""
         import numpy as np
 
         p = self._params(params)
         d = np.asarray(driver, float)
+        xp: Any = np if driver_trig is None else GivenTrig(d, *driver_trig)
         with np.errstate(invalid="ignore", divide="ignore"):
-            return [coefficients(step, p, d, q, np) for step in self.steps if step.two_way]
+            return [coefficients(step, p, d, q, xp) for step in self.steps if step.two_way]
 
     def meets_np(self, q: Sequence[Any], driver: Any, params: Mapping[str, Any] | None = None,
                  coefs: list[Any] | None = None) -> list[Any]:
@@ -219,13 +221,15 @@ class Derivation(NamedTuple):
         return all((w in ("open", "+")) == wanted or m for w, wanted, m in zip(words, want.words, meets))
 
     def on_branch_np(self, q: Sequence[Any], driver: Any, want: BranchText,
-                     params: Mapping[str, Any] | None = None) -> Any:
+                     params: Mapping[str, Any] | None = None,
+                     driver_trig: tuple[Any, Any] | None = None) -> Any:
         """:meth:`on_branch` over arrays. A step's meeting is read only where its sign or
         word is not the one wanted (where every position has them, not at all: a sweep on
-        its branch pays nothing for the rule), with the same verdict as reading it everywhere."""
+        its branch pays nothing for the rule), with the same verdict as reading it everywhere.
+        ``driver_trig`` as for :meth:`solve_margins_np` (read with signs wanted)."""
         import numpy as np
 
-        coefs = None if want.signs is None else self.two_way_coefficients_np(q, driver, params)
+        coefs = None if want.signs is None else self.two_way_coefficients_np(q, driver, params, driver_trig)
         with np.errstate(invalid="ignore"):
             if want.signs is not None:
                 sides = self.signs_of_np(q, driver, params, coefs)
