@@ -281,6 +281,45 @@ def test_the_crank_rockers_angles_read_as_solve_file_gives_them():
 # --- the numpy twins it reads ----------------------------------------------------------------
 
 @pytest.mark.parametrize("name", ["crank_rocker.toml", "slider_crank.toml", "watt_sixbar.toml",
+                                  "fourbar_me581.toml", "fourbar_me581_theta4.toml"])
+def test_the_driver_trig_given_changes_no_bit(name):
+    """The closed-form and batch engines take the driver's cosine and sine once and give them
+    to solve_margins_np, on_branch_np and VectorLoops (driver_trig): the same bits as each
+    taking its own,
+    -0.0 among the drivers included (sin(-0.0) keeps the sign; the sums begin at 0.0)."""
+    from linkage.kinematics.vector_loops import VectorLoops, loop_plan
+
+    m = load(sample_path(name))
+    d = m.derivation
+    drv = np.radians(np.arange(-180.0, 180.0, 0.7))
+    drv[0] = -0.0
+    trig = (np.cos(drv), np.sin(drv))
+    q_pos = [np.full(len(drv), u.value) for u in m.unknowns]
+    for signs in d.branches:
+        own, given = d.solve_margins_np(drv, signs), d.solve_margins_np(drv, signs, driver_trig=trig)
+        for a, b in zip([*own[0], own[1], *own[2]], [*given[0], given[1], *given[2]]):
+            assert np.array_equal(a, b, equal_nan=True)
+            assert np.array_equal(np.signbit(a), np.signbit(b))
+    from linkage.problems.derive import read_branch
+
+    for signs in d.branches:  # the batch engine's branch rule, read with signs: the same verdicts
+        q, ok, _ = d.solve_margins_np(drv, signs)
+        q = [np.where(ok, c, 0.3) for c in q]
+        want = read_branch(d, "".join("+" if x > 0 else "-" for x in signs))
+        assert np.array_equal(d.on_branch_np(q, drv, want), d.on_branch_np(q, drv, want, driver_trig=trig))
+        coefs = zip(d.two_way_coefficients_np(q, drv), d.two_way_coefficients_np(q, drv, None, trig))
+        for own, given in coefs:
+            for x, y in zip([v for pair in own for v in pair], [v for pair in given for v in pair]):
+                x, y = np.broadcast_to(x, drv.shape), np.broadcast_to(y, drv.shape)
+                assert np.array_equal(x, y, equal_nan=True) and np.array_equal(np.signbit(x), np.signbit(y))
+    assert loop_plan(m).driver_angle
+    (phi, jac), (phi2, jac2) = (VectorLoops(loop_plan(m), drv, t).evaluate(q_pos, None) for t in (None, trig))
+    for x, y in zip([*phi, *(v for row in jac for v in row)], [*phi2, *(v for row in jac2 for v in row)]):
+        x, y = np.broadcast_to(x, drv.shape), np.broadcast_to(y, drv.shape)
+        assert np.array_equal(x, y) and np.array_equal(np.signbit(x), np.signbit(y))
+
+
+@pytest.mark.parametrize("name", ["crank_rocker.toml", "slider_crank.toml", "watt_sixbar.toml",
                                   "fourbar_me581.toml"])
 def test_solve_margins_np_equals_the_scalar_path(name):
     m = load(sample_path(name))
@@ -312,6 +351,23 @@ def test_closes_circle_array_is_its_scalar(grid):
 
     assert closes_circle_array(np.array(grid)) == closes_circle(grid)
     assert closes_circle_array(np.array(grid), 2 * math.pi) == closes_circle(grid, 2 * math.pi)
+    # with the grid's np.diff given (the closed-form engine takes it once): the same verdict
+    diff = np.diff(np.array(grid, dtype=float))
+    assert closes_circle_array(np.array(grid), 360.0, diff) == closes_circle(grid)
+
+
+def test_anchor_index_array_every_position_solved_is_the_masked_rule():
+    """anchor_index_array with solved=True (the closed-form engine: no masked copy) gives
+    what the masked path gives with every position solved, ties to the first, and the
+    scalar rule's index."""
+    from linkage.kinematics.angles import anchor_index, anchor_index_array
+
+    grid = np.arange(0.0, 360.0, 0.5)
+    for v0, closes in ((30.0, True), (359.9, True), (359.9, False), (-45.25, True), (90.25, False)):
+        got = anchor_index_array(grid, True, v0, closes)
+        masked = anchor_index_array(grid, np.ones((1, len(grid)), bool), v0, closes)
+        assert got.shape == (1,) and got[0] == masked[0]
+        assert got[0] == anchor_index(list(grid), [True] * len(grid), v0, closes)
 
 
 def test_unwrap_turns_array_every_position_solved_is_the_scalar_rule():

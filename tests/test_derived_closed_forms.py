@@ -721,19 +721,29 @@ def test_other_drivers_stepwise_closed_form_is_newton_polished() -> None:
     assert checked >= 15
 
 
-def test_two_angles_margin_np_orders_by_comparisons_as_a_sort_does() -> None:
-    """two_angles_margin_np sorts its three distances by comparisons, not np.sort: the same
-    bits as the margin of the sorted distances, NaN ordered last as np.sort orders it
-    (zero lengths and NaNs mixed in), so a twin's speed-up changes no verdict."""
+def test_two_angles_margin_np_orders_as_the_circle_intersection_and_is_nan_at_a_nan() -> None:
+    """two_angles_margin_np orders its three distances by the circle intersection's own rule
+    (assembly.descending_np, one home): the same bits as the margin of the sorted distances
+    wherever none is NaN (zero lengths mixed in), and NaN wherever one is (a step reading an
+    unknown an earlier step did not solve has no margin; before the fold a NaN was ordered
+    last, so three NaNs gave a margin of 0); the scalar rule gives the same."""
     rng = np.random.default_rng(33)
     n = 20_000
     a = [rng.normal(size=n) * rng.choice([0.0, 1.0, 1e-8], n) for _ in range(6)]
     for col in a:
         col[rng.random(n) < 0.05] = np.nan
+    a[0][:50] = a[1][:50] = a[2][:50] = a[4][:50] = np.nan  # all three distances NaN
     p, q, k = (a[0], a[1]), (a[2], a[3]), (a[4], a[5])
-    s = -np.sort(-np.stack((dyads.norm_np(*k), dyads.norm_np(*p), dyads.norm_np(*q))), axis=0)
+    dist = np.stack((dyads.norm_np(*k), dyads.norm_np(*p), dyads.norm_np(*q)))
+    s = -np.sort(-dist, axis=0)
     with np.errstate(invalid="ignore", divide="ignore"):
         want = np.where(s[0] > 0.0, (s[2] - (s[0] - s[1])) / s[0], 0.0)
+    nan = np.isnan(dist).any(axis=0)
+    want[nan] = np.nan
     got = dyads.two_angles_margin_np(p, q, k)
-    assert np.isnan(want).any() and (want == 0.0).any()
+    assert nan.any() and (want == 0.0).any() and (want[~nan] != 0.0).any()
     assert np.array_equal(got, want, equal_nan=True)
+    rows = np.flatnonzero(nan)[:200].tolist() + list(range(n - 200, n))
+    scalar = [dyads.two_angles_margin((p[0][i], p[1][i]), (q[0][i], q[1][i]), (k[0][i], k[1][i]))
+              for i in rows]
+    assert np.array_equal(got[rows], scalar, equal_nan=True)

@@ -65,14 +65,17 @@ def closes_circle(values: Sequence[float], turn: float = TURN) -> bool:
     return -slack <= closing <= largest + slack
 
 
-def closes_circle_array(values: Any, turn: float = TURN) -> bool:
-    """:func:`closes_circle` of a 1-D array of driver values (one grid, read at C speed)."""
+def closes_circle_array(values: Any, turn: float = TURN, diff: Any = None) -> bool:
+    """:func:`closes_circle` of a 1-D array of driver values (one grid, read at C speed).
+    ``diff``: np.diff of the values, where the caller took it; taken here when not given."""
     import numpy as np
 
     v = np.asarray(values, dtype=float)
     if len(v) < 2:
         return False
-    steps = np.diff(v) if v[1] > v[0] else -np.diff(v)
+    if diff is None:
+        diff = np.diff(v)
+    steps = diff if v[1] > v[0] else -diff
     if not (steps > 0.0).all():
         return False
     closing = turn - abs(float(v[-1]) - float(v[0]))
@@ -156,9 +159,16 @@ def unwrap_turns_array(values: Any, closes: bool) -> Any:
     solved = np.isfinite(a)
     if solved.all():
         # every position solved: read in grid order from the first (rule 1), each step
-        # from the previous value (0 before the first); the general path's result
-        prev = np.concatenate([np.zeros((rows, 1)), a[:, :-1]], axis=1)
-        return np.cumsum(np.floor((prev + 180.0 - a) / TURN), axis=1)
+        # from the previous value (0 before the first); the general path's result, its
+        # operations (((prev + 180) - a) / TURN, floor, cumsum) in place in one array
+        step = np.empty_like(a)
+        step[:, 0] = 0.0
+        step[:, 1:] = a[:, :-1]
+        step += 180.0
+        step -= a
+        step /= TURN
+        np.floor(step, out=step)
+        return np.cumsum(step, axis=1, out=step)
     start = circular_start_array(solved, closes)
     idx = (np.arange(n)[None, :] + start[:, None]) % n
     r = np.take_along_axis(a, idx, axis=1)
@@ -204,6 +214,8 @@ def anchor_index_array(values: Any, solved: Any, v0: float, closes: bool, turn: 
     if closes:
         d = d % turn
         d = np.minimum(d, turn - d)
+    if solved is True:  # every position solved, one row: no masked copy
+        return np.argmin(d, keepdims=True)
     return np.argmin(np.where(solved, d[None, :], np.inf), axis=1)
 
 

@@ -34,7 +34,7 @@ from .continuation import Solver, classify_gap, continue_step, solve_position, s
 from .limits import solved_ranges_array
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
 from .stepwise import sweep
-from .vector_loops import VectorLoops, loop_plan, singular_of, solve_linear
+from .vector_loops import LoopPlan, VectorLoops, loop_plan, singular_of, solve_linear
 
 STATUS_CODES = {"converged": 0, "no_solution": 1, "failed": 2, "off_branch": 3}
 CODE_STATUS = {v: k for k, v in STATUS_CODES.items()}
@@ -405,7 +405,10 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     n, code = len(kinds), STATUS_CODES
     refs, left, usable = _warm_starts(coarse, vals, n)
     drivers = vals * drv_scale
-    loops = VectorLoops(loop_plan(m) if model is m.model else model, drivers)
+    # the driver's cosine and sine, taken once for the loop equations and the branch rule
+    plan = loop_plan(m) if model is m.model else LoopPlan.of(model)
+    trig = (np.cos(drivers), np.sin(drivers)) if plan.driver_angle else None
+    loops = VectorLoops(plan, drivers, trig)
     q_all = [r * sc for r, sc in zip(refs, scale)]
     done = _vector_newton(loops, q_all, usable, m.length_scale, kinds, tol, max_iter, iters, det_out)
     status[done] = code["converged"]
@@ -418,7 +421,7 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     for j in range(2, n):
         np.maximum(moved, gaps[j], out=moved)
     status[done & (moved > np.take(coarse.allowed, left))] = code["failed"]
-    status[done & ~_on_branch_columns(m, cols, names, det_out, branch, drivers)] = code["failed"]
+    status[done & ~_on_branch_columns(m, cols, names, det_out, branch, drivers, trig)] = code["failed"]
     # angles reported continuously with the guess (the one-at-a-time sweep's convention):
     # a solution within half a turn of its guess is already the representative nearest it
     for j, k in enumerate(kinds):
@@ -523,12 +526,14 @@ def _have_closed(m: Mechanism, solver: Solver, value: float) -> bool:
 
 
 def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence[str], det: np.ndarray,
-                       target: str | None, drivers: np.ndarray) -> np.ndarray:
+                       target: str | None, drivers: np.ndarray,
+                       driver_trig: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """True where a solution (one array per unknown, display units, at ``drivers`` in
     internal units) lies on the target branch: a branch of the derivation (its signs, or
     its name: each two-way step's word by the derivation's own rule, as
     :func:`~linkage.kinematics.designs.design_signs` reads them), else the sign of det J
-    (``det+``, ``det-``)."""
+    (``det+``, ``det-``). ``driver_trig``: np.cos and np.sin of ``drivers`` where the
+    caller took them (:meth:`~linkage.problems.derive.Derivation.on_branch_np`)."""
     if target is None:
         return np.ones(len(det), dtype=bool)
     der = m.derivation
@@ -540,4 +545,4 @@ def _on_branch_columns(m: Mechanism, cols: Sequence[np.ndarray], names: Sequence
     kinds = {u.name: u.kind for u in m.unknowns}
     q = [radians(c) if kinds[n] == "angle" else c for n, c in zip(names, cols)]
     # the derivation's one rule (a name's mirror: the continuity test has already decided)
-    return np.broadcast_to(der.on_branch_np(q, drivers, want), (len(det),))
+    return np.broadcast_to(der.on_branch_np(q, drivers, want, driver_trig=driver_trig), (len(det),))

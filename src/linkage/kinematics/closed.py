@@ -118,7 +118,10 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
         return None
     vals = np.asarray(values, dtype=float)
     n_pos = len(vals)
-    if vals.ndim != 1 or n_pos < 2 or not (vals[1:] > vals[:-1]).all():
+    if vals.ndim != 1 or n_pos < 2:
+        return None
+    diff = np.diff(vals)  # (b - a > 0 exactly where b > a: IEEE subtraction underflows gradually)
+    if not (diff > 0.0).all():
         return None
     # the driver's magnitude, refused as the one-at-a-time engine refuses it
     check_driver_values(m, [float(vals[0]), float(vals[-1])])
@@ -149,7 +152,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
         iters[lo:lo + BLOCK] = it
         ratio[lo:lo + BLOCK] = rt
     assert words is not None
-    closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn)
+    closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn, diff)
     if _touch_candidate(closes, det, ratio):
         return None
     shown = _display(m, plan, tol, max_iter, vals, cols, closes)
@@ -200,11 +203,14 @@ def _block(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, signs: tuple[float, 
     iterations, |det J| over J's columns' lengths, the branch's words), or None where the
     engine does not apply."""
     d = m.derivation
-    q, ok, margins = d.solve_margins_np(drv, signs)  # (fresh arrays, this block's own)
+    # the driver's cosine and sine, taken once for the closed form and the loop equations
+    plan_loops = loop_plan(m)
+    trig = (np.cos(drv), np.sin(drv)) if plan_loops.driver_angle else None
+    q, ok, margins = d.solve_margins_np(drv, signs, driver_trig=trig)  # (fresh arrays, this block's own)
     if not ok.all() or not all((margin > MARGIN_FLOOR).all() for margin in margins):  # (NaN too)
         return None
     k = len(drv)
-    loops = VectorLoops(loop_plan(m), drv)
+    loops = VectorLoops(plan_loops, drv, trig)
     steps = plan.steps
     # each position stopped as the single solve's loop stops it (linkage.rules)
     stops = SystemStops(tol, residual_gate(tol, m.length_scale), partial(step_size_array, q, None))

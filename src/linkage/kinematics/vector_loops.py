@@ -27,6 +27,12 @@ class LoopPlan:
     n: int
     loops: tuple[tuple[tuple[Any, Any] | Term, ...], ...]
 
+    @property
+    def driver_angle(self) -> bool:
+        """Whether a term's angle is the driver itself (no offset): where the cosine and sine
+        of the driver values are worth taking once for several readers (``driver_trig``)."""
+        return any(len(t) == 6 and t[4] == DRIVER and t[5] == 0.0 for loop in self.loops for t in loop)
+
     @classmethod
     def of(cls, model: LoopModel) -> LoopPlan:
         loops = []
@@ -56,14 +62,17 @@ class VectorLoops:
     (column by column): strided access into (N, m, n) arrays costs several times more.
     """
 
-    def __init__(self, model: LoopModel | LoopPlan, drv: np.ndarray) -> None:
+    def __init__(self, model: LoopModel | LoopPlan, drv: np.ndarray,
+                 driver_trig: tuple[np.ndarray, np.ndarray] | None = None) -> None:
         """The loops of ``model`` at the driver values ``drv``; a :class:`LoopPlan` of it
-        (kept by a caller that sweeps the same model again) gives the same loops."""
+        (kept by a caller that sweeps the same model again) gives the same loops.
+        ``driver_trig``: np.cos and np.sin of ``drv``, where the caller took them for its
+        own use too; taken here when not given."""
         plan = model if isinstance(model, LoopPlan) else LoopPlan.of(model)
         terms = [[t if len(t) == 2 else (t[0], drv if t[2] == DRIVER else t[1], t[2] if t[2] >= 0 else -1,
                                          drv if t[4] == DRIVER else t[3], t[4] if t[4] >= 0 else -1, t[5])
                   for t in loop] for loop in plan.loops]
-        self.setup(terms, plan.n, len(drv))
+        self.setup(terms, plan.n, len(drv), None if driver_trig is None else (drv, *driver_trig))
 
     @classmethod
     def of_terms(cls, terms: Sequence[Sequence[Term]], n: int, size: int) -> VectorLoops:
@@ -74,9 +83,11 @@ class VectorLoops:
         self.setup(terms, n, size)
         return self
 
-    def setup(self, terms: Sequence[Sequence[tuple[Any, Any] | Term]], n: int, size: int) -> None:
+    def setup(self, terms: Sequence[Sequence[tuple[Any, Any] | Term]], n: int, size: int,
+              given: tuple[Any, Any, Any] | None = None) -> None:
         """``terms``: each loop's terms (:data:`Term`, no DRIVER index left), or for a term
-        with nothing unknown its x and y already (:class:`LoopPlan`)."""
+        with nothing unknown its x and y already (:class:`LoopPlan`). ``given``: (an angle
+        array, its cosine, its sine) for a term at that angle with no offset."""
         self.n = n
         self.m = 2 * len(terms)
         # Terms whose length and angle are both known do not change while iterating:
@@ -90,8 +101,14 @@ class VectorLoops:
                     x, y = term
                 elif term[2] < 0 and term[4] < 0:
                     sign, r, _, th, _, off = term
-                    tt = th + off
-                    x, y = sign * r * np.cos(tt), sign * r * np.sin(tt)
+                    if given is not None and th is given[0] and off == 0.0:
+                        # cos(th + 0) is cos(th); sin differs only in the sign of a zero,
+                        # which a sum begun from 0.0 does not keep: the same fixed sums
+                        c, s = given[1], given[2]
+                    else:
+                        tt = th + off
+                        c, s = np.cos(tt), np.sin(tt)
+                    x, y = sign * r * c, sign * r * s
                 else:
                     self.moving.append((li, *term))  # type: ignore[arg-type]
                     continue

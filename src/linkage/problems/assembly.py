@@ -85,8 +85,9 @@ def descending_np(p: Any, q: Any, s: Any) -> tuple[Any, Any, Any]:
     """The three largest first, as ``sorted((p, q, s), reverse=True)`` orders each position,
     by comparisons alone (the same values as a sort, for a fraction of a stacked sort's
     time, and scalars stay scalars: two link lengths order once, not once per position).
-    With a NaN among them the smallest is NaN (``np.minimum`` propagates it), which is all
-    :func:`triangle_np` reads of such a position: its gap is NaN, so ``ok`` is False."""
+    With a NaN among them all three are NaN (``np.minimum`` and ``np.maximum`` propagate
+    it): :func:`triangle_np`'s gap is NaN there, so ``ok`` is False, and the two-circle
+    margin (:func:`~.dyads.two_angles_margin_np`, the other reader) is NaN."""
     import numpy as np
 
     lo, hi = np.minimum(p, q), np.maximum(p, q)

@@ -42,6 +42,7 @@ from .steps import (
     is_open,
     is_open_np,
     solve_step,
+    solve_step_margin_np,
     solve_step_np,
     step_margin,
     step_margin_np,
@@ -180,17 +181,19 @@ class Derivation(NamedTuple):
                 out.append(abs(step_margin(step.case, first, second, k)) <= TANGENT_SLACK)
         return tuple(out)
 
-    def two_way_coefficients_np(self, q: Sequence[Any], driver: Any,
-                                params: Mapping[str, Any] | None = None) -> list[Any]:
+    def two_way_coefficients_np(self, q: Sequence[Any], driver: Any, params: Mapping[str, Any] | None = None,
+                                driver_trig: tuple[Any, Any] | None = None) -> list[Any]:
         """Each two-way step's (first, second, K) over arrays at a configuration: what
         :meth:`meets_np`, :meth:`signs_of_np` and :meth:`words_of_np` read, computed once
-        where one caller asks for several (``coefs``)."""
+        where one caller asks for several (``coefs``). ``driver_trig`` as for
+        :meth:`solve_margins_np`."""
         import numpy as np
 
         p = self._params(params)
         d = np.asarray(driver, float)
+        xp: Any = np if driver_trig is None else GivenTrig(d, *driver_trig)
         with np.errstate(invalid="ignore", divide="ignore"):
-            return [coefficients(step, p, d, q, np) for step in self.steps if step.two_way]
+            return [coefficients(step, p, d, q, xp) for step in self.steps if step.two_way]
 
     def meets_np(self, q: Sequence[Any], driver: Any, params: Mapping[str, Any] | None = None,
                  coefs: list[Any] | None = None) -> list[Any]:
@@ -218,13 +221,15 @@ class Derivation(NamedTuple):
         return all((w in ("open", "+")) == wanted or m for w, wanted, m in zip(words, want.words, meets))
 
     def on_branch_np(self, q: Sequence[Any], driver: Any, want: BranchText,
-                     params: Mapping[str, Any] | None = None) -> Any:
+                     params: Mapping[str, Any] | None = None,
+                     driver_trig: tuple[Any, Any] | None = None) -> Any:
         """:meth:`on_branch` over arrays. A step's meeting is read only where its sign or
         word is not the one wanted (where every position has them, not at all: a sweep on
-        its branch pays nothing for the rule), with the same verdict as reading it everywhere."""
+        its branch pays nothing for the rule), with the same verdict as reading it everywhere.
+        ``driver_trig`` as for :meth:`solve_margins_np` (read with signs wanted)."""
         import numpy as np
 
-        coefs = None if want.signs is None else self.two_way_coefficients_np(q, driver, params)
+        coefs = None if want.signs is None else self.two_way_coefficients_np(q, driver, params, driver_trig)
         with np.errstate(invalid="ignore"):
             if want.signs is not None:
                 sides = self.signs_of_np(q, driver, params, coefs)
@@ -273,26 +278,34 @@ class Derivation(NamedTuple):
         q, ok, _ = self.solve_margins_np(driver, signs, params)
         return q, ok
 
-    def solve_margins_np(self, driver: Any, signs: Sequence[float],
-                         params: Mapping[str, Any] | None = None) -> tuple[list[Any], Any, list[Any]]:
+    def solve_margins_np(self, driver: Any, signs: Sequence[float], params: Mapping[str, Any] | None = None,
+                         driver_trig: tuple[Any, Any] | None = None) -> tuple[list[Any], Any, list[Any]]:
         """:meth:`solve_np` and :meth:`margins_np` in one pass (a sweep needs both):
-        (unknowns, ok, margins)."""
+        (unknowns, ok, margins). ``driver_trig``: np.cos and np.sin of ``driver`` (an angle,
+        a float array), where the caller takes them for its own use too (the closed-form
+        sweep's loop equations); taken here when not given."""
         import numpy as np
 
         p = self._params(params)
         d = np.asarray(driver, float)
+        xp: Any = np if driver_trig is None else GivenTrig(d, *driver_trig)
         q: list[Any] = [None] * self.n
-        shape = np.broadcast_shapes(d.shape, *(np.shape(v) for v in p.values()))
+        # a float parameter broadcasts to anything: only arrays (a scan's designs) are
+        # asked (np.broadcast_shapes costs microseconds a call, a sweep's every call)
+        shapes = [np.shape(v) for v in p.values() if v.__class__ is not float]
+        shape = np.broadcast_shapes(d.shape, *shapes) if shapes else d.shape
         ok: Any = None
         out = []
         signs_left = iter(signs)
         with np.errstate(invalid="ignore", divide="ignore"):
             for step in self.steps:
                 sigma = next(signs_left) if step.two_way else 0.0
-                first, second, k = coefficients(step, p, d, q, np)
+                first, second, k = coefficients(step, p, d, q, xp)
                 if step.two_way:
-                    out.append(step_margin_np(step.case, first, second, k))
-                a, b, fine = solve_step_np(step.case, first, second, k, sigma)
+                    a, b, fine, margin = solve_step_margin_np(step.case, first, second, k, sigma)
+                    out.append(margin)
+                else:
+                    a, b, fine = solve_step_np(step.case, first, second, k, sigma)
                 ok = fine if ok is None else ok & fine
                 q[step.unknowns[0]], q[step.unknowns[1]] = a, b
         if ok is None or np.shape(ok) != shape:
@@ -445,6 +458,32 @@ class Derivation(NamedTuple):
         where = ", ".join(named) or "none: it cannot be assembled there"
         raise ValueError(f"no {text!r} assembly here (assemblies: {where}; or their signs, one + "
                          f"or - per closed-form step with two roots, e.g. {'+' * count})")
+
+
+class GivenTrig:
+    """numpy as :func:`~.steps.coefficients` reads it (``xp``), with the cosine and sine of
+    one array as a caller already took them (np.cos and np.sin of that very array: the
+    same bits); np.cos and np.sin of anything else."""
+
+    __slots__ = ("c", "of", "s")
+
+    def __init__(self, of: Any, c: Any, s: Any) -> None:
+        self.of, self.c, self.s = of, c, s
+
+    def cos(self, t: Any) -> Any:
+        import numpy as np
+
+        return self.c if t is self.of else np.cos(t)
+
+    def sin(self, t: Any) -> Any:
+        import numpy as np
+
+        return self.s if t is self.of else np.sin(t)
+
+    def __getattr__(self, name: str) -> Any:
+        import numpy as np
+
+        return getattr(np, name)
 
 
 def _side_np(step: Step, coefs: Any, q: Sequence[Any]) -> Any:

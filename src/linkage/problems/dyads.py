@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from .assembly import TANGENT_SLACK, triangle, triangle_np
+from .assembly import TANGENT_SLACK, descending_np, triangle, triangle_np
 
 Pair = tuple[float, float]
 
@@ -86,13 +86,19 @@ def two_angles(p: Pair, q: Pair, k: Pair, sigma: float) -> tuple[float, float] |
     return math.atan2(ey, ex), math.atan2(fy, fx)
 
 
+def two_angles_norms_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any]) -> tuple[Any, Any, Any]:
+    """(|K|, |P|, |Q|) over arrays: the three distances of the two-circle case, which its
+    solution and its margin both read (computed once where a caller wants both)."""
+    return norm_np(k[0], k[1]), norm_np(p[0], p[1]), norm_np(q[0], q[1])
+
+
 def two_angles_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any],
-                  sigma: float) -> tuple[Any, Any, Any]:
-    """:func:`two_angles` over arrays: (a, b, ok); NaN where ``ok`` is False."""
+                  sigma: float, norms: tuple[Any, Any, Any] | None = None) -> tuple[Any, Any, Any]:
+    """:func:`two_angles` over arrays: (a, b, ok); NaN where ``ok`` is False. ``norms``:
+    :func:`two_angles_norms_np` of the same p, q, k, where the caller has them."""
     import numpy as np
 
-    d = norm_np(k[0], k[1])
-    rp, rq = norm_np(p[0], p[1]), norm_np(q[0], q[1])
+    d, rp, rq = two_angles_norms_np(p, q, k) if norms is None else norms
     a, h, ok = triangle_np(d, rp, rq)
     with np.errstate(invalid="ignore", divide="ignore"):  # K = 0: a and b are inf
         b = ((rq - rp) * (rq + rp) + d * d) / (2.0 * d)
@@ -120,24 +126,27 @@ def two_angles_side_np(p: tuple[Any, Any], k: tuple[Any, Any], alpha: Any) -> An
 
 def two_angles_margin(p: Pair, q: Pair, k: Pair) -> float:
     """How far the two circles are from parting, relative to the largest distance:
-    min of the triangle's three slacks (negative: they miss)."""
-    d = norm(k[0], k[1])
-    x, y, z = sorted((d, norm(*p), norm(*q)), reverse=True)
+    min of the triangle's three slacks (negative: they miss); 0 where all three distances
+    are 0, NaN where one is NaN (an unknown the step reads was not solved: no margin)."""
+    d, rp, rq = norm(k[0], k[1]), norm(*p), norm(*q)
+    if math.isnan(d + rp + rq):  # (sorted() puts a NaN anywhere: decided before it)
+        return math.nan
+    x, y, z = sorted((d, rp, rq), reverse=True)
     return (z - (x - y)) / x if x > 0.0 else 0.0
 
 
-def two_angles_margin_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any]) -> Any:
+def two_angles_margin_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any],
+                         norms: tuple[Any, Any, Any] | None = None) -> Any:
+    """:func:`two_angles_margin` over arrays, its three distances ordered by the circle
+    intersection's own rule (:func:`~.assembly.descending_np`: a NaN among them makes all
+    three NaN, so the margin is NaN there, as the scalar rule gives). ``norms`` as for
+    :func:`two_angles_np`."""
     import numpy as np
 
-    d, rp, rq = norm_np(k[0], k[1]), norm_np(p[0], p[1]), norm_np(q[0], q[1])
-    # the sorted three by comparisons (no arithmetic: the values np.sort gives, for a third
-    # of its time on a million positions); with a NaN as np.sort orders it (last): x the
-    # largest of the rest (fmax), z NaN, so the margin NaN unless x is not positive
-    lo, hi = np.minimum(d, rp), np.fmax(d, rp)
-    x, z = np.fmax(hi, rq), np.minimum(lo, rq)
-    y = np.maximum(lo, np.minimum(hi, rq))
+    x, y, z = descending_np(*(two_angles_norms_np(p, q, k) if norms is None else norms))
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(x > 0.0, (z - (x - y)) / x, 0.0)
+        # x >= 0 or NaN: "!= 0" is the scalar's "> 0" and lets the NaN through
+        return np.where(x != 0.0, (z - (x - y)) / x, 0.0)
 
 
 # --- a line and a circle ---------------------------------------------------------------------

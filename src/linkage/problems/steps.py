@@ -199,6 +199,17 @@ def solve_step_np(case: str, first: Any, second: Any, k: Any, sigma: float) -> t
     return dyads.two_lengths_np(first, second, k)
 
 
+def solve_step_margin_np(case: str, first: Any, second: Any, k: Any,
+                         sigma: float) -> tuple[Any, Any, Any, Any]:
+    """:func:`solve_step_np` and :func:`step_margin_np` of one step in one pass: (a, b, ok,
+    margin), the two-circle case's three distances computed once for both."""
+    if case == TWO_ANGLES:
+        norms = dyads.two_angles_norms_np(first, second, k)
+        return (*dyads.two_angles_np(first, second, k, sigma, norms),
+                dyads.two_angles_margin_np(first, second, k, norms))
+    return (*solve_step_np(case, first, second, k, sigma), step_margin_np(case, first, second, k))
+
+
 def step_side(case: str, first: Any, second: Any, k: Any, a: float, b: float) -> float:
     if case == TWO_ANGLES:
         return dyads.two_angles_side(first, k, a)
