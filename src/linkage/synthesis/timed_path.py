@@ -57,7 +57,8 @@ class TimedSolutions:
     crank_deg: tuple[float, ...]
     """The prescribed crank angles (deg; only their differences count)."""
     cranks: Burmester
-    """The crank problem's Burmester account: its pairs are the crank dyads."""
+    """The crank problem's Burmester account: its pairs are the crank dyads (its poses, and
+    the rocker problems', are the points less their mean: :func:`timed_four_bars`)."""
     rockers: tuple[Burmester | None, ...]
     """Each crank dyad's rocker problem; None where its coupler does not turn (no rocker
     problem: the coupler translates and its pins move on congruent curves)."""
@@ -108,8 +109,10 @@ def free_choices(count: int) -> str:
 
 def check_timed_points(points: Any) -> tuple[tuple[complex, ...], tuple[float, ...]]:
     """Five points (x, y, crank angle in deg), finite, distinct, the crank turning, as the
-    points and the crank angles: every misuse an InputError naming it (arguments.check_number,
-    the one rule for numbers)."""
+    points and the crank angles reduced modulo 360 deg (exactly, by fmod: only the angles
+    modulo a turn count, and a large angle's conversion to radians would round by its size
+    times 1e-16): every misuse an InputError naming it (arguments.check_number, the one rule
+    for numbers)."""
     from ..arguments import check_number
 
     if isinstance(points, (str, bytes)) or not isinstance(points, Sequence):
@@ -129,7 +132,7 @@ def check_timed_points(points: Any) -> tuple[tuple[complex, ...], tuple[float, .
         x, y, a = (check_number(f"points[{k}]", v) for v in p)
         if not all(abs(v) < 1e12 for v in (x, y, a)):
             raise InputError(f"points[{k}] must be finite numbers below 1e12 in size, got {p!r}")
-        out.append((complex(x, y), a))
+        out.append((complex(x, y), math.fmod(a, 360.0)))  # exact: radians(1e11) would round by 1e-7 rad
     pts, angles = tuple(p for p, _ in out), tuple(a for _, a in out)
     size = max(abs(p - pts[0]) for p in pts)
     for i in range(TIMED_POINTS):
@@ -149,9 +152,12 @@ def check_timed_points(points: Any) -> tuple[tuple[complex, ...], tuple[float, .
 def timed_four_bars(points: Any, seed: int = 0) -> TimedSolutions:
     """Every four-bar through five timed points (module docstring): Burmester's problem for
     the crank dyads, then for each one's rocker dyads."""
-    p, angles = check_timed_points(points)
-    centre = sum(p) / len(p)
-    size = max(abs(q - centre) for q in p)
+    given, angles = check_timed_points(points)
+    # solved about the points' centre (the problem is the same when translated): far from
+    # the origin, p + r z - G would cancel its digits and a root fail Burmester's rigidity test
+    centre = sum(given) / len(given)
+    p = tuple(q - centre for q in given)
+    size = max(abs(q) for q in p)
     cranks = burmester([(q.real, q.imag, a - angles[0]) for q, a in zip(p, angles)], seed)
     rockers: list[Burmester | None] = []
     four_bars: list[TimedFourBar] = []
@@ -170,8 +176,9 @@ def timed_four_bars(points: Any, seed: int = 0) -> TimedSolutions:
         if itself is None or gaps[itself] > SAME_DYAD * size:
             unmatched += 1  # a root of the rocker problem is missing: say so, keep every pair
             itself = None
-        four_bars += [four_bar(i, k, c, r, p, alpha) for k, r in enumerate(problem.cranks) if k != itself]
-    return TimedSolutions(p, angles, cranks, tuple(rockers), tuple(four_bars), unmatched)
+        four_bars += [moved(four_bar(i, k, c, r, p, alpha), centre)
+                      for k, r in enumerate(problem.cranks) if k != itself]
+    return TimedSolutions(given, angles, cranks, tuple(rockers), tuple(four_bars), unmatched)
 
 
 RETRIES = 3
@@ -221,3 +228,9 @@ def four_bar(i: int, k: int, crank: Crank, rocker: Crank, points: list[complex],
         configurations.append((cmath.phase(m - A), cmath.phase(n - m), cmath.phase(n - B)))
     M1, N1 = points[0] - Z, complex(*rocker.first)
     return TimedFourBar(i, k, (A, B, M1, N1), tuple(configurations))
+
+
+def moved(fb: TimedFourBar, by: complex) -> TimedFourBar:
+    """The four-bar translated by ``by`` (its angles unchanged)."""
+    return TimedFourBar(fb.crank, fb.rocker, tuple(v + by for v in fb.pivots),  # type: ignore[arg-type]
+                        fb.configurations)
