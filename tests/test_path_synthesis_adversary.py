@@ -77,3 +77,49 @@ def test_timed_points_at_micrometre_and_kilometre_scale_find_every_four_bar(scal
     count, miss = _all_through([(x * scale, y * scale, a) for x, y, a in POINTS])
     assert count == 12
     assert miss < 1e-12
+
+
+def test_the_alpha_line_says_all_distinct_only_when_every_listed_root_is_certified() -> None:
+    """Found: the report said "all distinct" when no pair of the *certified* roots was left
+    undistinguished, also when some roots were not certified at all (no ball to compare:
+    nothing is known of their distinctness). The point of a real root moved by a tenth of
+    its size is not certified, and the line now says so."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from linkage.homotopy.alpha import certify, undistinguished
+    from linkage.homotopy.polynomials import PolySystem
+    from linkage.render.path_synthesis import certified_line
+
+    # x^2 + y^2 = 4, x y = 1: four real roots (+-(a, b), +-(b, a)), a, b = (sqrt 6 +- sqrt 2) / 2
+    system = PolySystem(2, ({(2, 0): 1.0, (0, 2): 1.0, (0, 0): -4.0}, {(1, 1): 1.0, (0, 0): -1.0}))
+    a, b = (6 ** 0.5 + 2 ** 0.5) / 2, (6 ** 0.5 - 2 ** 0.5) / 2
+    points = [np.array([a, b]), np.array([b, a]), np.array([-a, -b]), np.array([-b, -a]) * 1.1]
+    certs = tuple(certify(system, x) for x in points)
+    assert [c.certified and c.real for c in certs] == [True, True, True, False]
+    line = certified_line(SimpleNamespace(certificates=(certs, undistinguished(points, certs))))
+    assert line.endswith("3 of the 4 real four-bars certified real, the certified ones distinct")
+
+
+def test_a_certified_real_point_is_certified_real() -> None:
+    """Found: a real point (its own conjugate) of a real system with 0.03 <= alpha < 0.158
+    was certified but not certified real: the realness test asked alpha < 0.03 for the
+    point's conjugate to share its root, which it is. Newton's iterates from a real point
+    are real, so its root is; checked here against Newton's limit at 50 digits."""
+    import mpmath
+    import numpy as np
+
+    from linkage.homotopy.alpha import certify
+    from linkage.homotopy.polynomials import PolySystem
+
+    system = PolySystem(2, ({(2, 0): 1.0, (0, 2): 1.0, (0, 0): -4.0}, {(1, 1): 1.0, (0, 0): -1.0}))
+    a, b = (6 ** 0.5 + 2 ** 0.5) / 2, (6 ** 0.5 - 2 ** 0.5) / 2
+    x = np.array([-b, -a]) * 1.01
+    c = certify(system, x)
+    assert 0.03 < c.alpha < 0.15 and c.certified and c.real
+    with mpmath.workdps(50):
+        root = mpmath.findroot([lambda u, v: u * u + v * v - 4, lambda u, v: u * v - 1], (x[0], x[1]))
+        assert mpmath.norm(root - mpmath.matrix([-mpmath.sqrt(6) / 2 + mpmath.sqrt(2) / 2,
+                                                 -mpmath.sqrt(6) / 2 - mpmath.sqrt(2) / 2])) < 1e-40
+        assert mpmath.norm(root - mpmath.matrix(list(x))) <= c.radius
