@@ -123,3 +123,56 @@ def test_a_certified_real_point_is_certified_real() -> None:
         assert mpmath.norm(root - mpmath.matrix([-mpmath.sqrt(6) / 2 + mpmath.sqrt(2) / 2,
                                                  -mpmath.sqrt(6) / 2 - mpmath.sqrt(2) / 2])) < 1e-40
         assert mpmath.norm(root - mpmath.matrix(list(x))) <= c.radius
+
+
+def _point_args(points) -> list[str]:  # type: ignore[no-untyped-def]
+    return [f"--point={x!r},{y!r},{a!r}" for x, y, a in points]
+
+
+def test_the_written_range_follows_the_crank_round_when_the_angles_wrap(cli, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """Found: crank angles 300, 340, 20, 60, 100 (the example's, 280 deg on) wrote a driver
+    range from the first point back through 100 - 300 = -200 deg, so a sweep over it met
+    points 1 and 5 only. The turn is now the way round that meets the points in order in
+    under a turn (+160 deg: timed_path.prescribed_turn), and a sweep over the written range
+    in steps of 40 deg puts P on every point."""
+    import csv
+    import io
+
+    wrapped = [(x, y, (a + 280.0) % 360.0) for x, y, a in POINTS]
+    design = tmp_path / "wrapped.toml"
+    out = cli("synthesize", "--path", *_point_args(wrapped), "-o", str(design))
+    assert out.code == 0 and design.exists()
+    swept = cli("sweep", str(design), "--step", "40", "-f", "csv")
+    assert swept.code == 0
+    rows = [r for r in csv.DictReader(io.StringIO(swept.out)) if r["status"] == "converged"]
+    assert len(rows) == 5
+    reached = [complex(float(r["P.x (m)"]), float(r["P.y (m)"])) for r in rows]
+    for x, y, _ in POINTS:
+        assert min(abs(p - complex(x, y)) for p in reached) <= 1e-9 * 3
+
+
+@pytest.mark.parametrize("extra", [["--design", "0", "-o", "x.toml"], ["--design", "-3"], ["--design", "2"]])
+@pytest.mark.parametrize("timed", [True, False])
+def test_a_design_number_out_of_range_or_without_a_file_is_refused_before_solving(cli, tmp_path, extra,  # type: ignore[no-untyped-def]
+                                                                                   timed) -> None:
+    """Found: --design -3 (or any K) without -o FILE.toml was silently ignored (exit 0), and
+    --design 0 -o FILE.toml was refused only after the solve (half a minute for untimed
+    points). Now one line and exit 2 before any work."""
+    import os
+
+    points = _point_args(POINTS) if timed else [f"--point={x!r},{y!r}" for x, y, _ in POINTS]
+    here = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        out = cli("synthesize", "--path", *points, *extra)
+    finally:
+        os.chdir(here)
+    assert out.code == 2 and out.out == ""
+    assert out.err.count("\n") == 1 and "--design" in out.err
+    assert not (tmp_path / "x.toml").exists()
+
+
+def test_a_timed_point_out_of_range_is_named_as_its_option(cli) -> None:  # type: ignore[no-untyped-def]
+    """Found: --point X,Y,1e300 was refused as "points[4] must be ...", the API's name."""
+    out = cli("synthesize", "--path", *_point_args(POINTS[:4]), "--point=-1.3129,2.2146,1e300")
+    assert out.code == 2 and out.err.startswith("error: --point 5 must be finite numbers below 1e12")

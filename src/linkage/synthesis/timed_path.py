@@ -24,6 +24,7 @@ four-bars. Five timed points leave no free choice; four leave one free number fo
 from __future__ import annotations
 
 import cmath
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -147,6 +148,16 @@ def check_timed_points(points: Any) -> tuple[tuple[complex, ...], tuple[float, .
                 raise InputError(f"points {j + 1} and {i + 1} have the same crank angle (mod 360 deg): the "
                                  "crank, the input, cannot put the coupler point in two places at one angle")
     return pts, angles
+
+
+def prescribed_turn(crank_deg: Sequence[float]) -> float:
+    """The crank's turn (deg) from the first point to the last, meeting the others in their
+    order: the way round (forward or back) on which that is less than a turn (only the
+    angles modulo a turn count, so 300, 340, 20, 60, 100 is a turn of +160, not 100 - 300);
+    forward, more than a turn, when neither is."""
+    forward = sum((b - a) % 360.0 for a, b in itertools.pairwise(crank_deg))
+    backward = forward - 360.0 * (len(crank_deg) - 1)
+    return backward if forward >= 360.0 and backward > -360.0 else forward
 
 
 def timed_four_bars(points: Any, seed: int = 0) -> TimedSolutions:
