@@ -176,3 +176,35 @@ def test_a_timed_point_out_of_range_is_named_as_its_option(cli) -> None:  # type
     """Found: --point X,Y,1e300 was refused as "points[4] must be ...", the API's name."""
     out = cli("synthesize", "--path", *_point_args(POINTS[:4]), "--point=-1.3129,2.2146,1e300")
     assert out.code == 2 and out.err.startswith("error: --point 5 must be finite numbers below 1e12")
+
+
+def test_a_numpy_array_of_timed_points_is_the_timed_problem() -> None:
+    """Found: linkage.synthesize_path(np.array(five (x, y, deg) rows)) was taken for five
+    untimed points (a numpy array is not a Sequence), its angles dropped without a word, and
+    a full nine-point solve run instead. Now the timed problem, as for lists."""
+    import numpy as np
+
+    import linkage
+
+    result = linkage.synthesize_path(np.array(POINTS))
+    assert type(result).__name__ == "TimedPathSynthesis" and len(result.designs) == 12
+    assert max(_miss(fb, POINTS) for fb in result.designs) < 1e-12
+
+
+@pytest.mark.parametrize("call, points, said", [
+    ("search_path", [p for p in POINTS], "points[0] must be a pair of numbers (x, y), got 3 of them"),
+    ("synthesize_path", [(*p, 0.0) for p in POINTS], "points[0] must be a pair of numbers (x, y), got 4"),
+    ("synthesize_path", [(str(x), str(y)) for x, y, _ in POINTS], "points[0] must be a number, got '0.1579'"),
+])
+def test_rows_that_are_not_pairs_of_numbers_are_refused_not_read_as_their_first_two(  # type: ignore[no-untyped-def]
+        call, points, said) -> None:
+    """Found: search_path with timed points ran an untimed search (the angles dropped), rows of
+    four numbers were read as their first two (and refused as "coincide"), and text "0.1579"
+    was taken for a number, where every other API refuses it (arguments.check_number)."""
+    import re
+
+    import linkage
+    from linkage.errors import InputError
+
+    with pytest.raises(InputError, match=re.escape(said)):
+        getattr(linkage, call)(points)

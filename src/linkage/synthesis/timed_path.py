@@ -92,8 +92,19 @@ def missing_roots(problem: Burmester) -> int:
     return min(short, problem.failed + problem.unresolved)
 
 
+def as_rows(points: Any) -> Any:
+    """A numpy array of points, and numpy rows, as lists (the checks below read sequences);
+    anything else as it is."""
+    if hasattr(points, "tolist") and hasattr(points, "ndim"):
+        return points.tolist()
+    if isinstance(points, Sequence) and not isinstance(points, (str, bytes)):
+        return [p.tolist() if hasattr(p, "tolist") and hasattr(p, "ndim") else p for p in points]
+    return points
+
+
 def is_timed(points: Any) -> bool:
     """Whether some point carries a third number (a crank angle): the timed problem."""
+    points = as_rows(points)
     if isinstance(points, (str, bytes)) or not isinstance(points, Sequence):
         return False
     return any(isinstance(p, Sequence) and not isinstance(p, (str, bytes)) and len(p) == 3 for p in points)
@@ -116,6 +127,7 @@ def check_timed_points(points: Any) -> tuple[tuple[complex, ...], tuple[float, .
     for numbers)."""
     from ..arguments import check_number
 
+    points = as_rows(points)
     if isinstance(points, (str, bytes)) or not isinstance(points, Sequence):
         raise InputError(f"points must be a list of (x, y, crank angle in deg), got {points!r}")
     shapes = {len(p) if isinstance(p, Sequence) and not isinstance(p, (str, bytes)) else 0 for p in points}
