@@ -208,3 +208,13 @@ def test_rows_that_are_not_pairs_of_numbers_are_refused_not_read_as_their_first_
 
     with pytest.raises(InputError, match=re.escape(said)):
         getattr(linkage, call)(points)
+
+
+def test_timed_points_spanning_1e_minus_300_are_refused_in_the_points_terms() -> None:
+    """Found: points at 1e-300 of the example's size were refused by the engine's loader, "<path
+    synthesis>: parameters.r1.value: a length must be ...", naming a file the user never gave."""
+    import linkage
+    from linkage.errors import InputError
+
+    with pytest.raises(InputError, match=r"^points: they span .* below 1e-80"):
+        linkage.synthesize_path([(x * 1e-300, y * 1e-300, a) for x, y, a in POINTS])

@@ -36,6 +36,9 @@ from .burmester import Burmester, Crank, burmester_points
 
 TIMED_POINTS = 5
 """A four-bar's crank dyad meets at most five points with prescribed crank angles."""
+SMALLEST = 1e-80
+"""Points spanning less are refused: the four-bars' lengths would fall below the engine's
+least length (1e-100), which judges them."""
 SAME_DYAD = 1e-7
 """A rocker problem's pair within this (of the points' size) of the crank dyad's pivots is
 the crank dyad itself."""
@@ -148,6 +151,8 @@ def check_timed_points(points: Any) -> tuple[tuple[complex, ...], tuple[float, .
         out.append((complex(x, y), math.fmod(a, 360.0)))  # exact: radians(1e11) would round by 1e-7 rad
     pts, angles = tuple(p for p, _ in out), tuple(a for _, a in out)
     size = max(abs(p - pts[0]) for p in pts)
+    if 0.0 < size < SMALLEST:  # the engine that judges the designs takes lengths from 1e-100
+        raise InputError(f"points: they span {size:g}, below {SMALLEST:g}: give them in a smaller unit")
     for i in range(TIMED_POINTS):
         for j in range(i):
             if abs(pts[i] - pts[j]) <= 1e-9 * size:
