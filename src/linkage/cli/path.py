@@ -34,8 +34,9 @@ def path_command(point: list[str], via: list[str], *, search: bool, samples: Opt
     from ..synthesis.path import check_points, synthesize_path
     from ..synthesis.path_points import check_via
     from .path_search import as_options
-    from .timed_path import is_timed, timed_path_command
+    from .timed_path import check_design, is_timed, timed_path_command
 
+    check_design(design, write_file)  # before the solve, not after it
     if is_timed(point):  # X,Y,DEG: prescribed timing, five points
         return timed_path_command(point, via, search=search, samples=samples, seed=seed, design=design,
                                   output=output, write_file=write_file, force=force, fmt=fmt,

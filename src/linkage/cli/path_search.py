@@ -20,7 +20,9 @@ def path_search_command(pairs: list[tuple[float, float]], samples: Optional[int]
     from ..render.path_search import path_search_report
     from ..synthesis.path_search import search_path
     from .progress import progress_bar
+    from .timed_path import check_design
 
+    check_design(design, write_file)
     try:
         with progress_bar(PATHS * (samples or 1), minimum=0, label="tracking paths") as advance:
             result = search_path(pairs, samples, progress=advance, **options)

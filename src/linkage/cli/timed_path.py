@@ -30,6 +30,26 @@ def read_timed_points(point: list[str]) -> list[tuple[float, ...]]:
     return out
 
 
+def check_design(design: Optional[int], write_file: bool) -> None:
+    """--design K, checked before any work: a whole number from 1, and only with -o FILE.toml
+    (it picks the design written; without a file it would be silently ignored)."""
+    from ..arguments import check_whole
+
+    if design is None:
+        return
+    check_whole("--design", design, 1)
+    if not write_file:
+        raise InputError(f"--design {design} picks the design -o FILE.toml writes: give -o FILE.toml")
+
+
+def api_names(message: str) -> str:
+    """An API message with its names as the command's: points[k] is --point k + 1."""
+    import re
+
+    message = message.replace("min_transmission", "--min-transmission")
+    return re.sub(r"\bpoints\[(\d+)\]", lambda m: f"--point {int(m.group(1)) + 1}", message)
+
+
 def timed_path_command(point: list[str], via: list[str], *, search: bool, samples: Optional[int], seed: int,
                        design: Optional[int], output: Optional[Path], write_file: bool, force: bool, fmt: str,
                        report_out: Optional[Path], digits: int, table: Optional[str],
@@ -37,6 +57,7 @@ def timed_path_command(point: list[str], via: list[str], *, search: bool, sample
     from ..render import writers
     from ..render.path_synthesis import timed_path_report, timed_ranked
     from ..synthesis.path import mechanism_text, synthesize_timed_path
+    from ..synthesis.timed_path import prescribed_turn
 
     untimed = (("--via", via or None), ("--search", search or None), ("--samples", samples),
                ("--scheduler", scheduler), ("--workers", workers))
@@ -44,10 +65,11 @@ def timed_path_command(point: list[str], via: list[str], *, search: bool, sample
         if given is not None:
             raise InputError(f"{option} is for untimed points (X,Y): five timed points are two Burmester "
                              "problems, solved here")
+    check_design(design, write_file)
     try:
         result = synthesize_timed_path(read_timed_points(point), seed=seed, min_transmission=min_transmission)
     except InputError as exc:  # the API's argument names, as the command's options
-        raise InputError(str(exc).replace("min_transmission", "--min-transmission")) from None
+        raise InputError(api_names(str(exc))) from None
     writers.write(timed_path_report(result, digits), fmt, report_out, table=table)
     order = timed_ranked(result)  # cognate groups
     clean = [g for g in order if not result.designs[result.groups[g][0]].defects]
@@ -64,7 +86,7 @@ def timed_path_command(point: list[str], via: list[str], *, search: bool, sample
 
             fb = result.designs[result.groups[chosen][0]]
             # its driver's range: from the first point through the prescribed turn
-            turn = result.crank_deg[-1] - result.crank_deg[0]
+            turn = prescribed_turn(result.crank_deg)
             text = mechanism_text(fb, "four-bar through five timed points",
                                   (fb.crank_deg[0], fb.crank_deg[0] + turn))
             write_mechanism(output, text, force, said=" (its coupler point P passes through the points at "

@@ -18,7 +18,9 @@ system f and a point x where Df(x) is invertible:
   solutions with one associated root (Hauenstein and Sottile, sec. 2.2). A real structure
   R (here R(x) = conj(x[conjugate]), :attr:`PolySystem.conjugate`) with f(R(x)) = A conj(f(x))
   for a constant invertible A maps Newton's iterates to Newton's iterates, so the root of
-  R(x) is R(xi); with y = R(x) the root is its own image: real. If instead
+  R(x) is R(xi); with y = R(x) the root is its own image: real. A point that is its own
+  image, x = R(x) exactly, needs only alpha < alpha_0: its iterates are their own images,
+  and so is their limit. If instead
   ||x - R(x)|| > 4 beta, the root is not real (a real xi would be within 2 beta of both x
   and R(x)).
 
@@ -272,7 +274,8 @@ def verdict(found: tuple[mpmath.mpf, mpmath.mpf, mpmath.mpf] | None, u: np.ndarr
         with mpmath.workdps(DIGITS):
             U = [mpmath.mpc(complex(v)) for v in u]
             gap = mpmath.sqrt(sum(abs(U[m] - mpmath.conj(U[v])) ** 2 for v, m in enumerate(mirror)))
-            real = alpha * (1 + SAFETY) < ALPHA_SAME and gap * (1 + SAFETY) * 20 * gamma < 1
+            # a point its own image has Newton iterates their own images: its root is real
+            real = gap == 0 or (alpha * (1 + SAFETY) < ALPHA_SAME and gap * (1 + SAFETY) * 20 * gamma < 1)
             not_real = gap > 4 * beta * (1 + SAFETY)
     radius = float(2 * beta * largest * (1 + SAFETY)) if certified else math.inf
     return Certificate(float(alpha), float(beta), float(gamma), bool(certified), bool(real), bool(not_real),

@@ -93,7 +93,18 @@ def certified_line(s: Any) -> str:
     real = sum(c.real for _, c in pairs)
     return (f"alpha test (Smale; 50 digits): {len(pairs)} of {finite} nonsingular root"
             f"{'s' if finite != 1 else ''} certified, {real} of them real"
-            + (", all distinct" if not apart else f", {len(apart)} pair(s) not told apart"))
+            + distinct_text(len(apart), len(pairs), finite))
+
+
+def distinct_text(apart: int, certified: int, listed: int) -> str:
+    """What the alpha test says of distinctness, ``apart`` pairs of the ``certified`` points
+    not told apart (linkage.homotopy.alpha.undistinguished): "all distinct" only when every
+    one of the ``listed`` points is certified (an uncertified one has no ball to compare)."""
+    if apart:
+        return f", {apart} pair(s) not told apart"
+    if certified == listed:
+        return ", all distinct"
+    return ", the certified ones distinct" if certified > 1 else ""
 
 
 def _bound_text(s: Any, lengths: bool) -> str:

@@ -92,10 +92,12 @@ def certified_line(result: Any) -> str:
     """The alpha test's verdict on the real four-bars (``result.certificates``,
     :func:`linkage.synthesis.path.real_certificates`): how many are certified real, and
     whether all are told apart."""
+    from .assemblies import distinct_text
+
     certs, apart = result.certificates
     return (f"alpha test (Smale; 50 digits): {sum(c.certified and c.real for c in certs)} of the "
             f"{len(certs)} real four-bars certified real"
-            + (", all distinct" if not apart else f", {len(apart)} pair(s) not told apart"))
+            + distinct_text(len(apart), sum(c.certified for c in certs), len(certs)))
 
 
 def summary_lines(result: Any) -> list[str]:

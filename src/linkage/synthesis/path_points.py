@@ -21,7 +21,6 @@ across it by a seeded random offset.
 from __future__ import annotations
 
 import itertools
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,14 +41,24 @@ FARTHEST = 1e150
 
 
 def as_points(name: str, points: object) -> list[complex]:
-    """Pairs (x, y) of finite numbers as complex numbers x + iy, or InputError naming ``name``."""
+    """Pairs (x, y) of finite numbers (arguments.check_number, the one rule for numbers) as
+    complex numbers x + iy, or InputError naming ``name``: a row of three numbers is refused,
+    not read as its first two (a crank angle would be dropped without a word)."""
+    from ..arguments import check_number
+
     try:
-        pts = [complex(float(p[0]), float(p[1])) for p in points]  # type: ignore[attr-defined, index]
-    except (TypeError, ValueError, IndexError):
-        raise InputError(f"{name} must be pairs of numbers (x, y)") from None
-    if not all(math.isfinite(p.real) and math.isfinite(p.imag) for p in pts):
-        raise InputError(f"{name} must be finite numbers")
-    return pts
+        rows = [list(p) for p in points]  # type: ignore[union-attr]
+    except TypeError:
+        rows = None
+    if rows is None or isinstance(points, (str, bytes)):
+        raise InputError(f"{name} must be pairs of numbers (x, y)")
+    for k, row in enumerate(rows):
+        if len(row) != 2:
+            raise InputError(f"{name}[{k}] must be a pair of numbers (x, y), got {len(row)} of them"
+                             + (" (with a crank angle, every point is timed: give five, to synthesize_path)"
+                                if len(row) == 3 and name == "points" else ""))
+    return [complex(check_number(f"{name}[{k}]", x), check_number(f"{name}[{k}]", y))
+            for k, (x, y) in enumerate(rows)]
 
 
 def check_distinct(name: str, pts: list[complex], labels: list[str]) -> None:

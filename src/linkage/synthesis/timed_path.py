@@ -24,6 +24,7 @@ four-bars. Five timed points leave no free choice; four leave one free number fo
 from __future__ import annotations
 
 import cmath
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -35,6 +36,9 @@ from .burmester import Burmester, Crank, burmester_points
 
 TIMED_POINTS = 5
 """A four-bar's crank dyad meets at most five points with prescribed crank angles."""
+SMALLEST = 1e-80
+"""Points spanning less are refused: the four-bars' lengths would fall below the engine's
+least length (1e-100), which judges them."""
 SAME_DYAD = 1e-7
 """A rocker problem's pair within this (of the points' size) of the crank dyad's pivots is
 the crank dyad itself."""
@@ -57,7 +61,8 @@ class TimedSolutions:
     crank_deg: tuple[float, ...]
     """The prescribed crank angles (deg; only their differences count)."""
     cranks: Burmester
-    """The crank problem's Burmester account: its pairs are the crank dyads."""
+    """The crank problem's Burmester account: its pairs are the crank dyads (its poses, and
+    the rocker problems', are the points less their mean: :func:`timed_four_bars`)."""
     rockers: tuple[Burmester | None, ...]
     """Each crank dyad's rocker problem; None where its coupler does not turn (no rocker
     problem: the coupler translates and its pins move on congruent curves)."""
@@ -90,8 +95,19 @@ def missing_roots(problem: Burmester) -> int:
     return min(short, problem.failed + problem.unresolved)
 
 
+def as_rows(points: Any) -> Any:
+    """A numpy array of points, and numpy rows, as lists (the checks below read sequences);
+    anything else as it is."""
+    if hasattr(points, "tolist") and hasattr(points, "ndim"):
+        return points.tolist()
+    if isinstance(points, Sequence) and not isinstance(points, (str, bytes)):
+        return [p.tolist() if hasattr(p, "tolist") and hasattr(p, "ndim") else p for p in points]
+    return points
+
+
 def is_timed(points: Any) -> bool:
     """Whether some point carries a third number (a crank angle): the timed problem."""
+    points = as_rows(points)
     if isinstance(points, (str, bytes)) or not isinstance(points, Sequence):
         return False
     return any(isinstance(p, Sequence) and not isinstance(p, (str, bytes)) and len(p) == 3 for p in points)
@@ -108,10 +124,13 @@ def free_choices(count: int) -> str:
 
 def check_timed_points(points: Any) -> tuple[tuple[complex, ...], tuple[float, ...]]:
     """Five points (x, y, crank angle in deg), finite, distinct, the crank turning, as the
-    points and the crank angles: every misuse an InputError naming it (arguments.check_number,
-    the one rule for numbers)."""
+    points and the crank angles reduced modulo 360 deg (exactly, by fmod: only the angles
+    modulo a turn count, and a large angle's conversion to radians would round by its size
+    times 1e-16): every misuse an InputError naming it (arguments.check_number, the one rule
+    for numbers)."""
     from ..arguments import check_number
 
+    points = as_rows(points)
     if isinstance(points, (str, bytes)) or not isinstance(points, Sequence):
         raise InputError(f"points must be a list of (x, y, crank angle in deg), got {points!r}")
     shapes = {len(p) if isinstance(p, Sequence) and not isinstance(p, (str, bytes)) else 0 for p in points}
@@ -129,9 +148,11 @@ def check_timed_points(points: Any) -> tuple[tuple[complex, ...], tuple[float, .
         x, y, a = (check_number(f"points[{k}]", v) for v in p)
         if not all(abs(v) < 1e12 for v in (x, y, a)):
             raise InputError(f"points[{k}] must be finite numbers below 1e12 in size, got {p!r}")
-        out.append((complex(x, y), a))
+        out.append((complex(x, y), math.fmod(a, 360.0)))  # exact: radians(1e11) would round by 1e-7 rad
     pts, angles = tuple(p for p, _ in out), tuple(a for _, a in out)
     size = max(abs(p - pts[0]) for p in pts)
+    if 0.0 < size < SMALLEST:  # the engine that judges the designs takes lengths from 1e-100
+        raise InputError(f"points: they span {size:g}, below {SMALLEST:g}: give them in a smaller unit")
     for i in range(TIMED_POINTS):
         for j in range(i):
             if abs(pts[i] - pts[j]) <= 1e-9 * size:
@@ -146,12 +167,25 @@ def check_timed_points(points: Any) -> tuple[tuple[complex, ...], tuple[float, .
     return pts, angles
 
 
+def prescribed_turn(crank_deg: Sequence[float]) -> float:
+    """The crank's turn (deg) from the first point to the last, meeting the others in their
+    order: the way round (forward or back) on which that is less than a turn (only the
+    angles modulo a turn count, so 300, 340, 20, 60, 100 is a turn of +160, not 100 - 300);
+    forward, more than a turn, when neither is."""
+    forward = sum((b - a) % 360.0 for a, b in itertools.pairwise(crank_deg))
+    backward = forward - 360.0 * (len(crank_deg) - 1)
+    return backward if forward >= 360.0 and backward > -360.0 else forward
+
+
 def timed_four_bars(points: Any, seed: int = 0) -> TimedSolutions:
     """Every four-bar through five timed points (module docstring): Burmester's problem for
     the crank dyads, then for each one's rocker dyads."""
-    p, angles = check_timed_points(points)
-    centre = sum(p) / len(p)
-    size = max(abs(q - centre) for q in p)
+    given, angles = check_timed_points(points)
+    # solved about the points' centre (the problem is the same when translated): far from
+    # the origin, p + r z - G would cancel its digits and a root fail Burmester's rigidity test
+    centre = sum(given) / len(given)
+    p = tuple(q - centre for q in given)
+    size = max(abs(q) for q in p)
     cranks = burmester([(q.real, q.imag, a - angles[0]) for q, a in zip(p, angles)], seed)
     rockers: list[Burmester | None] = []
     four_bars: list[TimedFourBar] = []
@@ -170,8 +204,9 @@ def timed_four_bars(points: Any, seed: int = 0) -> TimedSolutions:
         if itself is None or gaps[itself] > SAME_DYAD * size:
             unmatched += 1  # a root of the rocker problem is missing: say so, keep every pair
             itself = None
-        four_bars += [four_bar(i, k, c, r, p, alpha) for k, r in enumerate(problem.cranks) if k != itself]
-    return TimedSolutions(p, angles, cranks, tuple(rockers), tuple(four_bars), unmatched)
+        four_bars += [moved(four_bar(i, k, c, r, p, alpha), centre)
+                      for k, r in enumerate(problem.cranks) if k != itself]
+    return TimedSolutions(given, angles, cranks, tuple(rockers), tuple(four_bars), unmatched)
 
 
 RETRIES = 3
@@ -221,3 +256,9 @@ def four_bar(i: int, k: int, crank: Crank, rocker: Crank, points: list[complex],
         configurations.append((cmath.phase(m - A), cmath.phase(n - m), cmath.phase(n - B)))
     M1, N1 = points[0] - Z, complex(*rocker.first)
     return TimedFourBar(i, k, (A, B, M1, N1), tuple(configurations))
+
+
+def moved(fb: TimedFourBar, by: complex) -> TimedFourBar:
+    """The four-bar translated by ``by`` (its angles unchanged)."""
+    return TimedFourBar(fb.crank, fb.rocker, tuple(v + by for v in fb.pivots),  # type: ignore[arg-type]
+                        fb.configurations)
