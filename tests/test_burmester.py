@@ -13,6 +13,7 @@ from __future__ import annotations
 import itertools
 import math
 import random
+from pathlib import Path
 
 import mpmath
 import numpy as np
@@ -20,6 +21,8 @@ import pytest
 
 from linkage.errors import InputError
 from linkage.synthesis.burmester import Pose, burmester_points
+
+ROOT = Path(__file__).resolve().parents[1]
 
 mpmath.mp.dps = 50
 
@@ -220,3 +223,20 @@ def test_a_pose_object_and_a_tuple_are_the_same():
     a = burmester_points(poses)
     b = burmester_points([Pose(*p) for p in poses])
     assert [c.ground for c in a.cranks] == [c.ground for c in b.cranks]
+
+
+@pytest.mark.parametrize("offset", [1e5, 1e6])
+def test_poses_far_from_the_origin_keep_every_crank(offset):
+    """The adversary's finding: docs/motion_poses.txt moved by 1e5 lost all 4 cranks as
+    'unresolved' (their rigidity judged in absolute coordinates, where 1e5 sizes away leaves
+    no digits). Judged about the poses' centre, the same 4 cranks come back, shifted."""
+    base = [tuple(float(v) for v in line.split(","))
+            for line in (ROOT / "docs" / "motion_poses.txt").read_text().splitlines()
+            if line.strip() and not line.startswith("#")]
+    near = burmester_points(base)
+    far = burmester_points([(x + offset, y - offset, a) for x, y, a in base])
+    assert far.unresolved == 0 and len(far.cranks) == len(near.cranks) == 4
+    for a, b in zip(sorted(near.cranks, key=lambda c: c.ground), sorted(far.cranks, key=lambda c: c.ground)):
+        assert abs(b.ground[0] - offset - a.ground[0]) <= 1e-6  # mm, the poses spread over about 10
+        assert abs(b.ground[1] + offset - a.ground[1]) <= 1e-6
+        assert abs(b.length - a.length) <= 1e-6

@@ -162,14 +162,18 @@ def burmester_points(poses: Sequence[Pose | Sequence[float]], seed: int = 0) -> 
             continue
         x, _ = polish_real(system, e.x.real)
         gx, gy, zx, zy = x
-        G = complex(gx, gy) * size + centre
+        # the crank's rigidity is judged about the poses' centre, where the system is posed:
+        # in absolute coordinates poses far from the origin (1e4 sizes away) lose its digits
+        g = complex(gx, gy) * size
         z = complex(zx, zy) * size  # body frame: the first pose's frame, scaled back
         moving = []
         for p in ps:
             r = complex(math.cos(radians(p.angle_deg)), math.sin(radians(p.angle_deg)))
-            moving.append(complex(p.x, p.y) + r * z)
-        lengths = [abs(m - G) for m in moving]
+            moving.append(complex(p.x, p.y) - centre + r * z)
+        lengths = [abs(m - g) for m in moving]
         residual = max(abs(v - lengths[0]) for v in lengths) / size
+        G = g + centre
+        moving[0] += centre
         if not residual <= RIGID:
             unresolved += 1
             continue
