@@ -28,8 +28,12 @@ def test_dash_h_is_help(cli):
 def test_completion_is_offered_and_works():
     help_text = subprocess.run([*LINKAGE, "--help"], capture_output=True, text=True, timeout=60).stdout
     assert "--install-completion" in help_text and "--show-completion" in help_text
+    # typer reads --show-completion as a flag and detects the shell from the parent
+    # processes, so the test failed when pytest ran without a shell above it (orphaned by
+    # `(pytest &)`); with detection off it takes the shell named, as a user's script does
     p = subprocess.run([*LINKAGE, "--show-completion", "bash"], capture_output=True, text=True, timeout=60,
-                       env={"PATH": "/usr/bin:/bin", "HOME": "/tmp"})
+                       env={"PATH": "/usr/bin:/bin", "HOME": "/tmp",
+                            "_TYPER_COMPLETE_TEST_DISABLE_SHELL_DETECTION": "1"})
     assert p.returncode == 0 and "complete" in p.stdout and "_linkage_completion" in p.stdout
 
 
