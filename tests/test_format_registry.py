@@ -109,29 +109,3 @@ def test_a_format_whose_package_is_missing_or_broken_is_refused_in_one_line(monk
     assert not (tmp_path / "t.gone").exists()
 
 
-def test_the_prefetch_thread_warms_the_sink_once_its_modules_are_imported(monkeypatch, tmp_path):
-    """writers.prefetch imports a format's modules beside the command's computing, then runs
-    the sink's warm-up there (pyarrow's first-block set-up, Sink.warm), so that the first
-    block written finds it done; a module that fails to import skips the warm-up quietly."""
-    (tmp_path / "linkage_test_warm").mkdir()
-    (tmp_path / "linkage_test_warm" / "__init__.py").write_text("LOADED = True\n")
-    monkeypatch.syspath_prepend(str(tmp_path))
-    warmed: list[tuple[bool, int | None]] = []
-
-    class WarmSink(ProbeSink):
-        @classmethod
-        def warm(cls, rows):
-            import sys
-
-            warmed.append(("linkage_test_warm" in sys.modules, rows))
-
-    monkeypatch.setitem(formats.FORMATS, "warm", formats.Format(
-        "warm", (".warm",), WarmSink, needs=("linkage_test_warm", "pip install it")))
-    writers.prefetch("warm", 12)
-    writers.wait_for_prefetch()
-    assert warmed == [(True, 12)]
-    monkeypatch.setitem(formats.FORMATS, "warm", formats.Format(
-        "warm", (".warm",), WarmSink, needs=("linkage_test_no_such_package", "pip install it")))
-    writers.prefetch("warm", 12)
-    writers.wait_for_prefetch()
-    assert warmed == [(True, 12)]

@@ -121,7 +121,7 @@ def prefetch(fmt: str, rows: int | None = None) -> None:
     if names and sink is not None:
         import threading
 
-        thread = threading.Thread(target=import_quietly, args=(names, lambda: sink.warm(rows)),
+        thread = threading.Thread(target=import_quietly, args=(names,),
                                   name="linkage-prefetch")
         _prefetching.append(thread)
         thread.start()
