@@ -99,7 +99,7 @@ def solve_general(F: Any, x0: Any, *, jac: Any, method: str, tol: float, rtol: f
                   show_jacobian: bool) -> Result:
     """:func:`solve_system` by the general path, every argument checked; a TypeError or
     IndexError from F or jac is named (:func:`~linkage.solve.diagnose.names_bad_callables`)."""
-    NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system = _system_solvers()
+    NewtonSystem, max_abs, newton_system, SystemProblem, generic_system = _system_solvers()
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r} for a system; choose from {', '.join(SYSTEM_METHODS)}")
     crit = check_criteria(tol, rtol, ftol, max_iter)
@@ -119,7 +119,7 @@ def solve_general(F: Any, x0: Any, *, jac: Any, method: str, tol: float, rtol: f
     gate = residual_gate(crit.ftol if crit.ftol is not None else crit.tol, problem.length_scale)
     rows = None
     if method == "newton" and kind == "analytic" and not record:
-        q, phi, err, status, detail, iterations, nfev, njev = newton_system_lean(
+        q, phi, err, status, detail, iterations, nfev, njev = newton_system.newton_system_lean(
             problem, q0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
         x, stopped = tuple(q), status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN)
         residual = max_abs(phi)
@@ -216,11 +216,13 @@ def packaged(m: Any, problem: Any, crit: Criteria, gate: float, outcome: tuple[A
 @functools.lru_cache(maxsize=1)
 def _system_solvers() -> tuple[Any, ...]:
     """The system solvers, imported on the first system solve (never by a scalar one;
-    Levenberg-Marquardt only when asked for)."""
-    from ..methods.newton_system import NewtonSystem, max_abs, newton_system_lean
+    Levenberg-Marquardt only when asked for; the lean loop read from its module where
+    it runs, compiled on its first use)."""
+    from ..methods import newton_system
+    from ..methods.newton_system import NewtonSystem, max_abs
     from ..problems.system import SystemProblem, generic_system
 
-    return NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system
+    return NewtonSystem, max_abs, newton_system, SystemProblem, generic_system
 
 
 @functools.lru_cache(maxsize=1)
