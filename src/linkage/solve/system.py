@@ -71,8 +71,8 @@ _recent = RecentCriteria()
 def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float | None, max_iter: int,
                 damped: bool) -> Result | None:
     """Newton with recording off by a short front door, where one applies: user callables
-    of two unknowns from a finite tuple start (judged and packaged here, a call less on a 6 us
-    solve), or a compiled problem of two unknowns that converges
+    of two unknowns from a start of two finite floats, a tuple or a list (judged and packaged
+    here, a call less on a 6 us solve), or a compiled problem of two unknowns that converges
     (:func:`_mechanism_two`); the same Result as the general path (tests/test_compile.py).
     None for anything else, and where a user function returned the wrong kind of value:
     the general path then runs and names it."""
@@ -82,12 +82,23 @@ def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float 
     else:
         crit = _recent.check(tol, rtol, ftol, max_iter)
     try:
-        if (jac is not None and type(x0) is tuple and len(x0) == 2 and type(x0[0]) is float
-                and type(x0[1]) is float and x0[0] - x0[0] == 0.0 and x0[1] - x0[1] == 0.0 and callable(F)):
+        if (jac is not None and (type(x0) is tuple or type(x0) is list) and len(x0) == 2
+                and type(x0[0]) is float and type(x0[1]) is float and x0[0] - x0[0] == 0.0
+                and x0[1] - x0[1] == 0.0 and callable(F)):
             newton_2x2, max_abs, _, (names, kinds, _), _ = _two_loaded or _two_unknowns()
-            phi0, gate, problem = _two_start(F, jac, x0, crit)
+            try:
+                phi0 = F(list(x0))
+            except (ArithmeticError, ValueError) as exc:
+                raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
+            real_vector("F", phi0, 2, "at x0")
+            if len(phi0) != 2:
+                raise InputError(f"the system has {len(phi0)} equations for 2 unknowns")
+            last = _last_two
+            problem = last[2] if last[0] is F and last[1] is jac else user_two_problem(F, jac)
+            c_tol, c_rtol, c_ftol, c_max = crit
+            gate = c_ftol if c_ftol is not None else c_tol
             q, phi, err, status, detail, iterations, nfev, njev = newton_2x2(
-                problem, x0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
+                problem, x0, phi0, c_tol, c_rtol, gate, c_max, damped)
             residual = max_abs(phi)
             status, detail = system_verdict(status, detail, residual, gate)
             return Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, njev,
@@ -279,31 +290,18 @@ def _two_unknown_result(problem: Any, q0: tuple[float, ...], phi0: Any, crit: Cr
 
 
 _last_two: tuple[Any, Any, Any] = (None, None, None)
-"""The user functions (F, jac) :func:`_two_start` last solved, with their problem: solving
+"""The user functions (F, jac) :func:`fast_newton` last solved, with their problem: solving
 the same functions again (from another start, at other tolerances) builds none."""
 
 
-def _two_start(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float, float],
-               crit: Criteria) -> tuple[Any, float, Any]:
-    """For ``newton`` on user callables of two unknowns (:func:`fast_newton`): Phi(x0)
-    checked as the general path checks it, the residual gate, and the problem (none built
-    unless a step is refused; the same functions solved again reuse the last one)."""
-    try:
-        phi0 = F(list(x0))
-    except (ArithmeticError, ValueError) as exc:
-        raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
-    real_vector("F", phi0, 2, "at x0")
-    if len(phi0) != 2:
-        raise InputError(f"the system has {len(phi0)} equations for 2 unknowns")
+def user_two_problem(F: Callable[..., Any], jac: Callable[..., Any]) -> Any:
+    """The problem :func:`fast_newton` hands user callables of two unknowns to: none built
+    unless a step is refused; kept, so the same functions solved again reuse it."""
     global _last_two
-    last = _last_two
-    if last[0] is F and last[1] is jac:
-        problem = last[2]
-    else:
-        LeanProblem, generic_system = _two_loaded[2], _two_loaded[4]
-        problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
-        _last_two = (F, jac, problem)
-    return phi0, crit.ftol if crit.ftol is not None else crit.tol, problem
+    _, _, LeanProblem, _, generic_system = _two_loaded
+    problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
+    _last_two = (F, jac, problem)
+    return problem
 
 
 def user_two_meta(crit: Criteria, gate: float, names: tuple[str, ...],
