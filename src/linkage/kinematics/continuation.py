@@ -27,7 +27,8 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from ..linalg import SingularMatrix, det_from_lu, lu, lu_solve, lu_two
-from ..methods.newton_system import max_abs, newton_system_lean
+from ..methods import newton_system
+from ..methods.newton_system import max_abs
 from ..methods.newton_two import newton_two_of
 from ..problems.derive import parse_signs, read_branch
 from ..problems.loops import ANGLE_UNITS, Mechanism
@@ -102,7 +103,8 @@ class Solver:
         except (ArithmeticError, ValueError):
             return None
         light = LeanProblem(F, J, self.step_scales, lambda: self.problem(value))
-        q, phi, _err, status, _detail, iterations, _nfev, _njev = newton_system_lean(
+        # read from the module: the loop is compiled on its first use, not at import
+        q, phi, _err, status, _detail, iterations, _nfev, _njev = newton_system.newton_system_lean(
             light, tuple(guess), phi0, self.tol, 0.0, self.gate, self.max_iter, damped)
         status, _ = system_verdict(status, "", max_abs(phi), self.gate)
         return (J, q, iterations) if status.converged else None

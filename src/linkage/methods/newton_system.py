@@ -44,6 +44,14 @@ def max_abs(v: Any) -> float:
     return m
 
 
+def larger_of(u: str, v: str) -> str:
+    """Source of max(u, v) for two magnitudes named ``u`` and ``v`` (each >= 0 or NaN), NaN
+    (``_nan``) if either is NaN, as :func:`max_abs` of two values: ``u`` when ``u >= v``,
+    else ``v`` when ``v >= u``, else one is NaN. Two comparisons at most, where testing
+    both for NaN first takes four (the generated 2x2 loops write it three times a step)."""
+    return f"({u} if {u} >= {v} else {v} if {v} >= {u} else _nan)"
+
+
 def fd_jacobian(problem: SystemProblem, q: list[float], phi: list[float],
                 h: float | None) -> list[list[float]]:
     """Forward differences, one coordinate at a time; columns as in the course notes
@@ -370,7 +378,7 @@ NEWTON_SYSTEM_LOOP = Loop(
         if n == 2:
             p0, p1 = phi
             a0, a1 = abs(p0), abs(p1)
-            fx = (a0 if a0 >= a1 else a1) if a0 == a0 and a1 == a1 else _nan
+            fx = """ + larger_of("a0", "a1") + """
             (a, b), (c, d) = jac
             det = a * d - b * c
             if _invertible(det, abs(a * d) + abs(b * c)):
@@ -396,7 +404,7 @@ NEWTON_SYSTEM_LOOP = Loop(
     after="""\
         if scales is None and n == 2:
             e0, e1 = abs(step[0]), abs(step[1])
-            err = (e0 if e0 >= e1 else e1) if e0 == e0 and e1 == e1 else _nan
+            err = """ + larger_of("e0", "e1") + """
         else:
             err = _step_size(step, scales)
         q, phi = trial, phi_t
@@ -421,7 +429,7 @@ NEWTON_2X2_LOOP = Loop(
         nfev, njev = 1, 0
         err = fx = _inf
         a0, a1 = abs(x0), abs(x1)
-        runaway = _RUNAWAY * (1.0 + (_nan if a0 != a0 or a1 != a1 else (a0 if a0 >= a1 else a1)))
+        runaway = _RUNAWAY * (1.0 + """ + larger_of("a0", "a1") + """)
         shrink = 1.0 - 1e-4
         tiny = 64.0 * _EPS
         """,
@@ -431,7 +439,7 @@ NEWTON_2X2_LOOP = Loop(
         # |v| written "v if v > 0.0 else 0.0 - v": the same bits as abs (-0.0 included), no call
         a0 = p0 if p0 > 0.0 else 0.0 - p0
         a1 = p1 if p1 > 0.0 else 0.0 - p1
-        fx = (a0 if a0 >= a1 else a1) if a0 == a0 and a1 == a1 else _nan
+        fx = """ + larger_of("a0", "a1") + """
         ad = a * d
         bc = b * c
         det = ad - bc
@@ -446,9 +454,9 @@ NEWTON_2X2_LOOP = Loop(
                 st = f0 * f0 + f1 * f1
                 if not st <= shrink * ss:
                     e0, e1 = abs(d0), abs(d1)
-                    step_size = _nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
+                    step_size = """ + larger_of("e0", "e1") + """
                     e0, e1 = abs(x0), abs(x1)
-                    q_size = _nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
+                    q_size = """ + larger_of("e0", "e1") + """
                     if not step_size <= tiny * (1.0 + q_size):
                         refused = True  # the whole step does not lower |Phi|: the method decides
                         nfev -= 1
@@ -462,12 +470,12 @@ st = f0 * f0 + f1 * f1
     after="""\
         e0 = d0 if d0 > 0.0 else 0.0 - d0
         e1 = d1 if d1 > 0.0 else 0.0 - d1
-        err = (e0 if e0 >= e1 else e1) if e0 == e0 and e1 == e1 else _nan
+        err = """ + larger_of("e0", "e1") + """
         x0, x1, p0, p1 = t0, t1, f0, f1
         ss = st  # the new phi's sum of squares, as the step computed it (read only when damped)
         e0 = x0 if x0 > 0.0 else 0.0 - x0
         e1 = x1 if x1 > 0.0 else 0.0 - x1
-        size_q = _nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
+        size_q = """ + larger_of("e0", "e1") + """
         """,
     result="[x0, x1], [p0, p1], err, status, detail, k, nfev, njev",
     residual_test=False, step_test="system", diverge="runaway", diverge_when="not damped",
@@ -479,5 +487,19 @@ scalars: the same operations in the same order, so the same iterates, status and
 _LOOP_NAMES = {"_NewtonSystem": NewtonSystem, "_State": NewtonSystemState, "_max_abs": max_abs,
                "_direction": newton_direction, "_sumsq": _sumsq, "_EPS": EPS, "_invertible": invertible,
                "_step_size": step_measure}
-newton_2x2 = build_loop(NEWTON_2X2_LOOP, _LOOP_NAMES)
-newton_system_lean = build_loop(NEWTON_SYSTEM_LOOP, {**_LOOP_NAMES, "_newton_2x2": newton_2x2})
+
+
+def __getattr__(name: str) -> Any:
+    """``newton_2x2`` and ``newton_system_lean``, compiled on their first use (PEP 562), not
+    at import: a cold start that solves no system does not pay about 2.7 ms for them. Each
+    is compiled once and kept as the module's attribute (a race compiles the same source
+    twice: either result is the same function)."""
+    if name == "newton_2x2":
+        loop = build_loop(NEWTON_2X2_LOOP, _LOOP_NAMES)
+    elif name == "newton_system_lean":
+        two = globals().get("newton_2x2") or __getattr__("newton_2x2")
+        loop = build_loop(NEWTON_SYSTEM_LOOP, {**_LOOP_NAMES, "_newton_2x2": two})
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = loop
+    return loop

@@ -23,6 +23,7 @@ from typing import Any
 from ..codegen import Terms, model_pieces
 from ..iterate import Loop, build_loop
 from ..rules import invertible
+from .newton_system import larger_of
 
 
 def _at(text: str) -> str:
@@ -42,12 +43,12 @@ def newton_two_loop(terms: Terms, n: int) -> Loop:
 err = fx = _inf
 a0 = x0 if x0 >= 0.0 else -x0
 a1 = x1 if x1 >= 0.0 else -x1
-runaway = _RUNAWAY * (1.0 + (_nan if a0 != a0 or a1 != a1 else (a0 if a0 >= a1 else a1)))
+runaway = _RUNAWAY * (1.0 + """ + larger_of("a0", "a1") + """)
 """,
         step="""\
 a0 = p0 if p0 >= 0.0 else -p0
 a1 = p1 if p1 >= 0.0 else -p1
-fx = (a0 if a0 >= a1 else a1) if a0 == a0 and a1 == a1 else _nan
+fx = """ + larger_of("a0", "a1") + """
 ad = j00 * j11
 bc = j01 * j10
 det = ad - bc
@@ -61,10 +62,10 @@ x1 = x1 + h1
         after="""\
 e0 = h0 if h0 >= 0.0 else -h0
 e1 = h1 if h1 >= 0.0 else -h1
-err = (e0 if e0 >= e1 else e1) if e0 == e0 and e1 == e1 else _nan
+err = """ + larger_of("e0", "e1") + """
 e0 = x0 if x0 >= 0.0 else -x0
 e1 = x1 if x1 >= 0.0 else -x1
-size_q = _nan if e0 != e0 or e1 != e1 else (e0 if e0 >= e1 else e1)
+size_q = """ + larger_of("e0", "e1") + """
 """,
         tail="""\
 if status is _S.MAX_ITER:

@@ -71,19 +71,38 @@ _recent = RecentCriteria()
 def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float | None, max_iter: int,
                 damped: bool) -> Result | None:
     """Newton with recording off by a short front door, where one applies: user callables
-    of two unknowns from a finite tuple start (:func:`_newton_two`), or a compiled problem
-    of two unknowns that converges (:func:`_mechanism_two`); the same Result as the general
-    path (tests/test_compile.py). None for anything else, and where a user function
-    returned the wrong kind of value: the general path then runs and names it."""
+    of two unknowns from a start of two finite floats, a tuple or a list (judged and packaged
+    here, a call less on a 6 us solve), or a compiled problem of two unknowns that converges
+    (:func:`_mechanism_two`); the same Result as the general path (tests/test_compile.py).
+    None for anything else, and where a user function returned the wrong kind of value:
+    the general path then runs and names it."""
     seen = _recent.seen
     if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter:
         crit = seen[4]
     else:
         crit = _recent.check(tol, rtol, ftol, max_iter)
     try:
-        if (jac is not None and type(x0) is tuple and len(x0) == 2 and type(x0[0]) is float
-                and type(x0[1]) is float and x0[0] - x0[0] == 0.0 and x0[1] - x0[1] == 0.0 and callable(F)):
-            return _newton_two(F, jac, x0, crit, damped)
+        if (jac is not None and (type(x0) is tuple or type(x0) is list) and len(x0) == 2
+                and type(x0[0]) is float and type(x0[1]) is float and x0[0] - x0[0] == 0.0
+                and x0[1] - x0[1] == 0.0 and callable(F)):
+            newton_2x2, max_abs, _, (names, kinds, _), _ = _two_loaded or _two_unknowns()
+            try:
+                phi0 = F(list(x0))
+            except (ArithmeticError, ValueError) as exc:
+                raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
+            real_vector("F", phi0, 2, "at x0")
+            if len(phi0) != 2:
+                raise InputError(f"the system has {len(phi0)} equations for 2 unknowns")
+            last = _last_two
+            problem = last[2] if last[0] is F and last[1] is jac else user_two_problem(F, jac)
+            c_tol, c_rtol, c_ftol, c_max = crit
+            gate = c_ftol if c_ftol is not None else c_tol
+            q, phi, err, status, detail, iterations, nfev, njev = newton_2x2(
+                problem, x0, phi0, c_tol, c_rtol, gate, c_max, damped)
+            residual = max_abs(phi)
+            status, detail = system_verdict(status, detail, residual, gate)
+            return Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, njev,
+                               (user_two_meta, crit, gate, names, kinds))
         SystemProblem = _system_solvers()[3]
         if (jac is None and type(F) is SystemProblem and len(F.names) == 2 and F.J is not None
                 and F.step_scales is None):
@@ -99,7 +118,7 @@ def solve_general(F: Any, x0: Any, *, jac: Any, method: str, tol: float, rtol: f
                   show_jacobian: bool) -> Result:
     """:func:`solve_system` by the general path, every argument checked; a TypeError or
     IndexError from F or jac is named (:func:`~linkage.solve.diagnose.names_bad_callables`)."""
-    NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system = _system_solvers()
+    NewtonSystem, max_abs, newton_system, SystemProblem, generic_system = _system_solvers()
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r} for a system; choose from {', '.join(SYSTEM_METHODS)}")
     crit = check_criteria(tol, rtol, ftol, max_iter)
@@ -119,7 +138,7 @@ def solve_general(F: Any, x0: Any, *, jac: Any, method: str, tol: float, rtol: f
     gate = residual_gate(crit.ftol if crit.ftol is not None else crit.tol, problem.length_scale)
     rows = None
     if method == "newton" and kind == "analytic" and not record:
-        q, phi, err, status, detail, iterations, nfev, njev = newton_system_lean(
+        q, phi, err, status, detail, iterations, nfev, njev = newton_system.newton_system_lean(
             problem, q0, phi0, crit.tol, crit.rtol, gate, crit.max_iter, damped)
         x, stopped = tuple(q), status in (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN)
         residual = max_abs(phi)
@@ -216,20 +235,28 @@ def packaged(m: Any, problem: Any, crit: Criteria, gate: float, outcome: tuple[A
 @functools.lru_cache(maxsize=1)
 def _system_solvers() -> tuple[Any, ...]:
     """The system solvers, imported on the first system solve (never by a scalar one;
-    Levenberg-Marquardt only when asked for)."""
-    from ..methods.newton_system import NewtonSystem, max_abs, newton_system_lean
+    Levenberg-Marquardt only when asked for; the lean loop read from its module where
+    it runs, compiled on its first use)."""
+    from ..methods import newton_system
+    from ..methods.newton_system import NewtonSystem, max_abs
     from ..problems.system import SystemProblem, generic_system
 
-    return NewtonSystem, max_abs, newton_system_lean, SystemProblem, generic_system
+    return NewtonSystem, max_abs, newton_system, SystemProblem, generic_system
 
 
-@functools.lru_cache(maxsize=1)
+_two_loaded: tuple[Any, ...] = ()
+"""What :func:`_two_unknowns` loaded, read as a module global on the hot path."""
+
+
 def _two_unknowns() -> tuple[Any, ...]:
-    """What :func:`_newton_two` needs, imported once (a scalar solve never pays for it)."""
-    from ..methods.newton_system import max_abs, newton_2x2
-    from ..problems.system import LeanProblem, generic_labels, generic_system
+    """What :func:`fast_newton` needs, imported once (a scalar solve never pays for it)."""
+    global _two_loaded
+    if not _two_loaded:
+        from ..methods.newton_system import max_abs, newton_2x2
+        from ..problems.system import LeanProblem, generic_labels, generic_system
 
-    return newton_2x2, max_abs, LeanProblem, generic_labels(2), generic_system
+        _two_loaded = (newton_2x2, max_abs, LeanProblem, generic_labels(2), generic_system)
+    return _two_loaded
 
 
 def system_verdict(status: Status, detail: str, residual: float, gate: float,
@@ -239,7 +266,7 @@ def system_verdict(status: Status, detail: str, residual: float, gate: float,
     tolerance is a root to that tolerance (ill-conditioned, so the step test could not
     pass); a converged status with |Phi| above it is not."""
     if residual <= gate:
-        if stopped and status in _STOPPED:
+        if stopped and status in _STOPPED:  # a tuple: found by identity, no Enum hash (about 0.1 us)
             return Status.CONVERGED_RESIDUAL, f"max|Phi| = {residual:.3g} <= {gate:.3g}; {detail}"
         return status, detail
     if status.converged:
@@ -247,7 +274,7 @@ def system_verdict(status: Status, detail: str, residual: float, gate: float,
     return status, detail
 
 
-_STOPPED = frozenset({Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN})
+_STOPPED = (Status.LOCAL_MINIMUM, Status.SINGULAR_JACOBIAN)
 
 
 def _two_unknown_result(problem: Any, q0: tuple[float, ...], phi0: Any, crit: Criteria, gate: float,
@@ -263,33 +290,18 @@ def _two_unknown_result(problem: Any, q0: tuple[float, ...], phi0: Any, crit: Cr
 
 
 _last_two: tuple[Any, Any, Any] = (None, None, None)
-"""The user functions (F, jac) :func:`_newton_two` last solved, with their problem: solving
+"""The user functions (F, jac) :func:`fast_newton` last solved, with their problem: solving
 the same functions again (from another start, at other tolerances) builds none."""
 
 
-def _newton_two(F: Callable[..., Any], jac: Callable[..., Any], x0: tuple[float, float], crit: Criteria,
-                damped: bool) -> Result:
-    """:func:`solve_system` for ``newton`` on user callables of two unknowns, with the
-    general path's checks and packaging, but no problem object unless a step is refused."""
-    loaded = _two_unknowns()
-    _, _, LeanProblem, (names, kinds, _), generic_system = loaded
-    try:
-        phi0 = F(list(x0))
-    except (ArithmeticError, ValueError) as exc:
-        raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
-    real_vector("F", phi0, 2, "at x0")
-    if len(phi0) != 2:
-        raise InputError(f"the system has {len(phi0)} equations for 2 unknowns")
-    gate = crit.ftol if crit.ftol is not None else crit.tol
+def user_two_problem(F: Callable[..., Any], jac: Callable[..., Any]) -> Any:
+    """The problem :func:`fast_newton` hands user callables of two unknowns to: none built
+    unless a step is refused; kept, so the same functions solved again reuse it."""
     global _last_two
-    last = _last_two
-    if last[0] is F and last[1] is jac:
-        problem = last[2]
-    else:
-        problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
-        _last_two = (F, jac, problem)
-    meta = (user_two_meta, crit, gate, names, kinds)
-    return _two_unknown_result(problem, x0, phi0, crit, gate, damped, meta, loaded)
+    _, _, LeanProblem, _, generic_system = _two_loaded
+    problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
+    _last_two = (F, jac, problem)
+    return problem
 
 
 def user_two_meta(crit: Criteria, gate: float, names: tuple[str, ...],
