@@ -21,11 +21,12 @@ from .bodies import Frame, metre
 EPS = sys.float_info.epsilon
 
 
-def body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], acc: Mapping[str, Any]
-                 ) -> dict[str, tuple[Any, Any, Any]]:
+def body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], acc: Mapping[str, Any],
+                turned: Mapping[str, tuple[Any, Any, Any]] | None = None) -> dict[str, tuple[Any, Any, Any]]:
     """Each body's (rotation since the drawing, omega, alpha), arrays over the positions:
     from two of its joints, a one-joint block from the body its line is on; the ground's
-    all zero."""
+    all zero. ``turned``: this function's answer at the same ``pos`` (other rates), whose
+    rotations are taken as they are rather than found again (the same numbers)."""
     import numpy as np
 
     d = frame.drawing
@@ -44,8 +45,12 @@ def body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], ac
         r2 = rx * rx + ry * ry
         dvx, dvy = vel[j1][0] - vel[j0][0], vel[j1][1] - vel[j0][1]
         dax, day = acc[j1][0] - acc[j0][0], acc[j1][1] - acc[j0][1]
-        drawn = math.atan2(d.xy[j1][1] - d.xy[j0][1], d.xy[j1][0] - d.xy[j0][0])
-        out[body] = (np.arctan2(ry, rx) - drawn, (rx * dvy - ry * dvx) / r2, (rx * day - ry * dax) / r2)
+        if turned is None:
+            drawn = math.atan2(d.xy[j1][1] - d.xy[j0][1], d.xy[j1][0] - d.xy[j0][0])
+            rotation = np.arctan2(ry, rx) - drawn
+        else:
+            rotation = turned[body][0]
+        out[body] = (rotation, (rx * dvy - ry * dvx) / r2, (rx * day - ry * dax) / r2)
     for body in pending:
         slide = d.sliders.get(body)
         out[body] = out.get(slide.on, out["ground"]) if slide is not None else out["ground"]
@@ -287,8 +292,9 @@ def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[s
     d = frame.drawing
     n_pos = len(next(iter(pos.values()))[0])
     motion = body_motion(frame, pos, vel, acc)
-    zeros = {j: (np.zeros(n_pos), np.zeros(n_pos)) for j in pos}
-    star = body_motion(frame, pos, vstar, zeros)
+    zero = np.zeros(n_pos)  # read only: the still accelerations of the unit-speed motion
+    zeros = {j: (zero, zero) for j in pos}
+    star = body_motion(frame, pos, vstar, zeros, turned=motion)
     moving = [b for b in d.bodies if b != "ground"]
     row = {b: 3 * i for i, b in enumerate(moving)}
     unknowns = assemble(frame, pos, motion, row)
