@@ -14,7 +14,7 @@ import pytest
 from linkage.kinematics import load_matrix
 from linkage.kinematics.force_sweeps import batch_forces
 from linkage.kinematics.forces import TOGGLE_COND
-from linkage.kinematics.load_matrix import eliminate_np, solve_bounded_np
+from linkage.kinematics.load_matrix import eliminate_np, first_largest, solve_bounded_np
 from linkage.kinematics.loading import load
 from linkage.kinematics.sweep import sweep_mechanism
 from linkage.linalg import cond1, lu, lu_solve
@@ -67,6 +67,18 @@ def test_the_elimination_is_the_scalar_lu_bit_for_bit() -> None:
     for k in range(len(a)):
         packed, _, _ = lu(a[k].tolist())
         assert t[:, :, k].tolist() == [list(row) for row in packed]
+
+
+def test_the_pivot_is_the_scalar_lu_s_first_largest_with_ties_and_nan() -> None:
+    """The pivot rule without argmax (its transposed copy held the GIL): the row
+    ``max(rows, key=abs)`` picks, as linalg.lu does, where values tie in magnitude, where
+    one is NaN, and where all are zero."""
+    rng = np.random.default_rng(5)
+    column = rng.choice([0.0, 1.0, -1.0, 2.0, -2.0, np.nan], size=(6, 4000))
+    for rows in (np.array([0, 1, 2, 3, 4, 5]), np.array([1, 3, 4]), np.array([2, 5])):
+        got = first_largest(column, rows)
+        want = [max(rows.tolist(), key=lambda i: abs(column[i, s])) for s in range(column.shape[1])]
+        assert got.tolist() == want
 
 
 def test_a_scan_inverts_only_the_matrices_the_bound_does_not_pass(monkeypatch) -> None:

@@ -427,7 +427,7 @@ def eliminate_np(t: Any, y: Any) -> None:
         rows = np.flatnonzero(t[k:, k].any(axis=1)) + k
         if rows.size == 0:
             continue  # zero in every system: singular, and nothing to eliminate
-        p = rows[np.abs(t[rows, k]).argmax(axis=0)] if rows.size > 1 else np.full(count, rows[0])
+        p = first_largest(t[:, k], rows)
         chosen = np.bincount(p - k, minlength=n - k)
         for r in np.flatnonzero(chosen[1:]) + 1:
             other = k + r
@@ -448,6 +448,24 @@ def eliminate_np(t: Any, y: Any) -> None:
             np.multiply(mult, t[k, c0:c1], out=keep[0][:c1 - c0])
             t[i, c0:c1] -= keep[0][:c1 - c0]
             y[i] -= mult * y[k]
+
+
+def first_largest(column: Any, rows: Any) -> Any:
+    """Each system's pivot row among ``rows`` of ``column`` (n, N): the first of the largest
+    in magnitude, as ``linalg.lu``'s ``max`` picks it (a later row wins only where it is
+    strictly larger, so a NaN never wins nor loses its place). Row by row, element-wise:
+    an ``argmax`` across rows makes a transposed copy of its rows and runs a short loop
+    per system, about five times the time of this, all of it holding the GIL."""
+    import numpy as np
+
+    p = np.full(column.shape[1], rows[0])
+    best = np.abs(column[rows[0]])
+    for r in rows[1:]:
+        size = np.abs(column[r])
+        larger = size > best
+        np.copyto(p, r, where=larger)
+        np.copyto(best, size, where=larger)
+    return p
 
 
 def inverse_bound_np(lu_abs: Any) -> tuple[Any, Any]:
