@@ -115,6 +115,38 @@ def test_a_scan_inverts_only_the_matrices_the_bound_does_not_pass(monkeypatch) -
     assert near_toggles > 0
 
 
+def test_the_screen_eliminating_in_place_gives_the_numbers_of_a_copy(monkeypatch) -> None:
+    """The screen eliminates in the force matrices themselves and builds those it does not
+    pass anew (load_matrix.force_matrix) for their exact numbers: the same unknowns and
+    condition numbers, bit for bit, as eliminating a copy, near toggles included."""
+    m = load(ROOT / "sample_inputs" / "crank_rocker_joints.toml")
+    loads = Loads({"P": (0.0, -20.0)}, {"rocker": -2.0}, {}, None)
+    values = np.arange(0.0, 360.0, 0.5)
+    real = load_matrix.solve_scaled
+    rebuilt = []
+
+    def both(frame, a, rhs, cols, screen_below=None, again=None):
+        if screen_below is None:  # the sweep's own loads: exact numbers, nothing spent
+            return real(frame, a, rhs, cols, screen_below, again)
+        assert again is not None
+        a0, rhs0 = a.copy(), rhs.copy()
+        x, cond = real(frame, a, rhs, cols, screen_below, again)
+        x0, cond0 = real(frame, a0, rhs0, cols, screen_below)
+        np.testing.assert_array_equal(x.view(np.int64), x0.view(np.int64))
+        np.testing.assert_array_equal(cond.view(np.int64), cond0.view(np.int64))
+        rebuilt.append(int((~(cond < screen_below)).sum()))
+        return x, cond
+
+    monkeypatch.setattr(load_matrix, "solve_scaled", both)
+    for coupler in (60.0, 100.0):
+        mm = m.with_values({"coupler": coupler}, {})
+        r = sweep_mechanism(mm, [float(v) for v in values], loads=loads)
+        q = [np.array([math.radians(p.solution[u.name]) if p.solution else np.nan for p in r.positions])
+             for u in mm.unknowns]
+        batch_forces(mm, q, np.radians(values), loads)
+    assert sum(rebuilt) > 0  # positions the screen did not pass were built again
+
+
 def test_the_bound_is_the_exact_number_for_a_diagonal_matrix_up_to_its_rounding_margin() -> None:
     """Where g is exact (L = I, U diagonal: g = max 1/|d|), the bound is at least the
     condition number the scalar cond1 finds, and more by no more than what it adds: the
