@@ -14,7 +14,7 @@ import pytest
 from linkage.kinematics import load_matrix
 from linkage.kinematics.force_sweeps import batch_forces
 from linkage.kinematics.forces import TOGGLE_COND
-from linkage.kinematics.load_matrix import eliminate_np, solve_bounded_np
+from linkage.kinematics.load_matrix import eliminate_np, first_largest, solve_bounded_np
 from linkage.kinematics.loading import load
 from linkage.kinematics.sweep import sweep_mechanism
 from linkage.linalg import cond1, lu, lu_solve
@@ -69,6 +69,18 @@ def test_the_elimination_is_the_scalar_lu_bit_for_bit() -> None:
         assert t[:, :, k].tolist() == [list(row) for row in packed]
 
 
+def test_the_pivot_is_the_scalar_lu_s_first_largest_with_ties_and_nan() -> None:
+    """The pivot rule without argmax (its transposed copy held the GIL): the row
+    ``max(rows, key=abs)`` picks, as linalg.lu does, where values tie in magnitude, where
+    one is NaN, and where all are zero."""
+    rng = np.random.default_rng(5)
+    column = rng.choice([0.0, 1.0, -1.0, 2.0, -2.0, np.nan], size=(6, 4000))
+    for rows in (np.array([0, 1, 2, 3, 4, 5]), np.array([1, 3, 4]), np.array([2, 5])):
+        got = first_largest(column, rows)
+        want = [max(rows.tolist(), key=lambda i: abs(column[i, s])) for s in range(column.shape[1])]
+        assert got.tolist() == want
+
+
 def test_a_scan_inverts_only_the_matrices_the_bound_does_not_pass(monkeypatch) -> None:
     """Crank-rocker designs whose couplers pass limit positions: the exact condition number
     (one inverse per matrix) only at the positions whose bound reaches TOGGLE_COND (every
@@ -101,6 +113,38 @@ def test_a_scan_inverts_only_the_matrices_the_bound_does_not_pass(monkeypatch) -
             if s_one != "unsolved":
                 assert (s_one == "ok") == (code == 0)
     assert near_toggles > 0
+
+
+def test_the_screen_eliminating_in_place_gives_the_numbers_of_a_copy(monkeypatch) -> None:
+    """The screen eliminates in the force matrices themselves and builds those it does not
+    pass anew (load_matrix.force_matrix) for their exact numbers: the same unknowns and
+    condition numbers, bit for bit, as eliminating a copy, near toggles included."""
+    m = load(ROOT / "sample_inputs" / "crank_rocker_joints.toml")
+    loads = Loads({"P": (0.0, -20.0)}, {"rocker": -2.0}, {}, None)
+    values = np.arange(0.0, 360.0, 0.5)
+    real = load_matrix.solve_scaled
+    rebuilt = []
+
+    def both(frame, a, rhs, cols, screen_below=None, again=None):
+        if screen_below is None:  # the sweep's own loads: exact numbers, nothing spent
+            return real(frame, a, rhs, cols, screen_below, again)
+        assert again is not None
+        a0, rhs0 = a.copy(), rhs.copy()
+        x, cond = real(frame, a, rhs, cols, screen_below, again)
+        x0, cond0 = real(frame, a0, rhs0, cols, screen_below)
+        np.testing.assert_array_equal(x.view(np.int64), x0.view(np.int64))
+        np.testing.assert_array_equal(cond.view(np.int64), cond0.view(np.int64))
+        rebuilt.append(int((~(cond < screen_below)).sum()))
+        return x, cond
+
+    monkeypatch.setattr(load_matrix, "solve_scaled", both)
+    for coupler in (60.0, 100.0):
+        mm = m.with_values({"coupler": coupler}, {})
+        r = sweep_mechanism(mm, [float(v) for v in values], loads=loads)
+        q = [np.array([math.radians(p.solution[u.name]) if p.solution else np.nan for p in r.positions])
+             for u in mm.unknowns]
+        batch_forces(mm, q, np.radians(values), loads)
+    assert sum(rebuilt) > 0  # positions the screen did not pass were built again
 
 
 def test_the_bound_is_the_exact_number_for_a_diagonal_matrix_up_to_its_rounding_margin() -> None:

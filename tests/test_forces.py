@@ -329,3 +329,32 @@ def test_a_sliding_driver_gets_an_input_force(tmp_path) -> None:
                 f = forces_at(m, q, loads, speed=speed, accel=accel, driver=drv)
                 assert f.input_unit == "N" and f.status in ("ok", "near_toggle")
                 _check(m, q, loads, speed, accel, drv)
+
+
+@pytest.mark.parametrize("path", JOINT_SAMPLES, ids=lambda p: p.stem)
+def test_the_unit_speed_motion_takes_the_rotations_found_once(path: Path) -> None:
+    """The matrix method finds each body's rotation once for both of its motions
+    (load_matrix.body_motion's ``turned``): the same numbers as found again."""
+    import numpy as np
+
+    from linkage.kinematics.bodies import Frame
+    from linkage.kinematics.load_matrix import body_motion
+    from linkage.kinematics.placing import place_motion_np
+    from linkage.kinematics.rates import motions_rates_np
+    from linkage.problems.loops import LoopModel
+
+    m = load(path)
+    model = LoopModel.compile(m, {})
+    q = [np.full(3, u.value) for u in m.unknowns]
+    d = np.full(3, m.driver.value)
+    ((qd, qdd),), _ = motions_rates_np(model, q, d, ((1.5, 0.25),))
+    placed = place_motion_np(model, q, d, qd, 1.5, qdd, 0.25)
+    pos, vel, acc = ({j: (v[i].real, v[i].imag) for j, v in placed.items()} for i in range(3))
+    frame = Frame.of(m)
+    first = body_motion(frame, pos, vel, acc)
+    still = {j: (np.zeros(3), np.zeros(3)) for j in pos}
+    again, reused = body_motion(frame, pos, vel, still), body_motion(frame, pos, vel, still, turned=first)
+    assert again.keys() == reused.keys()
+    for b in again:
+        for x, y in zip(again[b], reused[b]):
+            np.testing.assert_array_equal(x, y)

@@ -22,6 +22,18 @@ def test_a_loaded_scan_of_900_designs_is_cut_into_equal_tasks_for_two_workers():
     assert tasks == TASKS_PER_WORKER * 2 and size * tasks - 900 < tasks
 
 
+def test_a_loaded_scan_of_200_designs_is_cut_into_a_task_per_worker():
+    """Finding: 200 designs x 360 positions in three tasks of 67 on two workers kept one
+    idle for the last third of the scan (issue 33's loaded-scan row)."""
+    assert balanced(555, 200, 360, 2) == 100
+    for designs in (150, 200, 250, 400, 900, 5_000):
+        for workers in (2, 3, 4):
+            size = balanced(10**6, designs, 360, workers)
+            tasks = -(-designs // size)
+            if designs * 360 >= workers * MIN_TASK_POSITIONS:
+                assert tasks % workers == 0, (designs, workers)
+
+
 def test_the_cut_never_exceeds_the_size_nor_splits_a_small_scan():
     for designs in (1, 7, 50, 900, 10_000, 10**6):
         for workers in (1, 2, 8):

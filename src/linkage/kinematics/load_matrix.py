@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -21,11 +21,12 @@ from .bodies import Frame, metre
 EPS = sys.float_info.epsilon
 
 
-def body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], acc: Mapping[str, Any]
-                 ) -> dict[str, tuple[Any, Any, Any]]:
+def body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], acc: Mapping[str, Any],
+                turned: Mapping[str, tuple[Any, Any, Any]] | None = None) -> dict[str, tuple[Any, Any, Any]]:
     """Each body's (rotation since the drawing, omega, alpha), arrays over the positions:
     from two of its joints, a one-joint block from the body its line is on; the ground's
-    all zero."""
+    all zero. ``turned``: this function's answer at the same ``pos`` (other rates), whose
+    rotations are taken as they are rather than found again (the same numbers)."""
     import numpy as np
 
     d = frame.drawing
@@ -44,8 +45,12 @@ def body_motion(frame: Frame, pos: Mapping[str, Any], vel: Mapping[str, Any], ac
         r2 = rx * rx + ry * ry
         dvx, dvy = vel[j1][0] - vel[j0][0], vel[j1][1] - vel[j0][1]
         dax, day = acc[j1][0] - acc[j0][0], acc[j1][1] - acc[j0][1]
-        drawn = math.atan2(d.xy[j1][1] - d.xy[j0][1], d.xy[j1][0] - d.xy[j0][0])
-        out[body] = (np.arctan2(ry, rx) - drawn, (rx * dvy - ry * dvx) / r2, (rx * day - ry * dax) / r2)
+        if turned is None:
+            drawn = math.atan2(d.xy[j1][1] - d.xy[j0][1], d.xy[j1][0] - d.xy[j0][0])
+            rotation = np.arctan2(ry, rx) - drawn
+        else:
+            rotation = turned[body][0]
+        out[body] = (rotation, (rx * dvy - ry * dvx) / r2, (rx * day - ry * dax) / r2)
     for body in pending:
         slide = d.sliders.get(body)
         out[body] = out.get(slide.on, out["ground"]) if slide is not None else out["ground"]
@@ -238,7 +243,8 @@ def known_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], acc: Mapping[s
 
 
 def solve_scaled(frame: Frame, a: Any, rhs: Any, cols: Sequence[tuple[str, Any]],
-                 screen_below: float | None = None) -> tuple[Any, Any]:
+                 screen_below: float | None = None, again: Callable[[Any], Any] | None = None
+                 ) -> tuple[Any, Any]:
     """(the unknowns (N, n), the condition number (N,)) of each position's system, ``a``
     (n, n, N) and ``rhs`` (n, N) with the positions last, solved in the mechanism's own
     size: moments per metre of it, torques as forces at that arm, so the condition number
@@ -250,27 +256,54 @@ def solve_scaled(frame: Frame, a: Any, rhs: Any, cols: Sequence[tuple[str, Any]]
     solution for the unknowns (what a verdict needs: the bound is at least the exact
     number, so a verdict the bound passes the exact number passes too); elsewhere, and
     always without it, the exact number and solution by :func:`condition_np` (one inverse
-    per matrix, two and a half times the work of the LU)."""
+    per matrix, two and a half times the work of the LU). ``again(which)``, where given,
+    builds ``a`` (unscaled) anew for the positions ``which``: the screen then eliminates
+    in ``a`` itself, and the positions it does not pass get their matrices from it."""
     import numpy as np
 
     n_pos = a.shape[-1]
     size = np.broadcast_to(np.asarray(frame.size, dtype=float), (n_pos,))
     couples = [i for i, (kind, _) in enumerate(cols)
                if kind == "slider_m" or (kind == "input" and frame.driver_slider is None)]
-    a[2::3] /= size
+    scale_moments(a, size, couples)
     rhs[2::3] /= size
-    a[:, couples] *= size
     if screen_below is None:
         cond, x = condition_np(a.transpose(2, 0, 1), rhs.T)
     else:
-        x, cond = solve_bounded_np(a, rhs)
-        exact = ~(cond < screen_below)
-        if exact.any():
-            cond[exact], x[exact] = condition_np(a[:, :, exact].transpose(2, 0, 1), rhs[:, exact].T)
+        x, cond = solve_bounded_np(a, rhs, overwrite_a=again is not None)
+        exact = np.flatnonzero(~(cond < screen_below))
+        if exact.size:
+            m = a[:, :, exact] if again is None else scale_moments(again(exact), size[exact], couples)
+            # each matrix contiguous, as a[:, :, exact] lays it out: the norms' sums in one order
+            cond[exact], x[exact] = condition_np(np.ascontiguousarray(m.transpose(2, 0, 1)), rhs[:, exact].T)
     good = np.isfinite(cond) & (cond * EPS < 0.5)
     x = np.where(good[:, None], x, np.nan)
     x[:, couples] *= size[:, None]
     return x, cond
+
+
+def scale_moments(a: Any, size: Any, couples: Sequence[int]) -> Any:
+    """``a`` (n, n, N) in place, and returned, in the mechanism's ``size`` (N,): each
+    moment row per unit of it, each couple's column at that arm (:func:`solve_scaled`)."""
+    a[2::3] /= size
+    a[:, couples] *= size
+    return a
+
+
+def force_matrix(entries: Sequence[tuple[int, int, Any]], n: int, n_pos: int, which: Any = None) -> Any:
+    """The equilibrium matrices (n, n, positions) of :func:`assemble`'s entries, summed in
+    their order; of the positions ``which`` only, where given (the same numbers)."""
+    import numpy as np
+
+    if which is None:
+        a = np.zeros((n, n, n_pos))  # the positions last: each entry's values contiguous
+        for r, c, v in entries:
+            a[r, c] += v
+        return a
+    a = np.zeros((n, n, len(which)))
+    for r, c, v in entries:
+        a[r, c] += np.broadcast_to(v, (n_pos,))[which]
+    return a
 
 
 def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[str, tuple[Any, Any]],
@@ -287,8 +320,9 @@ def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[s
     d = frame.drawing
     n_pos = len(next(iter(pos.values()))[0])
     motion = body_motion(frame, pos, vel, acc)
-    zeros = {j: (np.zeros(n_pos), np.zeros(n_pos)) for j in pos}
-    star = body_motion(frame, pos, vstar, zeros)
+    zero = np.zeros(n_pos)  # read only: the still accelerations of the unit-speed motion
+    zeros = {j: (zero, zero) for j in pos}
+    star = body_motion(frame, pos, vstar, zeros, turned=motion)
     moving = [b for b in d.bodies if b != "ground"]
     row = {b: 3 * i for i, b in enumerate(moving)}
     unknowns = assemble(frame, pos, motion, row)
@@ -296,11 +330,10 @@ def solve_loads(frame: Frame, pos: Mapping[str, tuple[Any, Any]], vel: Mapping[s
     if n_eq != n_un:
         raise InputError(f"{source}: {n_eq} equilibrium equations but {n_un} unknown forces: the matrix "
                          "method needs a mobility-1 mechanism of pins and sliders")
-    a = np.zeros((n_eq, n_un, n_pos))  # the positions last: each entry's values contiguous
-    for r, c, v in unknowns.entries:
-        a[r, c] += v
+    a = force_matrix(unknowns.entries, n_eq, n_pos)
     known = known_loads(frame, pos, acc, vstar, motion, star, loads, row, n_eq)
-    x, cond = solve_scaled(frame, a, known.rhs, unknowns.cols, screen_below)
+    x, cond = solve_scaled(frame, a, known.rhs, unknowns.cols, screen_below,
+                           again=lambda which: force_matrix(unknowns.entries, n_eq, n_pos, which))
     # the unit driver speed's own size: rad/s, or the length unit per second in m/s
     vp = -known.power / (1.0 if frame.driver_slider is None else metre(frame.length_unit))
     pins, sliders, ground = reactions(frame, pos, unknowns, x)
@@ -363,11 +396,13 @@ def condition_np(a: Any, rhs: Any) -> tuple[Any, Any]:
     return cond, x[..., 0]
 
 
-def solve_bounded_np(a: Any, rhs: Any) -> tuple[Any, Any]:
+def solve_bounded_np(a: Any, rhs: Any, overwrite_a: bool = False) -> tuple[Any, Any]:
     """Each system of a stack, ``a`` (n, n, N) and ``rhs`` (n, N) with the N systems last:
     its solution (N, n) by LU with partial pivoting, and a certified upper bound (N,) of
     its 1-norm condition number ||A||_1 ||A^-1||_1 (NaN or inf where none is found: a
-    zero pivot, a non-finite entry). ``a`` and ``rhs`` are left as they are.
+    zero pivot, a non-finite entry). ``rhs`` is left as it is, and ``a`` unless
+    ``overwrite_a`` (then its elimination is done in ``a``, which is spent: a copy of a
+    large stack costs a tenth of a loaded scan's time on two threads).
 
     The elimination runs over all N systems at once, one pivot step at a time, skipping
     the rows and columns that are zero in every system (a force matrix is mostly zeros
@@ -386,8 +421,13 @@ def solve_bounded_np(a: Any, rhs: Any) -> tuple[Any, Any]:
     import numpy as np
 
     n = a.shape[0]
-    t, y = a.copy(), rhs.copy()
     with np.errstate(all="ignore"):
+        # ||A||_1, the largest column sum, a row at a time, before the elimination may spend A
+        sums, row = np.abs(a[0]), np.empty(a.shape[1:])
+        for i in range(1, n):
+            sums += np.abs(a[i], out=row)
+        norm = sums.max(axis=0)
+        t, y = (a if overwrite_a else a.copy()), rhs.copy()
         eliminate_np(t, y)
         x = np.empty_like(y)
         for k in range(n - 1, -1, -1):
@@ -397,12 +437,7 @@ def solve_bounded_np(a: Any, rhs: Any) -> tuple[Any, Any]:
         gamma = n * EPS / (1.0 - n * EPS)
         ge = g * gamma * lu_norm * safety
         bound = np.where(ge < 1.0, g / (1.0 - ge), np.inf)
-        # ||A||_1, the largest column sum, a row at a time into t's first two rows (spent)
-        sums, row = t[0], t[-1]
-        np.abs(a[0], out=sums)
-        for i in range(1, n):
-            sums += np.abs(a[i], out=row)
-        upper = sums.max(axis=0) * bound * safety
+        upper = norm * bound * safety
     return x.T, upper
 
 
@@ -421,7 +456,7 @@ def eliminate_np(t: Any, y: Any) -> None:
         rows = np.flatnonzero(t[k:, k].any(axis=1)) + k
         if rows.size == 0:
             continue  # zero in every system: singular, and nothing to eliminate
-        p = rows[np.abs(t[rows, k]).argmax(axis=0)] if rows.size > 1 else np.full(count, rows[0])
+        p = first_largest(t[:, k], rows)
         chosen = np.bincount(p - k, minlength=n - k)
         for r in np.flatnonzero(chosen[1:]) + 1:
             other = k + r
@@ -442,6 +477,24 @@ def eliminate_np(t: Any, y: Any) -> None:
             np.multiply(mult, t[k, c0:c1], out=keep[0][:c1 - c0])
             t[i, c0:c1] -= keep[0][:c1 - c0]
             y[i] -= mult * y[k]
+
+
+def first_largest(column: Any, rows: Any) -> Any:
+    """Each system's pivot row among ``rows`` of ``column`` (n, N): the first of the largest
+    in magnitude, as ``linalg.lu``'s ``max`` picks it (a later row wins only where it is
+    strictly larger, so a NaN never wins nor loses its place). Row by row, element-wise:
+    an ``argmax`` across rows makes a transposed copy of its rows and runs a short loop
+    per system, about five times the time of this, all of it holding the GIL."""
+    import numpy as np
+
+    p = np.full(column.shape[1], rows[0])
+    best = np.abs(column[rows[0]])
+    for r in rows[1:]:
+        size = np.abs(column[r])
+        larger = size > best
+        np.copyto(p, r, where=larger)
+        np.copyto(best, size, where=larger)
+    return p
 
 
 def inverse_bound_np(lu_abs: Any) -> tuple[Any, Any]:

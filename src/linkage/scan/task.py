@@ -77,10 +77,12 @@ def run_chunk(job: ScanJob, start: int, designs: np.ndarray) -> dict[str, np.nda
     return out
 
 
-FORCE_BATCH_CELLS = 1_000_000
-"""Force-matrix numbers built at once (8 MB): a chunk's positions go through the matrix
-method in slices of this many numbers (benchmarks/loaded_scan.py: 4,000,000 took 10% more
-processor time, its arrays beyond the caches; 600,000 as much as this)."""
+FORCE_BATCH_CELLS = 2_000_000
+"""Force-matrix numbers built at once (16 MB): a chunk's positions go through the matrix
+method in slices of this many numbers. On dask's threads each numpy call of a slice is a
+hand-over of the GIL between the workers, so fewer, larger calls use both cores better
+(benchmarks/loaded_scan.py, two workers, interleaved: 1,000,000 took 10% more wall time
+than this, 250,000 twice as much; 6,000,000, its arrays beyond the caches, 15% more)."""
 
 
 def load_metrics(m: Mechanism, params: Mapping[str, np.ndarray], sol: DesignSolutions, loads: Any,
@@ -142,10 +144,14 @@ array work to outweigh a task's fixed cost."""
 def balanced(size: int, designs: int, positions: int, workers: int) -> int:
     """``size`` designs per task, or fewer so that ``designs`` make at least
     TASKS_PER_WORKER tasks per worker, of nearly equal size (each at least
-    MIN_TASK_POSITIONS positions): every worker busy to the end on a local scheduler."""
+    MIN_TASK_POSITIONS positions), as many as a whole number of rounds of the workers
+    where there are enough for one: every worker busy to the end on a local scheduler
+    (three equal tasks on two workers kept one idle for the last third of the scan)."""
     if workers <= 1:
         return size
     tasks = max(1, min(TASKS_PER_WORKER * workers, designs * max(positions, 1) // MIN_TASK_POSITIONS))
+    if tasks > workers:
+        tasks -= tasks % workers
     return max(1, min(size, -(-designs // tasks)))
 
 
