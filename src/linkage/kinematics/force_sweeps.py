@@ -74,7 +74,8 @@ def batch_forces(mechanism: Any, q: Sequence[Any], d: Any, loads: Loads, *, spee
     # (forces.per_unit_speed, as one position's forces get them), else their own rates
     by_speed = speed_usable(speed)
     motions = ((speed, accel),) if by_speed else ((1.0, 0.0), (speed, accel)) if moves else ((1.0, 0.0),)
-    rates, ok = motions_rates_np(model, qs, ds, motions)
+    # a static load reads positions and the unit speed's velocities, no accelerations
+    rates, ok = motions_rates_np(model, qs, ds, motions, accelerations=moves)
     placed = [place_motion_np(model, qs, ds, qd, v, qdd, a) for (qd, qdd), (v, a) in zip(rates, motions)]
     moving, unit = placed[-1], placed[0]
     k = metre(frame.length_unit)

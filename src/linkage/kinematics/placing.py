@@ -128,27 +128,34 @@ def place_motion_np(model: LoopModel, q: Any, d: Any, qd: Any, vd: float, qdd: A
                     ) -> dict[str, tuple[Any, Any, Any]]:
     """:func:`place`'s twin over arrays: every named joint and point, name -> (position,
     velocity, acceleration) as complex arrays, each vector by :func:`~.vectors.term`'s formulas and
-    the joints by the one placing rule (:func:`walk`)."""
+    the joints by the one placing rule (:func:`walk`). With ``qdd`` None the accelerations
+    are not computed and are None (a static load needs positions and velocities only)."""
     import numpy as np
 
     d = np.asarray(d, dtype=float)
     zero = np.zeros(d.shape, dtype=complex)
+    with_acc = qdd is not None
 
     def part(t: Any, _at: Any) -> tuple[Any, Any, Any]:
         sign, lc, li, ac, ai, off = t
         r, th = value_of(li, lc, q, d), value_of(ai, ac, q, d) + off
         r1, w = rate_of(li, qd, vd), rate_of(ai, qd, vd)
-        r2, al = rate_of(li, qdd, vdd), rate_of(ai, qdd, vdd)
         e = np.exp(1j * th)
+        if not with_acc:
+            return sign * r * e, sign * (r1 + 1j * r * w) * e, zero
+        r2, al = rate_of(li, qdd, vdd), rate_of(ai, qdd, vdd)
         return (sign * r * e, sign * (r1 + 1j * r * w) * e,
                 sign * (r2 + 1j * r * al + 2j * r1 * w - r * w * w) * e)
 
     def add(start: Any, parts: Any, sign: float) -> tuple[Any, Any, Any]:
         p, v, a = start
         for dp, dv, da in parts:
-            p, v, a = p + sign * dp, v + sign * dv, a + sign * da
+            p, v = p + sign * dp, v + sign * dv
+            a = a + sign * da if with_acc else a
         return p, v, a
 
     origin0 = (zero + complex(*model.mechanism.origin), zero, zero)
     placed = walk(model, part, add, origin0, lambda xy: (zero + complex(*xy), zero, zero))
+    if not with_acc:
+        return {k: (p + zero, v + zero, None) for k, (p, v, _) in placed.items()}
     return {k: (p + zero, v + zero, a + zero) for k, (p, v, a) in placed.items()}

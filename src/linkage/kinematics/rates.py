@@ -243,10 +243,12 @@ def solve_rates_np(model: LoopModel, q: Any, d: Any, speed: float, accel: float
     return qd, qdd, solved
 
 
-def motions_rates_np(model: LoopModel, q: Any, d: Any, motions: Any) -> tuple[list[Any], Any]:
+def motions_rates_np(model: LoopModel, q: Any, d: Any, motions: Any, *, accelerations: bool = True
+                     ) -> tuple[list[Any], Any]:
     """:func:`solve_rates_np` at each driver (speed, accel) of ``motions``, J and its
     inverse found once for all of them: [(q', q'') per motion], solved. q' is the unit
-    speed's times the speed (J q' = -(dPhi/dv) v' is linear in v')."""
+    speed's times the speed (J q' = -(dPhi/dv) v' is linear in v'). Without
+    ``accelerations`` q'' is None (not computed: a static load needs velocities only)."""
     import numpy as np
 
     d = np.asarray(d, dtype=float)
@@ -256,6 +258,9 @@ def motions_rates_np(model: LoopModel, q: Any, d: Any, motions: Any) -> tuple[li
     out = []
     for speed, accel in motions:
         qd_list = list(np.moveaxis(speed * unit, -1, 0))
+        if not accelerations:
+            out.append((qd_list, None))
+            continue
         rhs = accel * dv + np.stack(np.broadcast_arrays(d, *bias_np(model, q, d, qd_list, speed))[1:],
                                     axis=-1)
         qdd = -np.einsum("...ij,...j->...i", inv, rhs)
