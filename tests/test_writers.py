@@ -85,6 +85,29 @@ def test_csv_and_json_read_back_bit_for_bit(tmp_path: Path, monkeypatch: pytest.
                                 "rows": [["A", 1.5], ['B, "c"', None]]}
 
 
+def test_parquet_file_is_the_bytes_pyarrow_parquet_writes(tmp_path: Path) -> None:
+    """The sink's writer (pyarrow's own, without pyarrow.parquet's filesystem imports) writes
+    the file pyarrow.parquet.ParquetWriter writes, byte for byte: with text dictionary-encoded,
+    with no dictionary, and with no column at all."""
+    pa = pytest.importorskip("pyarrow")
+    pq = pytest.importorskip("pyarrow.parquet")
+    x = awkward_numbers(500)
+    words = np.array(["converged", "no_solution", None] * 172, dtype=object)[: len(x)]
+    fields = [pa.field("theta2", pa.float64(), metadata={b"unit": b"deg"}), pa.field("status", pa.string())]
+    schema = pa.schema(fields, metadata={"linkage": '{"title": "t"}'})
+    table = pa.Table.from_arrays([pa.array(x, mask=~np.isfinite(x)), pa.array(words, type=pa.string())],
+                                 schema=schema)
+    for k, (s, t, dictionary) in enumerate([(schema, table, ["status"]), (schema, table, False),
+                                             (pa.schema([], metadata={"linkage": "{}"}), None, True)]):
+        ours, theirs = tmp_path / f"ours{k}.parquet", tmp_path / f"theirs{k}.parquet"
+        for writer in (formats.parquet_writer(str(ours), s, dictionary),
+                       pq.ParquetWriter(str(theirs), s, use_dictionary=dictionary)):
+            if t is not None:
+                writer.write_table(t)
+            writer.close()
+        assert ours.read_bytes() == theirs.read_bytes()
+
+
 def test_parquet_and_xlsx_read_back(tmp_path: Path) -> None:
     pq = pytest.importorskip("pyarrow.parquet")
     openpyxl = pytest.importorskip("openpyxl")
