@@ -32,6 +32,7 @@ from .cells import (
     has_pyarrow,
     is_array,
     json_values,
+    plain_values,
     quote_csv,
     safe_name,
 )
@@ -183,13 +184,14 @@ class ParquetSink(Sink):
 
         arrays = []
         for c, f, v in zip(self.columns, self.schema, values):
-            if c.kind == "number":  # NaN and infinities are no value, as in CSV and JSON
-                import numpy as np
+            if c.kind == "number" and not (is_array(v) and v.dtype.kind == "f"):
+                import numpy as np  # NaN and infinities are no value, as in CSV and JSON
 
-                x = np.asarray(v if is_array(v) else [math.nan if x is None else x for x in v], dtype=float)
-                arrays.append(pa.array(x, type=f.type, mask=~np.isfinite(x)))
-            else:
-                arrays.append(pa.array(v if is_array(v) else list(v), type=f.type))
+                v = np.asarray(v if is_array(v) else [math.nan if x is None else x for x in v], dtype=float)
+            a = cells.arrow_array(c.kind, v)
+            if a is None:
+                a = pa.array(plain_values(v), type=f.type)
+            arrays.append(a if a.type == f.type else a.cast(f.type))
         self.writer.write_table(pa.Table.from_arrays(arrays, schema=self.schema))
         self.count += len(values[0]) if values else 0
 
