@@ -85,6 +85,51 @@ def test_csv_and_json_read_back_bit_for_bit(tmp_path: Path, monkeypatch: pytest.
                                 "rows": [["A", 1.5], ['B, "c"', None]]}
 
 
+def test_arrow_columns_from_numpy_buffers_are_pyarrows_own_conversion() -> None:
+    """cells.arrow_array (numeric columns made from the numpy buffer, no numpy.ma) gives the
+    array pyarrow's pa.array makes, NaN and infinities masked: strided and big-endian
+    arrays, integers of every width, booleans, text with None; not its kind: None."""
+    pa = pytest.importorskip("pyarrow")
+    x = awkward_numbers(300)
+    numbers = [x, x[::3], x.astype(">f8"), np.array([]), np.full(9, math.nan), np.float32([1.5, math.inf])]
+    for v in numbers:
+        want = pa.array(np.asarray(v, dtype=float), mask=~np.isfinite(v))
+        got = cells.arrow_array("number", v)
+        assert got.equals(want) and got.null_count == want.null_count
+    ints = [np.arange(-5, 5, dtype=t) for t in ("i1", "i2", "<i4", ">i4", "i8")] + [np.arange(7, dtype="u8")]
+    for v in ints:
+        assert cells.arrow_array("int", v).equals(pa.array(v.astype(v.dtype.newbyteorder("="))))
+    flags = np.array([True, False, True] * 7)
+    assert cells.arrow_array("bool", flags).equals(pa.array(flags))
+    assert cells.arrow_array("bool", flags[::2]).equals(pa.array(flags[::2]))
+    words = np.array(["a", None, "b, c"], dtype=object)
+    assert cells.arrow_array("text", words).equals(pa.array(words, type=pa.string()))
+    assert cells.arrow_array("number", np.arange(3)) is None and cells.arrow_array("int", x) is None
+
+
+def test_parquet_file_is_the_bytes_pyarrow_parquet_writes(tmp_path: Path) -> None:
+    """The sink's writer (pyarrow's own, without pyarrow.parquet's filesystem imports) writes
+    the file pyarrow.parquet.ParquetWriter writes, byte for byte: with text dictionary-encoded,
+    with no dictionary, and with no column at all."""
+    pa = pytest.importorskip("pyarrow")
+    pq = pytest.importorskip("pyarrow.parquet")
+    x = awkward_numbers(500)
+    words = np.array(["converged", "no_solution", None] * 172, dtype=object)[: len(x)]
+    fields = [pa.field("theta2", pa.float64(), metadata={b"unit": b"deg"}), pa.field("status", pa.string())]
+    schema = pa.schema(fields, metadata={"linkage": '{"title": "t"}'})
+    table = pa.Table.from_arrays([pa.array(x, mask=~np.isfinite(x)), pa.array(words, type=pa.string())],
+                                 schema=schema)
+    for k, (s, t, dictionary) in enumerate([(schema, table, ["status"]), (schema, table, False),
+                                             (pa.schema([], metadata={"linkage": "{}"}), None, True)]):
+        ours, theirs = tmp_path / f"ours{k}.parquet", tmp_path / f"theirs{k}.parquet"
+        for writer in (formats.parquet_writer(str(ours), s, dictionary),
+                       pq.ParquetWriter(str(theirs), s, use_dictionary=dictionary)):
+            if t is not None:
+                writer.write_table(t)
+            writer.close()
+        assert ours.read_bytes() == theirs.read_bytes()
+
+
 def test_parquet_and_xlsx_read_back(tmp_path: Path) -> None:
     pq = pytest.importorskip("pyarrow.parquet")
     openpyxl = pytest.importorskip("openpyxl")

@@ -14,6 +14,7 @@ terminal, a FIFO) are written in place, since renaming over them would replace t
 from __future__ import annotations
 
 import contextlib
+import errno
 import functools
 import os
 import re
@@ -227,14 +228,8 @@ def atomic_target(path: Path) -> Iterator[str]:
         except OSError as exc:
             raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
         return
-    folder = os.path.dirname(real) or "."
-    suffix = os.path.splitext(real)[1]
     try:
-        import tempfile
-
-        fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(real)}.", suffix=f".part{suffix}",
-                                   dir=folder)
-        os.close(fd)
+        tmp = temporary_beside(real)
     except OSError as exc:
         raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
     try:
@@ -250,6 +245,23 @@ def atomic_target(path: Path) -> Iterator[str]:
     except BaseException:
         _remove(tmp)
         raise
+
+
+def temporary_beside(real: str) -> str:
+    """A new empty file beside ``real``, made by this call (``.name.XXXXXXXX.part.suffix``,
+    mode 0600), as ``tempfile.mkstemp`` makes it: without tempfile's import (random and
+    shutil: 5 ms of a fresh process, for one name)."""
+    folder = os.path.dirname(real) or "."
+    suffix = os.path.splitext(real)[1]
+    flags = os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+    for _ in range(100):
+        tmp = os.path.join(folder, f".{os.path.basename(real)}.{os.urandom(4).hex()}.part{suffix}")
+        try:
+            os.close(os.open(tmp, flags, 0o600))
+        except FileExistsError:
+            continue
+        return tmp
+    raise FileExistsError(errno.EEXIST, "no free temporary name", folder)
 
 
 def _sync(path: str) -> None:

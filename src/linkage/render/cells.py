@@ -147,33 +147,54 @@ ARROW_BATCH = 4 * SLICE
 
 def arrow_table(columns: Sequence[Column], values: Sequence[Any]) -> Any:
     """A block of rows as a pyarrow table whose CSV text (``quoting_style="none"``) is the
-    cells :func:`cell_texts` makes with pyarrow's numbers (tests check it): numbers
-    NaN and infinities masked (no value), integers, booleans and text as they are; None
-    where a column is not a numpy array of its kind (the caller goes cell by cell). Text
-    that needs quoting is refused by the writer itself, before it writes a row."""
-    import numpy as np
+    cells :func:`cell_texts` makes with pyarrow's numbers (tests check it): each column by
+    :func:`arrow_array`; None where a column is not a numpy array of its kind (the caller
+    goes cell by cell). Text that needs quoting is refused by the writer itself, before it
+    writes a row."""
     import pyarrow as pa
 
     arrays = []
     for c, v in zip(columns, values):
-        kind = v.dtype.kind if is_array(v) else ""
-        if c.kind == "number" and kind == "f":
-            arrays.append(pa.array(v, mask=~np.isfinite(v)))
-        elif (c.kind == "int" and kind in "iu" and kind) or (c.kind == "bool" and kind == "b"):
-            arrays.append(pa.array(v))
-        elif c.kind == "text" and kind in ("O", "U", ""):
-            try:
-                arrays.append(pa.array(v, type=pa.string()))
-            except (pa.ArrowException, TypeError):  # not text throughout
-                return None
-        else:
+        try:
+            a = arrow_array(c.kind, v)
+        except (pa.ArrowException, TypeError):  # text not text throughout
             return None
+        if a is None:
+            return None
+        arrays.append(a)
     return pa.Table.from_arrays(arrays, names=[str(j) for j in range(len(arrays))])
 
 
+def arrow_array(kind: str, values: Any) -> Any:
+    """A column of ``kind`` as a pyarrow array, if ``values`` is a numpy array of that kind
+    (text: any object or str array, or a list), else None: numbers as doubles, NaN and
+    infinities masked (no value); integers and booleans as they are. The numeric arrays are
+    made from the numpy array's own buffer (pyarrow's ``pa.array`` of a numpy array imports
+    numpy.ma, 10 to 15 ms of a fresh process, and makes a mask of every column)."""
+    import numpy as np
+    import pyarrow as pa
+
+    dtype = values.dtype.kind if is_array(values) else ""
+    if kind == "number" and dtype == "f":
+        x = np.ascontiguousarray(values, dtype=np.float64)
+        finite = np.isfinite(x)
+        nulls = len(x) - int(np.count_nonzero(finite))
+        valid = pa.py_buffer(np.packbits(finite, bitorder="little")) if nulls else None
+        return pa.Array.from_buffers(pa.float64(), len(x), [valid, pa.py_buffer(x)], null_count=nulls)
+    if kind == "int" and dtype and dtype in "iu":
+        x = np.ascontiguousarray(values, dtype=values.dtype.newbyteorder("="))
+        return pa.Array.from_buffers(pa.from_numpy_dtype(x.dtype), len(x), [None, pa.py_buffer(x)])
+    if kind == "bool" and dtype == "b":
+        bits = pa.py_buffer(np.packbits(np.ascontiguousarray(values), bitorder="little"))
+        return pa.Array.from_buffers(pa.bool_(), len(values), [None, bits])
+    if kind == "text" and dtype in ("O", "U", ""):
+        return pa.array(plain_values(values), type=pa.string())
+    return None
+
+
 def warm_arrow() -> None:
-    """pyarrow's first conversion of a block sets pyarrow up (it imports numpy.ma, for one:
-    about 10 ms; the later blocks convert in microseconds): done here on a one-row block of
+    """pyarrow's first conversion of a block sets pyarrow up (the later blocks convert in
+    microseconds): done here on a one-row block of
     each kind :func:`arrow_table` converts, for a sink's :meth:`Sink.warm`."""
     import numpy as np
 

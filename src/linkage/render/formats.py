@@ -32,6 +32,7 @@ from .cells import (
     has_pyarrow,
     is_array,
     json_values,
+    plain_values,
     quote_csv,
     safe_name,
 )
@@ -149,7 +150,7 @@ class ParquetSink(Sink):
 
     @classmethod
     def modules(cls, rows: int | None) -> tuple[str, ...]:
-        return ("pyarrow.parquet",)
+        return (PARQUET_WRITER,)
 
     @classmethod
     def warm(cls, rows: int | None) -> None:
@@ -161,7 +162,6 @@ class ParquetSink(Sink):
 
     def begin(self, name: str, columns: Sequence[Column], rows: int | None = None) -> None:
         import pyarrow as pa
-        import pyarrow.parquet as pq
 
         super().begin(name, columns, rows)
         types = {"number": pa.float64(), "int": pa.int64(), "bool": pa.bool_(), "text": pa.string()}
@@ -177,20 +177,21 @@ class ParquetSink(Sink):
         # every column of doubles it costs 3x the write (0.40 s against 0.13 s for a
         # 360,001-position sweep) and saves nothing, as the doubles rarely repeat
         words = [c.name for c in self.columns if c.kind == "text"]
-        self.writer = pq.ParquetWriter(target, self.schema, use_dictionary=words or False)
+        self.writer = parquet_writer(target, self.schema, words or False)
 
     def rows(self, values: Sequence[Any]) -> None:
         import pyarrow as pa
 
         arrays = []
         for c, f, v in zip(self.columns, self.schema, values):
-            if c.kind == "number":  # NaN and infinities are no value, as in CSV and JSON
-                import numpy as np
+            if c.kind == "number" and not (is_array(v) and v.dtype.kind == "f"):
+                import numpy as np  # NaN and infinities are no value, as in CSV and JSON
 
-                x = np.asarray(v if is_array(v) else [math.nan if x is None else x for x in v], dtype=float)
-                arrays.append(pa.array(x, type=f.type, mask=~np.isfinite(x)))
-            else:
-                arrays.append(pa.array(v if is_array(v) else list(v), type=f.type))
+                v = np.asarray(v if is_array(v) else [math.nan if x is None else x for x in v], dtype=float)
+            a = cells.arrow_array(c.kind, v)
+            if a is None:
+                a = pa.array(plain_values(v), type=f.type)
+            arrays.append(a if a.type == f.type else a.cast(f.type))
         self.writer.write_table(pa.Table.from_arrays(arrays, schema=self.schema))
         self.count += len(values[0]) if values else 0
 
@@ -210,18 +211,67 @@ class ParquetSink(Sink):
             import json
 
             import pyarrow as pa
-            import pyarrow.parquet as pq
 
             from .export import clean
 
             schema = pa.schema([], metadata={"linkage": json.dumps(clean(self.meta))})
-            pq.ParquetWriter(self.path, schema).close()
+            parquet_writer(self.path, schema, True).close()
         self.abandon()
 
     def abandon(self) -> None:
         if self.writer is not None:
             with contextlib.suppress(Exception):
                 self.writer.close()
+
+
+PARQUET_WRITER = "pyarrow._parquet"
+"""The module of pyarrow's Parquet writer itself. ``pyarrow.parquet`` wraps it, and imports
+pyarrow.fs for the wrapper's filesystems (with ssl, urllib and S3's client: 0.05 s of a
+fresh process, a sixth of a 360,001-position sweep's computing); a sink writes a local
+file, which needs none of them."""
+PARQUET_OPTIONS = {"version": "2.6", "compression": "snappy", "write_statistics": True,
+                   "use_deprecated_int96_timestamps": False, "writer_engine_version": "V2",
+                   "data_page_version": "1.0", "use_compliant_nested_type": True, "store_schema": True}
+"""``pyarrow.parquet.ParquetWriter``'s defaults, as it hands them to the writer (pyarrow 14
+to 26): the file's bytes are the wrapper's (tests/test_writers.py checks it)."""
+
+
+class ParquetFile:
+    """pyarrow's Parquet writer on a local file, and the file closed with it."""
+
+    def __init__(self, path: str, schema: Any, use_dictionary: Any) -> None:
+        import pyarrow as pa
+        from pyarrow import _parquet  # pyarrow's own writer: see PARQUET_WRITER
+
+        self.file = pa.OSFile(path, "wb")
+        try:
+            self.writer = _parquet.ParquetWriter(self.file, schema, use_dictionary=use_dictionary,
+                                                 **PARQUET_OPTIONS)
+        except BaseException:
+            self.file.close()
+            raise
+
+    def write_table(self, table: Any) -> None:
+        self.writer.write_table(table)
+
+    def close(self) -> None:
+        try:
+            self.writer.close()
+        finally:
+            self.file.close()
+
+
+def parquet_writer(path: str, schema: Any, use_dictionary: Any) -> Any:
+    """A Parquet writer of ``schema`` to the local file ``path`` (``use_dictionary``: True,
+    False or the columns to dictionary-encode), as ``pyarrow.parquet.ParquetWriter`` makes
+    it, without the wrapper's imports (:data:`PARQUET_WRITER`); the wrapper itself where
+    this pyarrow's writer takes other arguments."""
+    try:
+        return ParquetFile(path, schema, use_dictionary)
+    except TypeError:
+        import pyarrow.parquet as pq
+
+        return pq.ParquetWriter(path, schema, use_dictionary=use_dictionary)
 
 
 XLSX_ROWS = 1_048_575
@@ -325,7 +375,7 @@ FORMATS: dict[str, Format] = {f.name: f for f in (
     Format("csv", (".csv",), CsvSink, one_table=True),
     Format("json", (".json",), JsonSink),
     Format("parquet", (".parquet",), ParquetSink, binary=True, one_table=True,
-           needs=("pyarrow.parquet", "pip install 'linkage-kinematics[scan]'")),
+           needs=(PARQUET_WRITER, "pip install 'linkage-kinematics[scan]'")),
     Format("xlsx", (".xlsx",), XlsxSink, binary=True,
            needs=("openpyxl", "pip install 'linkage-kinematics[xlsx]'")),
 )}
