@@ -268,7 +268,7 @@ def parquet_writer(path: str, schema: Any, use_dictionary: Any) -> Any:
     this pyarrow's writer takes other arguments."""
     try:
         return ParquetFile(path, schema, use_dictionary)
-    except TypeError:
+    except (ImportError, AttributeError, TypeError):  # a pyarrow whose private writer moved or changed
         import pyarrow.parquet as pq
 
         return pq.ParquetWriter(path, schema, use_dictionary=use_dictionary)
