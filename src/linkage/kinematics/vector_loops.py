@@ -48,6 +48,11 @@ class LoopPlan:
         return cls(model.n, tuple(loops))
 
 
+def numpy_cos_sin(x: Any) -> tuple[Any, Any]:
+    """np.cos and np.sin of ``x``: the trigonometry :class:`VectorLoops` takes by default."""
+    return np.cos(x), np.sin(x)
+
+
 def loop_plan(m: Mechanism) -> LoopPlan:
     """The :class:`LoopPlan` of ``m``'s loop model, made once per mechanism (:func:`~.pose.implied`)."""
     from .pose import implied
@@ -62,12 +67,18 @@ class VectorLoops:
     (column by column): strided access into (N, m, n) arrays costs several times more.
     """
 
+    cos_sin: Any = staticmethod(numpy_cos_sin)
+    """cos and sin of an unknown angle's array, taken directly (see :meth:`_trig`)."""
+
     def __init__(self, model: LoopModel | LoopPlan, drv: np.ndarray,
-                 driver_trig: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+                 driver_trig: tuple[np.ndarray, np.ndarray] | None = None, cos_sin: Any = None) -> None:
         """The loops of ``model`` at the driver values ``drv``; a :class:`LoopPlan` of it
         (kept by a caller that sweeps the same model again) gives the same loops.
         ``driver_trig``: np.cos and np.sin of ``drv``, where the caller took them for its
-        own use too; taken here when not given."""
+        own use too; taken here when not given. ``cos_sin``: a function giving cos and sin
+        of an array within a stated bound (:mod:`.half_angle`), for np.cos and np.sin."""
+        if cos_sin is not None:
+            self.cos_sin = cos_sin
         plan = model if isinstance(model, LoopPlan) else LoopPlan.of(model)
         terms = [[t if len(t) == 2 else (t[0], drv if t[2] == DRIVER else t[1], t[2] if t[2] >= 0 else -1,
                                          drv if t[4] == DRIVER else t[3], t[4] if t[4] >= 0 else -1, t[5])
@@ -134,7 +145,7 @@ class VectorLoops:
                 tt = q[aidx] if aidx >= 0 else sub(th)
                 if off:
                     tt = tt + off
-                c, s = np.cos(tt), np.sin(tt)
+                c, s = self.cos_sin(tt)
             rc, rs = sign * rr * c, sign * rr * s
             phi[2 * li] = phi[2 * li] + rc
             phi[2 * li + 1] = phi[2 * li + 1] + rs
@@ -175,7 +186,7 @@ class VectorLoops:
             trig[key] = (None, c, s, False)
             return c, s
         tt = qa + off if off else qa
-        c, s = np.cos(tt), np.sin(tt)
+        c, s = self.cos_sin(tt)
         trig[key] = (qa.copy(), c, s, True)
         return c, s
 
