@@ -269,13 +269,15 @@ def test_batch_blocks_give_the_answer_of_one_block(name, lo, hi, monkeypatch):
 def test_batch_grid_index_equals_searchsorted():
     import numpy as np
 
-    from linkage.kinematics.batch import _grid_index
+    from linkage.kinematics.warm_starts import grid_left
 
     rng = np.random.default_rng(4)
     grid = np.linspace(-30.0, 400.0, 361)
     for vals in (np.sort(rng.uniform(-50, 420, 5000)), rng.uniform(-50, 420, 5000), grid.copy(),
                  np.repeat(grid[::7], 3), np.array([grid[5]]), np.array([-100.0, 1000.0])):
-        assert np.array_equal(_grid_index(grid, vals), np.searchsorted(grid, vals, side="right"))
+        want = np.clip(np.searchsorted(grid, vals, side="right"), 1, len(grid) - 1) - 1
+        assert np.array_equal(grid_left(grid, vals), want)
+    assert np.array_equal(grid_left(grid[:1], np.array([-1.0, 0.0, 5.0])), [0, 0, 0])
 
 
 def test_batch_of_no_position_and_of_one():

@@ -36,6 +36,7 @@ from .limits import solved_ranges_array
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
 from .stepwise import sweep
 from .vector_loops import LoopPlan, VectorLoops, loop_plan, singular_of, solve_linear
+from .warm_starts import Coarse, coarse_intervals, warm_starts
 
 STATUS_CODES = {"converged": 0, "no_solution": 1, "failed": 2, "off_branch": 3}
 CODE_STATUS = {v: k for k, v in STATUS_CODES.items()}
@@ -274,7 +275,7 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
 
 
 def _coarse_pass(solver: Solver, rough: SweepResult, grid: Sequence[float],
-                 scale: Sequence[float]) -> _Coarse:
+                 scale: Sequence[float]) -> Coarse:
     """The coarse sweep as the blocks read it: its solutions (display units) and the exact
     tangents dq/dv there (:func:`~.continuation.tangent`); a position without a tangent is
     no end of a usable interval."""
@@ -292,7 +293,7 @@ def _coarse_pass(solver: Solver, rough: SweepResult, grid: Sequence[float],
                 no_tangent[c] = True
             else:
                 slopes[c] = [ti / sc for ti, sc in zip(t, scale)]
-    return _coarse(grid_arr, ok_coarse & ~no_tangent, coarse_sol, slopes, kinds)
+    return coarse_intervals(grid_arr, ok_coarse & ~no_tangent, coarse_sol, slopes, kinds)
 
 
 def _one_at_a_time(m: Mechanism, solver: Solver, rough: SweepResult, grid_arr: np.ndarray, vals: np.ndarray,
@@ -347,16 +348,6 @@ def _gap_status(m: Mechanism, solver: Solver, rough: SweepResult, near: Sequence
     return others[0] if others else "failed"
 
 
-def _grid_index(grid: np.ndarray, vals: np.ndarray) -> np.ndarray:
-    """np.searchsorted(grid, vals, side="right"): for ascending vals (a sweep's) by one
-    merge, a quarter of the binary searches' time."""
-    if len(vals) > 1 and not (vals[1:] >= vals[:-1]).all():
-        return np.searchsorted(grid, vals, side="right")
-    # grid[c] <= vals[i] exactly when i >= first[c]: count the grid points passed
-    first = np.searchsorted(vals, grid, side="left")
-    return np.cumsum(np.bincount(first, minlength=len(vals) + 1)[:len(vals)])
-
-
 VECTOR_ITER = 30
 """The most iterations of the vectorised Newton (the few slower positions go one at a time)."""
 
@@ -364,37 +355,7 @@ BLOCK = 16_384
 """Positions per block of the batch engine's vectorised steps (temporaries of 128 kB)."""
 
 
-@dataclass(frozen=True)
-class _Coarse:
-    """The coarse pass as the blocks read it, arranged per interval [grid[c], grid[c + 1]]
-    where a block would otherwise recompute it per position."""
-
-    grid: np.ndarray
-    pair_usable: np.ndarray  # both ends solved, with a tangent
-    width: np.ndarray
-    solution: np.ndarray    # one row per unknown, per grid point (1-D rows gather faster)
-    next_value: np.ndarray  # the right end's value; for an angle, the one nearest the left's
-    slopes: np.ndarray      # dq/dv, one row per unknown, per grid point (display units)
-    allowed: np.ndarray     # how far a position may move from its guess (continuity)
-
-
-def _coarse(grid: np.ndarray, usable: np.ndarray, sol: np.ndarray, slopes: np.ndarray,
-            kinds: Sequence[str]) -> _Coarse:
-    rows = np.ascontiguousarray(sol.T)
-    one = len(grid) == 1  # a one-point grid is one interval, from the point to itself
-    nxt = rows.copy() if one else np.concatenate((rows[:, 1:], rows[:, -1:]), axis=1)
-    for j, k in enumerate(kinds):
-        if k == "angle":
-            nxt[j] = nearest_turn_array(rows[j], nxt[j])
-    with np.errstate(invalid="ignore"):
-        spread = np.zeros(1) if one else np.nanmax(np.abs(sol[1:] - sol[:-1]), axis=1, initial=0.0)
-    allowed = 2.0 * np.where(np.isfinite(spread), spread, 0.0) + 1e-6
-    pair = usable.copy() if one else np.append(usable[:-1] & usable[1:], False)
-    width = np.zeros(1) if one else np.append(grid[1:] - grid[:-1], 0.0)
-    return _Coarse(grid, pair, width, rows, nxt, np.ascontiguousarray(slopes.T), allowed)
-
-
-def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str], kinds: Sequence[str],
+def _settle(m: Mechanism, model: LoopModel, coarse: Coarse, names: Sequence[str], kinds: Sequence[str],
             scale: Sequence[float], vals: np.ndarray, drv_scale: float, tol: float, max_iter: int,
             branch: str | None, status: np.ndarray, iters: np.ndarray, det_out: np.ndarray,
             shown: np.ndarray, ref: np.ndarray) -> None:
@@ -404,7 +365,7 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     arrays, written into the (N, n) outputs once (reading a strided column costs
     several times more)."""
     n, code = len(kinds), STATUS_CODES
-    refs, left, usable = _warm_starts(coarse, vals, n)
+    refs, left, usable = warm_starts(coarse, vals)
     drivers = vals * drv_scale
     # the driver's cosine and sine, taken once for the loop equations and the branch rule;
     # every cosine and sine here from the half-angle tangent (a fifth of the time of np.cos
@@ -439,34 +400,6 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     if left_over.size:
         for j in range(n):
             ref[left_over, j] = refs[j][left_over]
-
-
-def _warm_starts(coarse: _Coarse, vals: np.ndarray,
-                 n: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
-    """Step 2, the warm starts (display units, one array per unknown): cubic Hermite
-    interpolation between coarse neighbours that both solved, with the exact tangents
-    dq/dv there (error ~ h^4: two Newton steps do); with each position's left grid index
-    and whether its interval is usable."""
-    take = np.take
-    right = np.clip(_grid_index(coarse.grid, vals), 1, len(coarse.grid) - 1)
-    left = right - 1
-    usable = take(coarse.pair_usable, left)
-    width = take(coarse.width, left)
-    g_left = take(coarse.grid, left)
-    if width.min() > 0.0:
-        u = (vals - g_left) / width
-    else:  # a one-point grid
-        u = np.where(width > 0, (vals - g_left) / np.where(width > 0, width, 1.0), 0.0)
-    one_minus_u_sq, u_sq = (1 - u) ** 2, u * u
-    h00, h10 = (1 + 2 * u) * one_minus_u_sq, u * one_minus_u_sq
-    h01, h11 = u_sq * (3 - 2 * u), u_sq * (u - 1)
-    h10, h11 = h10 * width, h11 * width  # (h10 * width) * slope, as written before: the same bits
-    refs = []
-    for j in range(n):
-        y0, y1 = take(coarse.solution[j], left), take(coarse.next_value[j], left)
-        refs.append(h00 * y0 + h10 * take(coarse.slopes[j], left) + h01 * y1
-                    + h11 * take(coarse.slopes[j], right))
-    return refs, left, usable
 
 
 def _vector_newton(loops: VectorLoops, q_all: list[np.ndarray], live: np.ndarray, size: float,
