@@ -34,6 +34,7 @@ from .continuation import Solver, classify_gap, continue_step, solve_position, s
 from .half_angle import cos_sin
 from .limits import solved_ranges_array
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
+from .rates import solve_rates_np
 from .stepwise import sweep
 from .vector_loops import LoopPlan, VectorLoops, loop_plan, singular_of, solve_linear
 from .warm_starts import Coarse, coarse_intervals, warm_starts
@@ -293,7 +294,21 @@ def _coarse_pass(solver: Solver, rough: SweepResult, grid: Sequence[float],
                 no_tangent[c] = True
             else:
                 slopes[c] = [ti / sc for ti, sc in zip(t, scale)]
-    return coarse_intervals(grid_arr, ok_coarse & ~no_tangent, coarse_sol, slopes, kinds)
+    return coarse_intervals(grid_arr, ok_coarse & ~no_tangent, coarse_sol, slopes,
+                            _curvatures(solver, coarse_sol, grid_arr, scale), kinds)
+
+
+def _curvatures(solver: Solver, sol: np.ndarray, grid: np.ndarray, scale: Sequence[float]) -> np.ndarray:
+    """d2q/dv2 at the coarse points (display units, one row per point; 0 where the coarse
+    pass did not solve or J is singular): the acceleration analysis of
+    :func:`~.rates.solve_rates_np` at unit driver speed and no driver acceleration."""
+    drv_scale = solver.scale
+    q = [sol[:, j] * sc for j, sc in enumerate(scale)]
+    with np.errstate(all="ignore"):
+        _, qdd, _ = solve_rates_np(solver.model, q, grid * drv_scale, 1.0, 0.0)
+        out = np.stack([np.asarray(a, dtype=float) * (drv_scale * drv_scale / sc)
+                        for a, sc in zip(qdd, scale)], axis=1)
+    return np.where(np.isfinite(out), out, 0.0)
 
 
 def _one_at_a_time(m: Mechanism, solver: Solver, rough: SweepResult, grid_arr: np.ndarray, vals: np.ndarray,
@@ -350,6 +365,10 @@ def _gap_status(m: Mechanism, solver: Solver, rough: SweepResult, near: Sequence
 
 VECTOR_ITER = 30
 """The most iterations of the vectorised Newton (the few slower positions go one at a time)."""
+
+FULL_ITERATIONS = 1
+"""Newton iterations of the vectorised Newton over every position of a block at once;
+the later ones gather the positions still going."""
 
 BLOCK = 16_384
 """Positions per block of the batch engine's vectorised steps (temporaries of 128 kB)."""
@@ -408,18 +427,19 @@ def _vector_newton(loops: VectorLoops, q_all: list[np.ndarray], live: np.ndarray
     """Step 3, textbook Newton at the ``live`` positions (q_all updated in place, internal
     units), each stopped as the single solve's loop stops it (:class:`~linkage.rules.SystemStops`,
     with its scales: a length step relative to the mechanism's size, max|Phi| within
-    tol x size); where each converged. The first two iterations (all most positions
-    need) evaluate every position and move only the live ones (no gathers); later ones
-    gather the few left. Position by position the iterates do not depend on the block."""
+    tol x size); where each converged. The first iteration (all most positions need from
+    the quintic warm start) evaluates every position and moves only the live ones (no
+    gathers); later ones gather the few left. Position by position the iterates do not
+    depend on the block: every evaluation takes its cosines and sines directly."""
     n, n_pos = len(kinds), len(live)
     steps = step_scales(kinds, size)
     stops = SystemStops(tol, residual_gate(tol, size), step_size_array(q_all, None))
     live = live.copy()
     done = np.zeros(n_pos, dtype=bool)
     it = 0
-    while it < min(2, max_iter) and live.any():
+    while it < min(FULL_ITERATIONS, max_iter) and live.any():
         it += 1
-        phi, jac = loops.evaluate(q_all, None, near=it > 1)
+        phi, jac = loops.evaluate(q_all, None)
         dq, det = solve_linear(jac, phi, n_pos)
         singular = singular_of(jac, det)
         step = step_size_array(dq, steps)
