@@ -291,34 +291,3 @@ def test_batch_of_no_position_and_of_one():
     assert list(one.status) == [0]
     want = sweep(m, [10.0]).positions[0].solution
     assert np.allclose(one.solution[0], [want["theta3"], want["theta4"]], rtol=0, atol=1e-10)
-
-
-def test_batch_trigonometry_after_a_small_step_is_within_a_few_ulps():
-    """The batch's second Newton evaluation takes cos and sin of each angle from the
-    first by the angle-addition formula where the step is at most 1e-6 rad; elsewhere
-    (a larger step, NaN) directly. Either way within 4 units in the last place of
-    np.cos/np.sin, and never twice in a row."""
-    import numpy as np
-
-    from linkage.kinematics.vector_loops import VectorLoops
-
-    m = load_mechanism(SAMPLES / "crank_rocker.toml")
-    rng = np.random.default_rng(11)
-    size = 200_000
-    loops = VectorLoops(m.model, rng.uniform(-7, 7, size))
-    q = [rng.uniform(-40, 40, size), rng.uniform(-7, 7, size)]
-    loops.evaluate(q, None)
-    step = rng.choice([1e-6, 1e-9, 1e-12, 3e-5, 0.1], size) * rng.choice([-1.0, 1.0], size)
-    step[::1000] = np.nan
-    q1 = [q[0] + step, q[1] - step]
-    loops.evaluate(q1, None, near=True)
-    assert not any(t[3] for t in loops.last_trig.values())  # the formula was used
-    for (aidx, _off), (_, c, s, _direct) in loops.last_trig.items():
-        want_c, want_s = np.cos(q1[aidx]), np.sin(q1[aidx])
-        ok = np.isfinite(want_c)
-        assert np.array_equal(np.isnan(c), ~ok)
-        ulp = np.spacing(1.0)
-        assert np.max(np.abs(c[ok] - want_c[ok])) <= 4 * ulp
-        assert np.max(np.abs(s[ok] - want_s[ok])) <= 4 * ulp
-    loops.evaluate([q1[0] + 1e-9, q1[1]], None, near=True)  # never twice in a row
-    assert all(t[3] for t in loops.last_trig.values())

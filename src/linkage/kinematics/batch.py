@@ -30,11 +30,10 @@ from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism
 from ..rules import GOING, SystemStops, converged_codes, residual_gate, step_scales, step_size_array
 from ..units import RAD_PER_DEG, degrees, radians
 from .angles import nearest_turn, nearest_turn_array
-from .continuation import Solver, classify_gap, continue_step, solve_position, solver_q, tangent
+from .continuation import Solver, classify_gap, continue_step, solve_position, solver_q
 from .half_angle import cos_sin
 from .limits import solved_ranges_array
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
-from .rates import solve_rates_np
 from .stepwise import sweep
 from .vector_loops import LoopPlan, VectorLoops, loop_plan, singular_of, solve_linear
 from .warm_starts import Coarse, coarse_intervals, warm_starts
@@ -183,16 +182,19 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
                         float(b.det[i]) if sol else None, self._transmission(sol, float(b.values[i])))
 
     def _transmission(self, sol: dict[str, float] | None, value: float) -> float | None:
-        """The transmission angle of a solved position (deg), by the derivation's rule
-        (:meth:`~linkage.problems.derive.Derivation.transmission`), as the one-at-a-time
-        sweep reports it."""
+        """The transmission angle of a solved position (deg), by the derivation's rule as
+        this sweep's columns compute it (its numpy twin,
+        :meth:`~linkage.problems.derive.Derivation.transmission_np`, as
+        :func:`~.columns.transmission_column` reads it): a position read and its row in a
+        written table are the same number, bit for bit."""
         m = self.batch.source
         if sol is None or m is None or not m.derivation.fourbars:
             return None
         scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-        q = [radians(sol[u.name]) if u.kind == "angle" else sol[u.name] for u in m.unknowns]
-        mu = m.derivation.transmission(q, value * scale)
-        return None if mu is None else degrees(mu)
+        q = [np.array([radians(sol[u.name]) if u.kind == "angle" else sol[u.name]]) for u in m.unknowns]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mu = m.derivation.transmission_np(q, np.array([value * scale]))
+        return float(degrees(mu)[0])
 
     def summary(self) -> dict[str, int]:
         codes, counts = np.unique(self.batch.status, return_counts=True)
@@ -277,38 +279,30 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
 
 def _coarse_pass(solver: Solver, rough: SweepResult, grid: Sequence[float],
                  scale: Sequence[float]) -> Coarse:
-    """The coarse sweep as the blocks read it: its solutions (display units) and the exact
-    tangents dq/dv there (:func:`~.continuation.tangent`); a position without a tangent is
-    no end of a usable interval."""
+    """The coarse sweep as the blocks read it: its solutions and their exact first and
+    second derivatives dq/dv and d2q/dv2 there (display units), by the acceleration
+    analysis of :func:`~.rates.solve_rates_np` at unit driver speed and no driver
+    acceleration, at every coarse point at once; a position where J is singular (no
+    tangent) is no end of a usable interval."""
+    from .rates import solve_rates_np  # (a small sweep, which imports this module, never loads it)
+
     names, kinds = solver.names, solver.kinds
     ok_coarse = np.array([p.status == "converged" for p in rough.positions])
     grid_arr = np.array(grid)
     coarse_sol = np.array([[p.solution[nm] if p.solution else np.nan for nm in names]
                            for p in rough.positions])
-    slopes = np.zeros_like(coarse_sol)
-    no_tangent = np.zeros(len(grid_arr), dtype=bool)
-    for c, p in enumerate(rough.positions):
-        if p.solution is not None:
-            t = tangent(solver, p.input, solver_q(solver, p))
-            if t is None:
-                no_tangent[c] = True
-            else:
-                slopes[c] = [ti / sc for ti, sc in zip(t, scale)]
-    return coarse_intervals(grid_arr, ok_coarse & ~no_tangent, coarse_sol, slopes,
-                            _curvatures(solver, coarse_sol, grid_arr, scale), kinds)
-
-
-def _curvatures(solver: Solver, sol: np.ndarray, grid: np.ndarray, scale: Sequence[float]) -> np.ndarray:
-    """d2q/dv2 at the coarse points (display units, one row per point; 0 where the coarse
-    pass did not solve or J is singular): the acceleration analysis of
-    :func:`~.rates.solve_rates_np` at unit driver speed and no driver acceleration."""
     drv_scale = solver.scale
-    q = [sol[:, j] * sc for j, sc in enumerate(scale)]
+    q = [coarse_sol[:, j] * sc for j, sc in enumerate(scale)]
     with np.errstate(all="ignore"):
-        _, qdd, _ = solve_rates_np(solver.model, q, grid * drv_scale, 1.0, 0.0)
-        out = np.stack([np.asarray(a, dtype=float) * (drv_scale * drv_scale / sc)
-                        for a, sc in zip(qdd, scale)], axis=1)
-    return np.where(np.isfinite(out), out, 0.0)
+        qd, qdd, solved = solve_rates_np(solver.model, q, grid_arr * drv_scale, 1.0, 0.0)
+        # d(q / sc) / d(v / drv_scale) and the second derivative likewise
+        slopes = np.stack([np.asarray(a, dtype=float) * (drv_scale / sc) for a, sc in zip(qd, scale)], axis=1)
+        bends = np.stack([np.asarray(a, dtype=float) * (drv_scale * drv_scale / sc)
+                          for a, sc in zip(qdd, scale)], axis=1)
+    usable = ok_coarse & np.broadcast_to(solved, ok_coarse.shape) & np.isfinite(slopes).all(axis=1)
+    usable &= np.isfinite(bends).all(axis=1)
+    return coarse_intervals(grid_arr, usable, coarse_sol, np.where(usable[:, None], slopes, 0.0),
+                            np.where(usable[:, None], bends, 0.0), kinds)
 
 
 def _one_at_a_time(m: Mechanism, solver: Solver, rough: SweepResult, grid_arr: np.ndarray, vals: np.ndarray,
