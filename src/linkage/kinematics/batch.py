@@ -136,6 +136,7 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
     def __init__(self, batch: BatchResult) -> None:
         self.batch = batch
         self._chunk: tuple[int, Sequence[Position]] = (-1, ())  # the last chunk with rates
+        self._angles: tuple[int, np.ndarray] = (-1, np.zeros(0))  # the last chunk's transmission
 
     def __len__(self) -> int:
         return len(self.batch.values)
@@ -179,22 +180,29 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         sol = ({n: float(b.solution[i, j]) for j, n in enumerate(b.coarse.names)}
                if st == "converged" else None)
         return Position(float(b.values[i]), st, sol, b.branch if sol else None, int(b.iterations[i]),
-                        float(b.det[i]) if sol else None, self._transmission(sol, float(b.values[i])))
+                        float(b.det[i]) if sol else None, self._transmission(i) if sol else None)
 
-    def _transmission(self, sol: dict[str, float] | None, value: float) -> float | None:
-        """The transmission angle of a solved position (deg), by the derivation's rule as
+    def _transmission(self, i: int) -> float | None:
+        """The transmission angle of solved position ``i`` (deg), by the derivation's rule as
         this sweep's columns compute it (its numpy twin,
         :meth:`~linkage.problems.derive.Derivation.transmission_np`, as
         :func:`~.columns.transmission_column` reads it): a position read and its row in a
-        written table are the same number, bit for bit."""
-        m = self.batch.source
-        if sol is None or m is None or not m.derivation.fourbars:
+        written table are the same number, bit for bit. A chunk of positions at a time
+        (RATES_CHUNK), the last chunk kept."""
+        b = self.batch
+        m = b.source
+        if m is None or not m.derivation.fourbars:
             return None
-        scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-        q = [np.array([radians(sol[u.name]) if u.kind == "angle" else sol[u.name]]) for u in m.unknowns]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            mu = m.derivation.transmission_np(q, np.array([value * scale]))
-        return float(degrees(mu)[0])
+        start = i - i % RATES_CHUNK
+        if self._angles[0] != start:
+            stop = min(len(self), start + RATES_CHUNK)
+            scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+            q = [radians(b.solution[start:stop, j]) if u.kind == "angle" else b.solution[start:stop, j]
+                 for j, u in enumerate(m.unknowns)]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                mu = m.derivation.transmission_np(q, b.values[start:stop] * scale)
+            self._angles = (start, degrees(np.broadcast_to(mu, (stop - start,))))
+        return float(self._angles[1][i - start])
 
     def summary(self) -> dict[str, int]:
         codes, counts = np.unique(self.batch.status, return_counts=True)
