@@ -43,3 +43,26 @@ def test_crank_rocker_warm_start_settles_in_one_newton_step():
     for j, want in enumerate((t3, t4)):
         gap = np.abs((got.solution[:, j] - want + 180.0) % 360.0 - 180.0)
         assert np.max(radians(gap)) <= 1e-12
+
+
+def test_batch_coarse_pass_by_the_closed_form_is_the_one_at_a_time_sweeps():
+    """The front door passes the closed form (kinematics/closed.py) for the coarse pass:
+    where it applies, the batch's statuses, branch and ranges are those of the coarse pass
+    by the one-at-a-time sweep, and its solutions agree to the stopping rule."""
+    from linkage.kinematics.closed import closed_sweep
+    from linkage.kinematics.positions import driver_values
+
+    tried = 0
+    for path in sorted(SAMPLES.glob("*.toml")):
+        name = path.stem
+        m = load(path)
+        values = np.array(driver_values(0.0, 360.0, None, 5001))
+        by_closed = batch_sweep(m, values, coarse_engine=closed_sweep)
+        by_steps = batch_sweep(m, values)
+        tried += closed_sweep(m, values[::10]) is not None
+        assert np.array_equal(by_closed.status, by_steps.status), name
+        assert by_closed.branch == by_steps.branch, name
+        assert by_closed.to_sweep().feasible_ranges == by_steps.to_sweep().feasible_ranges, name
+        ok = by_steps.status == 0
+        assert np.max(np.abs(by_closed.solution[ok] - by_steps.solution[ok]), initial=0.0) <= 1e-9, name
+    assert tried >= 5

@@ -18,7 +18,7 @@ The answers equal the one-at-a-time sweep's to about 1e-12 (tests check it).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from functools import partial
 from typing import Any
@@ -218,12 +218,16 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
 
 def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: str | None = None,
                 tol: float = 1e-12, max_iter: int = 50, coarse: int = 361, speed: float | None = None,
-                accel: float = 0.0, joints: bool = False) -> BatchResult:
+                accel: float = 0.0, joints: bool = False,
+                coarse_engine: Callable[..., BatchResult | None] | None = None) -> BatchResult:
     """Solve ``m`` at every driver value in ``values`` (display units, ascending). With a
     driver ``speed`` (and ``accel``) or ``joints``, every solved position read from the
     result carries ``.rates`` as the one-at-a-time sweep's do. ``max_iter`` caps every
     Newton run, as in the one-at-a-time sweep (the vectorised one at VECTOR_ITER at most:
-    a position slower than that goes the one-at-a-time way)."""
+    a position slower than that goes the one-at-a-time way). ``coarse_engine``: an engine
+    that sweeps the coarse grid as the one-at-a-time sweep does, or gives None where it
+    does not apply (the front door passes the closed form, :func:`~.closed.closed_sweep`,
+    which this module may not import: it imports this one)."""
     rates = (speed, accel) if speed is not None or joints else None
     vals = np.asarray(values, dtype=float)
     if vals.ndim != 1:
@@ -242,12 +246,14 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
                            np.zeros(0, dtype=np.int32), rough.branch, rough, 0, m, rates)
     lo, hi = float(vals[0]), float(vals[-1])
     grid = driver_values(lo, hi, None, min(coarse, n_pos))
-    rough = sweep(m, grid, branch=branch, tol=tol, max_iter=max_iter)
+    fast = None if coarse_engine is None else coarse_engine(m, grid, branch=branch, tol=tol,
+                                                            max_iter=max_iter)
+    rough = sweep(m, grid, branch=branch, tol=tol, max_iter=max_iter) if fast is None else fast.to_sweep()
     solver = Solver(m, "newton", tol, max_iter)
     names, kinds = solver.names, solver.kinds
     n = len(names)
     scale = [RAD_PER_DEG if k == "angle" else 1.0 for k in kinds]
-    coarse = _coarse_pass(solver, rough, grid, scale)
+    coarse = _coarse_pass(solver, rough, grid, scale, fast)
     grid_arr = coarse.grid
     drv_scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     code = STATUS_CODES
@@ -286,7 +292,7 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
 
 
 def _coarse_pass(solver: Solver, rough: SweepResult, grid: Sequence[float],
-                 scale: Sequence[float]) -> Coarse:
+                 scale: Sequence[float], fast: BatchResult | None = None) -> Coarse:
     """The coarse sweep as the blocks read it: its solutions and their exact first and
     second derivatives dq/dv and d2q/dv2 there (display units), by the acceleration
     analysis of :func:`~.rates.solve_rates_np` at unit driver speed and no driver
@@ -295,10 +301,14 @@ def _coarse_pass(solver: Solver, rough: SweepResult, grid: Sequence[float],
     from .rates import solve_rates_np  # (a small sweep, which imports this module, never loads it)
 
     names, kinds = solver.names, solver.kinds
-    ok_coarse = np.array([p.status == "converged" for p in rough.positions])
     grid_arr = np.array(grid)
-    coarse_sol = np.array([[p.solution[nm] if p.solution else np.nan for nm in names]
-                           for p in rough.positions])
+    if fast is not None:  # its columns, without a Position built per point
+        ok_coarse = fast.status == STATUS_CODES["converged"]
+        coarse_sol = np.where(ok_coarse[:, None], fast.solution, np.nan)
+    else:
+        ok_coarse = np.array([p.status == "converged" for p in rough.positions])
+        coarse_sol = np.array([[p.solution[nm] if p.solution else np.nan for nm in names]
+                               for p in rough.positions])
     drv_scale = solver.scale
     q = [coarse_sol[:, j] * sc for j, sc in enumerate(scale)]
     with np.errstate(all="ignore"):
