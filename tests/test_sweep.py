@@ -269,13 +269,15 @@ def test_batch_blocks_give_the_answer_of_one_block(name, lo, hi, monkeypatch):
 def test_batch_grid_index_equals_searchsorted():
     import numpy as np
 
-    from linkage.kinematics.batch import _grid_index
+    from linkage.kinematics.warm_starts import grid_left
 
     rng = np.random.default_rng(4)
     grid = np.linspace(-30.0, 400.0, 361)
     for vals in (np.sort(rng.uniform(-50, 420, 5000)), rng.uniform(-50, 420, 5000), grid.copy(),
                  np.repeat(grid[::7], 3), np.array([grid[5]]), np.array([-100.0, 1000.0])):
-        assert np.array_equal(_grid_index(grid, vals), np.searchsorted(grid, vals, side="right"))
+        want = np.clip(np.searchsorted(grid, vals, side="right"), 1, len(grid) - 1) - 1
+        assert np.array_equal(grid_left(grid, vals), want)
+    assert np.array_equal(grid_left(grid[:1], np.array([-1.0, 0.0, 5.0])), [0, 0, 0])
 
 
 def test_batch_of_no_position_and_of_one():
@@ -289,34 +291,3 @@ def test_batch_of_no_position_and_of_one():
     assert list(one.status) == [0]
     want = sweep(m, [10.0]).positions[0].solution
     assert np.allclose(one.solution[0], [want["theta3"], want["theta4"]], rtol=0, atol=1e-10)
-
-
-def test_batch_trigonometry_after_a_small_step_is_within_a_few_ulps():
-    """The batch's second Newton evaluation takes cos and sin of each angle from the
-    first by the angle-addition formula where the step is at most 1e-6 rad; elsewhere
-    (a larger step, NaN) directly. Either way within 4 units in the last place of
-    np.cos/np.sin, and never twice in a row."""
-    import numpy as np
-
-    from linkage.kinematics.vector_loops import VectorLoops
-
-    m = load_mechanism(SAMPLES / "crank_rocker.toml")
-    rng = np.random.default_rng(11)
-    size = 200_000
-    loops = VectorLoops(m.model, rng.uniform(-7, 7, size))
-    q = [rng.uniform(-40, 40, size), rng.uniform(-7, 7, size)]
-    loops.evaluate(q, None)
-    step = rng.choice([1e-6, 1e-9, 1e-12, 3e-5, 0.1], size) * rng.choice([-1.0, 1.0], size)
-    step[::1000] = np.nan
-    q1 = [q[0] + step, q[1] - step]
-    loops.evaluate(q1, None, near=True)
-    assert not any(t[3] for t in loops.last_trig.values())  # the formula was used
-    for (aidx, _off), (_, c, s, _direct) in loops.last_trig.items():
-        want_c, want_s = np.cos(q1[aidx]), np.sin(q1[aidx])
-        ok = np.isfinite(want_c)
-        assert np.array_equal(np.isnan(c), ~ok)
-        ulp = np.spacing(1.0)
-        assert np.max(np.abs(c[ok] - want_c[ok])) <= 4 * ulp
-        assert np.max(np.abs(s[ok] - want_s[ok])) <= 4 * ulp
-    loops.evaluate([q1[0] + 1e-9, q1[1]], None, near=True)  # never twice in a row
-    assert all(t[3] for t in loops.last_trig.values())

@@ -18,7 +18,7 @@ The answers equal the one-at-a-time sweep's to about 1e-12 (tests check it).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from functools import partial
 from typing import Any
@@ -30,11 +30,13 @@ from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism
 from ..rules import GOING, SystemStops, converged_codes, residual_gate, step_scales, step_size_array
 from ..units import RAD_PER_DEG, degrees, radians
 from .angles import nearest_turn, nearest_turn_array
-from .continuation import Solver, classify_gap, continue_step, solve_position, solver_q, tangent
+from .continuation import Solver, classify_gap, continue_step, solve_position, solver_q
+from .half_angle import cos_sin
 from .limits import solved_ranges_array
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
 from .stepwise import sweep
 from .vector_loops import LoopPlan, VectorLoops, loop_plan, singular_of, solve_linear
+from .warm_starts import Coarse, coarse_intervals, warm_starts
 
 STATUS_CODES = {"converged": 0, "no_solution": 1, "failed": 2, "off_branch": 3}
 CODE_STATUS = {v: k for k, v in STATUS_CODES.items()}
@@ -134,6 +136,7 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
     def __init__(self, batch: BatchResult) -> None:
         self.batch = batch
         self._chunk: tuple[int, Sequence[Position]] = (-1, ())  # the last chunk with rates
+        self._angles: tuple[int, np.ndarray] = (-1, np.zeros(0))  # the last chunk's transmission
 
     def __len__(self) -> int:
         return len(self.batch.values)
@@ -177,19 +180,29 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
         sol = ({n: float(b.solution[i, j]) for j, n in enumerate(b.coarse.names)}
                if st == "converged" else None)
         return Position(float(b.values[i]), st, sol, b.branch if sol else None, int(b.iterations[i]),
-                        float(b.det[i]) if sol else None, self._transmission(sol, float(b.values[i])))
+                        float(b.det[i]) if sol else None, self._transmission(i) if sol else None)
 
-    def _transmission(self, sol: dict[str, float] | None, value: float) -> float | None:
-        """The transmission angle of a solved position (deg), by the derivation's rule
-        (:meth:`~linkage.problems.derive.Derivation.transmission`), as the one-at-a-time
-        sweep reports it."""
-        m = self.batch.source
-        if sol is None or m is None or not m.derivation.fourbars:
+    def _transmission(self, i: int) -> float | None:
+        """The transmission angle of solved position ``i`` (deg), by the derivation's rule as
+        this sweep's columns compute it (its numpy twin,
+        :meth:`~linkage.problems.derive.Derivation.transmission_np`, as
+        :func:`~.columns.transmission_column` reads it): a position read and its row in a
+        written table are the same number, bit for bit. A chunk of positions at a time
+        (RATES_CHUNK), the last chunk kept."""
+        b = self.batch
+        m = b.source
+        if m is None or not m.derivation.fourbars:
             return None
-        scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
-        q = [radians(sol[u.name]) if u.kind == "angle" else sol[u.name] for u in m.unknowns]
-        mu = m.derivation.transmission(q, value * scale)
-        return None if mu is None else degrees(mu)
+        start = i - i % RATES_CHUNK
+        if self._angles[0] != start:
+            stop = min(len(self), start + RATES_CHUNK)
+            scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
+            q = [radians(b.solution[start:stop, j]) if u.kind == "angle" else b.solution[start:stop, j]
+                 for j, u in enumerate(m.unknowns)]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                mu = m.derivation.transmission_np(q, b.values[start:stop] * scale)
+            self._angles = (start, degrees(np.broadcast_to(mu, (stop - start,))))
+        return float(self._angles[1][i - start])
 
     def summary(self) -> dict[str, int]:
         codes, counts = np.unique(self.batch.status, return_counts=True)
@@ -205,12 +218,16 @@ class BatchPositions(Sequence):  # type: ignore[type-arg]
 
 def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: str | None = None,
                 tol: float = 1e-12, max_iter: int = 50, coarse: int = 361, speed: float | None = None,
-                accel: float = 0.0, joints: bool = False) -> BatchResult:
+                accel: float = 0.0, joints: bool = False,
+                coarse_engine: Callable[..., BatchResult | None] | None = None) -> BatchResult:
     """Solve ``m`` at every driver value in ``values`` (display units, ascending). With a
     driver ``speed`` (and ``accel``) or ``joints``, every solved position read from the
     result carries ``.rates`` as the one-at-a-time sweep's do. ``max_iter`` caps every
     Newton run, as in the one-at-a-time sweep (the vectorised one at VECTOR_ITER at most:
-    a position slower than that goes the one-at-a-time way)."""
+    a position slower than that goes the one-at-a-time way). ``coarse_engine``: an engine
+    that sweeps the coarse grid as the one-at-a-time sweep does, or gives None where it
+    does not apply (the front door passes the closed form, :func:`~.closed.closed_sweep`,
+    which this module may not import: it imports this one)."""
     rates = (speed, accel) if speed is not None or joints else None
     vals = np.asarray(values, dtype=float)
     if vals.ndim != 1:
@@ -229,12 +246,14 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
                            np.zeros(0, dtype=np.int32), rough.branch, rough, 0, m, rates)
     lo, hi = float(vals[0]), float(vals[-1])
     grid = driver_values(lo, hi, None, min(coarse, n_pos))
-    rough = sweep(m, grid, branch=branch, tol=tol, max_iter=max_iter)
+    fast = None if coarse_engine is None else coarse_engine(m, grid, branch=branch, tol=tol,
+                                                            max_iter=max_iter)
+    rough = sweep(m, grid, branch=branch, tol=tol, max_iter=max_iter) if fast is None else fast.to_sweep()
     solver = Solver(m, "newton", tol, max_iter)
     names, kinds = solver.names, solver.kinds
     n = len(names)
     scale = [RAD_PER_DEG if k == "angle" else 1.0 for k in kinds]
-    coarse = _coarse_pass(solver, rough, grid, scale)
+    coarse = _coarse_pass(solver, rough, grid, scale, fast)
     grid_arr = coarse.grid
     drv_scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
     code = STATUS_CODES
@@ -273,25 +292,35 @@ def batch_sweep(m: Mechanism, values: Sequence[float] | np.ndarray, *, branch: s
 
 
 def _coarse_pass(solver: Solver, rough: SweepResult, grid: Sequence[float],
-                 scale: Sequence[float]) -> _Coarse:
-    """The coarse sweep as the blocks read it: its solutions (display units) and the exact
-    tangents dq/dv there (:func:`~.continuation.tangent`); a position without a tangent is
-    no end of a usable interval."""
+                 scale: Sequence[float], fast: BatchResult | None = None) -> Coarse:
+    """The coarse sweep as the blocks read it: its solutions and their exact first and
+    second derivatives dq/dv and d2q/dv2 there (display units), by the acceleration
+    analysis of :func:`~.rates.solve_rates_np` at unit driver speed and no driver
+    acceleration, at every coarse point at once; a position where J is singular (no
+    tangent) is no end of a usable interval."""
+    from .rates import solve_rates_np  # (a small sweep, which imports this module, never loads it)
+
     names, kinds = solver.names, solver.kinds
-    ok_coarse = np.array([p.status == "converged" for p in rough.positions])
     grid_arr = np.array(grid)
-    coarse_sol = np.array([[p.solution[nm] if p.solution else np.nan for nm in names]
-                           for p in rough.positions])
-    slopes = np.zeros_like(coarse_sol)
-    no_tangent = np.zeros(len(grid_arr), dtype=bool)
-    for c, p in enumerate(rough.positions):
-        if p.solution is not None:
-            t = tangent(solver, p.input, solver_q(solver, p))
-            if t is None:
-                no_tangent[c] = True
-            else:
-                slopes[c] = [ti / sc for ti, sc in zip(t, scale)]
-    return _coarse(grid_arr, ok_coarse & ~no_tangent, coarse_sol, slopes, kinds)
+    if fast is not None:  # its columns, without a Position built per point
+        ok_coarse = fast.status == STATUS_CODES["converged"]
+        coarse_sol = np.where(ok_coarse[:, None], fast.solution, np.nan)
+    else:
+        ok_coarse = np.array([p.status == "converged" for p in rough.positions])
+        coarse_sol = np.array([[p.solution[nm] if p.solution else np.nan for nm in names]
+                               for p in rough.positions])
+    drv_scale = solver.scale
+    q = [coarse_sol[:, j] * sc for j, sc in enumerate(scale)]
+    with np.errstate(all="ignore"):
+        qd, qdd, solved = solve_rates_np(solver.model, q, grid_arr * drv_scale, 1.0, 0.0)
+        # d(q / sc) / d(v / drv_scale) and the second derivative likewise
+        slopes = np.stack([np.asarray(a, dtype=float) * (drv_scale / sc) for a, sc in zip(qd, scale)], axis=1)
+        bends = np.stack([np.asarray(a, dtype=float) * (drv_scale * drv_scale / sc)
+                          for a, sc in zip(qdd, scale)], axis=1)
+    usable = ok_coarse & np.broadcast_to(solved, ok_coarse.shape) & np.isfinite(slopes).all(axis=1)
+    usable &= np.isfinite(bends).all(axis=1)
+    return coarse_intervals(grid_arr, usable, coarse_sol, np.where(usable[:, None], slopes, 0.0),
+                            np.where(usable[:, None], bends, 0.0), kinds)
 
 
 def _one_at_a_time(m: Mechanism, solver: Solver, rough: SweepResult, grid_arr: np.ndarray, vals: np.ndarray,
@@ -346,54 +375,18 @@ def _gap_status(m: Mechanism, solver: Solver, rough: SweepResult, near: Sequence
     return others[0] if others else "failed"
 
 
-def _grid_index(grid: np.ndarray, vals: np.ndarray) -> np.ndarray:
-    """np.searchsorted(grid, vals, side="right"): for ascending vals (a sweep's) by one
-    merge, a quarter of the binary searches' time."""
-    if len(vals) > 1 and not (vals[1:] >= vals[:-1]).all():
-        return np.searchsorted(grid, vals, side="right")
-    # grid[c] <= vals[i] exactly when i >= first[c]: count the grid points passed
-    first = np.searchsorted(vals, grid, side="left")
-    return np.cumsum(np.bincount(first, minlength=len(vals) + 1)[:len(vals)])
-
-
 VECTOR_ITER = 30
 """The most iterations of the vectorised Newton (the few slower positions go one at a time)."""
+
+FULL_ITERATIONS = 1
+"""Newton iterations of the vectorised Newton over every position of a block at once;
+the later ones gather the positions still going."""
 
 BLOCK = 16_384
 """Positions per block of the batch engine's vectorised steps (temporaries of 128 kB)."""
 
 
-@dataclass(frozen=True)
-class _Coarse:
-    """The coarse pass as the blocks read it, arranged per interval [grid[c], grid[c + 1]]
-    where a block would otherwise recompute it per position."""
-
-    grid: np.ndarray
-    pair_usable: np.ndarray  # both ends solved, with a tangent
-    width: np.ndarray
-    solution: np.ndarray    # one row per unknown, per grid point (1-D rows gather faster)
-    next_value: np.ndarray  # the right end's value; for an angle, the one nearest the left's
-    slopes: np.ndarray      # dq/dv, one row per unknown, per grid point (display units)
-    allowed: np.ndarray     # how far a position may move from its guess (continuity)
-
-
-def _coarse(grid: np.ndarray, usable: np.ndarray, sol: np.ndarray, slopes: np.ndarray,
-            kinds: Sequence[str]) -> _Coarse:
-    rows = np.ascontiguousarray(sol.T)
-    one = len(grid) == 1  # a one-point grid is one interval, from the point to itself
-    nxt = rows.copy() if one else np.concatenate((rows[:, 1:], rows[:, -1:]), axis=1)
-    for j, k in enumerate(kinds):
-        if k == "angle":
-            nxt[j] = nearest_turn_array(rows[j], nxt[j])
-    with np.errstate(invalid="ignore"):
-        spread = np.zeros(1) if one else np.nanmax(np.abs(sol[1:] - sol[:-1]), axis=1, initial=0.0)
-    allowed = 2.0 * np.where(np.isfinite(spread), spread, 0.0) + 1e-6
-    pair = usable.copy() if one else np.append(usable[:-1] & usable[1:], False)
-    width = np.zeros(1) if one else np.append(grid[1:] - grid[:-1], 0.0)
-    return _Coarse(grid, pair, width, rows, nxt, np.ascontiguousarray(slopes.T), allowed)
-
-
-def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str], kinds: Sequence[str],
+def _settle(m: Mechanism, model: LoopModel, coarse: Coarse, names: Sequence[str], kinds: Sequence[str],
             scale: Sequence[float], vals: np.ndarray, drv_scale: float, tol: float, max_iter: int,
             branch: str | None, status: np.ndarray, iters: np.ndarray, det_out: np.ndarray,
             shown: np.ndarray, ref: np.ndarray) -> None:
@@ -403,12 +396,14 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
     arrays, written into the (N, n) outputs once (reading a strided column costs
     several times more)."""
     n, code = len(kinds), STATUS_CODES
-    refs, left, usable = _warm_starts(coarse, vals, n)
+    refs, left, usable = warm_starts(coarse, vals)
     drivers = vals * drv_scale
-    # the driver's cosine and sine, taken once for the loop equations and the branch rule
+    # the driver's cosine and sine, taken once for the loop equations and the branch rule;
+    # every cosine and sine here from the half-angle tangent (a fifth of the time of np.cos
+    # and np.sin, within half_angle.ABS_ERROR of them)
     plan = loop_plan(m) if model is m.model else LoopPlan.of(model)
-    trig = (np.cos(drivers), np.sin(drivers)) if plan.driver_angle else None
-    loops = VectorLoops(plan, drivers, trig)
+    trig = cos_sin(drivers) if plan.driver_angle else None
+    loops = VectorLoops(plan, drivers, trig, cos_sin)
     q_all = [r * sc for r, sc in zip(refs, scale)]
     done = _vector_newton(loops, q_all, usable, m.length_scale, kinds, tol, max_iter, iters, det_out)
     status[done] = code["converged"]
@@ -438,52 +433,25 @@ def _settle(m: Mechanism, model: LoopModel, coarse: _Coarse, names: Sequence[str
             ref[left_over, j] = refs[j][left_over]
 
 
-def _warm_starts(coarse: _Coarse, vals: np.ndarray,
-                 n: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
-    """Step 2, the warm starts (display units, one array per unknown): cubic Hermite
-    interpolation between coarse neighbours that both solved, with the exact tangents
-    dq/dv there (error ~ h^4: two Newton steps do); with each position's left grid index
-    and whether its interval is usable."""
-    take = np.take
-    right = np.clip(_grid_index(coarse.grid, vals), 1, len(coarse.grid) - 1)
-    left = right - 1
-    usable = take(coarse.pair_usable, left)
-    width = take(coarse.width, left)
-    g_left = take(coarse.grid, left)
-    if width.min() > 0.0:
-        u = (vals - g_left) / width
-    else:  # a one-point grid
-        u = np.where(width > 0, (vals - g_left) / np.where(width > 0, width, 1.0), 0.0)
-    one_minus_u_sq, u_sq = (1 - u) ** 2, u * u
-    h00, h10 = (1 + 2 * u) * one_minus_u_sq, u * one_minus_u_sq
-    h01, h11 = u_sq * (3 - 2 * u), u_sq * (u - 1)
-    h10, h11 = h10 * width, h11 * width  # (h10 * width) * slope, as written before: the same bits
-    refs = []
-    for j in range(n):
-        y0, y1 = take(coarse.solution[j], left), take(coarse.next_value[j], left)
-        refs.append(h00 * y0 + h10 * take(coarse.slopes[j], left) + h01 * y1
-                    + h11 * take(coarse.slopes[j], right))
-    return refs, left, usable
-
-
 def _vector_newton(loops: VectorLoops, q_all: list[np.ndarray], live: np.ndarray, size: float,
                    kinds: Sequence[str], tol: float, max_iter: int, iters: np.ndarray,
                    det_out: np.ndarray) -> np.ndarray:
     """Step 3, textbook Newton at the ``live`` positions (q_all updated in place, internal
     units), each stopped as the single solve's loop stops it (:class:`~linkage.rules.SystemStops`,
     with its scales: a length step relative to the mechanism's size, max|Phi| within
-    tol x size); where each converged. The first two iterations (all most positions
-    need) evaluate every position and move only the live ones (no gathers); later ones
-    gather the few left. Position by position the iterates do not depend on the block."""
+    tol x size); where each converged. The first iteration (all most positions need from
+    the quintic warm start) evaluates every position and moves only the live ones (no
+    gathers); later ones gather the few left. Position by position the iterates do not
+    depend on the block: every evaluation takes its cosines and sines directly."""
     n, n_pos = len(kinds), len(live)
     steps = step_scales(kinds, size)
     stops = SystemStops(tol, residual_gate(tol, size), step_size_array(q_all, None))
     live = live.copy()
     done = np.zeros(n_pos, dtype=bool)
     it = 0
-    while it < min(2, max_iter) and live.any():
+    while it < min(FULL_ITERATIONS, max_iter) and live.any():
         it += 1
-        phi, jac = loops.evaluate(q_all, None, near=it > 1)
+        phi, jac = loops.evaluate(q_all, None)
         dq, det = solve_linear(jac, phi, n_pos)
         singular = singular_of(jac, det)
         step = step_size_array(dq, steps)

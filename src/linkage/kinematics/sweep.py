@@ -118,9 +118,11 @@ def sweep_mechanism(
         from dataclasses import replace
 
         from .batch import batch_sweep
+        from .closed import closed_sweep  # the coarse pass by the closed form, where it applies
 
         return replace(batch_sweep(m, values, branch=branch, tol=tol, max_iter=max_iter, speed=speed,
-                                   accel=accel, joints=joints).to_sweep(), method="newton (batch)")
+                                   accel=accel, joints=joints, coarse_engine=closed_sweep).to_sweep(),
+                       method="newton (batch)")
     if batch is None and method == "newton" and n:
         # a dyadic mechanism on one branch: its closed form at every position at once
         # (kinematics/closed.py), where it applies; otherwise the engines below, unchanged

@@ -48,6 +48,11 @@ class LoopPlan:
         return cls(model.n, tuple(loops))
 
 
+def numpy_cos_sin(x: Any) -> tuple[Any, Any]:
+    """np.cos and np.sin of ``x``: the trigonometry :class:`VectorLoops` takes by default."""
+    return np.cos(x), np.sin(x)
+
+
 def loop_plan(m: Mechanism) -> LoopPlan:
     """The :class:`LoopPlan` of ``m``'s loop model, made once per mechanism (:func:`~.pose.implied`)."""
     from .pose import implied
@@ -62,12 +67,18 @@ class VectorLoops:
     (column by column): strided access into (N, m, n) arrays costs several times more.
     """
 
+    cos_sin: Any = staticmethod(numpy_cos_sin)
+    """cos and sin of an unknown angle's array, taken directly (see :meth:`_trig`)."""
+
     def __init__(self, model: LoopModel | LoopPlan, drv: np.ndarray,
-                 driver_trig: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+                 driver_trig: tuple[np.ndarray, np.ndarray] | None = None, cos_sin: Any = None) -> None:
         """The loops of ``model`` at the driver values ``drv``; a :class:`LoopPlan` of it
         (kept by a caller that sweeps the same model again) gives the same loops.
-        ``driver_trig``: np.cos and np.sin of ``drv``, where the caller took them for its
-        own use too; taken here when not given."""
+        ``driver_trig``: cos and sin of ``drv`` (by ``cos_sin``), where the caller took them for its
+        own use too; taken here when not given. ``cos_sin``: a function giving cos and sin
+        of an array within a stated bound (:mod:`.half_angle`), for np.cos and np.sin."""
+        if cos_sin is not None:
+            self.cos_sin = cos_sin
         plan = model if isinstance(model, LoopPlan) else LoopPlan.of(model)
         terms = [[t if len(t) == 2 else (t[0], drv if t[2] == DRIVER else t[1], t[2] if t[2] >= 0 else -1,
                                          drv if t[4] == DRIVER else t[3], t[4] if t[4] >= 0 else -1, t[5])
@@ -116,25 +127,24 @@ class VectorLoops:
                 fixed[2 * li + 1] = fixed[2 * li + 1] + y
         self.fixed = [f if np.shape(f) == (size,) else np.full(size, f) for f in fixed]
 
-    def evaluate(self, q: list[np.ndarray], rows: np.ndarray | None,
-                 near: bool = False) -> tuple[list[np.ndarray], list[list[Any]]]:
-        """Phi (m arrays) and J (m x n arrays or zeros) at ``rows`` (None: all positions).
-        ``near``: q is the last evaluation's q plus a Newton step (see :meth:`_trig`)."""
+    def evaluate(self, q: list[np.ndarray],
+                 rows: np.ndarray | None) -> tuple[list[np.ndarray], list[list[Any]]]:
+        """Phi (m arrays) and J (m x n arrays or zeros) at ``rows`` (None: all positions)."""
         def sub(a: Any) -> Any:
             return a if rows is None or not isinstance(a, np.ndarray) else a[rows]
 
         phi: list[Any] = [sub(f) for f in self.fixed]  # replaced, never modified in place
         jac: list[list[Any]] = [[0.0] * self.n for _ in range(self.m)]
-        trig: dict[tuple[int, float], tuple[Any, Any, Any, bool]] = {}
+        trig: dict[tuple[int, float], tuple[Any, Any]] = {}
         for li, sign, r, lidx, th, aidx, off in self.moving:
             rr = q[lidx] if lidx >= 0 else sub(r)
             if aidx >= 0 and rows is None:
-                c, s = self._trig(trig, aidx, off, q[aidx], near)
+                c, s = self._trig(trig, aidx, off, q[aidx])
             else:
                 tt = q[aidx] if aidx >= 0 else sub(th)
                 if off:
                     tt = tt + off
-                c, s = np.cos(tt), np.sin(tt)
+                c, s = self.cos_sin(tt)
             rc, rs = sign * rr * c, sign * rr * s
             phi[2 * li] = phi[2 * li] + rc
             phi[2 * li + 1] = phi[2 * li + 1] + rs
@@ -144,40 +154,16 @@ class VectorLoops:
             if lidx >= 0:
                 jac[2 * li][lidx] = jac[2 * li][lidx] + sign * c
                 jac[2 * li + 1][lidx] = jac[2 * li + 1][lidx] + sign * s
-        self.last_trig = trig
         return phi, jac
 
-    SMALL_STEP = 1e-6
-    """rad: below this, cos d = 1 - d^2/2 and sin d = d to within 1.7e-19 (d^3/6)."""
-
-    def _trig(self, trig: dict[tuple[int, float], tuple[Any, Any, Any, bool]], aidx: int, off: float,
-              qa: np.ndarray, near: bool) -> tuple[Any, Any]:
-        """cos and sin of an unknown angle (plus its offset) at every position. Just after
-        a Newton step, where it moved at most SMALL_STEP, from the values computed
-        directly at the previous iterate by the angle-addition formula, within a few units in the
-        last place of np.cos and np.sin (tests/test_sweep.py) for a fraction of the time:
-        the batch's second Newton evaluation, which certifies every position, costs two
-        trigonometric calls less per angle. Never twice in a row: a value so obtained is
-        not the base of another."""
+    def _trig(self, trig: dict[tuple[int, float], tuple[Any, Any]], aidx: int, off: float,
+              qa: np.ndarray) -> tuple[Any, Any]:
+        """cos and sin of an unknown angle (plus its offset) at every position, taken once
+        per evaluation however many terms read them."""
         key = (aidx, off)
-        if key in trig:
-            return trig[key][1], trig[key][2]
-        last = getattr(self, "last_trig", {}).get(key) if near else None
-        if last is not None and last[3]:
-            d = qa - last[0]  # exact: the two iterates are within a factor of 2 of each other
-            c0, s0 = last[1], last[2]
-            cd = 1.0 - 0.5 * (d * d)
-            c, s = c0 * cd - s0 * d, s0 * cd + c0 * d
-            far = ~(np.abs(d) <= self.SMALL_STEP)  # (NaN included): those directly
-            if far.any():
-                tt = qa[far] + off if off else qa[far]
-                c[far], s[far] = np.cos(tt), np.sin(tt)
-            trig[key] = (None, c, s, False)
-            return c, s
-        tt = qa + off if off else qa
-        c, s = np.cos(tt), np.sin(tt)
-        trig[key] = (qa.copy(), c, s, True)
-        return c, s
+        if key not in trig:
+            trig[key] = self.cos_sin(qa + off if off else qa)
+        return trig[key]
 
 
 def solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[list[np.ndarray], np.ndarray]:
