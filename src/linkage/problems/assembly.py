@@ -223,9 +223,16 @@ def open_rule(word: str, sign: float, coupler: Any, output: Any, xp: Any = math)
     output turns anticlockwise from the coupler, sin(output - coupler) > 0; a slider is open
     where the coupler runs along the slide, cos(output - coupler) > 0. ``sign`` (+1 or -1,
     exact) is the orientation the loop traverses them in. A property of the configuration,
-    whatever drives it."""
+    whatever drives it.
+
+    The four-bar's sign of sin(turn) is read as the sign of tan(turn / 2), its equal
+    (sin x = 2 tan(x/2) cos^2(x/2); turn / 2 is exact): numpy's tangent runs on the vector
+    unit where its sine does not, and this rule was the batch sweep's largest single cost
+    (benchmarks/target_rows.py 6). The two differ only at turn = +-2^-1074, whose half
+    rounds to 0: a configuration 1e-323 rad from its toggle, called crossed.
+    tests/test_open_rule.py holds the verdicts to sin's."""
     turn = output - coupler
-    return sign * (xp.sin(turn) if word == "fourbar" else xp.cos(turn)) > 0.0
+    return sign * (xp.tan(turn * 0.5) if word == "fourbar" else xp.cos(turn)) > 0.0
 
 
 def is_open(t3: float, t4: float) -> bool:
