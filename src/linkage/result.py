@@ -193,10 +193,15 @@ class Result:
         obj.nfev = nfev
         obj.error = error
         obj.residual = residual
-        obj.detail = detail
-        obj.njev = njev
         obj.raw_meta = meta
-        obj.raw_history = history
+        # a field at its default is read from the class (``detail``, ``njev``) or built as
+        # its default (``history``): a smaller namespace to carry over to the Result
+        if detail:
+            obj.detail = detail
+        if njev:
+            obj.njev = njev
+        if history is not None:
+            obj.raw_history = history
         obj.__class__ = cls
         return obj  # type: ignore[return-value]
 
