@@ -237,3 +237,34 @@ def test_every_generated_loop_carries_the_one_ordered_rule():
         positions = [rule.index(mark) for mark in marks]
         assert positions == sorted(positions), loop.signature
     assert isinstance(NEWTON_LOOP, Loop)
+
+
+def test_newtons_quiet_path_takes_any_real_number_type_as_the_generic_loop_does():
+    """The quiet path of the generated Newton is comparisons only (no type test): f and f'
+    returning numpy floats, ints, or a complex value part of the way end where the
+    generic loop does, with its status, detail, iterate and count."""
+    import numpy as np
+
+    def numpy_f(x: float) -> Any:
+        return np.float64(x) ** 3 - 2.0 * x - 5.0
+
+    def complex_f(x: float) -> Any:  # real down to x = 1.5, then (x - 1.5) ** 0.5 is complex
+        return (x - 1.5) ** 0.5 - 0.2 if x >= 1.5 else complex(0.0, 1.0)
+
+    cases = [
+        (ScalarProblem(numpy_f, fprime=lambda x: np.float64(3.0) * x * x - 2.0), 3.0),
+        (ScalarProblem(lambda x: round(x) ** 2 - 4 if abs(x) < 1e6 else x * x - 4.0,
+                       fprime=lambda x: 2.0 * x), 7.0),
+        (ScalarProblem(complex_f, fprime=lambda x: 0.5 / (abs(x - 1.5) ** 0.5 + 1e-300)), 9.0),
+        (ScalarProblem(lambda x: x * x - 2.0, fprime=lambda x: 2.0 * x), 1e150),
+    ]
+    m = method_class("newton")()
+    for tol in (1e-12, 1e-6):
+        for problem, x0 in cases:
+            crit = Criteria(tol, 0.0, None, 60)
+            state = m.init(problem, x0)
+            final, status, detail, k, _ = run(m, problem, state, crit, record=False,
+                                              certify=_certify(problem))
+            r = newton_result(problem, x0, crit)
+            assert (r.status, r.detail, r.iterations) == (status, detail, k), (x0, tol)
+            assert _bits((r.x, r.residual, r.error)) == _bits((final.x, final.fx, final.err)), (x0, tol)

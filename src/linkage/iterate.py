@@ -147,6 +147,10 @@ def explain(exc: BaseException) -> tuple[Status, str]:
 _CONVERGED_NAMES = frozenset({"CONVERGED_STEP", "CONVERGED_EXACT", "CONVERGED_RESIDUAL"})
 
 
+SCALAR_MAGNITUDE = "(x if x >= 0.0 else -x)"
+"""|x| of a scalar iterate, as a loop's source computes it."""
+
+
 class Loop(NamedTuple):
     """A method's part of a generated loop; the stopping tests are :func:`stopping_tests`'.
 
@@ -184,7 +188,7 @@ class Loop(NamedTuple):
     """Test 6: ``""`` (a bracket cannot diverge), ``streak`` or ``runaway`` (systems)."""
     diverge_when: str = ""
     """An expression: test 6 runs only where it holds (``not damped``)."""
-    magnitude: str = "(x if x >= 0.0 else -x)"
+    magnitude: str = SCALAR_MAGNITUDE
     limit: str = "_step_limit(tol, rtol, ax) if rtol else tol"
     failure: str = ""
     """When given, every stop other than convergence runs this line instead (``return None``)."""
@@ -233,6 +237,9 @@ def quiet_path(out: _Emitter) -> None:
     plausibility, a certificate nor a system's residual gate is consulted), not above the
     previous error (test 6 resets its streak, where it runs) and above rounding (test 7)."""
     loop, put = out.loop, out.put
+    if takes_scalar_quiet_path(loop):
+        scalar_quiet_path(out)
+        return
     put(0, "if quiet and type(err) is float and type(fx) is float:")
     put(1, "size = fx if fx >= 0.0 else -fx")
     put(1, f"ax = {loop.magnitude}")
@@ -248,6 +255,35 @@ def quiet_path(out: _Emitter) -> None:
         put(2, "growth = 0")
     put(2, "prev_err = err")
     put(2, "continue")
+
+
+def takes_scalar_quiet_path(loop: Loop) -> bool:
+    """An open scalar method's loop (the guard, a divergence streak, |x| as the magnitude,
+    a residual after every step): its quiet path is :func:`scalar_quiet_path`."""
+    return (loop.guard and loop.diverge == "streak" and not loop.fx_optional
+            and loop.magnitude == SCALAR_MAGNITUDE)
+
+
+def scalar_quiet_path(out: _Emitter) -> None:
+    """:func:`quiet_path` for an open scalar method (Newton), in one chained condition of
+    comparisons only, each a test that cannot fire: the error above ``qtol`` (``tol``
+    where the path is allowed, else infinity, so the flag costs nothing per step) and not
+    above the previous one (test 6; ``prev_err`` starts at the largest float, so this
+    also says the error is finite); ``-best < f < best``: |f| finite and below the best
+    seen, which it becomes (a step that does not improve |f| takes the tests, which give
+    the same state); f not zero (tests 3-4); ``-err < rounding * x < err``, the error
+    above rounding, which also says x is finite (test 7). A value that does not compare
+    as a real number (a complex f) raises TypeError here and takes the tests, which name
+    it. So any real number type takes the same path as a float would."""
+    put = out.put
+    put(0, "try:")
+    put(1, "if qtol < err <= prev_err and -best < fx < best and fx != 0.0 and -err < _ROUNDING * x < err:")
+    put(2, "best = fx if fx >= 0.0 else -fx")
+    put(2, "growth = 0")
+    put(2, "prev_err = err")
+    put(2, "continue")
+    put(0, "except TypeError:")
+    put(1, "pass")
 
 
 def _value_tests(out: _Emitter) -> None:
@@ -358,14 +394,23 @@ def _block(text: str, level: int) -> list[str]:
 _QUIET_FTOL = "ftol is None and "
 
 
+def quiet_flag(loop: Loop) -> list[str]:
+    """The preamble's line that allows the quiet path: without ``rtol`` and a residual
+    test's ``ftol``; for :func:`scalar_quiet_path` as the threshold ``qtol``."""
+    allowed = f"{_QUIET_FTOL if loop.residual_test else ''}not rtol"
+    if takes_scalar_quiet_path(loop):
+        return [f"    qtol = tol if {allowed} else _inf"]
+    return [f"    quiet = {allowed}"]
+
+
 def loop_source(loop: Loop) -> str:
     """The source of the function ``loop`` describes: its setup, then for k = 1..max_iter
     its step and the ordered stopping tests, then test 8 (the cap) and its result."""
     lines = [f"def {loop.signature}:", *_block(loop.setup, 1),
              '    status, detail = _S.MAX_ITER, ""',
-             "    prev_err = _inf",
+             "    prev_err = _BIG",
              "    growth = uncertified = stalls = rounding_steps = k = " + ("extra = " * loop.counted) + "0",
-             *([f"    quiet = {_QUIET_FTOL if loop.residual_test else ''}not rtol"] if loop.quiet else []),
+             *(quiet_flag(loop) if loop.quiet else []),
              "    for k in range(1, max_iter + 1):",
              "        try:", *_block(loop.step, 3),
              "        except (ArithmeticError, ValueError) as exc:"]
@@ -385,7 +430,8 @@ def build_loop(loop: Loop, names: dict[str, Any] | None = None) -> Callable[...,
         "_S": STATUS_MEMBERS, "_inf": math.inf, "_nan": math.nan, "_isfinite": math.isfinite,
         "_explain": explain, "_judge": judge_certificate, "_stall": rounding_stall,
         "_worse": worse_than_seen, "_step_limit": step_limit, "_system_converged": system_converged,
-        "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_RUNAWAY": RUNAWAY, **(names or {})}
+        "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_BIG": sys.float_info.max, "_RUNAWAY": RUNAWAY,
+        **(names or {})}
     name = loop.signature.split("(", 1)[0]
     exec(compile(loop_source(loop), f"<linkage-loop {name}>", "exec"), namespace)
     return namespace[name]  # type: ignore[no-any-return]

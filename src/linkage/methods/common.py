@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
-from ..result import Status
+from ..problems.scalar import ScalarProblem
+from ..result import History, Status
 
 new_state = tuple.__new__
 """Build a NamedTuple state without its Python-level ``__new__``.
@@ -35,3 +37,18 @@ def start_stop(problem: Any, x0: float, fx: float) -> Any:
     if fx != fx or abs(fx) == float("inf"):
         return (Status.NON_FINITE, f"f({problem.var}={x0:g}) = {fx!r}")
     return None
+
+
+def history_of(m: Any, problem: ScalarProblem, rows: Any) -> History:
+    """A scalar solve's ``Result.history`` from its loop's rows (a list or an
+    :class:`~linkage.iterate.Rows`), built when first read."""
+    labels = column_labels(m, problem.var, problem.unit, problem.u is not None, problem.gprime is not None)
+    return History.of(labels, rows, len(labels) - 1)
+
+
+@functools.lru_cache(maxsize=128)
+def column_labels(m: Any, var: str, unit: str, has_u: bool, has_gprime: bool) -> tuple[str, ...]:
+    """A method's table headers for a problem's names and units (computed once)."""
+    shape = ScalarProblem(f=abs, var=var, unit=unit, u=abs if has_u else None,
+                          gprime=abs if has_gprime else None)
+    return tuple(c.label(var, unit) for c in m.columns(shape))

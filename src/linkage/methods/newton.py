@@ -15,10 +15,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import HISTORY_HEAD, Loop, build_loop, dedent
+from ..iterate import HISTORY_HEAD, Criteria, Loop, build_loop, dedent
 from ..problems.scalar import ScalarProblem
-from ..result import Column, Status
-from .common import new_state, start_stop
+from ..result import Column, Result, Status
+from .common import history_of, new_state, start_stop
 
 
 class NewtonState(NamedTuple):
@@ -82,6 +82,21 @@ def _join(*parts: str) -> str:
     return dedent("".join(part.rstrip(" ") for part in parts))
 
 
+def _packaged(record: bool, status: str, k: str, extra: str, err: str, detail: str) -> str:
+    """The loop's outcome as its Result (one expression for the start's verdict and the
+    loop's end): ``k`` steps, each two evaluations, after the start's one, and ``extra``
+    made by the certificate; meta and history kept raw (:meth:`Result.fast`)."""
+    history = "(_history, _method, problem, rows)" if record else "None"
+    return (f'_fast("newton", x, {status}, {k}, 1 + 2 * {k} + {extra}, {err}, fx, {detail}, 0, '
+            f'(_meta, problem, crit, x0), {history})')
+
+
+def newton_meta(problem: ScalarProblem, crit: Criteria, x0: float) -> dict[str, Any]:
+    """A Newton solve's ``Result.meta``, built when first read."""
+    return {"var": problem.var, "unit": problem.unit, "title": problem.title,
+            "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, "x0": x0}
+
+
 def newton_loop(record: bool) -> Loop:
     """Newton's step around the ordered stopping rule, recording rows into ``rows`` (an
     :class:`~linkage.iterate.Rows`, required) when ``record``; without it the loop has no row
@@ -89,18 +104,22 @@ def newton_loop(record: bool) -> Loop:
     (:func:`linkage.iterate.quiet_path`)."""
     name = "newton_lean" if record else "newton_quiet"
     return Loop(
-        signature=f"{name}(problem, x0, tol, rtol, ftol, max_iter, certify, rows=None)",
+        signature=f"{name}(problem, x0, crit, certify, rows=None)",
         setup=_join("""\
             append = rows.append  # the first HISTORY_HEAD rows, as Rows.add
             """ if record else "", """\
+            tol, rtol, ftol, max_iter = crit
             f, fp = problem.f, problem.fprime
             x = x0
             fx = f(x)
             if fx == 0.0 or fx - fx != 0.0:  # the start's verdict (_start_stop) can only be a stop
                 stop = _start_stop(problem, x0, fx)
                 if stop is not None:
-                    return x, fx, _inf, stop[0], stop[1], 0, 0
-            best = start = abs(fx) if isinstance(fx, float) else _inf
+            """, " " * 20 + "return " + _packaged(record, "stop[0]", "0", "0", "_inf", "stop[1]") + "\n", """\
+            if isinstance(fx, float):
+                best = start = abs(fx)
+            else:  # the guard's start (test 5); best as the largest float: a finite bound
+                best, start = _BIG, _inf
             err = _inf
             """),
         step=_join("""\
@@ -128,7 +147,7 @@ def newton_loop(record: bool) -> Loop:
             """ if record else "", """\
             x, fx = x1, fx1
             """),
-        result="x, fx, err, status, detail, k, extra",
+        tail="return " + _packaged(record, "status", "k", "extra", "err", "detail") + "\n",
         guard=True, step_test="certify", counted=True, diverge="streak", quiet=True)
 
 
@@ -136,13 +155,15 @@ NEWTON_LOOP = newton_loop(record=True)
 """Newton as one tight loop: the stopping rule of :mod:`linkage.iterate` around Newton's
 step, without states or method dispatch; the generic loop's status, root, iteration count
 and, into ``rows`` (an :class:`~linkage.iterate.Rows`), its table row for row
-(tests/test_compile.py, tests/test_kernel.py). ``newton_lean(problem, x0, tol, rtol, ftol,
-max_iter, certify, rows)`` returns (x, f(x), last error, status, detail, iterations,
-evaluations of f the certificate made); ``certify(problem, x, fx, width)`` decides a small
-step (:func:`linkage.solve.certify_root`)."""
+(tests/test_compile.py, tests/test_kernel.py). ``newton_lean(problem, x0, crit, certify,
+rows)`` returns the solve's :class:`~linkage.result.Result` (its meta and history built when
+first read); ``certify(problem, x, fx, width)`` decides a small step
+(:func:`linkage.solve.certify_root`)."""
 
-newton_lean = build_loop(NEWTON_LOOP, {"_start_stop": start_stop, "_HEAD": HISTORY_HEAD})
+_NAMES = {"_start_stop": start_stop, "_fast": Result.fast, "_meta": newton_meta, "_history": history_of,
+          "_method": Newton()}
+newton_lean = build_loop(NEWTON_LOOP, {**_NAMES, "_HEAD": HISTORY_HEAD})
 
 NEWTON_QUIET_LOOP = newton_loop(record=False)
-newton_quiet = build_loop(NEWTON_QUIET_LOOP, {"_start_stop": start_stop})
+newton_quiet = build_loop(NEWTON_QUIET_LOOP, _NAMES)
 """``newton_lean`` without rows (its ``rows`` is ignored): the same outcome, bit for bit."""

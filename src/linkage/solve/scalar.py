@@ -5,7 +5,6 @@ what it needs, how it is built. Nothing here names a method except Newton's fast
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import replace
@@ -15,6 +14,7 @@ from ..arguments import check_callable, check_number, check_reals, guarded
 from ..errors import InputError
 from ..iterate import Criteria, Rows, explain, run
 from ..methods import METHODS, SCALAR_METHODS, MethodEntry, method_class
+from ..methods.common import history_of
 from ..problems.scalar import ScalarProblem
 from ..result import History, Result, Status
 from .certificate import certify_root, check_sign_change, final_bracket, value_or_none
@@ -151,69 +151,38 @@ def failed_at_start(name: str, problem: ScalarProblem, x: float, crit: Criteria,
                         "tol": crit.tol, "rtol": crit.rtol, **start})
 
 
-_newton_loop: Any = None
-"""linkage.methods.newton.newton_lean once a scalar Newton solve has loaded it (a sweep or
-a system solve never does)."""
+_newton_loops: Any = None
+"""(linkage.methods.newton.newton_quiet, newton_lean) once a scalar Newton solve has loaded
+them (a sweep or a system solve never does)."""
 
 
-_newton_recording: Any = None
-_newton_method: Any = None
-"""With ``_newton_loop``: the recording loop and the method (for its table's columns)."""
+def _load_newton_loops() -> Any:
+    global _newton_loops
+    from ..methods.newton import newton_lean, newton_quiet
 
-
-def _load_newton_loop() -> Any:
-    global _newton_loop, _newton_recording, _newton_method
-    from ..methods.newton import Newton, newton_lean, newton_quiet
-
-    _newton_loop, _newton_recording, _newton_method = newton_quiet, newton_lean, Newton()
-    return newton_quiet
+    _newton_loops = (newton_quiet, newton_lean)
+    return _newton_loops
 
 
 def newton_result(problem: ScalarProblem, x0: float, crit: Criteria, record: bool = False) -> Result:
-    """Newton by its generated loop (:func:`~linkage.methods.newton.newton_lean`),
-    packaged exactly as :func:`finish` packages the generic loop's outcome (history
-    included when ``record``)."""
-    rows = Rows() if record else None
+    """Newton by its generated loop (:func:`~linkage.methods.newton.newton_lean`), which
+    packages its outcome as :func:`finish` packages the generic loop's (history included
+    when ``record``)."""
     try:
-        loop = _newton_loop or _load_newton_loop()
         if record:
-            loop = _newton_recording
-        x, fx, err, status, detail, k, extra = loop(problem, x0, crit.tol, crit.rtol, crit.ftol,
-                                                    crit.max_iter, certify_root, rows)
+            return (_newton_loops or _load_newton_loops())[1](problem, x0, crit, certify_root, Rows())
+        return (_newton_loops or _load_newton_loops())[0](problem, x0, crit, certify_root)
     except TypeError:  # the generic path's answer to a non-real f at the start
         return failed_at_start("newton", problem, x0, crit, record, {"x0": x0}, Status.DOMAIN_ERROR,
                                "f returned a non-real value")
     except (ArithmeticError, ValueError) as exc:
         return failed_at_start("newton", problem, x0, crit, record, {"x0": x0}, *explain(exc))
-    return Result.fast("newton", x, status, k, 1 + 2 * k + extra, err, fx, detail, 0,
-                       (newton_meta, problem, crit, x0),
-                       None if rows is None else (history_of, _newton_method, problem, rows))
-
-
-def newton_meta(problem: ScalarProblem, crit: Criteria, x0: float) -> dict[str, Any]:
-    """A Newton solve's ``Result.meta``, built when first read."""
-    return {"var": problem.var, "unit": problem.unit, "title": problem.title,
-            "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, "x0": x0}
 
 
 def scalar_meta(problem: ScalarProblem, crit: Criteria, start: dict[str, Any]) -> dict[str, Any]:
     """A scalar solve's ``Result.meta`` (the start as ``start`` names it), built when first read."""
     return {"var": problem.var, "unit": problem.unit, "title": problem.title,
             "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, **start}
-
-
-def history_of(m: Any, problem: ScalarProblem, rows: Rows) -> History:
-    """A scalar solve's ``Result.history`` from its loop's rows, built when first read."""
-    labels = column_labels(m, problem.var, problem.unit, problem.u is not None, problem.gprime is not None)
-    return History.of(labels, rows, len(labels) - 1)
-
-
-@functools.lru_cache(maxsize=128)
-def column_labels(m: Any, var: str, unit: str, has_u: bool, has_gprime: bool) -> tuple[str, ...]:
-    """A method's table headers for a problem's names and units (computed once)."""
-    shape = ScalarProblem(f=abs, var=var, unit=unit, u=abs if has_u else None,
-                          gprime=abs if has_gprime else None)
-    return tuple(c.label(var, unit) for c in m.columns(shape))
 
 
 def iterate_from(m: Any, problem: ScalarProblem, state: Any, crit: Criteria,
