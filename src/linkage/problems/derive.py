@@ -212,13 +212,19 @@ class Derivation(NamedTuple):
         two-way step on its sign (0, on the line, counts as either) or its word, except
         where the step's assemblies meet (:meth:`meets`), which is on either. Which of two
         assemblies of one name (a mirror) a position is on is the continuity test's to
-        decide. The one rule of every engine; :meth:`on_branch_np` is its twin."""
-        meets = self.meets(q, driver, params)
+        decide. The one rule of every engine; :meth:`on_branch_np` is its twin. As there, a
+        meeting is read only where a step's sign or word is not the one wanted (a sweep on
+        its branch, every position, does not pay for it): the same verdict as reading it
+        always."""
         if want.signs is not None:
             sides = self.signs_of(q, driver, params)
-            return all(s == w or s == 0.0 or m for s, w, m in zip(sides, want.signs, meets))
-        words = self.words_of(q, driver, params)
-        return all((w in ("open", "+")) == wanted or m for w, wanted, m in zip(words, want.words, meets))
+            hits = [s == w or s == 0.0 for s, w in zip(sides, want.signs)]
+        else:
+            words = self.words_of(q, driver, params)
+            hits = [(w in ("open", "+")) == wanted for w, wanted in zip(words, want.words)]
+        if all(hits):
+            return True
+        return all(h or m for h, m in zip(hits, self.meets(q, driver, params)))
 
     def on_branch_np(self, q: Sequence[Any], driver: Any, want: BranchText,
                      params: Mapping[str, Any] | None = None,
