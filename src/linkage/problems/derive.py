@@ -261,11 +261,14 @@ class Derivation(NamedTuple):
         q: list[float] = [math.nan] * self.n
         out: list[float] = []
         signs_left = iter(signs)
+        last = self.steps[-1] if self.steps else None
         for step in self.steps:
             sigma = next(signs_left) if step.two_way else 0.0
             first, second, k = coefficients(step, p, driver, q, math)
             if step.two_way:
                 out.append(step_margin(step.case, first, second, k))
+            if step is last:
+                break  # no later step reads its unknowns (a limit scan's every call)
             try:
                 got = solve_step(step.case, first, second, k, sigma)
             except ZeroDivisionError:
