@@ -207,7 +207,7 @@ class Derivation(NamedTuple):
             return [np.abs(step_margin_np(case, *c)) <= TANGENT_SLACK for case, c in zip(cases, coefs)]
 
     def on_branch(self, q: Sequence[float], driver: float, want: BranchText,
-                  params: Mapping[str, float] | None = None) -> bool:
+                  params: Mapping[str, float] | None = None, words: Sequence[str] | None = None) -> bool:
         """Whether a configuration is on the branch ``want`` (:func:`read_branch`): each
         two-way step on its sign (0, on the line, counts as either) or its word, except
         where the step's assemblies meet (:meth:`meets`), which is on either. Which of two
@@ -215,12 +215,14 @@ class Derivation(NamedTuple):
         decide. The one rule of every engine; :meth:`on_branch_np` is its twin. As there, a
         meeting is read only where a step's sign or word is not the one wanted (a sweep on
         its branch, every position, does not pay for it): the same verdict as reading it
-        always."""
+        always. ``words``: the configuration's :meth:`words_of` here, where the caller has
+        them (a sweep names every position)."""
         if want.signs is not None:
             sides = self.signs_of(q, driver, params)
             hits = [s == w or s == 0.0 for s, w in zip(sides, want.signs)]
         else:
-            words = self.words_of(q, driver, params)
+            if words is None:
+                words = self.words_of(q, driver, params)
             hits = [(w in ("open", "+")) == wanted for w, wanted in zip(words, want.words)]
         if all(hits):
             return True
