@@ -40,8 +40,13 @@ def test_a_sweep_without_rates_does_not_load_the_rate_engine():
 
 def test_a_sweep_table_without_rates_does_not_load_the_rate_engine():
     loaded = _loaded_after("import linkage.render.sweep")
-    assert "linkage.kinematics.labels" in loaded
+    assert "linkage.kinematics.sweep" in loaded
+    # the rate cells are imported only by a table that has rates (a cold sweep's start)
+    assert "linkage.render.rates" not in loaded
     assert "linkage.kinematics.rates" not in loaded
+    with_cells = _loaded_after("import linkage.render.sweep, linkage.render.rates")
+    assert "linkage.kinematics.labels" in with_cells
+    assert "linkage.kinematics.rates" not in with_cells
 
 
 def test_a_solves_rates_do_not_load_the_sweep_result_types():

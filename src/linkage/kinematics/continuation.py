@@ -174,7 +174,9 @@ class Solver:
                     self._wanted[target] = None  # no branch of this mechanism: no position is on it
             want = self._wanted[target]
             # the derivation's one rule: a step whose assemblies meet here is on either
-            return want is not None and d.on_branch(q, value * self.scale, want)
+            # (``label``, where given, is :meth:`branch` here: the words name_of joined)
+            return want is not None and d.on_branch(q, value * self.scale, want,
+                                                    words=None if label is None else label.split("/"))
         return (label if label is not None else self.branch(q, det, value)) == target
 
 

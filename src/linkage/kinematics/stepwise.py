@@ -297,12 +297,19 @@ def _anchor(solver: Solver, positions: list[Position], angles: list[str],
                         closes, driver_turn(m.driver.unit))
     if near is None:
         return none
-    from ..solve import solve_system
+    from .pose import file_pose
 
-    r = solve_system(solver.problem(v0), tuple(u.value for u in m.unknowns), tol=solver.tol, record=False)
-    if not r.converged:
-        return none
-    ref = solver.display(r.x)
+    # the file's pose as the sweep's default branch already solved it (solve FILE's own
+    # solve: the file's guesses at its driver value, Newton to 1e-12), where it did
+    x = file_pose(m) if solver.tol == 1e-12 else None
+    if x is None:
+        from ..solve import solve_system
+
+        r = solve_system(solver.problem(v0), tuple(u.value for u in m.unknowns), tol=solver.tol, record=False)
+        if not r.converged:
+            return none
+        x = r.x
+    ref = solver.display(x)
     sol = positions[near].solution
     assert sol is not None
     return {n: turn_shift(ref[n], continuous(sol[n], turns[n][near])) for n in angles}  # type: ignore[arg-type]

@@ -207,18 +207,26 @@ class Derivation(NamedTuple):
             return [np.abs(step_margin_np(case, *c)) <= TANGENT_SLACK for case, c in zip(cases, coefs)]
 
     def on_branch(self, q: Sequence[float], driver: float, want: BranchText,
-                  params: Mapping[str, float] | None = None) -> bool:
+                  params: Mapping[str, float] | None = None, words: Sequence[str] | None = None) -> bool:
         """Whether a configuration is on the branch ``want`` (:func:`read_branch`): each
         two-way step on its sign (0, on the line, counts as either) or its word, except
         where the step's assemblies meet (:meth:`meets`), which is on either. Which of two
         assemblies of one name (a mirror) a position is on is the continuity test's to
-        decide. The one rule of every engine; :meth:`on_branch_np` is its twin."""
-        meets = self.meets(q, driver, params)
+        decide. The one rule of every engine; :meth:`on_branch_np` is its twin. As there, a
+        meeting is read only where a step's sign or word is not the one wanted (a sweep on
+        its branch, every position, does not pay for it): the same verdict as reading it
+        always. ``words``: the configuration's :meth:`words_of` here, where the caller has
+        them (a sweep names every position)."""
         if want.signs is not None:
             sides = self.signs_of(q, driver, params)
-            return all(s == w or s == 0.0 or m for s, w, m in zip(sides, want.signs, meets))
-        words = self.words_of(q, driver, params)
-        return all((w in ("open", "+")) == wanted or m for w, wanted, m in zip(words, want.words, meets))
+            hits = [s == w or s == 0.0 for s, w in zip(sides, want.signs)]
+        else:
+            if words is None:
+                words = self.words_of(q, driver, params)
+            hits = [(w in ("open", "+")) == wanted for w, wanted in zip(words, want.words)]
+        if all(hits):
+            return True
+        return all(h or m for h, m in zip(hits, self.meets(q, driver, params)))
 
     def on_branch_np(self, q: Sequence[Any], driver: Any, want: BranchText,
                      params: Mapping[str, Any] | None = None,
@@ -255,11 +263,14 @@ class Derivation(NamedTuple):
         q: list[float] = [math.nan] * self.n
         out: list[float] = []
         signs_left = iter(signs)
+        last = self.steps[-1] if self.steps else None
         for step in self.steps:
             sigma = next(signs_left) if step.two_way else 0.0
             first, second, k = coefficients(step, p, driver, q, math)
             if step.two_way:
                 out.append(step_margin(step.case, first, second, k))
+            if step is last:
+                break  # no later step reads its unknowns (a limit scan's every call)
             try:
                 got = solve_step(step.case, first, second, k, sigma)
             except ZeroDivisionError:

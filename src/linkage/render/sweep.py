@@ -11,7 +11,6 @@ from ..kinematics.columns import SweepColumns, sweep_columns
 from ..kinematics.sweep import SweepResult
 from ..problems.closed_form import TRANSMISSION
 from .data import DataTable, Report, column, from_rows, split_header
-from .rates import rate_cells, rate_headers, rate_units_dict, rates_dict
 from .report import Block, Text, fmt, table
 
 
@@ -56,6 +55,8 @@ def sweep_table(s: SweepResult, cols: SweepColumns | None = None) -> DataTable:
         out.append(column(TRANSMISSION, "deg", c.transmission))
     joints = list(c.joints)
     if c.rates is not None:  # the scalar rates, a row at a time (the one definition)
+        from .rates import rate_headers  # a sweep without rates does not import them
+
         heads = rate_headers(s.names, _kinds(s), s.length_unit, joints, True)
         cells = RateCells(c.rates, s.names, joints, len(heads))
         for k, h in enumerate(heads):
@@ -87,6 +88,8 @@ class RateCells:
         """Rows ``start:stop``, one list per column."""
         if self._last[:2] != (start, stop):
             self._last = (-1, -1, [])
+            from .rates import rate_cells
+
             if hasattr(self.rates, "block") and stop > start:  # a batch's: the cells as arrays
                 cols = rate_cells(self.rates.block(start, stop), self.names, self.joints, True)
             else:
@@ -193,6 +196,8 @@ def ranges_of(s: SweepResult, cols: SweepColumns | None = None) -> dict[str, dic
 
 
 def sweep_dict(s: SweepResult, cols: SweepColumns | None = None) -> dict[str, Any]:
+    from .rates import rate_units_dict, rates_dict
+
     return {
         "mechanism": s.mechanism,
         "driver": {"name": s.driver, "unit": s.driver_unit},
@@ -246,6 +251,8 @@ def sweep_blocks(s: SweepResult, digits: int, max_rows: int = 400,
     picked = [p.tolist() if hasattr(p, "tolist") else list(p) for p in picked]
     rows = [tuple(_cell(v) for v in r) for r in zip(*picked)]
     if s.motion is not None and c.rates is not None:  # the unknowns' rates beside their values
+        from .rates import rate_cells, rate_headers
+
         headers += rate_headers(s.names, _kinds(s), s.length_unit, [], True, bounds=False)
         rows = [(*r, *rate_cells(c.rates[i], s.names, [], True, bounds=False)) for r, i in zip(rows, shown)]
     note = [] if every <= 1 else [f"(one row in {every} of {n} shown; "
