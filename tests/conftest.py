@@ -69,3 +69,14 @@ def run_process(*args: str, code: str | None = None) -> subprocess.CompletedProc
     cmd = [sys.executable, "-c", code] if code else [sys.executable, "-m", "linkage", *args]
     env = dict(os.environ, COLUMNS="200")
     return subprocess.run(cmd, capture_output=True, text=True, timeout=120, env=env)
+
+
+@pytest.fixture(scope="session")
+def crank_rocker_search():
+    """The suite's one complete nine-point solve (1,442 paths, about 35 s of two cores):
+    ``search_path`` on six of a Grashof crank-rocker's nine coupler points with the other
+    three as via points (tests/test_path_search.py). Shared for the session by the search's
+    tests and by tests/test_nine_point.py's known four-bar, so that it is tracked once."""
+    from test_path_search import search_the_crank_rocker
+
+    return search_the_crank_rocker()

@@ -129,9 +129,12 @@ def test_the_generic_monodromy_loops_the_nine_point_problem_one_root_per_orbit()
     assert len(npt.distinct(members)) == 6 * len(found.roots)
 
 
-def test_a_known_four_bar_is_found_among_the_solutions_through_its_points():
-    pts, z = _coupler_points(np.random.default_rng(2))
-    res = nt.solve_points(pts, max_routes=1)
+def test_a_known_four_bar_is_found_among_the_solutions_through_its_points(crank_rocker_search):
+    """The complete solve through a Grashof crank-rocker's nine coupler points (plane
+    geometry), shared with tests/test_path_search.py (tests/conftest.py)."""
+    pts, z = _grashof_crank_rocker_points(set())
+    res = crank_rocker_search.samples[0].solutions
+    assert crank_rocker_search.samples[0].points == tuple(pts)
     assert res.paths == 1442
     want = npt.canonical(z[None, :])[0]
     gaps = np.linalg.norm(res.solutions - want, axis=1)
@@ -254,13 +257,14 @@ def test_paths_tracked_as_dask_tasks_on_threads_and_a_loopback_cluster_end_where
     from linkage.synthesis.path import chunk_runner
 
     pts = [complex(x, y) for x, y in PROBLEM_3]
-    here = nt.solve_points(pts, max_routes=1, orbits=300)
-    threads = nt.solve_points(pts, max_routes=1, orbits=300, run=chunk_runner("threads", 2))
-    assert len(here.solutions) >= 290 and _same_sets(here.solutions, threads.solutions)
+    # 100 paths in chunks of 40: three tasks, the last one short, as 300 in the default 256 were two
+    options = {"max_routes": 1, "orbits": 100, "chunk": 40}
+    here = nt.solve_points(pts, **options)
+    threads = nt.solve_points(pts, **options, run=chunk_runner("threads", 2))
+    assert len(here.solutions) >= 95 and _same_sets(here.solutions, threads.solutions)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                                   dashboard_address=None) as cluster:
-        remote = nt.solve_points(pts, max_routes=1, orbits=300,
-                                  run=chunk_runner(cluster.scheduler_address, None))
+        remote = nt.solve_points(pts, **options, run=chunk_runner(cluster.scheduler_address, None))
     assert _same_sets(here.solutions, remote.solutions)
     assert remote.failed == here.failed
 
@@ -291,14 +295,21 @@ def test_a_low_transmission_angle_over_the_motion_is_a_transmission_defect():
     assert judge(z, pts, min_transmission=fb.transmission_min_deg + 1e-6).defects == ("transmission",)
 
 
+@pytest.fixture(scope="module")
+def problem_3_first_orbits():
+    """Problem 3's first 60 orbits, at the published size: the unit the scaled solves are
+    compared with (computed once for every scale)."""
+    return nt.solve_points([complex(x, y) for x, y in PROBLEM_3], max_routes=1, orbits=60)
+
+
 @pytest.mark.parametrize("scale", [1e-6, 1e3])
-def test_four_bars_through_points_scale_with_the_points(scale):
+def test_four_bars_through_points_scale_with_the_points(scale, problem_3_first_orbits):
     """Micrometres to kilometres: the same problem at another size gives the same four-bars
     at that size (the pivots scale with the points; the engine solves at unit size)."""
     pts = [complex(x, y) for x, y in PROBLEM_3]
-    unit = nt.solve_points(pts, max_routes=1, orbits=200)
-    moved = nt.solve_points([p * scale + (5.0 - 2.0j) * scale for p in pts], max_routes=1, orbits=200)
-    assert len(moved.solutions) == len(unit.solutions) >= 195
+    unit = problem_3_first_orbits
+    moved = nt.solve_points([p * scale + (5.0 - 2.0j) * scale for p in pts], max_routes=1, orbits=60)
+    assert len(moved.solutions) == len(unit.solutions) >= 57
     assert _same_sets(unit.solutions, moved.solutions / scale)
 
 

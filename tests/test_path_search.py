@@ -36,11 +36,16 @@ def curve() -> tuple[list[complex], np.ndarray]:
     return _grashof_crank_rocker_points(set())
 
 
-@pytest.fixture(scope="module")
-def known(curve):
-    """The one complete nine-point solve of this file (about 35 s of two cores)."""
-    pts, _ = curve
+def search_the_crank_rocker():
+    """The search through the six given points with the three via points: a complete
+    nine-point solve, run once a session (tests/conftest.py's ``crank_rocker_search``)."""
+    pts, _ = _grashof_crank_rocker_points(set())
     return search_path(_pairs([pts[i] for i in GIVEN]), via=_pairs([pts[i] for i in VIA]))
+
+
+@pytest.fixture(scope="module")
+def known(crank_rocker_search):
+    return crank_rocker_search
 
 
 def _through(fb, point: complex, crank_deg: float) -> float:
