@@ -192,19 +192,6 @@ def arrow_array(kind: str, values: Any) -> Any:
     return None
 
 
-def warm_arrow() -> None:
-    """pyarrow's first conversion of a block sets pyarrow up (the later blocks convert in
-    microseconds): done here on a one-row block of
-    each kind :func:`arrow_table` converts, for a sink's :meth:`Sink.warm`."""
-    import numpy as np
-
-    columns = (Column("0", values=np.zeros(1)),
-               Column("1", values=np.array(["x"], dtype=object), kind="text"),
-               Column("2", values=np.zeros(1, dtype=np.int64), kind="int"),
-               Column("3", values=np.zeros(1, dtype=bool), kind="bool"))
-    arrow_table(columns, [c.values for c in columns])
-
-
 UNSAFE = frozenset('[]:*?/\\\0')
 """Characters an xlsx sheet name or a file name cannot hold."""
 
@@ -253,13 +240,6 @@ class Sink:
         """The modules this format imports to write a table of ``rows`` rows (None: not
         known), for writers.prefetch."""
         return ()
-
-    @classmethod
-    def warm(cls, rows: int | None) -> None:
-        """Run on writers.prefetch's thread once :meth:`modules` are imported: what this
-        format's first block would otherwise set up on the command's own thread, after its
-        computing. Nothing by default."""
-        return None
 
     @classmethod
     def meta_of(cls, report: Report, files: Sequence[str]) -> dict[str, Any]:

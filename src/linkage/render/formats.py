@@ -64,11 +64,6 @@ class CsvSink(Sink):
         """A table of ``rows`` rows may go through pyarrow's CSV writer (:meth:`rows`)."""
         return rows is not None and 2 * rows >= cells.FAST_CELLS
 
-    @classmethod
-    def warm(cls, rows: int | None) -> None:
-        if cls.blocks(rows):
-            cells.warm_arrow()
-
     def rows(self, values: Sequence[Any]) -> None:
         n = len(values[0]) if values else 0
         done = self._arrow_rows(values) if self.fast and n else 0
@@ -151,10 +146,6 @@ class ParquetSink(Sink):
     @classmethod
     def modules(cls, rows: int | None) -> tuple[str, ...]:
         return (PARQUET_WRITER,)
-
-    @classmethod
-    def warm(cls, rows: int | None) -> None:
-        cells.warm_arrow()  # its blocks' conversions are arrow_table's
 
     def __init__(self, out: IO[Any] | None, path: str | None, meta: dict[str, Any] | None = None) -> None:
         super().__init__(out, path, meta)

@@ -134,19 +134,17 @@ threads importing it at once (a flaky refusal, seen in tests/test_format_registr
 
 
 def wait_for_prefetch() -> None:
-    """Wait for the prefetch threads started (their imports and warm-ups) to finish."""
+    """Wait for the prefetch threads started (their imports) to finish."""
     while _prefetching:
         _prefetching.pop().join()
 
 
-def import_quietly(names: Sequence[str], then: Callable[[], None] | None = None) -> None:
-    """Import ``names``, then run ``then`` (a sink's warm-up); quietly: a failure is left to
-    the writer, which meets it again and says so."""
+def import_quietly(names: Sequence[str]) -> None:
+    """Import ``names``, quietly: a failure is left to the writer, which meets it again and
+    says so."""
     try:
         for name in names:
             __import__(name)
-        if then is not None:
-            then()
     except Exception:
         return
 
