@@ -5,7 +5,9 @@ the bench: ``linkage bench --full -f json -o bench.json``, then
 Each file keeps its table between the markers ``<!-- targets: begin -->`` and
 ``<!-- targets: end -->``; everything outside them is left as it is. The figures are the
 run's own (the bench's ``targets`` table: ratio, the medians of the pairs, met), rounded
-only here, for printing."""
+only here, for printing. docs/performance.md also keeps issue 34's two tables (absolute
+times, and every root checked at 50 digits: the bench's ``continuation`` record) between
+``<!-- continuation: begin -->`` and ``<!-- continuation: end -->``."""
 
 from __future__ import annotations
 
@@ -34,13 +36,37 @@ def table(targets: list[dict], label: str) -> str:
     return "\n".join(lines)
 
 
-def replace(path: Path, text: str) -> None:
+def seconds(t: float) -> str:
+    """A time in seconds as the bench prints it: ms below a second, 3 significant digits."""
+    return f"{t * 1e3:.3g} ms" if t < 1 else f"{t:.3g} s"
+
+
+def continuation_tables(record: dict, label: str) -> str:
+    """Issue 34's two tables from the bench's ``continuation`` record: the absolute
+    times against their bounds, then the 50-digit check of every root."""
+    yes = {True: "yes", False: "no", None: "n/a"}
+    lines = [f"The same run as issue 33's table above ({label}; {record['cores']}):", "",
+             "| target | bound | median | runs | found | met |", "|---|---|---|---|---|---|"]
+    for row in record["targets"]:
+        median = "n/a" if row["median"] is None else seconds(row["median"])
+        lines.append(f"| {row['target']} | {row['bound']:g} s | {median} | {row['runs']} | "
+                     f"{row['found']} | {yes[row['met']]} |")
+    lines += ["", "| roots of | roots | worst residual | above 1e-12 | worst error | duplicates "
+              "| spurious | met |", "|---|---|---|---|---|---|---|---|"]
+    for row in record["certified"]:
+        lines.append(f"| {row['target']} | {row['roots']} | {row['worst residual']:.3g} "
+                     f"| {row['above 1e-12']} | {row['worst error']:.3g} | {row['duplicates']} "
+                     f"| {row['spurious']} | {yes[row['met']]} |")
+    return "\n".join(lines)
+
+
+def replace(path: Path, text: str, begin: str = BEGIN, end: str = END) -> None:
     """``text`` between the markers of ``path`` (which must hold them, once)."""
     old = path.read_text()
-    pattern = re.compile(re.escape(BEGIN) + r".*?" + re.escape(END), re.S)
+    pattern = re.compile(re.escape(begin) + r".*?" + re.escape(end), re.S)
     if len(pattern.findall(old)) != 1:
-        raise SystemExit(f"{path}: expected one {BEGIN} ... {END} block")
-    path.write_text(pattern.sub(lambda _: f"{BEGIN}\n{text}\n{END}", old))
+        raise SystemExit(f"{path}: expected one {begin} ... {end} block")
+    path.write_text(pattern.sub(lambda _: f"{begin}\n{text}\n{end}", old))
 
 
 def main() -> None:
@@ -48,11 +74,16 @@ def main() -> None:
     parser.add_argument("bench_json", type=Path)
     parser.add_argument("--label", required=True, help="the commit and the machine's state")
     args = parser.parse_args()
-    targets = json.loads(args.bench_json.read_text())["targets"]
+    run = json.loads(args.bench_json.read_text())
+    targets = run["targets"]
     # the README shows issue 33's rows (its guide's length is bounded); the page, all
     for name, rows in (("README.md", targets[:len(ROWS)]), ("docs/performance.md", targets)):
         replace(ROOT / name, table(rows, args.label))
         print(f"updated {name}")
+    if run.get("continuation"):
+        replace(ROOT / "docs/performance.md", continuation_tables(run["continuation"], args.label),
+                "<!-- continuation: begin -->", "<!-- continuation: end -->")
+        print("updated docs/performance.md's issue 34 tables")
 
 
 if __name__ == "__main__":

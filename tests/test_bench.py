@@ -369,3 +369,35 @@ def test_the_nine_point_root_check_counts_a_cognate_as_a_duplicate():
     got = nine_point_certificate(np.stack([z, cognate, moved]), d, db)
     assert (got.roots, got.duplicates, got.spurious, got.above, got.met) == (3, 1, 1, 1, False)
     assert got.worst_residual > 1e-8
+
+
+def test_the_performance_tables_are_written_from_one_bench_json_between_their_markers(tmp_path):
+    """benchmarks/performance_table.py writes issue 33's table and issue 34's two tables
+    from the run's own figures, and leaves everything outside the markers as it was."""
+    import importlib.util
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parent.parent / "benchmarks" / "performance_table.py"
+    spec = importlib.util.spec_from_file_location("performance_table", script)
+    table = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(table)
+    run = {"targets": [{"target": "row a", "measured": 2.345, "met": False, "ratio": "x: 2.3 / 1.0 us"}],
+           "continuation": {"cores": "2 cores", "targets": [
+               {"target": "six-bar", "bound": 0.05, "median": 0.0215, "runs": 5, "found": "4 paths",
+                "met": True}],
+               "certified": [{"target": "six-bar", "roots": 4, "worst residual": 1.1138e-16, "above 1e-12": 0,
+                              "worst error": 1.6775e-16, "duplicates": 0, "spurious": 0, "met": True}]}}
+    page = tmp_path / "page.md"
+    page.write_text("before\n<!-- targets: begin -->\nold\n<!-- targets: end -->\nmiddle\n"
+                    "<!-- continuation: begin -->\nold\n<!-- continuation: end -->\nafter\n")
+    table.replace(page, table.table(run["targets"], "abc1234"))
+    table.replace(page, table.continuation_tables(run["continuation"], "abc1234"),
+                  "<!-- continuation: begin -->", "<!-- continuation: end -->")
+    text = page.read_text()
+    assert text.startswith("before\n") and "\nmiddle\n" in text and text.endswith("\nafter\n")
+    assert "old" not in text
+    assert "| row a | 2.35 | 2.3 / 1.0 us | no |" in text
+    assert "| six-bar | 0.05 s | 21.5 ms | 5 | 4 paths | yes |" in text
+    assert "| six-bar | 4 | 1.11e-16 | 0 | 1.68e-16 | 0 | 0 | yes |" in text
+    with pytest.raises(SystemExit):
+        table.replace(tmp_path / "page.md", "x", "<!-- none: begin -->", "<!-- none: end -->")
