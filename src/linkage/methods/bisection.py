@@ -126,4 +126,5 @@ BISECTION_LOOP = Loop(
     result="_State(x, fx, err, None, a, fa, b, fb, a, fa, b, fb), status, detail, k")
 """Bisection's loop: the stopping rule of :mod:`linkage.iterate` around halving the bracket."""
 
-bisection_lean = build_loop(BISECTION_LOOP, {"_State": BisectionState, "_same_sign": same_sign})
+bisection_lean = build_loop(BISECTION_LOOP, {"_State": BisectionState, "_same_sign": same_sign},
+                            fixed_source=True)

@@ -104,4 +104,4 @@ FIXED_POINT_LOOP = Loop(
     fx_optional=True, guard=True, step_test="certify", diverge="streak")
 """Fixed-point iteration's loop: the stopping rule of :mod:`linkage.iterate` around x = g(x)."""
 
-fixed_point_lean = build_loop(FIXED_POINT_LOOP, {"_State": FixedPointState})
+fixed_point_lean = build_loop(FIXED_POINT_LOOP, {"_State": FixedPointState}, fixed_source=True)

@@ -162,8 +162,8 @@ first read); ``certify(problem, x, fx, width)`` decides a small step
 
 _NAMES = {"_start_stop": start_stop, "_fast": Result.fast, "_meta": newton_meta, "_history": history_of,
           "_method": Newton()}
-newton_lean = build_loop(NEWTON_LOOP, {**_NAMES, "_HEAD": HISTORY_HEAD})
+newton_lean = build_loop(NEWTON_LOOP, {**_NAMES, "_HEAD": HISTORY_HEAD}, fixed_source=True)
 
 NEWTON_QUIET_LOOP = newton_loop(record=False)
-newton_quiet = build_loop(NEWTON_QUIET_LOOP, _NAMES)
+newton_quiet = build_loop(NEWTON_QUIET_LOOP, _NAMES, fixed_source=True)
 """``newton_lean`` without rows (its ``rows`` is ignored): the same outcome, bit for bit."""

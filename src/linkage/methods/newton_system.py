@@ -495,10 +495,10 @@ def __getattr__(name: str) -> Any:
     is compiled once and kept as the module's attribute (a race compiles the same source
     twice: either result is the same function)."""
     if name == "newton_2x2":
-        loop = build_loop(NEWTON_2X2_LOOP, _LOOP_NAMES)
+        loop = build_loop(NEWTON_2X2_LOOP, _LOOP_NAMES, fixed_source=True)
     elif name == "newton_system_lean":
         two = globals().get("newton_2x2") or __getattr__("newton_2x2")
-        loop = build_loop(NEWTON_SYSTEM_LOOP, {**_LOOP_NAMES, "_newton_2x2": two})
+        loop = build_loop(NEWTON_SYSTEM_LOOP, {**_LOOP_NAMES, "_newton_2x2": two}, fixed_source=True)
     else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     globals()[name] = loop

@@ -144,4 +144,4 @@ SECANT_LOOP = Loop(
     guard=True, step_test="certify", diverge="streak")
 """The secant method's loop: the stopping rule of :mod:`linkage.iterate` around its step."""
 
-secant_lean = build_loop(SECANT_LOOP, {"_State": SecantState})
+secant_lean = build_loop(SECANT_LOOP, {"_State": SecantState}, fixed_source=True)
