@@ -234,21 +234,26 @@ def quiet_path(out: _Emitter) -> None:
     """A step after which no test can fire, recognised in one condition and continued from
     with exactly the state the tests would leave (the guard's best |f|, no growth, the
     error as the previous one); any other step goes through tests 2-7 in order. Only
-    without ``rtol`` and a residual test's ``ftol`` (the flag ``quiet`` the loop's
-    preamble sets), with floats: |f| (a system's max|Phi|) finite and not zero (tests
-    2-4), the error finite and above ``tol`` (test 5, so neither the guard, the
-    plausibility, a certificate nor a system's residual gate is consulted), not above the
-    previous error (test 6 resets its streak, where it runs) and above rounding (test 7)."""
+    without ``rtol`` and a residual test's ``ftol`` (``qtol``, the threshold the loop's
+    preamble sets: ``tol`` where the path is allowed, else infinity, so the flag costs
+    nothing per step). One chain of comparisons: the error above ``qtol`` (test 5, so
+    neither the guard, the plausibility, a certificate nor a system's residual gate is
+    consulted) and finite, by not being above the previous error where test 6 runs
+    (``prev_err`` starts at the largest float and only ever holds finite errors), else by
+    ``< inf``; f (a system's max|Phi|) finite and not zero (tests 2-4); the error above
+    rounding (test 7). A value that does not compare as a real number (a complex f, a
+    missing residual) raises TypeError here and takes the tests, which name it; any real
+    number type takes the path a float would, with the same state after it."""
     loop, put = out.loop, out.put
     if takes_scalar_quiet_path(loop):
         scalar_quiet_path(out)
         return
-    put(0, "if quiet and type(err) is float and type(fx) is float:")
-    put(1, "size = fx if fx >= 0.0 else -fx")
-    put(1, f"ax = {loop.magnitude}")
-    growth = " and err <= prev_err" if loop.diverge else ""
-    put(1, f"if 0.0 < size < _inf and tol < err < _inf{growth} and err > _ROUNDING * ax:")
+    finite_err = "err <= prev_err" if loop.diverge else "err < _inf"
+    put(0, "try:")
+    put(1, f"if qtol < {finite_err} and -_inf < fx < _inf and fx != 0.0"
+           f" and err > _ROUNDING * {loop.magnitude}:")
     if loop.guard:
+        put(2, "size = fx if fx >= 0.0 else -fx")
         put(2, "if size < best:")
         put(3, "best = size")
     if loop.diverge and loop.diverge_when:
@@ -258,6 +263,8 @@ def quiet_path(out: _Emitter) -> None:
         put(2, "growth = 0")
     put(2, "prev_err = err")
     put(2, "continue")
+    put(0, "except TypeError:")
+    put(1, "pass")
 
 
 def takes_scalar_quiet_path(loop: Loop) -> bool:
@@ -399,11 +406,9 @@ _QUIET_FTOL = "ftol is None and "
 
 def quiet_flag(loop: Loop) -> list[str]:
     """The preamble's line that allows the quiet path: without ``rtol`` and a residual
-    test's ``ftol``; for :func:`scalar_quiet_path` as the threshold ``qtol``."""
+    test's ``ftol``, as the threshold ``qtol`` of :func:`quiet_path`."""
     allowed = f"{_QUIET_FTOL if loop.residual_test else ''}not rtol"
-    if takes_scalar_quiet_path(loop):
-        return [f"    qtol = tol if {allowed} else _inf"]
-    return [f"    quiet = {allowed}"]
+    return [f"    qtol = tol if {allowed} else _inf"]
 
 
 def loop_source(loop: Loop) -> str:

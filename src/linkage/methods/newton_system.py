@@ -26,7 +26,7 @@ from ..iterate import Loop, build_loop, dedent, indent
 from ..linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve, pivot_ratio
 from ..problems.system import SystemProblem
 from ..result import Column, Status
-from ..rules import invertible, pivots_invertible, step_size
+from ..rules import invertible, invertible_source, pivots_invertible, step_size
 from ..units import degrees
 from .common import new_state
 
@@ -444,7 +444,8 @@ NEWTON_2X2_LOOP = Loop(
         bc = b * c
         det = ad - bc
         refused = True
-        if _invertible(det, (ad if ad > 0.0 else 0.0 - ad) + (bc if bc > 0.0 else 0.0 - bc)):
+        if """ + invertible_source(
+            "det", "(ad if ad > 0.0 else 0.0 - ad) + (bc if bc > 0.0 else 0.0 - bc)") + """:
             d0, d1 = (b * p1 - d * p0) / det, (c * p0 - a * p1) / det
             t0, t1 = x0 + d0, x1 + d1
             f0, f1 = F([t0, t1])

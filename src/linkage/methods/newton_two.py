@@ -22,7 +22,7 @@ from typing import Any
 
 from ..codegen import Terms, model_pieces
 from ..iterate import Loop, build_loop
-from ..rules import invertible
+from ..rules import invertible_source
 from .newton_system import larger_of
 
 
@@ -52,7 +52,7 @@ fx = """ + larger_of("a0", "a1") + """
 ad = j00 * j11
 bc = j01 * j10
 det = ad - bc
-if not _invertible(det, (ad if ad >= 0.0 else -ad) + (bc if bc >= 0.0 else -bc)):
+if not """ + invertible_source("det", "(ad if ad >= 0.0 else -ad) + (bc if bc >= 0.0 else -bc)") + """:
     return None
 h0 = (j01 * p1 - j11 * p0) / det
 h1 = (j10 * p0 - j00 * p1) / det
@@ -82,8 +82,7 @@ return k, x0, x1, j00, j01, j10, j11, w0, w1
 @functools.lru_cache(maxsize=64)
 def compiled_newton_two(terms: Terms, n: int) -> Callable[..., Any]:
     """The compiled loop for a model's terms (once per model per process)."""
-    return build_loop(newton_two_loop(terms, n), {"_cos": math.cos, "_sin": math.sin,
-                                                   "_invertible": invertible})
+    return build_loop(newton_two_loop(terms, n), {"_cos": math.cos, "_sin": math.sin})
 
 
 def newton_two_of(model: Any) -> Callable[..., Any]:
