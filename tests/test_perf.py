@@ -109,3 +109,29 @@ def test_a_scan_does_not_load_the_rate_engine():
 
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "False"
+
+
+def test_driver_values_as_an_array_are_the_lists_values_bit_for_bit():
+    """A sweep of more positions than ``array_above`` gets its driver values as a numpy
+    array (no list of 360,001 floats to build and convert): the same values, bit for bit,
+    as the list, for steps and for points, across signs, scales and the grid's end."""
+    import random
+
+    import numpy as np
+
+    from linkage.kinematics.positions import driver_values
+
+    rng = random.Random(39)
+    cases = [(0.0, 360.0, 0.001, None), (-0.0, 1.0, 0.1, None), (-180.0, 180.0, None, 7919),
+             (1e-6, 2e-6, 1e-9, None), (-1e5, 1e5, None, 20001), (0.1, 0.7, 0.1, None)]
+    for _ in range(200):
+        a = rng.uniform(-1e3, 1e3) * 10.0 ** rng.randint(-6, 3)
+        b = a + abs(a or 1.0) * rng.uniform(0.001, 10.0)
+        cases.append((a, b, (b - a) / rng.uniform(2.0, 3000.0), None))
+        cases.append((a, b, None, rng.randint(2, 3000)))
+    for a, b, step, points in cases:
+        listed = driver_values(a, b, step, points)
+        arrayed = driver_values(a, b, step, points, array_above=1)
+        assert isinstance(arrayed, np.ndarray) and arrayed.dtype == np.float64
+        assert np.array_equal(np.array(listed).view(np.int64), arrayed.view(np.int64)), (a, b, step, points)
+    assert driver_values(0.0, 1.0, 0.5, None, array_above=3) == [0.0, 0.5, 1.0]  # not above: a list

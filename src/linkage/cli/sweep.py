@@ -125,7 +125,7 @@ def sweep(
     a, b = driver_span(mechanism, start, stop)
     if points is None and step is None:
         step = 1.0
-    values = driver_values(a, b, step, points)
+    values = driver_values(a, b, step, points, array_above=BATCH_ABOVE)
     note_closed_form(mechanism)
     w, a_ = parse_motion(speed, accel, mechanism)
     motion = (speed, accel)
