@@ -98,8 +98,9 @@ def walk(model: LoopModel, part: Any, add: Any, origin0: Any, at_rest: Any) -> d
     moving vectors (a ground pivot then has exactly zero velocity, and fewer terms round),
     a point from its joint; a joint of ``model.drawn`` (a fixed joint of a drawing) where it
     was drawn, exactly. ``part(term, (loop, index))`` is a vector's value (``None`` for a
-    point's), ``add(start, parts, sign)`` their sum, ``at_rest((x, y))`` a joint standing
-    still there."""
+    point's; computed once, and only for a vector a joint's side reads: a four-bar's
+    coupler vector, say, places no joint), ``add(start, parts, sign)`` their sum,
+    ``at_rest((x, y))`` a joint standing still there."""
     placed: dict[str, Any] = {}
     for i, (loop, terms) in enumerate(zip(model.mechanism.loops, model.terms)):
         names = loop.joints
@@ -107,7 +108,7 @@ def walk(model: LoopModel, part: Any, add: Any, origin0: Any, at_rest: Any) -> d
             placed[names[0]] = at_rest(model.drawn[names[0]])
         start = placed.get(names[0]) if names and names[0] else None
         origin = start if start is not None else origin0
-        parts = [part(t, (i, j)) for j, t in enumerate(terms)]
+        parts: dict[int, Any] = {}  # each vector's value once, and only where a joint reads it
         moving = [t[2] != FIXED or t[4] != FIXED for t in terms]
         for k in range(len(terms)):
             if not names or not names[k] or names[k] in placed:
@@ -117,8 +118,11 @@ def walk(model: LoopModel, part: Any, add: Any, origin0: Any, at_rest: Any) -> d
                 continue
             forward, backward = range(k), range(k, len(terms))
             ahead = sum(moving[j] for j in forward) <= sum(moving[j] for j in backward)
-            placed[names[k]] = add(origin, [parts[j] for j in (forward if ahead else backward)],
-                                   1.0 if ahead else -1.0)
+            side = forward if ahead else backward
+            for j in side:
+                if j not in parts:
+                    parts[j] = part(terms[j], (i, j))
+            placed[names[k]] = add(origin, [parts[j] for j in side], 1.0 if ahead else -1.0)
     for name, (origin_name, terms) in model.point_terms.items():
         placed[name] = add(placed.get(origin_name, origin0), [part(t, None) for t in terms], 1.0)
     return placed
