@@ -391,6 +391,28 @@ def test_twins_agree_with_math_to_a_few_ulps_on_any_cpu() -> None:
     assert_ulps(np.arctan2(x, y), [math.atan2(a, b) for a, b in zip(x, y)], ATAN2_ULPS, what="atan2")
 
 
+def test_two_angles_with_margin_np_is_its_two_functions_bit_for_bit() -> None:
+    """The closed-form sweep's fused two-circle step (one ordering of the three distances,
+    the triangle's slack as the margin's numerator) gives two_angles_np's and
+    two_angles_margin_np's bits: random circles, K = 0, NaN, exact and near tangency
+    (r1 + r2 = d, by a few ulps either way), micrometre and kilometre scales."""
+    rng = np.random.default_rng(33)
+    n = 4000
+    p, q, k = (rng.uniform(-100, 100, (2, n)) for _ in range(3))
+    k[:, :5] = 0.0
+    p[0, 5:8] = np.nan
+    # tangent circles: |K| = |P| + |Q| exactly and a few ulps off
+    rp, rq = np.hypot(*p[:, 8:400]), np.hypot(*q[:, 8:400])
+    k[0, 8:400], k[1, 8:400] = (rp + rq) * (1.0 + rng.integers(-4, 5, 392) * 2.2e-16), 0.0
+    for scale in (1e-6, 1.0, 1e3):
+        ps, qs, ks = (tuple(v * scale) for v in (p, q, k))
+        for sigma in (1.0, -1.0):
+            a, b, ok, margin = dyads.two_angles_with_margin_np(ps, qs, ks, sigma)
+            a0, b0, ok0 = dyads.two_angles_np(ps, qs, ks, sigma)
+            assert _same(a, a0) and _same(b, b0) and np.array_equal(ok, ok0)
+            assert _same(margin, dyads.two_angles_margin_np(ps, qs, ks))
+
+
 def test_dyad_twins_equal_their_scalar_functions() -> None:
     rng = np.random.default_rng(8)
     n = 3000

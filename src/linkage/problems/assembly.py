@@ -70,15 +70,26 @@ def triangle_np(d: Any, r: Any, rho: Any) -> tuple[Any, Any, Any]:
     import numpy as np
 
     d, r, rho = np.asarray(d, float), np.asarray(r, float), np.asarray(rho, float)
-    x, y, z = descending_np(d, r, rho)
     with np.errstate(invalid="ignore", divide="ignore"):  # (inf - inf: NaN, refused)
-        gap = z - (x - y)
-        ok = (gap >= -TANGENT_SLACK * x) & (d > 0.0)
-        gap = np.maximum(gap, 0.0)
-        area4 = (x + (y + z)) * gap * (z + (x - y)) * (x + (y - z))
-        h = np.where(ok, np.sqrt(np.maximum(area4, 0.0)) / (2.0 * d), np.nan)
-        a = ((r - rho) * (r + rho) + d * d) / (2.0 * d)
+        a, h, ok, _ = triangle_sorted_np(d, r, rho, *descending_np(d, r, rho))
     return a, h, ok
+
+
+def triangle_sorted_np(d: Any, r: Any, rho: Any, x: Any, y: Any, z: Any) -> tuple[Any, Any, Any, Any]:
+    """:func:`triangle_np`'s body, the three distances already ordered (``x, y, z`` =
+    :func:`descending_np` of them): (a, h, ok, gap), ``gap`` = z - (x - y) before it is
+    clamped, the slack the two-circle margin (:func:`~.dyads.margin_of_gap_np`) divides by
+    x, so a caller wanting both orders and subtracts once. The caller holds numpy's
+    invalid and divide warnings off (inf - inf and K = 0 are refused through ``ok``)."""
+    import numpy as np
+
+    raw = z - (x - y)
+    ok = (raw >= -TANGENT_SLACK * x) & (d > 0.0)
+    gap = np.maximum(raw, 0.0)
+    area4 = (x + (y + z)) * gap * (z + (x - y)) * (x + (y - z))
+    h = np.where(ok, np.sqrt(np.maximum(area4, 0.0)) / (2.0 * d), np.nan)
+    a = ((r - rho) * (r + rho) + d * d) / (2.0 * d)
+    return a, h, ok, raw
 
 
 def descending_np(p: Any, q: Any, s: Any) -> tuple[Any, Any, Any]:

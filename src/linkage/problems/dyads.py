@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from .assembly import TANGENT_SLACK, descending_np, triangle, triangle_np
+from .assembly import TANGENT_SLACK, descending_np, triangle, triangle_np, triangle_sorted_np
 
 Pair = tuple[float, float]
 
@@ -101,12 +101,36 @@ def two_angles_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any],
     d, rp, rq = two_angles_norms_np(p, q, k) if norms is None else norms
     a, h, ok = triangle_np(d, rp, rq)
     with np.errstate(invalid="ignore", divide="ignore"):  # K = 0: a and b are inf
-        b = ((rq - rp) * (rq + rp) + d * d) / (2.0 * d)
-        wx, wy = _cmul_conj(-k[0], -k[1], p[0], p[1])
-        ex, ey = _cmul(a, sigma * h + 0.0, wx, wy)
-        vx, vy = _cmul_conj(-k[0], -k[1], q[0], q[1])
-        fx, fy = _cmul(b, -sigma * h + 0.0, vx, vy)
-    return np.arctan2(ey, ex), np.arctan2(fy, fx), ok
+        return (*angles_of_triangle_np(p, q, k, sigma, d, rp, rq, a, h), ok)
+
+
+def two_angles_with_margin_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any],
+                               sigma: float) -> tuple[Any, Any, Any, Any]:
+    """:func:`two_angles_np` and :func:`two_angles_margin_np` in one pass: (a, b, ok,
+    margin). The three distances are computed and ordered once, the triangle's slack
+    (:func:`~.assembly.triangle_sorted_np`) is the margin's numerator (the same
+    expression, so the same bits), and numpy's warnings are held off once."""
+    import numpy as np
+
+    d, rp, rq = two_angles_norms_np(p, q, k)
+    x, y, z = descending_np(d, rp, rq)
+    with np.errstate(invalid="ignore", divide="ignore"):  # K = 0: a and b are inf
+        a, h, ok, gap = triangle_sorted_np(d, rp, rq, x, y, z)
+        return (*angles_of_triangle_np(p, q, k, sigma, d, rp, rq, a, h), ok, margin_of_gap_np(gap, x))
+
+
+def angles_of_triangle_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any], sigma: float,
+                          d: Any, rp: Any, rq: Any, a: Any, h: Any) -> tuple[Any, Any]:
+    """:func:`two_angles`' last lines over arrays: the two angles from the triangle (a, h)
+    of the distances (d, rp, rq). The caller holds numpy's warnings off (K = 0: inf)."""
+    import numpy as np
+
+    b = ((rq - rp) * (rq + rp) + d * d) / (2.0 * d)
+    wx, wy = _cmul_conj(-k[0], -k[1], p[0], p[1])
+    ex, ey = _cmul(a, sigma * h + 0.0, wx, wy)
+    vx, vy = _cmul_conj(-k[0], -k[1], q[0], q[1])
+    fx, fy = _cmul(b, -sigma * h + 0.0, vx, vy)
+    return np.arctan2(ey, ex), np.arctan2(fy, fx)
 
 
 def two_angles_side(p: Pair, k: Pair, alpha: float) -> float:
@@ -145,8 +169,17 @@ def two_angles_margin_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, A
 
     x, y, z = descending_np(*(two_angles_norms_np(p, q, k) if norms is None else norms))
     with np.errstate(invalid="ignore", divide="ignore"):
-        # x >= 0 or NaN: "!= 0" is the scalar's "> 0" and lets the NaN through
-        return np.where(x != 0.0, (z - (x - y)) / x, 0.0)
+        return margin_of_gap_np(z - (x - y), x)
+
+
+def margin_of_gap_np(gap: Any, x: Any) -> Any:
+    """The two-circle margin from its slack ``gap`` = z - (x - y) and the largest distance
+    ``x`` (:func:`two_angles_margin`'s last line over arrays; the caller holds numpy's
+    warnings off)."""
+    import numpy as np
+
+    # x >= 0 or NaN: "!= 0" is the scalar's "> 0" and lets the NaN through
+    return np.where(x != 0.0, gap / x, 0.0)
 
 
 # --- a line and a circle ---------------------------------------------------------------------

@@ -204,9 +204,7 @@ def solve_step_margin_np(case: str, first: Any, second: Any, k: Any,
     """:func:`solve_step_np` and :func:`step_margin_np` of one step in one pass: (a, b, ok,
     margin), the two-circle case's three distances computed once for both."""
     if case == TWO_ANGLES:
-        norms = dyads.two_angles_norms_np(first, second, k)
-        return (*dyads.two_angles_np(first, second, k, sigma, norms),
-                dyads.two_angles_margin_np(first, second, k, norms))
+        return dyads.two_angles_with_margin_np(first, second, k, sigma)
     return (*solve_step_np(case, first, second, k, sigma), step_margin_np(case, first, second, k))
 
 
