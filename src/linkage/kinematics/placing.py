@@ -88,8 +88,18 @@ def place_np(model: LoopModel, q: Any, d: Any) -> dict[str, tuple[Any, Any]]:
 
     origin0 = (zero + model.mechanism.origin[0], zero + model.mechanism.origin[1])
     placed = walk(model, part, add, origin0, lambda xy: (zero + xy[0], zero + xy[1]))
-    # a constant joint (a ground pivot) as a full column, as every position has it
-    return {k: (x + zero, y + zero) for k, (x, y) in placed.items()}
+    # a constant joint (a ground pivot) as a full column, as every position has it; a
+    # column already full and not another joint's too (a point without vectors is its
+    # joint's sums) kept, not copied
+    seen: set[int] = set()
+
+    def column(v: Any) -> Any:
+        if getattr(v, "shape", None) == d.shape and id(v) not in seen:
+            seen.add(id(v))
+            return v
+        return v + zero
+
+    return {k: (column(x), column(y)) for k, (x, y) in placed.items()}
 
 
 def walk(model: LoopModel, part: Any, add: Any, origin0: Any, at_rest: Any) -> dict[str, Any]:
