@@ -107,6 +107,32 @@ def test_arrow_columns_from_numpy_buffers_are_pyarrows_own_conversion() -> None:
     assert cells.arrow_array("number", np.arange(3)) is None and cells.arrow_array("int", x) is None
 
 
+def test_a_column_of_one_double_is_written_as_pyarrow_formats_it() -> None:
+    """A CSV column holding one double throughout goes out as its text repeated
+    (cells.repeated_text): the same bytes as pyarrow formatting every cell, for awkward
+    doubles (-0.0 and 0.0 apart, subnormals, 1e16, 1e-5 boundaries, long digits); a column
+    that differs in one row, or by the sign of a zero, or holds a NaN, is formatted cell
+    by cell."""
+    pytest.importorskip("pyarrow")
+    import pyarrow as pa
+
+    n = cells.REPEATED_FROM + 5
+    head = [v for v in awkward_numbers(200) if math.isfinite(v)]
+    values = [*head, 1e-5, 9.999999999999999e-06, 1e-4, 0.0001234, 1e15, 1e21, -1.5e300, 4e-320, 0.1 + 0.2]
+    cols = (Column("x", "mm", np.zeros(n)),)
+    for v in values:
+        x = np.full(n, v)
+        table = cells.arrow_table(cols, [x])
+        assert table.schema.types[0] == pa.string()
+        double = pa.Table.from_arrays([cells.arrow_array("number", x)], names=["0"])
+        assert cells.csv_bytes(table).to_pybytes() == cells.csv_bytes(double).to_pybytes()
+    for other in (1.0, -0.0, math.nan):
+        x = np.zeros(n)
+        x[n // 2] = other
+        assert cells.arrow_table(cols, [x]).schema.types[0] == pa.float64()
+    assert cells.arrow_table(cols, [np.zeros(cells.REPEATED_FROM - 1)]).schema.types[0] == pa.float64()
+
+
 def test_parquet_file_is_the_bytes_pyarrow_parquet_writes(tmp_path: Path) -> None:
     """The sink's writer (pyarrow's own, without pyarrow.parquet's filesystem imports) writes
     the file pyarrow.parquet.ParquetWriter writes, byte for byte: with text dictionary-encoded,
