@@ -133,6 +133,29 @@ def test_a_column_of_one_double_is_written_as_pyarrow_formats_it() -> None:
     assert cells.arrow_table(cols, [np.zeros(cells.REPEATED_FROM - 1)]).schema.types[0] == pa.float64()
 
 
+def test_a_csv_slice_that_needs_quoting_goes_cell_by_cell_from_its_first_row() -> None:
+    """Each slice's pyarrow table is made on its formatting thread (cells.csv_slices): a
+    word with a comma in a later slice stops the block path at that slice's first row,
+    the rest written cell by cell, and the file is the bytes the cell-by-cell path writes
+    throughout; the slices before it and the rows after it are all there, once."""
+    pytest.importorskip("pyarrow")
+    import io
+
+    n = max(3 * cells.CSV_WINDOW, cells.FAST_CELLS // 2) + 11
+    words = np.array(["converged", None, "open"], dtype=object)[np.arange(n) % 3]
+    words[2 * cells.CSV_WINDOW + 5] = "a,b"
+    cols = (Column("k", "", np.arange(n) - 7, "int"), Column("s", "", words, "text"))
+    out = {}
+    for fast in (True, False):
+        sink = formats.CsvSink(io.StringIO(), None)
+        sink.begin("t", cols, n if fast else None)
+        assert sink.fast is fast
+        sink.rows([c.values for c in cols])
+        out[fast] = sink.out.getvalue()
+    assert out[True] == out[False]
+    assert out[True].count("\n") == n + 1 and '"a,b"' in out[True]
+
+
 def test_parquet_file_is_the_bytes_pyarrow_parquet_writes(tmp_path: Path) -> None:
     """The sink's writer (pyarrow's own, without pyarrow.parquet's filesystem imports) writes
     the file pyarrow.parquet.ParquetWriter writes, byte for byte: with text dictionary-encoded,

@@ -96,20 +96,27 @@ MAX_CSV_THREADS = 8
 """Threads formatting a CSV's slices side by side: one per core, at most this many."""
 
 
-def csv_slices(table: Any) -> Iterator[tuple[int, Any]]:
-    """``table``'s rows as CSV (:func:`csv_bytes`), in order: (first row, its text, None where
-    refused) for each slice of CSV_WINDOW / cores rows. Each slice is one task, formatted in
-    one pass by pyarrow (which releases the GIL) on a thread per core, a window of slices
-    ahead of the one written: a task per core per window, no per-column or per-block round
-    trip, and the slices' text the only copy."""
+def csv_slices(columns: Sequence[Column], values: Sequence[Any], rows: int) -> Iterator[tuple[int, Any]]:
+    """The rows of ``values`` (numpy arrays or lists, :func:`slices_ready`) as CSV, in
+    order: (first row, its text, None where refused) for each slice of CSV_WINDOW / cores
+    rows. Each slice is one task on a thread per core: made a pyarrow table
+    (:func:`arrow_table`) and formatted in one pass (:func:`csv_bytes`, pyarrow releasing
+    the GIL), a window of slices ahead of the one written; so the first slice's text is
+    under way while the later slices' columns are converted, no per-column or per-block
+    round trip, and the slices' text the only copy."""
     import os
 
     workers = max(1, min(os.cpu_count() or 1, MAX_CSV_THREADS))
     step = max(1, -(-CSV_WINDOW // workers))
-    starts = range(0, table.num_rows, step)
+    starts = range(0, rows, step)
+
+    def text(a: int) -> Any:
+        table = arrow_table(columns, [v[a:a + step] for v in values])
+        return None if table is None else csv_bytes(table)
+
     if workers == 1 or len(starts) == 1:
         for a in starts:
-            yield a, csv_bytes(table.slice(a, step))
+            yield a, text(a)
         return
     from collections import deque
     from concurrent.futures import ThreadPoolExecutor
@@ -117,13 +124,19 @@ def csv_slices(table: Any) -> Iterator[tuple[int, Any]]:
     with ThreadPoolExecutor(workers) as pool:
         ahead: deque[tuple[int, Any]] = deque()
         for a in starts:
-            ahead.append((a, pool.submit(csv_bytes, table.slice(a, step))))
+            ahead.append((a, pool.submit(text, a)))
             if len(ahead) > 2 * workers:
                 first, done = ahead.popleft()
                 yield first, done.result()
         while ahead:
             first, done = ahead.popleft()
             yield first, done.result()
+
+
+def slices_ready(values: Sequence[Any]) -> bool:
+    """Every column a numpy array or a list: sliced on the formatting threads as they are
+    (a column computed as it is read, a sweep's rates, is read on the writing thread)."""
+    return all(is_array(v) or type(v) is list for v in values)
 
 
 def csv_bytes(table: Any) -> Any:
