@@ -156,6 +156,42 @@ def test_a_csv_slice_that_needs_quoting_goes_cell_by_cell_from_its_first_row() -
     assert out[True].count("\n") == n + 1 and '"a,b"' in out[True]
 
 
+def test_a_column_of_one_word_is_pyarrows_array_of_it(tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    """A long text column of one word throughout (cells.repeated_word: a sweep's status
+    where every position solved) is the array pa.array makes (equal objects or not, any
+    UTF-8), its CSV and parquet files the bytes written without the shortcut; one cell
+    other (None, another word) or a short column: converted cell by cell."""
+    pa = pytest.importorskip("pyarrow")
+    n = cells.REPEATED_FROM + 3
+    for word in ("converged", "öpen ∠", "x"):
+        same = np.array([word] * n, dtype=object)
+        equal = np.array(["".join(word)] * n, dtype=object)  # equal, not one object
+        for v in (same, equal, [word] * n):
+            got = cells.arrow_array("text", v)
+            assert got.equals(pa.array(list(v), type=pa.string()))
+            assert cells.repeated_word(list(v)) is not None
+    for odd in (None, "conv", ""):
+        v = ["converged"] * n
+        v[n // 2] = odd
+        assert cells.repeated_word(v) is None
+        assert cells.arrow_array("text", v).equals(pa.array(v, type=pa.string()))
+    assert cells.repeated_word(["a"] * (cells.REPEATED_FROM - 1)) is None
+    big = cells.FAST_CELLS  # the CSV's block path too
+    cols = (Column("s", "", np.array(["open"] * big, dtype=object), "text"),
+            Column("x", "mm", np.full(big, 1.5)))
+    files = {}
+    for shortcut in (True, False):
+        if not shortcut:
+            monkeypatch.setattr(cells, "REPEATED_FROM", 10**9)
+        for fmt in ("csv", "parquet"):
+            (tmp_path / str(shortcut)).mkdir(exist_ok=True)
+            out = tmp_path / str(shortcut) / f"t.{fmt}"  # the name is in the parquet file
+            writers.write(Report("r", (DataTable("t", cols),), list), fmt, out)
+            files[shortcut, fmt] = out.read_bytes()
+    assert files[True, "csv"] == files[False, "csv"] and files[True, "parquet"] == files[False, "parquet"]
+
+
 def test_parquet_file_is_the_bytes_pyarrow_parquet_writes(tmp_path: Path) -> None:
     """The sink's writer (pyarrow's own, without pyarrow.parquet's filesystem imports) writes
     the file pyarrow.parquet.ParquetWriter writes, byte for byte: with text dictionary-encoded,

@@ -200,7 +200,15 @@ def repeated_text(column: Any) -> Any:
     if not (bits == bits[0]).all():
         return None
     text = csv_bytes(pa.Table.from_arrays([column.slice(0, 1)], names=["0"]))
-    word = text.to_pybytes().rstrip(b"\n") if text is not None else b""
+    return repeated(text.to_pybytes().rstrip(b"\n") if text is not None else b"", n)
+
+
+def repeated(word: bytes, n: int) -> Any:
+    """A pyarrow string array of ``word`` (UTF-8) ``n`` times, made from its buffers; None
+    for an empty word or past a string array's 2 GB."""
+    import numpy as np
+    import pyarrow as pa
+
     if not word or len(word) * n >= 2**31:
         return None
     offsets = np.arange(n + 1, dtype=np.int32) * np.int32(len(word))
@@ -230,8 +238,21 @@ def arrow_array(kind: str, values: Any) -> Any:
         bits = pa.py_buffer(np.packbits(np.ascontiguousarray(values), bitorder="little"))
         return pa.Array.from_buffers(pa.bool_(), len(values), [None, bits])
     if kind == "text" and dtype in ("O", "U", ""):
-        return pa.array(plain_values(values), type=pa.string())
+        seq = plain_values(values)
+        word = repeated_word(seq)
+        return pa.array(seq, type=pa.string()) if word is None else word
     return None
+
+
+def repeated_word(seq: list[Any]) -> Any:
+    """A long list of one text throughout (a sweep's status or branch where every
+    position solved) as a pyarrow string array made from its buffers, the array
+    ``pa.array`` makes of it (tests check it): counted at C speed (``list.count``, each
+    cell the same object), not converted cell by cell (9 ms per 360,001 cells); else None."""
+    n = len(seq)
+    if n < REPEATED_FROM or type(seq[0]) is not str or seq.count(seq[0]) != n:
+        return None
+    return repeated(seq[0].encode("utf-8"), n)
 
 
 UNSAFE = frozenset('[]:*?/\\\0')
