@@ -106,6 +106,26 @@ def _api_rows(r):
 ENGINES = {"one at a time": dict(batch=False), "batch": dict(batch=True), "closed form": {}}
 
 
+@pytest.mark.parametrize("name", ["crank_rocker.toml", "watt_sixbar_joints.toml", "slider_crank.toml"])
+def test_place_np_on_threads_is_bit_for_bit_place_np_in_line(name, monkeypatch):
+    """A long block's vectors computed on threads (placing.THREAD_FROM) give the very
+    bits of the same sums computed in line, for solved and random configurations."""
+    from linkage.kinematics import placing
+
+    m = load(SAMPLES / name)
+    n = placing.THREAD_FROM + 7
+    rng = np.random.default_rng(33)
+    q = [rng.uniform(-7.0, 7.0, n) if u.kind == "angle" else rng.uniform(-2.0, 2.0, n) * m.length_scale
+         for u in m.unknowns]
+    d = rng.uniform(-7.0, 7.0, n) if m.driver.kind == "angle" else rng.uniform(-1, 1, n) * m.length_scale
+    threaded = place_np(m.model, q, d)
+    monkeypatch.setattr(placing, "THREAD_FROM", 10**12)
+    in_line = place_np(m.model, q, d)
+    assert list(threaded) == list(in_line) and threaded
+    for k, (x, y) in in_line.items():
+        assert threaded[k][0].tobytes() == x.tobytes() and threaded[k][1].tobytes() == y.tobytes()
+
+
 @pytest.mark.parametrize("engine", list(ENGINES))
 def test_the_csv_and_json_read_back_to_the_apis_numbers_bit_for_bit(engine, tmp_path):
     """CSV and JSON hold the same doubles; they are the API's own numbers bit for bit except

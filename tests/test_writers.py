@@ -107,6 +107,91 @@ def test_arrow_columns_from_numpy_buffers_are_pyarrows_own_conversion() -> None:
     assert cells.arrow_array("number", np.arange(3)) is None and cells.arrow_array("int", x) is None
 
 
+def test_a_column_of_one_double_is_written_as_pyarrow_formats_it() -> None:
+    """A CSV column holding one double throughout goes out as its text repeated
+    (cells.repeated_text): the same bytes as pyarrow formatting every cell, for awkward
+    doubles (-0.0 and 0.0 apart, subnormals, 1e16, 1e-5 boundaries, long digits); a column
+    that differs in one row, or by the sign of a zero, or holds a NaN, is formatted cell
+    by cell."""
+    pytest.importorskip("pyarrow")
+    import pyarrow as pa
+
+    n = cells.REPEATED_FROM + 5
+    head = [v for v in awkward_numbers(200) if math.isfinite(v)]
+    values = [*head, 1e-5, 9.999999999999999e-06, 1e-4, 0.0001234, 1e15, 1e21, -1.5e300, 4e-320, 0.1 + 0.2]
+    cols = (Column("x", "mm", np.zeros(n)),)
+    for v in values:
+        x = np.full(n, v)
+        table = cells.arrow_table(cols, [x])
+        assert table.schema.types[0] == pa.string()
+        double = pa.Table.from_arrays([cells.arrow_array("number", x)], names=["0"])
+        assert cells.csv_bytes(table).to_pybytes() == cells.csv_bytes(double).to_pybytes()
+    for other in (1.0, -0.0, math.nan):
+        x = np.zeros(n)
+        x[n // 2] = other
+        assert cells.arrow_table(cols, [x]).schema.types[0] == pa.float64()
+    assert cells.arrow_table(cols, [np.zeros(cells.REPEATED_FROM - 1)]).schema.types[0] == pa.float64()
+
+
+def test_a_csv_slice_that_needs_quoting_goes_cell_by_cell_from_its_first_row() -> None:
+    """Each slice's pyarrow table is made on its formatting thread (cells.csv_slices): a
+    word with a comma in a later slice stops the block path at that slice's first row,
+    the rest written cell by cell, and the file is the bytes the cell-by-cell path writes
+    throughout; the slices before it and the rows after it are all there, once."""
+    pytest.importorskip("pyarrow")
+    import io
+
+    n = max(3 * cells.CSV_WINDOW, cells.FAST_CELLS // 2) + 11
+    words = np.array(["converged", None, "open"], dtype=object)[np.arange(n) % 3]
+    words[2 * cells.CSV_WINDOW + 5] = "a,b"
+    cols = (Column("k", "", np.arange(n) - 7, "int"), Column("s", "", words, "text"))
+    out = {}
+    for fast in (True, False):
+        sink = formats.CsvSink(io.StringIO(), None)
+        sink.begin("t", cols, n if fast else None)
+        assert sink.fast is fast
+        sink.rows([c.values for c in cols])
+        out[fast] = sink.out.getvalue()
+    assert out[True] == out[False]
+    assert out[True].count("\n") == n + 1 and '"a,b"' in out[True]
+
+
+def test_a_column_of_one_word_is_pyarrows_array_of_it(tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    """A long text column of one word throughout (cells.repeated_word: a sweep's status
+    where every position solved) is the array pa.array makes (equal objects or not, any
+    UTF-8), its CSV and parquet files the bytes written without the shortcut; one cell
+    other (None, another word) or a short column: converted cell by cell."""
+    pa = pytest.importorskip("pyarrow")
+    n = cells.REPEATED_FROM + 3
+    for word in ("converged", "öpen ∠", "x"):
+        same = np.array([word] * n, dtype=object)
+        equal = np.array(["".join(word)] * n, dtype=object)  # equal, not one object
+        for v in (same, equal, [word] * n):
+            got = cells.arrow_array("text", v)
+            assert got.equals(pa.array(list(v), type=pa.string()))
+            assert cells.repeated_word(list(v)) is not None
+    for odd in (None, "conv", ""):
+        v = ["converged"] * n
+        v[n // 2] = odd
+        assert cells.repeated_word(v) is None
+        assert cells.arrow_array("text", v).equals(pa.array(v, type=pa.string()))
+    assert cells.repeated_word(["a"] * (cells.REPEATED_FROM - 1)) is None
+    big = cells.FAST_CELLS  # the CSV's block path too
+    cols = (Column("s", "", np.array(["open"] * big, dtype=object), "text"),
+            Column("x", "mm", np.full(big, 1.5)))
+    files = {}
+    for shortcut in (True, False):
+        if not shortcut:
+            monkeypatch.setattr(cells, "REPEATED_FROM", 10**9)
+        for fmt in ("csv", "parquet"):
+            (tmp_path / str(shortcut)).mkdir(exist_ok=True)
+            out = tmp_path / str(shortcut) / f"t.{fmt}"  # the name is in the parquet file
+            writers.write(Report("r", (DataTable("t", cols),), list), fmt, out)
+            files[shortcut, fmt] = out.read_bytes()
+    assert files[True, "csv"] == files[False, "csv"] and files[True, "parquet"] == files[False, "parquet"]
+
+
 def test_parquet_file_is_the_bytes_pyarrow_parquet_writes(tmp_path: Path) -> None:
     """The sink's writer (pyarrow's own, without pyarrow.parquet's filesystem imports) writes
     the file pyarrow.parquet.ParquetWriter writes, byte for byte: with text dictionary-encoded,

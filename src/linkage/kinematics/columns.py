@@ -94,7 +94,8 @@ def _array_columns(s: SweepResult, b: Any) -> SweepColumns:
     branch = np.full(n, None, dtype=object)
     if b.branch is not None:  # one text object shared, not one made per position
         branch[solved] = b.branch
-    det = np.where(solved, b.det, nan)
+    everywhere = bool(solved.all())
+    det = where_solved(solved, b.det, everywhere)
     m = b.source
     transmission = np.full(n, nan)
     joints: dict[str, tuple[Any, Any]] = {}
@@ -117,9 +118,21 @@ def _array_columns(s: SweepResult, b: Any) -> SweepColumns:
             from .placing import place_np
 
             placed = place_np(m.model, q, d)
-            joints = {k: (np.where(solved, x, nan), np.where(solved, y, nan)) for k, (x, y) in placed.items()}
+            joints = {k: (where_solved(solved, x, everywhere), where_solved(solved, y, everywhere))
+                      for k, (x, y) in placed.items()}
     return SweepColumns(np.asarray(b.values, dtype=float), status, solution, branch,
                         np.asarray(b.iterations), det, transmission, joints, rates, True)
+
+
+def where_solved(solved: Any, x: Any, everywhere: bool) -> Any:
+    """``x`` where a position solved, NaN elsewhere: ``x`` itself (a fresh array, read
+    only from here on) when every position solved, as ``np.where`` would copy it unchanged
+    (ten columns of 360,001 doubles: each copy a new 2.9 MB a fresh process faults in)."""
+    import numpy as np
+
+    if everywhere and getattr(x, "shape", None) == solved.shape:
+        return x
+    return np.where(solved, x, np.float64(math.nan))
 
 
 def transmission_column(m: Any, q: Sequence[Any], d: Any, solved: Any) -> Any:

@@ -62,6 +62,10 @@ def place_bounded(model: LoopModel, q: Any, d: Any, qd: Any, vd: Any, qdd: Any, 
                  lambda xy: (complex(*xy), 0j, 0j, 0.0, 0.0))
 
 
+THREAD_FROM = 50_000
+"""Positions from which :func:`place_np` computes each vector's column on a thread."""
+
+
 def place_np(model: LoopModel, q: Any, d: Any) -> dict[str, tuple[Any, Any]]:
     """:func:`place`'s positions over arrays: every named joint and point, name -> (x, y)
     arrays, for ``q`` (one array per unknown, internal units) and driver values ``d``.
@@ -73,23 +77,49 @@ def place_np(model: LoopModel, q: Any, d: Any) -> dict[str, tuple[Any, Any]]:
     d = np.asarray(d, dtype=float)
     zero = np.zeros(d.shape)
 
-    def part(t: Any, _at: Any) -> tuple[Any, Any]:
+    import threading
+
+    def vector(sr: Any, th: Any, out: list[Any]) -> None:
+        out[:] = sr * np.cos(th), sr * np.sin(th)
+
+    def part(t: Any, _at: Any) -> Any:
         sign, lc, li, ac, ai, off = t
         r = q[li] if li >= 0 else (d if li == DRIVER else lc)
         th = (q[ai] if ai >= 0 else (d if ai == DRIVER else ac)) + off
         sr = sign * r  # as _term: (sign r) e^(i theta), e^(i theta) = cos + i sin
-        return sr * np.cos(th), sr * np.sin(th)
+        if np.ndim(th) == 0 or th.size < THREAD_FROM:
+            return sr * np.cos(th), sr * np.sin(th)
+        # a long column's cosines and sines on a thread (numpy releases the GIL in them),
+        # beside the loop's next vector: the same operations, so the same bits
+        out: list[Any] = []
+        thread = threading.Thread(target=vector, args=(sr, th, out), name="linkage-place")
+        thread.start()
+        return thread, out, sr, th
 
     def add(start: tuple[Any, Any], parts: Any, sign: float) -> tuple[Any, Any]:
         x, y = start
-        for dx, dy in parts:
+        for p in parts:
+            if isinstance(p[0], threading.Thread):
+                p[0].join()
+                p = p[1] or (p[2] * np.cos(p[3]), p[2] * np.sin(p[3]))  # the thread failed: here
+            dx, dy = p
             x, y = x + sign * dx, y + sign * dy
         return x, y
 
     origin0 = (zero + model.mechanism.origin[0], zero + model.mechanism.origin[1])
     placed = walk(model, part, add, origin0, lambda xy: (zero + xy[0], zero + xy[1]))
-    # a constant joint (a ground pivot) as a full column, as every position has it
-    return {k: (x + zero, y + zero) for k, (x, y) in placed.items()}
+    # a constant joint (a ground pivot) as a full column, as every position has it; a
+    # column already full and not another joint's too (a point without vectors is its
+    # joint's sums) kept, not copied
+    seen: set[int] = set()
+
+    def column(v: Any) -> Any:
+        if getattr(v, "shape", None) == d.shape and id(v) not in seen:
+            seen.add(id(v))
+            return v
+        return v + zero
+
+    return {k: (column(x), column(y)) for k, (x, y) in placed.items()}
 
 
 def walk(model: LoopModel, part: Any, add: Any, origin0: Any, at_rest: Any) -> dict[str, Any]:

@@ -80,19 +80,19 @@ class CsvSink(Sink):
         cannot), its slices formatted in one pass each (:func:`.cells.csv_slices`) and
         written in order into the file's bytes. A slice refused (text that needs quoting)
         stops it at that slice's first row, none of which is written."""
-        table = cells.arrow_table(self.columns, values)
-        if table is None:
+        if not cells.slices_ready(values):
             return 0
         binary = getattr(self.out, "buffer", None)  # a file or standard output: its bytes
         self.out.flush()  # type: ignore[union-attr]
-        for a, text in cells.csv_slices(table):
+        n = len(values[0])
+        for a, text in cells.csv_slices(self.columns, values, n):
             if text is None:
                 return a
             if binary is not None:
                 binary.write(text)
             else:
                 self.out.write(text.to_pybytes().decode("utf-8"))  # type: ignore[union-attr]
-        return table.num_rows
+        return n
 
 
 class JsonSink(Sink):
