@@ -138,21 +138,24 @@ def walk(model: LoopModel, part: Any, add: Any, origin0: Any, at_rest: Any) -> d
             placed[names[0]] = at_rest(model.drawn[names[0]])
         start = placed.get(names[0]) if names and names[0] else None
         origin = start if start is not None else origin0
-        parts: dict[int, Any] = {}  # each vector's value once, and only where a joint reads it
         moving = [t[2] != FIXED or t[4] != FIXED for t in terms]
+        sides: dict[str, tuple[range, float] | None] = {}  # None: a drawn joint, at rest
         for k in range(len(terms)):
-            if not names or not names[k] or names[k] in placed:
+            if not names or not names[k] or names[k] in placed or names[k] in sides:
                 continue
             if names[k] in model.drawn:
-                placed[names[k]] = at_rest(model.drawn[names[k]])
+                sides[names[k]] = None
                 continue
             forward, backward = range(k), range(k, len(terms))
             ahead = sum(moving[j] for j in forward) <= sum(moving[j] for j in backward)
-            side = forward if ahead else backward
-            for j in side:
-                if j not in parts:
-                    parts[j] = part(terms[j], (i, j))
-            placed[names[k]] = add(origin, [parts[j] for j in side], 1.0 if ahead else -1.0)
+            sides[names[k]] = (forward, 1.0) if ahead else (backward, -1.0)
+        # each vector's value once, only where a joint reads it, all of them before any sum
+        # (a part may be computing on a thread: place_np)
+        read = sorted({j for side in sides.values() if side is not None for j in side[0]})
+        parts = {j: part(terms[j], (i, j)) for j in read}
+        for name, side in sides.items():
+            placed[name] = (at_rest(model.drawn[name]) if side is None
+                            else add(origin, [parts[j] for j in side[0]], side[1]))
     for name, (origin_name, terms) in model.point_terms.items():
         placed[name] = add(placed.get(origin_name, origin0), [part(t, None) for t in terms], 1.0)
     return placed
