@@ -25,7 +25,9 @@ ROOT = Path(__file__).resolve().parent.parent
 def table(targets: list[dict], label: str) -> str:
     """The markdown table of the bench's targets, a row each, as measured: issue 33's
     first, then the earlier targets the bench still judges."""
-    lines = [f"One run of `linkage bench --full` ({label}); each ratio is the median of interleaved pairs.",
+    lines = [f"One run of `linkage bench --full -f json -o bench.json` ({label}), written here by "
+             "`python benchmarks/performance_table.py bench.json`; each ratio is the median of "
+             "interleaved pairs.",
              "", "| target | ratio | measured (median of pairs) | met |", "|---|---|---|---|"]
     for row in targets:
         ratio = row["measured"]

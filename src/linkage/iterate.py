@@ -37,7 +37,6 @@ are kept and the count of rows left out between them is reported.
 
 from __future__ import annotations
 
-import contextlib
 import math
 import os
 import sys
@@ -441,7 +440,7 @@ def compiled(source: str, filename: str, fixed_source: bool) -> CodeType:
     """``compile(source, filename, "exec")``. Where ``fixed_source`` (the source depends
     only on this package's code, so there are finitely many), the code is kept between
     runs as Python keeps a module's bytecode, in :data:`LOOP_CACHE`: compiling a loop takes
-    0.4 to 1.3 ms, reading it back about 20 us, and a cold ``linkage solve`` compiles two.
+    0.4 to 1.3 ms, reading it back about 15 us, and a cold ``linkage solve`` compiles two.
     A kept file is used only if it holds this very source (compared whole, not by its
     hash) for this interpreter's bytecode (``sys.implementation.cache_tag`` in its name);
     one that is unreadable, damaged or of another source is compiled again and replaced.
@@ -470,18 +469,19 @@ def compiled(source: str, filename: str, fixed_source: bool) -> CodeType:
 
 
 def keep(path: str, data: bytes) -> None:
-    """Write ``data`` to ``path`` whole or not at all (a new file renamed into place, so a
-    reader never sees half of one); quietly: a cache that cannot be written is no error."""
-    part = f"{path}.{os.getpid()}.part"
+    """Write ``data`` to ``path`` whole or not at all (:func:`linkage.files.atomic_target`:
+    a reader never sees half a file); quietly: a cache that cannot be written is no error."""
+    from pathlib import Path
+
+    from .errors import OutputError
+    from .files import atomic_target
+
     try:
         os.makedirs(os.path.dirname(path), exist_ok=True)
-        fd = os.open(part, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
-        with os.fdopen(fd, "wb") as out:
+        with atomic_target(Path(path)) as part, open(part, "wb") as out:
             out.write(data)
-        os.replace(part, path)
-    except OSError:
-        with contextlib.suppress(OSError):
-            os.unlink(part)
+    except (OSError, OutputError):
+        return
 
 
 def build_loop(loop: Loop, names: dict[str, Any] | None = None, *,

@@ -80,7 +80,10 @@ def place_np(model: LoopModel, q: Any, d: Any) -> dict[str, tuple[Any, Any]]:
     import threading
 
     def vector(sr: Any, th: Any, out: list[Any]) -> None:
-        out[:] = sr * np.cos(th), sr * np.sin(th)
+        try:
+            out[:] = sr * np.cos(th), sr * np.sin(th)
+        except Exception:  # left empty: computed again in line, where the error is raised and named
+            return
 
     def part(t: Any, _at: Any) -> Any:
         sign, lc, li, ac, ai, off = t

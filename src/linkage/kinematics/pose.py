@@ -64,6 +64,10 @@ def file_branch_uncached(m: Mechanism) -> str | None:
     return sign_text(signs) if all(signs) else None
 
 
+FILE_POSE_TOL = 1e-12
+"""The tolerance the file's pose is solved to (``linkage solve FILE``'s default)."""
+
+
 def file_pose(m: Mechanism) -> tuple[float, ...] | None:
     """The file's pose (internal units): its guesses solved at its driver value, where the
     loops have a derived closed form with two-way steps; None otherwise or where it does
@@ -79,7 +83,7 @@ def file_pose_uncached(m: Mechanism) -> tuple[float, ...] | None:
         return None
     from ..solve import solve_system
 
-    r = solve_system(m.problem(), tol=1e-12)
+    r = solve_system(m.problem(), tol=FILE_POSE_TOL)
     return tuple(r.x) if r.converged else None
 
 

@@ -297,11 +297,11 @@ def _anchor(solver: Solver, positions: list[Position], angles: list[str],
                         closes, driver_turn(m.driver.unit))
     if near is None:
         return none
-    from .pose import file_pose
+    from .pose import FILE_POSE_TOL, file_pose
 
     # the file's pose as the sweep's default branch already solved it (solve FILE's own
     # solve: the file's guesses at its driver value, Newton to 1e-12), where it did
-    x = file_pose(m) if solver.tol == 1e-12 else None
+    x = file_pose(m) if solver.tol == FILE_POSE_TOL else None
     if x is None:
         from ..solve import solve_system
 

@@ -161,7 +161,8 @@ ARROW_BATCH = 4 * SLICE
 def arrow_table(columns: Sequence[Column], values: Sequence[Any]) -> Any:
     """A block of rows as a pyarrow table whose CSV text (``quoting_style="none"``) is the
     cells :func:`cell_texts` makes with pyarrow's numbers (tests check it): each column by
-    :func:`arrow_array`; None where a column is not a numpy array of its kind (the caller
+    :func:`arrow_array` (a long column of one double throughout as its text repeated,
+    :func:`repeated_text`); None where a column is not a numpy array of its kind (the caller
     goes cell by cell). Text that needs quoting is refused by the writer itself, before it
     writes a row."""
     import pyarrow as pa
@@ -174,9 +175,8 @@ def arrow_table(columns: Sequence[Column], values: Sequence[Any]) -> Any:
             return None
         if a is None:
             return None
-        if c.kind == "number":
-            a = repeated_text(a) or a
-        arrays.append(a)
+        text = repeated_text(a) if c.kind == "number" else None
+        arrays.append(a if text is None else text)
     return pa.Table.from_arrays(arrays, names=[str(j) for j in range(len(arrays))])
 
 
