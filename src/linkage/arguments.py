@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable, Iterator, Mapping, Sequence
+from operator import countOf
 from typing import Any
 
 from .errors import InputError
@@ -192,11 +193,13 @@ def check_reals(name: str, values: Any, length: int | None = None, labels: Seque
         # checks below, which cost microseconds on a solve of a few
         size = len(values)
         if size <= 1000 and (most is None or size <= most) and (length is None or size == length):
-            for v in values:
-                if type(v) is not float or v - v != 0.0:
-                    break
-            else:
-                return list(values)
+            # every entry a float, counted at C speed, and their sum finite: a NaN or an
+            # infinity makes it NaN or infinite, so every entry is finite (a sum that
+            # overflows only sends finite values to the checks below, which pass them)
+            if countOf(map(type, values), float) == size:
+                total = sum(values)
+                if total - total == 0.0:
+                    return list(values)
     if values is None or isinstance(values, (str, bytes, Mapping)) or is_real(values):
         raise InputError(f"{name} must be a sequence of numbers (a list, tuple or 1-D array), "
                          f"got {describe(values)}")

@@ -65,9 +65,10 @@ def closes_circle(values: Sequence[float], turn: float = TURN) -> bool:
     return -slack <= closing <= largest + slack
 
 
-def closes_circle_array(values: Any, turn: float = TURN, diff: Any = None) -> bool:
+def closes_circle_array(values: Any, turn: float = TURN, diff: Any = None, rising: bool = False) -> bool:
     """:func:`closes_circle` of a 1-D array of driver values (one grid, read at C speed).
-    ``diff``: np.diff of the values, where the caller took it; taken here when not given."""
+    ``diff``: np.diff of the values, where the caller took it; taken here when not given.
+    ``rising``: the caller has checked that every entry of ``diff`` is > 0."""
     import numpy as np
 
     v = np.asarray(values, dtype=float)
@@ -75,10 +76,14 @@ def closes_circle_array(values: Any, turn: float = TURN, diff: Any = None) -> bo
         return False
     if diff is None:
         diff = np.diff(v)
-    steps = diff if v[1] > v[0] else -diff
-    if not (steps > 0.0).all():
-        return False
-    closing = turn - abs(float(v[-1]) - float(v[0]))
+    first, last = float(v[0]), float(v[-1])
+    if rising:
+        steps = diff
+    else:
+        steps = diff if float(v[1]) > first else -diff
+        if not (steps > 0.0).all():
+            return False
+    closing = turn - abs(last - first)
     slack = 1e-9 * turn
     return bool(-slack <= closing <= float(steps.max()) + slack)
 
@@ -161,14 +166,14 @@ def unwrap_turns_array(values: Any, closes: bool) -> Any:
         # every position solved: read in grid order from the first (rule 1), each step
         # from the previous value (0 before the first); the general path's result, its
         # operations (((prev + 180) - a) / TURN, floor, cumsum) in place in one array
+        # (0 + 180 is 180 exactly; add.accumulate is cumsum's loop without its wrapper)
         step = np.empty_like(a)
-        step[:, 0] = 0.0
-        step[:, 1:] = a[:, :-1]
-        step += 180.0
+        step[:, 0] = 180.0
+        np.add(a[:, :-1], 180.0, out=step[:, 1:])
         step -= a
         step /= TURN
         np.floor(step, out=step)
-        return np.cumsum(step, axis=1, out=step)
+        return np.add.accumulate(step, axis=1, out=step)
     start = circular_start_array(solved, closes)
     idx = (np.arange(n)[None, :] + start[:, None]) % n
     r = np.take_along_axis(a, idx, axis=1)
@@ -212,10 +217,10 @@ def anchor_index_array(values: Any, solved: Any, v0: float, closes: bool, turn: 
 
     d = np.abs(np.asarray(values, dtype=float) - v0)
     if closes:
-        d = d % turn
+        d = np.fmod(d, turn)  # d % turn: the same for d >= 0 (or NaN), without floor-mod's fix-ups
         d = np.minimum(d, turn - d)
     if solved is True:  # every position solved, one row: no masked copy
-        return np.argmin(d, keepdims=True)
+        return d.argmin(keepdims=True)
     return np.argmin(np.where(solved, d[None, :], np.inf), axis=1)
 
 

@@ -51,6 +51,7 @@ from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
 from .pose import implied, step_words
 from .positions import SweepResult, check_driver_values
+from .stepwise import classification_of
 from .vector_loops import VectorLoops, loop_plan, per_position, singular_of, solve_linear
 
 MARGIN_FLOOR = 1e-8
@@ -120,7 +121,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     n_pos = len(vals)
     if vals.ndim != 1 or n_pos < 2:
         return None
-    diff = np.diff(vals)  # (b - a > 0 exactly where b > a: IEEE subtraction underflows gradually)
+    diff = vals[1:] - vals[:-1]  # np.diff (b - a > 0 exactly where b > a: subtraction underflows gradually)
     if not (diff > 0.0).all():
         return None
     # the driver's magnitude, refused as the one-at-a-time engine refuses it
@@ -152,13 +153,11 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
         iters[lo:lo + BLOCK] = it
         ratio[lo:lo + BLOCK] = rt
     assert words is not None
-    closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn, diff)
+    closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn, diff, rising=True)
     if _touch_candidate(closes, det, ratio):
         return None
     shown = _display(m, plan, tol, max_iter, vals, cols, closes)
     label = "/".join(words)
-    from .stepwise import classification_of
-
     # the followed branch as the one-at-a-time engine reports it: its name where each name
     # is one sign branch, else its signs (each position still carries its name)
     followed = label if plan.names_are_signs else sign_text(signs)
@@ -309,7 +308,8 @@ def _display(m: Mechanism, plan: ClosedPlan, tol: float, max_iter: int, vals: np
     """The unknowns in display units, each angle continuous along the cycle and anchored to
     what ``solve FILE`` gives (the rule of :mod:`.angles`, as the one-at-a-time engine)."""
     kinds, angles = plan.kinds, list(plan.angles)
-    if len(angles) == len(kinds):
+    every = len(angles) == len(kinds)
+    if every:
         out = degrees(cols)  # every unknown an angle: one pass
     else:
         out = cols.copy()
@@ -317,7 +317,7 @@ def _display(m: Mechanism, plan: ClosedPlan, tol: float, max_iter: int, vals: np
             out[j] = degrees(cols[j])
     if not angles:
         return out
-    turns = unwrap_turns_array(out[angles], closes)
+    turns = unwrap_turns_array(out if every else out[angles], closes)
     # (every position solved: the anchor is the grid point nearest the file's driver value)
     near = int(anchor_index_array(vals, True, m.driver.value / plan.scale, closes, plan.turn)[0])
     shift = np.zeros(len(angles))
@@ -326,7 +326,7 @@ def _display(m: Mechanism, plan: ClosedPlan, tol: float, max_iter: int, vals: np
         for a, j in enumerate(angles):
             at = continuous(float(out[j, near]), float(turns[a, near]))
             shift[a] = turn_shift(degrees(ref[j]), at)
-    if len(angles) == len(kinds):
+    if every:
         return continuous(out, turns + shift[:, None])  # elementwise: the rows' own values
     for a, j in enumerate(angles):
         out[j] = continuous(out[j], turns[a] + shift[a])

@@ -13,7 +13,11 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from ..arguments import check_callable, check_flag, check_motion, check_reals, check_text
+from ..errors import InputError
 from ..problems.loops import Mechanism
+from ..solve import check_criteria
+from .loading import mechanism_of
 from .pose import POSE_MEETS, file_branch, pose_meets, step_words
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
 from .stepwise import sweep
@@ -72,11 +76,6 @@ def sweep_mechanism(
     them), as ``result.forces`` (a :class:`~linkage.Forces` or None per position) and
     ``result.force_columns()``.
     """
-    from ..arguments import check_callable, check_flag, check_motion, check_reals, check_text
-    from ..errors import InputError
-    from ..solve import check_criteria
-    from .loading import mechanism_of
-
     # the front door: every argument checked once, InputError naming it
     m = mechanism_of("mechanism", mechanism)
     values = check_reals("values", values, most=MAX_POSITIONS, keep_array=True)
@@ -160,7 +159,6 @@ def branch_choices(m: Mechanism) -> list[str]:
 def check_branch(m: Mechanism, branch: str) -> None:
     """InputError naming ``branch`` unless it is a name or sign string of ``m``'s derived
     closed form (:func:`branch_choices`)."""
-    from ..errors import InputError
     from ..problems.derive import sign_text
 
     refusal = m.derivation.branch_refusal(m.source)
