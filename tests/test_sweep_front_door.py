@@ -14,8 +14,6 @@ from linkage.errors import InputError
 from linkage.kinematics.angles import (
     anchor_index,
     anchor_index_array,
-    closes_circle,
-    closes_circle_array,
     unwrap_turns,
     unwrap_turns_array,
 )
@@ -99,17 +97,3 @@ def test_unwrap_turns_array_fast_path_is_the_scalar_rule_far_out(seed):
         got = unwrap_turns_array(rows, closes)
         for row, turns in zip(rows, got):
             assert list(turns) == unwrap_turns(list(row), closes)
-
-
-@pytest.mark.parametrize("grid", [
-    [float(k) for k in range(361)], [float(k) for k in range(360)], [0.0, 90.0, 180.0, 270.0],
-    [0.0, 1.0], [0.1 * k for k in range(3601)], [0.0, 100.0, 200.0, 300.0, 380.0], [0.0, 0.5, 359.0],
-])
-def test_closes_circle_array_on_a_rising_grid_is_its_scalar(grid):
-    """``rising=True`` (the closed-form engine has checked every step > 0) gives the verdict
-    of the scalar rule, which checks it again."""
-    v = np.array(grid)
-    diff = v[1:] - v[:-1]
-    assert np.array_equal(diff, np.diff(v))
-    assert closes_circle_array(v, 360.0, diff, rising=True) == closes_circle(grid)
-    assert closes_circle_array(v, 2 * math.pi, diff, rising=True) == closes_circle(grid, 2 * math.pi)

@@ -65,10 +65,9 @@ def closes_circle(values: Sequence[float], turn: float = TURN) -> bool:
     return -slack <= closing <= largest + slack
 
 
-def closes_circle_array(values: Any, turn: float = TURN, diff: Any = None, rising: bool = False) -> bool:
+def closes_circle_array(values: Any, turn: float = TURN, diff: Any = None) -> bool:
     """:func:`closes_circle` of a 1-D array of driver values (one grid, read at C speed).
-    ``diff``: np.diff of the values, where the caller took it; taken here when not given.
-    ``rising``: the caller has checked that every entry of ``diff`` is > 0."""
+    ``diff``: np.diff of the values, where the caller took it; taken here when not given."""
     import numpy as np
 
     v = np.asarray(values, dtype=float)
@@ -76,14 +75,10 @@ def closes_circle_array(values: Any, turn: float = TURN, diff: Any = None, risin
         return False
     if diff is None:
         diff = np.diff(v)
-    first, last = float(v[0]), float(v[-1])
-    if rising:
-        steps = diff
-    else:
-        steps = diff if float(v[1]) > first else -diff
-        if not (steps > 0.0).all():
-            return False
-    closing = turn - abs(last - first)
+    steps = diff if v[1] > v[0] else -diff
+    if not (steps > 0.0).all():
+        return False
+    closing = turn - abs(float(v[-1]) - float(v[0]))
     slack = 1e-9 * turn
     return bool(-slack <= closing <= float(steps.max()) + slack)
 

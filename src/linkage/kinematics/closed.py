@@ -121,7 +121,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     n_pos = len(vals)
     if vals.ndim != 1 or n_pos < 2:
         return None
-    diff = vals[1:] - vals[:-1]  # np.diff (b - a > 0 exactly where b > a: subtraction underflows gradually)
+    diff = np.diff(vals)  # (b - a > 0 exactly where b > a: IEEE subtraction underflows gradually)
     if not (diff > 0.0).all():
         return None
     # the driver's magnitude, refused as the one-at-a-time engine refuses it
@@ -153,7 +153,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
         iters[lo:lo + BLOCK] = it
         ratio[lo:lo + BLOCK] = rt
     assert words is not None
-    closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn, diff, rising=True)
+    closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn, diff)
     if _touch_candidate(closes, det, ratio):
         return None
     shown = _display(m, plan, tol, max_iter, vals, cols, closes)

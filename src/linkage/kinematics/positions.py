@@ -8,8 +8,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..errors import InputError
-from ..problems.loops import Mechanism, magnitude_problem
+from ..problems.loops import Mechanism
 from ..units import RAD_PER_DEG
 
 
@@ -146,6 +145,9 @@ MAX_POSITIONS = 2_000_000
 def check_driver_values(m: Mechanism, values: Sequence[float]) -> list[float]:
     """The values as floats, or InputError: too many, not finite, or beyond what the
     driver's kind can represent (see :func:`~linkage.problems.loops.magnitude_problem`)."""
+    from ..errors import InputError
+    from ..problems.loops import magnitude_problem
+
     if len(values) > MAX_POSITIONS:
         raise InputError(f"{len(values):,} driver values is more than {MAX_POSITIONS:,}; sweep in parts")
     out = [float(v) for v in values]
@@ -170,6 +172,8 @@ def driver_values(start: float, stop: float, step: float | None, points: int | N
 
     Refuses (InputError) more than MAX_POSITIONS values, and ranges whose values double
     precision cannot tell apart at that spacing (``--from 1e26 --step 1``)."""
+    from ..errors import InputError
+
     for name, v in (("--from", start), ("--to", stop)):
         if not math.isfinite(v):
             raise InputError(f"{name} must be finite, got {v!r}")
