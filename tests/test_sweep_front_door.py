@@ -97,3 +97,34 @@ def test_unwrap_turns_array_fast_path_is_the_scalar_rule_far_out(seed):
         got = unwrap_turns_array(rows, closes)
         for row, turns in zip(rows, got):
             assert list(turns) == unwrap_turns(list(row), closes)
+
+
+def test_a_cold_sweep_does_not_load_the_scalar_solve():
+    """A command-line sweep reads the system solve and the criteria: the scalar solve, its
+    root certificate and its problem type are not loaded (linkage.solve's names are
+    imported on first use), and every name is still importable from linkage.solve."""
+    import os
+    import subprocess
+    import sys
+
+    from linkage.samples import sample_path
+
+    probe = ("import sys, runpy\n"
+             f"sys.argv = ['linkage', 'sweep', {str(sample_path('crank_rocker.toml'))!r}]\n"
+             "try:\n    runpy.run_module('linkage', run_name='__main__')\nexcept SystemExit:\n    pass\n"
+             "print(' '.join(m for m in sys.modules if m.startswith('linkage')), file=sys.stderr)")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True,
+                         env=dict(os.environ))
+    loaded = set(out.stderr.split())
+    assert {"linkage.solve.system", "linkage.solve.criteria", "linkage.kinematics.stepwise"} <= loaded
+    assert not loaded & {"linkage.solve.scalar", "linkage.solve.certificate", "linkage.problems.scalar"}
+    import linkage.solve as solve
+
+    for name in solve.__all__:
+        assert getattr(solve, name) is not None
+    from linkage.solve import certify_root, solve_scalar
+
+    assert solve_scalar.__module__ == "linkage.solve.scalar"
+    assert certify_root.__module__ == "linkage.solve.certificate"
+    with pytest.raises(AttributeError, match="no attribute 'nothing'"):
+        solve.nothing  # noqa: B018

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import functools
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ..problems.scalar import ScalarProblem
 from ..result import History, Status
+
+if TYPE_CHECKING:  # loaded where a table is labelled: the system methods use new_state alone
+    from ..problems.scalar import ScalarProblem
 
 new_state = tuple.__new__
 """Build a NamedTuple state without its Python-level ``__new__``.
@@ -49,6 +51,8 @@ def history_of(m: Any, problem: ScalarProblem, rows: Any) -> History:
 @functools.lru_cache(maxsize=128)
 def column_labels(m: Any, var: str, unit: str, has_u: bool, has_gprime: bool) -> tuple[str, ...]:
     """A method's table headers for a problem's names and units (computed once)."""
+    from ..problems.scalar import ScalarProblem
+
     shape = ScalarProblem(f=abs, var=var, unit=unit, u=abs if has_u else None,
                           gprime=abs if has_gprime else None)
     return tuple(c.label(var, unit) for c in m.columns(shape))

@@ -6,12 +6,14 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..arguments import check_reals, real_matrix, real_result, real_vector
 from ..errors import InputError
-from ..problems.scalar import ScalarProblem
 from ..result import Result
+
+if TYPE_CHECKING:  # annotations only: the system solve does not load the scalar problem type
+    from ..problems.scalar import ScalarProblem
 
 
 def diagnose_scalar(problem: ScalarProblem, x0: float, rerun: Callable[[ScalarProblem], Any]) -> None:
