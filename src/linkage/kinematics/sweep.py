@@ -17,7 +17,6 @@ from ..arguments import check_callable, check_flag, check_motion, check_reals, c
 from ..errors import InputError
 from ..problems.loops import Mechanism
 from ..solve import check_criteria
-from .loading import mechanism_of
 from .pose import POSE_MEETS, file_branch, pose_meets, step_words
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
 from .stepwise import sweep
@@ -77,7 +76,12 @@ def sweep_mechanism(
     ``result.force_columns()``.
     """
     # the front door: every argument checked once, InputError naming it
-    m = mechanism_of("mechanism", mechanism)
+    if isinstance(mechanism, Mechanism):
+        m = mechanism
+    else:  # a path (or a misuse): loading's modules only then
+        from .loading import mechanism_of
+
+        m = mechanism_of("mechanism", mechanism)
     values = check_reals("values", values, most=MAX_POSITIONS, keep_array=True)
     check_criteria(tol, 0.0, None, max_iter)
     check_text("branch", branch)
