@@ -114,7 +114,7 @@ def test_the_sweep_is_split_by_what_it_does():
 # --- issue 33: layers, sizes, private attributes ------------------------------------------
 
 LAYERS: tuple[frozenset[str], ...] = (
-    frozenset({"errors", "numbers", "units", "result", "files", "samples", "arguments", "rules", "linalg",
+    frozenset({"errors", "numbers", "units", "result", "files", "samples", "arguments", "rules", "linalg", "records",
                "version"}),
     frozenset({"problems", "codegen"}),
     frozenset({"methods", "iterate", "analysis", "kernel"}),
