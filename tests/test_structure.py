@@ -114,8 +114,8 @@ def test_the_sweep_is_split_by_what_it_does():
 # --- issue 33: layers, sizes, private attributes ------------------------------------------
 
 LAYERS: tuple[frozenset[str], ...] = (
-    frozenset({"errors", "numbers", "units", "result", "files", "samples", "arguments", "rules", "linalg", "records",
-               "version"}),
+    frozenset({"errors", "numbers", "units", "result", "files", "samples", "arguments", "rules", "linalg",
+               "records", "version"}),
     frozenset({"problems", "codegen"}),
     frozenset({"methods", "iterate", "analysis", "kernel"}),
     frozenset({"solve", "homotopy"}),
