@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import marshal
 import os
+import re
 import subprocess
 import sys
 import threading
@@ -161,3 +162,12 @@ def test_the_cli_prints_the_same_from_kept_and_compiled_methods(tmp_path):
     assert first.stdout == second.stdout and "theta" in first.stdout
     assert any(name.startswith("dataclass-linkage.result.") for name in kept)
     assert sorted(p.name for p in tmp_path.iterdir()) == kept
+
+
+def test_every_frozen_dataclass_of_the_package_is_made_by_records_frozen():
+    """One way to make the package's frozen records: a new class that skips records.frozen
+    would compile its methods at every import again."""
+    src = Path(records.__file__).parent
+    offenders = [str(p.relative_to(src)) for p in sorted(src.rglob("*.py"))
+                 if re.search(r"^@(dataclasses\.)?dataclass\(frozen=True\)", p.read_text(), re.M)]
+    assert offenders == []
