@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+import signal
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -80,3 +81,10 @@ def crank_rocker_search():
     from test_path_search import search_the_crank_rocker
 
     return search_the_crank_rocker()
+
+
+def sigint_as_at_a_terminal() -> None:
+    """The child's SIGINT at its default, as a terminal's foreground job has it: a test run
+    started as a background job (``pytest &``) has it ignored, POSIX shells' rule for
+    background jobs, which Python and so the child keep (the signal would then be lost)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

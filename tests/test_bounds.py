@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import CliRun
+from conftest import CliRun, sigint_as_at_a_terminal
 from linkage import load_mechanism, solve_system
 from linkage.errors import InputError, ParseError
 from linkage.files import MAX_TOML_KEY_PARTS, MAX_TOML_NESTING
@@ -321,7 +321,7 @@ def test_sigterm_during_a_scan_leaves_no_part_files(tmp_path, sig, code, line):
     child = subprocess.Popen(
         [sys.executable, "-m", "linkage", "scan", str(CRANK_ROCKER), "--vary", "r2=20:60:2000",
          "--vary", "r3=80:160:1000", "--chunk", "50", "-o", str(out)],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=sigint_as_at_a_terminal)
     try:
         deadline = time.monotonic() + 60  # guards against a hang only
         while not any(p.name.startswith(".designs.csv.") for p in tmp_path.iterdir()):

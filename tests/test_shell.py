@@ -10,6 +10,8 @@ import sys
 import time
 from pathlib import Path
 
+from conftest import sigint_as_at_a_terminal
+
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
 LINKAGE = [sys.executable, "-m", "linkage"]
 
@@ -61,7 +63,7 @@ def test_dash_reads_the_mechanism_from_standard_input():
 def test_sigint_is_one_line_and_exit_130():
     p = subprocess.Popen([*LINKAGE, "sweep", str(SAMPLES / "crank_rocker.toml"), "--step", "0.001",
                           "--no-batch", "--format", "csv"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                         text=True)
+                         text=True, preexec_fn=sigint_as_at_a_terminal)
     time.sleep(2.0)
     p.send_signal(signal.SIGINT)
     _, err = p.communicate(timeout=60)

@@ -115,7 +115,7 @@ def test_the_sweep_is_split_by_what_it_does():
 
 LAYERS: tuple[frozenset[str], ...] = (
     frozenset({"errors", "numbers", "units", "result", "files", "samples", "arguments", "rules", "linalg",
-               "version"}),
+               "records", "version"}),
     frozenset({"problems", "codegen"}),
     frozenset({"methods", "iterate", "analysis", "kernel"}),
     frozenset({"solve", "homotopy"}),

@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from enum import Enum
 from types import SimpleNamespace
 from typing import Any, NamedTuple
 
 from .errors import NotConvergedError
+from .records import frozen
 
 
 class Status(Enum):
@@ -98,7 +98,7 @@ def _per(num: str, den: str) -> str:
     return f"{num or '1'}/{den}"
 
 
-@dataclass(frozen=True)
+@frozen
 class History:
     """The recorded iterations: column labels (with units) and one tuple per row.
 
@@ -151,7 +151,7 @@ class IterationRecord(NamedTuple):
     values: dict[str, Any]
 
 
-@dataclass(frozen=True)
+@frozen
 class Result:
     """The outcome of one solve. The same type for every method and every outcome.
 

@@ -14,12 +14,13 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any, NamedTuple
 
 from ..errors import InputError
 from ..methods import GOLDEN, METHODS
 from ..problems.scalar import ScalarProblem
+from ..records import frozen
 from ..result import Result
 
 ROUNDING_LEVEL = 8.0 * sys.float_info.epsilon
@@ -41,7 +42,7 @@ class ConvergenceRow(NamedTuple):
     rounding: bool
 
 
-@dataclass(frozen=True)
+@frozen
 class Convergence:
     """Estimated and theoretical convergence of one run."""
 

@@ -49,11 +49,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import mpmath
 import numpy as np
 
+from ..records import frozen
 from .polynomials import Polynomial, PolySystem
 
 DIGITS = 50
@@ -66,7 +66,7 @@ SAFETY = 1e-6
 """Relative margin on every verdict, far above the 50-digit rounding (module docstring)."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Certificate:
     """Smale's alpha test at one point (module docstring). ``certified``: Newton's method
     from the point converges quadratically to a root within ``radius``; ``real``: that root

@@ -34,9 +34,9 @@ of six is enough to track (:func:`orbit`):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+
+from ..records import frozen
 
 A, X, B, Y, AB, XB, BB, YB = range(8)
 """Columns of an unknown vector: a, x, b, y, abar, xbar, bbar, ybar."""
@@ -223,7 +223,7 @@ def owners(Z: np.ndarray) -> np.ndarray:
     return owner
 
 
-@dataclass(frozen=True)
+@frozen
 class Instance:
     """Points (delta, deltabar: P_j - P_0 in isotropic coordinates, j = 1..8) and the
     solutions known for them, one per orbit of six (:func:`orbit`)."""

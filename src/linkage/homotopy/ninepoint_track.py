@@ -7,11 +7,11 @@ monodromy loops that made the stored instance (:class:`NinePointLoops`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..records import frozen
 from .ninepoint import (
     REFINED,
     RESIDUAL,
@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from .tracker import PathLog
 
 
-@dataclass(frozen=True)
+@frozen
 class ParameterSegment:
     """The points moving on a straight line, delta(t) = (1 - t) start + t end, for all
     paths at once; an instance of the homotopy protocol of :func:`.tracker.track`
@@ -106,7 +106,7 @@ def track_segment(segment: ParameterSegment, Z: np.ndarray, max_step: float = MA
     return z1, ok & np.all(np.isfinite(z1), axis=1), log
 
 
-@dataclass(frozen=True)
+@frozen
 class NinePointLoops:
     """The nine-point problem as :func:`.parameter.monodromy` loops it: the parameters are
     the points, (delta, deltabar) as one vector of 16; a corner of a loop is random complex
@@ -135,7 +135,7 @@ class NinePointLoops:
         return [i - len(known) for i in distinct(np.vstack([known, roots])) if i >= len(known)]
 
 
-@dataclass(frozen=True)
+@frozen
 class NinePointSolutions:
     """The four-bars through nine points, one per orbit (cognates and dyad order), and how
     they were found."""
@@ -174,7 +174,7 @@ projective coordinates (infinite)."""
 REACHED, AGAIN, DUPLICATE, UNSETTLED, UNDERFLOW, TOO_MANY_STEPS, INFINITE = range(len(OUTCOMES))
 
 
-@dataclass(frozen=True)
+@frozen
 class PathRecord:
     """Every path of every route, one entry each, as arrays (routes in order, each route's
     paths in start order): what the tracker counted (summed over the route's legs), what the
@@ -200,7 +200,7 @@ class PathRecord:
 
 MAX_ROUTES = 4
 
-@dataclass(frozen=True)
+@frozen
 class Route:
     """One way from the stored instance to the target: its legs (points at each end) and
     each leg's projective patch. A value, so that a chunk of paths can be sent to a worker."""

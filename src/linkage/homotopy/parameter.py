@@ -24,19 +24,19 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from functools import cached_property
 from itertools import pairwise
 from typing import Protocol
 
 import numpy as np
 
+from ..records import frozen
 from .polynomials import HomogeneousForm, Polynomial, PolySystem
 from .solve import Solutions, on_patch, track_all
 from .tracker import velocity
 
 
-@dataclass(frozen=True)
+@frozen
 class Family:
     """F(x; p): each exponent tuple has n entries for x, then k for p."""
 
@@ -97,7 +97,7 @@ class ParameterFamily(Protocol):
     def at(self, p: np.ndarray) -> PolySystem: ...
 
 
-@dataclass(frozen=True)
+@frozen
 class JointForm:
     """A family's polynomials over (X0, x, p) as one HomogeneousForm."""
 
@@ -110,7 +110,7 @@ class JointForm:
         return F, J[:, :, :self.n + 1], np.einsum("pmk,pk->pm", J[:, :, self.n + 1:], dp)
 
 
-@dataclass(frozen=True)
+@frozen
 class ParameterHomotopy:
     """H(X, t) = F(X; p(t)), p(t) = p0 + tau(t) (p1 - p0), on the patch a.X = 1."""
 
@@ -196,7 +196,7 @@ class Loops(Protocol):
         ...
 
 
-@dataclass(frozen=True)
+@frozen
 class FamilyLoops:
     """A family's loops: corners at the scale of ``p``, legs by :func:`track_parameters`
     (an endpoint is kept as a finite root of residual at most GOOD_RESIDUAL), roots equal
@@ -232,7 +232,7 @@ class FamilyLoops:
         return out
 
 
-@dataclass(frozen=True)
+@frozen
 class Loop:
     """One monodromy loop: the count after it, the roots it added, the paths it dropped."""
 
@@ -242,7 +242,7 @@ class Loop:
     seconds: float
 
 
-@dataclass(frozen=True)
+@frozen
 class Monodromy:
     """The roots of F(x; p) found from the seeds, and how the count grew."""
 

@@ -12,16 +12,17 @@ Polynomials Arising in Engineering and Science*, World Scientific 2005, ch. 3).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+
+from ..records import frozen
 
 Polynomial = Mapping[tuple[int, ...], complex]
 """Exponents -> coefficient; an exponent tuple has one entry per (affine) variable."""
 
 
-@dataclass(frozen=True)
+@frozen
 class PolySystem:
     """A square or overdetermined polynomial system in ``n`` affine variables."""
 
@@ -94,7 +95,7 @@ class PolySystem:
         return self.homogeneous.jacobian(X)[:, :, 1:]
 
 
-@dataclass(frozen=True)
+@frozen
 class HomogeneousForm:
     """Each polynomial homogenised to its degree, as matrices over one list of monomials:
     F(X) = C M(X) and dF/dX_v = D_v M(X), M(X) the monomials' values."""

@@ -27,11 +27,11 @@ geometrically with the samples.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
+from ..records import frozen
 from .alpha import Certificate, certify, has_real_structure, normalised, undistinguished
 from .polynomials import PolySystem
 from .start import start_for
@@ -62,7 +62,7 @@ REAL = 1e-9
 against max(1, |x|)."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Endpoint:
     """Where one path ended, and what it is."""
 
@@ -81,7 +81,7 @@ class Endpoint:
     endgame: bool = True  # the Cauchy endgame ran (False: tracked to t = 1 itself, nonsingular there)
 
 
-@dataclass(frozen=True)
+@frozen
 class Solutions:
     """Every path's endpoint, and the homotopy that made them."""
 

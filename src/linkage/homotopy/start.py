@@ -19,17 +19,16 @@ are the roots of those systems.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from ..records import frozen
 from .polynomials import PolySystem, total_degree_start, total_degree_start_points
 
 TOTAL_DEGREE = "total degree"
 LINEAR_PRODUCT = "linear product"
 
 
-@dataclass(frozen=True)
+@frozen
 class LinearProduct:
     """G_i(X) = prod_k A[i, k] . X over each equation's factors (a factor past its
     equation's count is 1), homogeneous in X = (X0, x): evaluated like a HomogeneousForm."""
@@ -59,7 +58,7 @@ class LinearProduct:
         return self.both(X)[1]
 
 
-@dataclass(frozen=True)
+@frozen
 class Start:
     """A start system, its roots (affine), each equation's degree in the homotopy (the
     target is homogenised to it) and the bound its root count is."""

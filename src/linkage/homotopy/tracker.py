@@ -19,6 +19,7 @@ from typing import Protocol
 
 import numpy as np
 
+from ..records import frozen
 from .polynomials import HomogeneousForm
 from .start import LinearProduct
 
@@ -51,7 +52,7 @@ def velocity(h: PathHomotopy, X: np.ndarray, t: np.ndarray, dt: np.ndarray) -> n
     return -solve_batched(J, Ht * dt[:, None])
 
 
-@dataclass(frozen=True)
+@frozen
 class Homotopy:
     """H(X, t) = (1 - t) gamma G + t F on the patch a.X = 1."""
 

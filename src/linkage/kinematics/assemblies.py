@@ -15,7 +15,7 @@ multihomogeneous Bezout number or fewer, stated beside the total degree.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -23,13 +23,14 @@ import numpy as np
 from ..errors import InputError
 from ..homotopy import PolySystem, Solutions, condition, solve
 from ..problems.loops import ANGLE_UNITS, DRIVER, Mechanism
+from ..records import frozen
 from ..units import degrees, radians
 from .angles import nearest_turn
 
 Monomials = dict[tuple[int, ...], complex]
 
 
-@dataclass(frozen=True)
+@frozen
 class Assembly:
     """One real assembly: the unknowns (internal units), its name, its residual."""
 
@@ -42,7 +43,7 @@ class Assembly:
     joints: dict[str, tuple[float, float]]  # every named joint and point
 
 
-@dataclass(frozen=True)
+@frozen
 class Assemblies:
     mechanism: Mechanism
     driver: float  # internal units

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from functools import partial
 from typing import Any
 
@@ -27,6 +27,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism
+from ..records import frozen
 from ..rules import GOING, SystemStops, converged_codes, residual_gate, step_scales, step_size_array
 from ..units import RAD_PER_DEG, degrees, radians
 from .angles import nearest_turn, nearest_turn_array
@@ -42,7 +43,7 @@ STATUS_CODES = {"converged": 0, "no_solution": 1, "failed": 2, "off_branch": 3}
 CODE_STATUS = {v: k for k, v in STATUS_CODES.items()}
 
 
-@dataclass(frozen=True)
+@frozen
 class BatchResult:
     """Arrays, one entry per position: driver values, status codes, solutions (display
     units, shape (N, n)), det J and Newton iterations; the branch they are all on."""

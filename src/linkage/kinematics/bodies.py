@@ -6,11 +6,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
 from ..problems.loads import Loads, parse_loads
+from ..records import frozen
 
 
 def metre(length_unit: str) -> float:
@@ -87,7 +87,7 @@ def _force(label: str, item: str, parts: Sequence[str]) -> list[float]:
 # --- one position ------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@frozen
 class Frame:
     """The drawing's bodies as the matrix method needs them."""
 

@@ -30,10 +30,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
+from ..records import frozen
 from ..units import degrees, radians
 
 H = tuple[float, float, float]
@@ -98,7 +98,7 @@ def at_infinity(direction_rad: float) -> H:
     return (math.cos(direction_rad), math.sin(direction_rad), 0.0)
 
 
-@dataclass(frozen=True)
+@frozen
 class Place:
     """Where a homogeneous point is, by the one rule (:func:`place_of`)."""
 
@@ -145,7 +145,7 @@ def velocity_centre(w_i: float, p_i: tuple[float, float], v_i: tuple[float, floa
 
 # --- a pose's bodies and their motion ----------------------------------------------------------
 
-@dataclass(frozen=True)
+@frozen
 class Pose:
     """A joints-form mechanism solved at one driver value, with the rates of a unit driver
     speed: everything the centres need."""
@@ -204,7 +204,7 @@ def angular_velocity(mechanism: Any, rates: Any, speed: float, body: str) -> flo
     return speed if name == mechanism.driver.name else rates.velocities[name]
 
 
-@dataclass(frozen=True)
+@frozen
 class HomogeneousFrame:
     """The frame the homogeneous points are in: lengths from ``origin`` over ``size``."""
 
@@ -356,7 +356,7 @@ def kennedy(bodies: Sequence[str], known: Mapping[tuple[str, str], H]
         found[best[1]] = (best[2], best[3])
 
 
-@dataclass(frozen=True)
+@frozen
 class Centre:
     """One relative instant centre."""
 
@@ -384,7 +384,7 @@ class Centre:
     other)."""
 
 
-@dataclass(frozen=True)
+@frozen
 class InstantCentres:
     """The n(n-1)/2 instant centres of a mechanism at one pose (:func:`instant_centres`)."""
 

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
+from ..records import frozen
 from ..units import degrees, radians
 from .centres import (
     HomogeneousFrame,
@@ -28,7 +28,7 @@ from .centres import (
 )
 
 
-@dataclass(frozen=True)
+@frozen
 class CentrodePoint:
     input: float
     """The driver value (display unit)."""
@@ -44,7 +44,7 @@ class CentrodePoint:
     changes sign between positions, the centre passes through infinity."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Centrodes:
     """The fixed and moving centrodes of ``body`` relative to the ground over a sweep."""
 

@@ -27,11 +27,11 @@ length means the same for a crank angle and a slide.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..problems.loops import Mechanism
+from ..records import frozen
 from .assemblies import Assemblies, assemblies, same_configuration
 
 MAX_STEP = 0.05
@@ -46,7 +46,7 @@ MATCH = 1e-7
 """Configurations closer than this (rad, or of the size) are the same assembly."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Circuit:
     """One closed curve of configurations, and the assemblies at the start value on it."""
 
@@ -63,7 +63,7 @@ class Circuit:
     configurations: tuple[tuple[float, ...], ...]
 
 
-@dataclass(frozen=True)
+@frozen
 class Circuits:
     assemblies: Assemblies
     circuits: tuple[Circuit, ...]

@@ -28,7 +28,6 @@ built only when it is read.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import partial
 from typing import Any
 
@@ -36,6 +35,7 @@ import numpy as np
 
 from ..problems.derive import sign_text
 from ..problems.loops import ANGLE_UNITS, Mechanism
+from ..records import frozen
 from ..rules import GOING, SystemStops, converged_codes, residual_gate, step_scales, step_size_array
 from ..units import degrees
 from .angles import (
@@ -66,7 +66,7 @@ BLOCK = 65_536
 """Positions per block (the temporaries stay small for a million positions)."""
 
 
-@dataclass(frozen=True)
+@frozen
 class ClosedPlan:
     """What this engine reads of a mechanism, whatever the values: derived once per
     mechanism (:func:`~.pose.implied`; a Mechanism is frozen), not on every sweep."""

@@ -33,13 +33,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..problems.derive import Derivation, read_branch
 from ..problems.loops import ANGLE_UNITS, Mechanism, VectorTerm
+from ..records import frozen
 from ..units import degrees, radians
 from .angles import (
     anchor_index_array,
@@ -69,7 +69,7 @@ SEED_DISTANCE = 1e-6
 still be that position: further means it went to another assembly."""
 
 
-@dataclass(frozen=True)
+@frozen
 class DesignSolutions:
     """Every design at every driver value. ``status`` and ``feasible`` are (designs,
     positions); ``solution`` is (designs, positions, unknowns) in display units (deg for

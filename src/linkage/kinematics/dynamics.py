@@ -29,10 +29,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from ..problems.loads import Loads
+from ..records import frozen
 
 DEAD_POINT_SENSITIVITY = 300.0
 """A position is a dead point (the driver no longer drives the mechanism) where some
@@ -52,7 +53,7 @@ ASSEMBLY_RTOL = 1e-9
 """A position closes its loops to this, relative to the mechanism's size, or it is not
 assembled there."""
 
-@dataclass(frozen=True)
+@frozen
 class Friction:
     """Pin friction: each pin joins its owner (the ground where it is fixed, else the first
     link listing it) to each other link on it, and each such pair's relative rotation
@@ -73,7 +74,7 @@ class Friction:
         return self.default_coulomb > 0.0 or any(v > 0.0 for v in self.coulomb.values())
 
 
-@dataclass(frozen=True)
+@frozen
 class Drive:
     """The driving torque (N m) or force (N) as a function of t (s), theta (rad or m) and
     omega (rad/s or m/s): ``text`` through the equations' safe parser
@@ -88,7 +89,7 @@ class Drive:
         return function_of(self.text, ("t", "theta", "omega"), self.constants, what="drive")
 
 
-@dataclass(frozen=True)
+@frozen
 class Point:
     """The mechanism at one driver value, per unit driver speed (SI)."""
 

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from ..problems.loads import Loads
+from ..records import frozen
 from .bodies import Frame, force_size, metre
 from .forces import (
     TOGGLE_COND,
@@ -24,7 +24,7 @@ from .forces import (
 from .load_matrix import ForceArrays, solve_loads
 
 
-@dataclass(frozen=True)
+@frozen
 class BatchForces:
     """:func:`batch_forces`' answer: the matrix method's arrays (NaN where unsolved or
     undefined), each position's status (FORCE_STATUSES codes), its largest pin force and
@@ -122,7 +122,7 @@ class SolvedPosition(NamedTuple):
     rates: Any
 
 
-@dataclass(frozen=True)
+@frozen
 class SolvedRows:
     """A chunk's solved positions as arrays: their indices in the sweep, the unknowns (one
     array each) and the driver, internal units."""
@@ -135,7 +135,7 @@ class SolvedRows:
         return len(self.index)
 
 
-@dataclass(frozen=True)
+@frozen
 class ChunkForces:
     """The matrix method over a chunk's solved positions (:func:`chunk_forces`)."""
 
@@ -341,7 +341,7 @@ def _chunk_columns(cf: ChunkForces, start: int, size: int, loads: Loads) -> Load
     return LoadChunk(start, status, columns)
 
 
-@dataclass(frozen=True)
+@frozen
 class SweepLoads:
     """A sweep's loads as columns (numpy arrays, one entry per position) and their peaks
     (:func:`sweep_load_columns`)."""

@@ -24,11 +24,11 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
 from ..problems.loads import Loads
+from ..records import frozen
 from .bodies import Frame, checked_loads, metre
 from .load_matrix import ForceArrays, solve_loads
 
@@ -42,7 +42,7 @@ TOGGLE_COND = 1e3
 with the condition number."""
 
 
-@dataclass(frozen=True)
+@frozen
 class PinForce:
     joint: str
     on: str
@@ -57,7 +57,7 @@ class PinForce:
         return math.hypot(self.fx, self.fy)
 
 
-@dataclass(frozen=True)
+@frozen
 class SliderForce:
     slider: str
     on: str
@@ -68,7 +68,7 @@ class SliderForce:
     """N m, on the slider."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Forces:
     """One position's loads answer (SI units)."""
 

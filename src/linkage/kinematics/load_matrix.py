@@ -10,11 +10,11 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from ..errors import InputError
 from ..problems.loads import Loads, load_link
+from ..records import frozen
 from ..units import radians
 from .bodies import Frame, metre
 
@@ -89,7 +89,7 @@ def cross(r: tuple[Any, Any], f: tuple[Any, Any]) -> Any:
     return r[0] * f[1] - r[1] * f[0]
 
 
-@dataclass(frozen=True)
+@frozen
 class ForceArrays:
     """The matrix method over N positions at once (arrays of shape (N,), NaN where the
     force matrix is singular)."""

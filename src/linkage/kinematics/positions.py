@@ -5,14 +5,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from ..problems.loops import Mechanism
+from ..records import frozen
 from ..units import RAD_PER_DEG
 
 
-@dataclass(frozen=True)
+@frozen
 class Position:
     input: float
     status: str  # "converged", "no_solution", "off_branch" or "failed"
@@ -28,7 +29,7 @@ class Position:
     :class:`~linkage.kinematics.rates.Rates`, or None where unsolved."""
 
 
-@dataclass(frozen=True)
+@frozen
 class SweepResult:
     mechanism: str
     driver: str

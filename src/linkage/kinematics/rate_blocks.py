@@ -12,10 +12,10 @@ from RATES_BLOCK_ABOVE solved positions.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..problems.loops import ANGLE_UNITS, LoopModel
+from ..records import frozen
 from ..units import radians
 from .labels import rate_label
 from .placing import place_bounded
@@ -29,7 +29,7 @@ if TYPE_CHECKING:  # a solve's rates do not load the sweep's types
 OK, ILL, UNDEFINED = "ok", "ill_conditioned", "undefined"
 
 
-@dataclass(frozen=True)
+@frozen
 class RateBlock:
     """Rates at a block of positions, one array entry per position (internal units, as
     :class:`~.rates.Rates`), NaN where a rate is absent (``status`` undefined: then only

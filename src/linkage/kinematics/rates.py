@@ -24,11 +24,12 @@ block of positions (a sweep's chunk) runs the same definitions over numpy arrays
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from ..methods.newton_system import max_abs, newton_direction
 from ..problems.loops import DRIVER, LoopModel
+from ..records import frozen
 from .block_linalg import direction_np
 from .labels import rate_label
 from .placing import place, place_bounded
@@ -43,7 +44,7 @@ POLISH_STEPS = 60
 """Most Newton steps taken to polish a position before its rates (each must shrink)."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Rates:
     """One position's kinematics. ``velocities``/``accelerations``: unknown name -> rad/s
     and rad/s^2 (angles) or length unit/s and /s^2 (lengths); the joint and point maps:

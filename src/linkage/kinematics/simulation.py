@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
 from ..problems.loads import Loads
+from ..records import frozen
 from ..units import radians
 from .dynamics import DEAD_POINT_SENSITIVITY, Drive, Dynamics, Friction
 
@@ -32,7 +32,7 @@ EVENTS = ("dead_point", "limit_of_assembly", "stopped", "integration_failed")
 at rest under Coulomb friction (sticking is not modelled), the integrator's own failure."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Simulation:
     """``linkage.simulate``'s answer (SI; theta in rad or m). Arrays over the output times."""
 
@@ -72,7 +72,7 @@ class Simulation:
     """(t, theta, omega) at 2001 times from the integrator's dense output, for pictures."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Cycle:
     """The last full driver turn's speed fluctuation (flywheel sizing)."""
 

@@ -5,19 +5,19 @@ the single solve's test of a singular J on arrays."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..problems.loops import DRIVER, LoopModel, Mechanism
+from ..records import frozen
 
 Term = tuple[float, Any, int, Any, int, float]
 """(sign, length, length index, angle, angle index, offset): an index >= 0 names an
 unknown, -1 a fixed value, DRIVER the driver."""
 
 
-@dataclass(frozen=True)
+@frozen
 class LoopPlan:
     """A loop model's terms as :class:`VectorLoops` reads them, sorted once per model
     (``model.terms`` with the driver's places marked): each loop's terms whose length and

@@ -11,14 +11,14 @@ evaluates them by Horner's rule."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
+from ..records import frozen
 from .angles import nearest_turn_array
 
 
-@dataclass(frozen=True)
+@frozen
 class Coarse:
     """The coarse pass as the blocks read it, arranged per interval [grid[c], grid[c + 1]]
     where a block would otherwise recompute it per position."""

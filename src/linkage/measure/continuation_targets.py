@@ -18,11 +18,11 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from ..records import frozen
 from ..synthesis.path import PROBLEM_3
 
 PUBLISHED_ORBITS = 1442
@@ -49,7 +49,7 @@ DUPLICATE = 1e-6
 (looser than the engines' own test, 1e-8, so that a near miss shows)."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Certificate:
     """The roots a run listed, checked at 50 digits: the worst relative residual and how
     many are above RESIDUAL, the worst distance to the 50-digit root (relative), roots
@@ -67,7 +67,7 @@ class Certificate:
         return self.worst_residual <= RESIDUAL and self.duplicates == 0 and self.spurious == 0
 
 
-@dataclass(frozen=True)
+@frozen
 class Found:
     """What a run found, said in a line; whether it is all the target asks; its roots checked."""
 
@@ -76,7 +76,7 @@ class Found:
     certificate: Certificate
 
 
-@dataclass(frozen=True)
+@frozen
 class Timed:
     """Seconds of each run, and what the last run found."""
 
@@ -88,7 +88,7 @@ class Timed:
         return float(np.median(self.seconds))
 
 
-@dataclass(frozen=True)
+@frozen
 class Row:
     """One target: met when the median run takes at most ``bound`` seconds and finds all
     the target asks (``Found.complete``)."""
@@ -310,7 +310,7 @@ ROWS = (
 MEASURES: dict[Row, Measure] = dict(zip(ROWS, (problem_3, burmester, sixbar_assemblies)))
 
 
-@dataclass(frozen=True)
+@frozen
 class Outcome:
     row: Row
     timed: Timed | None

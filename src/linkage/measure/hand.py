@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
+from ..records import frozen
 from ..units import degrees
 
 
@@ -72,7 +72,7 @@ def fourbar_open(theta2: Any, r1: float, r2: float, r3: float, r4: float) -> tup
     return degrees(t3), degrees(t4)
 
 
-@dataclass(frozen=True)
+@frozen
 class DrawnFourbar:
     """A crank-rocker as sample_inputs/crank_rocker_joints.toml draws it (mm): O2 at the
     origin, O4 on the x axis, the crank pin A, the coupler-rocker pin B, a coupler point P,

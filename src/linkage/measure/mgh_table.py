@@ -9,17 +9,17 @@ battery and the tests.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 from ..problems.catalog import mgh_cases
+from ..records import frozen
 
 SOLVED_RESIDUAL = 1e-8
 TOL = 1e-10
 MAX_ITER = 200
 
 
-@dataclass(frozen=True)
+@frozen
 class Outcome:
     case: str
     solver: str

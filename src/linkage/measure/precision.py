@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
+from ..records import frozen
 from .hand import hand_newton, hand_newton_2x2
 from .timing import time_per_call
 
@@ -29,7 +29,7 @@ SCIPY_KEYWORDS = {"fprime": "fprime", "fsecond": "fprime2"}
 """root_scalar's keyword for each problem function a registered method needs."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Measurement:
     problem: str
     contender: str

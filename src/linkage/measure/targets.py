@@ -14,10 +14,10 @@ import statistics
 import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..records import frozen
 from .processes import FLOOR, ProcessFailed, cold_commands, linkage_command, python_command, runner
 from .timing import Pairs, interleaved_pairs
 
@@ -25,7 +25,7 @@ Target = tuple[str, str, "float | None", "bool | None"]
 """(target, comparison, measured ratio, met): None where this run could not judge it."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Row:
     """One target: ``name`` as issue 33's table names the measure, met when the ratio is at
     most ``bound`` (at least, where ``at_least``); ``part`` tells two targets of one
@@ -74,7 +74,7 @@ EARLIER = (
 """The earlier targets measured the same way (the sweeps' and the scan's: :mod:`.sweeps`)."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Settings:
     """How hard to measure: ``repeats`` pairs, in-process batches of about ``budget`` s."""
 
@@ -88,7 +88,7 @@ class Skipped(Exception):
     """This run cannot measure the row (an optional package is missing); the reason."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Measured:
     """Pairs, and what else the row's target asks (cores used): ``detail`` says it,
     ``also_met`` judges it."""
@@ -327,7 +327,7 @@ MEASURES: dict[Row, Measure] = dict(zip(ROWS + EARLIER, (
 """How each row (issue 33's, then the earlier ones) is measured."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Outcome:
     row: Row
     pairs: Pairs | None

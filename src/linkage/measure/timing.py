@@ -8,13 +8,14 @@ import gc
 import statistics
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
+
+from ..records import frozen
 
 Clock = Callable[[], float]
 
 
-@dataclass(frozen=True)
+@frozen
 class Pairs:
     """Seconds of A and of B, taken in turn (``a[i]`` just before ``b[i]``), per call."""
 

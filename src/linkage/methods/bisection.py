@@ -13,11 +13,11 @@ c, e = (b - a) / 2.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
 from ..iterate import Loop, build_loop
 from ..problems.scalar import ScalarProblem
+from ..records import frozen
 from ..result import Column, Status
 from .common import new_state, same_sign
 
@@ -58,7 +58,7 @@ def init_bracket(problem: ScalarProblem, a: float,
     return fa, fb, None
 
 
-@dataclass(frozen=True)
+@frozen
 class Bisection:
     name: ClassVar[str] = "bisection"
     bracketing: ClassVar[bool] = True

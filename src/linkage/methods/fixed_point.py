@@ -14,11 +14,11 @@ g'(x_i), error = x_i - x_{i+1} (signed).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
 from ..iterate import Loop, build_loop
 from ..problems.scalar import ScalarProblem
+from ..records import frozen
 from ..result import Column, Status
 from .common import display, new_state
 
@@ -31,7 +31,7 @@ class FixedPointState(NamedTuple):
     xp: float
 
 
-@dataclass(frozen=True)
+@frozen
 class FixedPoint:
     """``evaluate_f``: compute f(x_{i+1}) each step, for a residual test."""
 

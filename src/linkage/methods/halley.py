@@ -11,10 +11,10 @@ Rows: i, x_i, f(x_i), f'(x_i), f''(x_i), x_{i+1}, |x_{i+1} - x_i|.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
 from ..problems.scalar import ScalarProblem
+from ..records import frozen
 from ..result import Column, Status
 from .common import new_state, start_stop
 
@@ -30,7 +30,7 @@ class HalleyState(NamedTuple):
     d2fxp: float
 
 
-@dataclass(frozen=True)
+@frozen
 class Halley:
     name: ClassVar[str] = "halley"
     bracketing: ClassVar[bool] = False

@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
 from ..problems.scalar import ScalarProblem
+from ..records import frozen
 from ..result import Column, Status
 from .bisection import init_bracket
 from .common import new_state
@@ -52,7 +52,7 @@ def _settle(xpre: float, fpre: float, xcur: float, fcur: float, xblk: float, fbl
     return xpre, fpre, xcur, fcur, xblk, fblk, spre, scur
 
 
-@dataclass(frozen=True)
+@frozen
 class Hybrid:
     """``tol``/``rtol``: the shortest step taken, which should match the stopping test."""
 

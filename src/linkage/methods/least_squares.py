@@ -13,11 +13,11 @@ that no assembly exists, the solve reports ``no_solution`` instead.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
 from ..linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve
 from ..problems.system import SystemProblem
+from ..records import frozen
 from ..result import Column, Status
 from .common import new_state
 from .newton_system import (
@@ -56,7 +56,7 @@ class LMState(NamedTuple):
     that Newton's own test calls nonsingular (newton_system.newton_direction)."""
 
 
-@dataclass(frozen=True)
+@frozen
 class LevenbergMarquardt:
     jacobian: str = "analytic"
     fd_step: float | None = None

@@ -12,11 +12,11 @@ Rows follow the student report (docs/worked_examples.md P2): i, x_i, f(x_i), f'(
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
 from ..iterate import HISTORY_HEAD, Criteria, Loop, build_loop, dedent
 from ..problems.scalar import ScalarProblem
+from ..records import frozen
 from ..result import Column, Result, Status
 from .common import history_of, new_state, start_stop
 
@@ -31,7 +31,7 @@ class NewtonState(NamedTuple):
     dfxp: float
 
 
-@dataclass(frozen=True)
+@frozen
 class Newton:
     name: ClassVar[str] = "newton"
     bracketing: ClassVar[bool] = False

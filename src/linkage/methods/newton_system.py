@@ -19,12 +19,12 @@ from __future__ import annotations
 import math
 import operator
 import sys
-from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
 from ..iterate import Loop, build_loop, dedent, indent
 from ..linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve, pivot_ratio
 from ..problems.system import SystemProblem
+from ..records import frozen
 from ..result import Column, Status
 from ..rules import invertible, invertible_source, pivots_invertible, step_size
 from ..units import degrees
@@ -170,7 +170,7 @@ def _sumsq(v: Any) -> float:
     return total
 
 
-@dataclass(frozen=True)
+@frozen
 class NewtonSystem:
     """``jacobian``: "analytic" or "fd"; ``fd_step``: h for "fd" (None: sqrt(eps) max(1, |q|));
     ``damped``: globalised (the default; False for the textbook iteration); ``diagnostics``:

@@ -11,10 +11,10 @@ Error measure: the bracket width |b - a|, which bounds |c - r| because c is an e
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
 from ..problems.scalar import ScalarProblem
+from ..records import frozen
 from ..result import Column, Status
 from .bisection import init_bracket
 from .common import new_state, same_sign
@@ -38,7 +38,7 @@ class RegulaFalsiState(NamedTuple):
     row_fb: float
 
 
-@dataclass(frozen=True)
+@frozen
 class RegulaFalsi:
     name: ClassVar[str] = "regula-falsi"
     bracketing: ClassVar[bool] = True

@@ -12,11 +12,11 @@ x_{i+1}, |x_{i+1} - x_i|.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
 from ..iterate import Loop, build_loop
 from ..problems.scalar import ScalarProblem
+from ..records import frozen
 from ..result import Column, Status
 from .common import new_state
 
@@ -34,7 +34,7 @@ class SecantState(NamedTuple):
     slope_before: float
 
 
-@dataclass(frozen=True)
+@frozen
 class Secant:
     name: ClassVar[str] = "secant"
     bracketing: ClassVar[bool] = False

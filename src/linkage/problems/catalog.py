@@ -14,8 +14,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
+from ..records import frozen
 from .classic import Case, classic_cases
 from .expression import equation_problem
 from .freudenstein import fourbar_equation
@@ -26,7 +25,7 @@ __all__ = ["BENCH_SCALAR", "BENCH_SYSTEMS", "CATALOG", "Case", "CatalogEntry", "
            "classic_cases", "entry", "mgh_cases"]
 
 
-@dataclass(frozen=True)
+@frozen
 class CatalogEntry:
     name: str
     equation: str | None

@@ -12,13 +12,14 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
+
+from ..records import frozen
 
 EPS = sys.float_info.epsilon
 
 
-@dataclass(frozen=True)
+@frozen
 class Case:
     family: str
     name: str

@@ -31,9 +31,9 @@ from __future__ import annotations
 import ast
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 
 from ..errors import ParseError
+from ..records import frozen
 from ..units import RAD_PER_DEG
 from .scalar import ScalarProblem
 
@@ -120,7 +120,7 @@ _NAMESPACE = {
 
 # --- the operation list -----------------------------------------------------------------
 
-@dataclass(frozen=True)
+@frozen
 class Op:
     """One operation: ``kind`` is ``num``, ``x``, ``neg``, ``+ - * / **`` or a function name;
     ``args`` index earlier operations; ``value`` is the number of a ``num``."""
@@ -272,7 +272,7 @@ def parse_ops(text: str, *, what: str = "equation", variables: tuple[str, ...] =
     return tuple(b.ops[: out[-1] + 1])
 
 
-@dataclass(frozen=True)
+@frozen
 class _Names:
     """The names a text may use besides pi, e and the functions."""
 
@@ -515,7 +515,7 @@ def build(source: str) -> Fn:
     return namespace["fn"]  # type: ignore[no-any-return]
 
 
-@dataclass(frozen=True)
+@frozen
 class Expression:
     """A parsed function of x, compiled to straight-line code with exact derivatives."""
 

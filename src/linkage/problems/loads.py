@@ -4,13 +4,14 @@ against its drawing; kinematics.forces solves for the forces they cause."""
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from ..errors import InputError
+from ..records import frozen
 
 
-@dataclass(frozen=True)
+@frozen
 class Mass:
     mass: float
     """kg"""
@@ -20,7 +21,7 @@ class Mass:
     """kg m^2, about the centre of mass."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Loads:
     forces: dict[str, tuple[float, float]] = field(default_factory=dict)
     """Joint or point -> (Fx, Fy) in N, fixed in the ground frame."""

@@ -33,10 +33,11 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from ..errors import InputError, ParseError
+from ..records import frozen
 from ..units import RAD_PER_DEG, degrees, radians
 from .system import SystemProblem
 
@@ -124,7 +125,7 @@ class Loop(NamedTuple):
     joints: tuple[str, ...] = ()  # the start point of each vector ("" unnamed), for drawings
 
 
-@dataclass(frozen=True)
+@frozen
 class Mechanism:
     """A mechanism read from a file: parameters, driver, unknowns and vector loops."""
 
@@ -277,7 +278,7 @@ def drawn_ground(m: Mechanism, values: Mapping[str, Any]) -> dict[str, tuple[flo
     return {j: drawing.xy[j] for j in drawing.ground}
 
 
-@dataclass(frozen=True)
+@frozen
 class LoopModel:
     """The loops compiled once: each term is (sign, length constant, length index, angle
     constant, angle index, offset); an index >= 0 is an unknown, DRIVER the driver."""

@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+
+from ..records import frozen
 
 Vec = list[float]
 
 
-@dataclass(frozen=True)
+@frozen
 class SquareSystem:
     name: str
     n: int

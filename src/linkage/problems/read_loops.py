@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from typing import Any
 
 from ..errors import ParseError
+from ..records import frozen
 from ..units import radians
 from .columns import column_clash
 from .loops import (
@@ -38,7 +38,7 @@ TOP_KEYS = {"name", "description", "length_unit", "closed_form", "parameters", "
 Fail = Callable[[str, str], ParseError]
 
 
-@dataclass(frozen=True)
+@frozen
 class _Reading:
     """What every part of one file's reading needs: its name for messages, its length unit
     and how each name is used (the unit a bare number takes)."""

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+
+from ..records import frozen
 
 Fn = Callable[[float], float]
 
 
-@dataclass(frozen=True)
+@frozen
 class ScalarProblem:
     """f(x) = 0, plus optional derivatives and a fixed-point form x = g(x).
 

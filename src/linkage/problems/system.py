@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
+from ..records import frozen
 from ..units import degrees, radians
 
 Vector = Sequence[float]
@@ -14,7 +15,7 @@ Residual = Callable[[Vector], list[float]]
 Jacobian = Callable[[Vector], list[list[float]]]
 
 
-@dataclass(frozen=True)
+@frozen
 class SystemProblem:
     """Phi(q) = 0. Unknowns are held in internal units (radians for angles).
 

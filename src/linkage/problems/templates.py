@@ -20,10 +20,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
+from ..records import frozen
 from ..units import radians
 from . import dyads
 from .toml_text import toml_value
@@ -40,7 +40,7 @@ MAX_ANGLE_DEG = 1e6
 Joints = dict[str, Point]
 
 
-@dataclass(frozen=True)
+@frozen
 class Kind:
     """A mechanism ``linkage new`` draws: its lengths in ``--links`` order, the sample file
     whose dimensions and driver value are the defaults, its bodies, and how it is drawn."""

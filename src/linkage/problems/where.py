@@ -17,12 +17,12 @@ from __future__ import annotations
 import ast
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..errors import ParseError
+from ..records import frozen
 from .expression import (
     BINOPS,
     CONSTANTS,
@@ -51,7 +51,7 @@ _ARITH = {"+": np.add, "-": np.subtract, "*": np.multiply, "/": np.true_divide, 
 _WORDS = {"true": True, "false": False, "True": True, "False": False}
 
 
-@dataclass(frozen=True)
+@frozen
 class _Op:
     kind: str  # num, text, col, neg, not, and, or, an arithmetic symbol, a comparison, a function
     args: tuple[int, ...] = ()

@@ -25,11 +25,11 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
+from ..records import frozen
 from ..units import radians
 
 SUFFIXES = (".dxf", ".svg")
@@ -49,7 +49,7 @@ CAD_EXTRA = "pip install 'linkage-kinematics[cad]'"
 Point = tuple[float, float]
 
 
-@dataclass(frozen=True)
+@frozen
 class Body:
     """A body's outline at the pose: ``role`` is ground, driven or link."""
 
@@ -65,7 +65,7 @@ class Body:
         return any(p != self.points[0] for p in self.points)
 
 
-@dataclass(frozen=True)
+@frozen
 class SlideMark:
     """A slider's line (on the layer of the body it is fixed to) and its block (on its own)."""
 
@@ -76,7 +76,7 @@ class SlideMark:
     block: tuple[Point, Point, Point, Point]
 
 
-@dataclass(frozen=True)
+@frozen
 class Mark:
     """A named joint (``kind`` joint or ground) or point (``kind`` point) at the pose; an
     unnamed loop corner has the name ""."""
@@ -86,7 +86,7 @@ class Mark:
     kind: str
 
 
-@dataclass(frozen=True)
+@frozen
 class Curve:
     """A point's path over the sweep: one polyline per stretch the sweep solved."""
 
@@ -94,7 +94,7 @@ class Curve:
     pieces: tuple[tuple[Point, ...], ...]
 
 
-@dataclass(frozen=True)
+@frozen
 class Sheet:
     title: str
     unit: str

@@ -4,10 +4,10 @@ picture: the driver's angle and speed against time (docs/simulate.md)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..records import frozen
 from ..units import degrees
 from .data import Report, from_rows
 from .report import Block, Text, fmt, table
@@ -29,7 +29,7 @@ Headers = list[tuple[str, str]]
 """(name, unit) of each column."""
 
 
-@dataclass(frozen=True)
+@frozen
 class _Checks:
     """The run's verdicts and the numbers its lines quote."""
 

@@ -7,12 +7,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InputError, ParseError
 from ..problems.loops import Mechanism
+from ..records import frozen
 
 MAX_DESIGNS = 10_000_000
 MAX_SCAN_POSITIONS = 100_000
@@ -20,7 +20,7 @@ MAX_SAMPLE_VALUES = 20_000_000
 """--samples x varied parameters: the drawn designs are held in memory (160 MB)."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Vary:
     """One ``--vary NAME=LO:HI[:N]``: file units, N points (None: sampled)."""
 

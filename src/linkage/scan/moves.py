@@ -4,13 +4,13 @@ coordinates become the derived loops' parameters."""
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..errors import InputError, ParseError
 from ..problems.loops import Mechanism
+from ..records import frozen
 from ..units import degrees
 from .designs import Vary
 
@@ -21,7 +21,7 @@ def coordinate_column(joint: str, axis: str) -> str:
     return f"{joint}_{axis}"
 
 
-@dataclass(frozen=True)
+@frozen
 class GroundMove:
     """A ground joint a scan moves: where it is drawn, the plan's columns giving its x and
     y (-1: as drawn) and the derived parameters that place it from the ground's first
@@ -34,7 +34,7 @@ class GroundMove:
     angle: str
 
 
-@dataclass(frozen=True)
+@frozen
 class JointMoves:
     """The coordinates of a joints file's ground joints that a scan varies, and how each
     design's coordinates become the derived loops' parameters: the ground is a star from

@@ -8,7 +8,6 @@ import contextlib
 import time
 from collections.abc import Callable, Mapping, Sequence
 from contextlib import AbstractContextManager as ContextManager
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -16,6 +15,7 @@ import numpy as np
 from ..errors import InputError
 from ..problems.columns import columns_of
 from ..problems.loops import Mechanism
+from ..records import frozen
 from .designs import MAX_DESIGNS, MAX_SCAN_POSITIONS, DesignPlan, Vary, check_varies, parse_vary
 from .engine import run_chunks
 from .keep import Keeper, take
@@ -58,7 +58,7 @@ def default_branch(m: Mechanism, branch: str | None, tol: float) -> str | None:
     return signs
 
 
-@dataclass(frozen=True)
+@frozen
 class ScanSetup:
     """A checked scan: the designs, the record columns, the filter and the branch."""
 
@@ -122,7 +122,7 @@ CLI_NAMES = {"descending": "--desc", "values": "--from/--to/--step", "speed": "-
 """``linkage scan``'s spelling where it is not ``--`` and the keyword."""
 
 
-@dataclass(frozen=True)
+@frozen
 class ScanRequest:
     """A scan as asked, before any check: the mechanism, the varied parameters (file
     units), the driver values, and the options of :func:`scan` / ``linkage scan``.
@@ -162,7 +162,7 @@ class ScanRequest:
         return API_NAMES.get(option, option)
 
 
-@dataclass(frozen=True)
+@frozen
 class OpenScan:
     """A checked scan, ready to run: its setup, the task every chunk carries, designs per task."""
 
@@ -229,7 +229,7 @@ def local_workers(req: ScanRequest) -> int:
     return req.workers or os.cpu_count() or 1
 
 
-@dataclass(frozen=True)
+@frozen
 class ScanOutcome:
     """What a scan did: its setup, the designs scanned, the keeper (what it counted and
     kept), the records held at the end, and its wall-clock seconds."""

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -14,6 +13,7 @@ import numpy as np
 from ..errors import InputError
 from ..kinematics.designs import CONVERGED, DesignSolutions, engine_for, solve_designs
 from ..problems.loops import Mechanism
+from ..records import frozen
 from ..units import radians
 from .metrics import design_metrics
 from .moves import JointMoves
@@ -34,7 +34,7 @@ or the Python API's returned columns; streamed output holds one chunk."""
 
 # --- one task ---------------------------------------------------------------------------------
 
-@dataclass(frozen=True)
+@frozen
 class ScanJob:
     """What every task needs, small and picklable: the mechanism as text (workers need no
     file), the --set overrides, the varied names, the driver values and the options."""

@@ -32,7 +32,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -40,6 +40,7 @@ import numpy as np
 from ..errors import InputError, ParseError
 from ..kinematics.designs import CONVERGED, solve_designs
 from ..problems.loops import ANGLE_UNITS, LoopModel, Mechanism
+from ..records import frozen
 from ..units import degrees, radians
 from .designs import MAX_SCAN_POSITIONS, Vary
 from .moves import JointMoves, joint_moves
@@ -61,7 +62,7 @@ percentiles sort a copy)."""
 DEFAULT_SAMPLES = 1000
 
 
-@dataclass(frozen=True)
+@frozen
 class Tolerance:
     """One ``--tol NAME=±D``: a parameter (or ``JOINT.x``/``JOINT.y``) and its D > 0,
     in the file's units."""
@@ -102,7 +103,7 @@ def check_tolerance(name: str, d: Any, label: str = API) -> Tolerance:
 
 # --- what each tolerance moves ------------------------------------------------------------------
 
-@dataclass(frozen=True)
+@frozen
 class Direction:
     """What one tolerance moves: ``column`` (the scan's column: the name, or ``O4_x`` for a
     joint's coordinate), its nominal value (file units), and d(parameter)/d(tolerance) of
@@ -114,7 +115,7 @@ class Direction:
     rates: tuple[tuple[str, float], ...]
 
 
-@dataclass(frozen=True)
+@frozen
 class Plan:
     """The checked tolerances: their directions, and how a joints file's coordinates
     become parameters (None: no coordinate is toleranced)."""
@@ -233,7 +234,7 @@ def tolerance_chunk(job: ScanJob, start: int, designs: np.ndarray) -> dict[str, 
     return {"design": np.arange(start, start + len(designs)), "assembled": assembled, "outputs": outputs}
 
 
-@dataclass(frozen=True)
+@frozen
 class Samples:
     """The Monte Carlo's designs, drawn once (design i the same whatever the chunking or
     the scheduler): what :func:`linkage.scan.engine.run_chunks` reads as its plan."""
@@ -262,7 +263,7 @@ def draw(plan: Plan, samples: int, seed: int, distribution: str) -> Samples:
 
 # --- the study ---------------------------------------------------------------------------------
 
-@dataclass(frozen=True)
+@frozen
 class ToleranceStudy:
     """A tolerance study over the driver values ``values`` (display units). Arrays are
     indexed [output, position] (``sensitivity`` [output, tolerance, position]), in

@@ -4,15 +4,15 @@ design's values are read and kept in the nominal's turn (docs/tolerance.md)."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..problems.loops import Mechanism
+from ..records import frozen
 
 
-@dataclass(frozen=True)
+@frozen
 class Output:
     """One output: an unknown (``index`` into the unknowns) or a named point's x or y."""
 

@@ -18,24 +18,24 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..errors import InputError
 from ..homotopy import PolySystem, Solutions, condition, solve
+from ..records import frozen
 from ..units import radians
 
 
-@dataclass(frozen=True)
+@frozen
 class Pose:
     x: float
     y: float
     angle_deg: float
 
 
-@dataclass(frozen=True)
+@frozen
 class Crank:
     """A Burmester pair: the ground pivot, the moving pivot in the body's frame and where it
     is at the first pose, the crank's length."""
@@ -48,7 +48,7 @@ class Crank:
     condition: float
 
 
-@dataclass(frozen=True)
+@frozen
 class Burmester:
     poses: tuple[Pose, ...]
     cranks: tuple[Crank, ...]

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
+from ..records import frozen
 from .error_curve import CurvePoint, Design
 from .request import GRID, PrecisionPoint, value_of
 from .solve import assembly_gap, branch_label, grashof_of, off_branch
@@ -16,7 +16,7 @@ DEFECTS = ("no_linkage", "branch", "grashof", "order", "transmission")
 """Every defect's name, as JSON and exit 1 report them."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Defect:
     name: str
     message: str

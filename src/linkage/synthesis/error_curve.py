@@ -6,13 +6,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 
+from ..records import frozen
 from .request import GRID, SOLVER_TOL, PrecisionPoint, Request, value_of
 from .solve import Linkage, assembly_gap, linkage_of, transmission_deg, transmission_deg_np
 
 
-@dataclass(frozen=True)
+@frozen
 class CurvePoint:
     x: float
     y: float
@@ -26,7 +26,7 @@ class CurvePoint:
 
 
 
-@dataclass(frozen=True)
+@frozen
 class Design:
     """One synthesised linkage with what its error needs: the real R, the branch sign at
     the first precision point, and the shifts between the equation's angles and its own."""

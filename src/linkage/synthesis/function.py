@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 
+from ..records import frozen
 from ..units import radians
 from .defects import Defect, judge
 from .error_curve import CurvePoint, dense_transmission, design_of, extrema, structural_error
@@ -14,7 +15,7 @@ from .request import MIN_TRANSMISSION_DEG, PrecisionPoint, Request, value_of
 from .solve import Linkage, branch_label, grashof_of, solve_coefficients
 
 
-@dataclass(frozen=True)
+@frozen
 class FunctionSynthesis:
     """Everything ``linkage synthesize`` reports, as a value."""
 

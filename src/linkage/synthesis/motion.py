@@ -20,10 +20,10 @@ import cmath
 import itertools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
+from ..records import frozen
 from ..units import degrees, radians
 from .burmester import Burmester, Crank, Pose, burmester_points, checked_poses
 from .defects import Defect
@@ -36,7 +36,7 @@ STEP_DEG = 1.0
 """The sweep's largest input step between poses."""
 
 
-@dataclass(frozen=True)
+@frozen
 class MotionDesign:
     """A four-bar from Burmester cranks ``cranks`` (input, output), drawn at pose 1."""
 
@@ -60,7 +60,7 @@ class MotionDesign:
         return [d.name for d in self.defects]
 
 
-@dataclass(frozen=True)
+@frozen
 class MotionSynthesis:
     """The cranks through the poses (every Burmester crank for five poses, the two chosen
     for three) and every four-bar from two of them."""

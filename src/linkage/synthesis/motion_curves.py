@@ -17,11 +17,11 @@ from __future__ import annotations
 
 import cmath
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from ..records import frozen
 from ..units import radians
 from .burmester import Pose
 
@@ -31,7 +31,7 @@ BOX = 5.0
 """The grid spans the poses' centre +- this many times their size."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Curves:
     """Points of the centre-point curve (ground pivots) and, row for row, of the
     circle-point curve (the moving pivots at pose 1); ``spread``: each crank's largest

@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import cmath
 import math
-from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
 
@@ -36,6 +35,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..homotopy import ninepoint, ninepoint_track
+from ..records import frozen
 from ..units import degrees, radians
 from .request import MIN_TRANSMISSION_DEG
 from .timed_path import TimedSolutions, check_timed_points, is_timed, timed_four_bars
@@ -49,7 +49,7 @@ ON_POINT = 1e-9
 """A position reaches its point when P is within this of it, relative to the linkage's size."""
 
 
-@dataclass(frozen=True)
+@frozen
 class PathFourBar:
     """One four-bar through the points, in the plane of the points (first position)."""
 
@@ -74,7 +74,7 @@ class PathFourBar:
                 abs(self.pin_n - self.pin_m), abs(self.pin_n - self.ground_b))
 
 
-@dataclass(frozen=True)
+@frozen
 class PathSynthesis:
     points: tuple[complex, ...]
     designs: tuple[tuple[PathFourBar, ...], ...]  # per real orbit: its three cognates
@@ -102,7 +102,7 @@ def real_certificates(solutions: ninepoint_track.NinePointSolutions
     return certs, undistinguished(list(rows), certs)
 
 
-@dataclass(frozen=True)
+@frozen
 class TimedPathSynthesis:
     """Five points with the crank's angle at each: every four-bar through them with that
     timing (:mod:`.timed_path`), each judged (:func:`judge_four_bar`)."""

@@ -21,11 +21,11 @@ across it by a seeded random offset.
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InputError
+from ..records import frozen
 
 POINTS = 9
 """A four-bar's dimensions of design: nine points fix finitely many."""
@@ -89,7 +89,7 @@ def check_via(via: object, given: list[complex]) -> list[complex]:
     return extra
 
 
-@dataclass(frozen=True)
+@frozen
 class NinePoints:
     """The nine points solved: the given points in their order with the extra points
     between them, ``extra`` the positions of the extra ones."""

@@ -9,9 +9,9 @@ are already tasks on the scan's runner (both cores busy, one sample's paths in m
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
 from ..errors import InputError
+from ..records import frozen
 from .path import PathFourBar, PathSynthesis, check_points, chunk_runner, path_options, solve_nine
 from .path_points import POINTS, check_via, nine_points
 from .request import MIN_TRANSMISSION_DEG
@@ -20,7 +20,7 @@ MAX_SAMPLES = 1000
 """At about half a minute of two cores a sample, more is a cluster's day."""
 
 
-@dataclass(frozen=True)
+@frozen
 class RankedDesign:
     """A defect-free four-bar of a search: which sample found it, which real design of that
     sample's (0-based, in the order found) and which of its three Roberts cognates (1 to 3).
@@ -33,7 +33,7 @@ class RankedDesign:
     four_bar: PathFourBar
 
 
-@dataclass(frozen=True)
+@frozen
 class PathSearch:
     points: tuple[complex, ...]  # the given points
     samples: tuple[PathSynthesis, ...]  # a nine-point synthesis per sample of the extra points

@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from ..errors import InputError
+from ..records import frozen
 
 SPACINGS = ("chebyshev", "uniform", "optimal")
 MIN_TRANSMISSION_DEG = 30.0
@@ -25,7 +26,7 @@ EQUIOSCILLATION = 0.01
 
 
 
-@dataclass(frozen=True)
+@frozen
 class PrecisionPoint:
     x: float
     y: float
@@ -36,7 +37,7 @@ class PrecisionPoint:
 
 
 
-@dataclass(frozen=True)
+@frozen
 class Request:
     """A synthesis asked for, checked."""
 

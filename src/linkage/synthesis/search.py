@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
+from ..records import frozen
 from .defects import turns_np
 from .request import GRID, MIN_TRANSMISSION_DEG, Request, make_request, parse_range, value_of
 from .solve import (
@@ -29,7 +29,7 @@ SEARCH_CHUNK = 200
 """Candidates per task: each holds a few arrays of GRID values per candidate."""
 
 
-@dataclass(frozen=True)
+@frozen
 class SearchJob:
     """What a search task needs (picklable: the function travels as its text)."""
 
@@ -74,7 +74,7 @@ def grid_of(req: Request, grid: int) -> tuple[Any, Any, Any]:
     return gx, (gx - lo) / (hi - lo), (gy - y0) / (y1 - y0)
 
 
-@dataclass(frozen=True)
+@frozen
 class Candidates:
     """Candidates' linkages as columns (one row each): the precision points' angles, R,
     the real lengths (NaN: no linkage), the turned links' shifts (deg) and the branch sign
@@ -287,7 +287,7 @@ def check_varies(varies: Sequence[Any]) -> None:
             raise InputError(f"--vary {v.name}: bounds beyond 1e6 deg are not supported")
 
 
-@dataclass(frozen=True)
+@frozen
 class SearchResult:
     rows: dict[str, Any]
     """The kept candidates (no defects), best first: columns."""

@@ -7,15 +7,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
+from ..records import frozen
 from ..units import degrees, radians
 from .request import BRANCH_TOL_DEG, Request
 
 
-@dataclass(frozen=True)
+@frozen
 class Linkage:
     """The real linkage of a solution: positive lengths (input a, coupler b, output c,
     ground d) and whether the input or output link is drawn the other way (a negative R2

@@ -27,10 +27,10 @@ import cmath
 import itertools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError
+from ..records import frozen
 from ..units import degrees, radians
 from .burmester import Burmester, Crank, burmester_points
 
@@ -44,7 +44,7 @@ SAME_DYAD = 1e-7
 the crank dyad itself."""
 
 
-@dataclass(frozen=True)
+@frozen
 class TimedFourBar:
     """A four-bar from crank dyad ``crank`` and the ``rocker``-th pair of its rocker problem,
     at the first point, with its (crank, coupler, rocker) angles in rad at each point."""
@@ -55,7 +55,7 @@ class TimedFourBar:
     configurations: tuple[tuple[float, float, float], ...]
 
 
-@dataclass(frozen=True)
+@frozen
 class TimedSolutions:
     points: tuple[complex, ...]
     crank_deg: tuple[float, ...]

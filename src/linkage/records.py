@@ -1,0 +1,148 @@
+"""The package's frozen dataclasses, made as :func:`dataclasses.dataclass` makes them, with
+the bytecode of their generated methods kept between runs.
+
+Python 3.11's ``dataclass`` writes each class's ``__init__``, ``__repr__``, ``__eq__``,
+``__hash__``, ``__setattr__`` and ``__delattr__`` as source text and compiles it on every
+import: about 0.5 ms a class, 5 ms of the 10 a cold ``linkage sweep`` creates (measured
+with ``dataclasses.exec`` timed; docs/performance.md, "Cold starts"). :func:`frozen` is
+``dataclass(frozen=True)`` whose compilations, while it makes the class, go through
+:func:`kept_code`: the code of a source this package's classes gave before, read back from
+one file in the package's ``__pycache__`` as Python keeps a module's bytecode. The source
+is the dictionary's key, compared whole, so a kept code object is the compilation of that
+very text; the file's name carries the interpreter's ``cache_tag``. Nothing else changes:
+the same source runs through the same ``exec`` with the same namespaces, compiled with the
+flags ``dataclasses`` compiles it with (none inherited).
+
+Only the classes made through :func:`frozen`, in the thread making one, use the store:
+another thread's or a user's dataclasses compile as ever and are never written down, so
+the file holds at most this package's classes' methods. Nothing is written where Python
+writes no bytecode (``sys.dont_write_bytecode``) or the directory cannot be written; a
+damaged or foreign file is read as empty and replaced.
+"""
+
+from __future__ import annotations
+
+import builtins
+import dataclasses
+import os
+import sys
+import threading
+from types import CodeType
+from typing import Any, TypeVar
+
+T = TypeVar("T")
+
+STORE: str | None = os.path.join(os.path.dirname(__file__), "__pycache__")
+"""The directory of the kept file (beside the package's own bytecode); None: nowhere."""
+
+_STATE = threading.local()
+"""``making``: the module whose class this thread is making through :func:`frozen`, or None."""
+
+_MAKING = threading.RLock()
+"""Held while :func:`frozen` has ``dataclasses.exec`` in place (one class at a time)."""
+
+_LOCK = threading.Lock()
+"""Guards the kept codes."""
+
+
+def store_path(module: str) -> str | None:
+    """The kept file of ``module``'s classes for this interpreter, or None (no store, no
+    cache tag). A file a module: a command reads only the classes it imports."""
+    tag = sys.implementation.cache_tag
+    if STORE is None or tag is None:
+        return None
+    return os.path.join(STORE, f"dataclass-{module}.{tag}.marshal")
+
+
+def _read(path: str | None) -> dict[str, CodeType]:
+    """The kept codes, or {} where the file is missing, unreadable or not such a table."""
+    import marshal
+
+    if path is None:
+        return {}
+    try:
+        with open(path, "rb") as kept:
+            held = marshal.loads(kept.read())
+    except (OSError, ValueError, EOFError, TypeError):
+        return {}
+    if type(held) is not dict or not all(type(k) is str and isinstance(v, CodeType) for k, v in held.items()):
+        return {}
+    return held
+
+
+_codes: dict[str, dict[str, CodeType]] = {}
+"""Each module's kept codes, read when it first makes a class."""
+_added: set[str] = set()
+"""The modules whose codes this run compiled (written at exit)."""
+
+
+def kept_code(module: str, source: str) -> CodeType:
+    """``source`` compiled as ``exec(source, ...)`` compiles it in :mod:`dataclasses` (file
+    name ``<string>``, no inherited future flags), or the kept code of that very text."""
+    with _LOCK:
+        codes = _codes.get(module)
+        if codes is None:
+            codes = _codes[module] = _read(store_path(module))
+        code = codes.get(source)
+        if code is None:
+            code = compile(source, "<string>", "exec", dont_inherit=True)
+            codes[source] = code
+            if not _added:
+                import atexit
+
+                atexit.register(save)  # the first run of a command writes its files once
+            _added.add(module)
+    return code
+
+
+def _exec(source: Any, globals: Any = None, locals: Any = None, /) -> None:
+    """``exec`` as :mod:`dataclasses` calls it, through the kept codes while this thread
+    makes a class through :func:`frozen` (any other call passes straight through)."""
+    module = getattr(_STATE, "making", None)
+    if module is not None and type(source) is str:
+        source = kept_code(module, source)
+    builtins.exec(source, globals, locals)
+
+
+_ABSENT = object()
+
+
+def frozen(cls: type[T]) -> type[T]:
+    """``dataclasses.dataclass(frozen=True)(cls)``, its methods' bytecode kept (see the module)."""
+    with _MAKING:
+        had = dataclasses.__dict__.get("exec", _ABSENT)
+        dataclasses.exec = _exec  # type: ignore[attr-defined]  # the name dataclasses calls
+        _STATE.making = cls.__module__
+        try:
+            return dataclasses.dataclass(frozen=True)(cls)
+        finally:
+            _STATE.making = None
+            if had is _ABSENT:
+                del dataclasses.exec  # type: ignore[attr-defined]
+            else:
+                dataclasses.exec = had  # type: ignore[attr-defined]
+
+
+def save() -> None:
+    """Write the codes of each module this run compiled new ones for; quietly: a store
+    that cannot be written is no error."""
+    if sys.dont_write_bytecode:
+        return
+    import marshal
+    from pathlib import Path
+
+    from .errors import OutputError
+    from .files import atomic_target
+
+    with _LOCK:
+        todo = [(store_path(m), marshal.dumps(_codes[m])) for m in sorted(_added)]
+        _added.clear()
+    for path, data in todo:
+        if path is None:
+            continue
+        try:
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+            with atomic_target(Path(path)) as part, open(part, "wb") as out:
+                out.write(data)
+        except (OSError, OutputError):
+            continue
