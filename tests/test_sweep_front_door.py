@@ -97,6 +97,9 @@ def test_unwrap_turns_array_fast_path_is_the_scalar_rule_far_out(seed):
         got = unwrap_turns_array(rows, closes)
         for row, turns in zip(rows, got):
             assert list(turns) == unwrap_turns(list(row), closes)
+        # told every value is finite (the closed-form engine), the same turns, bit for bit
+        assert np.array_equal(unwrap_turns_array(rows, closes, every=True), got)
+        assert not np.signbit(got[got == 0.0]).any()  # no -0.0: _display adds no zero shift
 
 
 def test_a_cold_sweep_does_not_load_the_scalar_solve():

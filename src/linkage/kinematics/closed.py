@@ -317,7 +317,7 @@ def _display(m: Mechanism, plan: ClosedPlan, tol: float, max_iter: int, vals: np
             out[j] = degrees(cols[j])
     if not angles:
         return out
-    turns = unwrap_turns_array(out if every else out[angles], closes)
+    turns = unwrap_turns_array(out if every else out[angles], closes, every=True)  # (all solved)
     # (every position solved: the anchor is the grid point nearest the file's driver value)
     near = int(anchor_index_array(vals, True, m.driver.value / plan.scale, closes, plan.turn)[0])
     shift = np.zeros(len(angles))
@@ -327,7 +327,9 @@ def _display(m: Mechanism, plan: ClosedPlan, tol: float, max_iter: int, vals: np
             at = continuous(float(out[j, near]), float(turns[a, near]))
             shift[a] = turn_shift(degrees(ref[j]), at)
     if every:
-        return continuous(out, turns + shift[:, None])  # elementwise: the rows' own values
+        # elementwise: the rows' own values; no shift adds nothing (turns are never -0.0:
+        # floor(x) is -0.0 only for x = -0.0, and (prev + 180) - a is never -0.0)
+        return continuous(out, turns + shift[:, None] if shift.any() else turns)
     for a, j in enumerate(angles):
         out[j] = continuous(out[j], turns[a] + shift[a])
     return out
