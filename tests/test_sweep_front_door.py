@@ -98,7 +98,7 @@ def test_unwrap_turns_array_fast_path_is_the_scalar_rule_far_out(seed):
         for row, turns in zip(rows, got):
             assert list(turns) == unwrap_turns(list(row), closes)
         # told every value is finite (the closed-form engine), the same turns, bit for bit
-        assert np.array_equal(unwrap_turns_array(rows, closes, every=True), got)
+        assert np.array_equal(unwrap_turns_array(rows, closes, all_solved=True), got)
         assert not np.signbit(got[got == 0.0]).any()  # no -0.0: _display adds no zero shift
 
 

@@ -147,9 +147,9 @@ def unwrap_turns(values: Sequence[float | None], closes: bool) -> list[int | Non
     return out
 
 
-def unwrap_turns_array(values: Any, closes: bool, every: bool = False) -> Any:
+def unwrap_turns_array(values: Any, closes: bool, all_solved: bool = False) -> Any:
     """:func:`unwrap_turns` of each row of a 2-D array of degrees (NaN where unsolved):
-    a float array of whole turns, NaN where unsolved. ``every``: the caller's values are
+    a float array of whole turns, NaN where unsolved. ``all_solved``: the caller's values are
     all finite (every position solved: the closed-form engine), so none is looked for."""
     import numpy as np
 
@@ -157,7 +157,7 @@ def unwrap_turns_array(values: Any, closes: bool, every: bool = False) -> Any:
     rows, n = a.shape
     if n == 0:
         return a.copy()
-    solved = None if every else np.isfinite(a)
+    solved = None if all_solved else np.isfinite(a)
     if solved is None or solved.all():
         # every position solved: read in grid order from the first (rule 1), each step
         # from the previous value (0 before the first); the general path's result, its

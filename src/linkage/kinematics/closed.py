@@ -317,7 +317,7 @@ def _display(m: Mechanism, plan: ClosedPlan, tol: float, max_iter: int, vals: np
             out[j] = degrees(cols[j])
     if not angles:
         return out
-    turns = unwrap_turns_array(out if every else out[angles], closes, every=True)  # (all solved)
+    turns = unwrap_turns_array(out if every else out[angles], closes, all_solved=True)
     # (every position solved: the anchor is the grid point nearest the file's driver value)
     near = int(anchor_index_array(vals, True, m.driver.value / plan.scale, closes, plan.turn)[0])
     shift = np.zeros(len(angles))
