@@ -215,6 +215,30 @@ def test_parquet_file_is_the_bytes_pyarrow_parquet_writes(tmp_path: Path) -> Non
         assert ours.read_bytes() == theirs.read_bytes()
 
 
+def test_an_int32_column_widened_by_numpy_is_pyarrows_cast(tmp_path: Path) -> None:
+    """A sweep's iterations (int32) go to the int64 parquet field widened by numpy
+    (formats.widened) instead of pyarrow's cast (which imports pyarrow.compute): the same
+    array, and the same file bytes as the column given as int64; a column that does not fit
+    int64 (uint64) is left to pyarrow."""
+    pa = pytest.importorskip("pyarrow")
+    counts = np.array([0, 1, 7, -3, 2**31 - 1, -(2**31)] * 400, dtype=np.int32)
+    for v in (counts, counts.astype(np.int16), counts.astype(np.uint32)):
+        ours = cells.arrow_array("int", formats.widened("int", v))
+        assert ours.type == pa.int64()
+        assert ours.equals(pa.array(v).cast(pa.int64()))
+    big = np.array([2**64 - 1], dtype=np.uint64)
+    assert formats.widened("int", big) is big
+    x = np.linspace(0.0, 1.0, len(counts))
+    files = []
+    for k, iterations in enumerate((counts, counts.astype(np.int64))):
+        out = tmp_path / f"k{k}" / "t.parquet"
+        out.parent.mkdir()
+        t = DataTable("positions", (Column("theta2", "deg", x), Column("iterations", "", iterations, "int")))
+        writers.write(Report("t", (t,), lambda: [], None), "parquet", out)
+        files.append(out.read_bytes())
+    assert files[0] == files[1]
+
+
 def test_parquet_and_xlsx_read_back(tmp_path: Path) -> None:
     pq = pytest.importorskip("pyarrow.parquet")
     openpyxl = pytest.importorskip("openpyxl")

@@ -104,8 +104,12 @@ def _array_columns(s: SweepResult, b: Any) -> SweepColumns:
         scale = ANGLE_UNITS[m.driver.unit] if m.driver.kind == "angle" else 1.0
         q = [radians(solution[u.name]) if u.kind == "angle" else solution[u.name] for u in m.unknowns]
         d = np.asarray(b.values, dtype=float) * scale
+        placing = b.rates is not None and b.rates[0] is None
         if m.derivation.fourbars:
-            transmission = transmission_column(m, q, d, solved)
+            # beside place_np's sums when there are joints to place (numpy's sin, cos and
+            # arctan2 release the GIL): the same function, so the same bits
+            transmission = beside(transmission_column, m, q, d, solved) if placing and n >= BESIDE_FROM \
+                else transmission_column(m, q, d, solved)
         if b.rates is not None and b.rates[0] is not None:
             # computed as read, a chunk at a time (the batch's own chunks), never all held
             rates = RateChunks(s.positions)
@@ -114,14 +118,45 @@ def _array_columns(s: SweepResult, b: Any) -> SweepColumns:
             at = None if first is None else int(first) - int(first) % rates.chunk
             names = [] if at is None else list(rates.chunk_block(at).joints)
             joints = {j: (RateColumn(rates, j, 0), RateColumn(rates, j, 1)) for j in names}
-        elif b.rates is not None:
+        elif placing:
             from .placing import place_np
 
             placed = place_np(m.model, q, d)
             joints = {k: (where_solved(solved, x, everywhere), where_solved(solved, y, everywhere))
                       for k, (x, y) in placed.items()}
+    if callable(transmission):
+        transmission = transmission()
     return SweepColumns(np.asarray(b.values, dtype=float), status, solution, branch,
                         np.asarray(b.iterations), det, transmission, joints, rates, True)
+
+
+BESIDE_FROM = 50_000
+"""Positions from which a sweep's transmission angles are computed on a thread beside its
+joints (:func:`beside`)."""
+
+
+def beside(f: Callable[..., Any], *args: Any) -> Callable[[], Any]:
+    """``f(*args)`` started on a thread; the call returned gives its value, waiting for it.
+    Where the thread failed, ``f(*args)`` is called again there, raising its error in line
+    (no thread traceback)."""
+    import threading
+
+    out: list[Any] = []
+
+    def run() -> None:
+        try:
+            out.append(f(*args))
+        except Exception:  # left empty: called again in line, where the error is raised
+            return
+
+    thread = threading.Thread(target=run, name="linkage-columns")
+    thread.start()
+
+    def value() -> Any:
+        thread.join()
+        return out[0] if out else f(*args)
+
+    return value
 
 
 def where_solved(solved: Any, x: Any, everywhere: bool) -> Any:

@@ -179,6 +179,7 @@ class ParquetSink(Sink):
                 import numpy as np  # NaN and infinities are no value, as in CSV and JSON
 
                 v = np.asarray(v if is_array(v) else [math.nan if x is None else x for x in v], dtype=float)
+            v = widened(c.kind, v)
             a = cells.arrow_array(c.kind, v)
             if a is None:
                 a = pa.array(plain_values(v), type=f.type)
@@ -213,6 +214,20 @@ class ParquetSink(Sink):
         if self.writer is not None:
             with contextlib.suppress(Exception):
                 self.writer.close()
+
+
+def widened(kind: str, values: Any) -> Any:
+    """An integer column (a sweep's iterations, int32) as int64, the parquet field's type,
+    widened by numpy where every value fits (the same numbers): pyarrow's own cast imports
+    pyarrow.compute, 0.04 to 0.08 s of a fresh process, for a copy numpy makes in 1 ms.
+    Any other column as it is (pyarrow casts it, and refuses what does not fit)."""
+    if kind != "int" or not is_array(values) or values.dtype.kind not in "iu":
+        return values
+    import numpy as np
+
+    if values.dtype == np.int64 or not np.can_cast(values.dtype, np.int64):
+        return values
+    return values.astype(np.int64)
 
 
 PARQUET_WRITER = "pyarrow._parquet"
