@@ -28,6 +28,7 @@ built only when it is read.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import partial
 from typing import Any
@@ -49,7 +50,7 @@ from .angles import (
 from .batch import STATUS_CODES, BatchResult
 from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
-from .pose import implied, step_words
+from .pose import implied, implied_recent, step_words
 from .positions import SweepResult, check_driver_values
 from .vector_loops import VectorLoops, loop_plan, per_position, singular_of, solve_linear
 
@@ -126,7 +127,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     # the driver's magnitude, refused as the one-at-a-time engine refuses it
     check_driver_values(m, [float(vals[0]), float(vals[-1])])
     scale = plan.scale
-    signs = _followed_signs(m, tol, max_iter, float(vals[0]), scale, branch)
+    signs = followed_signs(m, tol, max_iter, float(vals[0]), scale, branch)
     if signs is None:
         return None
     kinds = plan.kinds
@@ -170,9 +171,22 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
                        np.ascontiguousarray(shown.T), det, iters, label, meta, 0, m, rates)
 
 
-def _followed_signs(m: Mechanism, tol: float, max_iter: int, first: float, scale: float,
-                    branch: str | None) -> tuple[float, ...] | None:
-    """The signs of the branch to follow, or None (this engine then does not apply)."""
+def followed_signs(m: Mechanism, tol: float, max_iter: int, first: float, scale: float,
+                   branch: str | None) -> tuple[float, ...] | None:
+    """The signs of the branch to follow from the first driver value ``first`` (display
+    units), or None (this engine then does not apply): a function of the mechanism and the
+    arguments alone, so kept on the mechanism for the most recent of them
+    (:func:`~.pose.implied_recent`: a mechanism swept from many first values keeps a few),
+    not solved again on every sweep. ``first``'s sign is part of the key: -0.0 and 0.0 are
+    equal but not the same driver value to the solve."""
+    key = (first, math.copysign(1.0, first), tol, max_iter, branch)
+    return implied_recent(m, "closed_followed_signs", key,
+                          lambda m: followed_signs_uncached(m, tol, max_iter, first, scale, branch))
+
+
+def followed_signs_uncached(m: Mechanism, tol: float, max_iter: int, first: float, scale: float,
+                            branch: str | None) -> tuple[float, ...] | None:
+    """:func:`followed_signs` solved afresh."""
     d = m.derivation
     if branch is not None:
         try:
