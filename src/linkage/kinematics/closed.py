@@ -11,10 +11,20 @@ a sweep that stays on one branch needs no continuation:
    branch at every driver value: all above ``MARGIN_FLOOR`` means no limit position at a
    grid point, so each position is that branch's closed form
    (:meth:`~linkage.problems.derive.Derivation.solve_np`), for all positions at once.
-3. One vectorised Newton-Raphson step from it under the single solve's stopping rule
-   (:mod:`linkage.rules`, the batch engine's :class:`~.vector_loops.VectorLoops` and
-   :func:`~.vector_loops.solve_linear`): a position is converged only where the rule holds; the
-   few where it does not take more steps, up to ``POLISH_ITER``.
+3. The evidence that each is a root to the single solve's standard, without a Newton
+   step: Phi and J evaluated at the closed form's own answer (the batch engine's
+   :class:`~.vector_loops.VectorLoops`) and the Newton step they imply
+   (:func:`~.vector_loops.solve_linear`), not taken. Where that step and max|Phi| meet the
+   single solve's convergence test (:func:`linkage.rules.system_converged_array`: the step
+   within tol, the residual within tol x length scale), the loop would stop there as
+   converged, so the closed form is reported as it is: 0 iterations, and det J is J's at
+   the reported position (what the one-at-a-time engine reports). The rare positions where
+   it does not (rounding near a limit, a tolerance near rounding) take Newton steps from it
+   under the single solve's stopping rule (:class:`~linkage.rules.SystemStops`), up to
+   ``POLISH_ITER``: their iterations count those steps, and their det J is J's at the point
+   the last step was taken from, as the scalar loop reports it. (An a-priori bound of the
+   closed form's error would spare Phi and the step, but not J, whose trigonometry is most
+   of the evidence's cost: det J and its ratio are read below.)
 4. The checks that make it the one-at-a-time engine's answer: det J of one sign, no
    position where that engine would search for a touch of det J = 0 between grid points
    (a local minimum of |det J| with J near singular), one branch name throughout (a
@@ -37,7 +47,15 @@ import numpy as np
 
 from ..problems.derive import sign_text
 from ..problems.loops import ANGLE_UNITS, Mechanism
-from ..rules import GOING, SystemStops, converged_codes, residual_gate, step_scales, step_size_array
+from ..rules import (
+    GOING,
+    SystemStops,
+    converged_codes,
+    residual_gate,
+    step_scales,
+    step_size_array,
+    system_converged_array,
+)
 from ..units import degrees
 from .angles import (
     anchor_index_array,
@@ -59,8 +77,9 @@ MARGIN_FLOOR = 1e-8
 limit than that, the one-at-a-time engine decides (continuation, step halving, gaps)."""
 
 POLISH_ITER = 3
-"""The most Newton steps after the closed form (one is all a position needs; a second
-only where rounding left the first's residual above the gate)."""
+"""The most Newton steps from the closed form where the evidence does not certify it
+(one is all such a position needs; a second only where rounding left the first's
+residual above the gate)."""
 
 BLOCK = 65_536
 """Positions per block (the temporaries stay small for a million positions)."""
@@ -214,8 +233,8 @@ def followed_signs_uncached(m: Mechanism, tol: float, max_iter: int, first: floa
 def _block(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, signs: tuple[float, ...], tol: float,
            max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[str]] | None:
     """One block of driver values (internal units): (unknowns (n, k) internal, det J,
-    iterations, |det J| over J's columns' lengths, the branch's words), or None where the
-    engine does not apply."""
+    Newton steps taken, |det J| over J's columns' lengths, the branch's words), or None
+    where the engine does not apply."""
     d = m.derivation
     # the driver's cosine and sine, taken once for the closed form and the loop equations
     plan_loops = loop_plan(m)
@@ -225,48 +244,59 @@ def _block(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, signs: tuple[float, 
         return None
     k = len(drv)
     loops = VectorLoops(plan_loops, drv, trig)
-    steps = plan.steps
-    # each position stopped as the single solve's loop stops it (linkage.rules)
-    stops = SystemStops(tol, residual_gate(tol, m.length_scale), partial(step_size_array, q, None))
-    det = np.empty(k)
+    # the evidence: Phi and J at the closed form's own answer and the Newton step they
+    # imply (not taken), judged by the single solve's convergence test (linkage.rules)
+    phi, jac = loops.evaluate(q, None)
+    dq, det = solve_linear(jac, phi, k)
+    gate = residual_gate(tol, m.length_scale)
+    with np.errstate(invalid="ignore"):  # (NaN: not certified)
+        certified = system_converged_array(step_size_array(dq, plan.steps), step_size_array(phi, None),
+                                           tol, gate)
+    ratio = np.abs(det) / _column_lengths(jac, k)
     iters = np.zeros(k, dtype=np.int32)
-    ratio = np.empty(k)
-    active = np.arange(k)
-    it = 0
-    while active.size:
-        if it >= max_iter:
-            return None  # not every position met the rule: the one-at-a-time engine decides
-        it += 1
-        rows = None if active.size == k else active
-        sub = q if rows is None else [c[rows] for c in q]
-        phi, jac = loops.evaluate(sub, rows)
-        dq, dt = solve_linear(jac, phi, active.size)
-        singular = singular_of(jac, dt)
-        if singular.any():
-            moved = [s + np.where(singular, 0.0, d) for s, d in zip(sub, dq)]
-        else:
-            moved = [s + d for s, d in zip(sub, dq)]  # (the same sums: nothing held back)
-            singular = None
-        codes = stops.judge(step_size_array(dq, steps), step_size_array(phi, None), singular,
-                            partial(step_size_array, moved, None), rows)
-        going = codes == GOING
-        if not (converged_codes(codes) | going).all():
-            return None  # a position the loop stops unconverged: the one-at-a-time engine's
-        ratio_now = np.abs(dt) / _column_lengths(jac, active.size)
-        if rows is None:  # the first step, at every position: the arrays themselves
-            q, det, ratio = moved, dt, ratio_now
-            iters[:] = it
-        else:
-            for j in range(len(q)):
-                q[j][active] = moved[j]
-            det[active], ratio[active], iters[active] = dt, ratio_now, it
-        active = active[going]
+    if not certified.all() and not _polish(loops, q, det, ratio, iters, np.flatnonzero(~certified),
+                                           plan.steps, tol, gate, max_iter):
+        return None
     if not ((det > 0).all() or (det < 0).all()):
         return None  # det J changes sign: a toggle, the one-at-a-time engine's to locate
     words = _words(m, plan, drv, q)
     if words is None:
         return None
     return np.array(q), det, iters, ratio, words
+
+
+def _polish(loops: VectorLoops, q: list[np.ndarray], det: np.ndarray, ratio: np.ndarray,
+            iters: np.ndarray, active: np.ndarray, steps: tuple[float, ...] | None, tol: float, gate: float,
+            max_iter: int) -> bool:
+    """Newton-Raphson from the closed form at the positions ``active`` (where the
+    evidence of :func:`_block` does not certify it), each stopped as the single solve's
+    loop stops it (:class:`~linkage.rules.SystemStops`); ``q``, ``det``, ``ratio`` and
+    ``iters`` updated there in place (det J and the ratio of the point the last step was
+    taken from, as that loop reports them). False where a position does not converge in
+    ``max_iter`` steps or the loop stops it unconverged: the one-at-a-time engine decides."""
+    q0 = [c.copy() for c in q]  # (the runaway bound's base: the closed form)
+    stops = SystemStops(tol, gate, partial(step_size_array, q0, None))
+    it = 0
+    while active.size:
+        if it >= max_iter:
+            return False
+        it += 1
+        sub = [c[active] for c in q]
+        phi, jac = loops.evaluate(sub, active)
+        dq, dt = solve_linear(jac, phi, active.size)
+        singular = singular_of(jac, dt)
+        moved = [s + np.where(singular, 0.0, d) for s, d in zip(sub, dq)]
+        codes = stops.judge(step_size_array(dq, steps), step_size_array(phi, None),
+                            singular if singular.any() else None, partial(step_size_array, moved, None),
+                            active)
+        going = codes == GOING
+        if not (converged_codes(codes) | going).all():
+            return False
+        for j in range(len(q)):
+            q[j][active] = moved[j]
+        det[active], ratio[active], iters[active] = dt, np.abs(dt) / _column_lengths(jac, active.size), it
+        active = active[going]
+    return True
 
 
 def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray) -> bool:
