@@ -188,3 +188,17 @@ def test_a_tolerance_below_rounding_is_the_one_at_a_time_engines():
     engine's, unconverged positions and all."""
     m = load(sample_path("crank_rocker.toml"))
     assert closed_sweep(m, [float(k) for k in range(0, 361, 10)], tol=1e-17) is None
+
+
+def test_blocks_give_the_answer_of_one_block(monkeypatch):
+    """The engine settles BLOCK positions at a time (one block is its own answer, not
+    copied): blocks of 50 give what one block gives, position by position."""
+    m = load(sample_path("watt_sixbar.toml"))
+    values = [0.5 * k for k in range(721)]
+    whole = closed_sweep(m, values)
+    monkeypatch.setattr(closed, "BLOCK", 50)
+    parts = closed_sweep(m, values)
+    assert whole is not None and parts is not None
+    for f in ("solution", "det", "iterations"):
+        assert np.array_equal(getattr(whole, f), getattr(parts, f)), f
+    assert whole.branch == parts.branch

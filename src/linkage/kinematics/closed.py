@@ -149,29 +149,10 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     signs = followed_signs(m, tol, max_iter, float(vals[0]), scale, branch)
     if signs is None:
         return None
-    kinds = plan.kinds
-    n = len(kinds)
-    cols = np.empty((n, n_pos))
-    det = np.empty(n_pos)
-    iters = np.empty(n_pos, dtype=np.int32)
-    ratio = np.empty(n_pos)
-    words: list[str] | None = None
-    det_sign = 0.0
-    for lo in range(0, n_pos, BLOCK):
-        got = _block(m, plan, vals[lo:lo + BLOCK] * scale, signs, tol, min(max_iter, POLISH_ITER))
-        if got is None:
-            return None
-        q, dt, it, rt, w = got
-        s = float(np.sign(dt[0]))
-        if words is None:
-            words, det_sign = w, s
-        elif w != words or s != det_sign:
-            return None
-        cols[:, lo:lo + BLOCK] = q
-        det[lo:lo + BLOCK] = dt
-        iters[lo:lo + BLOCK] = it
-        ratio[lo:lo + BLOCK] = rt
-    assert words is not None
+    got = _blocks(m, plan, vals, signs, tol, min(max_iter, POLISH_ITER))
+    if got is None:
+        return None
+    cols, det, iters, ratio, words = got
     closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn, diff)
     if _touch_candidate(closes, det, ratio):
         return None
@@ -188,6 +169,38 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     rates = (speed, accel) if speed is not None or joints else None
     return BatchResult(vals, np.full(n_pos, STATUS_CODES["converged"], dtype=np.int8),
                        np.ascontiguousarray(shown.T), det, iters, label, meta, 0, m, rates)
+
+
+def _blocks(m: Mechanism, plan: ClosedPlan, vals: np.ndarray, signs: tuple[float, ...], tol: float,
+            max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[str]] | None:
+    """:func:`_block` over every ``BLOCK`` of the driver values (display units), joined:
+    None where a block is None or two name the branch or sign det J differently. One block
+    (up to ``BLOCK`` positions) is its own answer, not copied."""
+    n_pos = len(vals)
+    if n_pos <= BLOCK:
+        return _block(m, plan, vals * plan.scale, signs, tol, max_iter)
+    cols = np.empty((len(plan.kinds), n_pos))
+    det = np.empty(n_pos)
+    iters = np.empty(n_pos, dtype=np.int32)
+    ratio = np.empty(n_pos)
+    words: list[str] | None = None
+    det_sign = 0.0
+    for lo in range(0, n_pos, BLOCK):
+        got = _block(m, plan, vals[lo:lo + BLOCK] * plan.scale, signs, tol, max_iter)
+        if got is None:
+            return None
+        q, dt, it, rt, w = got
+        s = float(np.sign(dt[0]))
+        if words is None:
+            words, det_sign = w, s
+        elif w != words or s != det_sign:
+            return None
+        cols[:, lo:lo + BLOCK] = q
+        det[lo:lo + BLOCK] = dt
+        iters[lo:lo + BLOCK] = it
+        ratio[lo:lo + BLOCK] = rt
+    assert words is not None
+    return cols, det, iters, ratio, words
 
 
 def followed_signs(m: Mechanism, tol: float, max_iter: int, first: float, scale: float,
