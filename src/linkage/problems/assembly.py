@@ -85,10 +85,11 @@ def triangle_sorted_np(d: Any, r: Any, rho: Any, x: Any, y: Any, z: Any, dd: Any
     warnings off (inf - inf and K = 0 are refused through ``ok``)."""
     import numpy as np
 
-    raw = z - (x - y)
+    x_y = x - y  # (read twice, as the scalar's two x - y: the same bits)
+    raw = z - x_y
     ok = (raw >= -TANGENT_SLACK * x) & (d > 0.0)
     gap = np.maximum(raw, 0.0)
-    area4 = (x + (y + z)) * gap * (z + (x - y)) * (x + (y - z))
+    area4 = (x + (y + z)) * gap * (z + x_y) * (x + (y - z))
     if two_d is None:
         two_d = 2.0 * d
     # area4 is +0.0, positive or NaN (each factor is: x >= y >= z >= +0.0 and gap is
