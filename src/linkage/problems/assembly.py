@@ -92,9 +92,7 @@ def triangle_sorted_np(d: Any, r: Any, rho: Any, x: Any, y: Any, z: Any, dd: Any
     area4 = (x + (y + z)) * gap * (z + x_y) * (x + (y - z))
     if two_d is None:
         two_d = 2.0 * d
-    # area4 is +0.0, positive or NaN (each factor is: x >= y >= z >= +0.0 and gap is
-    # clamped), so the scalar's max(area4, 0.0) would change no bit here
-    h = np.where(ok, np.sqrt(area4) / two_d, np.nan)
+    h = np.where(ok, np.sqrt(np.maximum(area4, 0.0)) / two_d, np.nan)
     a = ((r - rho) * (r + rho) + (d * d if dd is None else dd)) / two_d
     return a, h, ok, raw
 
