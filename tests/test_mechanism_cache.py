@@ -35,14 +35,20 @@ def _uncached_branch(m) -> str | None:
     return sign_text(signs) if all(signs) else None
 
 
-def test_the_cached_branch_is_the_uncached_one_on_random_four_bars():
-    rng = random.Random(33)
+def _random_four_bars(rng, count):
+    """``count`` four-bars of crank_rocker.toml's loop: random lengths, drawn pose and
+    guesses (both assemblies, and poses that do not assemble)."""
     base = load(CRANK_ROCKER)
-    seen = set()
-    for _ in range(60):
+    for _ in range(count):
         values = {k: rng.uniform(20.0, 160.0) for k in ("r2", "r3", "r4")}
         guesses = {"theta3": rng.uniform(-180.0, 180.0), "theta4": rng.uniform(-180.0, 180.0)}
-        m = base.with_values({**values, "theta2": rng.uniform(0.0, 360.0)}, guesses)
+        yield base.with_values({**values, "theta2": rng.uniform(0.0, 360.0)}, guesses)
+
+
+def test_the_cached_branch_is_the_uncached_one_on_random_four_bars():
+    rng = random.Random(33)
+    seen = set()
+    for m in _random_four_bars(rng, 60):
         first = pose.file_branch(m)
         assert first == _uncached_branch(m)
         assert pose.file_branch(m) == first  # the second read is the cache's
@@ -107,3 +113,60 @@ def test_the_closed_form_anchor_is_per_criteria(tol):
     got = closed_sweep(m, [float(k) for k in range(0, 361, 10)], branch=pose.file_branch(m), tol=tol)
     assert got is not None
     assert ("closed_anchor", tol, 50) in pose.IMPLIED[id(m)]
+
+
+def test_the_followed_branch_is_kept_per_first_value_and_is_the_uncached_one():
+    """The closed-form engine's branch to follow (Newton from the file's guess at the first
+    driver value, where no branch is given) is solved once per mechanism and arguments:
+    the same signs as solved afresh, on random four-bars, first values and criteria."""
+    from linkage.kinematics.closed import closed_plan, followed_signs, followed_signs_uncached
+
+    rng = random.Random(40)
+    seen = set()
+    for m in _random_four_bars(rng, 40):
+        scale = closed_plan(m).scale
+        first = rng.choice([0.0, -0.0, rng.uniform(-360.0, 360.0)])
+        for tol, branch in ((1e-12, None), (1e-9, None), (1e-12, "+"), (1e-12, "crossed")):
+            want = followed_signs_uncached(m, tol, 50, first, scale, branch)
+            assert followed_signs(m, tol, 50, first, scale, branch) == want
+            assert followed_signs(m, tol, 50, first, scale, branch) == want  # the kept one
+            seen.add(want)
+    assert {(1.0,), (-1.0,), None} <= seen
+
+
+def test_a_mechanism_swept_from_many_first_values_keeps_a_few_branches(monkeypatch):
+    """The kept branches are bounded (pose.RECENT per mechanism, the least recently used
+    dropped), and a sweep from a kept first value solves nothing by Newton."""
+    import linkage.kinematics.continuation as continuation
+
+    m = load(CRANK_ROCKER)
+    for k in range(3 * pose.RECENT):
+        assert closed_sweep(m, [float(k), k + 10.0, k + 20.0]) is not None
+        if k == 2 * pose.RECENT:
+            closed_sweep(m, [0.5 * pose.RECENT, 50.0])  # a recent use keeps it
+    kept = pose.IMPLIED[id(m)]["closed_followed_signs"]
+    assert len(kept) == pose.RECENT
+    firsts = {key[0] for key in kept}
+    assert firsts == {float(k) for k in range(2 * pose.RECENT + 1, 3 * pose.RECENT)} | {0.5 * pose.RECENT}
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a Newton solve for a branch already kept")
+
+    monkeypatch.setattr(continuation.Solver, "solve_lean", refuse)
+    assert closed_sweep(m, [float(3 * pose.RECENT - 1), 200.0]) is not None
+
+
+def test_implied_recent_drops_the_least_recently_used():
+    m = load(CRANK_ROCKER)
+    calls = []
+
+    def compute(args):
+        return lambda m: calls.append(args) or args
+
+    for k in range(5):
+        assert pose.implied_recent(m, "probe", k, compute(k), keep=3) == k
+    assert pose.implied_recent(m, "probe", 2, compute(2), keep=3) == 2  # kept: 2, 3, 4
+    assert pose.implied_recent(m, "probe", 5, compute(5), keep=3) == 5  # drops 3
+    assert pose.implied_recent(m, "probe", 3, compute(3), keep=3) == 3  # computed again
+    assert calls == [0, 1, 2, 3, 4, 5, 3]
+    assert list(pose.IMPLIED[id(m)]["probe"]) == [2, 5, 3]

@@ -11,10 +11,20 @@ a sweep that stays on one branch needs no continuation:
    branch at every driver value: all above ``MARGIN_FLOOR`` means no limit position at a
    grid point, so each position is that branch's closed form
    (:meth:`~linkage.problems.derive.Derivation.solve_np`), for all positions at once.
-3. One vectorised Newton-Raphson step from it under the single solve's stopping rule
-   (:mod:`linkage.rules`, the batch engine's :class:`~.vector_loops.VectorLoops` and
-   :func:`~.vector_loops.solve_linear`): a position is converged only where the rule holds; the
-   few where it does not take more steps, up to ``POLISH_ITER``.
+3. The evidence that each is a root to the single solve's standard, without a Newton
+   step: Phi and J evaluated at the closed form's own answer (the batch engine's
+   :class:`~.vector_loops.VectorLoops`) and the Newton step they imply
+   (:func:`~.vector_loops.solve_linear`), not taken. Where that step and max|Phi| meet the
+   single solve's convergence test (:func:`linkage.rules.system_converged_array`: the step
+   within tol, the residual within tol x length scale), the loop would stop there as
+   converged, so the closed form is reported as it is: 0 iterations, and det J is J's at
+   the reported position (what the one-at-a-time engine reports). The rare positions where
+   it does not (rounding near a limit, a tolerance near rounding) take Newton steps from it
+   under the single solve's stopping rule (:class:`~linkage.rules.SystemStops`), up to
+   ``POLISH_ITER``: their iterations count those steps, and their det J is J's at the point
+   the last step was taken from, as the scalar loop reports it. (An a-priori bound of the
+   closed form's error would spare Phi and the step, but not J, whose trigonometry is most
+   of the evidence's cost: det J and its ratio are read below.)
 4. The checks that make it the one-at-a-time engine's answer: det J of one sign, no
    position where that engine would search for a touch of det J = 0 between grid points
    (a local minimum of |det J| with J near singular), one branch name throughout (a
@@ -28,6 +38,7 @@ built only when it is read.
 
 from __future__ import annotations
 
+import math
 from functools import partial
 from typing import Any
 
@@ -36,7 +47,15 @@ import numpy as np
 from ..problems.derive import sign_text
 from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..records import frozen
-from ..rules import GOING, SystemStops, converged_codes, residual_gate, step_scales, step_size_array
+from ..rules import (
+    GOING,
+    SystemStops,
+    converged_codes,
+    residual_gate,
+    step_scales,
+    step_size_array,
+    system_converged_array,
+)
 from ..units import degrees
 from .angles import (
     anchor_index_array,
@@ -49,7 +68,7 @@ from .angles import (
 from .batch import STATUS_CODES, BatchResult
 from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
-from .pose import implied, step_words
+from .pose import implied, implied_recent, step_words
 from .positions import SweepResult, check_driver_values
 from .stepwise import classification_of
 from .vector_loops import VectorLoops, loop_plan, per_position, singular_of, solve_linear
@@ -59,8 +78,9 @@ MARGIN_FLOOR = 1e-8
 limit than that, the one-at-a-time engine decides (continuation, step halving, gaps)."""
 
 POLISH_ITER = 3
-"""The most Newton steps after the closed form (one is all a position needs; a second
-only where rounding left the first's residual above the gate)."""
+"""The most Newton steps from the closed form where the evidence does not certify it
+(one is all such a position needs; a second only where rounding left the first's
+residual above the gate)."""
 
 BLOCK = 65_536
 """Positions per block (the temporaries stay small for a million positions)."""
@@ -122,37 +142,18 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     if vals.ndim != 1 or n_pos < 2:
         return None
     diff = np.diff(vals)  # (b - a > 0 exactly where b > a: IEEE subtraction underflows gradually)
-    if not (diff > 0.0).all():
+    if not _every(diff > 0.0):
         return None
     # the driver's magnitude, refused as the one-at-a-time engine refuses it
     check_driver_values(m, [float(vals[0]), float(vals[-1])])
     scale = plan.scale
-    signs = _followed_signs(m, tol, max_iter, float(vals[0]), scale, branch)
+    signs = followed_signs(m, tol, max_iter, float(vals[0]), scale, branch)
     if signs is None:
         return None
-    kinds = plan.kinds
-    n = len(kinds)
-    cols = np.empty((n, n_pos))
-    det = np.empty(n_pos)
-    iters = np.empty(n_pos, dtype=np.int32)
-    ratio = np.empty(n_pos)
-    words: list[str] | None = None
-    det_sign = 0.0
-    for lo in range(0, n_pos, BLOCK):
-        got = _block(m, plan, vals[lo:lo + BLOCK] * scale, signs, tol, min(max_iter, POLISH_ITER))
-        if got is None:
-            return None
-        q, dt, it, rt, w = got
-        s = float(np.sign(dt[0]))
-        if words is None:
-            words, det_sign = w, s
-        elif w != words or s != det_sign:
-            return None
-        cols[:, lo:lo + BLOCK] = q
-        det[lo:lo + BLOCK] = dt
-        iters[lo:lo + BLOCK] = it
-        ratio[lo:lo + BLOCK] = rt
-    assert words is not None
+    got = _blocks(m, plan, vals, signs, tol, min(max_iter, POLISH_ITER))
+    if got is None:
+        return None
+    cols, det, iters, ratio, words = got
     closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn, diff)
     if _touch_candidate(closes, det, ratio):
         return None
@@ -169,9 +170,54 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
                        np.ascontiguousarray(shown.T), det, iters, label, meta, 0, m, rates)
 
 
-def _followed_signs(m: Mechanism, tol: float, max_iter: int, first: float, scale: float,
-                    branch: str | None) -> tuple[float, ...] | None:
-    """The signs of the branch to follow, or None (this engine then does not apply)."""
+def _blocks(m: Mechanism, plan: ClosedPlan, vals: np.ndarray, signs: tuple[float, ...], tol: float,
+            max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[str]] | None:
+    """:func:`_block` over every ``BLOCK`` of the driver values (display units), joined:
+    None where a block is None or two name the branch or sign det J differently. One block
+    (up to ``BLOCK`` positions) is its own answer, not copied."""
+    n_pos = len(vals)
+    if n_pos <= BLOCK:
+        return _block(m, plan, vals * plan.scale, signs, tol, max_iter)
+    cols = np.empty((len(plan.kinds), n_pos))
+    det = np.empty(n_pos)
+    iters = np.empty(n_pos, dtype=np.int32)
+    ratio = np.empty(n_pos)
+    words: list[str] | None = None
+    det_sign = 0.0
+    for lo in range(0, n_pos, BLOCK):
+        got = _block(m, plan, vals[lo:lo + BLOCK] * plan.scale, signs, tol, max_iter)
+        if got is None:
+            return None
+        q, dt, it, rt, w = got
+        s = float(np.sign(dt[0]))
+        if words is None:
+            words, det_sign = w, s
+        elif w != words or s != det_sign:
+            return None
+        cols[:, lo:lo + BLOCK] = q
+        det[lo:lo + BLOCK] = dt
+        iters[lo:lo + BLOCK] = it
+        ratio[lo:lo + BLOCK] = rt
+    assert words is not None
+    return cols, det, iters, ratio, words
+
+
+def followed_signs(m: Mechanism, tol: float, max_iter: int, first: float, scale: float,
+                   branch: str | None) -> tuple[float, ...] | None:
+    """The signs of the branch to follow from the first driver value ``first`` (display
+    units), or None (this engine then does not apply): a function of the mechanism and the
+    arguments alone, so kept on the mechanism for the most recent of them
+    (:func:`~.pose.implied_recent`: a mechanism swept from many first values keeps a few),
+    not solved again on every sweep. ``first``'s sign is part of the key: -0.0 and 0.0 are
+    equal but not the same driver value to the solve."""
+    key = (first, math.copysign(1.0, first), tol, max_iter, branch)
+    return implied_recent(m, "closed_followed_signs", key,
+                          lambda m: followed_signs_uncached(m, tol, max_iter, first, scale, branch))
+
+
+def followed_signs_uncached(m: Mechanism, tol: float, max_iter: int, first: float, scale: float,
+                            branch: str | None) -> tuple[float, ...] | None:
+    """:func:`followed_signs` solved afresh."""
     d = m.derivation
     if branch is not None:
         try:
@@ -199,59 +245,76 @@ def _followed_signs(m: Mechanism, tol: float, max_iter: int, first: float, scale
 def _block(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, signs: tuple[float, ...], tol: float,
            max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[str]] | None:
     """One block of driver values (internal units): (unknowns (n, k) internal, det J,
-    iterations, |det J| over J's columns' lengths, the branch's words), or None where the
-    engine does not apply."""
+    Newton steps taken, |det J| over J's columns' lengths, the branch's words), or None
+    where the engine does not apply."""
     d = m.derivation
     # the driver's cosine and sine, taken once for the closed form and the loop equations
     plan_loops = loop_plan(m)
     trig = (np.cos(drv), np.sin(drv)) if plan_loops.driver_angle else None
     q, ok, margins = d.solve_margins_np(drv, signs, driver_trig=trig)  # (fresh arrays, this block's own)
-    if not ok.all() or not all((margin > MARGIN_FLOOR).all() for margin in margins):  # (NaN too)
+    if not _every(ok) or not all(_every(margin > MARGIN_FLOOR) for margin in margins):  # (NaN too)
         return None
     k = len(drv)
     loops = VectorLoops(plan_loops, drv, trig)
-    steps = plan.steps
-    # each position stopped as the single solve's loop stops it (linkage.rules)
-    stops = SystemStops(tol, residual_gate(tol, m.length_scale), partial(step_size_array, q, None))
-    det = np.empty(k)
+    # the evidence: Phi and J at the closed form's own answer and the Newton step they
+    # imply (not taken), judged by the single solve's convergence test (linkage.rules)
+    phi, jac = loops.evaluate(q, None)
+    dq, det = solve_linear(jac, phi, k)
+    gate = residual_gate(tol, m.length_scale)
+    with np.errstate(invalid="ignore"):  # (NaN: not certified)
+        certified = system_converged_array(step_size_array(dq, plan.steps), step_size_array(phi, None),
+                                           tol, gate)
+    ratio = np.abs(det) / _column_lengths(jac, k)
     iters = np.zeros(k, dtype=np.int32)
-    ratio = np.empty(k)
-    active = np.arange(k)
-    it = 0
-    while active.size:
-        if it >= max_iter:
-            return None  # not every position met the rule: the one-at-a-time engine decides
-        it += 1
-        rows = None if active.size == k else active
-        sub = q if rows is None else [c[rows] for c in q]
-        phi, jac = loops.evaluate(sub, rows)
-        dq, dt = solve_linear(jac, phi, active.size)
-        singular = singular_of(jac, dt)
-        if singular.any():
-            moved = [s + np.where(singular, 0.0, d) for s, d in zip(sub, dq)]
-        else:
-            moved = [s + d for s, d in zip(sub, dq)]  # (the same sums: nothing held back)
-            singular = None
-        codes = stops.judge(step_size_array(dq, steps), step_size_array(phi, None), singular,
-                            partial(step_size_array, moved, None), rows)
-        going = codes == GOING
-        if not (converged_codes(codes) | going).all():
-            return None  # a position the loop stops unconverged: the one-at-a-time engine's
-        ratio_now = np.abs(dt) / _column_lengths(jac, active.size)
-        if rows is None:  # the first step, at every position: the arrays themselves
-            q, det, ratio = moved, dt, ratio_now
-            iters[:] = it
-        else:
-            for j in range(len(q)):
-                q[j][active] = moved[j]
-            det[active], ratio[active], iters[active] = dt, ratio_now, it
-        active = active[going]
-    if not ((det > 0).all() or (det < 0).all()):
+    if not _every(certified) and not _polish(loops, q, det, ratio, iters, np.flatnonzero(~certified),
+                                           plan.steps, tol, gate, max_iter):
+        return None
+    if not (_every(det > 0.0) or _every(det < 0.0)):
         return None  # det J changes sign: a toggle, the one-at-a-time engine's to locate
     words = _words(m, plan, drv, q)
     if words is None:
         return None
     return np.array(q), det, iters, ratio, words
+
+
+def _polish(loops: VectorLoops, q: list[np.ndarray], det: np.ndarray, ratio: np.ndarray,
+            iters: np.ndarray, active: np.ndarray, steps: tuple[float, ...] | None, tol: float, gate: float,
+            max_iter: int) -> bool:
+    """Newton-Raphson from the closed form at the positions ``active`` (where the
+    evidence of :func:`_block` does not certify it), each stopped as the single solve's
+    loop stops it (:class:`~linkage.rules.SystemStops`); ``q``, ``det``, ``ratio`` and
+    ``iters`` updated there in place (det J and the ratio of the point the last step was
+    taken from, as that loop reports them). False where a position does not converge in
+    ``max_iter`` steps or the loop stops it unconverged: the one-at-a-time engine decides."""
+    q0 = [c.copy() for c in q]  # (the runaway bound's base: the closed form)
+    stops = SystemStops(tol, gate, partial(step_size_array, q0, None))
+    it = 0
+    while active.size:
+        if it >= max_iter:
+            return False
+        it += 1
+        sub = [c[active] for c in q]
+        phi, jac = loops.evaluate(sub, active)
+        dq, dt = solve_linear(jac, phi, active.size)
+        singular = singular_of(jac, dt)
+        moved = [s + np.where(singular, 0.0, d) for s, d in zip(sub, dq)]
+        codes = stops.judge(step_size_array(dq, steps), step_size_array(phi, None),
+                            singular if singular.any() else None, partial(step_size_array, moved, None),
+                            active)
+        going = codes == GOING
+        if not (converged_codes(codes) | going).all():
+            return False
+        for j in range(len(q)):
+            q[j][active] = moved[j]
+        det[active], ratio[active], iters[active] = dt, np.abs(dt) / _column_lengths(jac, active.size), it
+        active = active[going]
+    return True
+
+
+def _every(mask: np.ndarray) -> bool:
+    """Whether every entry of a boolean array is True: ``mask.all()``, counted (np.count_nonzero
+    takes a fifth of ndarray.all's time on a block of hundreds, and a sweep asks several times)."""
+    return bool(np.count_nonzero(mask) == mask.size)
 
 
 def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray) -> bool:
@@ -260,7 +323,7 @@ def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray) -> bool:
     neighbours taken around the circle where the grid closes it (more often than that
     engine: a candidate only sends the sweep to it)."""
     close = ~(ratio > TOUCH_CANDIDATE)  # J near singular (NaN too): rare, so tested first
-    if not (close if closes else close[1:-1]).any():
+    if not np.count_nonzero(close if closes else close[1:-1]):
         return False
     a = np.abs(det)
     if closes:

@@ -32,16 +32,48 @@ def implied(m: Mechanism, what: Hashable, compute: Callable[[Mechanism], T]) -> 
     name and the arguments it depends on) and kept while ``m`` lives. ``compute`` must
     depend on nothing but ``m`` and ``what``; the value is shared, so it must not be
     changed by a caller (a tuple, a frozen dataclass, or a copy handed out)."""
-    key = id(m)
-    table = IMPLIED.get(key)
-    if table is None:
-        table = IMPLIED[key] = {}
-        weakref.finalize(m, IMPLIED.pop, key, None)
+    table = _table(m)
     try:
         return table[what]  # type: ignore[no-any-return]
     except KeyError:
         value = table[what] = compute(m)
         return value
+
+
+RECENT = 16
+"""How many values of one ``what`` :func:`implied_recent` keeps per mechanism."""
+
+
+def implied_recent(m: Mechanism, what: Hashable, args: Hashable, compute: Callable[[Mechanism], T],
+                   keep: int = RECENT) -> T:
+    """:func:`implied` for what depends on arguments that may take many values over a
+    mechanism's life (a sweep's first driver value): ``compute(m)`` for ``what`` and
+    ``args``, the ``keep`` most recently used of them kept while ``m`` lives (the least
+    recently used dropped first), so a mechanism swept from a million first values holds
+    ``keep`` entries, not a million. The same contract on ``compute`` as :func:`implied`."""
+    table = _table(m)
+    recent = table.get(what)
+    if recent is None:
+        recent = table[what] = {}
+    try:
+        value = recent.pop(args)  # (read again at the end: a dict keeps insertion order)
+    except KeyError:
+        value = compute(m)
+        held = list(recent)  # (one step under the GIL, where another thread may add one)
+        for old in held[:max(len(held) - keep + 1, 0)]:
+            recent.pop(old, None)
+    recent[args] = value
+    return value  # type: ignore[no-any-return]
+
+
+def _table(m: Mechanism) -> dict[Hashable, Any]:
+    """``m``'s entry of :data:`IMPLIED`, made (with its finalizer) at the first read."""
+    key = id(m)
+    table = IMPLIED.get(key)
+    if table is None:
+        table = IMPLIED[key] = {}
+        weakref.finalize(m, IMPLIED.pop, key, None)
+    return table
 
 
 def file_branch(m: Mechanism) -> str | None:

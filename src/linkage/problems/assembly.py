@@ -75,20 +75,25 @@ def triangle_np(d: Any, r: Any, rho: Any) -> tuple[Any, Any, Any]:
     return a, h, ok
 
 
-def triangle_sorted_np(d: Any, r: Any, rho: Any, x: Any, y: Any, z: Any) -> tuple[Any, Any, Any, Any]:
+def triangle_sorted_np(d: Any, r: Any, rho: Any, x: Any, y: Any, z: Any, dd: Any = None,
+                       two_d: Any = None) -> tuple[Any, Any, Any, Any]:
     """:func:`triangle_np`'s body, the three distances already ordered (``x, y, z`` =
     :func:`descending_np` of them): (a, h, ok, gap), ``gap`` = z - (x - y) before it is
     clamped, the slack the two-circle margin (:func:`~.dyads.margin_of_gap_np`) divides by
-    x, so a caller wanting both orders and subtracts once. The caller holds numpy's
-    invalid and divide warnings off (inf - inf and K = 0 are refused through ``ok``)."""
+    x, so a caller wanting both orders and subtracts once. ``dd`` and ``two_d``: d * d and
+    2.0 * d where the caller formed them. The caller holds numpy's invalid and divide
+    warnings off (inf - inf and K = 0 are refused through ``ok``)."""
     import numpy as np
 
-    raw = z - (x - y)
+    x_y = x - y  # (read twice, as the scalar's two x - y: the same bits)
+    raw = z - x_y
     ok = (raw >= -TANGENT_SLACK * x) & (d > 0.0)
     gap = np.maximum(raw, 0.0)
-    area4 = (x + (y + z)) * gap * (z + (x - y)) * (x + (y - z))
-    h = np.where(ok, np.sqrt(np.maximum(area4, 0.0)) / (2.0 * d), np.nan)
-    a = ((r - rho) * (r + rho) + d * d) / (2.0 * d)
+    area4 = (x + (y + z)) * gap * (z + x_y) * (x + (y - z))
+    if two_d is None:
+        two_d = 2.0 * d
+    h = np.where(ok, np.sqrt(np.maximum(area4, 0.0)) / two_d, np.nan)
+    a = ((r - rho) * (r + rho) + (d * d if dd is None else dd)) / two_d
     return a, h, ok, raw
 
 

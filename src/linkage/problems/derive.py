@@ -324,7 +324,7 @@ class Derivation(NamedTuple):
         # a step the driver does not reach (two loops whose difference drops it) has one
         # value for every driver: give it the drivers' shape like the other columns (fresh
         # arrays, a caller's to keep); where every position assembled, NaN replaces nothing
-        every = bool(ok.all())
+        every = bool(np.count_nonzero(ok) == ok.size)  # (ok.all(), counted: a fifth of its time)
         return ([(x.copy() if every else np.where(ok, x, np.nan)) if np.shape(x) == shape else
                  np.where(ok, np.broadcast_to(x, shape), np.nan) for x in q], ok,
                 [x if np.shape(x) == shape else np.broadcast_to(x, shape).copy() for x in out])

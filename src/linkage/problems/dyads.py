@@ -113,23 +113,33 @@ def two_angles_with_margin_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[A
     import numpy as np
 
     d, rp, rq = two_angles_norms_np(p, q, k)
-    x, y, z = descending_np(d, rp, rq)
+    # the two coefficients' lengths first: where they are numbers (a sweep's links) they are
+    # ordered once, not at every position (the same three values, so the same bits)
+    x, y, z = descending_np(rp, rq, d)
     with np.errstate(invalid="ignore", divide="ignore"):  # K = 0: a and b are inf
-        a, h, ok, gap = triangle_sorted_np(d, rp, rq, x, y, z)
-        return (*angles_of_triangle_np(p, q, k, sigma, d, rp, rq, a, h), ok, margin_of_gap_np(gap, x))
+        dd, two_d = d * d, 2.0 * d  # (read by a, h and b: formed once)
+        a, h, ok, gap = triangle_sorted_np(d, rp, rq, x, y, z, dd, two_d)
+        return (*angles_of_triangle_np(p, q, k, sigma, d, rp, rq, a, h, dd, two_d), ok,
+                margin_of_gap_np(gap, x))
 
 
 def angles_of_triangle_np(p: tuple[Any, Any], q: tuple[Any, Any], k: tuple[Any, Any], sigma: float,
-                          d: Any, rp: Any, rq: Any, a: Any, h: Any) -> tuple[Any, Any]:
+                          d: Any, rp: Any, rq: Any, a: Any, h: Any, dd: Any = None,
+                          two_d: Any = None) -> tuple[Any, Any]:
     """:func:`two_angles`' last lines over arrays: the two angles from the triangle (a, h)
-    of the distances (d, rp, rq). The caller holds numpy's warnings off (K = 0: inf)."""
+    of the distances (d, rp, rq); ``dd`` and ``two_d``: d * d and 2.0 * d where the
+    caller formed them. The caller holds numpy's warnings off (K = 0: inf)."""
     import numpy as np
 
-    b = ((rq - rp) * (rq + rp) + d * d) / (2.0 * d)
-    wx, wy = _cmul_conj(-k[0], -k[1], p[0], p[1])
-    ex, ey = _cmul(a, sigma * h + 0.0, wx, wy)
-    vx, vy = _cmul_conj(-k[0], -k[1], q[0], q[1])
-    fx, fy = _cmul(b, -sigma * h + 0.0, vx, vy)
+    b = ((rq - rp) * (rq + rp) + (d * d if dd is None else dd)) / (2.0 * d if two_d is None else two_d)
+    nkx, nky = -k[0], -k[1]
+    wx, wy = _cmul_conj(nkx, nky, p[0], p[1])
+    up = sigma * h + 0.0
+    ex, ey = _cmul(a, up, wx, wy)
+    vx, vy = _cmul_conj(nkx, nky, q[0], q[1])
+    # -sigma h + 0.0, the scalar's: up is never -0.0 (x + 0.0 is not), so 0.0 - up is
+    # -(sigma h) where that is not zero and +0.0 where it is, as -sigma * h + 0.0 gives
+    fx, fy = _cmul(b, 0.0 - up, vx, vy)
     return np.arctan2(ey, ex), np.arctan2(fy, fx)
 
 
