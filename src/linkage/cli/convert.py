@@ -36,7 +36,7 @@ def convert(
 
     from ..files import parse_toml, read_input
     from ..kinematics.loading import parse_mechanism
-    from ..problems.joints import is_joints_doc
+    from ..problems.read_loops import is_joints_doc
     from ..problems.toml_text import loops_text
 
     if form is not None and form.lower() not in ("joints", "loops"):

@@ -12,9 +12,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError, ParseError
-from ..problems.joints import is_joints_doc, off_drawing
 from ..problems.loops import ANGLE_UNITS, Mechanism, shown_value
-from ..problems.read_loops import read_mechanism
+from ..problems.read_loops import is_joints_doc, read_mechanism
 from ..units import degrees
 
 
@@ -65,6 +64,7 @@ def at_driver_value(m: Mechanism, doc: Mapping[str, Any], source: str) -> Mechan
     pose and must keep its sign of det J. A value the drawing's branch does not reach is
     refused."""
     from ..problems.closed_form import wrap_degrees
+    from ..problems.joints import off_drawing
 
     driver = doc["driver"]
     value = shown_value(m.driver)

@@ -59,12 +59,6 @@ MAX_JOINTS = 1000
 that the checks and the cycle basis stay instant on a hostile file."""
 
 
-def is_joints_doc(doc: Mapping[str, Any]) -> bool:
-    """Any key of the joints form: a drawing missing [links] (or holding [[loops]] too) is
-    then told what it lacks, not read as a loops file."""
-    return any(k in doc for k in ("joints", "links", "ground", "sliders"))
-
-
 def _number(v: Any) -> bool:
     """A finite real number (a TOML integer beyond a double's range is not: never
     converted, so never an OverflowError)."""

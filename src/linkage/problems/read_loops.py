@@ -112,19 +112,26 @@ class _Reading:
         return VectorTerm(float(sign), length, angle, radians(offset))
 
 
+def is_joints_doc(doc: Mapping[str, Any]) -> bool:
+    """Any key of the joints form: a drawing missing [links] (or holding [[loops]] too) is
+    then told what it lacks, not read as a loops file. Here, not in problems/joints.py:
+    a loops file's reading does not import the joints form's reader."""
+    return any(k in doc for k in ("joints", "links", "ground", "sliders"))
+
+
 def read_mechanism(doc: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:
     """The mechanism a parsed file describes, every error naming the file and the key. A
     drawing (the joints form) is read as drawn: its guesses are the drawn pose even where
     its [driver] value is elsewhere; :func:`linkage.kinematics.loading.parse_mechanism`,
     which every loader calls, solves them there (a solve is a layer above this one)."""
-    from .joints import is_joints_doc, loops_doc
-
     def fail(key: str, msg: str) -> ParseError:
         return ParseError(f"{source}: {key}: {msg}")
 
     _check_printable(doc, fail)  # a drawing's too, before its names are in a message
     drawn: Mapping[str, Any] | None = None
     if is_joints_doc(doc):  # a drawing: its loops derived (problems/joints.py)
+        from .joints import loops_doc
+
         drawn = doc
         doc = loops_doc(doc, source)
     name, length_unit, closed_form = _header(doc, fail)

@@ -69,7 +69,7 @@ def joint_moves(m: Mechanism, doc: Mapping[str, Any] | None, varies: Sequence[Va
     coords = [(k, v) for k, v in enumerate(varies) if v.name not in m.parameters and "." in v.name]
     if not coords:
         return list(varies), None
-    from ..problems.joints import is_joints_doc
+    from ..problems.read_loops import is_joints_doc
 
     first = coords[0][1].name
     if doc is None:  # the Python API given a Mechanism: its drawing is gone
