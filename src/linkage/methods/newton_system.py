@@ -352,10 +352,15 @@ s = _NewtonSystem("analytic", None, damped, diagnostics=False).step(problem, _St
     {q}, None, err, None, (), (), (), (), _nan, _nan, 1.0, nfev, njev, {phi}))
 nfev, njev = s.nfev, s.njev
 if s.stop is not None:
-    return (list(s.x), list(s.phi_x), s.err, s.stop[0], s.stop[1], k, nfev, njev)
+    {stopped}
+    err = s.err
+    status, detail = s.stop
+    break
 """
 """An iteration whose whole step is refused (a line search, a damped or singular step)
-goes to :meth:`NewtonSystem.step`: one implementation of globalisation."""
+goes to :meth:`NewtonSystem.step`: one implementation of globalisation. A stop it names
+ends the loop with its point (``stopped``: the assignment of its x and Phi) as the
+iterate, to the loop's result or tail."""
 
 NEWTON_SYSTEM_LOOP = Loop(
     signature="newton_system_lean(problem, q0, phi0, tol, rtol, gate, max_iter, damped)",
@@ -396,7 +401,8 @@ NEWTON_SYSTEM_LOOP = Loop(
                 phi_t = None  # the whole step does not lower |Phi|: the method decides
                 nfev -= 1
         if phi_t is None:
-        """) + indent(_FALLBACK.format(q="tuple(q)", phi="tuple(phi)")) + dedent("""\
+        """) + indent(_FALLBACK.format(
+            q="tuple(q)", phi="tuple(phi)", stopped="q, phi = list(s.x), list(s.phi_x)")) + dedent("""\
             step, trial, phi_t = list(s.dq), list(s.x), list(s.phi_x)
         else:
             step = dq
@@ -419,20 +425,30 @@ unknowns), handing a refused step to :meth:`NewtonSystem.step`. The outcome equa
 generic loop's (status, root, iterations; tests/test_compile.py). Returns (x, Phi(x),
 last error, status, detail, iterations, nfev, njev)."""
 
+_2X2_STOPPED = "x0, x1 = s.x\n    p0, p1 = s.phi_x"
+"""The iterate a stop named by :meth:`NewtonSystem.step` leaves to the two-unknown loops."""
+
+_2X2_START = """\
+F, Jf = problem.F, problem.J
+x0, x1 = q0
+p0, p1 = phi0
+"""
+"""How :data:`NEWTON_2X2_LOOP` starts: F, Jf, the start x0, x1 and Phi there p0, p1 (an
+entry of its own, :func:`newton_2x2_entry`, sets them its own way)."""
+
+_2X2_SETUP = dedent("""\
+    ss = st = p0 * p0 + p1 * p1  # _sumsq(phi), carried from the step that produced phi
+    nfev, njev = 1, 0
+    err = fx = _inf
+    a0, a1 = abs(x0), abs(x1)
+    runaway = _RUNAWAY * (1.0 + """ + larger_of("a0", "a1") + """)
+    shrink = 1.0 - 1e-4
+    tiny = 64.0 * _EPS
+    """)
+
 NEWTON_2X2_LOOP = Loop(
     signature="newton_2x2(problem, q0, phi0, tol, rtol, gate, max_iter, damped)",
-    setup="""\
-        F, Jf = problem.F, problem.J
-        x0, x1 = q0
-        p0, p1 = phi0
-        ss = st = p0 * p0 + p1 * p1  # _sumsq(phi), carried from the step that produced phi
-        nfev, njev = 1, 0
-        err = fx = _inf
-        a0, a1 = abs(x0), abs(x1)
-        runaway = _RUNAWAY * (1.0 + """ + larger_of("a0", "a1") + """)
-        shrink = 1.0 - 1e-4
-        tiny = 64.0 * _EPS
-        """,
+    setup=_2X2_START + _2X2_SETUP,
     step=dedent("""\
         (a, b), (c, d) = Jf([x0, x1])
         njev += 1
@@ -462,7 +478,7 @@ NEWTON_2X2_LOOP = Loop(
                         refused = True  # the whole step does not lower |Phi|: the method decides
                         nfev -= 1
         if refused:
-        """) + indent(_FALLBACK.format(q="(x0, x1)", phi="(p0, p1)") + """\
+        """) + indent(_FALLBACK.format(q="(x0, x1)", phi="(p0, p1)", stopped=_2X2_STOPPED) + """\
 d0, d1 = s.dq
 t0, t1 = s.x
 f0, f1 = s.phi_x
@@ -484,6 +500,20 @@ st = f0 * f0 + f1 * f1
 """:data:`NEWTON_SYSTEM_LOOP` for two unknowns measured as they are (every four-bar), on
 scalars: the same operations in the same order, so the same iterates, status and counts
 (tests/test_compile.py), without the per-iteration lists and helper calls."""
+
+def newton_2x2_entry(signature: str, start: str, tail: str) -> Loop:
+    """:data:`NEWTON_2X2_LOOP` with its own ``signature``, ``start`` (source that sets F, Jf,
+    x0, x1 and Phi there p0, p1, in place of reading them from ``problem``, ``q0`` and
+    ``phi0``) and ``tail`` (source after the loop, in place of returning its result): the
+    same iterations, so the same iterates, status and counts, for a front door that judges
+    and packages them in the same call (:func:`linkage.solve.system.fast_newton`)."""
+    return NEWTON_2X2_LOOP._replace(signature=signature, setup=dedent(start) + _2X2_SETUP, tail=tail)
+
+
+def compile_newton_2x2_entry(loop: Loop, names: dict[str, Any]) -> Any:
+    """An entry (:func:`newton_2x2_entry`) compiled with ``names`` beside the loop's own."""
+    return build_loop(loop, {**_LOOP_NAMES, **names}, fixed_source=True)
+
 
 _LOOP_NAMES = {"_NewtonSystem": NewtonSystem, "_State": NewtonSystemState, "_max_abs": max_abs,
                "_direction": newton_direction, "_sumsq": _sumsq, "_EPS": EPS, "_invertible": invertible,
