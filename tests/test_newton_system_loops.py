@@ -8,6 +8,7 @@ import random
 import struct
 import subprocess
 import sys
+from collections import Counter
 
 from linkage.methods.newton_system import larger_of, max_abs
 
@@ -50,3 +51,81 @@ def test_the_system_loops_compile_on_first_use_not_at_import() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "(False, False) (True, True) True"
+
+
+def test_the_two_unknown_quiet_path_tests_equal_the_rules_they_stand_for() -> None:
+    """The 2x2 loop's quiet path reads, in place of max|Phi| and max|q|: the old Phi's sum of
+    squares finite and positive, which implies max|Phi| finite and not zero (it may fail
+    where max|Phi| passes: the sum under- or overflows, and the tests then decide); and
+    the rounding test component by component, equal to err > ROUNDING max(|x0|, |x1|)."""
+    from linkage.iterate import ROUNDING
+    from linkage.methods.newton_system import NEWTON_2X2_LOOP
+
+    ns = {"_inf": math.inf, "_ROUNDING": ROUNDING, "damped": True}
+    residual = eval(f"lambda fs: {NEWTON_2X2_LOOP.quiet_residual}", ns)
+    rounding = eval(f"lambda err, x0, x1: {NEWTON_2X2_LOOP.quiet_rounding}", ns)
+    rng = random.Random(34)
+    values = (*SPECIAL, 1e-170, -1e-170, 1e160, -1e160, 1e-300, 3e-155, -1e154)
+    pairs = [(u, v) for u in values for v in values]
+    pairs += [(rng.uniform(-4.0, 4.0) * 10.0 ** rng.randint(-200, 200),
+               rng.uniform(-4.0, 4.0) * 10.0 ** rng.randint(-200, 200)) for _ in range(3_000)]
+    passed = declined = 0
+    for u, v in pairs:
+        fx = max_abs([u, v])
+        if residual(u * u + v * v):
+            assert -math.inf < fx < math.inf and fx != 0.0, (u, v)
+            passed += 1
+        elif -math.inf < fx < math.inf and fx != 0.0:
+            declined += 1
+        for err in (abs(u) * ROUNDING, abs(v) * 2 * ROUNDING, abs(u) + abs(v), 1e-300, math.nan, 1.0):
+            assert rounding(err, u, v) == (err > ROUNDING * max_abs([u, v])), (err, u, v)
+    assert passed > 1_000 and declined > 100
+
+
+def _scaled_system(rng: random.Random, scale: float):  # type: ignore[no-untyped-def]
+    """A random 2x2 system (linear plus a sine) scaled by ``scale``, so that the sum of
+    squares of Phi under- or overflows where max|Phi| does not."""
+    A = [[rng.uniform(-2, 2) for _ in range(2)] for _ in range(2)]
+    c = [rng.uniform(-3, 3) for _ in range(2)]
+    b = [rng.uniform(-4, 4) for _ in range(2)]
+
+    def F(q):  # type: ignore[no-untyped-def]
+        return [scale * (A[i][0] * q[0] + A[i][1] * q[1] + c[i] * math.sin(q[i]) - b[i]) for i in range(2)]
+
+    def J(q):  # type: ignore[no-untyped-def]
+        return [[scale * (A[i][j] + (c[i] * math.cos(q[i]) if i == j else 0.0)) for j in range(2)]
+                for i in range(2)]
+    return F, J, (rng.uniform(-4, 4), rng.uniform(-4, 4))
+
+
+def test_two_unknown_loop_equals_the_generic_loop_where_the_sum_of_squares_under_or_overflows() -> None:
+    """newton_2x2 against the generic loop stepping NewtonSystem, bit for bit (iterate,
+    Phi, error, status, detail, iterations, counts), on systems scaled so that |Phi|^2
+    underflows or overflows while max|Phi| is finite and not zero: the quiet path declines
+    those steps and the tests decide, as they do in the generic loop."""
+    from linkage.iterate import Criteria, run
+    from linkage.methods.newton_system import NewtonSystem, newton_2x2
+    from linkage.problems.system import generic_system
+    from linkage.result import Status
+
+    rng = random.Random(35)
+    statuses: Counter[Status] = Counter()
+    for case in range(240):
+        scale = (1e-165, 1e-150, 1e155, 1e150, 1.0)[case % 5]
+        F, J, q0 = _scaled_system(rng, scale)
+        damped = case % 2 == 0
+        tol = 10.0 ** rng.uniform(-14, -6)
+        gate = tol * scale
+        problem = generic_system(F, 2, J)
+        phi0 = F(list(q0))
+        got = newton_2x2(problem, q0, phi0, tol, 0.0, gate, 40, damped)
+        m = NewtonSystem("analytic", None, damped, diagnostics=False)
+        final, status, detail, k, _ = run(m, problem, m.init(problem, q0, phi0), Criteria(tol, 0.0, gate, 40),
+                                          record=False, magnitude=max_abs)
+        assert (got[3], got[4], got[5]) == (status, detail, k), case
+        assert [_bits(v) for v in (*got[0], *got[1], got[2])] == \
+            [_bits(v) for v in (*final.x, *final.phi_x, final.err)], case
+        if status is not Status.DOMAIN_ERROR:  # a step that raised: its J counts in the loop's njev only
+            assert (got[6], got[7]) == (final.nfev, final.njev), case
+        statuses[status] += 1
+    assert statuses[Status.CONVERGED_STEP] > 50 and len(statuses) >= 3, statuses

@@ -197,6 +197,15 @@ class Loop(NamedTuple):
     quiet: bool = False
     """Emit :func:`quiet_path` before the tests (needs ``tol`` and ``rtol`` as names, and
     ``ftol`` with ``residual_test``)."""
+    quiet_residual: str = ""
+    """The quiet path's test that f is finite and not zero, in place of reading ``fx``: an
+    expression that implies it (it may be false where f is; the tests then decide)."""
+    quiet_rounding: str = ""
+    """The quiet path's test that the error is above rounding, in place of
+    ``err > _ROUNDING * magnitude``: an expression equal to it."""
+    late: str = ""
+    """Source after a step the quiet path did not continue from, before the tests: what
+    they read that the step left uncomputed (with ``quiet_residual``, ``fx``)."""
 
 
 class _Emitter:
@@ -223,6 +232,7 @@ def stopping_tests(loop: Loop) -> list[str]:
     out = _Emitter(loop)
     if loop.quiet:
         quiet_path(out)
+    out.lines += _block(loop.late, 2)
     _value_tests(out)
     _step_test(out)
     _growth_tests(out)
@@ -249,8 +259,9 @@ def quiet_path(out: _Emitter) -> None:
         return
     finite_err = "err <= prev_err" if loop.diverge else "err < _inf"
     put(0, "try:")
-    put(1, f"if qtol < {finite_err} and -_inf < fx < _inf and fx != 0.0"
-           f" and err > _ROUNDING * {loop.magnitude}:")
+    residual = loop.quiet_residual or "-_inf < fx < _inf and fx != 0.0"
+    rounding = loop.quiet_rounding or f"err > _ROUNDING * {loop.magnitude}"
+    put(1, f"if qtol < {finite_err} and {residual} and {rounding}:")
     if loop.guard:
         put(2, "size = fx if fx >= 0.0 else -fx")
         put(2, "if size < best:")

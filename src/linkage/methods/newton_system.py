@@ -436,6 +436,14 @@ p0, p1 = phi0
 """How :data:`NEWTON_2X2_LOOP` starts: F, Jf, the start x0, x1 and Phi there p0, p1 (an
 entry of its own, :func:`newton_2x2_entry`, sets them its own way)."""
 
+_2X2_RESIDUAL = """\
+# |v| written "v if v > 0.0 else 0.0 - v": the same bits as abs (-0.0 included), no call
+a0 = {p0} if {p0} > 0.0 else 0.0 - {p0}
+a1 = {p1} if {p1} > 0.0 else 0.0 - {p1}
+fx = """ + larger_of("a0", "a1") + """
+"""
+"""max|Phi| of the two-unknown loops, ``fx``, from the entries of Phi {p0} and {p1}."""
+
 _2X2_SETUP = dedent("""\
     ss = st = p0 * p0 + p1 * p1  # _sumsq(phi), carried from the step that produced phi
     nfev, njev = 1, 0
@@ -452,10 +460,8 @@ NEWTON_2X2_LOOP = Loop(
     step=dedent("""\
         (a, b), (c, d) = Jf([x0, x1])
         njev += 1
-        # |v| written "v if v > 0.0 else 0.0 - v": the same bits as abs (-0.0 included), no call
-        a0 = p0 if p0 > 0.0 else 0.0 - p0
-        a1 = p1 if p1 > 0.0 else 0.0 - p1
-        fx = """ + larger_of("a0", "a1") + """
+        if not damped:  # max|Phi| where the step is taken from (damped: only where the tests read it)
+        """) + indent(_2X2_RESIDUAL.format(p0="p0", p1="p1")) + dedent("""\
         ad = a * d
         bc = b * c
         det = ad - bc
@@ -488,15 +494,22 @@ st = f0 * f0 + f1 * f1
         e0 = d0 if d0 > 0.0 else 0.0 - d0
         e1 = d1 if d1 > 0.0 else 0.0 - d1
         err = """ + larger_of("e0", "e1") + """
-        x0, x1, p0, p1 = t0, t1, f0, f1
-        ss = st  # the new phi's sum of squares, as the step computed it (read only when damped)
+        o0, o1, x0, x1, p0, p1 = p0, p1, t0, t1, f0, f1
+        fs, ss = ss, st  # the sums of squares of the old and the new phi (each read only when damped)
+        """,
+    late="if damped:\n" + indent(_2X2_RESIDUAL.format(p0="o0", p1="o1")) + dedent("""\
         e0 = x0 if x0 > 0.0 else 0.0 - x0
         e1 = x1 if x1 > 0.0 else 0.0 - x1
         size_q = """ + larger_of("e0", "e1") + """
-        """,
+        """),
     result="[x0, x1], [p0, p1], err, status, detail, k, nfev, njev",
     residual_test=False, step_test="system", diverge="runaway", diverge_when="not damped",
-    magnitude="size_q", quiet=True)
+    magnitude="size_q", quiet=True,
+    # damped: the old phi's sum of squares finite and positive says max|Phi| is (it may be
+    # finite and positive where the sum under- or overflows: the tests then decide)
+    quiet_residual="(0.0 < fs < _inf if damped else -_inf < fx < _inf and fx != 0.0)",
+    # err > _ROUNDING * max(|x0|, |x1|), component by component: rounding is symmetric
+    quiet_rounding="-err < _ROUNDING * x0 < err and -err < _ROUNDING * x1 < err")
 """:data:`NEWTON_SYSTEM_LOOP` for two unknowns measured as they are (every four-bar), on
 scalars: the same operations in the same order, so the same iterates, status and counts
 (tests/test_compile.py), without the per-iteration lists and helper calls."""
