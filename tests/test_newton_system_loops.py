@@ -53,23 +53,23 @@ def test_the_system_loops_compile_on_first_use_not_at_import() -> None:
     assert out.strip() == "(False, False) (True, True) True"
 
 
-def test_the_two_unknown_quiet_path_tests_equal_the_rules_they_stand_for() -> None:
+def test_the_two_unknown_quiet_path_tests_imply_the_rules_they_stand_for() -> None:
     """The 2x2 loop's quiet path reads, in place of max|Phi| and max|q|: the old Phi's sum of
-    squares finite and positive, which implies max|Phi| finite and not zero (it may fail
-    where max|Phi| passes: the sum under- or overflows, and the tests then decide); and
-    the rounding test component by component, equal to err > ROUNDING max(|x0|, |x1|)."""
+    squares finite and positive, which implies max|Phi| finite and not zero; and |x0|, |x1|
+    below tol / ROUNDING, which with the error above tol implies the error above rounding,
+    err > ROUNDING max(|x0|, |x1|). Each may fail where the rule passes (a sum that under-
+    or overflows, a large |x|): the tests then decide; they pass in the common case."""
     from linkage.iterate import ROUNDING
     from linkage.methods.newton_system import NEWTON_2X2_LOOP
 
-    ns = {"_inf": math.inf, "_ROUNDING": ROUNDING, "damped": True}
-    residual = eval(f"lambda fs: {NEWTON_2X2_LOOP.quiet_residual}", ns)
-    rounding = eval(f"lambda err, x0, x1: {NEWTON_2X2_LOOP.quiet_rounding}", ns)
+    residual = eval(f"lambda fs: {NEWTON_2X2_LOOP.quiet_residual}", {"_inf": math.inf, "damped": True})
+    rounding = eval(f"lambda x0, x1, low_x, high_x: {NEWTON_2X2_LOOP.quiet_rounding}")
     rng = random.Random(34)
-    values = (*SPECIAL, 1e-170, -1e-170, 1e160, -1e160, 1e-300, 3e-155, -1e154)
+    values = (*SPECIAL, 1e-170, -1e-170, 1e160, -1e160, 1e-300, 3e-155, -1e154, 1e-310, 2.0 ** 974)
     pairs = [(u, v) for u in values for v in values]
     pairs += [(rng.uniform(-4.0, 4.0) * 10.0 ** rng.randint(-200, 200),
                rng.uniform(-4.0, 4.0) * 10.0 ** rng.randint(-200, 200)) for _ in range(3_000)]
-    passed = declined = 0
+    passed = declined = quiet = 0
     for u, v in pairs:
         fx = max_abs([u, v])
         if residual(u * u + v * v):
@@ -77,9 +77,13 @@ def test_the_two_unknown_quiet_path_tests_equal_the_rules_they_stand_for() -> No
             passed += 1
         elif -math.inf < fx < math.inf and fx != 0.0:
             declined += 1
-        for err in (abs(u) * ROUNDING, abs(v) * 2 * ROUNDING, abs(u) + abs(v), 1e-300, math.nan, 1.0):
-            assert rounding(err, u, v) == (err > ROUNDING * max_abs([u, v])), (err, u, v)
-    assert passed > 1_000 and declined > 100
+        for tol in (*values[:6], 1e-12, 1e-6, 1e293, 1e300, 5e-324, abs(u), abs(v) * ROUNDING):
+            high_x = tol / ROUNDING  # as the loop's setup sets them
+            for err in (math.nextafter(tol, math.inf), tol * 3.0, 1.0, math.inf, math.nan):
+                if tol < err and rounding(u, v, -high_x, high_x):
+                    assert err > ROUNDING * max_abs([u, v]), (err, u, v, tol)
+                    quiet += 1
+    assert passed > 1_000 and declined > 100 and quiet > 10_000
 
 
 def _scaled_system(rng: random.Random, scale: float):  # type: ignore[no-untyped-def]

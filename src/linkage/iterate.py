@@ -202,7 +202,8 @@ class Loop(NamedTuple):
     expression that implies it (it may be false where f is; the tests then decide)."""
     quiet_rounding: str = ""
     """The quiet path's test that the error is above rounding, in place of
-    ``err > _ROUNDING * magnitude``: an expression equal to it."""
+    ``err > _ROUNDING * magnitude``: an expression that, with the error above ``qtol``,
+    implies it (it may be false where the test passes; the tests then decide)."""
     late: str = ""
     """Source after a step the quiet path did not continue from, before the tests: what
     they read that the step left uncomputed (with ``quiet_residual``, ``fx``)."""

@@ -453,6 +453,8 @@ _2X2_SETUP = dedent("""\
         runaway = _RUNAWAY * (1.0 + """ + larger_of("a0", "a1") + """)
     shrink = 1.0 - 1e-4
     tiny = 64.0 * _EPS
+    high_x = tol / _ROUNDING  # the quiet path's bound on |x| (quiet_rounding)
+    low_x = -high_x
     """)
 
 NEWTON_2X2_LOOP = Loop(
@@ -515,8 +517,10 @@ st = f0 * f0 + f1 * f1
     # damped: the old phi's sum of squares finite and positive says max|Phi| is (it may be
     # finite and positive where the sum under- or overflows: the tests then decide)
     quiet_residual="(0.0 < fs < _inf if damped else -_inf < fx < _inf and fx != 0.0)",
-    # err > _ROUNDING * max(|x0|, |x1|), component by component: rounding is symmetric
-    quiet_rounding="-err < _ROUNDING * x0 < err and -err < _ROUNDING * x1 < err")
+    # |x0|, |x1| below tol / _ROUNDING, with err above tol (qtol), says err > _ROUNDING max(|x0|, |x1|):
+    # _ROUNDING is a power of two, so _ROUNDING * (tol / _ROUNDING) is tol exactly, and rounding
+    # is monotonic (it may fail where the rounding test passes: the tests then decide)
+    quiet_rounding="low_x < x0 < high_x and low_x < x1 < high_x")
 """:data:`NEWTON_SYSTEM_LOOP` for two unknowns measured as they are (every four-bar), on
 scalars: the same operations in the same order, so the same iterates, status and counts
 (tests/test_compile.py), without the per-iteration lists and helper calls."""
