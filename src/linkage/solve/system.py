@@ -63,9 +63,8 @@ def solve_system(
                 and len(x0) == 2):
             a, b = x0
             if type(a) is float and type(b) is float and a - a == 0.0 and b - b == 0.0:
-                _, _, _, _, _, _, _, entry, problem, c_tol, c_rtol, gate, c_max, meta = ready
                 try:
-                    return entry(problem, a, b, c_tol, c_rtol, gate, c_max, damped, meta)  # type: ignore[no-any-return]
+                    return ready[7](ready, a, b)  # type: ignore[no-any-return]
                 except (TypeError, IndexError, RecursionError):
                     return solve_general(F, x0, jac=jac, method=method, tol=tol, rtol=rtol, ftol=ftol,
                                          max_iter=max_iter, record=record, fd_step=fd_step, damped=damped,
@@ -107,10 +106,11 @@ def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float 
             c_tol, c_rtol, c_ftol, c_max = crit
             gate = c_ftol if c_ftol is not None else c_tol
             meta = (user_two_meta, crit, gate, names, kinds)
+            ready = (F, jac, tol, rtol, ftol, max_iter, damped,
+                     entry, problem, c_tol, c_rtol, gate, c_max, meta)
             if _recent.seen[4] is crit and (damped is True or damped is False):
-                _ready = (F, jac, tol, rtol, ftol, max_iter, damped,
-                          entry, problem, c_tol, c_rtol, gate, c_max, meta)
-            return entry(problem, x0[0], x0[1], c_tol, c_rtol, gate, c_max, damped, meta)  # type: ignore[no-any-return]
+                _ready = ready
+            return entry(ready, x0[0], x0[1])  # type: ignore[no-any-return]
         SystemProblem = _system_solvers()[3]
         if (jac is None and type(F) is SystemProblem and len(F.names) == 2 and F.J is not None
                 and F.step_scales is None):
@@ -124,13 +124,16 @@ _ready: tuple[Any, ...] = (None,) * 14
 """The user callables (F, jac), the criteria objects (tol, rtol, ftol, max_iter) and
 ``damped`` :func:`fast_newton` last solved, then what it solved them with (the entry, the
 problem, the checked criteria, the gate, the raw meta): read by identity in
-:func:`solve_system`, one assignment, so a reader sees all or none. Only criteria that
+:func:`solve_system`, which hands the whole record to the entry (three arguments, not nine);
+one assignment, so a reader sees all or none. Only criteria that
 :class:`~.criteria.RecentCriteria` remembers (floats, ints, None) and a bool ``damped``,
 which cannot change under the same identity."""
 
-USER_TWO_SIGNATURE = "newton_2x2_user(problem, x0, x1, tol, rtol, gate, max_iter, damped, meta)"
+USER_TWO_SIGNATURE = "newton_2x2_user(ready, x0, x1)"
+"""The entry takes :data:`_ready`'s record (or one like it) and the start."""
 
 USER_TWO_START = """\
+_, _, _, _, _, _, damped, _, problem, tol, rtol, gate, max_iter, meta = ready
 F, Jf = problem.F, problem.J
 try:
     phi0 = F([x0, x1])
