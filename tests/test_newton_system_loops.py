@@ -133,3 +133,17 @@ def test_two_unknown_loop_equals_the_generic_loop_where_the_sum_of_squares_under
             assert (got[6], got[7]) == (final.nfev, final.njev), case
         statuses[status] += 1
     assert statuses[Status.CONVERGED_STEP] > 50 and len(statuses) >= 3, statuses
+
+
+def test_the_generated_system_convergence_test_is_the_rule() -> None:
+    """rules.system_converged_source, which the generated loops read, gives
+    rules.system_converged's verdict on special, boundary and random values."""
+    from linkage.rules import system_converged, system_converged_source
+
+    inline = eval(f"lambda err, fx, limit, gate: {system_converged_source('err', 'fx', 'limit', 'gate')}")
+    rng = random.Random(36)
+    values = (*SPECIAL, 1e-12, math.nextafter(1e-12, 0.0), math.nextafter(1e-12, 1.0))
+    cases = [(e, f, lim, g) for e in values for f in values for lim in values[::3] for g in values[::4]]
+    cases += [tuple(rng.choice((1e-12, rng.uniform(0.0, 2e-12))) for _ in range(4)) for _ in range(2_000)]
+    for err, fx, limit, gate in cases:
+        assert bool(inline(err, fx, limit, gate)) == system_converged(err, fx, limit, gate), (err, fx, limit)

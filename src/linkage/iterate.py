@@ -46,7 +46,7 @@ from types import CodeType
 from typing import Any, NamedTuple
 
 from .result import STATUS_MEMBERS, Status
-from .rules import step_limit, system_converged, worse_than_seen
+from .rules import step_limit, system_converged_source, worse_than_seen
 
 UNCERTIFIED_LIMIT = 4
 """Small steps without evidence of a root after which an open scalar method stops."""
@@ -366,7 +366,7 @@ def _step_test(out: _Emitter) -> None:
         put(2, "status, detail = verdict, why")
         put(2, "break")
     else:  # systems: the step and the residual (linkage.rules.system_converged)
-        put(1, "if fx is not None and _system_converged(err, fx, limit, gate):")
+        put(1, f"if fx is not None and {system_converged_source('err', 'fx', 'limit', 'gate')}:")
         stop(2, "CONVERGED_STEP")
         if loop.step_test == "minimizes":
             stop(1, "LOCAL_MINIMUM", 'f"the least-squares residual stalls at {abs(fx or _nan):.3g}, '
@@ -504,7 +504,7 @@ def build_loop(loop: Loop, names: dict[str, Any] | None = None, *,
     namespace: dict[str, Any] = {
         "_S": STATUS_MEMBERS, "_inf": math.inf, "_nan": math.nan, "_isfinite": math.isfinite,
         "_explain": explain, "_judge": judge_certificate, "_stall": rounding_stall,
-        "_worse": worse_than_seen, "_step_limit": step_limit, "_system_converged": system_converged,
+        "_worse": worse_than_seen, "_step_limit": step_limit,
         "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_BIG": sys.float_info.max, "_RUNAWAY": RUNAWAY,
         **(names or {})}
     name = loop.signature.split("(", 1)[0]
