@@ -100,7 +100,7 @@ def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float 
         if (jac is not None and (type(x0) is tuple or type(x0) is list) and len(x0) == 2
                 and type(x0[0]) is float and type(x0[1]) is float and x0[0] - x0[0] == 0.0
                 and x0[1] - x0[1] == 0.0 and callable(F)):
-            entry, (names, kinds, _) = _user_two or _user_two_entry()
+            entry, (names, kinds, _), _, _ = _user_two or _user_two_entry()
             last = _last_two
             problem = last[2] if last[0] is F and last[1] is jac else user_two_problem(F, jac)
             c_tol, c_rtol, c_ftol, c_max = crit
@@ -168,16 +168,17 @@ _user_two: tuple[Any, ...] = ()
 
 def _user_two_entry() -> tuple[Any, ...]:
     """The entry for user callables of two unknowns (Newton's two-unknown loop judged and
-    packaged in its own call) and the generic labels of two unknowns, built once."""
+    packaged in its own call), the generic labels of two unknowns and what
+    :func:`user_two_problem` builds with, made and imported once."""
     global _user_two
     if not _user_two:
         from ..methods.newton_system import compile_newton_2x2_entry, max_abs
-        from ..problems.system import generic_labels
+        from ..problems.system import LeanProblem, generic_labels, generic_system
 
         entry = compile_newton_2x2_entry(user_two_loop(), {
             "_unevaluable": unevaluable_start, "_residual_checked": residual_checked,
             "_verdict": system_verdict, "_fast": Result.fast, "_max_abs": max_abs})
-        _user_two = (entry, generic_labels(2))
+        _user_two = (entry, generic_labels(2), LeanProblem, generic_system)
     return _user_two
 
 
@@ -385,7 +386,7 @@ def user_two_problem(F: Callable[..., Any], jac: Callable[..., Any]) -> Any:
     """The problem :func:`fast_newton` hands user callables of two unknowns to: none built
     unless a step is refused; kept, so the same functions solved again reuse it."""
     global _last_two
-    from ..problems.system import LeanProblem, generic_system
+    _, _, LeanProblem, generic_system = _user_two  # loaded by fast_newton before it calls this
 
     problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
     _last_two = (F, jac, problem)
