@@ -297,6 +297,65 @@ def test_the_two_unknown_front_door_equals_the_general_path():
 
 
 
+def test_a_remembered_two_unknown_solve_equals_the_general_path():
+    """The same user callables at the same criteria objects solved again go from
+    solve_system straight to the loop (solve.system._ready); each Result equals the general
+    path's, from every start, damped or not, after other functions and other criteria
+    were solved in between; criteria of a mutable or non-float type and a non-bool damped
+    are not remembered; a function that later returns the wrong kind of value is named as
+    the general path names it."""
+    import numpy as np
+
+    from linkage import solve_system
+    from linkage.errors import InputError
+    from linkage.measure.stress_cases import fourbar_cases, fourbar_mechanism
+    from linkage.solve import system
+
+    problems = [fourbar_mechanism(it).problem() for it in fourbar_cases(random.Random(3), 40)]
+    rng = random.Random(4)
+    tol, ftol, rtol = 1e-11, 1e-9, 0.0
+    remembered = 0
+    for p in problems:
+        for damped in (True, False):
+            for _ in range(3):
+                x0 = (rng.uniform(-3.0, 3.0), rng.uniform(-3.0, 3.0))
+                for start in (x0, list(x0)):
+                    fast = solve_system(p.F, start, jac=p.J, tol=tol, ftol=ftol, rtol=rtol, max_iter=30,
+                                        record=False, damped=damped)
+                    remembered += system._ready[0] is p.F and system._ready[6] is damped
+                    full = general_path(p.F, list(x0), jac=p.J, tol=tol, ftol=ftol, rtol=rtol, max_iter=30,
+                                        record=False, damped=damped)
+                    assert repr(seen(fast)) == repr(seen(full)), (x0, damped)
+    assert remembered == len(problems) * 2 * 3 * 2
+    p = problems[0]
+    for options in (dict(tol=np.float64(1e-10)), dict(tol=1e-10, damped=1)):
+        fast = solve_system(p.F, (0.5, 1.0), jac=p.J, record=False, **options)
+        assert system._ready[0] is not p.F, options
+        full = general_path(p.F, [0.5, 1.0], jac=p.J, record=False, **options)
+        assert repr(seen(fast)) == repr(seen(full)), options
+
+    broken: list[str] = []
+
+    def F(q: Any) -> Any:
+        return None if "F" in broken else p.F(q)
+
+    def J(q: Any) -> Any:
+        return None if "J" in broken else p.J(q)
+
+    for name, named in (("F", "F must return"), ("J", "jac must return")):
+        broken.clear()
+        solve_system(F, (0.5, 1.0), jac=J, tol=tol, record=False)
+        assert system._ready[0] is F
+        broken.append(name)
+        messages = []
+        for solve in (lambda: solve_system(F, (0.5, 1.0), jac=J, tol=tol, record=False),
+                      lambda: general_path(F, [0.5, 1.0], jac=J, tol=tol, record=False)):
+            with pytest.raises(InputError) as caught:
+                solve()
+            messages.append(str(caught.value))
+        assert messages[0] == messages[1] and messages[0].startswith(named), messages
+
+
 def test_the_two_unknown_mechanism_front_door_equals_the_general_path():
     """A compiled problem of two angles with a tuple start (its own x0 included) takes a
     short front door when Newton converges; a list start takes the general path."""

@@ -46,7 +46,7 @@ from types import CodeType
 from typing import Any, NamedTuple
 
 from .result import STATUS_MEMBERS, Status
-from .rules import step_limit, system_converged, worse_than_seen
+from .rules import step_limit, system_converged_source, worse_than_seen
 
 UNCERTIFIED_LIMIT = 4
 """Small steps without evidence of a root after which an open scalar method stops."""
@@ -197,6 +197,16 @@ class Loop(NamedTuple):
     quiet: bool = False
     """Emit :func:`quiet_path` before the tests (needs ``tol`` and ``rtol`` as names, and
     ``ftol`` with ``residual_test``)."""
+    quiet_residual: str = ""
+    """The quiet path's test that f is finite and not zero, in place of reading ``fx``: an
+    expression that implies it (it may be false where f is; the tests then decide)."""
+    quiet_rounding: str = ""
+    """The quiet path's test that the error is above rounding, in place of
+    ``err > _ROUNDING * magnitude``: an expression that, with the error above ``qtol``,
+    implies it (it may be false where the test passes; the tests then decide)."""
+    late: str = ""
+    """Source after a step the quiet path did not continue from, before the tests: what
+    they read that the step left uncomputed (with ``quiet_residual``, ``fx``)."""
 
 
 class _Emitter:
@@ -223,6 +233,7 @@ def stopping_tests(loop: Loop) -> list[str]:
     out = _Emitter(loop)
     if loop.quiet:
         quiet_path(out)
+    out.lines += _block(loop.late, 2)
     _value_tests(out)
     _step_test(out)
     _growth_tests(out)
@@ -249,8 +260,9 @@ def quiet_path(out: _Emitter) -> None:
         return
     finite_err = "err <= prev_err" if loop.diverge else "err < _inf"
     put(0, "try:")
-    put(1, f"if qtol < {finite_err} and -_inf < fx < _inf and fx != 0.0"
-           f" and err > _ROUNDING * {loop.magnitude}:")
+    residual = loop.quiet_residual or "-_inf < fx < _inf and fx != 0.0"
+    rounding = loop.quiet_rounding or f"err > _ROUNDING * {loop.magnitude}"
+    put(1, f"if qtol < {finite_err} and {residual} and {rounding}:")
     if loop.guard:
         put(2, "size = fx if fx >= 0.0 else -fx")
         put(2, "if size < best:")
@@ -354,7 +366,7 @@ def _step_test(out: _Emitter) -> None:
         put(2, "status, detail = verdict, why")
         put(2, "break")
     else:  # systems: the step and the residual (linkage.rules.system_converged)
-        put(1, "if fx is not None and _system_converged(err, fx, limit, gate):")
+        put(1, f"if fx is not None and {system_converged_source('err', 'fx', 'limit', 'gate')}:")
         stop(2, "CONVERGED_STEP")
         if loop.step_test == "minimizes":
             stop(1, "LOCAL_MINIMUM", 'f"the least-squares residual stalls at {abs(fx or _nan):.3g}, '
@@ -492,7 +504,7 @@ def build_loop(loop: Loop, names: dict[str, Any] | None = None, *,
     namespace: dict[str, Any] = {
         "_S": STATUS_MEMBERS, "_inf": math.inf, "_nan": math.nan, "_isfinite": math.isfinite,
         "_explain": explain, "_judge": judge_certificate, "_stall": rounding_stall,
-        "_worse": worse_than_seen, "_step_limit": step_limit, "_system_converged": system_converged,
+        "_worse": worse_than_seen, "_step_limit": step_limit,
         "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_BIG": sys.float_info.max, "_RUNAWAY": RUNAWAY,
         **(names or {})}
     name = loop.signature.split("(", 1)[0]

@@ -83,6 +83,13 @@ def system_converged(err: float, resid: float, limit: float, gate: float) -> boo
     return err <= limit and resid <= gate
 
 
+def system_converged_source(err: str, resid: str, limit: str, gate: str) -> str:
+    """Source of :func:`system_converged` for generated loops, on names: the same test
+    without the call (once a solve, about 1% of a two-unknown Newton solve);
+    tests/test_newton_system_loops.py holds the two to the same verdicts."""
+    return f"({err} <= {limit} and {resid} <= {gate})"
+
+
 def system_converged_array(err: Any, resid: Any, limit: Any, gate: Any) -> Any:
     """:func:`system_converged` position by position (numpy booleans)."""
     return (err <= limit) & (resid <= gate)

@@ -352,10 +352,15 @@ s = _NewtonSystem("analytic", None, damped, diagnostics=False).step(problem, _St
     {q}, None, err, None, (), (), (), (), _nan, _nan, 1.0, nfev, njev, {phi}))
 nfev, njev = s.nfev, s.njev
 if s.stop is not None:
-    return (list(s.x), list(s.phi_x), s.err, s.stop[0], s.stop[1], k, nfev, njev)
+    {stopped}
+    err = s.err
+    status, detail = s.stop
+    break
 """
 """An iteration whose whole step is refused (a line search, a damped or singular step)
-goes to :meth:`NewtonSystem.step`: one implementation of globalisation."""
+goes to :meth:`NewtonSystem.step`: one implementation of globalisation. A stop it names
+ends the loop with its point (``stopped``: the assignment of its x and Phi) as the
+iterate, to the loop's result or tail."""
 
 NEWTON_SYSTEM_LOOP = Loop(
     signature="newton_system_lean(problem, q0, phi0, tol, rtol, gate, max_iter, damped)",
@@ -396,7 +401,8 @@ NEWTON_SYSTEM_LOOP = Loop(
                 phi_t = None  # the whole step does not lower |Phi|: the method decides
                 nfev -= 1
         if phi_t is None:
-        """) + indent(_FALLBACK.format(q="tuple(q)", phi="tuple(phi)")) + dedent("""\
+        """) + indent(_FALLBACK.format(
+            q="tuple(q)", phi="tuple(phi)", stopped="q, phi = list(s.x), list(s.phi_x)")) + dedent("""\
             step, trial, phi_t = list(s.dq), list(s.x), list(s.phi_x)
         else:
             step = dq
@@ -419,27 +425,46 @@ unknowns), handing a refused step to :meth:`NewtonSystem.step`. The outcome equa
 generic loop's (status, root, iterations; tests/test_compile.py). Returns (x, Phi(x),
 last error, status, detail, iterations, nfev, njev)."""
 
-NEWTON_2X2_LOOP = Loop(
-    signature="newton_2x2(problem, q0, phi0, tol, rtol, gate, max_iter, damped)",
-    setup="""\
-        F, Jf = problem.F, problem.J
-        x0, x1 = q0
-        p0, p1 = phi0
-        ss = st = p0 * p0 + p1 * p1  # _sumsq(phi), carried from the step that produced phi
-        nfev, njev = 1, 0
-        err = fx = _inf
+_2X2_STOPPED = "x0, x1 = s.x\n    p0, p1 = s.phi_x"
+"""The iterate a stop named by :meth:`NewtonSystem.step` leaves to the two-unknown loops."""
+
+_2X2_START = """\
+F, Jf = problem.F, problem.J
+x0, x1 = q0
+p0, p1 = phi0
+"""
+"""How :data:`NEWTON_2X2_LOOP` starts: F, Jf, the start x0, x1 and Phi there p0, p1 (an
+entry of its own, :func:`newton_2x2_entry`, sets them its own way)."""
+
+_2X2_RESIDUAL = """\
+# |v| written "v if v > 0.0 else 0.0 - v": the same bits as abs (-0.0 included), no call
+a0 = {p0} if {p0} > 0.0 else 0.0 - {p0}
+a1 = {p1} if {p1} > 0.0 else 0.0 - {p1}
+fx = """ + larger_of("a0", "a1") + """
+"""
+"""max|Phi| of the two-unknown loops, ``fx``, from the entries of Phi {p0} and {p1}."""
+
+_2X2_SETUP = dedent("""\
+    ss = st = p0 * p0 + p1 * p1  # _sumsq(phi), carried from the step that produced phi
+    nfev, njev = 1, 0
+    err = fx = _inf
+    if not damped:  # read by the divergence test only, which a damped run does not take
         a0, a1 = abs(x0), abs(x1)
         runaway = _RUNAWAY * (1.0 + """ + larger_of("a0", "a1") + """)
-        shrink = 1.0 - 1e-4
-        tiny = 64.0 * _EPS
-        """,
+    shrink = 1.0 - 1e-4
+    tiny = 64.0 * _EPS
+    high_x = tol / _ROUNDING  # the quiet path's bound on |x| (quiet_rounding)
+    low_x = -high_x
+    """)
+
+NEWTON_2X2_LOOP = Loop(
+    signature="newton_2x2(problem, q0, phi0, tol, rtol, gate, max_iter, damped)",
+    setup=_2X2_START + _2X2_SETUP,
     step=dedent("""\
         (a, b), (c, d) = Jf([x0, x1])
         njev += 1
-        # |v| written "v if v > 0.0 else 0.0 - v": the same bits as abs (-0.0 included), no call
-        a0 = p0 if p0 > 0.0 else 0.0 - p0
-        a1 = p1 if p1 > 0.0 else 0.0 - p1
-        fx = """ + larger_of("a0", "a1") + """
+        if not damped:  # max|Phi| where the step is taken from (damped: only where the tests read it)
+        """) + indent(_2X2_RESIDUAL.format(p0="p0", p1="p1")) + dedent("""\
         ad = a * d
         bc = b * c
         det = ad - bc
@@ -462,7 +487,7 @@ NEWTON_2X2_LOOP = Loop(
                         refused = True  # the whole step does not lower |Phi|: the method decides
                         nfev -= 1
         if refused:
-        """) + indent(_FALLBACK.format(q="(x0, x1)", phi="(p0, p1)") + """\
+        """) + indent(_FALLBACK.format(q="(x0, x1)", phi="(p0, p1)", stopped=_2X2_STOPPED) + """\
 d0, d1 = s.dq
 t0, t1 = s.x
 f0, f1 = s.phi_x
@@ -472,18 +497,47 @@ st = f0 * f0 + f1 * f1
         e0 = d0 if d0 > 0.0 else 0.0 - d0
         e1 = d1 if d1 > 0.0 else 0.0 - d1
         err = """ + larger_of("e0", "e1") + """
-        x0, x1, p0, p1 = t0, t1, f0, f1
-        ss = st  # the new phi's sum of squares, as the step computed it (read only when damped)
+        # one name at a time: six names in one assignment build and unpack a tuple (0.15 us a solve)
+        o0 = p0
+        o1 = p1
+        x0 = t0
+        x1 = t1
+        p0 = f0
+        p1 = f1
+        fs, ss = ss, st  # the sums of squares of the old and the new phi (each read only when damped)
+        """,
+    late="if damped:\n" + indent(_2X2_RESIDUAL.format(p0="o0", p1="o1")) + dedent("""\
         e0 = x0 if x0 > 0.0 else 0.0 - x0
         e1 = x1 if x1 > 0.0 else 0.0 - x1
         size_q = """ + larger_of("e0", "e1") + """
-        """,
+        """),
     result="[x0, x1], [p0, p1], err, status, detail, k, nfev, njev",
     residual_test=False, step_test="system", diverge="runaway", diverge_when="not damped",
-    magnitude="size_q", quiet=True)
+    magnitude="size_q", quiet=True,
+    # damped: the old phi's sum of squares finite and positive says max|Phi| is (it may be
+    # finite and positive where the sum under- or overflows: the tests then decide)
+    quiet_residual="(0.0 < fs < _inf if damped else -_inf < fx < _inf and fx != 0.0)",
+    # |x0|, |x1| below tol / _ROUNDING, with err above tol (qtol), says err > _ROUNDING max(|x0|, |x1|):
+    # _ROUNDING is a power of two, so _ROUNDING * (tol / _ROUNDING) is tol exactly, and rounding
+    # is monotonic (it may fail where the rounding test passes: the tests then decide)
+    quiet_rounding="low_x < x0 < high_x and low_x < x1 < high_x")
 """:data:`NEWTON_SYSTEM_LOOP` for two unknowns measured as they are (every four-bar), on
 scalars: the same operations in the same order, so the same iterates, status and counts
 (tests/test_compile.py), without the per-iteration lists and helper calls."""
+
+def newton_2x2_entry(signature: str, start: str, tail: str) -> Loop:
+    """:data:`NEWTON_2X2_LOOP` with its own ``signature``, ``start`` (source that sets F, Jf,
+    x0, x1 and Phi there p0, p1, in place of reading them from ``problem``, ``q0`` and
+    ``phi0``) and ``tail`` (source after the loop, in place of returning its result): the
+    same iterations, so the same iterates, status and counts, for a front door that judges
+    and packages them in the same call (:func:`linkage.solve.system.fast_newton`)."""
+    return NEWTON_2X2_LOOP._replace(signature=signature, setup=dedent(start) + _2X2_SETUP, tail=tail)
+
+
+def compile_newton_2x2_entry(loop: Loop, names: dict[str, Any]) -> Any:
+    """An entry (:func:`newton_2x2_entry`) compiled with ``names`` beside the loop's own."""
+    return build_loop(loop, {**_LOOP_NAMES, **names}, fixed_source=True)
+
 
 _LOOP_NAMES = {"_NewtonSystem": NewtonSystem, "_State": NewtonSystemState, "_max_abs": max_abs,
                "_direction": newton_direction, "_sumsq": _sumsq, "_EPS": EPS, "_invertible": invertible,

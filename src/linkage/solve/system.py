@@ -57,6 +57,18 @@ def solve_system(
     Returns a :class:`Result` with ``x`` (a tuple), ``nfev`` and ``njev``.
     """
     if method == "newton" and not record and fd_step is None:
+        ready = _ready
+        if (ready[0] is F and ready[1] is jac and ready[2] is tol and ready[3] is rtol and ready[4] is ftol
+                and ready[5] is max_iter and ready[6] is damped and (type(x0) is tuple or type(x0) is list)
+                and len(x0) == 2):
+            a, b = x0
+            if type(a) is float and type(b) is float and a - a == 0.0 and b - b == 0.0:
+                try:
+                    return ready[7](ready, a, b)  # type: ignore[no-any-return]
+                except (TypeError, IndexError, RecursionError):
+                    return solve_general(F, x0, jac=jac, method=method, tol=tol, rtol=rtol, ftol=ftol,
+                                         max_iter=max_iter, record=record, fd_step=fd_step, damped=damped,
+                                         show_jacobian=show_jacobian)
         fast = fast_newton(F, x0, jac, tol, rtol, ftol, max_iter, damped)
         if fast is not None:
             return fast
@@ -72,10 +84,13 @@ def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float 
                 damped: bool) -> Result | None:
     """Newton with recording off by a short front door, where one applies: user callables
     of two unknowns from a start of two finite floats, a tuple or a list (judged and packaged
-    here, a call less on a 6 us solve), or a compiled problem of two unknowns that converges
-    (:func:`_mechanism_two`); the same Result as the general path (tests/test_compile.py).
-    None for anything else, and where a user function returned the wrong kind of value:
-    the general path then runs and names it."""
+    in the loop's own call, :func:`user_two_entry`), or a compiled problem of two unknowns
+    that converges (:func:`_mechanism_two`); the same Result as the general path
+    (tests/test_compile.py). None for anything else, and where a user function returned the
+    wrong kind of value: the general path then runs and names it. User callables solved
+    with criteria of immutable values are remembered (:data:`_ready`): solving the same
+    functions at the same criteria again goes from :func:`solve_system` straight to the loop."""
+    global _ready
     seen = _recent.seen
     if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter:
         crit = seen[4]
@@ -85,24 +100,17 @@ def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float 
         if (jac is not None and (type(x0) is tuple or type(x0) is list) and len(x0) == 2
                 and type(x0[0]) is float and type(x0[1]) is float and x0[0] - x0[0] == 0.0
                 and x0[1] - x0[1] == 0.0 and callable(F)):
-            newton_2x2, max_abs, _, (names, kinds, _), _ = _two_loaded or _two_unknowns()
-            try:
-                phi0 = F(list(x0))
-            except (ArithmeticError, ValueError) as exc:
-                raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
-            real_vector("F", phi0, 2, "at x0")
-            if len(phi0) != 2:
-                raise InputError(f"the system has {len(phi0)} equations for 2 unknowns")
+            entry, (names, kinds, _), _, _ = _user_two or _user_two_entry()
             last = _last_two
             problem = last[2] if last[0] is F and last[1] is jac else user_two_problem(F, jac)
             c_tol, c_rtol, c_ftol, c_max = crit
             gate = c_ftol if c_ftol is not None else c_tol
-            q, phi, err, status, detail, iterations, nfev, njev = newton_2x2(
-                problem, x0, phi0, c_tol, c_rtol, gate, c_max, damped)
-            residual = max_abs(phi)
-            status, detail = system_verdict(status, detail, residual, gate)
-            return Result.fast("newton", tuple(q), status, iterations, nfev, err, residual, detail, njev,
-                               (user_two_meta, crit, gate, names, kinds))
+            meta = (user_two_meta, crit, gate, names, kinds)
+            ready = (F, jac, tol, rtol, ftol, max_iter, damped,
+                     entry, problem, c_tol, c_rtol, gate, c_max, meta)
+            if _recent.seen[4] is crit and (damped is True or damped is False):
+                _ready = ready
+            return entry(ready, x0[0], x0[1])  # type: ignore[no-any-return]
         SystemProblem = _system_solvers()[3]
         if (jac is None and type(F) is SystemProblem and len(F.names) == 2 and F.J is not None
                 and F.step_scales is None):
@@ -110,6 +118,77 @@ def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float 
     except (TypeError, IndexError, RecursionError):
         pass
     return None
+
+
+_ready: tuple[Any, ...] = (None,) * 14
+"""The user callables (F, jac), the criteria objects (tol, rtol, ftol, max_iter) and
+``damped`` :func:`fast_newton` last solved, then what it solved them with (the entry, the
+problem, the checked criteria, the gate, the raw meta): read by identity in
+:func:`solve_system`, which hands the whole record to the entry (three arguments, not nine);
+one assignment, so a reader sees all or none. Only criteria that
+:class:`~.criteria.RecentCriteria` remembers (floats, ints, None) and a bool ``damped``,
+which cannot change under the same identity."""
+
+USER_TWO_SIGNATURE = "newton_2x2_user(ready, x0, x1)"
+"""The entry takes :data:`_ready`'s record (or one like it) and the start."""
+
+USER_TWO_START = """\
+_, _, _, _, _, _, damped, _, problem, tol, rtol, gate, max_iter, meta = ready
+F, Jf = problem.F, problem.J
+try:
+    phi0 = F([x0, x1])
+except (ArithmeticError, ValueError) as exc:
+    raise _unevaluable(exc) from None
+if not (type(phi0) is list and len(phi0) == 2 and type(phi0[0]) is float and type(phi0[1]) is float):
+    _residual_checked(phi0, 2)
+p0, p1 = phi0
+"""
+"""The user entry's start: Phi at x0, checked as :func:`residual_at_start` checks it (a
+list of two floats passes on sight)."""
+
+USER_TWO_TAIL = """\
+if type(p0) is float and type(p1) is float:
+    a0 = p0 if p0 > 0.0 else 0.0 - p0
+    a1 = p1 if p1 > 0.0 else 0.0 - p1
+    residual = """ + "{larger}" + """
+else:
+    residual = _max_abs((p0, p1))
+# system_verdict leaves a converged step within the gate as it is: the common case, no call
+if status is not _S.CONVERGED_STEP or not residual <= gate:
+    status, detail = _verdict(status, detail, residual, gate)
+return _fast("newton", (x0, x1), status, k, nfev, err, residual, detail, njev, meta)
+"""
+"""The user entry's tail: max|Phi| at the end (:func:`~linkage.methods.newton_system.max_abs`,
+for two floats as its bits by ``larger_of``), :func:`system_verdict` and the Result, as
+:func:`_two_unknown_result` makes them."""
+
+_user_two: tuple[Any, ...] = ()
+"""What :func:`_user_two_entry` built, read as a module global on the hot path."""
+
+
+def _user_two_entry() -> tuple[Any, ...]:
+    """The entry for user callables of two unknowns (Newton's two-unknown loop judged and
+    packaged in its own call), the generic labels of two unknowns and what
+    :func:`user_two_problem` builds with, made and imported once."""
+    global _user_two
+    if not _user_two:
+        from ..methods.newton_system import compile_newton_2x2_entry, max_abs
+        from ..problems.system import LeanProblem, generic_labels, generic_system
+
+        entry = compile_newton_2x2_entry(user_two_loop(), {
+            "_unevaluable": unevaluable_start, "_residual_checked": residual_checked,
+            "_verdict": system_verdict, "_fast": Result.fast, "_max_abs": max_abs})
+        _user_two = (entry, generic_labels(2), LeanProblem, generic_system)
+    return _user_two
+
+
+def user_two_loop() -> Any:
+    """The loop of the entry for user callables of two unknowns (a
+    :class:`~linkage.iterate.Loop`): Newton's two-unknown loop, its start and tail these."""
+    from ..methods.newton_system import larger_of, newton_2x2_entry
+
+    return newton_2x2_entry(USER_TWO_SIGNATURE, USER_TWO_START,
+                            USER_TWO_TAIL.replace("{larger}", larger_of("a0", "a1")))
 
 
 @names_bad_callables
@@ -198,11 +277,21 @@ def residual_at_start(problem: Any, q0: tuple[float, ...]) -> Any:
     try:
         phi0 = problem.F(list(q0))
     except (ArithmeticError, ValueError) as exc:
-        raise InputError(f"the residual cannot be evaluated at x0: {exc}") from None
-    real_vector("F", phi0, problem.n, "at x0")
-    if len(phi0) != problem.n:
-        raise InputError(f"the system has {len(phi0)} equations for {problem.n} unknowns")
+        raise unevaluable_start(exc) from None
+    residual_checked(phi0, problem.n)
     return phi0
+
+
+def unevaluable_start(exc: BaseException) -> InputError:
+    """The error for a residual that raised ``exc`` at x0."""
+    return InputError(f"the residual cannot be evaluated at x0: {exc}")
+
+
+def residual_checked(phi0: Any, n: int) -> None:
+    """InputError unless ``phi0``, Phi at x0, is a sequence of n real numbers."""
+    real_vector("F", phi0, n, "at x0")
+    if len(phi0) != n:
+        raise InputError(f"the system has {len(phi0)} equations for {n} unknowns")
 
 
 def packaged(m: Any, problem: Any, crit: Criteria, gate: float, outcome: tuple[Any, ...], rows: Any,
@@ -253,9 +342,8 @@ def _two_unknowns() -> tuple[Any, ...]:
     global _two_loaded
     if not _two_loaded:
         from ..methods.newton_system import max_abs, newton_2x2
-        from ..problems.system import LeanProblem, generic_labels, generic_system
 
-        _two_loaded = (newton_2x2, max_abs, LeanProblem, generic_labels(2), generic_system)
+        _two_loaded = (newton_2x2, max_abs)
     return _two_loaded
 
 
@@ -298,7 +386,8 @@ def user_two_problem(F: Callable[..., Any], jac: Callable[..., Any]) -> Any:
     """The problem :func:`fast_newton` hands user callables of two unknowns to: none built
     unless a step is refused; kept, so the same functions solved again reuse it."""
     global _last_two
-    _, _, LeanProblem, _, generic_system = _two_loaded
+    _, _, LeanProblem, generic_system = _user_two  # loaded by fast_newton before it calls this
+
     problem = LeanProblem(F, jac, None, lambda: generic_system(F, 2, jac))
     _last_two = (F, jac, problem)
     return problem
