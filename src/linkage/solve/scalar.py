@@ -104,10 +104,17 @@ def solve_scalar(
                                "f returned a non-real value")
     except (ArithmeticError, ValueError) as exc:
         return failed_at_start(m.name, problem, args[0], crit, record, start, *explain(exc))
-    # a g (or f') that returns something other than a number fails inside the loop: name it
+    return finish_guarded(m, problem, state, crit, record, start, args[0])
+
+
+def finish_guarded(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: bool,
+                   start: dict[str, Any], x0: float) -> Result:
+    """:func:`finish`, where a g (or f') that returns something other than a number, failing
+    inside the loop, is named (:func:`diagnose_scalar`). Its own function: the closures it
+    makes would otherwise be cells that :func:`solve_scalar`'s every call, the fast path's
+    included, allocates on entry."""
     return guarded(lambda: finish(m, problem, state, crit, record, start),
-                   lambda: diagnose_scalar(problem, args[0],
-                                           lambda p: finish(m, p, state, crit, record, start)))
+                   lambda: diagnose_scalar(problem, x0, lambda p: finish(m, p, state, crit, record, start)))
 
 
 def starting_points(entry: MethodEntry, problem: ScalarProblem, x0: Any, x1: Any,
