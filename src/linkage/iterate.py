@@ -282,10 +282,11 @@ def scalar_quiet_path(out: _Emitter) -> None:
     ``0 < |f| < best``: |f| finite, not zero (tests 2-4) and below the best seen, which it
     becomes (a step that does not improve |f| takes the tests, which give the same state);
     the error above rounding (test 7): implied by ``|x| < xcap``, where ``xcap`` is
-    ``qtol / ROUNDING`` (exact, ROUNDING being a power of two, so ``ROUNDING * |x| <= qtol <
-    err``), else compared as test 7 does. A value that does not compare as a real number (a
-    complex f) raises TypeError here and takes the tests, which name it; so any real number
-    type takes the same path as a float would.
+    ``qtol / ROUNDING`` (exact: ROUNDING and its inverse, by which the preamble multiplies,
+    are powers of two; so ``ROUNDING * |x| <= qtol < err``), else compared as test 7 does.
+    A value that does not compare as a real number (a complex f) raises TypeError here and
+    takes the tests, which name it; so any real number type takes the same path as a float
+    would.
 
     Written as one ``and`` of single comparisons, no chain and no negated bound: CPython
     3.11 specialises a float comparison only where a jump follows it (a chain's middle
@@ -417,7 +418,7 @@ def quiet_flag(loop: Loop) -> list[str]:
     allowed = f"{_QUIET_FTOL if loop.residual_test else ''}not rtol"
     lines = [f"    qtol = tol if {allowed} else _inf"]
     if takes_scalar_quiet_path(loop):  # |x| below which test 7 cannot fire (scalar_quiet_path)
-        lines += ["    xcap = qtol / _ROUNDING", "    nxcap = -xcap"]
+        lines += ["    xcap = qtol * _PER_ROUNDING", "    nxcap = -xcap"]
     return lines
 
 
@@ -504,7 +505,8 @@ def build_loop(loop: Loop, names: dict[str, Any] | None = None, *,
         "_S": STATUS_MEMBERS, "_inf": math.inf, "_nan": math.nan, "_isfinite": math.isfinite,
         "_explain": explain, "_judge": judge_certificate, "_stall": rounding_stall,
         "_worse": worse_than_seen, "_step_limit": step_limit, "_system_converged": system_converged,
-        "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_BIG": sys.float_info.max, "_RUNAWAY": RUNAWAY,
+        "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_PER_ROUNDING": 1.0 / ROUNDING,
+        "_BIG": sys.float_info.max, "_RUNAWAY": RUNAWAY,
         **(names or {})}
     name = loop.signature.split("(", 1)[0]
     exec(compiled(loop_source(loop), f"<linkage-loop {name}>", fixed_source), namespace)

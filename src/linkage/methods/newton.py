@@ -138,9 +138,7 @@ def newton_loop(record: bool) -> Loop:
             fx1 = f(x1)
             """),
         after=_join("""\
-            err = x1 - x
-            if err < 0.0:
-                err = -err
+            err = x1 - x if x1 >= x else x - x1  # |x1 - x| (the same bits), no second float
             """, """\
             if k <= _HEAD:
                 append((k, x, fx, d, x1, err))
