@@ -271,3 +271,26 @@ def test_newtons_quiet_path_takes_any_real_number_type_as_the_generic_loop_does(
             r = newton_result(problem, x0, crit)
             assert (r.status, r.detail, r.iterations) == (status, detail, k), (x0, tol)
             assert _bits((r.x, r.residual, r.error)) == _bits((final.x, final.fx, final.err)), (x0, tol)
+
+
+def test_newtons_quiet_path_bound_on_x_is_exact_about_rounding():
+    """The quiet path reads test 7 (rounding) from |x| < tol / ROUNDING, exact only because
+    ROUNDING is a power of two; roots on both sides of that bound (where the path compares
+    as test 7 does instead) end where the generic loop does, bit for bit."""
+    from linkage.iterate import ROUNDING
+
+    assert math.frexp(ROUNDING)[0] == 0.5
+    m = method_class("newton")()
+    for tol in (1e-16, 1e-14, 1e-12):
+        cap = tol / ROUNDING
+        for scale in (0.25, 0.999, 1.0, 1.001, 4.0, -1.0, -4.0):
+            root = scale * cap
+            problem = ScalarProblem(lambda x, r=root: (x - r) * (x + 0.5 * r) + 1e-3 * math.sin(x),
+                                    fprime=lambda x, r=root: 2.0 * x - 0.5 * r + 1e-3 * math.cos(x))
+            x0 = root * 1.3 + 0.7
+            crit = Criteria(tol, 0.0, None, 80)
+            final, status, detail, k, _ = run(m, problem, m.init(problem, x0), crit, record=False,
+                                              certify=_certify(problem))
+            r = newton_result(problem, x0, crit)
+            assert (r.status, r.detail, r.iterations) == (status, detail, k), (tol, scale)
+            assert _bits((r.x, r.residual, r.error)) == _bits((final.x, final.fx, final.err)), (tol, scale)

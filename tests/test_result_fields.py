@@ -62,3 +62,21 @@ def test_an_ordinary_result_holds_its_own_fields():
     r = Result("newton", 1.0, Status.CONVERGED_STEP, 1, 3, 0.0, 0.0, meta={"tol": 1.0})
     assert r.meta == {"tol": 1.0} and r.history is None
     assert Result("newton", 1.0, Status.CONVERGED_STEP, 1, 3, 0.0, 0.0).meta is None
+
+
+def test_the_statements_of_fast_source_make_what_result_fast_makes():
+    """A generated loop builds its Result from fast_source's statements instead of calling
+    Result.fast: the same type, the same namespace (raw fields included), equal fields."""
+    from linkage.result import FAST_NAMES, Status, fast_source
+
+    for detail, history in (("", None), ("why", None), ("", "(tuple, ())")):
+        lines = fast_source('"newton"', "1.5", "_status", "3", "7", "1e-9", "2e-17", "detail",
+                            "(dict, ())", history)
+        namespace = {**FAST_NAMES, "_status": Status.CONVERGED_STEP}
+        exec("def build(detail):\n" + "".join(f"    {line}\n" for line in lines), namespace)
+        made = namespace["build"](detail)
+        fast = Result.fast("newton", 1.5, Status.CONVERGED_STEP, 3, 7, 1e-9, 2e-17, detail, 0, (dict, ()),
+                           None if history is None else (tuple, ()))
+        assert type(made) is type(fast) is Result
+        assert vars(made) == vars(fast)
+        assert made == fast and made.meta == fast.meta == {} and made.history == fast.history

@@ -58,7 +58,8 @@ RUNAWAY = 1e8
 """For systems, growing steps are divergence only once |q| exceeds this times 1 + |q0|."""
 
 ROUNDING = 4.0 * sys.float_info.epsilon
-"""Relative size of a step that is indistinguishable from rounding noise."""
+"""Relative size of a step that is indistinguishable from rounding noise (a power of two:
+:func:`scalar_quiet_path` divides by it exactly)."""
 
 MAX_ITER_LIMIT = 100_000
 """The largest iteration cap accepted: a run that has not converged by then never will."""
@@ -286,20 +287,28 @@ def takes_scalar_quiet_path(loop: Loop) -> bool:
 
 
 def scalar_quiet_path(out: _Emitter) -> None:
-    """:func:`quiet_path` for an open scalar method (Newton), in one chained condition of
-    comparisons only, each a test that cannot fire: the error above ``qtol`` (``tol``
-    where the path is allowed, else infinity, so the flag costs nothing per step) and not
-    above the previous one (test 6; ``prev_err`` starts at the largest float, so this
-    also says the error is finite); ``-best < f < best``: |f| finite and below the best
-    seen, which it becomes (a step that does not improve |f| takes the tests, which give
-    the same state); f not zero (tests 3-4); ``-err < rounding * x < err``, the error
-    above rounding, which also says x is finite (test 7). A value that does not compare
-    as a real number (a complex f) raises TypeError here and takes the tests, which name
-    it. So any real number type takes the same path as a float would."""
+    """:func:`quiet_path` for an open scalar method (Newton): comparisons only, each a test
+    that cannot fire: the error above ``qtol`` (``tol`` where the path is allowed, else
+    infinity, so the flag costs nothing per step) and not above the previous one (test 6;
+    ``prev_err`` starts at the largest float, so this also says the error is finite);
+    ``0 < |f| < best``: |f| finite, not zero (tests 2-4) and below the best seen, which it
+    becomes (a step that does not improve |f| takes the tests, which give the same state);
+    the error above rounding (test 7): implied by ``|x| < xcap``, where ``xcap`` is
+    ``qtol / ROUNDING`` (exact: ROUNDING and its inverse, by which the preamble multiplies,
+    are powers of two; so ``ROUNDING * |x| <= qtol < err``), else compared as test 7 does.
+    A value that does not compare as a real number (a complex f) raises TypeError here and
+    takes the tests, which name it; so any real number type takes the same path as a float
+    would.
+
+    Written as one ``and`` of single comparisons, no chain and no negated bound: CPython
+    3.11 specialises a float comparison only where a jump follows it (a chain's middle
+    comparison is generic), and ``-err`` or ``ROUNDING * x`` would make a float per step."""
     put = out.put
     put(0, "try:")
-    put(1, "if qtol < err <= prev_err and -best < fx < best and fx != 0.0 and -err < _ROUNDING * x < err:")
-    put(2, "best = fx if fx >= 0.0 else -fx")
+    put(1, "size = fx if fx >= 0.0 else -fx")
+    put(1, "if (err > qtol and err <= prev_err and size < best and size > 0.0")
+    put(1, "        and (x < xcap and x > nxcap or err > _ROUNDING * (x if x >= 0.0 else -x))):")
+    put(2, "best = size")
     put(2, "growth = 0")
     put(2, "prev_err = err")
     put(2, "continue")
@@ -419,7 +428,10 @@ def quiet_flag(loop: Loop) -> list[str]:
     """The preamble's line that allows the quiet path: without ``rtol`` and a residual
     test's ``ftol``, as the threshold ``qtol`` of :func:`quiet_path`."""
     allowed = f"{_QUIET_FTOL if loop.residual_test else ''}not rtol"
-    return [f"    qtol = tol if {allowed} else _inf"]
+    lines = [f"    qtol = tol if {allowed} else _inf"]
+    if takes_scalar_quiet_path(loop):  # |x| below which test 7 cannot fire (scalar_quiet_path)
+        lines += ["    xcap = qtol * _PER_ROUNDING", "    nxcap = -xcap"]
+    return lines
 
 
 def loop_source(loop: Loop) -> str:
@@ -505,7 +517,8 @@ def build_loop(loop: Loop, names: dict[str, Any] | None = None, *,
         "_S": STATUS_MEMBERS, "_inf": math.inf, "_nan": math.nan, "_isfinite": math.isfinite,
         "_explain": explain, "_judge": judge_certificate, "_stall": rounding_stall,
         "_worse": worse_than_seen, "_step_limit": step_limit,
-        "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_BIG": sys.float_info.max, "_RUNAWAY": RUNAWAY,
+        "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_PER_ROUNDING": 1.0 / ROUNDING,
+        "_BIG": sys.float_info.max, "_RUNAWAY": RUNAWAY,
         **(names or {})}
     name = loop.signature.split("(", 1)[0]
     exec(compiled(loop_source(loop), f"<linkage-loop {name}>", fixed_source), namespace)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 from enum import Enum
-from types import SimpleNamespace
 from typing import Any, NamedTuple
 
 from .errors import NotConvergedError
@@ -39,10 +38,21 @@ class Status(Enum):
         return _MESSAGES[self]
 
 
-STATUS_MEMBERS = SimpleNamespace(**Status.__members__)
+class StatusMembers:
+    """The statuses as the attributes of a plain instance (:data:`STATUS_MEMBERS`)."""
+
+    def __init__(self) -> None:
+        for name, member in Status.__members__.items():
+            setattr(self, name, member)
+
+
+STATUS_MEMBERS = StatusMembers()
 """The statuses as plain attributes, for the hot paths (the generated loops read them as
 ``_S.MAX_ITER``): the same members, read as an instance attribute (about 10 ns) where an
-Enum class attribute costs about 150 ns on Python 3.11, several times per solve."""
+Enum class attribute costs about 150 ns on Python 3.11, several times per solve. An instance
+of a class of its own, not a ``SimpleNamespace``, whose attributes CPython 3.11 reads by
+the generic lookup every time (it specialises attribute reads for instances of classes
+defined in Python only)."""
 
 _CONVERGED = frozenset({Status.CONVERGED_STEP, Status.CONVERGED_RESIDUAL, Status.CONVERGED_EXACT})
 
@@ -252,9 +262,29 @@ _setattr = object.__setattr__
 
 
 class ResultBuilder:
-    """A :class:`Result` under construction by :meth:`Result.fast`: an object of Result's
-    layout (a namespace, weak references) whose attributes are set as plain stores, and
-    whose class is then set to Result. Nothing else makes or holds one."""
+    """A :class:`Result` under construction by :meth:`Result.fast` (or :func:`fast_source`):
+    an object of Result's layout (a namespace, weak references) whose attributes are set as
+    plain stores, and whose class is then set to Result. Nothing else makes or holds one."""
+
+
+FAST_NAMES = {"_new_result": _new, "_ResultBuilder": ResultBuilder, "_Result": Result}
+"""The names :func:`fast_source`'s statements read."""
+
+
+def fast_source(method: str, x: str, status: str, iterations: str, nfev: str, error: str, residual: str,
+                detail: str, meta: str, history: str | None = None) -> list[str]:
+    """Statements (unindented source lines) that return what :meth:`Result.fast` returns for
+    these expressions with ``njev`` 0 (``detail`` read twice: no side effects; ``history``
+    None when not kept): for a generated loop, which so builds its Result in its own frame instead of
+    calling ``fast`` with eleven arguments (tests/test_result_fields.py holds the two equal)."""
+    lines = ["_r = _new_result(_ResultBuilder)"]
+    lines += [f"_r.{name} = {value}" for name, value in (
+        ("method", method), ("x", x), ("status", status), ("iterations", iterations), ("nfev", nfev),
+        ("error", error), ("residual", residual), ("raw_meta", meta))]
+    lines += [f"if {detail}:", f"    _r.detail = {detail}"]
+    if history is not None:
+        lines.append(f"_r.raw_history = {history}")
+    return [*lines, "_r.__class__ = _Result", "return _r"]
 
 Raw = tuple
 """A field kept raw: ``(builder, *arguments)``, the value being ``builder(*arguments)``."""

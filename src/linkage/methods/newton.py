@@ -17,7 +17,7 @@ from typing import Any, ClassVar, NamedTuple
 from ..iterate import HISTORY_HEAD, Criteria, Loop, build_loop, dedent
 from ..problems.scalar import ScalarProblem
 from ..records import frozen
-from ..result import Column, Result, Status
+from ..result import FAST_NAMES, Column, Status, fast_source
 from .common import history_of, new_state, start_stop
 
 
@@ -82,13 +82,15 @@ def _join(*parts: str) -> str:
     return dedent("".join(part.rstrip(" ") for part in parts))
 
 
-def _packaged(record: bool, status: str, k: str, extra: str, err: str, detail: str) -> str:
-    """The loop's outcome as its Result (one expression for the start's verdict and the
-    loop's end): ``k`` steps, each two evaluations, after the start's one, and ``extra``
-    made by the certificate; meta and history kept raw (:meth:`Result.fast`)."""
-    history = "(_history, _method, problem, rows)" if record else "None"
-    return (f'_fast("newton", x, {status}, {k}, 1 + 2 * {k} + {extra}, {err}, fx, {detail}, 0, '
-            f'(_meta, problem, crit, x0), {history})')
+def _packaged(record: bool, status: str, k: str, extra: str, err: str, detail: str, indent: int) -> str:
+    """The loop's outcome as its Result (for the start's verdict and the loop's end),
+    returned, as lines at ``indent`` spaces: ``k`` steps, each two evaluations, after the
+    start's one, and ``extra`` made by the certificate; meta and history kept raw
+    (:func:`linkage.result.fast_source`, the statements of :meth:`Result.fast`)."""
+    history = "(_history, _method, problem, rows)" if record else None
+    lines = fast_source('"newton"', "x", status, k, f"1 + 2 * {k} + {extra}", err, "fx", detail,
+                        "(_meta, problem, crit, x0)", history)
+    return "".join(" " * indent + line + "\n" for line in lines)
 
 
 def newton_meta(problem: ScalarProblem, crit: Criteria, x0: float) -> dict[str, Any]:
@@ -115,7 +117,7 @@ def newton_loop(record: bool) -> Loop:
             if fx == 0.0 or fx - fx != 0.0:  # the start's verdict (_start_stop) can only be a stop
                 stop = _start_stop(problem, x0, fx)
                 if stop is not None:
-            """, " " * 20 + "return " + _packaged(record, "stop[0]", "0", "0", "_inf", "stop[1]") + "\n", """\
+            """, _packaged(record, "stop[0]", "0", "0", "_inf", "stop[1]", 20), """\
             if isinstance(fx, float):
                 best = start = abs(fx)
             else:  # the guard's start (test 5); best as the largest float: a finite bound
@@ -136,9 +138,7 @@ def newton_loop(record: bool) -> Loop:
             fx1 = f(x1)
             """),
         after=_join("""\
-            err = x1 - x
-            if err < 0.0:
-                err = -err
+            err = x1 - x if x1 >= x else x - x1  # |x1 - x| (the same bits), no second float
             """, """\
             if k <= _HEAD:
                 append((k, x, fx, d, x1, err))
@@ -147,7 +147,7 @@ def newton_loop(record: bool) -> Loop:
             """ if record else "", """\
             x, fx = x1, fx1
             """),
-        tail="return " + _packaged(record, "status", "k", "extra", "err", "detail") + "\n",
+        tail=_packaged(record, "status", "k", "extra", "err", "detail", 0),
         guard=True, step_test="certify", counted=True, diverge="streak", quiet=True)
 
 
@@ -160,8 +160,8 @@ rows)`` returns the solve's :class:`~linkage.result.Result` (its meta and histor
 first read); ``certify(problem, x, fx, width)`` decides a small step
 (:func:`linkage.solve.certify_root`)."""
 
-_NAMES = {"_start_stop": start_stop, "_fast": Result.fast, "_meta": newton_meta, "_history": history_of,
-          "_method": Newton()}
+_NAMES = {"_start_stop": start_stop, "_meta": newton_meta, "_history": history_of, "_method": Newton(),
+          **FAST_NAMES}
 newton_lean = build_loop(NEWTON_LOOP, {**_NAMES, "_HEAD": HISTORY_HEAD}, fixed_source=True)
 
 NEWTON_QUIET_LOOP = newton_loop(record=False)

@@ -80,6 +80,15 @@ def solve_scalar(
         if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter:
             return newton_result(f, x0, seen[4], record)
         return newton_result(f, x0, _recent.check(tol, rtol, ftol, max_iter), record)
+    return solve_checked(f, method, x0, x1, bracket, fprime, g, tol, rtol, ftol, max_iter, record)
+
+
+def solve_checked(f: Callable[[float], float] | ScalarProblem, method: str, x0: Any, x1: Any, bracket: Any,
+                  fprime: Any, g: Any, tol: float, rtol: float, ftol: float | None, max_iter: int,
+                  record: bool) -> Result:
+    """:func:`solve_scalar`'s general front door: every argument checked, then the method
+    run. Its own function: the fast path's frame then holds only the arguments (a frame's
+    every local is set up and cleared on each call)."""
     entry = METHODS.get(method)
     if entry is None:
         raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")
@@ -104,10 +113,17 @@ def solve_scalar(
                                "f returned a non-real value")
     except (ArithmeticError, ValueError) as exc:
         return failed_at_start(m.name, problem, args[0], crit, record, start, *explain(exc))
-    # a g (or f') that returns something other than a number fails inside the loop: name it
+    return finish_guarded(m, problem, state, crit, record, start, args[0])
+
+
+def finish_guarded(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: bool,
+                   start: dict[str, Any], x0: float) -> Result:
+    """:func:`finish`, where a g (or f') that returns something other than a number, failing
+    inside the loop, is named (:func:`diagnose_scalar`). Its own function: the closures it
+    makes would otherwise be cells that :func:`solve_scalar`'s every call, the fast path's
+    included, allocates on entry."""
     return guarded(lambda: finish(m, problem, state, crit, record, start),
-                   lambda: diagnose_scalar(problem, args[0],
-                                           lambda p: finish(m, p, state, crit, record, start)))
+                   lambda: diagnose_scalar(problem, x0, lambda p: finish(m, p, state, crit, record, start)))
 
 
 def starting_points(entry: MethodEntry, problem: ScalarProblem, x0: Any, x1: Any,
