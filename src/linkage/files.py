@@ -253,6 +253,17 @@ def atomic_target(path: Path) -> Iterator[str]:
         raise
 
 
+def keep_quietly(path: str, data: bytes) -> None:
+    """Write a cache file (kept bytecode) whole or not at all, through :func:`atomic_target`
+    (a reader never sees half a file); quietly: a cache that cannot be written is no error."""
+    try:
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with atomic_target(Path(path)) as part, open(part, "wb") as out:
+            out.write(data)
+    except (OSError, OutputError):
+        return
+
+
 def temporary_beside(real: str) -> str:
     """A new empty file beside ``real``, made by this call (``.name.XXXXXXXX.part.suffix``,
     mode 0600), as ``tempfile.mkstemp`` makes it: without tempfile's import (random and

@@ -477,6 +477,8 @@ def compiled(source: str, filename: str, fixed_source: bool) -> CodeType:
     import marshal
     import zlib
 
+    from .files import keep_quietly
+
     path = os.path.join(LOOP_CACHE, f"loop-{zlib.crc32(source.encode()):08x}-{len(source):x}.{tag}.marshal")
     try:
         with open(path, "rb") as kept:
@@ -488,24 +490,8 @@ def compiled(source: str, filename: str, fixed_source: bool) -> CodeType:
         pass
     code = compile(source, filename, "exec")
     if not sys.dont_write_bytecode:
-        keep(path, marshal.dumps((source, filename, code)))
+        keep_quietly(path, marshal.dumps((source, filename, code)))
     return code
-
-
-def keep(path: str, data: bytes) -> None:
-    """Write ``data`` to ``path`` whole or not at all (:func:`linkage.files.atomic_target`:
-    a reader never sees half a file); quietly: a cache that cannot be written is no error."""
-    from pathlib import Path
-
-    from .errors import OutputError
-    from .files import atomic_target
-
-    try:
-        os.makedirs(os.path.dirname(path), exist_ok=True)
-        with atomic_target(Path(path)) as part, open(part, "wb") as out:
-            out.write(data)
-    except (OSError, OutputError):
-        return
 
 
 def build_loop(loop: Loop, names: dict[str, Any] | None = None, *,

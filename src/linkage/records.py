@@ -129,20 +129,12 @@ def save() -> None:
     if sys.dont_write_bytecode:
         return
     import marshal
-    from pathlib import Path
 
-    from .errors import OutputError
-    from .files import atomic_target
+    from .files import keep_quietly
 
     with _LOCK:
         todo = [(store_path(m), marshal.dumps(_codes[m])) for m in sorted(_added)]
         _added.clear()
     for path, data in todo:
-        if path is None:
-            continue
-        try:
-            os.makedirs(os.path.dirname(path), exist_ok=True)
-            with atomic_target(Path(path)) as part, open(part, "wb") as out:
-                out.write(data)
-        except (OSError, OutputError):
-            continue
+        if path is not None:
+            keep_quietly(path, data)
