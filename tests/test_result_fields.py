@@ -80,3 +80,21 @@ def test_the_statements_of_fast_source_make_what_result_fast_makes():
         assert type(made) is type(fast) is Result
         assert vars(made) == vars(fast)
         assert made == fast and made.meta == fast.meta == {} and made.history == fast.history
+
+
+def test_fast_source_with_njev_makes_what_result_fast_makes():
+    """The system loops' Result (with Jacobian evaluations, or none) from fast_source's
+    statements: the namespace of Result.fast's, njev stored only where it is not 0."""
+    from linkage.result import FAST_NAMES, Status, fast_source
+
+    for detail, njev in (("", 0), ("", 4), ("why", 2)):
+        lines = fast_source('"newton"', "(1.5, 2.5)", "_status", "3", "7", "1e-9", "2e-17", "detail",
+                            "(dict, ())", None, "njev")
+        namespace = {**FAST_NAMES, "_status": Status.CONVERGED_STEP}
+        exec("def build(detail, njev):\n" + "".join(f"    {line}\n" for line in lines), namespace)
+        made = namespace["build"](detail, njev)
+        fast = Result.fast("newton", (1.5, 2.5), Status.CONVERGED_STEP, 3, 7, 1e-9, 2e-17, detail, njev,
+                           (dict, ()))
+        assert type(made) is type(fast) is Result
+        assert vars(made) == vars(fast)
+        assert made == fast and made.njev == fast.njev == njev

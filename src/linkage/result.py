@@ -272,16 +272,19 @@ FAST_NAMES = {"_new_result": _new, "_ResultBuilder": ResultBuilder, "_Result": R
 
 
 def fast_source(method: str, x: str, status: str, iterations: str, nfev: str, error: str, residual: str,
-                detail: str, meta: str, history: str | None = None) -> list[str]:
+                detail: str, meta: str, history: str | None = None, njev: str | None = None) -> list[str]:
     """Statements (unindented source lines) that return what :meth:`Result.fast` returns for
-    these expressions with ``njev`` 0 (``detail`` read twice: no side effects; ``history``
-    None when not kept): for a generated loop, which so builds its Result in its own frame instead of
-    calling ``fast`` with eleven arguments (tests/test_result_fields.py holds the two equal)."""
+    these expressions (``detail`` and ``njev`` read twice: no side effects; ``history``
+    None when not kept, ``njev`` None for 0): for a generated loop, which so builds its Result in its
+    own frame instead of calling ``fast`` with eleven arguments (tests/test_result_fields.py holds
+    the two equal)."""
     lines = ["_r = _new_result(_ResultBuilder)"]
     lines += [f"_r.{name} = {value}" for name, value in (
         ("method", method), ("x", x), ("status", status), ("iterations", iterations), ("nfev", nfev),
         ("error", error), ("residual", residual), ("raw_meta", meta))]
     lines += [f"if {detail}:", f"    _r.detail = {detail}"]
+    if njev is not None:
+        lines += [f"if {njev}:", f"    _r.njev = {njev}"]
     if history is not None:
         lines.append(f"_r.raw_history = {history}")
     return [*lines, "_r.__class__ = _Result", "return _r"]

@@ -12,7 +12,7 @@ from typing import Any
 from ..arguments import check_callable, check_number, check_reals, real_vector
 from ..errors import InputError
 from ..iterate import Criteria, run
-from ..result import History, Raw, Result, Status, given
+from ..result import FAST_NAMES, History, Raw, Result, Status, fast_source, given
 from ..rules import residual_gate
 from .criteria import MAX_RELATIVE_TOL, RecentCriteria, check_criteria
 from .diagnose import names_bad_callables
@@ -156,11 +156,12 @@ else:
 # system_verdict leaves a converged step within the gate as it is: the common case, no call
 if status is not _S.CONVERGED_STEP or not residual <= gate:
     status, detail = _verdict(status, detail, residual, gate)
-return _fast("newton", (x0, x1), status, k, nfev, err, residual, detail, njev, meta)
-"""
+""" + "\n".join(fast_source('"newton"', "(x0, x1)", "status", "k", "nfev", "err", "residual", "detail",
+                            "meta", None, "njev")) + "\n"
 """The user entry's tail: max|Phi| at the end (:func:`~linkage.methods.newton_system.max_abs`,
 for two floats as its bits by ``larger_of``), :func:`system_verdict` and the Result, as
-:func:`_two_unknown_result` makes them."""
+:func:`_two_unknown_result` makes them (built in the entry's frame, :func:`~linkage.result.fast_source`:
+the statements of :meth:`Result.fast`)."""
 
 _user_two: tuple[Any, ...] = ()
 """What :func:`_user_two_entry` built, read as a module global on the hot path."""
@@ -177,7 +178,7 @@ def _user_two_entry() -> tuple[Any, ...]:
 
         entry = compile_newton_2x2_entry(user_two_loop(), {
             "_unevaluable": unevaluable_start, "_residual_checked": residual_checked,
-            "_verdict": system_verdict, "_fast": Result.fast, "_max_abs": max_abs})
+            "_verdict": system_verdict, "_max_abs": max_abs, **FAST_NAMES})
         _user_two = (entry, generic_labels(2), LeanProblem, generic_system)
     return _user_two
 
