@@ -254,16 +254,21 @@ def quiet_path(out: _Emitter) -> None:
     ``< inf``; f (a system's max|Phi|) finite and not zero (tests 2-4); the error above
     rounding (test 7). A value that does not compare as a real number (a complex f, a
     missing residual) raises TypeError here and takes the tests, which name it; any real
-    number type takes the path a float would, with the same state after it."""
+    number type takes the path a float would, with the same state after it.
+
+    Written as one ``and`` of single comparisons, no chain (``qtol < err <= prev_err``):
+    CPython 3.11 specialises a float comparison only where a jump follows it, so a chain's
+    comparisons are generic (:func:`scalar_quiet_path`; ``err > qtol`` is ``qtol < err``
+    reflected, the same verdict for every real number type)."""
     loop, put = out.loop, out.put
     if takes_scalar_quiet_path(loop):
         scalar_quiet_path(out)
         return
     finite_err = "err <= prev_err" if loop.diverge else "err < _inf"
     put(0, "try:")
-    residual = loop.quiet_residual or "-_inf < fx < _inf and fx != 0.0"
+    residual = loop.quiet_residual or QUIET_RESIDUAL
     rounding = loop.quiet_rounding or f"err > _ROUNDING * {loop.magnitude}"
-    put(1, f"if qtol < {finite_err} and {residual} and {rounding}:")
+    put(1, f"if err > qtol and {finite_err} and {residual} and {rounding}:")
     if loop.guard:
         put(2, "size = fx if fx >= 0.0 else -fx")
         put(2, "if size < best:")
@@ -277,6 +282,10 @@ def quiet_path(out: _Emitter) -> None:
     put(2, "continue")
     put(0, "except TypeError:")
     put(1, "pass")
+
+
+QUIET_RESIDUAL = "fx > -_inf and fx < _inf and fx != 0.0"
+"""The quiet path's default test that f is finite and not zero."""
 
 
 def takes_scalar_quiet_path(loop: Loop) -> bool:

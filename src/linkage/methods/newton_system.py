@@ -21,7 +21,7 @@ import operator
 import sys
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import Loop, build_loop, dedent, indent
+from ..iterate import QUIET_RESIDUAL, Loop, build_loop, dedent, indent
 from ..linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve, pivot_ratio
 from ..problems.system import SystemProblem
 from ..records import frozen
@@ -516,11 +516,12 @@ st = f0 * f0 + f1 * f1
     magnitude="size_q", quiet=True,
     # damped: the old phi's sum of squares finite and positive says max|Phi| is (it may be
     # finite and positive where the sum under- or overflows: the tests then decide)
-    quiet_residual="(0.0 < fs < _inf if damped else -_inf < fx < _inf and fx != 0.0)",
+    quiet_residual=f"(fs > 0.0 and fs < _inf if damped else {QUIET_RESIDUAL})",
     # |x0|, |x1| below tol / _ROUNDING, with err above tol (qtol), says err > _ROUNDING max(|x0|, |x1|):
     # _ROUNDING is a power of two, so _ROUNDING * (tol / _ROUNDING) is tol exactly, and rounding
     # is monotonic (it may fail where the rounding test passes: the tests then decide)
-    quiet_rounding="low_x < x0 < high_x and low_x < x1 < high_x")
+    # (single comparisons, no chains: iterate.quiet_path says why)
+    quiet_rounding="x0 > low_x and x0 < high_x and x1 > low_x and x1 < high_x")
 """:data:`NEWTON_SYSTEM_LOOP` for two unknowns measured as they are (every four-bar), on
 scalars: the same operations in the same order, so the same iterates, status and counts
 (tests/test_compile.py), without the per-iteration lists and helper calls."""
