@@ -457,6 +457,15 @@ _2X2_SETUP = dedent("""\
     low_x = -high_x
     """)
 
+_2X2_REFUSED = _FALLBACK.format(q="(x0, x1)", phi="(p0, p1)", stopped=_2X2_STOPPED) + """\
+d0, d1 = s.dq
+t0, t1 = s.x
+f0, f1 = s.phi_x
+st = f0 * f0 + f1 * f1
+"""
+"""A refused step in the two-unknown loops (a singular J, or a whole step that does not
+lower |Phi|): :meth:`NewtonSystem.step` decides, and the loop goes on from its step."""
+
 NEWTON_2X2_LOOP = Loop(
     signature="newton_2x2(problem, q0, phi0, tol, rtol, gate, max_iter, damped)",
     setup=_2X2_START + _2X2_SETUP,
@@ -468,14 +477,13 @@ NEWTON_2X2_LOOP = Loop(
         ad = a * d
         bc = b * c
         det = ad - bc
-        refused = True
+        # a refused step written in both places it is refused: no flag set and tested each step
         if """ + invertible_source(
             "det", "(ad if ad > 0.0 else 0.0 - ad) + (bc if bc > 0.0 else 0.0 - bc)") + """:
             d0, d1 = (b * p1 - d * p0) / det, (c * p0 - a * p1) / det
             t0, t1 = x0 + d0, x1 + d1
             f0, f1 = F([t0, t1])
             nfev += 1
-            refused = False
             if damped:
                 st = f0 * f0 + f1 * f1
                 if not st <= shrink * ss:
@@ -484,15 +492,8 @@ NEWTON_2X2_LOOP = Loop(
                     e0, e1 = abs(x0), abs(x1)
                     q_size = """ + larger_of("e0", "e1") + """
                     if not step_size <= tiny * (1.0 + q_size):
-                        refused = True  # the whole step does not lower |Phi|: the method decides
-                        nfev -= 1
-        if refused:
-        """) + indent(_FALLBACK.format(q="(x0, x1)", phi="(p0, p1)", stopped=_2X2_STOPPED) + """\
-d0, d1 = s.dq
-t0, t1 = s.x
-f0, f1 = s.phi_x
-st = f0 * f0 + f1 * f1
-"""),
+                        nfev -= 1  # the whole step does not lower |Phi|: the method decides
+        """) + indent(indent(indent(indent(_2X2_REFUSED)))) + "else:\n" + indent(_2X2_REFUSED),
     after="""\
         e0 = d0 if d0 > 0.0 else 0.0 - d0
         e1 = d1 if d1 > 0.0 else 0.0 - d1
