@@ -147,3 +147,27 @@ def test_the_generated_system_convergence_test_is_the_rule() -> None:
     cases += [tuple(rng.choice((1e-12, rng.uniform(0.0, 2e-12))) for _ in range(4)) for _ in range(2_000)]
     for err, fx, limit, gate in cases:
         assert bool(inline(err, fx, limit, gate)) == system_converged(err, fx, limit, gate), (err, fx, limit)
+
+
+def test_the_two_by_two_singularity_test_is_the_rules_verdict() -> None:
+    """invertible_2x2_source (a finite det where ad and bc have opposite signs, else the
+    rule's source) gives rules.invertible(det, |ad| + |bc|)'s verdict: every product of
+    special values, and random ones of every sign and of wide exponents (overflow,
+    underflow and cancellation included)."""
+    from linkage.methods.newton_system import invertible_2x2_source
+    from linkage.rules import invertible
+
+    test = eval(f"lambda ad, bc, det: {invertible_2x2_source('ad', 'bc', 'det')}", {"_inf": math.inf})
+    rng = random.Random(11)
+    pairs = [(u, v) for u in SPECIAL for v in SPECIAL]
+    for _ in range(20000):
+        u = rng.choice((-1.0, 1.0)) * rng.random() * 10.0 ** rng.randint(-320, 308)
+        v = u * (1.0 + rng.choice((0.0, 1e-13, 1e-12, 1e-11, 1e-3, -1.0, -2.0))) if rng.random() < 0.3 \
+            else rng.choice((-1.0, 1.0)) * rng.random() * 10.0 ** rng.randint(-320, 308)
+        pairs.append((u, v))
+    opposite = 0
+    for ad, bc in pairs:
+        det = ad - bc
+        assert test(ad, bc, det) is invertible(det, abs(ad) + abs(bc)), (ad, bc)
+        opposite += ad * bc < 0.0
+    assert opposite > 5000

@@ -52,6 +52,21 @@ def larger_of(u: str, v: str) -> str:
     return f"({u} if {u} >= {v} else {v} if {v} >= {u} else _nan)"
 
 
+def invertible_2x2_source(ad: str, bc: str, det: str) -> str:
+    """Source of :func:`~linkage.rules.invertible` for a 2x2 J, ``invertible(det, |ad| + |bc|)``
+    with ``det`` = ``ad - bc`` (three names): where ``ad`` and ``bc`` have opposite signs,
+    ``|det|`` is ``fl(|ad| + |bc|)`` itself (rounding is symmetric in sign), which is above
+    SINGULAR_RATIO times itself exactly when it is finite (and it is above 0): the rule's verdict is
+    then "det is finite", two or three comparisons and no float made (the rule's own form
+    makes up to five); any other case (and an infinite det) takes the rule's own source
+    (:func:`~linkage.rules.invertible_source`). A four-bar's ``ad`` and ``bc`` have opposite
+    signs wherever the sines of theta3 and theta4 do, or their cosines do (the bench's case);
+    tests/test_newton_system_loops.py holds the verdicts to the rule's."""
+    size = f"({ad} if {ad} > 0.0 else 0.0 - {ad}) + ({bc} if {bc} > 0.0 else 0.0 - {bc})"
+    return (f"({ad} < 0.0 and {bc} > 0.0 and {det} > -_inf or {ad} > 0.0 and {bc} < 0.0 and {det} < _inf"
+            f" or {invertible_source(det, size)})")
+
+
 def fd_jacobian(problem: SystemProblem, q: list[float], phi: list[float],
                 h: float | None) -> list[list[float]]:
     """Forward differences, one coordinate at a time; columns as in the course notes
@@ -478,8 +493,7 @@ NEWTON_2X2_LOOP = Loop(
         bc = b * c
         det = ad - bc
         # a refused step written in both places it is refused: no flag set and tested each step
-        if """ + invertible_source(
-            "det", "(ad if ad > 0.0 else 0.0 - ad) + (bc if bc > 0.0 else 0.0 - bc)") + """:
+        if """ + invertible_2x2_source("ad", "bc", "det") + """:
             d0, d1 = (b * p1 - d * p0) / det, (c * p0 - a * p1) / det
             t0, t1 = x0 + d0, x1 + d1
             f0, f1 = F([t0, t1])
