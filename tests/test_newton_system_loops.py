@@ -157,7 +157,8 @@ def test_the_two_by_two_singularity_test_is_the_rules_verdict() -> None:
     from linkage.methods.newton_system import invertible_2x2_source
     from linkage.rules import invertible
 
-    test = eval(f"lambda ad, bc, det: {invertible_2x2_source('ad', 'bc', 'det')}", {"_inf": math.inf})
+    test = eval(f"lambda ad, bc, det: {invertible_2x2_source('ad', 'bc', 'det')}",
+                {"_inf": math.inf, "_ninf": -math.inf})
     rng = random.Random(11)
     pairs = [(u, v) for u in SPECIAL for v in SPECIAL]
     for _ in range(20000):

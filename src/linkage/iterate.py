@@ -284,8 +284,9 @@ def quiet_path(out: _Emitter) -> None:
     put(1, "pass")
 
 
-QUIET_RESIDUAL = "fx > -_inf and fx < _inf and fx != 0.0"
-"""The quiet path's default test that f is finite and not zero."""
+QUIET_RESIDUAL = "fx > _ninf and fx < _inf and fx != 0.0"
+"""The quiet path's default test that f is finite and not zero (``_ninf``, not ``-_inf``,
+which would negate, making a float, at every test)."""
 
 
 def takes_scalar_quiet_path(loop: Loop) -> bool:
@@ -509,9 +510,9 @@ def build_loop(loop: Loop, names: dict[str, Any] | None = None, *,
     ``fixed_source``: the loop's source depends only on this package's code, and its
     bytecode may be kept between runs (:func:`compiled`)."""
     namespace: dict[str, Any] = {
-        "_S": STATUS_MEMBERS, "_inf": math.inf, "_nan": math.nan, "_isfinite": math.isfinite,
-        "_explain": explain, "_judge": judge_certificate, "_stall": rounding_stall,
-        "_worse": worse_than_seen, "_step_limit": step_limit,
+        "_S": STATUS_MEMBERS, "_inf": math.inf, "_ninf": -math.inf, "_nan": math.nan,
+        "_isfinite": math.isfinite, "_explain": explain, "_judge": judge_certificate,
+        "_stall": rounding_stall, "_worse": worse_than_seen, "_step_limit": step_limit,
         "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_PER_ROUNDING": 1.0 / ROUNDING,
         "_BIG": sys.float_info.max, "_RUNAWAY": RUNAWAY,
         **(names or {})}

@@ -58,12 +58,13 @@ def invertible_2x2_source(ad: str, bc: str, det: str) -> str:
     ``|det|`` is ``fl(|ad| + |bc|)`` itself (rounding is symmetric in sign), which is above
     SINGULAR_RATIO times itself exactly when it is finite (and it is above 0): the rule's verdict is
     then "det is finite", two or three comparisons and no float made (the rule's own form
-    makes up to five); any other case (and an infinite det) takes the rule's own source
+    makes up to five; ``_ninf`` is minus infinity, :func:`~linkage.iterate.build_loop`'s name);
+    any other case (and an infinite det) takes the rule's own source
     (:func:`~linkage.rules.invertible_source`). A four-bar's ``ad`` and ``bc`` have opposite
     signs wherever the sines of theta3 and theta4 do, or their cosines do (the bench's case);
     tests/test_newton_system_loops.py holds the verdicts to the rule's."""
     size = f"({ad} if {ad} > 0.0 else 0.0 - {ad}) + ({bc} if {bc} > 0.0 else 0.0 - {bc})"
-    return (f"({ad} < 0.0 and {bc} > 0.0 and {det} > -_inf or {ad} > 0.0 and {bc} < 0.0 and {det} < _inf"
+    return (f"({ad} < 0.0 and {bc} > 0.0 and {det} > _ninf or {ad} > 0.0 and {bc} < 0.0 and {det} < _inf"
             f" or {invertible_source(det, size)})")
 
 
