@@ -233,7 +233,7 @@ def test_every_generated_loop_carries_the_one_ordered_rule():
     from linkage.solve.system import user_two_loop
 
     loops = (NEWTON_LOOP, SECANT_LOOP, FIXED_POINT_LOOP, BISECTION_LOOP, NEWTON_SYSTEM_LOOP, NEWTON_2X2_LOOP,
-             user_two_loop())
+             user_two_loop(True), user_two_loop(False))
     for loop in loops:
         rule = "\n".join(stopping_tests(loop))
         assert rule in loop_source(loop)

@@ -551,6 +551,28 @@ def newton_2x2_entry(signature: str, start: str, tail: str) -> Loop:
     return NEWTON_2X2_LOOP._replace(signature=signature, setup=dedent(start) + _2X2_SETUP, tail=tail)
 
 
+def with_damping(loop: Loop, damped: bool) -> Loop:
+    """``loop`` (an entry, :func:`newton_2x2_entry`, whose start does not read ``damped``) for
+    one value of ``damped``: the name written as the constant it is, so the compiler drops
+    the branches it rules out instead of the loop testing it at every step. A loop that tests
+    its truth only (every test here is ``if damped``, ``if not damped`` or ``x if damped else
+    y``; :class:`NewtonSystem` too) takes the same branches, so the same iterations."""
+    import re
+
+    word = "True" if damped else "False"
+
+    def written(text: str) -> str:  # the code of each line, not its comment
+        lines = []
+        for line in text.split("\n"):
+            code, mark, comment = line.partition("  #") if "  #" in line else line.partition("#") \
+                if line.lstrip().startswith("#") else (line, "", "")
+            lines.append(re.sub(r"\bdamped\b", word, code) + mark + comment)
+        return "\n".join(lines)
+
+    fields = ("setup", "step", "after", "late", "tail", "quiet_residual", "diverge_when")
+    return loop._replace(**{name: written(getattr(loop, name)) for name in fields})
+
+
 def compile_newton_2x2_entry(loop: Loop, names: dict[str, Any]) -> Any:
     """An entry (:func:`newton_2x2_entry`) compiled with ``names`` beside the loop's own."""
     return build_loop(loop, {**_LOOP_NAMES, **names}, fixed_source=True)

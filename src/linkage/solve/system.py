@@ -100,7 +100,9 @@ def fast_newton(F: Any, x0: Any, jac: Any, tol: float, rtol: float, ftol: float 
         if (jac is not None and (type(x0) is tuple or type(x0) is list) and len(x0) == 2
                 and type(x0[0]) is float and type(x0[1]) is float and x0[0] - x0[0] == 0.0
                 and x0[1] - x0[1] == 0.0 and callable(F)):
-            entry, (names, kinds, _), _, _ = _user_two or _user_two_entry()
+            entries, (names, kinds, _), _, _ = _user_two or _user_two_entry()
+            on = 1 if damped else 0  # the entry for damped's truth (user_two_loop)
+            entry = entries[on] or user_two_compiled(on)
             last = _last_two
             problem = last[2] if last[0] is F and last[1] is jac else user_two_problem(F, jac)
             c_tol, c_rtol, c_ftol, c_max = crit
@@ -130,10 +132,11 @@ one assignment, so a reader sees all or none. Only criteria that
 which cannot change under the same identity."""
 
 USER_TWO_SIGNATURE = "newton_2x2_user(ready, x0, x1)"
-"""The entry takes :data:`_ready`'s record (or one like it) and the start."""
+"""The entry takes :data:`_ready`'s record (or one like it) and the start; ``damped`` is
+its own (:func:`user_two_loop`), not read from the record."""
 
 USER_TWO_START = """\
-_, _, _, _, _, _, damped, _, problem, tol, rtol, gate, max_iter, meta = ready
+_, _, _, _, _, _, _, _, problem, tol, rtol, gate, max_iter, meta = ready
 F, Jf = problem.F, problem.J
 try:
     phi0 = F([x0, x1])
@@ -168,28 +171,38 @@ _user_two: tuple[Any, ...] = ()
 
 
 def _user_two_entry() -> tuple[Any, ...]:
-    """The entry for user callables of two unknowns (Newton's two-unknown loop judged and
-    packaged in its own call), the generic labels of two unknowns and what
-    :func:`user_two_problem` builds with, made and imported once."""
+    """The entries for user callables of two unknowns (Newton's two-unknown loop judged and
+    packaged in its own call; one for each truth of ``damped``, compiled on its first use by
+    :func:`user_two_compiled`), the generic labels of two unknowns and what
+    :func:`user_two_problem` builds with, imported once."""
     global _user_two
     if not _user_two:
-        from ..methods.newton_system import compile_newton_2x2_entry, max_abs
         from ..problems.system import LeanProblem, generic_labels, generic_system
 
-        entry = compile_newton_2x2_entry(user_two_loop(), {
-            "_unevaluable": unevaluable_start, "_residual_checked": residual_checked,
-            "_verdict": system_verdict, "_max_abs": max_abs, **FAST_NAMES})
-        _user_two = (entry, generic_labels(2), LeanProblem, generic_system)
+        _user_two = ([None, None], generic_labels(2), LeanProblem, generic_system)
     return _user_two
 
 
-def user_two_loop() -> Any:
-    """The loop of the entry for user callables of two unknowns (a
-    :class:`~linkage.iterate.Loop`): Newton's two-unknown loop, its start and tail these."""
-    from ..methods.newton_system import larger_of, newton_2x2_entry
+def user_two_compiled(on: int) -> Any:
+    """The entry for user callables of two unknowns with ``damped`` true (``on`` 1) or false
+    (0), compiled and kept in :data:`_user_two`."""
+    from ..methods.newton_system import compile_newton_2x2_entry, max_abs
 
-    return newton_2x2_entry(USER_TWO_SIGNATURE, USER_TWO_START,
-                            USER_TWO_TAIL.replace("{larger}", larger_of("a0", "a1")))
+    entry = compile_newton_2x2_entry(user_two_loop(bool(on)), {
+        "_unevaluable": unevaluable_start, "_residual_checked": residual_checked,
+        "_verdict": system_verdict, "_max_abs": max_abs, **FAST_NAMES})
+    (_user_two or _user_two_entry())[0][on] = entry
+    return entry
+
+
+def user_two_loop(damped: bool) -> Any:
+    """The loop of the entry for user callables of two unknowns (a
+    :class:`~linkage.iterate.Loop`): Newton's two-unknown loop, its start and tail these,
+    ``damped`` written in (:func:`~linkage.methods.newton_system.with_damping`)."""
+    from ..methods.newton_system import larger_of, newton_2x2_entry, with_damping
+
+    return with_damping(newton_2x2_entry(USER_TWO_SIGNATURE, USER_TWO_START,
+                                         USER_TWO_TAIL.replace("{larger}", larger_of("a0", "a1"))), damped)
 
 
 @names_bad_callables
