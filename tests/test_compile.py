@@ -254,6 +254,33 @@ def test_lean_system_newton_equals_the_generic_loop_on_the_stress_battery():
                   solve_system(s.F, s.start(factor), record=True, **kw), label)
 
 
+def test_the_user_two_unknown_entries_equal_the_generic_loop_from_anywhere():
+    """The entries for user callables of two unknowns, one compiled for each truth of
+    damped (solve.system.user_two_loop), against the generic loop (recording on, one
+    NewtonSystem.step a step): the same status, iterations, x, error, residual and counts
+    on four-bars from random starts (singular and refused steps included), and with damped
+    given as 1 and 0."""
+    from collections import Counter
+
+    from linkage import solve_system
+    from linkage.measure.stress_cases import fourbar_cases, fourbar_mechanism
+
+    rng = random.Random(12)
+    statuses: Counter = Counter()
+    for it in fourbar_cases(random.Random(13), 60):
+        p = fourbar_mechanism(it).problem()
+        for damped in (True, False, 1, 0):
+            x0 = (rng.uniform(-3.2, 3.2), rng.uniform(-3.2, 3.2))
+            kw = dict(jac=p.J, tol=1e-11, max_iter=40, damped=damped)
+            fast = solve_system(p.F, x0, record=False, **kw)
+            generic = solve_system(p.F, x0, record=True, **kw)
+            _same(fast, generic, (it["links"], x0, damped))
+            assert repr((fast.error, fast.residual, fast.nfev, fast.njev, fast.detail)) == \
+                repr((generic.error, generic.residual, generic.nfev, generic.njev, generic.detail)), x0
+            statuses[fast.status] += 1
+    assert len(statuses) >= 5, statuses  # converged, local minima, precision limits, the cap
+
+
 def seen(result: Any) -> dict[str, Any]:
     """A Result's fields as a reader sees them (a fast solve keeps some raw until read)."""
     return {name: getattr(result, name) for name in result.__dataclass_fields__}
