@@ -4,6 +4,7 @@ between runs (docs/performance.md, "Cold starts")."""
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import marshal
 import os
 import re
@@ -25,6 +26,8 @@ def store(tmp_path, monkeypatch):
     monkeypatch.setattr(records, "STORE", str(tmp_path))
     monkeypatch.setattr(records, "_codes", {})
     monkeypatch.setattr(records, "_added", set())
+    monkeypatch.setattr(records, "_used", {})
+    monkeypatch.setattr(records, "KEPT_MODULES", "")  # this test module's classes kept too
     monkeypatch.setattr(sys, "dont_write_bytecode", False)
     return tmp_path
 
@@ -171,3 +174,79 @@ def test_every_frozen_dataclass_of_the_package_is_made_by_records_frozen():
     offenders = [str(p.relative_to(src)) for p in sorted(src.rglob("*.py"))
                  if re.search(r"^@(dataclasses\.)?dataclass\(frozen=True\)", p.read_text(), re.M)]
     assert offenders == []
+
+
+def test_a_users_class_made_by_frozen_is_not_kept(store, monkeypatch):
+    monkeypatch.setattr(records, "KEPT_MODULES", "linkage.")
+    point, _ = _classes(records.frozen)
+    records.save()
+    assert point(1.0) == point(1.0, 0.0) and list(store.iterdir()) == []
+
+
+def test_an_edited_class_leaves_its_old_texts_at_the_next_write(store):
+    """The store holds the texts its last writing run used, not every text ever made."""
+    _classes(records.frozen)
+    records.save()
+    first = set(records._read(records.store_path(__name__)))
+    records._codes.clear()
+    records._used.clear()
+
+    @records.frozen
+    class Point:  # the same name, edited: one field more
+        x: float
+        y: float = 0.0
+        z: float = 0.0
+
+    records.save()
+    second = set(records._read(records.store_path(__name__)))
+    assert second and not (second - set(records._used[__name__])) and len(second) < len(first) + 6
+
+
+def test_the_store_follows_pycache_prefix(monkeypatch, tmp_path):
+    monkeypatch.setattr(sys, "pycache_prefix", str(tmp_path))
+    path = records.store_path("linkage.result")
+    assert path.startswith(str(tmp_path)) and path.endswith(".marshal")
+
+
+def test_a_dataclass_made_in_another_thread_meanwhile_is_as_ever(store):
+    """While frozen makes a class (its default read by dataclass blocks it there), another
+    thread's plain dataclass compiles as dataclasses compiles it: evaluated annotations,
+    not this module's string ones (records.py has the annotations future)."""
+    inside, release = threading.Event(), threading.Event()
+
+    class Slow:
+        def __get__(self, obj, owner):
+            inside.set()
+            release.wait(5)
+            return 0
+
+    out = {}
+
+    def user_thread():
+        inside.wait(5)
+        try:
+            @dataclasses.dataclass
+            class User:
+                x: int
+                y: float = 1.0
+
+            out["during"] = (User.__init__.__annotations__, str(inspect.signature(User)), inside.is_set())
+        finally:
+            release.set()
+
+    t = threading.Thread(target=user_thread)
+    t.start()
+
+    @records.frozen
+    class Pkg:
+        x: int = Slow()
+
+    t.join()
+
+    @dataclasses.dataclass
+    class User:
+        x: int
+        y: float = 1.0
+
+    assert out["during"] == (User.__init__.__annotations__, str(inspect.signature(User)), True)
+    assert "exec" not in dataclasses.__dict__

@@ -236,7 +236,7 @@ def check_reals(name: str, values: Any, length: int | None = None, labels: Seque
         if bad.size == 0:
             return arr if keep_array else arr.tolist()  # type: ignore[no-any-return]
         k = int(bad[0])
-        raise InputError(f"{name}[{labels[k] if labels else k}] must be finite, got {arr[k]!r}")
+        raise InputError(f"{name}[{labels[k] if labels else k}] must be finite, got {float(arr[k])!r}")
     out = []
     for k, v in enumerate(values):
         if type(v) is float and v - v == 0.0:

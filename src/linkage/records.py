@@ -13,10 +13,13 @@ very text; the file's name carries the interpreter's ``cache_tag``. Nothing else
 the same source runs through the same ``exec`` with the same namespaces, compiled with the
 flags ``dataclasses`` compiles it with (none inherited).
 
-Only the classes made through :func:`frozen`, in the thread making one, use the store:
+Only this package's classes made through :func:`frozen` (a module under ``linkage.``),
+in the thread making one, use the store:
 another thread's or a user's dataclasses compile as ever and are never written down, so
-the file holds at most this package's classes' methods. Nothing is written where Python
-writes no bytecode (``sys.dont_write_bytecode``) or the directory cannot be written; a
+the file holds at most this package's classes' methods, and only the texts its last
+writing run used (an edited class's old texts leave it). The directory is the package's
+``__pycache__``, or its place under ``sys.pycache_prefix`` where that is set. Nothing is
+written where Python writes no bytecode (``sys.dont_write_bytecode``) or the directory cannot be written; a
 damaged or foreign file is read as empty and replaced.
 """
 
@@ -32,7 +35,12 @@ from typing import Any, TypeVar
 
 T = TypeVar("T")
 
-STORE: str | None = os.path.join(os.path.dirname(__file__), "__pycache__")
+KEPT_MODULES = "linkage."
+"""The modules whose classes' methods are kept (a user's class made by :func:`frozen` is
+made as ever)."""
+
+_BESIDE = os.path.join(os.path.dirname(__file__), "__pycache__")
+STORE: str | None = _BESIDE
 """The directory of the kept file (beside the package's own bytecode); None: nowhere."""
 
 _STATE = threading.local()
@@ -51,7 +59,10 @@ def store_path(module: str) -> str | None:
     tag = sys.implementation.cache_tag
     if STORE is None or tag is None:
         return None
-    return os.path.join(STORE, f"dataclass-{module}.{tag}.marshal")
+    where = STORE
+    if sys.pycache_prefix and where == _BESIDE:  # where Python keeps this package's bytecode
+        where = os.path.join(sys.pycache_prefix, os.path.dirname(os.path.abspath(__file__)).lstrip(os.sep))
+    return os.path.join(where, f"dataclass-{module}.{tag}.marshal")
 
 
 def _read(path: str | None) -> dict[str, CodeType]:
@@ -74,6 +85,9 @@ _codes: dict[str, dict[str, CodeType]] = {}
 """Each module's kept codes, read when it first makes a class."""
 _added: set[str] = set()
 """The modules whose codes this run compiled (written at exit)."""
+_used: dict[str, dict[str, CodeType]] = {}
+"""Each module's codes this run read or compiled: what is written back, so a class's old
+texts (an edited source tree) leave the file at its next write instead of piling up."""
 
 
 def kept_code(module: str, source: str) -> CodeType:
@@ -84,6 +98,7 @@ def kept_code(module: str, source: str) -> CodeType:
         if codes is None:
             codes = _codes[module] = _read(store_path(module))
         code = codes.get(source)
+        _used.setdefault(module, {})
         if code is None:
             code = compile(source, "<string>", "exec", dont_inherit=True)
             codes[source] = code
@@ -92,15 +107,19 @@ def kept_code(module: str, source: str) -> CodeType:
 
                 atexit.register(save)  # the first run of a command writes its files once
             _added.add(module)
+        _used[module][source] = code
     return code
 
 
 def _exec(source: Any, globals: Any = None, locals: Any = None, /) -> None:
     """``exec`` as :mod:`dataclasses` calls it, through the kept codes while this thread
     makes a class through :func:`frozen` (any other call passes straight through)."""
-    module = getattr(_STATE, "making", None)
-    if module is not None and type(source) is str:
-        source = kept_code(module, source)
+    if type(source) is str:
+        module = getattr(_STATE, "making", None)
+        # another thread's class (or a user's) is compiled here too while the name is in
+        # place: as dataclasses compiles it, without this module's __future__ flags
+        source = kept_code(module, source) if module is not None else \
+            compile(source, "<string>", "exec", dont_inherit=True)
     builtins.exec(source, globals, locals)
 
 
@@ -112,7 +131,7 @@ def frozen(cls: type[T]) -> type[T]:
     with _MAKING:
         had = dataclasses.__dict__.get("exec", _ABSENT)
         dataclasses.exec = _exec  # type: ignore[attr-defined]  # the name dataclasses calls
-        _STATE.making = cls.__module__
+        _STATE.making = cls.__module__ if cls.__module__.startswith(KEPT_MODULES) else None
         try:
             return dataclasses.dataclass(frozen=True)(cls)
         finally:
@@ -133,7 +152,7 @@ def save() -> None:
     from .files import keep_quietly
 
     with _LOCK:
-        todo = [(store_path(m), marshal.dumps(_codes[m])) for m in sorted(_added)]
+        todo = [(store_path(m), marshal.dumps(_used[m])) for m in sorted(_added)]
         _added.clear()
     for path, data in todo:
         if path is not None:
