@@ -1,5 +1,5 @@
 """records.frozen: dataclass(frozen=True) with its generated methods' bytecode kept
-between runs (docs/performance.md, "Cold starts")."""
+between runs (docs/performance.md, "Dataclass methods kept between runs")."""
 
 from __future__ import annotations
 

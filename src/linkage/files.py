@@ -63,7 +63,7 @@ def check_toml_shape(text: str, where: str) -> None:
     if text.count(".") < MAX_TOML_KEY_PARTS and text.count("[") + text.count("{") <= MAX_TOML_NESTING:
         # too few dots and openers in the whole text for either refusal (each dot token and
         # each opener token is one such character): no tokenizer to compile, no pass (a
-        # command reading one small file, half a millisecond of a cold start)
+        # command reading one small file pays for neither)
         return
 
     def refuse(tok: re.Match[str], what: str) -> ParseError:

@@ -3,8 +3,8 @@ the bytecode of their generated methods kept between runs.
 
 Python 3.11's ``dataclass`` writes each class's ``__init__``, ``__repr__``, ``__eq__``,
 ``__hash__``, ``__setattr__`` and ``__delattr__`` as source text and compiles it on every
-import: about 0.5 ms a class, 5 ms of the 10 a cold ``linkage sweep`` creates (measured
-with ``dataclasses.exec`` timed; docs/performance.md, "Cold starts"). :func:`frozen` is
+import (a cold ``linkage sweep`` makes ten classes; what keeping them saves is measured in
+docs/performance.md, "Dataclass methods kept between runs"). :func:`frozen` is
 ``dataclass(frozen=True)`` whose compilations, while it makes the class, go through
 :func:`kept_code`: the code of a source this package's classes gave before, read back from
 one file in the package's ``__pycache__`` as Python keeps a module's bytecode. The source

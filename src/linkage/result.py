@@ -48,8 +48,8 @@ class StatusMembers:
 
 STATUS_MEMBERS = StatusMembers()
 """The statuses as plain attributes, for the hot paths (the generated loops read them as
-``_S.MAX_ITER``): the same members, read as an instance attribute (about 10 ns) where an
-Enum class attribute costs about 150 ns on Python 3.11, several times per solve. An instance
+``_S.MAX_ITER``): the same members, read as an instance attribute (a fast read) where an
+Enum class attribute is a slow lookup on Python 3.11, made several times per solve. An instance
 of a class of its own, not a ``SimpleNamespace``, whose attributes CPython 3.11 reads by
 the generic lookup every time (it specialises attribute reads for instances of classes
 defined in Python only)."""

@@ -513,7 +513,7 @@ NEWTON_2X2_LOOP = Loop(
         e0 = d0 if d0 > 0.0 else 0.0 - d0
         e1 = d1 if d1 > 0.0 else 0.0 - d1
         err = """ + larger_of("e0", "e1") + """
-        # one name at a time: six names in one assignment build and unpack a tuple (0.15 us a solve)
+        # one name at a time: six names in one assignment build and unpack a tuple every step
         o0 = p0
         o1 = p1
         x0 = t0

@@ -409,8 +409,8 @@ def _control() -> re.Pattern[str]:
 def control_character(text: str) -> re.Match[str] | None:
     """The first of :data:`CONTROL_CHARACTERS` in ``text``, or None. Every one of them is
     a character ``str.isprintable`` refuses (Unicode's Cc and Cf), so printable text needs
-    no search, and the expression is compiled only when a text is not (0.4 ms of a cold
-    start otherwise)."""
+    no search, and the expression is compiled only when a text is not (a cold start that
+    reads a printable file compiles none)."""
     return None if text.isprintable() else _control().search(text)
 _PROSE = ("description", "notes", "note")
 """Keys whose text may have tabs and newlines."""

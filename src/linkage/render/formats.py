@@ -219,7 +219,7 @@ class ParquetSink(Sink):
 def widened(kind: str, values: Any) -> Any:
     """An integer column (a sweep's iterations, int32) as int64, the parquet field's type,
     widened by numpy where every value fits (the same numbers): pyarrow's own cast imports
-    pyarrow.compute, 0.04 to 0.08 s of a fresh process, for a copy numpy makes in 1 ms.
+    pyarrow.compute, a large import in a fresh process, for a copy numpy makes directly.
     Any other column as it is (pyarrow casts it, and refuses what does not fit)."""
     if kind != "int" or not is_array(values) or values.dtype.kind not in "iu":
         return values
