@@ -103,6 +103,7 @@ class Criteria(NamedTuple):
     max_iter: int = 100
 
 
+STEPS = range(1, Criteria().max_iter + 1)  # k = 1..max_iter at the default cap: the loops' one range
 Outcome = tuple  # (final state, Status, detail, iterations, Rows or None)
 
 
@@ -452,7 +453,7 @@ def loop_source(loop: Loop) -> str:
              "    prev_err = _BIG",
              "    growth = uncertified = stalls = rounding_steps = k = " + ("extra = " * loop.counted) + "0",
              *(quiet_flag(loop) if loop.quiet else []),
-             "    for k in range(1, max_iter + 1):",
+             "    for k in (_STEPS if max_iter is _CAP else range(1, max_iter + 1)):",  # no range made
              "        try:", *_block(loop.step, 3),
              "        except (ArithmeticError, ValueError) as exc:"]
     if loop.failure:
@@ -514,7 +515,7 @@ def build_loop(loop: Loop, names: dict[str, Any] | None = None, *,
         "_isfinite": math.isfinite, "_explain": explain, "_judge": judge_certificate,
         "_stall": rounding_stall, "_worse": worse_than_seen, "_step_limit": step_limit,
         "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_PER_ROUNDING": 1.0 / ROUNDING,
-        "_BIG": sys.float_info.max, "_RUNAWAY": RUNAWAY,
+        "_BIG": sys.float_info.max, "_RUNAWAY": RUNAWAY, "_STEPS": STEPS, "_CAP": STEPS[-1],
         **(names or {})}
     name = loop.signature.split("(", 1)[0]
     exec(compiled(loop_source(loop), f"<linkage-loop {name}>", fixed_source), namespace)

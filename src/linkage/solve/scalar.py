@@ -77,9 +77,14 @@ def solve_scalar(
         # derivative and a finite start (what the front door below checks, and then
         # the same call)
         seen = _recent.seen
-        if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter:
-            return newton_result(f, x0, seen[4], record)
-        return newton_result(f, x0, _recent.check(tol, rtol, ftol, max_iter), record)
+        crit = (seen[4] if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter
+                else _recent.check(tol, rtol, ftol, max_iter))
+        if record:
+            return newton_result(f, x0, crit, True)
+        try:  # newton_result's quiet loop, called here: one Python frame fewer a solve
+            return (_newton_loops or _load_newton_loops())[0](f, x0, crit, certify_root)
+        except (TypeError, ArithmeticError, ValueError) as exc:
+            return newton_failed(f, x0, crit, False, exc)
     return solve_checked(f, method, x0, x1, bracket, fprime, g, tol, rtol, ftol, max_iter, record)
 
 
@@ -188,11 +193,18 @@ def newton_result(problem: ScalarProblem, x0: float, crit: Criteria, record: boo
         if record:
             return (_newton_loops or _load_newton_loops())[1](problem, x0, crit, certify_root, Rows())
         return (_newton_loops or _load_newton_loops())[0](problem, x0, crit, certify_root)
-    except TypeError:  # the generic path's answer to a non-real f at the start
+    except (TypeError, ArithmeticError, ValueError) as exc:
+        return newton_failed(problem, x0, crit, record, exc)
+
+
+def newton_failed(problem: ScalarProblem, x0: float, crit: Criteria, record: bool, exc: Exception) -> Result:
+    """The Result of a Newton solve whose loop raised ``exc`` (a TypeError, ArithmeticError
+    or ValueError its own tests did not catch): what the generic path answers for a start
+    it cannot evaluate (a TypeError: a non-real f)."""
+    if isinstance(exc, TypeError):
         return failed_at_start("newton", problem, x0, crit, record, {"x0": x0}, Status.DOMAIN_ERROR,
                                "f returned a non-real value")
-    except (ArithmeticError, ValueError) as exc:
-        return failed_at_start("newton", problem, x0, crit, record, {"x0": x0}, *explain(exc))
+    return failed_at_start("newton", problem, x0, crit, record, {"x0": x0}, *explain(exc))
 
 
 def scalar_meta(problem: ScalarProblem, crit: Criteria, start: dict[str, Any]) -> dict[str, Any]:

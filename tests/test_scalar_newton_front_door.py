@@ -1,0 +1,81 @@
+"""Scalar Newton's short front door (solve/scalar.py, ``solve_scalar``'s first branch) and
+the loops' iteration range (iterate.py, ``STEPS``): the front door calls the quiet loop
+itself, so a function that fails there must get the Result :func:`newton_result` gives (the
+definition it stands in for), and a loop at the default cap must take every step."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from linkage import ScalarProblem, solve_scalar
+from linkage.iterate import STEPS, Criteria
+from linkage.result import Status
+from linkage.solve.criteria import check_criteria
+from linkage.solve.scalar import newton_result
+
+
+def _fields(r: object) -> tuple[str, ...]:
+    names = ("method", "x", "status", "iterations", "nfev", "error", "residual", "detail", "history",
+             "njev", "meta")
+    return tuple(repr(getattr(r, name)) for name in names)  # repr: nan equals nan, -0.0 is not 0.0
+
+
+def _log_at_start(x: float) -> float:
+    return math.log(x)  # ValueError at a negative start
+
+
+def _inverse_at_start(x: float) -> float:
+    return 1.0 / x  # ZeroDivisionError at 0
+
+
+def _complex_root(x: float) -> float:
+    return (x - 5.0) ** 0.5 - 1.0  # complex left of 5: the step's comparison raises TypeError
+
+
+def _to_infinity(x: float) -> float:
+    return math.exp(x) - 1e300  # a step to infinity: the loop names it (NON_FINITE)
+
+
+FAILING = [
+    ("ValueError at the start", ScalarProblem(_log_at_start, fprime=lambda x: 1.0 / x), -1.0),
+    ("ZeroDivisionError at the start", ScalarProblem(_inverse_at_start, fprime=lambda x: -1.0 / x**2), 0.0),
+    ("a complex f", ScalarProblem(_complex_root, fprime=lambda x: 1.0), 1.0),
+    ("a derivative that returns None", ScalarProblem(lambda x: x * x - 2.0, fprime=lambda x: None), 1.0),
+    ("a derivative that raises TypeError", ScalarProblem(lambda x: x * x - 2.0, fprime=lambda x: "2x"), 1.0),
+    ("an infinite step", ScalarProblem(_to_infinity, fprime=lambda x: 1e-300), 0.0),
+]
+
+
+@pytest.mark.parametrize(("case", "problem", "x0"), FAILING, ids=[c[0] for c in FAILING])
+def test_the_short_front_door_answers_a_failing_function_as_newton_result_does(case, problem, x0):
+    crit = check_criteria(1e-12, 0.0, None, 100)
+    for _ in range(2):  # the criteria checked, then remembered
+        fast = solve_scalar(problem, method="newton", x0=x0, tol=1e-12, record=False)
+        assert _fields(fast) == _fields(newton_result(problem, x0, crit, False)), case
+        assert not fast.converged
+
+
+def test_the_short_front_door_answers_a_good_function_as_newton_result_does():
+    problem = ScalarProblem(lambda x: x * x - 2.0, fprime=lambda x: 2.0 * x)
+    for tol, max_iter in ((1e-12, 100), (1e-9, 7), (1e-15, 3)):
+        crit = check_criteria(tol, 0.0, None, max_iter)
+        fast = solve_scalar(problem, method="newton", x0=1.0, tol=tol, max_iter=max_iter, record=False)
+        assert _fields(fast) == _fields(newton_result(problem, 1.0, crit, False))
+
+
+def _cycle(x: float) -> float:
+    return x**3 - 2.0 * x + 2.0  # Newton from 0 cycles 0, 1, 0, ... (methods/newton.py)
+
+
+@pytest.mark.parametrize("max_iter", [1, 99, 100, 101, 250])
+def test_a_loop_at_the_default_cap_takes_every_step(max_iter):
+    assert STEPS == range(1, Criteria().max_iter + 1)
+    for record in (False, True):
+        newton = solve_scalar(_cycle, method="newton", x0=0.0, fprime=lambda x: 3.0 * x * x - 2.0,
+                              max_iter=max_iter, record=record)
+        fixed = solve_scalar(_cycle, method="fixed-point", x0=1.0, g=lambda x: -x, max_iter=max_iter,
+                             record=record)
+        for r in (newton, fixed):
+            assert (r.status, r.iterations) == (Status.MAX_ITER, max_iter)
