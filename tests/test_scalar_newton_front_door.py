@@ -79,3 +79,32 @@ def test_a_loop_at_the_default_cap_takes_every_step(max_iter):
                              record=record)
         for r in (newton, fixed):
             assert (r.status, r.iterations) == (Status.MAX_ITER, max_iter)
+
+
+
+def _refuses_far(x: float) -> float:
+    if x > 50.0:
+        raise ValueError(f"no model beyond 50, got {x!r}")
+    return x * x - 4.0
+
+
+def _slope_refuses_far(x: float) -> float:
+    if x > 5.0:
+        raise ValueError(f"no slope beyond 5, got {x!r}")
+    return 2.0 * x
+
+
+def test_a_function_that_raises_mid_loop_leaves_the_last_point_as_the_recording_loop_does():
+    # the quiet loop writes f's value over fx; the recording loop keeps it apart (fx1)
+    cases = [(ScalarProblem(_refuses_far, fprime=lambda x: 2.0 * x), x0) for x0 in (0.01, 3.0)]
+    cases.append((ScalarProblem(lambda x: x * x - 4.0, fprime=_slope_refuses_far), 0.3))
+    for problem, x0 in cases:
+        quiet = solve_scalar(problem, method="newton", x0=x0, tol=1e-12, record=False)
+        recorded = solve_scalar(problem, method="newton", x0=x0, tol=1e-12, record=True)
+        assert _fields(quiet)[:8] == _fields(recorded)[:8]
+    at_start = solve_scalar(cases[0][0], method="newton", x0=0.01, record=False)
+    assert (at_start.status, at_start.x, at_start.residual) == (Status.DOMAIN_ERROR, 0.01, 0.01 * 0.01 - 4.0)
+    x1 = 0.3 - (0.3 * 0.3 - 4.0) / 0.6  # the slope refused at the first step's end, x1 > 5
+    after_one = solve_scalar(cases[2][0], method="newton", x0=0.3, record=False)
+    assert (after_one.status, after_one.iterations, after_one.x, after_one.residual) == (
+        Status.DOMAIN_ERROR, 1, x1, x1 * x1 - 4.0)

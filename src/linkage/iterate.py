@@ -449,7 +449,6 @@ def loop_source(loop: Loop) -> str:
     """The source of the function ``loop`` describes: its setup, then for k = 1..max_iter
     its step and the ordered stopping tests, then test 8 (the cap) and its result."""
     lines = [f"def {loop.signature}:", *_block(loop.setup, 1),
-             '    status, detail = _S.MAX_ITER, ""',
              "    prev_err = _BIG",
              "    growth = uncertified = stalls = rounding_steps = k = " + ("extra = " * loop.counted) + "0",
              *(quiet_flag(loop) if loop.quiet else []),
@@ -461,7 +460,8 @@ def loop_source(loop: Loop) -> str:
     else:
         lines += ["            status, detail = _explain(exc)", "            k -= 1", "            break"]
     lines += _block(loop.after, 2)
-    lines += stopping_tests(loop)
+    lines += [*stopping_tests(loop), "    else:  # test 8, the cap: every other stop breaks",
+              '        status, detail = _S.MAX_ITER, ""']
     lines += _block(loop.tail, 1) if loop.tail else [f"    return {loop.result}"]
     return "\n".join(lines) + "\n"
 

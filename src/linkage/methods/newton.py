@@ -135,7 +135,10 @@ def newton_loop(record: bool) -> Loop:
                 detail = f"f'({problem.var}) = 0 at {problem.var} = {x!r}, f = {fx:.6g}"
                 break
             x1 = x - fx / d
+            """, """\
             fx1 = f(x1)
+            """ if record else """\
+            fx = f(x1)  # its row is not kept: fx itself, left as it was if f raises
             """),
         after=_join("""\
             err = x1 - x if x1 >= x else x - x1  # |x1 - x| (the same bits), no second float
@@ -144,8 +147,9 @@ def newton_loop(record: bool) -> Loop:
                 append((k, x, fx, d, x1, err))
             else:
                 rows.add((k, x, fx, d, x1, err))
-            """ if record else "", """\
             x, fx = x1, fx1
+            """ if record else """\
+            x = x1
             """),
         tail=_packaged(record, "status", "k", "extra", "err", "detail", 0),
         guard=True, step_test="certify", counted=True, diverge="streak", quiet=True)

@@ -82,7 +82,7 @@ def solve_scalar(
         if record:
             return newton_result(f, x0, crit, True)
         try:  # newton_result's quiet loop, called here: one Python frame fewer a solve
-            return (_newton_loops or _load_newton_loops())[0](f, x0, crit, certify_root)
+            return (_newton_quiet or _load_newton_loops())(f, x0, crit, certify_root)
         except (TypeError, ArithmeticError, ValueError) as exc:
             return newton_failed(f, x0, crit, False, exc)
     return solve_checked(f, method, x0, x1, bracket, fprime, g, tol, rtol, ftol, max_iter, record)
@@ -172,27 +172,32 @@ def failed_at_start(name: str, problem: ScalarProblem, x: float, crit: Criteria,
                         "tol": crit.tol, "rtol": crit.rtol, **start})
 
 
-_newton_loops: Any = None
-"""(linkage.methods.newton.newton_quiet, newton_lean) once a scalar Newton solve has loaded
-them (a sweep or a system solve never does)."""
+_newton_quiet: Any = None
+"""linkage.methods.newton.newton_quiet once a scalar Newton solve has loaded it (a sweep or
+a system solve never does); ``newton_lean`` is then in :data:`_newton_lean`."""
+_newton_lean: Any = None
 
 
 def _load_newton_loops() -> Any:
-    global _newton_loops
+    """Both loops loaded (the recording one first: a reader that sees the quiet one sees it);
+    the quiet one returned."""
+    global _newton_quiet, _newton_lean
     from ..methods.newton import newton_lean, newton_quiet
 
-    _newton_loops = (newton_quiet, newton_lean)
-    return _newton_loops
+    _newton_lean = newton_lean
+    _newton_quiet = newton_quiet
+    return newton_quiet
 
 
 def newton_result(problem: ScalarProblem, x0: float, crit: Criteria, record: bool = False) -> Result:
     """Newton by its generated loop (:func:`~linkage.methods.newton.newton_lean`), which
     packages its outcome as :func:`finish` packages the generic loop's (history included
     when ``record``)."""
+    quiet = _newton_quiet or _load_newton_loops()
     try:
         if record:
-            return (_newton_loops or _load_newton_loops())[1](problem, x0, crit, certify_root, Rows())
-        return (_newton_loops or _load_newton_loops())[0](problem, x0, crit, certify_root)
+            return _newton_lean(problem, x0, crit, certify_root, Rows())
+        return quiet(problem, x0, crit, certify_root)
     except (TypeError, ArithmeticError, ValueError) as exc:
         return newton_failed(problem, x0, crit, record, exc)
 
