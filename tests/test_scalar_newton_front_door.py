@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from linkage import ScalarProblem, solve_scalar
@@ -58,11 +59,16 @@ def test_the_short_front_door_answers_a_failing_function_as_newton_result_does(c
 
 
 def test_the_short_front_door_answers_a_good_function_as_newton_result_does():
+    # the loop gets the criteria's values as a plain tuple, remembered or not (a numpy tolerance)
     problem = ScalarProblem(lambda x: x * x - 2.0, fprime=lambda x: 2.0 * x)
-    for tol, max_iter in ((1e-12, 100), (1e-9, 7), (1e-15, 3)):
-        crit = check_criteria(tol, 0.0, None, max_iter)
-        fast = solve_scalar(problem, method="newton", x0=1.0, tol=tol, max_iter=max_iter, record=False)
-        assert _fields(fast) == _fields(newton_result(problem, 1.0, crit, False))
+    cases = ((1e-12, None, 100), (1e-9, 1e-3, 7), (1e-15, None, 3), (np.float64(1e-10), None, 9))
+    for tol, ftol, max_iter in cases:
+        crit = check_criteria(tol, 0.0, ftol, max_iter)
+        for _ in range(2):
+            fast = solve_scalar(problem, method="newton", x0=1.0, tol=tol, ftol=ftol, max_iter=max_iter,
+                                record=False)
+            assert _fields(fast) == _fields(newton_result(problem, 1.0, crit, False))
+            assert fast.meta["tol"] == tol and fast.meta["ftol"] == ftol
 
 
 def _cycle(x: float) -> float:

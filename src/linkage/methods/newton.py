@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Any, ClassVar, NamedTuple
 
-from ..iterate import HISTORY_HEAD, Criteria, Loop, build_loop, dedent
+from ..iterate import HISTORY_HEAD, Loop, build_loop, dedent
 from ..problems.scalar import ScalarProblem
 from ..records import frozen
 from ..result import FAST_NAMES, Column, Status, fast_source
@@ -93,10 +93,11 @@ def _packaged(record: bool, status: str, k: str, extra: str, err: str, detail: s
     return "".join(" " * indent + line + "\n" for line in lines)
 
 
-def newton_meta(problem: ScalarProblem, crit: Criteria, x0: float) -> dict[str, Any]:
-    """A Newton solve's ``Result.meta``, built when first read."""
+def newton_meta(problem: ScalarProblem, crit: tuple[Any, ...], x0: float) -> dict[str, Any]:
+    """A Newton solve's ``Result.meta``, built when first read; ``crit`` the loop's: a
+    :class:`~linkage.iterate.Criteria` or its values as a plain tuple (read by position)."""
     return {"var": problem.var, "unit": problem.unit, "title": problem.title,
-            "tol": crit.tol, "rtol": crit.rtol, "ftol": crit.ftol, "x0": x0}
+            "tol": crit[0], "rtol": crit[1], "ftol": crit[2], "x0": x0}
 
 
 def newton_loop(record: bool) -> Loop:
@@ -161,7 +162,8 @@ step, without states or method dispatch; the generic loop's status, root, iterat
 and, into ``rows`` (an :class:`~linkage.iterate.Rows`), its table row for row
 (tests/test_compile.py, tests/test_kernel.py). ``newton_lean(problem, x0, crit, certify,
 rows)`` returns the solve's :class:`~linkage.result.Result` (its meta and history built when
-first read); ``certify(problem, x, fx, width)`` decides a small step
+first read); ``crit`` is a :class:`~linkage.iterate.Criteria` or its values as a plain tuple
+(which unpacks faster); ``certify(problem, x, fx, width)`` decides a small step
 (:func:`linkage.solve.certify_root`)."""
 
 _NAMES = {"_start_stop": start_stop, "_meta": newton_meta, "_history": history_of, "_method": Newton(),

@@ -50,18 +50,19 @@ class RecentCriteria:
     """One front door's criteria checked last, kept with the very objects they were checked
     from. A solve given the same objects again (a session's constants, the defaults) reads
     ``seen[4]`` after four identity tests, where the remembered check costs a hashed call
-    (about 0.15 us of a 3 us solve). Kept only for floats, ints and None, which cannot
-    change under the same identity."""
+    (about 0.15 us of a 3 us solve); ``seen[5]`` holds the same values as a plain tuple,
+    which a loop unpacks without the iterator a NamedTuple's unpacking makes. Kept only for
+    floats, ints and None, which cannot change under the same identity."""
 
     __slots__ = ("seen",)
 
     def __init__(self) -> None:
-        self.seen: tuple[Any, ...] = (None, None, None, None, None)
+        self.seen: tuple[Any, ...] = (None, None, None, None, None, None)
 
     def check(self, tol: float, rtol: float, ftol: float | None, max_iter: int) -> Criteria:
         """:func:`check_criteria`, remembering the values when they are immutable."""
         crit = check_criteria(tol, rtol, ftol, max_iter)
         if (type(tol) is float and type(rtol) is float and (ftol is None or type(ftol) is float)
                 and type(max_iter) is int):
-            self.seen = (tol, rtol, ftol, max_iter, crit)  # one assignment: a reader sees all or none
+            self.seen = (tol, rtol, ftol, max_iter, crit, tuple(crit))  # one assignment: all or none
         return crit

@@ -77,12 +77,15 @@ def solve_scalar(
         # derivative and a finite start (what the front door below checks, and then
         # the same call)
         seen = _recent.seen
-        crit = (seen[4] if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter
-                else _recent.check(tol, rtol, ftol, max_iter))
+        if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter:
+            crit, values = seen[4], seen[5]
+        else:
+            crit = _recent.check(tol, rtol, ftol, max_iter)
+            values = tuple(crit)
         if record:
             return newton_result(f, x0, crit, True)
-        try:  # newton_result's quiet loop, called here: one Python frame fewer a solve
-            return (_newton_quiet or _load_newton_loops())(f, x0, crit, certify_root)
+        try:  # newton_result's quiet loop, called here (one Python frame fewer), on crit's values
+            return (_newton_quiet or _load_newton_loops())(f, x0, values, certify_root)
         except (TypeError, ArithmeticError, ValueError) as exc:
             return newton_failed(f, x0, crit, False, exc)
     return solve_checked(f, method, x0, x1, bracket, fprime, g, tol, rtol, ftol, max_iter, record)
