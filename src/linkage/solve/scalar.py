@@ -71,24 +71,25 @@ def solve_scalar(
     >>> round(r.root, 12), r.status.value
     (1.414213562373, 'converged_step')
     """
-    if (method == "newton" and type(f) is ScalarProblem and fprime is None
+    if not (method == "newton" and type(f) is ScalarProblem and fprime is None
             and type(x0) is float and x0 - x0 == 0.0 and f.fprime is not None):
-        # the common case, without the general front door: a problem with its
-        # derivative and a finite start (what the front door below checks, and then
-        # the same call)
-        seen = _recent.seen
-        if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter:
-            crit, values = seen[4], seen[5]
-        else:
-            crit = _recent.check(tol, rtol, ftol, max_iter)
-            values = tuple(crit)
-        if record:
-            return newton_result(f, x0, crit, True)
-        try:  # newton_result's quiet loop, called here (one Python frame fewer), on crit's values
-            return (_newton_quiet or _load_newton_loops())(f, x0, values, certify_root)
-        except (TypeError, ArithmeticError, ValueError) as exc:
-            return newton_failed(f, x0, crit, False, exc)
-    return solve_checked(f, method, x0, x1, bracket, fprime, g, tol, rtol, ftol, max_iter, record)
+        # (the general front door first: its jumps are short, so CPython 3.11 specialises
+        # the comparisons before them, which a jump past the whole fast path prevents)
+        return solve_checked(f, method, x0, x1, bracket, fprime, g, tol, rtol, ftol, max_iter, record)
+    # the common case, without the general front door: a problem with its derivative and a
+    # finite start (what the general front door checks, and then the same call)
+    seen = _recent.seen
+    if seen[0] is tol and seen[1] is rtol and seen[2] is ftol and seen[3] is max_iter:
+        crit, values = seen[4], seen[5]
+    else:
+        crit = _recent.check(tol, rtol, ftol, max_iter)
+        values = tuple(crit)
+    if record:
+        return newton_result(f, x0, crit, True)
+    try:  # newton_result's quiet loop, called here (one Python frame fewer), on crit's values
+        return (_newton_quiet or _load_newton_loops())(f, x0, values, certify_root)
+    except (TypeError, ArithmeticError, ValueError) as exc:
+        return newton_failed(f, x0, crit, False, exc)
 
 
 def solve_checked(f: Callable[[float], float] | ScalarProblem, method: str, x0: Any, x1: Any, bracket: Any,
