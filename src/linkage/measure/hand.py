@@ -72,6 +72,62 @@ def fourbar_open(theta2: Any, r1: float, r2: float, r3: float, r4: float) -> tup
     return degrees(t3), degrees(t4)
 
 
+def fourbar_open_certified(theta2_deg: Sequence[float], r1: float, r2: float, r3: float, r4: float,
+                           tol: float, gate: float, margin_floor: float) -> tuple[Any, Any, Any, Any]:
+    """The floor of a sweep that keeps the single solve's promise, by hand: theta3, theta4
+    (deg), det J and whether each position is certified, for crank angles ``theta2_deg``
+    (deg, a list, as ``linkage.sweep`` takes them). The least such a sweep computes: the
+    values as an array, checked strictly ascending; :func:`fourbar_open`'s closed form; each
+    position's assembly margin, (h / d)^2, above ``margin_floor``; the evidence that each
+    answer is a root (Phi and J at the reported angles, the Newton step they imply, the step
+    within ``tol`` and max|Phi| within ``gate``); det J of one sign. No unwrapping,
+    anchoring, branch names or result object. Raises ValueError where a check fails."""
+    import numpy as np
+
+    from ..units import radians
+
+    d = np.asarray(theta2_deg, dtype=float)
+    if np.count_nonzero(np.diff(d) > 0.0) != d.size - 1:
+        raise ValueError("driver values not strictly ascending")
+    t2 = radians(d)
+    ax = np.cos(t2)
+    ax *= r2
+    ay = np.sin(t2)
+    ay *= r2
+    dx = ax - r1
+    d2 = dx * dx
+    d2 += ay * ay
+    a = d2 + (r4 * r4 - r3 * r3)
+    a /= 2.0 * d2
+    h = np.square(a)
+    np.subtract(r4 * r4 / d2, h, out=h)
+    if np.count_nonzero(h > margin_floor) != h.size:
+        raise ValueError("a position near a limit")
+    np.sqrt(h, out=h)
+    bx = a * dx
+    bx += h * ay
+    by = a * ay
+    by -= h * dx
+    t4 = np.arctan2(by, bx)
+    bx += r1 - ax
+    by -= ay
+    t3 = np.arctan2(by, bx)
+    c3, s3, c4, s4 = np.cos(t3), np.sin(t3), np.cos(t4), np.sin(t4)
+    px = ax + r3 * c3  # Phi at the reported angles
+    px -= r4 * c4
+    px -= r1
+    py = ay + r3 * s3
+    py -= r4 * s4
+    j11, j12, j21, j22 = -r3 * s3, r4 * s4, r3 * c3, -r4 * c4
+    det = j11 * j22
+    det -= j12 * j21
+    step = np.maximum(np.abs((j22 * px - j12 * py) / det), np.abs((j11 * py - j21 * px) / det))
+    certified = (step <= tol) & (np.maximum(np.abs(px), np.abs(py)) <= gate)
+    if not (np.count_nonzero(det > 0.0) == det.size or np.count_nonzero(det < 0.0) == det.size):
+        raise ValueError("det J changes sign")
+    return degrees(t3), degrees(t4), det, certified
+
+
 @frozen
 class DrawnFourbar:
     """A crank-rocker as sample_inputs/crank_rocker_joints.toml draws it (mm): O2 at the
