@@ -47,6 +47,14 @@ def fourbar_open(theta2: Any, r1: float, r2: float, r3: float, r4: float) -> tup
     r4 about O4, on the side where sin(theta4 - theta3) > 0 for a crank-rocker drawn as
     sample_inputs/crank_rocker.toml is (Norton, *Design of Machinery*, section 4.5: the open
     configuration). Written tight: in place where numpy allows, one temporary at a time."""
+    t3, t4, _, _ = fourbar_open_radians(theta2, r1, r2, r3, r4)
+    return degrees(t3), degrees(t4)
+
+
+def fourbar_open_radians(theta2: Any, r1: float, r2: float, r3: float, r4: float,
+                         margin_floor: float | None = None) -> tuple[Any, Any, Any, Any]:
+    """:func:`fourbar_open`'s work: theta3, theta4 (rad) and the crank pin A's x and y. With
+    ``margin_floor``, raises ValueError where a position's margin, (h / d)^2, is not above it."""
     import numpy as np
 
     ax = np.cos(theta2)
@@ -60,6 +68,8 @@ def fourbar_open(theta2: Any, r1: float, r2: float, r3: float, r4: float) -> tup
     a /= 2.0 * d2
     h = np.square(a)  # (h / d)^2 = (r4 / d)^2 - (a / d)^2
     np.subtract(r4 * r4 / d2, h, out=h)
+    if margin_floor is not None and np.count_nonzero(h > margin_floor) != h.size:
+        raise ValueError("a position near a limit")
     np.sqrt(h, out=h)
     bx = a * dx
     bx += h * ay  # B - O4 = a (A - O4) - h perp(A - O4), the open side
@@ -68,8 +78,7 @@ def fourbar_open(theta2: Any, r1: float, r2: float, r3: float, r4: float) -> tup
     t4 = np.arctan2(by, bx)
     bx += r1 - ax
     by -= ay
-    t3 = np.arctan2(by, bx)
-    return degrees(t3), degrees(t4)
+    return np.arctan2(by, bx), t4, ax, ay
 
 
 def fourbar_open_certified(theta2_deg: Sequence[float], r1: float, r2: float, r3: float, r4: float,
@@ -89,29 +98,7 @@ def fourbar_open_certified(theta2_deg: Sequence[float], r1: float, r2: float, r3
     d = np.asarray(theta2_deg, dtype=float)
     if np.count_nonzero(np.diff(d) > 0.0) != d.size - 1:
         raise ValueError("driver values not strictly ascending")
-    t2 = radians(d)
-    ax = np.cos(t2)
-    ax *= r2
-    ay = np.sin(t2)
-    ay *= r2
-    dx = ax - r1
-    d2 = dx * dx
-    d2 += ay * ay
-    a = d2 + (r4 * r4 - r3 * r3)
-    a /= 2.0 * d2
-    h = np.square(a)
-    np.subtract(r4 * r4 / d2, h, out=h)
-    if np.count_nonzero(h > margin_floor) != h.size:
-        raise ValueError("a position near a limit")
-    np.sqrt(h, out=h)
-    bx = a * dx
-    bx += h * ay
-    by = a * ay
-    by -= h * dx
-    t4 = np.arctan2(by, bx)
-    bx += r1 - ax
-    by -= ay
-    t3 = np.arctan2(by, bx)
+    t3, t4, ax, ay = fourbar_open_radians(radians(d), r1, r2, r3, r4, margin_floor)
     c3, s3, c4, s4 = np.cos(t3), np.sin(t3), np.cos(t4), np.sin(t4)
     px = ax + r3 * c3  # Phi at the reported angles
     px -= r4 * c4
