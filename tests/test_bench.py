@@ -221,6 +221,40 @@ def test_the_hand_baselines_compute_what_the_library_computes():
     assert got == pytest.approx(spec["root"], abs=1e-10)
 
 
+def test_the_sweep_floor_is_the_closed_form_with_linkage_s_evidence():
+    """Row 5's floor (hand.fourbar_open_certified): the hand closed form's angles bit for bit,
+    every position certified on crank_rocker.toml by the single solve's test, det J
+    linkage.sweep's to rounding; refused as the closed-form engine refuses: values not
+    ascending, a position beyond or at a limit (the crank of a non-Grashof four-bar), a
+    margin under the floor."""
+    import numpy as np
+
+    import linkage
+    from linkage.kinematics.closed import MARGIN_FLOOR
+    from linkage.measure.hand import fourbar_open, fourbar_open_certified
+    from linkage.rules import residual_gate
+    from linkage.samples import sample_path
+    from linkage.units import radians
+
+    m = linkage.load_mechanism(sample_path("crank_rocker.toml"))
+    values = [float(v) for v in np.linspace(0.0, 360.0, 361)]
+    links = (100.0, 40.0, 120.0, 80.0)
+    gate = residual_gate(1e-12, m.length_scale)
+    t3, t4, det, certified = fourbar_open_certified(values, *links, 1e-12, gate, MARGIN_FLOOR)
+    h3, h4 = fourbar_open(radians(np.array(values)), *links)
+    assert np.array_equal(t3, h3) and np.array_equal(t4, h4)
+    assert certified.all()
+    swept = linkage.sweep(m, values)
+    assert list(det) == pytest.approx([p.det for p in swept.positions], rel=1e-12)
+    with pytest.raises(ValueError, match="ascending"):
+        fourbar_open_certified(values[::-1], *links, 1e-12, gate, MARGIN_FLOOR)
+    with pytest.raises(ValueError, match="limit"):
+        fourbar_open_certified(values, 100.0, 90.0, 60.0, 70.0, 1e-12, gate, MARGIN_FLOOR)
+    # the evidence is judged: at tol 1e-20 only positions whose Newton step is exactly 0 pass
+    strict = fourbar_open_certified(values, *links, 1e-20, gate, MARGIN_FLOOR)[3]
+    assert 0 < np.count_nonzero(~strict) < len(values)
+
+
 def test_the_hand_loaded_scan_is_the_scans_forces():
     """The loaded scan row's reference: the same designs' peak input torque, pin force and
     ground force as linkage.scan_designs gives them (the 9x9 systems written by hand)."""

@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 
 from ..problems.derive import Derivation, read_branch
-from ..problems.loops import ANGLE_UNITS, Mechanism, VectorTerm
+from ..problems.loops import ANGLE_UNITS, Mechanism
 from ..records import frozen
 from ..units import degrees, radians
 from .angles import (
@@ -56,7 +56,6 @@ from .design_loops import (
     NO_SOLUTION,
     OFF_BRANCH,
     design_grid,
-    design_resolver,
     design_size,
     design_terms,
     newton_block,
@@ -133,7 +132,7 @@ def solve_designs(m: Mechanism, params: Mapping[str, np.ndarray], values: Sequen
         q, status, feasible, engine = continuation_engine(m, params, vals, tol, n_designs)
     else:
         q, status, feasible, engine = sweep_engine(m, params, vals, branch, tol, n_designs)
-    found_paths = _paths(m, params, vals, q, status == CONVERGED) if paths else {}
+    found_paths = design_paths(m, params, vals, q, status == CONVERGED) if paths else {}
     kinds = tuple(u.kind for u in m.unknowns)
     shown = np.stack([degrees(c) if k == "angle" else c for c, k in zip(q, kinds)], axis=-1)
     shown[status != CONVERGED] = np.nan
@@ -342,34 +341,21 @@ def meeting_counts(m: Mechanism, params: Mapping[str, np.ndarray], sol: DesignSo
 
 # --- shared: joints and points, continuous angles ------------------------------------------------
 
-def _paths(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, q: list[np.ndarray],
+def design_paths(m: Mechanism, params: Mapping[str, np.ndarray], vals: np.ndarray, q: list[np.ndarray],
            solved: np.ndarray) -> dict[str, np.ndarray]:
-    """Every named joint and point at every solved position (complex, NaN elsewhere), as
-    LoopModel.points places them."""
+    """Every named joint and point at every solved position (complex, NaN elsewhere), by the
+    one placing rule (:func:`~.placing.place_np`, as a sweep places them) on each design's
+    own parameters."""
+    from ..problems.loops import LoopModel
+    from .placing import place_np
+
     n_designs = len(solved) // max(len(vals), 1)
     grid, drv = design_grid(m, params, vals, n_designs)
-    _, value = design_resolver(m, grid, drv, q)
-
-    def vec(t: VectorTerm) -> Any:
-        return t.sign * value(t.length) * np.exp(1j * (value(t.angle) + t.offset))
-
-    placed: dict[str, Any] = {}
-    for loop in m.loops:
-        names = loop.joints
-        start = complex(*m.origin)
-        p: Any = placed.get(names[0], start) if names and names[0] else start
-        for name, t in zip(names or [""] * len(loop.vectors), loop.vectors):
-            if name:
-                placed.setdefault(name, p)
-            p = p + vec(t)
-    for pname, (origin, vectors) in m.points.items():
-        p = placed[origin]
-        for t in vectors:
-            p = p + vec(t)
-        placed[pname] = p
+    model = LoopModel.compile(m, {k: v for k, v in grid.items() if k in params})
     out = {}
-    for name, p in placed.items():
-        full = np.broadcast_to(np.asarray(p, dtype=complex), solved.shape).copy()
+    for name, (x, y) in place_np(model, q, drv).items():
+        full = np.empty(solved.shape, dtype=complex)
+        full.real, full.imag = x, y
         full[~solved] = np.nan
         out[name] = full
     return out

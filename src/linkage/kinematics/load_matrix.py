@@ -446,7 +446,10 @@ def eliminate_np(t: Any, y: Any) -> None:
     the diagonal, L's multipliers below), its row swaps and forward elimination applied to
     ``y`` (n, N). A step's row swap is a whole-row copy where every system swaps the same
     rows, a masked one where some do; its update covers the rows and columns that are
-    non-zero in some system (the others' update is zero)."""
+    non-zero in some system (the others' update is zero). ``linalg.lu``'s numbers bit for bit
+    but for a zero's sign: a multiplier that is zero in one system and not in all is 0 /
+    pivot there (-0.0 under a negative pivot, where lu writes +0.0 and skips the row), which
+    the bound, reading |L| and |U|, does not see."""
     import numpy as np
 
     n, _, count = t.shape

@@ -47,6 +47,14 @@ def fourbar_open(theta2: Any, r1: float, r2: float, r3: float, r4: float) -> tup
     r4 about O4, on the side where sin(theta4 - theta3) > 0 for a crank-rocker drawn as
     sample_inputs/crank_rocker.toml is (Norton, *Design of Machinery*, section 4.5: the open
     configuration). Written tight: in place where numpy allows, one temporary at a time."""
+    t3, t4, _, _ = fourbar_open_radians(theta2, r1, r2, r3, r4)
+    return degrees(t3), degrees(t4)
+
+
+def fourbar_open_radians(theta2: Any, r1: float, r2: float, r3: float, r4: float,
+                         margin_floor: float | None = None) -> tuple[Any, Any, Any, Any]:
+    """:func:`fourbar_open`'s work: theta3, theta4 (rad) and the crank pin A's x and y. With
+    ``margin_floor``, raises ValueError where a position's margin, (h / d)^2, is not above it."""
     import numpy as np
 
     ax = np.cos(theta2)
@@ -60,6 +68,8 @@ def fourbar_open(theta2: Any, r1: float, r2: float, r3: float, r4: float) -> tup
     a /= 2.0 * d2
     h = np.square(a)  # (h / d)^2 = (r4 / d)^2 - (a / d)^2
     np.subtract(r4 * r4 / d2, h, out=h)
+    if margin_floor is not None and np.count_nonzero(h > margin_floor) != h.size:
+        raise ValueError("a position near a limit")
     np.sqrt(h, out=h)
     bx = a * dx
     bx += h * ay  # B - O4 = a (A - O4) - h perp(A - O4), the open side
@@ -68,8 +78,41 @@ def fourbar_open(theta2: Any, r1: float, r2: float, r3: float, r4: float) -> tup
     t4 = np.arctan2(by, bx)
     bx += r1 - ax
     by -= ay
-    t3 = np.arctan2(by, bx)
-    return degrees(t3), degrees(t4)
+    return np.arctan2(by, bx), t4, ax, ay
+
+
+def fourbar_open_certified(theta2_deg: Sequence[float], r1: float, r2: float, r3: float, r4: float,
+                           tol: float, gate: float, margin_floor: float) -> tuple[Any, Any, Any, Any]:
+    """The floor of a sweep that keeps the single solve's promise, by hand: theta3, theta4
+    (deg), det J and whether each position is certified, for crank angles ``theta2_deg``
+    (deg, a list, as ``linkage.sweep`` takes them). The least such a sweep computes: the
+    values as an array, checked strictly ascending; :func:`fourbar_open`'s closed form; each
+    position's assembly margin, (h / d)^2, above ``margin_floor``; the evidence that each
+    answer is a root (Phi and J at the reported angles, the Newton step they imply, the step
+    within ``tol`` and max|Phi| within ``gate``); det J of one sign. No unwrapping,
+    anchoring, branch names or result object. Raises ValueError where a check fails."""
+    import numpy as np
+
+    from ..units import radians
+
+    d = np.asarray(theta2_deg, dtype=float)
+    if np.count_nonzero(np.diff(d) > 0.0) != d.size - 1:
+        raise ValueError("driver values not strictly ascending")
+    t3, t4, ax, ay = fourbar_open_radians(radians(d), r1, r2, r3, r4, margin_floor)
+    c3, s3, c4, s4 = np.cos(t3), np.sin(t3), np.cos(t4), np.sin(t4)
+    px = ax + r3 * c3  # Phi at the reported angles
+    px -= r4 * c4
+    px -= r1
+    py = ay + r3 * s3
+    py -= r4 * s4
+    j11, j12, j21, j22 = -r3 * s3, r4 * s4, r3 * c3, -r4 * c4
+    det = j11 * j22
+    det -= j12 * j21
+    step = np.maximum(np.abs((j22 * px - j12 * py) / det), np.abs((j11 * py - j21 * px) / det))
+    certified = (step <= tol) & (np.maximum(np.abs(px), np.abs(py)) <= gate)
+    if not (np.count_nonzero(det > 0.0) == det.size or np.count_nonzero(det < 0.0) == det.size):
+        raise ValueError("det J changes sign")
+    return degrees(t3), degrees(t4), det, certified
 
 
 @frozen

@@ -188,21 +188,34 @@ def crank_rocker() -> tuple[Any, tuple[float, float, float, float]]:
 
 def sweep_against_closed_form(positions: int) -> Measure:
     """``linkage.sweep`` of crank_rocker.toml over 0..360 deg (the engine it picks) against
-    :func:`.hand.fourbar_open` on the same crank angles."""
+    :func:`.hand.fourbar_open` on the same crank angles. The short row also times the floor
+    (:func:`.hand.fourbar_open_certified`: the closed form with the evidence the single
+    solve's promise needs, by hand) against the same closed form, and says it: the least
+    the row's ratio can be."""
 
-    def measure(s: Settings) -> Pairs:
+    def measure(s: Settings) -> Pairs | Measured:
         import numpy as np
 
+        from ..kinematics.closed import MARGIN_FLOOR
+        from ..rules import residual_gate
         from ..units import radians
         from . import api
-        from .hand import fourbar_open
+        from .hand import fourbar_open, fourbar_open_certified
 
         m, links = crank_rocker()
         grid = np.linspace(0.0, 360.0, positions)
         values = grid if positions > 1_000 else [float(v) for v in grid]
         short = positions <= 1_000
-        return interleaved_pairs(lambda: api.sweep(m, values), lambda: fourbar_open(radians(grid), *links),
-                                 short_pairs(s) if short else s.repeats, s.budget if short else 0.0)
+        pairs = interleaved_pairs(lambda: api.sweep(m, values), lambda: fourbar_open(radians(grid), *links),
+                                  short_pairs(s) if short else s.repeats, s.budget if short else 0.0)
+        if not short:
+            return pairs
+        tol = tolerance()
+        gate = residual_gate(tol, m.length_scale)
+        floor = interleaved_pairs(
+            lambda: fourbar_open_certified(values, *links, tol, gate, MARGIN_FLOOR),
+            lambda: fourbar_open(radians(grid), *links), short_pairs(s), s.budget)
+        return Measured(pairs, f"the floor (closed form and its evidence by hand) {floor.ratio:.2f}x")
 
     return measure
 
