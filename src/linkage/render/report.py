@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any, NamedTuple
+from typing import Any
+
+from ..records import NamedTuple
 
 
 # A NamedTuple, not a frozen dataclass: built once per class at import, it costs
