@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from itertools import zip_longest
 from typing import Any
 
 from ..records import NamedTuple
@@ -132,12 +133,14 @@ def simple_table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     ``simple`` format (tests check they agree), without importing tabulate (about 20 ms
     of every piped command's start)."""
     widths = [len(h) + 2 for h in headers]  # tabulate's MIN_PADDING around a header
-    for r in rows:
-        for j, c in enumerate(r):
-            widths[j] = max(widths[j], len(c))
-    lines = ["  ".join(h.rjust(w) for h, w in zip(headers, widths)),
-             "  ".join("-" * w for w in widths)]
-    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in rows]
+    for j, cells in enumerate(zip_longest(*rows, fillvalue="")):  # a column at a time
+        widths[j] = max(widths[j], max(map(len, cells)))
+    # every line through one format (each cell right-aligned, as str.rjust): a sweep's
+    # table is hundreds of lines; a short row's missing cells are blanks, stripped below
+    n = len(widths)
+    aligned = "  ".join(f"{{:>{w}}}" for w in widths).format
+    lines = [aligned(*headers), "  ".join("-" * w for w in widths)]
+    lines += [aligned(*r) if len(r) == n else aligned(*r, *("",) * (n - len(r))) for r in rows]
     return "\n".join(line.rstrip() for line in lines)
 
 
