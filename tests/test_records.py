@@ -355,6 +355,26 @@ def test_named_tuple_refuses_what_typing_refuses(store):
         return out
 
     assert errors(records.NamedTuple) == errors(typing.NamedTuple) and len(errors(typing.NamedTuple)) == 3
+
+    def with_a_second_base(base):
+        try:
+            class Two(base, dict):
+                a: int
+        except TypeError as exc:
+            return str(exc)
+        return None
+
+    assert with_a_second_base(records.NamedTuple) == with_a_second_base(typing.NamedTuple) is not None
+    t = typing.TypeVar("t")
+
+    def generic(base):
+        class Holder(base, typing.Generic[t]):
+            item: t
+
+        return repr(Holder[int]).rsplit(".", 1)[-1], Holder(1), Holder.__mro__[1:]
+
+    if sys.version_info >= (3, 11):  # a generic NamedTuple is 3.11's (3.10 refuses both alike, above)
+        assert generic(records.NamedTuple) == generic(typing.NamedTuple)
     with pytest.raises(TypeError, match="base class"):
         records.NamedTuple("Functional", [("a", int)])
 

@@ -226,7 +226,13 @@ else:
         ``class Point(NamedTuple): x: float; y: float = 0.0``."""
         raise TypeError("linkage.records.NamedTuple is a base class: class Name(NamedTuple): ...")
 
-    NamedTuple.__mro_entries__ = lambda bases: (_KEPT_BASE,)
+    def _mro_entries(bases: tuple[Any, ...]) -> tuple[Any, ...]:
+        """typing's own entries for the same bases (its checks, its errors), this base for its."""
+        entries = typing.NamedTuple.__mro_entries__(tuple(typing.NamedTuple if b is NamedTuple else b
+                                                           for b in bases))
+        return tuple(_KEPT_BASE if b is _TYPING_BASE else b for b in entries)
+
+    NamedTuple.__mro_entries__ = _mro_entries
 
 
 def save() -> None:
