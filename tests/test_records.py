@@ -418,3 +418,32 @@ def test_a_users_named_tuple_is_not_kept(store, monkeypatch):
     point = _tuples(records.NamedTuple)[1]
     records.save()
     assert point(1.0) == point(1.0, 0.0) and list(store.iterdir()) == [] and __name__ not in records._codes
+
+
+def test_an_undocumented_class_reads_the_docstring_dataclass_writes(store):
+    """dataclass writes a class without a docstring its name and signature (by
+    inspect.signature, most of making such a class): frozen writes it when first read,
+    the same text, read from the class, an instance, inspect.getdoc and pydoc alike."""
+    import pydoc
+
+    plain = _classes(dataclasses.dataclass(frozen=True))
+    kept = _classes(records.frozen)
+    for a, b in zip(plain, kept):
+        assert isinstance(b.__dict__["__doc__"], records.SignatureDoc)  # not written yet
+        assert b.__doc__ == a.__doc__ and a.__doc__.startswith(a.__name__ + "(")
+        assert b.__dict__["__doc__"] == a.__doc__  # written once, then a plain string
+    point = kept[0]
+    assert point(1.0).__doc__ == plain[0](1.0).__doc__ and inspect.getdoc(point) == inspect.getdoc(plain[0])
+    assert pydoc.render_doc(point).replace(point.__qualname__, "") == \
+        pydoc.render_doc(plain[0]).replace(plain[0].__qualname__, "")
+
+    @records.frozen
+    class Documented:
+        """Its own words."""
+
+        a: int
+
+    class Sub(kept[1]):
+        pass
+
+    assert Documented.__doc__ == "Its own words." and Sub.__doc__ is None

@@ -179,10 +179,37 @@ def _routed(namespace: Any, name: str, routed: Any, module: Any) -> Iterator[Non
                 setattr(namespace, name, had)
 
 
+class SignatureDoc:
+    """The docstring :func:`dataclasses.dataclass` writes for a class that has none (its
+    name and signature, by the same expression), written when it is first read instead of
+    while the class is made: ``inspect.signature`` is most of what making such a class
+    costs a command's start (docs/performance.md, "Dataclass methods kept between runs")."""
+
+    def __get__(self, obj: Any, owner: type) -> str:
+        import inspect
+
+        try:
+            # In some cases fetching a signature is not possible (dataclasses' words)
+            text_sig = str(inspect.signature(owner)).replace(" -> None", "")
+        except (TypeError, ValueError):
+            text_sig = ""
+        text = owner.__name__ + text_sig
+        owner.__doc__ = text  # written once; a class's own __doc__ is never inherited
+        return text
+
+
 def frozen(cls: type[T]) -> type[T]:
-    """``dataclasses.dataclass(frozen=True)(cls)``, its methods' bytecode kept (see the module)."""
+    """``dataclasses.dataclass(frozen=True)(cls)``, its methods' bytecode kept (see the module),
+    and, for a class without a docstring, the one dataclass writes written when first read
+    (:class:`SignatureDoc`)."""
+    bare = not cls.__doc__  # dataclass's own test
+    if bare:
+        cls.__doc__ = "(written when read)"  # so that dataclass writes none now
     with _routed(dataclasses, "exec", _exec, cls.__module__):  # the name dataclasses calls
-        return dataclasses.dataclass(frozen=True)(cls)
+        made = dataclasses.dataclass(frozen=True)(cls)
+    if bare:
+        made.__doc__ = SignatureDoc()  # type: ignore[assignment]
+    return made
 
 
 _TYPING_BASE = typing.NamedTuple.__mro_entries__((typing.NamedTuple,))[0]  # type: ignore[attr-defined]
