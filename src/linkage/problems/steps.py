@@ -138,11 +138,10 @@ an id is never another step's)."""
 
 
 def _generated(step: Step) -> Any:
-    from ..records import kept_code
-
     source, consts = coefficients_source(step)
     namespace = {f"c{i}": v for i, v in enumerate(consts)}
-    exec(kept_code(__name__, source), namespace)  # the text's code, kept between runs
+    # compiled in each process, never kept: the text is a mechanism's (as a model's loop)
+    exec(compile(source, "<linkage-step>", "exec"), namespace)
     if len(_GENERATED) > 4096:  # designs of a scan share their steps: this is a bound, not a cache policy
         _GENERATED.clear()
     _GENERATED[id(step)] = (step, namespace["coefficients"])
