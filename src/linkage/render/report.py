@@ -35,7 +35,9 @@ def fmt(v: Any, digits: int = 12) -> str:
     """One cell: integers as they are, floats to ``digits`` significant digits."""
     if isinstance(v, float):  # first: a table's usual cell (a sweep's table has thousands)
         if math.isfinite(v):
-            return f"{v:.{digits}g}" if v != 0.0 else "0"
+            # printf's %g: the text of format(v, f".{digits}g") (the same conversion,
+            # tested), without building the format spec for every cell
+            return "%.*g" % (digits, v) if v != 0.0 else "0"  # noqa: UP031 (the faster of the two)
         return "NaN" if math.isnan(v) else "inf" if v > 0 else "-inf"
     if v is None:
         return "—"
