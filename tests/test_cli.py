@@ -227,6 +227,37 @@ def test_plain_tables_are_tabulates_simple_format_without_tabulate():
         assert simple_table(headers, rows) == want
 
 
+def _simple_table_cell_by_cell(headers, rows):
+    """simple_table as it was written before its lines went through one format: each cell
+    right-aligned by str.rjust, a row's cells only (a short row's line ends early)."""
+    widths = [len(h) + 2 for h in headers]
+    for r in rows:
+        for j, c in enumerate(r):
+            widths[j] = max(widths[j], len(c))
+    lines = ["  ".join(h.rjust(w) for h, w in zip(headers, widths)), "  ".join("-" * w for w in widths)]
+    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in rows]
+    return "\n".join(line.rstrip() for line in lines)
+
+
+def test_simple_table_is_its_cell_by_cell_layout_short_rows_included():
+    """The one-format lines equal the cell-by-cell ones on random tables whose rows may
+    be short (tabulate, above, pads them; this layout does not), with blanks, wide
+    characters and braces in cells."""
+    import random
+
+    from linkage.render.report import simple_table
+
+    rng = random.Random(11)
+    cells = ["—", "converged", "", " ", "{}", "{0}", "-0.5", "1e+300", "open (mirror)"]
+    for _ in range(500):
+        nc, nr = rng.randint(1, 7), rng.randint(0, 9)
+        headers = ["h" * rng.randint(0, 14) for _ in range(nc)]
+        rows = [tuple(f"{rng.uniform(-1e5, 1e5):.{rng.randint(1, 12)}g}" if rng.random() < 0.6
+                      else rng.choice(cells) for _ in range(rng.randint(0, nc) if rng.random() < 0.3 else nc))
+                for _ in range(nr)]
+        assert simple_table(headers, rows) == _simple_table_cell_by_cell(headers, rows)
+
+
 def test_a_piped_solve_does_not_import_tabulate():
     from conftest import run_process
 

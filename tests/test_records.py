@@ -3,6 +3,8 @@ between runs (docs/performance.md, "Dataclass methods kept between runs")."""
 
 from __future__ import annotations
 
+import collections
+import copy
 import dataclasses
 import inspect
 import marshal
@@ -11,6 +13,7 @@ import re
 import subprocess
 import sys
 import threading
+import typing
 from pathlib import Path
 
 import pytest
@@ -250,3 +253,197 @@ def test_a_dataclass_made_in_another_thread_meanwhile_is_as_ever(store):
 
     assert out["during"] == (User.__init__.__annotations__, str(inspect.signature(User)), True)
     assert "exec" not in dataclasses.__dict__
+
+
+# --- records.NamedTuple: typing.NamedTuple's class syntax, namedtuple's __new__ kept -------
+
+def _tuples(base):
+    """The same class statements (defaults, a method, a property, a class attribute, a
+    docstring, a nested class) with ``base`` as their base."""
+    class Plain(base):
+        a: int
+        b: str
+
+    class Point(base):
+        """A point."""
+
+        x: float
+        y: float = 0.0
+        tags: tuple[str, ...] = ()
+        ORIGIN_NAME = "O"
+
+        def norm(self) -> float:
+            return (self.x * self.x + self.y * self.y) ** 0.5
+
+        @property
+        def flipped(self) -> Point:
+            return self._replace(x=self.y, y=self.x)
+
+    class Outer:
+        class Inner(base):
+            value: int | None = None
+
+    return Plain, Point, Outer.Inner
+
+
+_METHODS = (classmethod, staticmethod, property)
+
+
+def _code_of(v) -> object:
+    """A method's code (namedtuple's methods: the very code object of collections' closures)."""
+    f = v.fget if isinstance(v, property) else getattr(v, "__func__", v)
+    return (type(v), f.__code__, f.__name__, f.__defaults__)
+
+
+def _tuple_shape(cls: type) -> dict:
+    new = cls.__new__
+    code = new.__code__
+    own = {k: v for k, v in vars(cls).items() if k not in ("__new__", "__annotations__")}
+    return {"mro": [c.__name__ for c in cls.__mro__], "metaclass": type(cls), "own": sorted(own),
+            "attrs": {k: v for k, v in own.items() if not callable(v) and not isinstance(v, _METHODS)
+                      and type(v).__name__ != "_tuplegetter"},
+            "getters": {k: v.__reduce__()[1] for k, v in own.items() if type(v).__name__ == "_tuplegetter"},
+            "code": {k: _code_of(v) for k, v in own.items() if callable(v) or isinstance(v, _METHODS)},
+            "new": (code.co_code, code.co_consts, code.co_names, code.co_varnames, code.co_filename,
+                    new.__name__, new.__qualname__, new.__doc__, new.__defaults__, new.__kwdefaults__),
+            "annotations": {k: getattr(v, "__forward_arg__", v) for k, v in cls.__annotations__.items()},
+            "new annotations": {k: getattr(v, "__forward_arg__", v) for k, v in new.__annotations__.items()},
+            "hints": typing.get_type_hints(cls),
+            "signature": re.sub(r"ForwardRef\(('[^']*'|\"[^\"]*\")\)", r"\1", str(inspect.signature(cls))),
+            "orig bases": getattr(cls, "__orig_bases__", None)}
+
+
+def test_named_tuple_is_typing_named_tuple_cold_and_warm(store):
+    """Compiled (cold store), read back (warm) and typing.NamedTuple's: the same class,
+    attribute for attribute and __new__ code for code; the annotations are the strings the
+    body wrote where typing holds ForwardRefs of them, and read as the same type hints."""
+    plain = _tuples(typing.NamedTuple)
+    cold = _tuples(records.NamedTuple)
+    records.save()
+    records._codes.clear()
+    warm = _tuples(records.NamedTuple)
+    assert any(key.startswith(records.EVAL_KEY) for key in records._codes[__name__])
+    for a, b, c in zip(plain, cold, warm):
+        assert _tuple_shape(a) == _tuple_shape(b) == _tuple_shape(c)
+        assert all(type(v) is str for v in c.__annotations__.values())
+        assert c.__new__.__annotations__ is c.__annotations__
+    for point in (plain[1], warm[1]):
+        p = point(3.0, 4.0)
+        assert isinstance(p, tuple) and p == (3.0, 4.0, ()) and hash(p) == hash((3.0, 4.0, ()))
+        assert repr(p) == "Point(x=3.0, y=4.0, tags=())" and p.norm() == 5.0
+        assert p.flipped == point(4.0, 3.0) and p._asdict() == {"x": 3.0, "y": 4.0, "tags": ()}
+        assert point._make([1.0, 2.0, ("t",)]) == point(1.0, 2.0, ("t",)) and point(1.0).y == 0.0
+        assert copy.deepcopy(p) == p and type(copy.deepcopy(p)) is point and p.ORIGIN_NAME == "O"
+        with pytest.raises(AttributeError):
+            p.x = 1.0  # type: ignore[misc]
+        with pytest.raises(TypeError):
+            point()  # type: ignore[call-arg]
+    assert warm[2].__qualname__ == plain[2].__qualname__ and warm[2]().value is None
+
+
+def test_named_tuple_refuses_what_typing_refuses(store):
+    """typing's own class maker decides: the same errors, word for word."""
+    def errors(base):
+        out = []
+        bodies = ("a: int = 1\n    b: int", "a: int\n    def _replace(self): pass",
+                  "a: int\n    __slots__ = ()")
+        for body in bodies:
+            try:
+                exec(f"class Bad(base):\n    {body}\n", {"base": base, "__name__": __name__})
+            except (TypeError, AttributeError) as exc:
+                out.append((type(exc), str(exc)))
+        return out
+
+    assert errors(records.NamedTuple) == errors(typing.NamedTuple) and len(errors(typing.NamedTuple)) == 3
+
+    def with_a_second_base(base):
+        try:
+            class Two(base, dict):
+                a: int
+        except TypeError as exc:
+            return str(exc)
+        return None
+
+    assert with_a_second_base(records.NamedTuple) == with_a_second_base(typing.NamedTuple) is not None
+    t = typing.TypeVar("t")
+
+    def generic(base):
+        class Holder(base, typing.Generic[t]):
+            item: t
+
+        return repr(Holder[int]).rsplit(".", 1)[-1], Holder(1), Holder.__mro__[1:]
+
+    if sys.version_info >= (3, 11):  # a generic NamedTuple is 3.11's (3.10 refuses both alike, above)
+        assert generic(records.NamedTuple) == generic(typing.NamedTuple)
+    with pytest.raises(TypeError, match="base class"):
+        records.NamedTuple("Functional", [("a", int)])
+
+
+def test_a_namedtuple_made_in_another_thread_meanwhile_is_as_ever(store):
+    """While records.NamedTuple makes a class (its field's name, read by namedtuple, blocks
+    it there), another thread's collections.namedtuple evaluates its __new__ as ever
+    (through the pass-through), and it is not kept; collections' namespace is as it was
+    afterwards."""
+    inside, release = threading.Event(), threading.Event()
+
+    class SlowName(str):
+        def __str__(self):  # namedtuple takes str() of each field name
+            inside.set()
+            release.wait(5)
+            return str.__str__(self)
+
+    out = {}
+
+    def user_thread():
+        inside.wait(5)
+        try:
+            theirs = collections.namedtuple("Theirs", "p q", defaults=(1,))
+            out["during"] = (theirs(0), theirs.__new__.__code__.co_filename, "eval" in collections.__dict__)
+        finally:
+            release.set()
+
+    t = threading.Thread(target=user_thread)
+    t.start()
+    body = {"__module__": __name__, "__qualname__": "Pkg", "__annotations__": {SlowName("x"): "int"}}
+    made = records.named_tuple("Pkg", (records._KEPT_BASE,), body)
+    t.join()
+    assert made(0) == (0,) and made._fields == ("x",)
+    assert repr(out["during"][0]) == "Theirs(p=0, q=1)" and out["during"][1:] == ("<string>", True)
+    assert "eval" not in collections.__dict__
+    assert all("_cls, p, q" not in src for codes in records._codes.values() for src in codes)
+
+
+def test_a_users_named_tuple_is_not_kept(store, monkeypatch):
+    monkeypatch.setattr(records, "KEPT_MODULES", "linkage.")
+    point = _tuples(records.NamedTuple)[1]
+    records.save()
+    assert point(1.0) == point(1.0, 0.0) and list(store.iterdir()) == [] and __name__ not in records._codes
+
+
+def test_an_undocumented_class_reads_the_docstring_dataclass_writes(store):
+    """dataclass writes a class without a docstring its name and signature (by
+    inspect.signature, most of making such a class): frozen writes it when first read,
+    the same text, read from the class, an instance, inspect.getdoc and pydoc alike."""
+    import pydoc
+
+    plain = _classes(dataclasses.dataclass(frozen=True))
+    kept = _classes(records.frozen)
+    for a, b in zip(plain, kept):
+        assert isinstance(b.__dict__["__doc__"], records.SignatureDoc)  # not written yet
+        assert b.__doc__ == a.__doc__ and a.__doc__.startswith(a.__name__ + "(")
+        assert b.__dict__["__doc__"] == a.__doc__  # written once, then a plain string
+    point = kept[0]
+    assert point(1.0).__doc__ == plain[0](1.0).__doc__ and inspect.getdoc(point) == inspect.getdoc(plain[0])
+    assert pydoc.render_doc(point).replace(point.__qualname__, "") == \
+        pydoc.render_doc(plain[0]).replace(plain[0].__qualname__, "")
+
+    @records.frozen
+    class Documented:
+        """Its own words."""
+
+        a: int
+
+    class Sub(kept[1]):
+        pass
+
+    assert Documented.__doc__ == "Its own words." and Sub.__doc__ is None

@@ -26,3 +26,22 @@ def test_a_finite_float_cell_is_its_g_format_at_the_digits():
     for v in rng.standard_normal(200) * 10.0 ** rng.integers(-300, 300, 200):
         for digits in (1, 6, 12, 17):
             assert fmt(float(v), digits) == format(float(v), f".{digits}g")
+
+
+def test_a_finite_float_cell_is_its_g_format_for_any_double():
+    """fmt writes a finite float by printf's %g at the digits: the text of format(v,
+    ".{digits}g") for any double (random bit patterns: subnormal, huge, every exponent)
+    and digits, numpy's float64 included."""
+    import random
+    import struct
+
+    rng = random.Random(13)
+    checked = 0
+    while checked < 20000:
+        v = struct.unpack("d", struct.pack("Q", rng.getrandbits(64)))[0]
+        if not math.isfinite(v) or v == 0.0:
+            continue
+        digits = rng.randint(1, 17)
+        assert fmt(v, digits) == format(v, f".{digits}g")
+        assert fmt(np.float64(v), digits) == format(v, f".{digits}g")
+        checked += 1

@@ -43,8 +43,9 @@ import sys
 from collections import deque
 from collections.abc import Callable
 from types import CodeType
-from typing import Any, NamedTuple
+from typing import Any
 
+from .records import NamedTuple
 from .result import STATUS_MEMBERS, Status
 from .rules import step_limit, system_converged_source, worse_than_seen
 

@@ -1,5 +1,6 @@
-"""The package's frozen dataclasses, made as :func:`dataclasses.dataclass` makes them, with
-the bytecode of their generated methods kept between runs.
+"""The package's frozen dataclasses and named tuples, made as :func:`dataclasses.dataclass`
+and :class:`typing.NamedTuple` make them, with the bytecode of their generated methods kept
+between runs.
 
 Python 3.11's ``dataclass`` writes each class's ``__init__``, ``__repr__``, ``__eq__``,
 ``__hash__``, ``__setattr__`` and ``__delattr__`` as source text and compiles it on every
@@ -21,17 +22,31 @@ writing run used (an edited class's old texts leave it). The directory is the pa
 ``__pycache__``, or its place under ``sys.pycache_prefix`` where that is set. Nothing is
 written where Python writes no bytecode (``sys.dont_write_bytecode``) or the directory cannot be written; a
 damaged or foreign file is read as empty and replaced.
+
+:data:`NamedTuple` is :class:`typing.NamedTuple` (its class syntax) made the same way:
+:func:`collections.namedtuple` evaluates each class's ``__new__`` from text, kept here as
+``frozen``'s methods are, and the annotations reach ``typing``'s class maker as
+placeholders, so that it compiles no :class:`typing.ForwardRef` for each field; the
+class's ``__annotations__`` are the strings the class body wrote (this package's modules
+have ``from __future__ import annotations``), which :func:`typing.get_type_hints` reads as
+it reads typing's ForwardRefs. Everything else is typing's own class maker: the same
+checks, fields, defaults, methods and errors (docs/performance.md, "Dataclass methods kept
+between runs").
 """
 
 from __future__ import annotations
 
 import builtins
+import collections
+import contextlib
 import dataclasses
 import os
 import sys
 import threading
+import typing
+from collections.abc import Iterator
 from types import CodeType
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 T = TypeVar("T")
 
@@ -90,24 +105,31 @@ _used: dict[str, dict[str, CodeType]] = {}
 texts (an edited source tree) leave the file at its next write instead of piling up."""
 
 
-def kept_code(module: str, source: str) -> CodeType:
+EVAL_KEY = "\0eval\0"
+"""What an ``eval`` source's key starts with (a NUL: no ``exec`` source, which is the key
+as it is, can contain one)."""
+
+
+def kept_code(module: str, source: str, mode: str = "exec") -> CodeType:
     """``source`` compiled as ``exec(source, ...)`` compiles it in :mod:`dataclasses` (file
-    name ``<string>``, no inherited future flags), or the kept code of that very text."""
+    name ``<string>``, no inherited future flags), or as ``eval(source, ...)`` does in
+    :mod:`collections` (``mode="eval"``), or the kept code of that very text and mode."""
+    key = source if mode == "exec" else EVAL_KEY + source
     with _LOCK:
         codes = _codes.get(module)
         if codes is None:
             codes = _codes[module] = _read(store_path(module))
-        code = codes.get(source)
+        code = codes.get(key)
         _used.setdefault(module, {})
         if code is None:
-            code = compile(source, "<string>", "exec", dont_inherit=True)
-            codes[source] = code
+            code = compile(source, "<string>", mode, dont_inherit=True)
+            codes[key] = code
             if not _added:
                 import atexit
 
                 atexit.register(save)  # the first run of a command writes its files once
             _added.add(module)
-        _used[module][source] = code
+        _used[module][key] = code
     return code
 
 
@@ -123,23 +145,121 @@ def _exec(source: Any, globals: Any = None, locals: Any = None, /) -> None:
     builtins.exec(source, globals, locals)
 
 
+def _eval(source: Any, globals: Any = None, locals: Any = None, /) -> Any:
+    """``eval`` as :func:`collections.namedtuple` calls it, through the kept codes while this
+    thread makes a class through :data:`NamedTuple` (any other call passes straight through,
+    compiled as ``eval`` compiles a string there: leading blanks dropped, no future flags)."""
+    if type(source) is str:
+        module = getattr(_STATE, "making", None)
+        source = source.lstrip(" \t")
+        source = kept_code(module, source, "eval") if module is not None else \
+            compile(source, "<string>", "eval", dont_inherit=True)
+    return builtins.eval(source, globals, locals)
+
+
 _ABSENT = object()
 
 
-def frozen(cls: type[T]) -> type[T]:
-    """``dataclasses.dataclass(frozen=True)(cls)``, its methods' bytecode kept (see the module)."""
+@contextlib.contextmanager
+def _routed(namespace: Any, name: str, routed: Any, module: Any) -> Iterator[None]:
+    """While this thread makes a class of ``module``: the builtin ``name`` a class maker's
+    module (``namespace``) calls is ``routed`` (through the kept codes for this package's
+    classes), one class at a time; as it was afterwards."""
     with _MAKING:
-        had = dataclasses.__dict__.get("exec", _ABSENT)
-        dataclasses.exec = _exec  # type: ignore[attr-defined]  # the name dataclasses calls
-        _STATE.making = cls.__module__ if cls.__module__.startswith(KEPT_MODULES) else None
+        had = namespace.__dict__.get(name, _ABSENT)
+        setattr(namespace, name, routed)
+        _STATE.making = module if type(module) is str and module.startswith(KEPT_MODULES) else None
         try:
-            return dataclasses.dataclass(frozen=True)(cls)
+            yield
         finally:
             _STATE.making = None
             if had is _ABSENT:
-                del dataclasses.exec  # type: ignore[attr-defined]
+                delattr(namespace, name)
             else:
-                dataclasses.exec = had  # type: ignore[attr-defined]
+                setattr(namespace, name, had)
+
+
+class SignatureDoc:
+    """The docstring :func:`dataclasses.dataclass` writes for a class that has none (its
+    name and signature, by the same expression), written when it is first read instead of
+    while the class is made: ``inspect.signature`` is most of what making such a class
+    costs a command's start (docs/performance.md, "Dataclass methods kept between runs")."""
+
+    def __get__(self, obj: Any, owner: type) -> str:
+        import inspect
+
+        try:
+            # In some cases fetching a signature is not possible (dataclasses' words)
+            text_sig = str(inspect.signature(owner)).replace(" -> None", "")
+        except (TypeError, ValueError):
+            text_sig = ""
+        text = owner.__name__ + text_sig
+        owner.__doc__ = text  # written once; a class's own __doc__ is never inherited
+        return text
+
+
+def frozen(cls: type[T]) -> type[T]:
+    """``dataclasses.dataclass(frozen=True)(cls)``, its methods' bytecode kept (see the module),
+    and, for a class without a docstring, the one dataclass writes written when first read
+    (:class:`SignatureDoc`)."""
+    bare = not cls.__doc__  # dataclass's own test
+    if bare:
+        cls.__doc__ = "(written when read)"  # so that dataclass writes none now
+    with _routed(dataclasses, "exec", _exec, cls.__module__):  # the name dataclasses calls
+        made = dataclasses.dataclass(frozen=True)(cls)
+    if bare:
+        made.__doc__ = SignatureDoc()  # type: ignore[assignment]
+    return made
+
+
+_TYPING_BASE = typing.NamedTuple.__mro_entries__((typing.NamedTuple,))[0]  # type: ignore[attr-defined]
+"""What a class statement naming :class:`typing.NamedTuple` derives from (typing's class
+maker asks for it among the bases)."""
+
+
+def named_tuple(typename: str, bases: tuple[type, ...], ns: dict[str, Any]) -> type:
+    """The class ``class typename(typing.NamedTuple)`` with body ``ns`` makes, through
+    typing's own class maker, its fields' annotations given as placeholders (no ForwardRef
+    compiled) and put back as written, and namedtuple's ``__new__`` through the kept codes
+    (see the module)."""
+    written = ns.get("__annotations__", {})
+    body = dict(ns)
+    body["__annotations__"] = dict.fromkeys(written, Any)
+    if "__orig_bases__" in body:  # the bases as written: typing's NamedTuple, as there
+        written_bases = body["__orig_bases__"]
+        body["__orig_bases__"] = tuple(typing.NamedTuple if b is NamedTuple else b for b in written_bases)
+    bases = tuple(_TYPING_BASE if b is _KEPT_BASE else b for b in bases)
+    with _routed(collections, "eval", _eval, ns.get("__module__")):  # the name namedtuple calls
+        made = typing.NamedTupleMeta.__new__(typing.NamedTupleMeta, typename, bases, body)  # type: ignore[attr-defined]
+    made.__annotations__ = made.__new__.__annotations__ = dict(written)
+    return made  # type: ignore[no-any-return]
+
+
+class _KeptTupleMeta(type):
+    """The metaclass of :data:`NamedTuple`'s base: a class statement's class is
+    :func:`named_tuple`'s."""
+
+    def __new__(cls, typename: str, bases: tuple[type, ...], ns: dict[str, Any]) -> Any:  # type: ignore[misc]
+        return named_tuple(typename, bases, ns)
+
+
+_KEPT_BASE = type.__new__(_KeptTupleMeta, "NamedTuple", (), {})
+
+if TYPE_CHECKING:
+    from typing import NamedTuple as NamedTuple
+else:
+    def NamedTuple(*args: Any, **kwargs: Any) -> Any:
+        """:class:`typing.NamedTuple`'s class syntax, its compilations kept (see the module):
+        ``class Point(NamedTuple): x: float; y: float = 0.0``."""
+        raise TypeError("linkage.records.NamedTuple is a base class: class Name(NamedTuple): ...")
+
+    def _mro_entries(bases: tuple[Any, ...]) -> tuple[Any, ...]:
+        """typing's own entries for the same bases (its checks, its errors), this base for its."""
+        entries = typing.NamedTuple.__mro_entries__(tuple(typing.NamedTuple if b is NamedTuple else b
+                                                           for b in bases))
+        return tuple(_KEPT_BASE if b is _TYPING_BASE else b for b in entries)
+
+    NamedTuple.__mro_entries__ = _mro_entries
 
 
 def save() -> None:

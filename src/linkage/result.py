@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import math
 from enum import Enum
-from typing import Any, NamedTuple
+from typing import Any
 
 from .errors import NotConvergedError
-from .records import frozen
+from .records import NamedTuple, frozen
 
 
 class Status(Enum):

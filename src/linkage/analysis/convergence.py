@@ -15,12 +15,12 @@ from __future__ import annotations
 import math
 import sys
 from dataclasses import field
-from typing import Any, NamedTuple
+from typing import Any
 
 from ..errors import InputError
 from ..methods import GOLDEN, METHODS
 from ..problems.scalar import ScalarProblem
-from ..records import frozen
+from ..records import NamedTuple, frozen
 from ..result import Result
 
 ROUNDING_LEVEL = 8.0 * sys.float_info.epsilon

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Mapping, Sequence
-from typing import Any, NamedTuple
+from typing import Any
 
 from ..problems.loads import Loads
-from ..records import frozen
+from ..records import NamedTuple, frozen
 from .bodies import Frame, force_size, metre
 from .forces import (
     TOGGLE_COND,

@@ -10,11 +10,11 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, NamedTuple
+from typing import Any
 
 from ..errors import InputError
 from ..problems.loads import Loads, load_link
-from ..records import frozen
+from ..records import NamedTuple, frozen
 from ..units import radians
 from .bodies import Frame, metre
 

@@ -14,10 +14,11 @@ from __future__ import annotations
 
 import math
 from operator import mul
-from typing import Any, NamedTuple
+from typing import Any
 
 from ..linalg import SingularMatrix, lu, lu_solve
 from ..problems.loops import DRIVER, LoopModel
+from ..records import NamedTuple
 from .block_linalg import lu_np, lu_solve_np
 from .vectors import EPS, SCALAR, rate_of, value_of
 

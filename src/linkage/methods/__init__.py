@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import math
 from importlib import import_module
-from typing import Any, NamedTuple
+from typing import Any
+
+from ..records import NamedTuple
 
 
 def _plain(cls: Any, crit: Any) -> Any:

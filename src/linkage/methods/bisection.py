@@ -13,11 +13,11 @@ c, e = (b - a) / 2.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, NamedTuple
+from typing import Any, ClassVar
 
 from ..iterate import Loop, build_loop
 from ..problems.scalar import ScalarProblem
-from ..records import frozen
+from ..records import NamedTuple, frozen
 from ..result import Column, Status
 from .common import new_state, same_sign
 

@@ -14,11 +14,11 @@ g'(x_i), error = x_i - x_{i+1} (signed).
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, NamedTuple
+from typing import Any, ClassVar
 
 from ..iterate import Loop, build_loop
 from ..problems.scalar import ScalarProblem
-from ..records import frozen
+from ..records import NamedTuple, frozen
 from ..result import Column, Status
 from .common import display, new_state
 

@@ -11,10 +11,10 @@ Rows: i, x_i, f(x_i), f'(x_i), f''(x_i), x_{i+1}, |x_{i+1} - x_i|.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, NamedTuple
+from typing import Any, ClassVar
 
 from ..problems.scalar import ScalarProblem
-from ..records import frozen
+from ..records import NamedTuple, frozen
 from ..result import Column, Status
 from .common import new_state, start_stop
 

@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import math
 import sys
-from typing import Any, ClassVar, NamedTuple
+from typing import Any, ClassVar
 
 from ..problems.scalar import ScalarProblem
-from ..records import frozen
+from ..records import NamedTuple, frozen
 from ..result import Column, Status
 from .bisection import init_bracket
 from .common import new_state

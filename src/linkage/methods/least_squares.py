@@ -13,11 +13,11 @@ that no assembly exists, the solve reports ``no_solution`` instead.
 from __future__ import annotations
 
 import math
-from typing import Any, ClassVar, NamedTuple
+from typing import Any, ClassVar
 
 from ..linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve
 from ..problems.system import SystemProblem
-from ..records import frozen
+from ..records import NamedTuple, frozen
 from ..result import Column, Status
 from .common import new_state
 from .newton_system import (

@@ -12,11 +12,11 @@ Rows follow the student report (docs/worked_examples.md P2): i, x_i, f(x_i), f'(
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, NamedTuple
+from typing import Any, ClassVar
 
 from ..iterate import HISTORY_HEAD, Loop, build_loop, dedent
 from ..problems.scalar import ScalarProblem
-from ..records import frozen
+from ..records import NamedTuple, frozen
 from ..result import FAST_NAMES, Column, Status, fast_source
 from .common import history_of, new_state, start_stop
 

@@ -19,12 +19,12 @@ from __future__ import annotations
 import math
 import operator
 import sys
-from typing import Any, ClassVar, NamedTuple
+from typing import Any, ClassVar
 
 from ..iterate import QUIET_RESIDUAL, Loop, build_loop, dedent, indent
 from ..linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve, pivot_ratio
 from ..problems.system import SystemProblem
-from ..records import frozen
+from ..records import NamedTuple, frozen
 from ..result import Column, Status
 from ..rules import invertible, invertible_source, pivots_invertible, step_size
 from ..units import degrees

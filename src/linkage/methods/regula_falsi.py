@@ -11,10 +11,10 @@ Error measure: the bracket width |b - a|, which bounds |c - r| because c is an e
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, NamedTuple
+from typing import Any, ClassVar
 
 from ..problems.scalar import ScalarProblem
-from ..records import frozen
+from ..records import NamedTuple, frozen
 from ..result import Column, Status
 from .bisection import init_bracket
 from .common import new_state, same_sign

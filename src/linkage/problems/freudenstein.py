@@ -18,9 +18,10 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Callable
-from typing import Any, NamedTuple
+from typing import Any
 
 from ..errors import InputError
+from ..records import NamedTuple
 from ..units import RAD_PER_DEG, degrees, radians
 from .assembly import is_open, label
 from .scalar import ScalarProblem

@@ -42,9 +42,10 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Mapping
-from typing import Any, NamedTuple
+from typing import Any
 
 from ..errors import ParseError
+from ..records import NamedTuple
 from ..units import degrees, radians
 from .closed_form import wrap_degrees
 

@@ -34,10 +34,10 @@ import functools
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import field
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, Any
 
 from ..errors import InputError, ParseError
-from ..records import frozen
+from ..records import NamedTuple, frozen
 from ..units import RAD_PER_DEG, degrees, radians
 from .system import SystemProblem
 

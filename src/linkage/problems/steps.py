@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from typing import Any, NamedTuple
+from typing import Any
 
+from ..records import NamedTuple
 from . import assembly, dyads
 
 DRIVER = -2
@@ -64,67 +65,95 @@ def ref_value(ref: Ref, params: Mapping[str, Any], d: Any, q: Sequence[Any]) -> 
     return ref
 
 
-# The sums of a step's terms, written once over a namespace (math or numpy): the scalar
-# path and its numpy twin evaluate the same expressions in the same order.
-def _known_sum(terms: Sequence[Term], params: Mapping[str, Any], d: Any, q: Sequence[Any],
-               xp: Any) -> tuple[Any, Any]:
-    x = y = 0.0
+# A step's coefficients are sums of its terms. Each step's sums are written out once as
+# straight-line text (:func:`coefficients_source`) and compiled into one function, run over
+# a namespace's cos and sin (math's on the scalar path, numpy's for its twin): a call loops
+# over no terms and calls no ref_value, and performs the operations of summing term by term
+# in the same order (tests/test_step_coefficients.py holds the two equal bit for bit).
+
+def _read(ref: Ref, consts: list[Any]) -> str:
+    """:func:`ref_value` of ``ref`` as text over the generated function's arguments
+    (``params``, ``d``, ``q``); a number becomes a constant of the function."""
+    if ref.__class__ is int:
+        return "d" if ref == DRIVER else f"q[{int(ref)}]"
+    if ref.__class__ is str:
+        return f"params[{str(ref)!r}]"
+    return _constant(ref, consts)
+
+
+def _constant(value: Any, consts: list[Any]) -> str:
+    consts.append(value)
+    return f"c{len(consts) - 1}"
+
+
+def _sum_text(x: str, y: str, terms: Sequence[Term], kind: str, consts: list[Any]) -> list[str]:
+    """The lines that sum ``terms`` into ``x`` and ``y``. ``kind``: ``known`` (sign * length *
+    e^(i (angle + offset)), K), ``angle`` (sign * length * e^(i offset): the coefficient of
+    e^(i angle)), ``length`` (sign * e^(i offset)) or ``length angle`` (sign * e^(i (angle +
+    offset))): the coefficient of a length."""
+    out = [f"{x} = {y} = 0.0"]
     for sign, lr, ar, off in terms:
-        r = sign * ref_value(lr, params, d, q)
-        t = ref_value(ar, params, d, q) + off if off else ref_value(ar, params, d, q)
-        x = x + r * xp.cos(t)
-        y = y + r * xp.sin(t)
-    return x, y
-
-
-def _angle_coefficient(terms: Sequence[Term], params: Mapping[str, Any], d: Any,
-                       q: Sequence[Any], xp: Any) -> tuple[Any, Any]:
-    """sum sign * length * e^(i offset): the coefficient of e^(i angle)."""
-    x = y = 0.0
-    for sign, lr, _, off in terms:
-        r = sign * ref_value(lr, params, d, q)
-        if off:
-            x = x + r * math.cos(off)
-            y = y + r * math.sin(off)
+        if kind in ("known", "angle"):
+            out.append(f"r = {_constant(sign, consts)} * {_read(lr, consts)}")
+        if kind in ("known", "length angle"):
+            at = _read(ar, consts)
+            out.append(f"t = {at} + {_constant(off, consts)}" if off else f"t = {at}")
+        if kind == "known":
+            out += [f"{x} = {x} + r * cos(t)", f"{y} = {y} + r * sin(t)"]
+        elif kind == "length angle":
+            sg = _constant(sign, consts)
+            out += [f"{x} = {x} + {sg} * cos(t)", f"{y} = {y} + {sg} * sin(t)"]
+        elif off:  # a fixed offset: its cosine and sine are numbers, taken once here
+            head = "r" if kind == "angle" else _constant(sign, consts)
+            c, s = _constant(math.cos(off), consts), _constant(math.sin(off), consts)
+            out += [f"{x} = {x} + {head} * {c}", f"{y} = {y} + {head} * {s}"]
         else:
-            x = x + r
-    return x, y
+            out.append(f"{x} = {x} + {'r' if kind == 'angle' else _constant(sign, consts)}")
+    return out
 
 
-def _length_coefficient(terms: Sequence[Term], params: Mapping[str, Any], d: Any,
-                        q: Sequence[Any], xp: Any, with_angle: bool) -> tuple[Any, Any]:
-    """sum sign * e^(i (angle + offset)) (``with_angle``) or sign * e^(i offset): the
-    coefficient of a length."""
-    x = y = 0.0
-    for sign, _, ar, off in terms:
-        if with_angle:
-            t = ref_value(ar, params, d, q) + off if off else ref_value(ar, params, d, q)
-            x = x + sign * xp.cos(t)
-            y = y + sign * xp.sin(t)
-        elif off:
-            x = x + sign * math.cos(off)
-            y = y + sign * math.sin(off)
-        else:
-            x = x + sign
-    return x, y
+CASE_KINDS = {TWO_ANGLES: ("angle", "angle"), ITS_LENGTH: ("angle", "length"),
+              OTHER_LENGTH: ("angle", "length angle"), TWO_LENGTHS: ("length angle", "length angle")}
+"""The coefficients of each case's two unknowns (:func:`_sum_text`'s kinds): P and Q, P and
+D, P and E, or E and F."""
+
+
+def coefficients_source(step: Step) -> tuple[str, list[Any]]:
+    """The text of ``step``'s coefficients function, ``coefficients(params, d, q, cos,
+    sin) -> (first, second, K)``, and its constants (``c0``, ``c1``, ... in its namespace):
+    K first, then first and second, each summed term by term as written."""
+    consts: list[Any] = []
+    first_kind, second_kind = CASE_KINDS.get(step.case, CASE_KINDS[TWO_LENGTHS])
+    lines = [*_sum_text("kx", "ky", step.known, "known", consts),
+             *_sum_text("ax", "ay", step.first, first_kind, consts),
+             *_sum_text("bx", "by", step.second, second_kind, consts),
+             "return (ax, ay), (bx, by), (kx, ky)"]
+    body = "".join(f"\n    {line}" for line in lines)
+    return f"def coefficients(params, d, q, cos, sin):{body}\n", consts
+
+
+_GENERATED: dict[int, tuple[Step, Any]] = {}
+"""Each step's compiled coefficients function, by the step's id (the step kept with it, so
+an id is never another step's)."""
+
+
+def _generated(step: Step) -> Any:
+    source, consts = coefficients_source(step)
+    namespace = {f"c{i}": v for i, v in enumerate(consts)}
+    # compiled in each process, never kept: the text is a mechanism's (as a model's loop)
+    exec(compile(source, "<linkage-step>", "exec"), namespace)
+    if len(_GENERATED) > 4096:  # designs of a scan share their steps: this is a bound, not a cache policy
+        _GENERATED.clear()
+    _GENERATED[id(step)] = (step, namespace["coefficients"])
+    return namespace["coefficients"]
 
 
 def coefficients(step: Step, params: Mapping[str, Any], d: Any, q: Sequence[Any],
                   xp: Any) -> tuple[tuple[Any, Any], tuple[Any, Any], tuple[Any, Any]]:
-    """(first, second, K) of a step at known values."""
-    k = _known_sum(step.known, params, d, q, xp)
-    case = step.case
-    if case == TWO_ANGLES:
-        return (_angle_coefficient(step.first, params, d, q, xp),
-                _angle_coefficient(step.second, params, d, q, xp), k)
-    if case == ITS_LENGTH:
-        return (_angle_coefficient(step.first, params, d, q, xp),
-                _length_coefficient(step.second, params, d, q, xp, False), k)
-    if case == OTHER_LENGTH:
-        return (_angle_coefficient(step.first, params, d, q, xp),
-                _length_coefficient(step.second, params, d, q, xp, True), k)
-    return (_length_coefficient(step.first, params, d, q, xp, True),
-            _length_coefficient(step.second, params, d, q, xp, True), k)
+    """(first, second, K) of a step at known values (``xp``: math, or numpy for arrays)."""
+    got = _GENERATED.get(id(step))
+    fn = got[1] if got is not None and got[0] is step else _generated(step)
+    return fn(params, d, q, xp.cos, xp.sin)  # type: ignore[no-any-return]
 
 
 def is_open(step: Step, params: Mapping[str, Any], d: Any, q: Sequence[Any], xp: Any = math) -> Any:

@@ -23,9 +23,10 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Mapping, Sequence
-from typing import Any, NamedTuple
+from typing import Any
 
 from ..errors import InputError
+from ..records import NamedTuple
 from ..units import degrees
 from .joints import GROUND
 from .toml_text import toml_key, toml_value

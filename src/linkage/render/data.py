@@ -10,7 +10,9 @@ them (a 360,001-position sweep written to CSV never builds either).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any, NamedTuple
+from typing import Any
+
+from ..records import NamedTuple
 
 KINDS = ("number", "int", "bool", "text")
 
