@@ -12,6 +12,7 @@ import sys
 import pytest
 
 from linkage import iterate
+from linkage.files import kept_bytes, read_kept
 from linkage.methods.newton import NEWTON_QUIET_LOOP
 
 SOURCE = "def f(x):\n    return x * 2.0 + 1.0\n"
@@ -35,7 +36,7 @@ def test_a_kept_loop_is_the_code_compiled_from_its_source(cache):
     assert name.endswith(f".{sys.implementation.cache_tag}.marshal")
     again = iterate.compiled(source, "<linkage-loop newton_quiet>", True)
     assert again == first == compile(source, "<linkage-loop newton_quiet>", "exec")
-    assert marshal.loads((cache / name).read_bytes())[0] == source
+    assert read_kept(str(cache / name))[0] == source
 
 
 def test_a_loop_built_from_the_cache_is_the_loop_built_by_compiling(cache):
@@ -67,25 +68,49 @@ def test_a_command_run_from_kept_loops_prints_what_one_compiling_them_prints():
 def test_a_damaged_kept_file_is_compiled_again_and_replaced(cache):
     iterate.compiled(SOURCE, "<t>", True)
     (name,) = kept(cache)
-    for damage in (b"", b"\x00garbage", marshal.dumps(("x",)), marshal.dumps(42),
+    for damage in (b"", b"\x00garbage", marshal.dumps(("x",)), kept_bytes(("x",)), kept_bytes(42),
                    (cache / name).read_bytes()[:-7]):
         (cache / name).write_bytes(damage)
         namespace: dict = {}
         exec(iterate.compiled(SOURCE, "<t>", True), namespace)
         assert namespace["f"](2.0) == 5.0
-        assert marshal.loads((cache / name).read_bytes())[0] == SOURCE
+        assert read_kept(str(cache / name))[0] == SOURCE
 
 
 def test_a_kept_file_of_another_source_or_filename_is_not_used(cache):
     iterate.compiled(SOURCE, "<t>", True)
     (name,) = kept(cache)
     other = "def f(x):\n    return math.inf\n"
-    (cache / name).write_bytes(marshal.dumps((other, "<t>", compile(other, "<t>", "exec"))))
+    (cache / name).write_bytes(kept_bytes((other, "<t>", compile(other, "<t>", "exec"))))
     namespace: dict = {"math": math}
     exec(iterate.compiled(SOURCE, "<t>", True), namespace)
     assert namespace["f"](2.0) == 5.0
     code = iterate.compiled(SOURCE, "<u>", True)
     assert code.co_filename == "<u>"
+
+
+def test_a_kept_file_of_another_bytecode_version_is_not_used(cache):
+    """The interpreter's magic number leads the file, as in a .pyc: code kept by another
+    build with the same cache tag (a release and its pre-release) is compiled again."""
+    from importlib.util import MAGIC_NUMBER
+
+    iterate.compiled(SOURCE, "<t>", True)
+    (name,) = kept(cache)
+    foreign = compile("def f(x):\n    return -1.0\n", "<t>", "exec")
+    other_magic = bytes([MAGIC_NUMBER[0] ^ 1]) + MAGIC_NUMBER[1:]
+    (cache / name).write_bytes(other_magic + marshal.dumps((SOURCE, "<t>", foreign)))
+    namespace: dict = {}
+    exec(iterate.compiled(SOURCE, "<t>", True), namespace)
+    assert namespace["f"](2.0) == 5.0
+    assert (cache / name).read_bytes().startswith(MAGIC_NUMBER)  # replaced
+
+
+def test_the_loop_cache_follows_pycache_prefix(cache, monkeypatch, tmp_path):
+    prefix = tmp_path / "prefix"
+    monkeypatch.setattr(sys, "pycache_prefix", str(prefix))
+    iterate.compiled(SOURCE, "<t>", True)
+    (written,) = [p for p in prefix.rglob("*.marshal")]
+    assert str(written.parent) == str(prefix) + os.path.dirname(os.path.abspath(str(cache)))
 
 
 def test_nothing_is_kept_for_a_model_loop_or_where_python_writes_no_bytecode(cache, monkeypatch):

@@ -104,7 +104,14 @@ def test_a_kept_code_is_used_only_for_its_own_text(store):
 
 def test_a_damaged_or_foreign_store_is_read_as_empty_and_replaced(store):
     path = Path(records.store_path(__name__))
-    for junk in (b"", b"\x00garbage", marshal.dumps({"x": 1}), marshal.dumps([1])):
+    from importlib.util import MAGIC_NUMBER
+
+    from linkage.files import kept_bytes
+
+    code = compile("x = 1", "<string>", "exec")
+    other_magic = bytes([MAGIC_NUMBER[0] ^ 1]) + MAGIC_NUMBER[1:]
+    for junk in (b"", b"\x00garbage", marshal.dumps({"x": 1}), marshal.dumps([1]), kept_bytes({"x": 1}),
+                 kept_bytes([1]), other_magic + marshal.dumps({"a": code})):
         path.write_bytes(junk)
         records._codes.clear()
         records._added.clear()

@@ -19,7 +19,9 @@ import functools
 import os
 import re
 import stat
+import sys
 from collections.abc import Iterator, Sequence
+from importlib.util import MAGIC_NUMBER
 from pathlib import Path
 from typing import Any
 
@@ -251,6 +253,72 @@ def atomic_target(path: Path) -> Iterator[str]:
     except BaseException:
         _remove(tmp)
         raise
+
+
+def kept_code_path(beside: str, name: str) -> str | None:
+    """Where a file of kept bytecode called ``name`` (this interpreter's cache tag appended)
+    lives for a package whose own bytecode is in ``beside`` (its ``__pycache__``): there, or
+    where Python puts that directory's bytecode under ``sys.pycache_prefix`` when it is set
+    (the Python documentation, "sys.pycache_prefix"); None where this interpreter keeps no
+    bytecode (no cache tag). One rule for every store of kept code (records, iterate)."""
+    tag = sys.implementation.cache_tag
+    if tag is None:
+        return None
+    if sys.pycache_prefix:
+        beside = os.path.join(sys.pycache_prefix, os.path.dirname(os.path.abspath(beside)).lstrip(os.sep))
+    return os.path.join(beside, f"{name}.{tag}.marshal")
+
+
+def read_kept(path: str | None) -> Any:
+    """What :func:`keep_quietly` kept at ``path`` with :func:`kept_bytes`, or None where the
+    file is missing, unreadable, damaged or written by another bytecode version (the
+    interpreter's magic number leads the file, as in a ``.pyc``: two builds that share a
+    cache tag, a release and its pre-release, do not read each other's code)."""
+    import marshal
+
+    if path is None:
+        return None
+    try:
+        with open(path, "rb") as kept:
+            data = kept.read()
+        if data[:len(MAGIC_NUMBER)] != MAGIC_NUMBER:
+            return None
+        return marshal.loads(data[len(MAGIC_NUMBER):])
+    except (OSError, ValueError, EOFError, TypeError):
+        return None
+
+
+def kept_bytes(value: Any) -> bytes:
+    """``value`` as :func:`read_kept` reads it back: the magic number, then marshal's bytes."""
+    import marshal
+
+    return MAGIC_NUMBER + marshal.dumps(value)
+
+
+def compiled_kept(source: str, filename: str, store: str | None) -> Any:
+    """``compile(source, filename, "exec")``, its code kept between runs in the directory
+    ``store`` (None: not kept) as Python keeps a module's bytecode. A kept file is used only
+    if it holds this very source (compared whole, not by its hash) and file name for this
+    interpreter's bytecode (its cache tag in the name, its magic number in the file:
+    :func:`read_kept`), in the place :func:`kept_code_path` gives (``sys.pycache_prefix``
+    followed); one that is missing, unreadable, damaged or of another source is compiled
+    again and replaced. Nothing is written where Python writes no bytecode
+    (``sys.dont_write_bytecode``) or the directory cannot be written."""
+    import zlib
+    from types import CodeType
+
+    name = f"loop-{zlib.crc32(source.encode()):08x}-{len(source):x}"
+    path = None if store is None else kept_code_path(store, name)
+    if path is None:
+        return compile(source, filename, "exec")
+    held = read_kept(path)
+    if (type(held) is tuple and len(held) == 3 and held[0] == source and held[1] == filename
+            and isinstance(held[2], CodeType)):
+        return held[2]
+    code = compile(source, filename, "exec")
+    if not sys.dont_write_bytecode:
+        keep_quietly(path, kept_bytes((source, filename, code)))
+    return code
 
 
 def keep_quietly(path: str, data: bytes) -> None:

@@ -473,37 +473,15 @@ runs (:func:`compiled`), beside the package's own; None: nowhere."""
 
 
 def compiled(source: str, filename: str, fixed_source: bool) -> CodeType:
-    """``compile(source, filename, "exec")``. Where ``fixed_source`` (the source depends
-    only on this package's code, so there are finitely many), the code is kept between
-    runs as Python keeps a module's bytecode, in :data:`LOOP_CACHE`: compiling a loop takes
-    0.4 to 1.3 ms, reading it back about 15 us, and a cold ``linkage solve`` compiles two.
-    A kept file is used only if it holds this very source (compared whole, not by its
-    hash) for this interpreter's bytecode (``sys.implementation.cache_tag`` in its name);
-    one that is unreadable, damaged or of another source is compiled again and replaced.
-    Nothing is written where Python writes no bytecode (``sys.dont_write_bytecode``) or
-    the directory cannot be written. A source built from a mechanism's numbers (a model's
-    loop) is never kept: there could be one per mechanism ever solved."""
-    tag = sys.implementation.cache_tag
-    if not fixed_source or LOOP_CACHE is None or tag is None:
-        return compile(source, filename, "exec")
-    import marshal
-    import zlib
+    """``compile(source, filename, "exec")``; where ``fixed_source`` (the source depends
+    only on this package's code, so there are finitely many), kept between runs in
+    :data:`LOOP_CACHE` (:func:`~linkage.files.compiled_kept`): compiling a loop takes 0.4 to
+    1.3 ms, reading it back about 15 us, and a cold ``linkage solve`` compiles two. A
+    source built from a mechanism's numbers (a model's loop) is never kept: there could be
+    one per mechanism ever solved."""
+    from .files import compiled_kept
 
-    from .files import keep_quietly
-
-    path = os.path.join(LOOP_CACHE, f"loop-{zlib.crc32(source.encode()):08x}-{len(source):x}.{tag}.marshal")
-    try:
-        with open(path, "rb") as kept:
-            held = marshal.loads(kept.read())
-        if (type(held) is tuple and len(held) == 3 and held[0] == source and held[1] == filename
-                and isinstance(held[2], CodeType)):
-            return held[2]
-    except (OSError, ValueError, EOFError, TypeError):
-        pass
-    code = compile(source, filename, "exec")
-    if not sys.dont_write_bytecode:
-        keep_quietly(path, marshal.dumps((source, filename, code)))
-    return code
+    return compiled_kept(source, filename, LOOP_CACHE if fixed_source else None)
 
 
 def build_loop(loop: Loop, names: dict[str, Any] | None = None, *,

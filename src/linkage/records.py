@@ -48,14 +48,17 @@ from collections.abc import Iterator
 from types import CodeType
 from typing import TYPE_CHECKING, Any, TypeVar
 
+# at import, not while a class is made: files' own imports (pathlib, urllib.parse) make named
+# tuples, which would go through kept_code while it holds its lock
+from .files import keep_quietly, kept_bytes, kept_code_path, read_kept
+
 T = TypeVar("T")
 
 KEPT_MODULES = "linkage."
 """The modules whose classes' methods are kept (a user's class made by :func:`frozen` is
 made as ever)."""
 
-_BESIDE = os.path.join(os.path.dirname(__file__), "__pycache__")
-STORE: str | None = _BESIDE
+STORE: str | None = os.path.join(os.path.dirname(__file__), "__pycache__")
 """The directory of the kept file (beside the package's own bytecode); None: nowhere."""
 
 _STATE = threading.local()
@@ -70,27 +73,15 @@ _LOCK = threading.Lock()
 
 def store_path(module: str) -> str | None:
     """The kept file of ``module``'s classes for this interpreter, or None (no store, no
-    cache tag). A file a module: a command reads only the classes it imports."""
-    tag = sys.implementation.cache_tag
-    if STORE is None or tag is None:
-        return None
-    where = STORE
-    if sys.pycache_prefix and where == _BESIDE:  # where Python keeps this package's bytecode
-        where = os.path.join(sys.pycache_prefix, os.path.dirname(os.path.abspath(__file__)).lstrip(os.sep))
-    return os.path.join(where, f"dataclass-{module}.{tag}.marshal")
+    cache tag): :func:`~linkage.files.kept_code_path`'s rule. A file a module: a command
+    reads only the classes it imports."""
+    return None if STORE is None else kept_code_path(STORE, f"dataclass-{module}")
 
 
 def _read(path: str | None) -> dict[str, CodeType]:
-    """The kept codes, or {} where the file is missing, unreadable or not such a table."""
-    import marshal
-
-    if path is None:
-        return {}
-    try:
-        with open(path, "rb") as kept:
-            held = marshal.loads(kept.read())
-    except (OSError, ValueError, EOFError, TypeError):
-        return {}
+    """The kept codes, or {} where the file is missing, unreadable, of another bytecode
+    version (:func:`~linkage.files.read_kept`) or not such a table."""
+    held = read_kept(path)
     if type(held) is not dict or not all(type(k) is str and isinstance(v, CodeType) for k, v in held.items()):
         return {}
     return held
@@ -267,12 +258,8 @@ def save() -> None:
     that cannot be written is no error."""
     if sys.dont_write_bytecode:
         return
-    import marshal
-
-    from .files import keep_quietly
-
     with _LOCK:
-        todo = [(store_path(m), marshal.dumps(_used[m])) for m in sorted(_added)]
+        todo = [(store_path(m), kept_bytes(_used[m])) for m in sorted(_added)]
         _added.clear()
     for path, data in todo:
         if path is not None:
