@@ -142,12 +142,20 @@ def certify_root(problem: ScalarProblem, x: float, fx: float | None, width: floa
     precision it can be computed with), or a sign change of f across [x - width, x + width]
     that is not a jump or a pole (:func:`check_sign_change`). Otherwise ``STALLED``: a
     small step is only a symptom (Newton near a pole, an overflowing power, a flat f).
-    Returns (status, detail, extra evaluations of f).
+    Where no double but x lies within ``width`` of x (the tolerance is below half the
+    spacing of doubles there: x = 1e17 deg, where that spacing is 16 deg), no evidence can
+    place a root within it, and a zero step says only that x + step rounds to x:
+    ``PRECISION_LIMIT``, unless f(x) is exactly zero. Returns (status, detail, extra
+    evaluations of f).
     """
     if not isinstance(fx, (int, float)) or not math.isfinite(fx):
         return Status.STALLED, f"f = {fx!r} at the last iterate", 0
     if fx == 0.0:
         return STATUS_MEMBERS.CONVERGED_STEP, "", 0
+    if x - width == x and x + width == x:
+        return (Status.PRECISION_LIMIT,
+                f"no double but {problem.var} = {x!r} lies within the tolerance {width:.3g} of it (doubles "
+                f"there are {math.ulp(x):.3g} apart), so no root can be shown within it; f = {fx:.3g}", 0)
     if problem.fbound is not None:
         bound = value_or_none(problem.fbound, x)
         if bound is not None and abs(fx) <= bound:
