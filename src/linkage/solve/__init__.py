@@ -23,5 +23,11 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
+def __dir__() -> list[str]:
+    """The module's names with the two imported on first use (PEP 562), as ``dir`` and a
+    completing shell list them."""
+    return sorted({*globals(), *__all__})
+
+
 __all__ = ["MAX_RELATIVE_TOL", "SYSTEM_METHODS", "certify_root", "check_criteria", "nearest_branch",
            "solve_scalar", "solve_system", "system_verdict"]
