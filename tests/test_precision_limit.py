@@ -56,11 +56,3 @@ def test_the_command_line_says_so_and_exits_1() -> None:
     assert "stopped at the limit of double precision" in run.stdout
     assert "converged" not in run.stdout.split("Convergence")[0].lower().replace("not converged", "")
 
-
-def test_dir_of_linkage_solve_lists_the_names_imported_on_first_use() -> None:
-    """solve_scalar and certify_root come through the module's __getattr__ (PEP 562); dir()
-    lists them without importing them."""
-    code = ("import sys, linkage.solve as s; names = dir(s); "
-            "print(all(n in names for n in s.__all__), 'linkage.solve.scalar' in sys.modules)")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.split() == ["True", "False"]
