@@ -186,6 +186,16 @@ def test_every_frozen_dataclass_of_the_package_is_made_by_records_frozen():
     assert offenders == []
 
 
+def test_every_named_tuple_of_the_package_is_made_by_records_named_tuple():
+    """One way to make the package's named tuples too: typing's own compiles a ForwardRef per
+    field and namedtuple's __new__ at every import (records.py is the one module that uses it)."""
+    src = Path(records.__file__).parent
+    pattern = r"^from typing import [^\n]*\bNamedTuple\b|\btyping\.NamedTuple\b"
+    offenders = [str(p.relative_to(src)) for p in sorted(src.rglob("*.py"))
+                 if p.name != "records.py" and re.search(pattern, p.read_text(), re.M)]
+    assert offenders == []
+
+
 def test_a_users_class_made_by_frozen_is_not_kept(store, monkeypatch):
     monkeypatch.setattr(records, "KEPT_MODULES", "linkage.")
     point, _ = _classes(records.frozen)

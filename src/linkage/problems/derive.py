@@ -30,8 +30,9 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Mapping, Sequence
-from typing import Any, NamedTuple
+from typing import Any
 
+from ..records import NamedTuple
 from .assembly import MIRROR, TANGENT_SLACK, Indeterminate
 from .steps import (
     FourbarLoop,

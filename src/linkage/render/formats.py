@@ -22,9 +22,10 @@ from __future__ import annotations
 import contextlib
 import math
 from collections.abc import Sequence
-from typing import IO, Any, NamedTuple
+from typing import IO, Any
 
 from ..errors import InputError
+from ..records import NamedTuple
 from . import cells
 from .cells import (
     Sink,
