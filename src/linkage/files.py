@@ -5,10 +5,14 @@ could block or never end) of at most :data:`MAX_INPUT_BYTES`; it is read with th
 
 Outputs: every path is checked before any work is done (:func:`check_outputs`): it may not
 resolve to an input (through symlinks and hard links alike), two outputs may not share a
-path, and its folder must exist. Regular files are written to a temporary file in the same
-folder and renamed over the target (:func:`write_atomic`, :func:`atomic_target`), so a full
-disk or an interrupted run leaves the old file as it was. Special files (``/dev/null``, a
-terminal, a FIFO) are written in place, since renaming over them would replace the device.
+path, and its folder must exist. While a command runs (:func:`command_paths`), every file it
+has read (:func:`read_input`) and every file it has written count as well, so a path known
+only once the work is done (a report's second table, ``FILE.NAME.csv``) meets the same
+check, and :func:`atomic_target` checks each path it writes again, last (:func:`claim_output`).
+Regular files are written to a temporary file in the same folder and renamed over the
+target (:func:`write_atomic`, :func:`atomic_target`), so a full disk or an interrupted run
+leaves the old file as it was. Special files (``/dev/null``, a terminal, a FIFO) are
+written in place, since renaming over them would replace the device.
 """
 
 from __future__ import annotations
@@ -162,6 +166,7 @@ def read_input(path: Path, what: str = "mechanism file") -> str:
         raise ParseError(f"cannot read {path}: {exc.strerror or exc}") from None
     if len(data) > MAX_INPUT_BYTES:
         raise ParseError(f"{path} is larger than {MAX_INPUT_BYTES:,} bytes")
+    note_input(path)
     return _text(data, str(path))
 
 
@@ -180,18 +185,79 @@ def _identity(path: Path) -> tuple[int, int] | None:
     return st.st_dev, st.st_ino
 
 
+class CommandPaths:
+    """The files one command has read and written so far, each under its real path and its
+    (device, inode) identity (a symlink and a hard link are the file they name)."""
+
+    __slots__ = ("inputs", "written")
+
+    def __init__(self) -> None:
+        self.inputs: dict[object, str] = {}
+        self.written: dict[object, str] = {}
+
+
+RUNNING: list[CommandPaths] = []
+"""The running command's paths (:func:`command_paths`); empty outside a command, where
+reading and writing record nothing (a library caller's files are its own business)."""
+
+
+@contextlib.contextmanager
+def command_paths() -> Iterator[CommandPaths]:
+    """While the block runs, :func:`read_input` records each file read, :func:`atomic_target`
+    each file written, and :func:`check_outputs` refuses an output that is one of them."""
+    run = CommandPaths()
+    RUNNING.append(run)
+    try:
+        yield run
+    finally:
+        RUNNING.remove(run)
+
+
+def _keys(path: Path | str) -> list[object]:
+    """The real path and, for an existing file, its identity: the keys a file is known by."""
+    ident = _identity(Path(path))
+    return [os.path.realpath(path)] + ([ident] if ident is not None else [])
+
+
+def note_input(path: Path | str) -> None:
+    """Record ``path`` as read by the running command (if one runs)."""
+    if RUNNING and str(path) != "-":
+        RUNNING[-1].inputs.update(dict.fromkeys(_keys(path), str(path)))
+
+
+def claim_output(path: Path | str) -> None:
+    """The last check of a path about to be written by the running command (if one runs):
+    not a file it read, not a file it wrote already; then recorded as written. Special files
+    (``/dev/null``) are exempt: writing one replaces nothing."""
+    if not RUNNING or _in_place(os.path.realpath(path)):
+        return
+    run = RUNNING[-1]
+    keys = _keys(path)
+    for key in keys:
+        if key in run.inputs:
+            named = "" if run.inputs[key] == str(path) else f" {run.inputs[key]}"
+            raise InputError(f"this command would write {path}, the input file{named}, and so replace it: "
+                             "choose another output path")
+        if key in run.written:
+            also = "" if run.written[key] == str(path) else f" (as {run.written[key]})"
+            raise InputError(f"this command would write {path} twice{also}: give each output its own path")
+    run.written.update(dict.fromkeys(keys, str(path)))
+
+
 def check_outputs(inputs: Sequence[Path | None], outputs: Sequence[tuple[str, Path | None]]) -> None:
     """Refuse, before any work, an output that is an input, two outputs on one path, an
-    output in a missing folder or on a directory. ``outputs`` pairs option names with paths."""
+    output in a missing folder or on a directory. ``outputs`` pairs option names with paths.
+    Within a command (:func:`command_paths`) the files it has read and written so far count
+    too."""
     given = [(opt, p) for opt, p in outputs if p is not None and str(p) != "-"]
-    in_ids = {}
+    in_ids: dict[object, Path | str] = dict(RUNNING[-1].inputs) if RUNNING else {}
     for p in inputs:
         if p is not None and str(p) != "-":
             ident = _identity(p)
             if ident is not None:
                 in_ids[ident] = p
             in_ids[os.path.realpath(p)] = p
-    seen: dict[object, str] = {}
+    seen: dict[object, str] = dict(RUNNING[-1].written) if RUNNING else {}
     for opt, p in given:
         real = os.path.realpath(p)
         ident = _identity(p)
@@ -223,12 +289,15 @@ def _in_place(path: str) -> bool:
 
 
 @contextlib.contextmanager
-def atomic_target(path: Path) -> Iterator[str]:
+def atomic_target(path: Path, *, output: bool = True) -> Iterator[str]:
     """Yield a temporary path beside ``path``; on success rename it over ``path``.
 
     Writes through a symlink to its target. On any failure the temporary file is
-    removed, the old file is untouched and an OutputError names the path.
+    removed, the old file is untouched and an OutputError names the path. An ``output``
+    of a command (not a cache: ``output=False``) is checked first by :func:`claim_output`.
     """
+    if output:
+        claim_output(path)
     real = os.path.realpath(path)
     if _in_place(real):
         try:
@@ -326,7 +395,7 @@ def keep_quietly(path: str, data: bytes) -> None:
     (a reader never sees half a file); quietly: a cache that cannot be written is no error."""
     try:
         os.makedirs(os.path.dirname(path), exist_ok=True)
-        with atomic_target(Path(path)) as part, open(part, "wb") as out:
+        with atomic_target(Path(path), output=False) as part, open(part, "wb") as out:
             out.write(data)
     except (OSError, OutputError):
         return

@@ -34,9 +34,12 @@ def run_cli(argv: list[str] | None = None) -> int:
     """Run the app and turn every error into one stderr line and an exit code; the notes
     a command made (:func:`note_closed_form`) follow its output when it ran (exit 0 or 1),
     not when it was refused or stopped (the error is then the one line)."""
+    from ..files import command_paths
+
     args = list(sys.argv[1:] if argv is None else argv)
     NOTED.clear()  # each command says its notes once
-    code = _run_command(args)
+    with command_paths():  # no output of the run may be a file it read or wrote (files.check_outputs)
+        code = _run_command(args)
     if code in (0, 1):
         for note in NOTED:
             typer.echo(_for_stderr(f"note: {note}"), err=True)

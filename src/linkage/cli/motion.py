@@ -21,10 +21,13 @@ def read_poses(pose: list[str], poses_file: Optional[Path]) -> list[tuple[float,
         if not pose:
             raise InputError("--motion: give 5 poses, --pose X,Y,DEG repeated (or --poses FILE)")
         return pose_list(pose)
-    try:
-        text = poses_file.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"--poses {poses_file}: cannot read it ({exc})") from None
+    from ..errors import ParseError
+    from ..files import read_input
+
+    try:  # as a mechanism file is read: a regular file, of bounded size (files.read_input)
+        text = read_input(poses_file, "poses file")
+    except ParseError as exc:
+        raise InputError(f"--poses: {exc}") from None
     lines = [ln.split("#", 1)[0].strip() for ln in text.splitlines()]
     return pose_list([",".join(ln.replace(",", " ").split()) for ln in lines if ln])
 

@@ -99,7 +99,8 @@ def sweep(
     from ..solve import SYSTEM_METHODS, check_criteria
 
     out_fmt = choose_format(fmt, output)
-    check_paths([file], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})
+    check_paths([file], [("--output", output), ("--plot", plot), ("--torque-plot", torque_plot)],
+                {"--plot": (plot, PICTURES), "--torque-plot": (torque_plot, PICTURES)})
     check_criteria(tol, 0.0, None, 50)
     equation_only = {"--r1": r1, "--r2": r2, "--r3": r3, "--links": links}
     if file is None:

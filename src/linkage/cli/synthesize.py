@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import DigitsOpt, ForceOpt, TableOpt, check_paths, mechanism_output
+from .options import PICTURES, DigitsOpt, ForceOpt, TableOpt, check_paths, mechanism_output
 from .root import app
 
 
@@ -184,9 +184,9 @@ def synthesize(
     design = output is not None and output.suffix.lower() == ".toml"
     report_out = None if design or output is None or str(output) == "-" else output
     fmt = writers.choose_format(fmt, report_out)
-    check_paths([], [("--output", output)], {"--plot": (plot, (".png", ".svg", ".pdf"))})
+    check_paths([poses], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})
     if design:
-        mechanism_output(output, force)
+        mechanism_output(output, force, [poses])
     if unit not in LENGTH_UNITS:
         raise InputError(f"--unit {unit!r} is not a length unit (units: {', '.join(LENGTH_UNITS)})")
     if motion:
