@@ -340,3 +340,37 @@ def test_a_drive_that_cannot_be_evaluated_is_one_line_or_a_named_event(cli):
     r = cli("simulate", loads, "--time", "0:1", "--drive", "theta/(t-0.5)", "--samples", "3", "-f", "plain")
     assert r.code == 1 and "internal error" not in r.err
     assert "event: integration_failed at t = 0.5 s" in r.out and "to 0.5 s" in r.out
+
+
+# --- what an adversarial pass found: never a hang, never an internal error ---------------------
+
+
+@pytest.mark.parametrize("span", [(1e15, 1.0000000000001e15), (1e14, 100000000000000.1), (1e12, 1e12 + 1.0)])
+def test_a_time_span_finer_than_double_precision_resolves_is_refused(cli, span):
+    """At t = 1e15 s times are 0.125 s apart: 0.1 s there had no time to step to (it ran
+    past a minute at full load), and 1e14 + 0.1 had output times out of order (an internal
+    error). The driver grids' rule (rules.grid_resolved) refuses them at once."""
+    with pytest.raises(InputError, match="finer than double precision"):
+        linkage.simulate(linkage.load_mechanism(str(LOADED)), drive="1", time=span)
+    run = cli("simulate", str(LOADED), "--time", f"{span[0]!r}:{span[1]!r}", "--drive", "1")
+    assert run.code == 2 and run.err.count("\n") == 1 and "finer than double precision" in run.err
+
+
+@pytest.mark.parametrize("drive,time", [("1e300", (0.0, 1.0)), ("1", (1e300, 1.0000001e300))])
+def test_a_run_that_cannot_take_a_step_ends_integration_failed_with_its_start(drive, time):
+    """A drive of 1e300 N m, or a span at 1e300 s, leaves the integrator no step: the run is
+    integration_failed at its start with the start's row, not an IndexError; forces beyond
+    the kinetostatic solver's range are undefined there, and counted."""
+    sim = linkage.simulate(linkage.load_mechanism(str(LOADED)), drive=drive, time=time)
+    assert sim.event == "integration_failed" and len(sim.t) == 1 and sim.t[0] == time[0]
+    if drive == "1e300":
+        assert sim.forces == (None,) and sim.beyond_rates == 1
+
+
+def test_a_drive_beyond_the_solvers_rates_leaves_those_forces_undefined_not_an_error(cli):
+    """The kinetostatic solver refuses a speed or acceleration above 1e12 from a person; a
+    simulated one there (a drive with a pole) leaves that row's forces undefined, said once,
+    instead of "accel must be ..." naming an option nobody gave."""
+    run = cli("simulate", str(LOADED), "--time", "0:0.4", "--drive", "1e300*omega", "--omega0", "1")
+    assert run.code == 1 and "accel must be" not in run.err
+    assert "forces undefined at 1 of 1 output times" in run.out

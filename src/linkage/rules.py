@@ -187,6 +187,24 @@ def continuity_measures_array(q_last: Sequence[Any], pred: Sequence[Any],
     return correction, moved, size
 
 
+# --- a grid that double precision resolves -----------------------------------------------------
+
+GRID_RESOLUTION = 1e6
+"""Doubles that at least separate two neighbouring values of a grid (a sweep's driver values,
+a simulation's output times): a spacing of fewer than this many units in the last place of
+its largest value leaves each value rounded by more than a millionth of the spacing."""
+
+
+def grid_resolved(start: float, stop: float, spacing: float) -> tuple[bool, float]:
+    """(whether values ``spacing`` apart from ``start`` to ``stop`` are resolved in double
+    precision, the spacing of doubles at the larger end): the one rule for driver grids and
+    output times."""
+    import math
+
+    ulp = math.ulp(max(abs(start), abs(stop)))
+    return spacing >= GRID_RESOLUTION * ulp, ulp
+
+
 # --- the array engines' stopping order ---------------------------------------------------------
 # The numpy twin of the ordered stopping tests iterate.run applies to Newton-Raphson on a
 # system (iterate.py's module docstring lists them; methods/newton_system.newton_2x2 is the

@@ -10,6 +10,7 @@ from typing import Any
 
 from ..problems.loops import Mechanism
 from ..records import frozen
+from ..rules import grid_resolved
 from ..units import RAD_PER_DEG
 
 
@@ -194,8 +195,8 @@ def driver_values(start: float, stop: float, step: float | None, points: int | N
             raise InputError(f"--from {start:g} --to {stop:g} --step {step:g} is more than "
                              f"{MAX_POSITIONS:,} positions; use a larger --step")
         spacing = step
-    ulp = math.ulp(max(abs(start), abs(stop)))
-    if points != 1 and not spacing >= 1e6 * ulp:
+    resolved, ulp = grid_resolved(start, stop, spacing)
+    if points != 1 and not resolved:
         raise InputError(f"--from {start:g} and --to {stop:g} are too large for a spacing of "
                          f"{spacing:g}: double precision resolves only {ulp:.3g} there")
     if points is not None:

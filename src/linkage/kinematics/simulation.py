@@ -70,6 +70,10 @@ class Simulation:
     """kg m^2, on the driver."""
     trace: tuple[Any, Any, Any] = ((), (), ())
     """(t, theta, omega) at 2001 times from the integrator's dense output, for pictures."""
+    beyond_rates: int = 0
+    """Output times whose forces are undefined (None) because the simulated speed or
+    acceleration is beyond the kinetostatic solver's range (:func:`linkage.arguments.rate_in_range`:
+    a drive with a pole, a drive of 1e300 N m)."""
 
 
 @frozen
@@ -101,15 +105,25 @@ class Cycle:
         return max(self.energy_swing / (cs * self.omega_mean ** 2) - self.inertia_mean, 0.0)
 
 
-def _checked_time(time: Any) -> tuple[float, float]:
+def _checked_time(time: Any, samples: int) -> tuple[float, float]:
+    """(start, end) s, finite, end > start, and ``samples`` output times between them that
+    double precision resolves (:func:`linkage.rules.grid_resolved`, the driver grids' rule:
+    at t = 1e15 s times are 0.125 s apart, and a span of 0.1 s there has no time in it for
+    the integrator to step to)."""
     from ..arguments import describe, finite_real
+    from ..rules import grid_resolved
 
     if not isinstance(time, (tuple, list)) or len(time) != 2:
         raise InputError(f"time: give (start, end) in s, got {describe(time)}")
     a, b = (finite_real(v) for v in time)
     if a is None or b is None or not b > a:
         raise InputError(f"time: give finite (start, end) in s with end > start, got {describe(time)}")
-    return float(a), float(b)
+    a, b = float(a), float(b)
+    resolved, ulp = grid_resolved(a, b, (b - a) / (samples - 1))
+    if not resolved:
+        raise InputError(f"time: {a!r} to {b!r} s in {samples} output times is finer than double precision "
+                         f"resolves there (times {ulp:.3g} s apart): start nearer 0 or span longer")
+    return a, b
 
 
 def _checked_friction(friction: Any, drawing: Any, what: str) -> tuple[float, dict[str, float]]:
@@ -172,7 +186,6 @@ def simulate(
 
     mechanism = mechanism_of("mechanism", mechanism)
     frame = Frame.of(mechanism)
-    start, end = _checked_time(time)
     if isinstance(drive, str):
         consts = {}
         for kname, v in (constants or {}).items():
@@ -212,6 +225,7 @@ def simulate(
     if not isinstance(samples, int) or isinstance(samples, bool) or not 2 <= samples <= 100_000:
         raise InputError("samples: give a whole number of output times from 2 to 100000, got "
                          f"{describe(samples)}")
+    start, end = _checked_time(time, samples)
     for name, tol in (("rtol", rtol), ("atol", atol)):
         if not 1e-14 <= check_number(name, tol) <= 1e-2:
             raise InputError(f"{name}: give a tolerance from 1e-14 to 1e-2, got {tol!r}")
@@ -348,6 +362,11 @@ def integrate(dyn: Dynamics, drive: Callable[[float, float, float], float], thet
         return _outputs(dyn, drive, sol, *_at_event(dyn, eq, sol, rtol, atol))
     event, event_time, message = None, None, ""
     t_out, y_out = sol.t, sol.y
+    if sol.status != 0 and not len(t_out):
+        # no step from the start (a drive or a span too large for any step: the rows are
+        # the start's alone, the run integration_failed there)
+        return _outputs(dyn, drive, sol, np.array([start]), np.array(y0, dtype=float)[:, None],
+                        "integration_failed", start, sol.message)
     if sol.status != 0:
         event, message = "integration_failed", sol.message
         ts = getattr(sol.sol, "ts", None) if sol.sol is not None else None
@@ -429,6 +448,7 @@ def _outputs(dyn: Dynamics, drive: Callable[[float, float, float], float], sol: 
              event: str | None, event_time: float | None, message: str) -> Simulation:
     import numpy as np
 
+    from ..arguments import rate_in_range
     from ..problems.loads import Loads
     from .forces import forces_at
 
@@ -438,6 +458,7 @@ def _outputs(dyn: Dynamics, drive: Callable[[float, float, float], float], sol: 
     unknowns = {u: np.zeros(n) for u in names}
     forces = []
     worst = size = 0.0
+    beyond = 0
     base = dyn.loads
     dyn.restart()
     for i in range(n):
@@ -462,8 +483,12 @@ def _outputs(dyn: Dynamics, drive: Callable[[float, float, float], float], sol: 
             torques[b] = torques.get(b, 0.0) + tq
         loads = Loads(base.forces, torques, base.masses, base.gravity, base.on)
         c = dyn.c
-        f = forces_at(dyn.mechanism, p.q, loads, speed=_at_rest(omega / c), accel=_at_rest(alpha[i] / c),
-                      driver=theta / c)
+        speed, accel = _at_rest(omega / c), _at_rest(alpha[i] / c)
+        if not (rate_in_range(speed) and rate_in_range(accel)):
+            beyond += 1  # the kinetostatic solver takes no such rate: no forces here
+            forces.append(None)
+            continue
+        f = forces_at(dyn.mechanism, p.q, loads, speed=speed, accel=accel, driver=theta / c)
         forces.append(f)
         if f.input is not None:
             need = f.input + dyn.flywheel * alpha[i]
@@ -471,14 +496,15 @@ def _outputs(dyn: Dynamics, drive: Callable[[float, float, float], float], sol: 
     total = kin + pot - y[2] - y[3] - y[4]
     energy = max(float(np.nanmax(np.abs(np.concatenate([kin, pot - pot[0], y[2], y[3], y[4]])))), 1e-300)
     balance = float(np.nanmax(np.abs(total - total[0]))) / energy
-    cycle = None if dyn.sliding else _last_cycle(dyn, sol, float(t[-1]))
+    stepped = sol.sol is not None and len(sol.t) > 0  # (not where no step was taken)
+    cycle = None if dyn.sliding or not stepped else _last_cycle(dyn, sol, float(t[-1]))
     unit = "N" if dyn.sliding else "N m"
     tt = np.linspace(float(t[0]), float(t[-1]), 2001)
-    dense = sol.sol(tt)
+    dense = sol.sol(tt) if stepped else np.repeat(np.asarray(y, dtype=float)[:, :1], len(tt), axis=1)
     return Simulation(t, y[0], y[1], alpha, tau, unknowns, kin, pot, y[2], y[3], y[4], balance,
                       tuple(forces), worst / max(size, 1e-300), event, event_time, message, int(sol.nfev),
                       cycle,
-                      unit, dyn.sliding, dyn.flywheel, (tt, dense[0], dense[1]))
+                      unit, dyn.sliding, dyn.flywheel, (tt, dense[0], dense[1]), beyond)
 
 
 def _last_cycle(dyn: Dynamics, sol: Any, t_end: float) -> Cycle | None:

@@ -157,6 +157,11 @@ def _lines(sim: Any, checks: _Checks, digits: int) -> list[str]:
         out.append(f"flywheel for Cs = {target:g}: about {fmt(c.flywheel_for(target), 3)} kg m^2 "
                    f"(kinetic energy swing {fmt(c.energy_swing, 3)} J over the turn)")
     out.append(f"integrator: DOP853, {sim.nfev} evaluations")
+    if sim.beyond_rates:
+        from ..arguments import MAX_RATE
+
+        out.append(f"forces undefined at {sim.beyond_rates} of {len(sim.t)} output times: the speed or "
+                   f"acceleration there is beyond {MAX_RATE:g} per s (the kinetostatic solver's range)")
     if sim.event is not None:
         out.append(f"event: {sim.event} at t = {fmt(sim.event_time, digits)} s: {sim.message}")
     return out
@@ -166,6 +171,7 @@ def _document(sim: Any, title: str, checks: _Checks) -> dict[str, Any]:
     """The json document's summary."""
     c = sim.cycle
     return {"title": title, "event": sim.event, "event_time": sim.event_time, "message": sim.message,
+            "forces_beyond_rates": sim.beyond_rates,
             "energy_balance": sim.balance, "energy_ok": checks.energy_ok, "drive_check": sim.drive_check,
             "drive_ok": checks.drive_ok, "evaluations": sim.nfev,
             "cycle": None if c is None else {"start": c.start, "end": c.end, "omega_min": c.omega_min,
