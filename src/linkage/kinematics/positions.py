@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from dataclasses import field
 from typing import Any
 
+from ..errors import InputError
 from ..problems.loops import Mechanism
 from ..records import frozen
 from ..units import RAD_PER_DEG
@@ -212,3 +213,24 @@ def driver_values(start: float, stop: float, step: float | None, points: int | N
 
         return start + np.arange(n + 1, dtype=np.float64) * step
     return [start + k * step for k in range(n + 1)]
+
+
+def check_assembles_somewhere(summary: dict[str, int], what: str, span: str) -> None:
+    """InputError where no position of a sweep assembles, every one ``no_solution`` (the
+    closed form has no real solution there, or least squares cannot close the loops:
+    docs/sweeps.md, "Statuses"): a linkage that cannot be assembled anywhere in the range
+    asked for is bad input, as ``centres`` and ``convert`` refuse it at one value. A sweep
+    where some position assembles keeps its ``no_solution`` rows. ``summary``: the count
+    of each status; ``what`` names the linkage, ``span`` the driver range."""
+    if summary and set(summary) == {"no_solution"}:
+        n = summary["no_solution"]
+        raise InputError(f"{what}: cannot be assembled at any {span} (no_solution at every one of "
+                         f"its {n} position{'s' if n != 1 else ''})")
+
+
+def driver_range_text(result: SweepResult) -> str:
+    """The driver range of a sweep's positions, as a refusal names it (display units)."""
+    inputs = result.inputs
+    low, high = min(inputs), max(inputs)
+    unit = f" {result.driver_unit}" if result.driver_unit else ""
+    return f"{result.driver} from {low:.12g} to {high:.12g}{unit}"
