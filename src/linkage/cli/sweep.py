@@ -149,7 +149,7 @@ def sweep(
     with progress_bar(2 * n if data else n, minimum=4000 if data else 2000) as advance:
         result = sweep_mechanism(mechanism, values, method=method, branch=branch, tol=tol, batch=batch,
                                  progress=advance, speed=w, accel=a_, joints=data or bool(path))
-        check_assembles_somewhere(result.summary, str(file), driver_range_text(result))
+        check_assembles_somewhere(result.summary, str(file), lambda: driver_range_text(result))
         if advance is not None and data:
             advance(n, f"writing {out_fmt}")
         note = "" if data or not named else \
@@ -230,7 +230,7 @@ def sweep_equation(a: float, b: float, step: float | None, points: int | None, m
     heading = coeffs.split(', ', 2)[2] if coeffs.count(', ') >= 2 else coeffs
     statuses = [r[1] for r in rows]
     check_assembles_somewhere({s: statuses.count(s) for s in set(statuses)}, f"the four-bar of {heading}",
-                              f"alpha from {values[0]:.12g} to {values[-1]:.12g} deg")
+                              lambda: f"alpha from {values[0]:.12g} to {values[-1]:.12g} deg")
     emit_report(equation_report(rows, method, tol, heading, digits), out_fmt, output)
     # as a mechanism sweep: where the linkage cannot be assembled is an answer, not a failure
     if any(r[2] is None and r[1] != "no_solution" for r in rows):
