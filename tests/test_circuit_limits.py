@@ -48,3 +48,24 @@ def test_assemblies_sweep_near_a_limit_prints_two_limit_positions(cli, start):
     assert out.code == 0, out.err
     assert "theta2 from -112.024313 to 112.024313 deg, 2 limit positions" in out.out
     assert "unfinished" not in out.out
+
+
+def _limit_deg(r1: float, r2: float, diagonal: float) -> float:
+    """The crank angle at which the diagonal A-O4 is ``diagonal`` (law of cosines, 40 digits)."""
+    with mp.workdps(40):
+        r1_, r2_, d = mpf(r1), mpf(r2), mpf(diagonal)
+        return float(mp_degrees(acos((r1_ * r1_ + r2_ * r2_ - d * d) / (2 * r1_ * r2_))))
+
+
+@pytest.mark.parametrize("gap_deg", [1e-3, 1e-6, 1e-9])
+@pytest.mark.parametrize("at_low", [True, False])
+def test_double_rocker_started_near_either_limit_reports_both(gap_deg, at_low):
+    """The Grashof double rocker r1..r4 = 100, 80, 30, 90 rocks between the folded (|r4 - r3|
+    = 60) and extended (r3 + r4 = 120) diagonals; started just inside either limit, the
+    circuit leaves away from it (near the low one) or through it (near the high one)."""
+    low, high = _limit_deg(100, 80, 60), _limit_deg(100, 80, 120)
+    start = low + gap_deg if at_low else high - gap_deg
+    m = load(SAMPLES / "crank_rocker.toml").with_values({"r2": 80, "r3": 30, "r4": 90}, {})
+    (circ,) = circuits(m, radians(start)).circuits
+    assert circ.status == "closed" and circ.members == (0, 1)
+    assert sorted(degrees(v) for v in circ.limits) == pytest.approx([low, high], abs=1e-9)
