@@ -115,5 +115,7 @@ def test_parallel_slides_along_the_known_vectors_are_a_change_point_not_unassemb
     assert doc["reference"] is None
     s, t = doc["solution"]["s"], doc["solution"]["t"]
     assert s + t == pytest.approx(50.0, abs=1e-6)  # Newton's answer is one of them
-    doc = json.loads(cli("solve", str(path), "--set", "theta=30", "--format", "json").out)
-    assert doc["reference"] == {}
+    # off the line the closed form has no assembly ({}): the command line refuses it (exit 2)
+    assert m.with_values({"theta": 30}, {}).problem().reference() == {}
+    run = cli("solve", str(path), "--set", "theta=30", "--format", "json")
+    assert run.code == 2 and "cannot be assembled at theta = 30" in run.err and run.out == ""

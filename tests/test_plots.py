@@ -85,7 +85,9 @@ def test_plot_bad_input(cli, tmp_path, monkeypatch, args, message):
     assert run.code == 2 and message in run.err
 
 
-def test_drawing_a_position_that_cannot_be_assembled_exits_1(cli, tmp_path):
+def test_drawing_a_position_that_cannot_be_assembled_is_refused(cli, tmp_path):
+    """Bad input, as centres refuses it: one line, exit 2, no picture (it was exit 1)."""
     run = cli("draw", str(SAMPLES / "fourbar_me581.toml"), "--set", "theta2=180",
               "-o", str(tmp_path / "x.png"))
-    assert run.code == 1 and "cannot draw" in run.err
+    assert run.code == 2 and "cannot be assembled at theta2 = 180 deg" in run.err
+    assert len(run.err.strip().splitlines()) == 1 and not (tmp_path / "x.png").exists()

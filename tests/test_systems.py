@@ -259,13 +259,19 @@ def test_a_change_point_is_indeterminate_not_unassemblable():
 
 
 def test_non_assemblable_input_is_no_solution_with_rows(cli):
-    run = cli("solve", ME581, "--set", "theta2=180", "--format", "json")
-    assert run.code == 1
-    doc = json.loads(run.out)
-    assert doc["status"] == "no_solution" and "cannot be assembled at theta2 = 180" in doc["message"]
-    assert len(doc["iterations"]) > 0
-    lm = json.loads(cli("solve", ME581, "--set", "theta2=180", "--method", "lm", "--format", "json").out)
-    assert lm["status"] == "no_solution" and lm["converged"] is False
+    """The library's solve runs and names it no_solution, with its rows; the command line
+    refuses it as bad input (one line, exit 2: docs/output.md, "Exit codes")."""
+    problem = load_mechanism(ME581).with_values({"theta2": 180}, {}).problem()
+    r = solve_system(problem)
+    assert r.status is Status.NO_SOLUTION and "cannot be assembled at theta2 = 180" in r.message
+    assert len(r.history.rows) > 0
+    lm = solve_system(problem, method="lm")
+    assert lm.status is Status.NO_SOLUTION and not lm.converged
+    for method in ("newton", "lm"):
+        run = cli("solve", ME581, "--set", "theta2=180", "--method", method, "--format", "json")
+        assert run.code == 2 and run.out == ""
+        assert run.err.strip().endswith("cannot be assembled at theta2 = 180 deg (the closed form has no "
+                                         "real solution)"), run.err
 
 
 def test_singular_start_is_a_named_stop(cli):

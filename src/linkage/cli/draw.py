@@ -39,10 +39,10 @@ def draw(
     Example: linkage draw sample_inputs/fourbar_me581.toml --set theta2=80 -o fourbar.png
     """
     from ..arguments import check_fps, check_number, driver_span
+    from ..kinematics.centres import assembled
     from ..kinematics.loading import load
     from ..kinematics.sweep import driver_values
     from ..kinematics.sweep import sweep as run_sweep
-    from ..solve import solve_system
 
     if output is None and animate is None:
         raise InputError("give -o PATH for a drawing, --animate PATH.gif for an animation, or both")
@@ -63,10 +63,7 @@ def draw(
     note_closed_form(mechanism)
     if output is not None:
         problem = mechanism.problem()
-        result = solve_system(problem, tol=1e-12, record=False)
-        if not result.converged:
-            typer.echo(f"error: cannot draw {file} at {problem.title}: {result.message}", err=True)
-            raise typer.Exit(1)
+        result = assembled(mechanism)  # refused as centres and convert refuse it (exit 2)
         if sheet:
             _write_sheet(mechanism, result.x, output, start, stop, step)
         else:

@@ -138,7 +138,7 @@ def solve(
     if bracket is not None:
         check_number("bracket start", bracket[0])
         check_number("bracket end", bracket[1])
-    problem = scalar_problem(equation, g, alpha, r1, r2, r3, links)
+    problem = scalar_problem(equation, g, alpha, r1, r2, r3, links, refuse_unassembled=True)
     summary = method == "all" or "," in method  # several methods: one summary row each
     if method == "all":
         names = [m for m in SCALAR_METHODS if applicable(m, problem, equation, x0, x1, bracket)]

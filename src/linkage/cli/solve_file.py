@@ -25,6 +25,7 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
     from ..problems.start import start_on_branch
     from ..render.system import branch_label, system_report
     from ..solve import SYSTEM_METHODS, solve_system
+    from ..solve.system import check_assembles
 
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r} for a mechanism file; choose from "
@@ -39,6 +40,7 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
 
     loads = command_loads(mechanism, *loads_given)
     problem = mechanism.problem()
+    check_assembles(problem, str(file))
     # the header says which loops are closed-form and which coupled (solve_system copies meta)
     problem = dataclasses.replace(problem, meta={**problem.meta, "closed_form": mechanism.derivation.summary})
     result = solve_system(problem, method=method, tol=tol, rtol=rtol, ftol=ftol, max_iter=max_iter,

@@ -93,6 +93,7 @@ def sweep(
     """
     from ..arguments import check_number, driver_span, parse_motion
     from ..kinematics.loading import load
+    from ..kinematics.positions import check_assembles_somewhere, driver_range_text
     from ..kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
     from ..render.sweep import sweep_report
     from ..render.writers import data_formats, is_data, prefetch
@@ -149,6 +150,7 @@ def sweep(
     with progress_bar(2 * n if data else n, minimum=4000 if data else 2000) as advance:
         result = sweep_mechanism(mechanism, values, method=method, branch=branch, tol=tol, batch=batch,
                                  progress=advance, speed=w, accel=a_, joints=data or bool(path))
+        check_assembles_somewhere(result.summary, str(file), lambda: driver_range_text(result))
         if advance is not None and data:
             advance(n, f"writing {out_fmt}")
         note = "" if data or not named else \
@@ -205,6 +207,7 @@ def sweep_equation(a: float, b: float, step: float | None, points: int | None, m
     docs/worked_examples.md P2): the options
     checked here, the walk in :func:`linkage.kinematics.equation_sweep.equation_sweep`."""
     from ..kinematics.equation_sweep import equation_sweep
+    from ..kinematics.positions import check_assembles_somewhere
     from ..kinematics.sweep import driver_values
     from ..methods import SCALAR_METHODS
     from ..problems.seed_equation import fourbar_coefficients, scalar_problem
@@ -226,6 +229,9 @@ def sweep_equation(a: float, b: float, step: float | None, points: int | None, m
     rs, _ = fourbar_coefficients(r1, r2, r3, links)
     rows = equation_sweep(values, rs, method, tol)
     heading = coeffs.split(', ', 2)[2] if coeffs.count(', ') >= 2 else coeffs
+    statuses = [r[1] for r in rows]
+    check_assembles_somewhere({s: statuses.count(s) for s in set(statuses)}, f"the four-bar of {heading}",
+                              lambda: f"alpha from {values[0]:.12g} to {values[-1]:.12g} deg")
     emit_report(equation_report(rows, method, tol, heading, digits), out_fmt, output)
     # as a mechanism sweep: where the linkage cannot be assembled is an answer, not a failure
     if any(r[2] is None and r[1] != "no_solution" for r in rows):

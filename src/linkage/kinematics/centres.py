@@ -501,14 +501,26 @@ def solve_pose(m: Any) -> Pose:
     """The joints-form mechanism ``m`` solved at its driver value (from its guesses: a
     drawing's drawn pose), with the rates of a unit driver speed; an InputError where it
     cannot be assembled."""
-    from ..solve import solve_system
     from .rates import position_rates
 
-    result = solve_system(m.problem(), tol=1e-12, record=False)
+    q = tuple(float(v) for v in assembled(m).x)
+    return Pose(m, q, m.driver.value, position_rates(m.model, list(q), m.driver.value, 1.0, 0.0))
+
+
+def assembled(m: Any) -> Any:
+    """The mechanism ``m`` solved at its driver value from its guesses (tol 1e-12): the pose
+    that ``centres`` and ``draw`` work from; an InputError ("cannot be
+    assembled at ...": where the closed form has no real solution, as ``solve`` refuses it;
+    otherwise with the solve's reason) where it does not solve."""
+    from ..solve import solve_system
+    from ..solve.system import check_assembles
+
+    problem = m.problem()
+    check_assembles(problem, m.source)
+    result = solve_system(problem, tol=1e-12, record=False)
     if not result.converged:
         raise InputError(f"{m.source}: cannot be assembled at {_driver_text(m)}: {result.message}")
-    q = tuple(float(v) for v in result.x)
-    return Pose(m, q, m.driver.value, position_rates(m.model, list(q), m.driver.value, 1.0, 0.0))
+    return result
 
 
 def drawing_unit(m: Any) -> float:
@@ -560,10 +572,7 @@ def at_driver(mechanism: Any, driver_value: Any = None, branch: Any = None) -> t
 
         m = start_on_branch(m, branch, False)
     if m.extra.get("drawing") is None:
-        from ..solve import solve_system
-
-        if not solve_system(m.problem(), tol=1e-12, record=False).converged:
-            raise InputError(f"{m.source}: cannot be assembled at {_driver_text(m)}")
+        assembled(m)
     jm, converted = joints_form(m)
     return m, solve_pose(jm), converted
 

@@ -148,21 +148,22 @@ def _solve_at(curve: _Curve, y: np.ndarray, d: float) -> np.ndarray | None:
     return y if float(np.max(np.abs(f))) <= 1e-12 else None
 
 
-def _limit(curve: _Curve, a: np.ndarray, ta: np.ndarray, h: float, slope_end: float) -> float:
+def _limit(curve: _Curve, a: np.ndarray, ta: np.ndarray, h: float,
+           slope_end: float) -> tuple[np.ndarray, float]:
     """The driver (scaled) at the limit position within the arc step of length ``h`` from
     ``a``: where the driver's slope along the arc (the tangent's last part) is zero,
     found by the Illinois method on the arc coordinate s along ``ta``, each trial point
     corrected onto the curve. Near its extremum the driver is quadratic in s, so an error
-    e in s is an error of order e^2 in the driver."""
+    e in s is an error of order e^2 in the driver. Returns the point (scaled) and its s."""
     s_lo, g_lo, s_hi, g_hi = 0.0, float(ta[-1]), h, slope_end
-    best = a
+    best, s_best = a, 0.0
     side = 0
     for _ in range(40):
         s = s_lo - g_lo * (s_hi - s_lo) / (g_hi - g_lo)
         y, _k = _correct(curve, a + s * ta, ta)
         if y is None:
             break
-        best = y
+        best, s_best = y, s
         g = float(_tangent(curve.at(y)[1], ta)[-1])
         if abs(g) <= 1e-14 or s_hi - s_lo <= 1e-15 * max(1.0, h):
             break
@@ -176,7 +177,7 @@ def _limit(curve: _Curve, a: np.ndarray, ta: np.ndarray, h: float, slope_end: fl
             if side == 1:
                 g_lo *= 0.5
             side = 1
-    return float(best[-1])
+    return best, s_best
 
 
 def _phase(m: Mechanism, d: float, d0: float) -> float:
@@ -185,6 +186,57 @@ def _phase(m: Mechanism, d: float, d0: float) -> float:
     if m.driver.kind == "angle":
         return (d - d0 + math.pi) % (2.0 * math.pi) - math.pi
     return d - d0
+
+
+def _start_crossings(curve: _Curve, start: Assemblies, a: np.ndarray, ta: np.ndarray, b: np.ndarray,
+                     fold: tuple[np.ndarray, float] | None) -> list[tuple[float, np.ndarray]]:
+    """Where the arc step from ``a`` (tangent ``ta``) to ``b`` crosses the start value, in
+    order along the step: (arc coordinate, the configuration solved at the start value).
+    A step through a limit position (``fold``) is two pieces, on each of which the driver
+    is monotone: started near a limit, a step can pass the start value on both sides of
+    the fold, and each crossing is located on its own piece (bisection on the arc) so it
+    is matched to the assembly of its own side, never to the other's."""
+    m = start.mechanism
+    knots = [(0.0, a), *([] if fold is None else [(fold[1], fold[0])]), (float((b - a) @ ta), b)]
+    phase = [_phase(m, float(y[-1] * curve.scale[-1]), float(start.driver)) for _, y in knots]
+    out = []
+    for j in range(len(knots) - 1):
+        p0, p1 = phase[j], phase[j + 1]
+        if not ((p0 <= 0.0 < p1 or p1 <= 0.0 < p0) and abs(p1 - p0) < math.pi):
+            continue
+        s_cross, near = knots[j + 1]
+        if fold is not None:
+            s_cross, near = _crossing_on_arc(curve, start, a, ta, knots[j][0], knots[j + 1][0], p0)
+        p = _phase(m, float(near[-1] * curve.scale[-1]), float(start.driver))
+        at = _solve_at(curve, near, float(near[-1]) - p / curve.scale[-1])
+        if at is not None:
+            out.append((s_cross, at))
+    return out
+
+
+def _crossing_on_arc(curve: _Curve, start: Assemblies, a: np.ndarray, ta: np.ndarray, s_lo: float,
+                     s_hi: float, p_lo: float) -> tuple[float, np.ndarray]:
+    """The point of the arc from ``a`` along ``ta`` nearest the start value between arc
+    coordinates ``s_lo`` (start-relative driver ``p_lo``) and ``s_hi``, the driver monotone
+    between them: bisection on s, each trial corrected onto the curve."""
+    m = start.mechanism
+    s_best, best = s_hi, None
+    for _ in range(64):
+        s = 0.5 * (s_lo + s_hi)
+        if s in (s_lo, s_hi):
+            break
+        y, _k = _correct(curve, a + s * ta, ta)
+        if y is None:
+            break
+        s_best, best = s, y
+        p = _phase(m, float(y[-1] * curve.scale[-1]), float(start.driver))
+        if (p <= 0.0) == (p_lo <= 0.0):
+            s_lo = s
+        else:
+            s_hi = s
+    if best is None:  # no trial corrected: the piece's end, solved at the start value by the caller
+        best = a if s_best == 0.0 else _correct(curve, a + s_best * ta, ta)[0]
+    return s_best, (a if best is None else best)
 
 
 def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
@@ -223,29 +275,31 @@ def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
             sign = new_sign
         ys.append(y_new)
         ts.append(t_new)
+        fold = None  # (the limit position's point, its arc coordinate) within this step
         if ts[-2][-1] * t_new[-1] < 0:
             h_step = float((y_new - ys[-2]) @ ts[-2])
-            limits.append(float(_limit(curve, ys[-2], ts[-2], h_step, float(t_new[-1])) * curve.scale[-1]))
+            fold = _limit(curve, ys[-2], ts[-2], h_step, float(t_new[-1]))
         if float(np.max(np.abs(y_new[:-1]))) > size_bound:
+            limits.extend(float(f[0][-1] * curve.scale[-1]) for f in (fold,) if f is not None)
             status = "unbounded"
             break
-        p0 = _phase(m, float(ys[-2][-1] * curve.scale[-1]), float(start.driver))
-        p1 = _phase(m, float(y_new[-1] * curve.scale[-1]), float(start.driver))
-        if (p0 <= 0.0 < p1 or p1 <= 0.0 < p0) and abs(p1 - p0) < math.pi:
+        for s_cross, at in _start_crossings(curve, start, ys[-2], ts[-2], y_new, fold):
             # crossed the start value: which assembly is this?
-            d_cross = float(y_new[-1]) - p1 / curve.scale[-1]
-            at = _solve_at(curve, y_new, d_cross)
-            if at is not None:
-                q = list(at[:-1] * curve.scale[:-1])
-                for i, a in enumerate(start.real):
-                    if same_configuration(q, a.q, m, MATCH):
-                        if i == first and travelled > 4.0 * MAX_STEP:
-                            status = "closed"
-                            ys[-1] = at  # end on the start configuration, not past it
-                        members.add(i)
-                        break
-            if status == "closed":
+            q = list(at[:-1] * curve.scale[:-1])
+            i = next((i for i, a in enumerate(start.real) if same_configuration(q, a.q, m, MATCH)), None)
+            if i is None:
+                continue
+            members.add(i)
+            if i == first and travelled > 4.0 * MAX_STEP:
+                status = "closed"
+                ys[-1] = at  # end on the start configuration, not past it
+                if fold is not None and s_cross < fold[1]:
+                    fold = None  # closed before this step's limit: the first step's, met again
                 break
+        if fold is not None:
+            limits.append(float(fold[0][-1] * curve.scale[-1]))
+        if status == "closed":
+            break
         h = min(MAX_STEP, h * (1.5 if k <= 2 else 1.0))
     drivers = [float(v[-1] * curve.scale[-1]) for v in ys]
     configurations = [tuple(float(x) for x in v[:-1] * curve.scale[:-1]) for v in ys]

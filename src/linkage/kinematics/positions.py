@@ -4,10 +4,11 @@ and the driver values it runs over, shared by every sweep engine."""
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import field
 from typing import Any
 
+from ..errors import InputError
 from ..problems.loops import Mechanism
 from ..records import frozen
 from ..rules import grid_resolved
@@ -213,3 +214,25 @@ def driver_values(start: float, stop: float, step: float | None, points: int | N
 
         return start + np.arange(n + 1, dtype=np.float64) * step
     return [start + k * step for k in range(n + 1)]
+
+
+def check_assembles_somewhere(summary: dict[str, int], what: str, span: Callable[[], str]) -> None:
+    """InputError where no position of a sweep assembles, every one ``no_solution`` (the
+    closed form has no real solution there, or least squares cannot close the loops:
+    docs/sweeps.md, "Statuses"): a linkage that cannot be assembled anywhere in the range
+    asked for is bad input, as ``centres`` and ``convert`` refuse it at one value. A sweep
+    where some position assembles keeps its ``no_solution`` rows. ``summary``: the count
+    of each status; ``what`` names the linkage, ``span()`` the driver range (text made
+    only for a refusal: reading a batch sweep's inputs costs more than its count)."""
+    if summary and set(summary) == {"no_solution"}:
+        n = summary["no_solution"]
+        raise InputError(f"{what}: cannot be assembled at any {span()} (no_solution at every one of "
+                         f"its {n} position{'s' if n != 1 else ''})")
+
+
+def driver_range_text(result: SweepResult) -> str:
+    """The driver range of a sweep's positions, as a refusal names it (display units)."""
+    inputs = result.inputs
+    low, high = min(inputs), max(inputs)
+    unit = f" {result.driver_unit}" if result.driver_unit else ""
+    return f"{result.driver} from {low:.12g} to {high:.12g}{unit}"

@@ -44,7 +44,11 @@ def fourbar_info(alpha: float | None, r1: str | None, r2: str | None, r3: str | 
 
 
 def scalar_problem(equation: str | None, g: str | None, alpha: float | None, r1: str | None,
-                    r2: str | None, r3: str | None, links: tuple[str, ...] | None) -> Any:
+                    r2: str | None, r3: str | None, links: tuple[str, ...] | None,
+                    refuse_unassembled: bool = False) -> Any:
+    """The equation's problem, or the four-bar's at ``alpha``; ``refuse_unassembled``: an
+    InputError where that four-bar cannot be assembled (:func:`check_assembles`; ``solve``
+    refuses it, a sweep over alpha reports the position)."""
     if equation is not None:
         given = [n for n, v in (("--alpha", alpha), ("--r1", r1), ("--r2", r2), ("--r3", r3),
                                 ("--links", links)) if v is not None]
@@ -58,8 +62,26 @@ def scalar_problem(equation: str | None, g: str | None, alpha: float | None, r1:
         raise InputError("--g applies to --equation; the four-bar has its own g = acos(u)")
     from .freudenstein import fourbar_equation
 
+    if refuse_unassembled:
+        check_assembles(alpha, r1, r2, r3, links)
     rs, _ = fourbar_coefficients(r1, r2, r3, links)
     return fourbar_equation(70.0 if alpha is None else alpha, *rs)
+
+
+def check_assembles(alpha: float | None, r1: str | None, r2: str | None, r3: str | None,
+                    links: tuple[str, ...] | None) -> None:
+    """InputError where the four-bar of these coefficients (or links) cannot be assembled at
+    ``alpha`` (deg, default 70): its input-output equation has no real root there, by the
+    closed form (:func:`~linkage.problems.freudenstein.equation_roots`)."""
+    from .freudenstein import equation_roots
+
+    rs, _ = fourbar_coefficients(r1, r2, r3, links)
+    a = 70.0 if alpha is None else alpha
+    if not equation_roots(a, *rs):
+        given = (f"--links {' '.join(links)}" if links is not None
+                 else f"R1 = {rs[0]:.10g}, R2 = {rs[1]:.10g}, R3 = {rs[2]:.10g}")
+        raise InputError(f"{given}: the four-bar cannot be assembled at alpha = {a:g} deg (its "
+                         "input-output equation has no real root there)")
 
 
 def applicable(name: str, problem: Any, equation: str | None, x0: Any, x1: Any, bracket: Any) -> bool:

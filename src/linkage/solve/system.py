@@ -323,16 +323,30 @@ def packaged(m: Any, problem: Any, crit: Criteria, gate: float, outcome: tuple[A
         meta["reference"] = reference
         if not reference and not status.converged:
             reason = detail if status is Status.NO_SOLUTION else status.message
-            driver = f"{problem.meta.get('driver')} = {problem.meta.get('driver_value'):g}"
-            status, detail = (Status.NO_SOLUTION,
-                              f"the linkage cannot be assembled at {driver} "
-                              f"{problem.meta.get('driver_unit', '')} (the closed form has no real "
-                              f"solution); {m.name}: {reason}")
+            status, detail = Status.NO_SOLUTION, f"{unassembled_text(problem)}; {m.name}: {reason}"
     history = None
     if rows is not None:
         history = system_history(m, problem, rows, show_jacobian, reference, x)
     return Result.fast(m.name, x, status, iterations, nfev, err, residual, detail, njev, (given, meta),
                        None if history is None else (given, history))
+
+
+def unassembled_text(problem: Any) -> str:
+    """What a mechanism's problem whose closed form has no real solution at its driver value
+    is: the verdict on a failed solve there (:func:`packaged`) and the refusal of one
+    (:func:`check_assembles`)."""
+    meta = problem.meta
+    return (f"the linkage cannot be assembled at {meta.get('driver')} = {meta.get('driver_value'):.12g} "
+            f"{meta.get('driver_unit', '')} (the closed form has no real solution)")
+
+
+def check_assembles(problem: Any, source: str) -> None:
+    """InputError where the closed form of a mechanism's ``problem`` (where one is derived)
+    has no real solution at its driver value: the linkage cannot be assembled there, so no
+    method can converge (``solve FILE`` refuses it as bad input, exit 2). Without a closed
+    form, or where it has a solution, nothing is refused."""
+    if problem.reference is not None and problem.reference() == {}:
+        raise InputError(f"{source}: {unassembled_text(problem)}")
 
 
 @functools.lru_cache(maxsize=1)

@@ -1,0 +1,71 @@
+"""A circuit traced from a start within a hair of a limit position (`linkage assemblies
+--sweep` at a driver value near a fold) reports the circuit's own limit positions, the
+crank angles where the coupler and rocker are collinear (Norton, "Design of Machinery",
+section 4.12: the diagonal A-O4 is r3 + r4), evaluated at 40 digits with mpmath."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from mpmath import acos, mp, mpf
+from mpmath import degrees as mp_degrees
+
+from linkage.kinematics.circuits import circuits
+from linkage.kinematics.loading import load
+from linkage.units import degrees, radians
+
+SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
+
+
+def _me581_limit_deg() -> float:
+    """The ME581 four-bar's (r1..r4 = 90, 30, 60, 45) limit crank angle: the law of cosines
+    on the triangle O2-A-O4 with A-O4 = r3 + r4 (40 digits)."""
+    with mp.workdps(40):
+        r1, r2, d = mpf(90), mpf(30), mpf(60) + mpf(45)
+        return float(mp_degrees(acos((r1 * r1 + r2 * r2 - d * d) / (2 * r1 * r2))))
+
+
+@pytest.mark.parametrize("side", [1.0, -1.0])
+@pytest.mark.parametrize("gap_deg", [1e-3, 1e-6, 1e-9])
+def test_circuit_started_near_a_limit_reports_its_two_limit_positions(side, gap_deg):
+    limit = _me581_limit_deg()
+    start = side * (limit - gap_deg)
+    m = load(SAMPLES / "fourbar_me581.toml")
+    c = circuits(m, radians(start))
+    assert len(c.assemblies.real) == 2
+    (circ,) = c.circuits
+    assert circ.status == "closed" and circ.members == (0, 1)
+    found = sorted(degrees(v) for v in circ.limits)
+    assert found == pytest.approx([-limit, limit], abs=1e-9), found
+    assert degrees(circ.driver_low) == pytest.approx(-limit, abs=1e-9)
+    assert degrees(circ.driver_high) == pytest.approx(limit, abs=1e-9)
+
+
+@pytest.mark.parametrize("start", ["112.02", "112.024", "112.0243"])
+def test_assemblies_sweep_near_a_limit_prints_two_limit_positions(cli, start):
+    out = cli("assemblies", str(SAMPLES / "fourbar_me581.toml"), "--sweep", "--set", f"theta2={start}")
+    assert out.code == 0, out.err
+    assert "theta2 from -112.024313 to 112.024313 deg, 2 limit positions" in out.out
+    assert "unfinished" not in out.out
+
+
+def _limit_deg(r1: float, r2: float, diagonal: float) -> float:
+    """The crank angle at which the diagonal A-O4 is ``diagonal`` (law of cosines, 40 digits)."""
+    with mp.workdps(40):
+        r1_, r2_, d = mpf(r1), mpf(r2), mpf(diagonal)
+        return float(mp_degrees(acos((r1_ * r1_ + r2_ * r2_ - d * d) / (2 * r1_ * r2_))))
+
+
+@pytest.mark.parametrize("gap_deg", [1e-3, 1e-6, 1e-9])
+@pytest.mark.parametrize("at_low", [True, False])
+def test_double_rocker_started_near_either_limit_reports_both(gap_deg, at_low):
+    """The Grashof double rocker r1..r4 = 100, 80, 30, 90 rocks between the folded (|r4 - r3|
+    = 60) and extended (r3 + r4 = 120) diagonals; started just inside either limit, the
+    circuit leaves away from it (near the low one) or through it (near the high one)."""
+    low, high = _limit_deg(100, 80, 60), _limit_deg(100, 80, 120)
+    start = low + gap_deg if at_low else high - gap_deg
+    m = load(SAMPLES / "crank_rocker.toml").with_values({"r2": 80, "r3": 30, "r4": 90}, {})
+    (circ,) = circuits(m, radians(start)).circuits
+    assert circ.status == "closed" and circ.members == (0, 1)
+    assert sorted(degrees(v) for v in circ.limits) == pytest.approx([low, high], abs=1e-9)
