@@ -1,0 +1,40 @@
+"""Regressions from the 2026-11-29 adversarial pass (findings 8-10): library calls and
+options at the edges of the double range or of the argument rules, each named after the
+finding. Bad input: InputError/ParseError in the library, exit 2 and one line at the
+command line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import linkage
+from linkage.errors import InputError, ParseError
+
+SAMPLES = Path(__file__).resolve().parents[1] / "sample_inputs"
+ME581 = SAMPLES / "fourbar_me581.toml"
+
+
+def one_line_exit_2(run) -> None:
+    assert run.code == 2, (run.code, run.out, run.err)
+    lines = [ln for ln in run.err.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: "), run.err
+    assert "Traceback" not in run.err and "internal error" not in run.err
+
+
+@pytest.mark.parametrize("links", [(1e-300, 1e300, 1, 1), (1e-100, 1e100, 1e-100, 1e100)])
+def test_coefficients_from_links_with_a_ratio_underflowing_is_an_input_error(links):
+    with pytest.raises(InputError, match="too extreme for double precision"):
+        linkage.coefficients_from_links(*links)
+
+
+def test_coefficients_from_links_keeps_a_tiny_coupler():
+    # the coupler b only enters squared: a ratio 1e-200 is no reason to refuse (R3 = 1.5)
+    r = linkage.coefficients_from_links(1, 1e-200, 1, 1)
+    assert (r.r1, r.r2, r.r3) == (1.0, 1.0, 1.5)
+
+
+def test_load_mechanism_with_a_null_byte_in_the_path_is_a_parse_error():
+    with pytest.raises(ParseError, match="null byte"):
+        linkage.load_mechanism("a\x00b")
