@@ -38,3 +38,13 @@ def test_coefficients_from_links_keeps_a_tiny_coupler():
 def test_load_mechanism_with_a_null_byte_in_the_path_is_a_parse_error():
     with pytest.raises(ParseError, match="null byte"):
         linkage.load_mechanism("a\x00b")
+
+
+def test_bisection_bracket_as_wide_as_the_double_range_is_valid(cli):
+    # b - a overflows for [-1e308, 1e308]; the width b/2 - a/2 does not
+    run = cli("solve", "-e", "x-1", "--method", "bisection", "--bracket", "-1e308", "1e308",
+              "--max-iter", "1200")
+    assert run.code == 0, run.out
+    assert "converged:" in run.out
+    r = linkage.solve_scalar(lambda x: x - 1.0, method="bisection", bracket=(-1e308, 1e308), max_iter=1200)
+    assert r.converged and abs(r.x - 1.0) <= 1e-6
