@@ -48,3 +48,9 @@ def test_bisection_bracket_as_wide_as_the_double_range_is_valid(cli):
     assert "converged:" in run.out
     r = linkage.solve_scalar(lambda x: x - 1.0, method="bisection", bracket=(-1e308, 1e308), max_iter=1200)
     assert r.converged and abs(r.x - 1.0) <= 1e-6
+
+
+def test_fd_step_has_an_upper_bound(cli):
+    # --fd-step 1e300 ran to NaN in max|dq| and det J = 0 beside cond J = 2.79
+    one_line_exit_2(cli("solve", str(ME581), "--method", "newton-fd", "--fd-step", "1e300"))
+    assert cli("solve", str(ME581), "--method", "newton-fd", "--fd-step", "1").code == 0

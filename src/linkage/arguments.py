@@ -122,6 +122,21 @@ def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: b
     return v
 
 
+MAX_FD_STEP = 1.0
+"""The largest forward-difference step h accepted (``fd_step``, --fd-step): a difference
+quotient is a derivative only for h small beside the unknowns' variation, and angle unknowns
+are in radians (one radian is already 57 degrees); the default is sqrt(eps) max(1, |q|)."""
+
+
+def check_fd_step(name: str, value: Any) -> float:
+    """A forward-difference step: a finite number > 0 and at most :data:`MAX_FD_STEP`."""
+    h = check_number(name, value, positive=True, allow_zero=False)
+    if h > MAX_FD_STEP:
+        raise InputError(f"{name} must be at most {MAX_FD_STEP:g} (a difference over a wider step is no "
+                         f"derivative; angles are in radians), got {h!r}")
+    return h
+
+
 def _complex(value: Any) -> bool:
     return isinstance(value, complex) or getattr(getattr(value, "dtype", None), "kind", "") == "c"
 
