@@ -54,3 +54,12 @@ def test_fd_step_has_an_upper_bound(cli):
     # --fd-step 1e300 ran to NaN in max|dq| and det J = 0 beside cond J = 2.79
     one_line_exit_2(cli("solve", str(ME581), "--method", "newton-fd", "--fd-step", "1e300"))
     assert cli("solve", str(ME581), "--method", "newton-fd", "--fd-step", "1").code == 0
+
+
+def test_negative_literal_vector_length_is_refused_as_parameters_are(tmp_path):
+    text = ME581.read_text()
+    assert 'length = "r1"' in text
+    bad = tmp_path / "neg.toml"
+    bad.write_text(text.replace('length = "r1"', "length = -30", 1))
+    with pytest.raises(ParseError, match="a length must be > 0, got -30"):
+        linkage.load_mechanism(bad)
