@@ -63,3 +63,12 @@ def test_negative_literal_vector_length_is_refused_as_parameters_are(tmp_path):
     bad.write_text(text.replace('length = "r1"', "length = -30", 1))
     with pytest.raises(ParseError, match="a length must be > 0, got -30"):
         linkage.load_mechanism(bad)
+
+
+@pytest.mark.parametrize("methods,why", [("all,foo", "unknown method 'foo'"),
+                                         ("foo,all", "unknown method 'foo'"),
+                                         ("all,newton", "'all' stands alone")])
+def test_method_list_names_the_unknown_entry_not_all(cli, methods, why):
+    run = cli("solve", "-e", "x-1", "--x0", "0", "--method", methods)
+    one_line_exit_2(run)
+    assert why in run.err

@@ -137,6 +137,21 @@ def check_fd_step(name: str, value: Any) -> float:
     return h
 
 
+def check_method_list(name: str, text: str, known: Sequence[str], every: str = "all") -> list[str]:
+    """The methods a comma-separated list names, each known and none twice, or an InputError
+    naming the entry at fault; ``every`` ("all": every method that applies) stands alone."""
+    names = [m.strip() for m in text.split(",")]
+    choose = f"choose from {', '.join(known)}, {every}"
+    unknown = [m for m in names if m not in known and m != every]
+    if unknown:
+        raise InputError(f"unknown method {unknown[0]!r} in {name}; {choose}")
+    if every in names:
+        raise InputError(f"{every!r} stands alone in {name}, got {text!r}")
+    if len(set(names)) < len(names):
+        raise InputError(f"a method named twice in {name} {text!r}; {choose}")
+    return names
+
+
 def _complex(value: Any) -> bool:
     return isinstance(value, complex) or getattr(getattr(value, "dtype", None), "kind", "") == "c"
 
