@@ -72,3 +72,16 @@ def test_method_list_names_the_unknown_entry_not_all(cli, methods, why):
     run = cli("solve", "-e", "x-1", "--x0", "0", "--method", methods)
     one_line_exit_2(run)
     assert why in run.err
+
+
+@pytest.mark.parametrize("equation", ["9**9**9**9", "exp(1000) + x", "x + 10**400.0"])
+def test_overflowing_constant_expression_is_bad_input(cli, equation):
+    # it raises OverflowError at every x: exit 2, not a failed run (exit 1)
+    run = cli("solve", "-e", equation, "--x0", "1")
+    one_line_exit_2(run)
+    assert "overflows a double" in run.err
+
+
+def test_overflow_to_inf_without_an_error_is_still_an_equation(cli):
+    # 1e308*10 is inf in IEEE arithmetic, 1/inf = 0: f(x) = x - 1 (no exception, not refused)
+    assert cli("solve", "-e", "1/(1e308*10)+x-1", "--x0", "1").code == 0
