@@ -85,3 +85,13 @@ def test_overflowing_constant_expression_is_bad_input(cli, equation):
 def test_overflow_to_inf_without_an_error_is_still_an_equation(cli):
     # 1e308*10 is inf in IEEE arithmetic, 1/inf = 0: f(x) = x - 1 (no exception, not refused)
     assert cli("solve", "-e", "1/(1e308*10)+x-1", "--x0", "1").code == 0
+
+
+def test_tolerance_text_table_prints_a_dash_not_nan_where_not_assembled(cli):
+    # r3 = 20 +-20 cm: not assembled at some positions (status not_assembled)
+    run = cli("tolerance", str(ME581), "--tol", "r3=20", "--samples", "20", "--step", "30")
+    assert run.code in (0, 1), run.err
+    assert "not_assembled" in run.out
+    assert "NaN" not in run.out and "nan" not in run.out
+    rows = [ln for ln in run.out.splitlines() if "not_assembled" in ln and "—" in ln]
+    assert rows, run.out
