@@ -290,6 +290,8 @@ BATTERY = [
      lambda: linkage.solve_system(_F, (1.0, 1.0), jac=_J, max_iter=2.7), "max_iter"),
     ("solve_system", "fd_step text",
      lambda: linkage.solve_system(_F, (1.0, 1.0), method="newton-fd", fd_step="x"), "fd_step"),
+    ("solve_system", "fd_step beyond the bound",
+     lambda: linkage.solve_system(_F, (1.0, 1.0), method="newton-fd", fd_step=1e300), "fd_step"),
     ("solve_system", "F None", lambda: linkage.solve_system(None, (1.0, 1.0)), "F"),
     # solve_scalar: g and the bracket
     ("solve_scalar", "g returns None",

@@ -122,6 +122,36 @@ def check_number(name: str, value: Any, *, positive: bool = False, allow_zero: b
     return v
 
 
+MAX_FD_STEP = 1.0
+"""The largest forward-difference step h accepted (``fd_step``, --fd-step): a difference
+quotient is a derivative only for h small beside the unknowns' variation, and angle unknowns
+are in radians (one radian is already 57 degrees); the default is sqrt(eps) max(1, |q|)."""
+
+
+def check_fd_step(name: str, value: Any) -> float:
+    """A forward-difference step: a finite number > 0 and at most :data:`MAX_FD_STEP`."""
+    h = check_number(name, value, positive=True, allow_zero=False)
+    if h > MAX_FD_STEP:
+        raise InputError(f"{name} must be at most {MAX_FD_STEP:g} (a difference over a wider step is no "
+                         f"derivative; angles are in radians), got {h!r}")
+    return h
+
+
+def check_method_list(name: str, text: str, known: Sequence[str], every: str = "all") -> list[str]:
+    """The methods a comma-separated list names, each known and none twice, or an InputError
+    naming the entry at fault; ``every`` ("all": every method that applies) stands alone."""
+    names = [m.strip() for m in text.split(",")]
+    choose = f"choose from {', '.join(known)}, {every}"
+    unknown = [m for m in names if m not in known and m != every]
+    if unknown:
+        raise InputError(f"unknown method {unknown[0]!r} in {name}; {choose}")
+    if every in names:
+        raise InputError(f"{every!r} stands alone in {name}, got {text!r}")
+    if len(set(names)) < len(names):
+        raise InputError(f"a method named twice in {name} {text!r}; {choose}")
+    return names
+
+
 def _complex(value: Any) -> bool:
     return isinstance(value, complex) or getattr(getattr(value, "dtype", None), "kind", "") == "c"
 

@@ -147,6 +147,8 @@ def read_input(path: Path, what: str = "mechanism file") -> str:
         raise ParseError(f"no such file: {path}") from None
     except OSError as exc:
         raise ParseError(f"cannot read {path}: {exc.strerror or exc}") from None
+    except ValueError:  # os.stat's refusal of an embedded null byte
+        raise ParseError(f"no such file: {str(path)!r} (a file name cannot hold a null byte)") from None
     if stat.S_ISDIR(st.st_mode):
         raise ParseError(f"{path} is a directory, not a {what}")
     if not stat.S_ISREG(st.st_mode):

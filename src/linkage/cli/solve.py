@@ -105,7 +105,7 @@ def solve(
     Example: linkage solve sample_inputs/fourbar_me581.toml --set theta2=80
     """
     from ..analysis.convergence import analyze
-    from ..arguments import check_number
+    from ..arguments import check_method_list, check_number
     from ..methods import BRACKETING, SCALAR_METHODS
     from ..problems.seed_equation import applicable, fourbar_coefficients, fourbar_info, scalar_problem
     from ..solve import check_criteria, solve_scalar
@@ -146,11 +146,7 @@ def solve(
             raise InputError("no method applies: give --x0 (newton), --x0 and --x1 (secant), "
                              "--bracket (bracketing) or --g with --x0 (fixed-point)")
     else:
-        names = [m.strip() for m in method.split(",")]
-        unknown = [m for m in names if m not in SCALAR_METHODS]
-        if unknown or len(set(names)) < len(names):
-            why = f"unknown method {unknown[0]!r}" if unknown else f"a method named twice in {method!r}"
-            raise InputError(f"{why}; choose from {', '.join(SCALAR_METHODS)}, all")
+        names = check_method_list("--method", method, SCALAR_METHODS)
 
     if summary:
         from ..measure.timing import time_per_solve

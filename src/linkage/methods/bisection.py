@@ -8,7 +8,8 @@ docs/worked_examples.md P2).
 Never fails on a valid bracket; it finds *a* root of odd multiplicity, or a pole
 where f changes sign (the residual then does not shrink: check it).
 Rows follow the student report (docs/worked_examples.md P2): the interval being bisected, its midpoint
-c, e = (b - a) / 2.
+c, e = (b - a) / 2, computed as b/2 - a/2 (the same bits for brackets of normal numbers,
+and no overflow for a bracket as wide as [-1e308, 1e308]).
 """
 
 from __future__ import annotations
@@ -84,7 +85,7 @@ class Bisection:
             a, b = b, a
         fa, fb, stop = init_bracket(problem, a, b)
         x = a if stop and fa == 0.0 else b if stop and fb == 0.0 else 0.5 * a + 0.5 * b
-        return BisectionState(x, fa if x == a else fb if x == b else None, 0.5 * (b - a), stop,
+        return BisectionState(x, fa if x == a else fb if x == b else None, 0.5 * b - 0.5 * a, stop,
                               a, fa, b, fb, a, fa, b, fb)
 
     def step(self, problem: ScalarProblem, s: BisectionState) -> BisectionState:
@@ -92,8 +93,8 @@ class Bisection:
         c = 0.5 * a + 0.5 * b
         fc = problem.f(c)
         if same_sign(fc, fa):
-            return new_state(BisectionState, (c, fc, 0.5 * (b - a), None, c, fc, b, fb, a, fa, b, fb))
-        return new_state(BisectionState, (c, fc, 0.5 * (b - a), None, a, fa, c, fc, a, fa, b, fb))
+            return new_state(BisectionState, (c, fc, 0.5 * b - 0.5 * a, None, c, fc, b, fb, a, fa, b, fb))
+        return new_state(BisectionState, (c, fc, 0.5 * b - 0.5 * a, None, a, fa, c, fc, a, fa, b, fb))
 
     def initial_row(self, problem: ScalarProblem, s: BisectionState) -> None:
         return None
@@ -117,7 +118,7 @@ BISECTION_LOOP = Loop(
         fc = f(c)
         """,
     after="""\
-        x, fx, err = c, fc, 0.5 * (b - a)
+        x, fx, err = c, fc, 0.5 * b - 0.5 * a
         if _same_sign(fc, fa):
             a, fa = c, fc
         else:

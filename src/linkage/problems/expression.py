@@ -143,7 +143,8 @@ _FOLD: dict[str, Callable[..., float]] = {
 class _Builder:
     """Appends operations, sharing identical ones and folding finite constant ones."""
 
-    def __init__(self) -> None:
+    def __init__(self, what: str = "equation") -> None:
+        self.what = what
         self.ops: list[Op] = []
         self.index: dict[tuple[str, tuple[int, ...], float], int] = {}
 
@@ -154,6 +155,11 @@ class _Builder:
             try:
                 v = float(fn(*vals))  # type: ignore[misc]
                 err = _folded_error(op.kind, vals, [self.ops[a].err for a in op.args], v)
+            except OverflowError:  # raised at every x alike: the text is at fault, not a start
+                shown = f" {op.kind} ".join(f"{v:g}" for v in vals) if len(vals) == 2 else \
+                    f"{op.kind}({', '.join(f'{v:g}' for v in vals)})"
+                raise ParseError(f"a constant in the {self.what} overflows a double ({shown}), so "
+                                 "it cannot be evaluated at any point") from None
             except (ArithmeticError, ValueError, TypeError):
                 v = err = math.nan
             if math.isfinite(v) and math.isfinite(err):
@@ -263,7 +269,7 @@ def parse_ops(text: str, *, what: str = "equation", variables: tuple[str, ...] =
     tree, _ = parse_tree(text, f"the {what}")
     shown = text if len(text) <= 60 else text[:57] + "..."
     names = _Names(variables, dict(constants or {}))
-    b = _Builder()
+    b = _Builder(what)
     out: list[int] = []
     walk_postorder(tree.body, lambda node: _check(node, shown, what, names),
                    lambda node: out.append(_emit(node, b, out, names)))

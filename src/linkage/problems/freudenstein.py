@@ -55,12 +55,15 @@ def coefficients_from_links(a: float, b: float, c: float, d: float) -> FourBarCo
                              "digits; give the lengths in a smaller unit")
     # Only ratios matter: scale by the longest link first, so squares neither overflow
     # nor underflow (links 9e307 or 1e-300 give the same R as links 9 or 1).
-    big = max(a, b, c, d)
+    given, big = (a, b, c, d), max(a, b, c, d)
     a, b, c, d = a / big, b / big, c / big, d / big
-    r = FourBarCoefficients(d / c, d / a, (a * a - b * b + c * c + d * d) / (2.0 * a * c))
-    if not all(math.isfinite(v) for v in (r.r1, r.r2, r.r3)):
-        raise InputError(f"the link ratios {a * big:g}, {b * big:g}, {c * big:g}, {d * big:g} are too "
-                         "extreme for double precision (R1, R2, R3 overflow)")
+    # a ratio (or 2 a c) can still underflow to 0 (links 1e-300 and 1e300): a division by it
+    # is refused below, as a ratio that overflows is
+    den = 2.0 * a * c
+    r = FourBarCoefficients(d / c, d / a, (a * a - b * b + c * c + d * d) / den) if den > 0.0 else None
+    if r is None or not all(math.isfinite(v) for v in (r.r1, r.r2, r.r3)):
+        raise InputError(f"the link ratios {', '.join(f'{v:g}' for v in given)} are too "
+                         "extreme for double precision (R1, R2, R3 leave its range)")
     return r
 
 

@@ -457,6 +457,9 @@ def _ref(value: Any, key: str, kind: str, known: Mapping[str, Quantity], fail: A
         why = magnitude_problem(internal, kind, "")
         if why:
             raise fail(key, why)
+        if kind == "length" and internal <= 0.0:  # the rule of [parameters] lengths (_parameters)
+            raise fail(key, f"a length must be > 0, got {v!r} (give sign = -1 to reverse a vector, "
+                            "or a parameter with signed = true for an offset)")
         return internal
     if not isinstance(value, str):
         raise fail(key, f"must be a name or a number, got {value!r}")

@@ -99,7 +99,8 @@ def tolerance_report(s: Any, digits: int) -> Report:
             out += [Text(""), _output_table(s, j, digits)]
         out += [Text(""), table("largest contributions (at positions whose status is ok)",
                                 ["output", "from", "±D", "largest", f"at {s.driver} ({s.driver_unit})"],
-                                [(f"{r[0]} ({r[1]})", r[2], r[3], r[4], r[5]) for r in summary_rows(s)],
+                                [(f"{r[0]} ({r[1]})", r[2], r[3], r[4] if r[5] is not None else None, r[5])
+                                 for r in summary_rows(s)],  # no position: "—", as the values
                                 digits)]
         out.append(Text(_status_line(s)))
         return out
@@ -140,7 +141,7 @@ def _output_table(s: Any, j: int, digits: int) -> Any:
         if mc:
             row += [float(s.mc_sigma[j, k]), float(s.mc_low[j, k]) - nom, float(s.mc_median[j, k]) - nom,
                     float(s.mc_high[j, k]) - nom, float(s.not_assembled[k])]
-        rows.append(row)
+        rows.append([None if v != v else v for v in row])  # NaN (no value: not assembled) shows "—"
     title = f"{o.name} ({o.unit})" + (": Monte Carlo percentiles from nominal" if mc else "")
     return table(title, headers, rows, digits)
 

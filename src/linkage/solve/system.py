@@ -9,7 +9,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any
 
-from ..arguments import check_callable, check_number, check_reals, real_vector
+from ..arguments import check_callable, check_fd_step, check_reals, real_vector
 from ..errors import InputError
 from ..iterate import Criteria, run
 from ..result import FAST_NAMES, History, Raw, Result, Status, fast_source, given
@@ -216,7 +216,7 @@ def solve_general(F: Any, x0: Any, *, jac: Any, method: str, tol: float, rtol: f
         raise InputError(f"unknown method {method!r} for a system; choose from {', '.join(SYSTEM_METHODS)}")
     crit = check_criteria(tol, rtol, ftol, max_iter)
     if fd_step is not None:
-        fd_step = check_number("fd_step", fd_step, positive=True, allow_zero=False)
+        fd_step = check_fd_step("fd_step", fd_step)
     problem, q0 = system_problem(F, x0, jac, crit, SystemProblem, generic_system)
     if method == "newton" and problem.J is None:
         raise InputError("newton needs the Jacobian jac; use method='newton-fd' to difference it")
