@@ -11,6 +11,7 @@ Before anything is timed, the floor's angles are checked against ``linkage.sweep
 
     python benchmarks/sweep_floor.py              # 15 pairs of each
     python benchmarks/sweep_floor.py --repeats 31
+    python benchmarks/sweep_floor.py --positions 3   # the fixed cost of a call
 """
 
 from __future__ import annotations
@@ -33,9 +34,10 @@ POSITIONS = 361
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=15)
+    ap.add_argument("--positions", type=int, default=POSITIONS, help="driver values over 0..360 deg")
     args = ap.parse_args()
     m, links = crank_rocker()
-    grid = np.linspace(0.0, 360.0, POSITIONS)
+    grid = np.linspace(0.0, 360.0, args.positions)
     values = [float(v) for v in grid]
     tol = tolerance()
     gate = residual_gate(tol, m.length_scale)
@@ -58,7 +60,7 @@ def main() -> None:
 
     low = interleaved_pairs(floor, bare, args.repeats, 0.005)
     whole = interleaved_pairs(lambda: linkage.sweep(m, values), bare, args.repeats, 0.005)
-    print(f"{POSITIONS} positions of crank_rocker.toml, {args.repeats} interleaved pairs, medians")
+    print(f"{args.positions} positions of crank_rocker.toml, {args.repeats} interleaved pairs, medians")
     print(f"  the floor (closed form and evidence) {low.a_median * 1e6:7.1f} us / "
           f"closed form {low.b_median * 1e6:6.1f} us = {low.ratio:.2f}x")
     print(f"  linkage.sweep                        {whole.a_median * 1e6:7.1f} us / "
