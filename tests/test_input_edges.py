@@ -95,3 +95,20 @@ def test_tolerance_text_table_prints_a_dash_not_nan_where_not_assembled(cli):
     assert "NaN" not in run.out and "nan" not in run.out
     rows = [ln for ln in run.out.splitlines() if "not_assembled" in ln and "—" in ln]
     assert rows, run.out
+
+
+def test_refusals_name_the_option_the_command_line_has():
+    """--fd-step refused as --fd-step (the library's check named it fd_step), simulate's
+    --omega0 as --omega0 (the shared rate parser named it --speed)."""
+    import subprocess
+    import sys
+
+    def err(*args: str) -> str:
+        run = subprocess.run([sys.executable, "-m", "linkage", *args], capture_output=True, text=True,
+                             check=False)
+        assert run.returncode == 2
+        return run.stderr
+
+    assert err("solve", str(ME581), "--method", "newton-fd", "--fd-step", "2").startswith("error: --fd-step ")
+    loaded = SAMPLES.parent / "docs" / "crank_rocker_loads.toml"
+    assert err("simulate", str(loaded), "--time", "0:1", "--omega0", "1e300").startswith("error: --omega0 ")

@@ -435,18 +435,20 @@ def guarded(call: Callable[[], Any], diagnose: Callable[[], None]) -> Any:
         raise
 
 
-def parse_motion(speed: str | None, accel: str | None, mechanism: Any) -> tuple[float | None, float]:
-    """--speed and --accel in internal units (rad/s, rad/s^2, or length/s, length/s^2)."""
+def parse_motion(speed: str | None, accel: str | None, mechanism: Any,
+                 names: tuple[str, str] = ("--speed", "--accel")) -> tuple[float | None, float]:
+    """--speed and --accel in internal units (rad/s, rad/s^2, or length/s, length/s^2);
+    ``names``: the options as the command names them (simulate's speed is --omega0)."""
     from .numbers import parse_quantity
 
     if speed is None:
         if accel is not None:
-            raise InputError("--accel needs --speed (the driver's velocity)")
+            raise InputError(f"{names[1]} needs {names[0]} (the driver's velocity)")
         return None, 0.0
     tables = _rate_units(mechanism)
     out = []
     accel = "0" if accel is None else accel  # an empty --accel '' is refused, not taken as 0
-    for option, text, units in (("--speed", speed, tables[0]), ("--accel", accel, tables[1])):
+    for option, text, units in ((names[0], speed, tables[0]), (names[1], accel, tables[1])):
         value, _ = parse_quantity(option, text, units)
         if not rate_in_range(value):
             raise InputError(f"{option} {text!r} is out of range "

@@ -135,7 +135,7 @@ def simulate(
     fc = _friction("--friction-coulomb", friction_coulomb or [])
     mechanism = load_file(file)
     loads = command_loads(mechanism, load or [], torque or [], gravity)
-    speed = parse_motion(omega0, None, mechanism)[0] or 0.0
+    speed = parse_motion(omega0, None, mechanism, ("--omega0", "--accel"))[0] or 0.0
     sim = run(mechanism, drive, span, constants=_constants(const or []), theta0=theta0, omega0=speed,
               loads=loads, friction_viscous=fv, friction_coulomb=fc, flywheel=flywheel, samples=samples,
               rtol=rtol, atol=rtol * 1e-2)

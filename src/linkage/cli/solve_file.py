@@ -19,7 +19,7 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
     import dataclasses
 
     from ..analysis.convergence import analyze
-    from ..arguments import parse_motion
+    from ..arguments import check_fd_step, parse_motion
     from ..kinematics.loading import load
     from ..problems.closed_form import fourbar_facts
     from ..problems.start import start_on_branch
@@ -30,6 +30,8 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
     if method not in SYSTEM_METHODS:
         raise InputError(f"unknown method {method!r} for a mechanism file; choose from "
                          f"{', '.join(SYSTEM_METHODS)}")
+    if fd_step is not None:
+        fd_step = check_fd_step("--fd-step", fd_step)  # named as the command line names it
     mechanism = load(file).with_values(parse_assignments("--set", set_),
                                        parse_assignments("--guess", guess))
     note_closed_form(mechanism)
