@@ -374,3 +374,6 @@ def test_a_drive_beyond_the_solvers_rates_leaves_those_forces_undefined_not_an_e
     run = cli("simulate", str(LOADED), "--time", "0:0.4", "--drive", "1e300*omega", "--omega0", "1")
     assert run.code == 1 and "accel must be" not in run.err
     assert "forces undefined at 1 of 1 output times" in run.out
+    # one row without forces: neither check has anything to compare, and says so (not "within")
+    assert "energy balance: nothing to compare" in run.out
+    assert "kinetostatic check: nothing to check" in run.out

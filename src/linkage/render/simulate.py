@@ -137,10 +137,14 @@ def _force_blocks(sim: Any, pins: list[tuple[str, str]], force_rows: list[tuple[
 def _lines(sim: Any, checks: _Checks, digits: int) -> list[str]:
     """The checks, the flywheel, the integrator and the event, one line each."""
     verdict = {True: "within", False: "BEYOND"}
+    # a check with nothing to compare says so, not "within" (a run that stopped at its start)
+    forced = sum(1 for f in sim.forces if f is not None and f.input is not None)
     out = [f"energy balance: {verdict[checks.energy_ok]} {checks.energy_tol:.2g} (kinetic + potential - "
-           f"work moves by {sim.balance:.2g} of the largest energy)",
+           f"work moves by {sim.balance:.2g} of the largest energy)" if len(sim.t) > 1 else
+           "energy balance: nothing to compare (one output time)",
            f"kinetostatic check: {verdict[checks.drive_ok]} {checks.drive_tol:.2g} (the matrix method's "
-           f"input differs from the drive by {sim.drive_check:.2g} of the equation's terms)"]
+           f"input differs from the drive by {sim.drive_check:.2g} of the equation's terms)" if forced else
+           "kinetostatic check: nothing to check (no output time has forces)"]
     c = sim.cycle
     if sim.sliding:
         out.append("flywheel: a sliding driver has no turn to size one for")
