@@ -194,9 +194,11 @@ def simulate_plot(sim: Any, mechanism: Any, path: Path) -> None:
     dcols, dk = _driver_columns(sim, mechanism.driver.name, mechanism.length_unit)
     fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(7, 5.5))
     t, theta, omega = sim.trace
-    ax1.plot(t, theta * dk[0], color="tab:blue")
+    # a run that stopped at its start is one point: drawn as a dot (a line of it shows nothing)
+    dot = "o" if len(sim.t) == 1 else None
+    ax1.plot(t[:1] if dot else t, (theta * dk[0])[:1] if dot else theta * dk[0], color="tab:blue", marker=dot)
     ax1.set_ylabel(f"{dcols[0][0]} ({dcols[0][1]})")
-    ax2.plot(t, omega * dk[1], color="tab:red")
+    ax2.plot(t[:1] if dot else t, (omega * dk[1])[:1] if dot else omega * dk[1], color="tab:red", marker=dot)
     ax2.set_ylabel(f"{dcols[1][0]} ({dcols[1][1]})")
     ax2.set_xlabel("t (s)")
     c = sim.cycle
