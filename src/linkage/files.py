@@ -255,25 +255,20 @@ def check_outputs(inputs: Sequence[Path | None], outputs: Sequence[tuple[str, Pa
     in_ids: dict[object, Path | str] = dict(RUNNING[-1].inputs) if RUNNING else {}
     for p in inputs:
         if p is not None and str(p) != "-":
-            ident = _identity(p)
-            if ident is not None:
-                in_ids[ident] = p
-            in_ids[os.path.realpath(p)] = p
+            in_ids.update(dict.fromkeys(_keys(p), p))
     seen: dict[object, str] = dict(RUNNING[-1].written) if RUNNING else {}
     for opt, p in given:
-        real = os.path.realpath(p)
-        ident = _identity(p)
-        for key in (real, ident):
-            if key is not None and key in in_ids:
+        keys = _keys(p)  # (its real path, then its (device, inode) where it exists)
+        for key in keys:
+            if key in in_ids:
                 raise InputError(f"{opt} {p} is the input file {in_ids[key]}; writing there would "
                                  "replace it: choose another path")
-        for key in (real, ident):
-            if key is not None and key in seen:
+        for key in keys:
+            if key in seen:
                 raise InputError(f"{opt} {p} and {seen[key]} name the same file; give each output "
                                  "its own path")
-        for key in (real, ident):
-            if key is not None:
-                seen[key] = f"{opt} {p}"
+        seen.update(dict.fromkeys(keys, f"{opt} {p}"))
+        real = keys[0]
         if os.path.isdir(real):
             raise InputError(f"{opt} {p} is a directory; give a file name")
         parent = os.path.dirname(real) or "."
@@ -366,7 +361,7 @@ def kept_bytes(value: Any) -> bytes:
     return MAGIC_NUMBER + marshal.dumps(value)
 
 
-def compiled_kept(source: str, filename: str, store: str | None) -> Any:
+def compiled_kept(source: str, filename: str, store: str | None, kind: str = "loop") -> Any:
     """``compile(source, filename, "exec")``, its code kept between runs in the directory
     ``store`` (None: not kept) as Python keeps a module's bytecode. A kept file is used only
     if it holds this very source (compared whole, not by its hash) and file name for this
@@ -378,7 +373,7 @@ def compiled_kept(source: str, filename: str, store: str | None) -> Any:
     import zlib
     from types import CodeType
 
-    name = f"loop-{zlib.crc32(source.encode()):08x}-{len(source):x}"
+    name = f"{kind}-{zlib.crc32(source.encode()):08x}-{len(source):x}"  # (kind: the file's prefix)
     path = None if store is None else kept_code_path(store, name)
     if path is None:
         return compile(source, filename, "exec")

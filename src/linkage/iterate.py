@@ -481,7 +481,7 @@ def compiled(source: str, filename: str, fixed_source: bool) -> CodeType:
     one per mechanism ever solved."""
     from .files import compiled_kept
 
-    return compiled_kept(source, filename, LOOP_CACHE if fixed_source else None)
+    return compiled_kept(source, filename, LOOP_CACHE if fixed_source else None, "loop")
 
 
 def build_loop(loop: Loop, names: dict[str, Any] | None = None, *,
