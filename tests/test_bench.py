@@ -435,3 +435,46 @@ def test_the_performance_tables_are_written_from_one_bench_json_between_their_ma
     assert "| six-bar | 4 | 1.11e-16 | 0 | 1.68e-16 | 0 | 0 | yes |" in text
     with pytest.raises(SystemExit):
         table.replace(tmp_path / "page.md", "x", "<!-- none: begin -->", "<!-- none: end -->")
+
+
+@pytest.mark.parametrize("suffix", ["csv", "parquet"])
+def test_the_file_floor_writes_the_cli_s_varying_columns(tmp_path, suffix):
+    """Rows 7 and 8's file by hand (hand.write_sweep_file): the columns it writes are the
+    command line's same columns of crank_rocker.toml to rounding, read back from both files
+    (by hand computing less than the file holds would flatter the hand, not the library).
+    1,001 positions, across the crank's 0/360 deg end, in slices of 97 rows."""
+    import numpy as np
+
+    pq = pytest.importorskip("pyarrow.parquet")
+    import pyarrow.csv as pcsv
+    from typer.testing import CliRunner
+
+    import linkage
+    from linkage.cli import app
+    from linkage.measure.hand import sweep_file_columns, write_sweep_file
+    from linkage.samples import sample_path
+
+    path = str(sample_path("crank_rocker.toml"))
+    values = [k * 0.4 - 20.0 for k in range(1001)]
+    r = linkage.sweep(linkage.load_mechanism(path), values)
+    by_hand = tmp_path / f"hand.{suffix}"
+    write_sweep_file(np.asarray(values), r.column("theta3"), r.column("theta4"), (100.0, 40.0, 120.0, 80.0),
+                     str(by_hand), suffix, rows_per_slice=97)
+    out = tmp_path / f"cli.{suffix}"
+    got = CliRunner().invoke(app, ["sweep", path, "--from", "-20", "--step", "0.4", "--to", "380",
+                                   "-o", str(out)])
+    assert got.exit_code == 0, got.output
+    if suffix == "parquet":
+        cli, hand = pq.read_table(out), pq.read_table(by_hand)
+    else:
+        cli = pcsv.read_csv(out)
+        hand = pcsv.read_csv(by_hand, read_options=pcsv.ReadOptions(column_names=list(
+            sweep_file_columns(np.zeros(1), np.zeros(1), np.zeros(1), 1.0, 1.0, 1.0, 1.0))))
+    assert hand.num_rows == cli.num_rows == 1001
+    names = {"det": "det J", "transmission": "transmission angle 0..90"}
+    for k in hand.column_names:
+        base = names.get(k, k)  # the CSV's header also names the unit
+        want = np.asarray(cli.column(next(c for c in cli.column_names if c in (base, f"{base} (deg)",
+                                                                                  f"{base} (mm)",
+                                                                                  f"{base} (mm^2/rad^2)"))))
+        assert np.asarray(hand.column(k)) == pytest.approx(want, rel=1e-12, abs=1e-9), k

@@ -115,6 +115,77 @@ def fourbar_open_certified(theta2_deg: Sequence[float], r1: float, r2: float, r3
     return degrees(t3), degrees(t4), det, certified
 
 
+CRANK_ROCKER_POINT = (60.0, 30.0)
+"""sample_inputs/crank_rocker.toml's coupler point P: 60 mm from A, at theta3 + 30 deg."""
+
+
+def sweep_file_columns(theta2_deg: Any, theta3_deg: Any, theta4_deg: Any, r1: float, r2: float, r3: float,
+                       r4: float, point: tuple[float, float] = CRANK_ROCKER_POINT) -> dict[str, Any]:
+    """The columns of a four-bar sweep's file that vary from row to row, by hand from its
+    angles (deg, numpy arrays): theta2, theta3, theta4 (deg), det J (mm^2/rad^2), the
+    transmission angle folded into 0..90 (deg), and x, y (mm) of the crank pin A, the
+    coupler-rocker pin B and the coupler point ``point`` (its distance from A and its angle
+    from the coupler, deg), each as vector loops place them (Norton, *Design of Machinery*,
+    sections 4.5 and 4.8)."""
+    import numpy as np
+
+    from ..units import radians
+
+    t2, t3 = radians(theta2_deg), radians(theta3_deg)
+    ax, ay = r2 * np.cos(t2), r2 * np.sin(t2)
+    bx, by = ax + r3 * np.cos(t3), ay + r3 * np.sin(t3)
+    t3 += radians(point[1])
+    px, py = ax + point[0] * np.cos(t3), ay + point[0] * np.sin(t3)
+    mu = np.abs(theta4_deg - theta3_deg) % 180.0
+    return {"theta2": theta2_deg, "theta3": theta3_deg, "theta4": theta4_deg,
+            "det": r3 * r4 * np.sin(radians(theta3_deg - theta4_deg)),
+            "transmission": np.minimum(mu, 180.0 - mu),
+            "A.x": ax, "A.y": ay, "B.x": bx, "B.y": by, "P.x": px, "P.y": py}
+
+
+def write_sweep_file(theta2_deg: Any, theta3_deg: Any, theta4_deg: Any,
+                     links: tuple[float, float, float, float], path: str, suffix: str,
+                     rows_per_slice: int = 32_768) -> None:
+    """A four-bar sweep's file by hand, from its angles (deg, numpy arrays) and links r1..r4:
+    :func:`sweep_file_columns` of each slice of ``rows_per_slice`` rows, on a thread per
+    core (numpy's cos and sin, and pyarrow, release the GIL), each slice's columns made a
+    pyarrow record batch; then CSV text by pyarrow's CSV writer, formatted on the same
+    threads and written in order, or Parquet in one ``pyarrow.parquet.write_table`` of the
+    batches, without dictionaries (which doubles that vary from row to row never use:
+    pyarrow tries one per column first). Less than the command line's file (no status,
+    branch, iteration or constant ground-pivot columns, no header, written in place: no
+    temporary file, rename or fsync), with the writers the package has."""
+    import os
+    from concurrent.futures import ThreadPoolExecutor
+
+    import pyarrow as pa
+
+    csv = suffix != "parquet"
+    if csv:
+        import pyarrow.csv as pcsv
+
+    def block(a: int) -> Any:
+        z = slice(a, a + rows_per_slice)
+        cols = sweep_file_columns(theta2_deg[z], theta3_deg[z], theta4_deg[z], *links)
+        batch = pa.RecordBatch.from_arrays([pa.array(v) for v in cols.values()], names=list(cols))
+        if not csv:
+            return batch
+        out = pa.BufferOutputStream()
+        pcsv.write_csv(batch, out, pcsv.WriteOptions(include_header=False, quoting_style="none"))
+        return out.getvalue()
+
+    with ThreadPoolExecutor(os.cpu_count() or 1) as pool:
+        blocks = pool.map(block, range(0, len(theta2_deg), rows_per_slice))
+        if csv:
+            with open(path, "wb") as f:
+                for text in blocks:
+                    f.write(text)
+            return
+        import pyarrow.parquet as pq
+
+        pq.write_table(pa.Table.from_batches(list(blocks)), path, use_dictionary=False)
+
+
 @frozen
 class DrawnFourbar:
     """A crank-rocker as sample_inputs/crank_rocker_joints.toml draws it (mm): O2 at the

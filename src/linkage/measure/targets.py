@@ -226,9 +226,13 @@ SWEEP_FILE_POSITIONS = 360_001
 
 def sweep_to_file(suffix: str) -> Measure:
     """``linkage sweep crank_rocker.toml --step 0.001 --to 360 -o FILE`` against a process
-    that runs ``linkage.sweep`` of the same positions through the API (and writes nothing)."""
+    that runs ``linkage.sweep`` of the same positions through the API (and writes nothing).
+    Also times the floor against the same API process, and says it: that process, then the
+    file's varying columns computed and written by hand through pyarrow
+    (:func:`.hand.write_sweep_file`): the row's ratio as plain code with the writers the
+    package has would make it."""
 
-    def measure(s: Settings) -> Pairs:
+    def measure(s: Settings) -> Measured:
         if suffix == "parquet":
             try:
                 import pyarrow.parquet  # noqa: F401
@@ -239,10 +243,18 @@ def sweep_to_file(suffix: str) -> Measure:
         path = str(sample_path("crank_rocker.toml"))
         cli = runner(linkage_command("sweep", path, "--step", "0.001", "--to", "360",
                                      "-o", str(s.work / f"sweep.{suffix}")))
-        api = runner(python_command(
-            f"import linkage; linkage.sweep(linkage.load_mechanism({path!r}), "
-            f"[k * 0.001 for k in range({SWEEP_FILE_POSITIONS})])"))
-        return interleaved_pairs(cli, api, s.repeats)
+        sweep = (f"import linkage; v = [k * 0.001 for k in range({SWEEP_FILE_POSITIONS})]; "
+                 f"r = linkage.sweep(linkage.load_mechanism({path!r}), v)")
+        api = runner(python_command(sweep))
+        pairs = interleaved_pairs(cli, api, s.repeats)
+        _, links = crank_rocker()
+        by_hand = runner(python_command(
+            f"{sweep}; import numpy as np; from linkage.measure.hand import write_sweep_file; "
+            f"write_sweep_file(np.asarray(v), r.column('theta3'), r.column('theta4'), {links!r}, "
+            f"{str(s.work / f'floor.{suffix}')!r}, {suffix!r})"))
+        floor = interleaved_pairs(by_hand, api, s.repeats)
+        return Measured(pairs, f"by hand (the API process, then the file's varying columns through "
+                               f"pyarrow) {floor.ratio:.2f}x")
 
     return measure
 
