@@ -4,6 +4,7 @@ here; its events and refusals."""
 
 from __future__ import annotations
 
+import json
 import math
 import random
 from pathlib import Path
@@ -377,3 +378,7 @@ def test_a_drive_beyond_the_solvers_rates_leaves_those_forces_undefined_not_an_e
     # one row without forces: neither check has anything to compare, and says so (not "within")
     assert "energy balance: nothing to compare" in run.out
     assert "kinetostatic check: nothing to check" in run.out
+    # and the json document says neither check was met or missed (null), not true
+    doc = json.loads(cli("simulate", str(LOADED), "--time", "0:0.4", "--drive", "1e300*omega",
+                         "--omega0", "1", "-f", "json").out)
+    assert doc["energy_ok"] is None and doc["drive_ok"] is None

@@ -33,8 +33,10 @@ Headers = list[tuple[str, str]]
 class _Checks:
     """The run's verdicts and the numbers its lines quote."""
 
-    energy_ok: bool
-    drive_ok: bool
+    energy_ok: bool | None
+    """None: nothing to compare (one output time)."""
+    drive_ok: bool | None
+    """None: nothing to check (no output time has forces)."""
     energy_tol: float
     drive_tol: float
     target_cs: float
@@ -54,8 +56,10 @@ def simulate_report(sim: Any, mechanism: Any, digits: int, energy_tol: float, dr
                         force_rows))
     title = (f"{mechanism.name or mechanism.source}: simulated from t = {fmt(sim.t[0], digits)} to "
              f"{fmt(sim.t[-1], digits)} s")
-    checks = _Checks(bool(sim.balance <= energy_tol), bool(sim.drive_check <= drive_tol),
-                     energy_tol, drive_tol, target_cs)
+    # a check with nothing to compare is neither met nor missed (a run that stopped at its start)
+    forced = any(f is not None and f.input is not None for f in sim.forces)
+    checks = _Checks(bool(sim.balance <= energy_tol) if len(sim.t) > 1 else None,
+                     bool(sim.drive_check <= drive_tol) if forced else None, energy_tol, drive_tol, target_cs)
 
     def blocks() -> list[Block]:
         head = [f"{a} ({b})" for a, b in motion_headers]
@@ -67,7 +71,7 @@ def simulate_report(sim: Any, mechanism: Any, digits: int, energy_tol: float, dr
         out += [table("energy", head, [r[:-1] for r in energy_rows], digits), Text("")]
         if pins:
             out += _force_blocks(sim, pins, force_rows, digits)
-        out += [Text(line, "" if ok else "red") for line, ok in zip(
+        out += [Text(line, "" if ok is not False else "red") for line, ok in zip(
             _lines(sim, checks, digits), [checks.energy_ok, checks.drive_ok, True, True, True, True, False])]
         return out
 
@@ -137,13 +141,12 @@ def _force_blocks(sim: Any, pins: list[tuple[str, str]], force_rows: list[tuple[
 def _lines(sim: Any, checks: _Checks, digits: int) -> list[str]:
     """The checks, the flywheel, the integrator and the event, one line each."""
     verdict = {True: "within", False: "BEYOND"}
-    # a check with nothing to compare says so, not "within" (a run that stopped at its start)
-    forced = sum(1 for f in sim.forces if f is not None and f.input is not None)
     out = [f"energy balance: {verdict[checks.energy_ok]} {checks.energy_tol:.2g} (kinetic + potential - "
-           f"work moves by {sim.balance:.2g} of the largest energy)" if len(sim.t) > 1 else
+           f"work moves by {sim.balance:.2g} of the largest energy)" if checks.energy_ok is not None else
            "energy balance: nothing to compare (one output time)",
            f"kinetostatic check: {verdict[checks.drive_ok]} {checks.drive_tol:.2g} (the matrix method's "
-           f"input differs from the drive by {sim.drive_check:.2g} of the equation's terms)" if forced else
+           f"input differs from the drive by {sim.drive_check:.2g} of the equation's terms)"
+           if checks.drive_ok is not None else
            "kinetostatic check: nothing to check (no output time has forces)"]
     c = sim.cycle
     if sim.sliding:
