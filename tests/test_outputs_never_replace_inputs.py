@@ -123,13 +123,28 @@ def test_sweep_torque_plot_and_plot_are_never_one_file(cli, here) -> None:
     assert folder_state(here) == before
 
 
-def test_synthesize_table_beside_the_output_never_replaces_the_plot(cli, here) -> None:
-    """The tables beside -o are named only once the report is made, after the plot is drawn:
-    the run is refused when it reaches the table, and the plot stays a picture."""
-    run = cli(*FUNCTION, "--plot", "s2.linkage.png", "-o", "s2.png", "--format", "csv")
-    refused(run, "twice")
-    assert not (here / "s2.png").exists()
-    assert (here / "s2.linkage.png").read_bytes().startswith(b"\x89PNG")
+PLOT_ON_A_TABLE = {
+    # command: the run, whose --plot is the path of a table written beside -o a.png --format csv
+    "synthesize": [*FUNCTION, "--plot", "a.linkage.png"],
+    "assemblies": ["assemblies", "m.toml", "--sweep", "--plot", "a.paths.png"],
+    "tolerance": ["tolerance", "m.toml", "--tol", "r2=0.1", "--samples", "20", "--plot", "a.largest.png"],
+    "solve": ["solve", "m.toml", "--plot", "a.joints.png"],
+    "sweep": ["sweep", "m.toml", "--step", "30", "--plot", "a.loads.png"],
+    "sweep --torque-plot": ["sweep", "m.toml", "--step", "30", "--torque-plot", "a.loads.png"],
+    "simulate": ["simulate", "m.toml", "--time", "0:0.05", "--drive", "1", "--plot", "a.energy.png"],
+}
+
+
+@pytest.mark.parametrize("command", sorted(PLOT_ON_A_TABLE))
+def test_a_table_beside_the_output_on_the_plot_s_path_writes_neither(cli, here, command) -> None:
+    """The tables beside -o are named only once the report is made: they are checked with
+    --plot then, before the report or the picture is written (the picture was drawn, then
+    the run refused at the table, in synthesize; the tables written, then the picture
+    refused, elsewhere)."""
+    shutil.copy(LOADED if command.startswith(("sweep", "simulate")) else ME581, here / "m.toml")
+    before = folder_state(here)
+    refused(cli(*PLOT_ON_A_TABLE[command], "-o", "a.png", "--format", "csv"), "name the same file")
+    assert folder_state(here) == before
 
 
 # --- 2: --poses is read as a mechanism file is ------------------------------------------------

@@ -191,11 +191,13 @@ class CommandPaths:
     """The files one command has read and written so far, each under its real path and its
     (device, inode) identity (a symlink and a hard link are the file they name)."""
 
-    __slots__ = ("inputs", "written")
+    __slots__ = ("inputs", "planned", "written")
 
     def __init__(self) -> None:
         self.inputs: dict[object, str] = {}
         self.written: dict[object, str] = {}
+        self.planned: dict[object, str] = {}
+        """The outputs the command named (:func:`check_outputs`), each as "OPTION PATH"."""
 
 
 RUNNING: list[CommandPaths] = []
@@ -250,7 +252,9 @@ def check_outputs(inputs: Sequence[Path | None], outputs: Sequence[tuple[str, Pa
     """Refuse, before any work, an output that is an input, two outputs on one path, an
     output in a missing folder or on a directory. ``outputs`` pairs option names with paths.
     Within a command (:func:`command_paths`) the files it has read and written so far count
-    too."""
+    too, and the outputs checked are recorded as the command's: a file it names only later
+    (a table beside -o, named once the report is made) is checked against them by
+    :func:`check_more_outputs`."""
     given = [(opt, p) for opt, p in outputs if p is not None and str(p) != "-"]
     in_ids: dict[object, Path | str] = dict(RUNNING[-1].inputs) if RUNNING else {}
     for p in inputs:
@@ -268,6 +272,8 @@ def check_outputs(inputs: Sequence[Path | None], outputs: Sequence[tuple[str, Pa
                 raise InputError(f"{opt} {p} and {seen[key]} name the same file; give each output "
                                  "its own path")
         seen.update(dict.fromkeys(keys, f"{opt} {p}"))
+        if RUNNING:
+            RUNNING[-1].planned.update(dict.fromkeys(keys, f"{opt} {p}"))
         real = keys[0]
         if os.path.isdir(real):
             raise InputError(f"{opt} {p} is a directory; give a file name")
@@ -275,6 +281,20 @@ def check_outputs(inputs: Sequence[Path | None], outputs: Sequence[tuple[str, Pa
         if not os.path.isdir(parent):
             raise InputError(f"cannot write {opt} {p}: the folder {os.path.dirname(str(p)) or '.'} "
                              "does not exist")
+
+
+def check_more_outputs(outputs: Sequence[tuple[str, Path]]) -> None:
+    """Refuse, before anything of them is written, outputs a command names only once its
+    work is done (the tables a one-table format writes beside -o) where one is an input or
+    one of the outputs the command named at its start (its --plot, say), by
+    :func:`check_outputs`' rule; outside a command, only among themselves."""
+    planned = dict(RUNNING[-1].planned) if RUNNING else {}
+    for opt, p in outputs:
+        for key in _keys(p):
+            if key in planned:
+                raise InputError(f"{planned[key]} and {opt} {p} name the same file; give each output "
+                                 "its own path")
+    check_outputs([], outputs)
 
 
 def _in_place(path: str) -> bool:

@@ -8,11 +8,14 @@ from typing import Any, Optional
 
 
 def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Optional[float],
-                accel: Optional[float], digits: int, plot: Optional[Path], cols: Any = None) -> Any:
-    """The sweep's report with a ``loads`` table (and its summary lines) added; ``plot``:
-    the input torque over the sweep, peak marked. ``cols``: the sweep's columns as its
-    report read them (kinematics.columns.sweep_columns; read here if not given), whose
-    rates the loads reuse."""
+                accel: Optional[float], digits: int, plot: Optional[Path], cols: Any = None
+                ) -> tuple[Any, Callable[[], None] | None]:
+    """The sweep's report with a ``loads`` table (and its summary lines) added, and with
+    ``plot`` the call that draws the input torque over the sweep, peak marked, into it
+    (made once the report is written: its tables beside -o are checked against the
+    picture's path first, render.writers.check_report_paths). ``cols``: the sweep's
+    columns as its report read them (kinematics.columns.sweep_columns; read here if not
+    given), whose rates the loads reuse."""
     from ..kinematics.columns import sweep_columns
     from ..kinematics.force_sweeps import FORCE_KEYS, LoadColumns
     from ..problems.loads import applied_rows
@@ -56,13 +59,14 @@ def sweep_loads(report: Any, mechanism: Any, result: Any, loads: Any, speed: Opt
                          shown, digits))
         return out
 
-    if plot is not None:  # every position's loads now (the positions table computes its rates again)
+    def draw() -> None:
         got = acc.result()
         rows = list(zip(_plain(cols.inputs), words[:].tolist(), got.columns["input"].tolist()))
         torque_plot(rows, name, unit, unit_in, plot, f"{mechanism.name}: input over the sweep",
                     got.peak_input)
-    return Report(report.title, (*report.tables, loads_table), lambda: [*report.blocks(), *lines()],
-                  report.document)
+
+    return (Report(report.title, (*report.tables, loads_table), lambda: [*report.blocks(), *lines()],
+                   report.document), None if plot is None else draw)
 
 
 def _plain(values: Any) -> list[Any]:

@@ -70,11 +70,11 @@ def motion_command(pose: list[str], poses_file: Optional[Path], circle: list[str
         if not 1 <= design <= len(m.designs):
             raise InputError(f"--design {design}: there are {len(m.designs)} designs (1 to {len(m.designs)})")
         chosen = design - 1
+    writers.write(motion_report(m, digits, unit), fmt, report_out, table=table)
     if plot is not None:
         from ..render.motion_synthesis import curves_plot
 
         curves_plot(m, plot, unit)
-    writers.write(motion_report(m, digits, unit), fmt, report_out, table=table)
     if m.curves is not None:
         return
     if write_file and output is not None:

@@ -159,18 +159,28 @@ def sweep(
 
         cols = sweep_columns(result)  # read once: a batch sweep's rates for its table and its loads
         report = sweep_report(result, digits, joints_note=note, cols=cols)
-        if loads is not None and (not loads.empty or loads.gravity is not None):
-            from .loads import sweep_loads
-
-            report = sweep_loads(report, mechanism, result, loads, w, a_, digits, torque_plot, cols)
-        elif torque_plot is not None:
-            raise InputError("--torque-plot needs loads: [loads] or [mass] in the file, or --load/--torque")
+        report, draw_torque = with_loads(report, mechanism, result, loads, (w, a_), digits, torque_plot, cols)
         emit_report(report, out_fmt, output, columns=columns, table=table,
                     progress=None if advance is None else (lambda rows: advance(n + rows)))
+        if draw_torque is not None:
+            draw_torque()
     if plot is not None:
         draw_sweep(result, mechanism, path, plot, motion)
     if result.summary.get("failed"):
         raise typer.Exit(1)
+
+
+def with_loads(report: Any, mechanism: Any, result: Any, loads: Any, motion: tuple[Any, Any], digits: int,
+               torque_plot: Path | None, cols: Any) -> tuple[Any, Any]:
+    """The report with its loads table where the run has loads (cli.loads.sweep_loads), and
+    the call that draws --torque-plot once the report is written (None without it)."""
+    if loads is not None and (not loads.empty or loads.gravity is not None):
+        from .loads import sweep_loads
+
+        return sweep_loads(report, mechanism, result, loads, *motion, digits, torque_plot, cols)
+    if torque_plot is not None:
+        raise InputError("--torque-plot needs loads: [loads] or [mass] in the file, or --load/--torque")
+    return report, None
 
 
 def check_path_names(mechanism: Any, path: list[str] | None, plot: Path | None, file: Path) -> list[str]:

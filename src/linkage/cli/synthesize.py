@@ -239,11 +239,11 @@ def synthesize(
         from .synthesis_output import write_chosen
 
         write_chosen(result, output, unit, force)  # type: ignore[arg-type]
+    writers.write(synthesis_report(result, digits, unit), fmt, report_out, table=table)
     if plot is not None and result.linkage is not None and result.curve:
         error_plot(result, plot)
     elif plot is not None:
         typer.echo(f"note: {plot} not drawn: there is no real linkage", err=True)
-    writers.write(synthesis_report(result, digits, unit), fmt, report_out, table=table)
     if result.defects:
         raise typer.Exit(1)
 

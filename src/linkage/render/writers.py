@@ -211,6 +211,36 @@ def sidecar_target(stack: contextlib.ExitStack, output: Path, table: str) -> str
     return stack.enter_context(atomic_target(Path(sidecar_name(output, table))))
 
 
+def check_report_paths(report: Report, fmt: str, output: Path | None, table: str | None = None) -> list[Path]:
+    """The sidecar files :func:`write` writes for ``report``, named only once the report is
+    made, checked against the inputs and the outputs the command named at its start
+    (files.check_more_outputs) before anything is written: a table file on the --plot's
+    path is refused with neither written, as every command writes its report before its
+    pictures. A one-table
+    format of several tables on standard output is refused here too. ``table``: --table's
+    (the report then has that one table)."""
+    to_stdout = output is None or str(output) == "-"
+    if table is not None:
+        report = pick_table(report, fmt, table)
+    spec = FORMATS.get(fmt)
+    if spec is None or spec.sink is None or not spec.one_table:
+        return []
+    tables = [t for t in report.tables if t.columns]
+    if to_stdout:
+        if len(tables) > 1:
+            names = ", ".join(t.name for t in tables)
+            raise InputError(f"{fmt} holds one table and this report has {len(tables)} ({names}): add "
+                             f"--table NAME for one on standard output, or -o FILE{spec.suffixes[0]} "
+                             "(one file each)")
+        return []
+    sides = side_paths(output, report)  # type: ignore[arg-type]
+    if sides:
+        from ..files import check_more_outputs
+
+        check_more_outputs([(f"-o {output}'s table file", p) for p in sides])
+    return sides
+
+
 def side_paths(output: Path, report: Report) -> list[Path]:
     """The files a one-table format's report of several tables writes beside ``output``."""
     return [Path(sidecar_name(output, t.name)) for t in [t for t in report.tables if t.columns][1:]]
@@ -249,20 +279,15 @@ def write(report: Report, fmt: str, output: Path | None, *,
           progress: Callable[[int], None] | None = None, table: str | None = None) -> None:
     """Write ``report`` in ``fmt`` to ``output`` (None or "-": standard output);
     ``progress(rows written)`` as a data format's rows go out; ``table`` (--table) keeps
-    that one of the report's tables (:func:`pick_table`)."""
+    that one of the report's tables (:func:`pick_table`). The report's sidecar files are
+    checked first (:func:`check_report_paths`)."""
     to_stdout = output is None or str(output) == "-"
-    sides: list[Path] = []  # a csv or parquet report's sidecar files
     if table is not None:
         report = pick_table(report, fmt, table)
     spec = FORMATS.get(fmt)
+    sides = check_report_paths(report, fmt, output)  # a csv or parquet report's sidecar files
     if spec is not None and spec.sink is not None:
         tables = [t for t in report.tables if t.columns]
-        if spec.one_table and to_stdout and len(tables) > 1:
-            names = ", ".join(t.name for t in tables)
-            raise InputError(f"{fmt} holds one table and this report has {len(tables)} ({names}): add "
-                             f"--table NAME for one on standard output, or -o FILE{spec.suffixes[0]} "
-                             "(one file each)")
-        sides = side_paths(output, report) if spec.one_table and not to_stdout else []  # type: ignore[arg-type]
         files = [Path(str(output)).name] + [p.name for p in sides] if not to_stdout else []
         with open_sink(fmt, output, spec.sink.meta_of(report, files)) as sink:
             write_tables(sink, tables, progress)
