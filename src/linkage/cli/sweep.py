@@ -91,7 +91,7 @@ def sweep(
 
     Example: linkage sweep --from 10 --to 160 --step 30
     """
-    from ..arguments import check_number, driver_span, parse_motion
+    from ..arguments import check_method, check_number, driver_span, parse_motion
     from ..kinematics.loading import load
     from ..kinematics.positions import check_assembles_somewhere, driver_range_text
     from ..kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
@@ -121,8 +121,7 @@ def sweep(
         raise InputError("give --step or --points, not both")
     if step is not None:
         check_number("--step", step)
-    if method not in SYSTEM_METHODS:
-        raise InputError(f"unknown method {method!r}; choose from {', '.join(SYSTEM_METHODS)}")
+    check_method("--method", method, SYSTEM_METHODS, "for a mechanism file")
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
     a, b = driver_span(mechanism, start, stop)
     if points is None and step is None:
@@ -206,6 +205,7 @@ def sweep_equation(a: float, b: float, step: float | None, points: int | None, m
     """The four-bar input-output equation over alpha (the student report's table,
     docs/worked_examples.md P2): the options
     checked here, the walk in :func:`linkage.kinematics.equation_sweep.equation_sweep`."""
+    from ..arguments import check_method
     from ..kinematics.equation_sweep import equation_sweep
     from ..kinematics.positions import check_assembles_somewhere
     from ..kinematics.sweep import driver_values
@@ -213,8 +213,7 @@ def sweep_equation(a: float, b: float, step: float | None, points: int | None, m
     from ..problems.seed_equation import fourbar_coefficients, scalar_problem
     from ..render.sweep import equation_report
 
-    if method not in SCALAR_METHODS:
-        raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")
+    check_method("--method", method, SCALAR_METHODS, "for the four-bar equation (sweep without FILE)")
     if plot is not None:
         raise InputError("--plot draws mechanism sweeps; without FILE use --format csv")
     if step is not None and points is not None:
