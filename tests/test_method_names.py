@@ -39,7 +39,8 @@ def the_refusal(*args: object) -> str:
 def test_check_method_returns_a_known_name_and_refuses_others_by_one_shape():
     assert check_method("--method", "lm", SYSTEM_METHODS) == "lm"
     assert choices(the_refusal("method", "nope", SYSTEM_METHODS, "for a system")) == list(SYSTEM_METHODS)
-    assert the_refusal("--method", "nope", ("a", "b")) == "unknown method 'nope' in --method; choose from a, b"
+    assert the_refusal("--method", "nope", ("a", "b")) == ("unknown method 'nope' in --method; "
+                                                           "choose from a, b")
 
 
 @pytest.mark.parametrize("value", [None, 3, ["newton"], {"newton": 1}, b"newton", "Newton", " newton"])
