@@ -6,6 +6,8 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import InputError
+from ..methods import SCALAR_METHODS
+from ..solve import SYSTEM_METHODS  # (a sweep imports it in any case: kinematics.sweep's criteria)
 from .options import (
     PICTURES,
     AccelOpt,
@@ -50,7 +52,8 @@ def sweep(
     step: Annotated[Optional[float], typer.Option(help="Driver increment (default 1).")] = None,
     points: Annotated[Optional[int], typer.Option(help="Number of evenly spaced positions "
                       "instead of --step.")] = None,
-    method: Annotated[str, typer.Option("--method", "-m", help="newton, newton-fd or lm.")] = "newton",
+    method: Annotated[str, typer.Option("--method", "-m", help=f"With FILE: {', '.join(SYSTEM_METHODS)}; "
+                      f"without (the four-bar equation): {', '.join(SCALAR_METHODS)}.")] = "newton",
     branch: Annotated[Optional[str], typer.Option(help="Assembly branch to follow (mechanisms "
                       "whose loops have a closed form), by name or signs as in solve --branch: open, "
                       "crossed, open/crossed for a six-bar, 'open (mirror)', +-; default: the "
@@ -97,7 +100,7 @@ def sweep(
     from ..kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
     from ..render.sweep import sweep_report
     from ..render.writers import data_formats, is_data, prefetch
-    from ..solve import SYSTEM_METHODS, check_criteria
+    from ..solve import check_criteria
 
     out_fmt = choose_format(fmt, output)
     check_paths([file], [("--output", output), ("--plot", plot), ("--torque-plot", torque_plot)],
@@ -209,11 +212,11 @@ def sweep_equation(a: float, b: float, step: float | None, points: int | None, m
     from ..kinematics.equation_sweep import equation_sweep
     from ..kinematics.positions import check_assembles_somewhere
     from ..kinematics.sweep import driver_values
-    from ..methods import SCALAR_METHODS
+    from ..methods import METHODS
     from ..problems.seed_equation import fourbar_coefficients, scalar_problem
     from ..render.sweep import equation_report
 
-    check_method("--method", method, SCALAR_METHODS, "for the four-bar equation (sweep without FILE)")
+    check_method("--method", method, METHODS, "for the four-bar equation (sweep without FILE)")
     if plot is not None:
         raise InputError("--plot draws mechanism sweeps; without FILE use --format csv")
     if step is not None and points is not None:
