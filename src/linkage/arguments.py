@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
 from operator import countOf
 from typing import Any
 
@@ -137,14 +137,27 @@ def check_fd_step(name: str, value: Any) -> float:
     return h
 
 
+def check_method(name: str, method: Any, known: Collection[str], scope: str = "") -> str:
+    """``method`` if it is one of the ``known`` names (a str), else InputError
+    "unknown method 'x' in NAME[ SCOPE]; choose from A, B, C": the one check of a method's
+    name, which every front door taking one calls (the command line's --method, the
+    library's ``method=``) and :func:`check_method_list` calls for each entry. ``known``
+    comes from the caller's registry (``linkage.methods.METHODS``, read when called, so a
+    method registered later is known; ``linkage.solve.SYSTEM_METHODS``): this layer knows
+    no method. ``scope`` says what the methods apply to ("for a mechanism file")."""
+    if isinstance(method, str) and method in known:
+        return method
+    where = f"{name} {scope}" if scope else name
+    raise InputError(f"unknown method {method!r} in {where}; choose from {', '.join(known)}")
+
+
 def check_method_list(name: str, text: str, known: Sequence[str], every: str = "all") -> list[str]:
     """The methods a comma-separated list names, each known and none twice, or an InputError
     naming the entry at fault; ``every`` ("all": every method that applies) stands alone."""
     names = [m.strip() for m in text.split(",")]
     choose = f"choose from {', '.join(known)}, {every}"
-    unknown = [m for m in names if m not in known and m != every]
-    if unknown:
-        raise InputError(f"unknown method {unknown[0]!r} in {name}; {choose}")
+    for m in names:
+        check_method(name, m, (*known, every))
     if every in names:
         raise InputError(f"{every!r} stands alone in {name}, got {text!r}")
     if len(set(names)) < len(names):

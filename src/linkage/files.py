@@ -200,8 +200,8 @@ class CommandPaths:
         """The outputs the command named (:func:`check_outputs`), each as "OPTION PATH"."""
 
 
-RUNNING: list[CommandPaths] = []
-"""The running command's paths (:func:`command_paths`); empty outside a command, where
+RUNNING: CommandPaths | None = None
+"""The running command's paths (:func:`command_paths`); None outside a command, where
 reading and writing record nothing (a library caller's files are its own business)."""
 
 
@@ -209,12 +209,12 @@ reading and writing record nothing (a library caller's files are its own busines
 def command_paths() -> Iterator[CommandPaths]:
     """While the block runs, :func:`read_input` records each file read, :func:`atomic_target`
     each file written, and :func:`check_outputs` refuses an output that is one of them."""
-    run = CommandPaths()
-    RUNNING.append(run)
+    global RUNNING
+    outer, RUNNING = RUNNING, CommandPaths()
     try:
-        yield run
-    finally:
-        RUNNING.remove(run)
+        yield RUNNING
+    finally:  # None again (or a caller's own block's paths: a block within keeps its own record)
+        RUNNING = outer
 
 
 def _keys(path: Path | str) -> list[object]:
@@ -225,17 +225,17 @@ def _keys(path: Path | str) -> list[object]:
 
 def note_input(path: Path | str) -> None:
     """Record ``path`` as read by the running command (if one runs)."""
-    if RUNNING and str(path) != "-":
-        RUNNING[-1].inputs.update(dict.fromkeys(_keys(path), str(path)))
+    if RUNNING is not None and str(path) != "-":
+        RUNNING.inputs.update(dict.fromkeys(_keys(path), str(path)))
 
 
 def claim_output(path: Path | str) -> None:
     """The last check of a path about to be written by the running command (if one runs):
     not a file it read, not a file it wrote already; then recorded as written. Special files
     (``/dev/null``) are exempt: writing one replaces nothing."""
-    if not RUNNING or _in_place(os.path.realpath(path)):
+    run = RUNNING
+    if run is None or _in_place(os.path.realpath(path)):
         return
-    run = RUNNING[-1]
     keys = _keys(path)
     for key in keys:
         if key in run.inputs:
@@ -256,11 +256,11 @@ def check_outputs(inputs: Sequence[Path | None], outputs: Sequence[tuple[str, Pa
     (a table beside -o, named once the report is made) is checked against them by
     :func:`check_more_outputs`."""
     given = [(opt, p) for opt, p in outputs if p is not None and str(p) != "-"]
-    in_ids: dict[object, Path | str] = dict(RUNNING[-1].inputs) if RUNNING else {}
+    in_ids: dict[object, Path | str] = dict(RUNNING.inputs) if RUNNING is not None else {}
     for p in inputs:
         if p is not None and str(p) != "-":
             in_ids.update(dict.fromkeys(_keys(p), p))
-    seen: dict[object, str] = dict(RUNNING[-1].written) if RUNNING else {}
+    seen: dict[object, str] = dict(RUNNING.written) if RUNNING is not None else {}
     for opt, p in given:
         keys = _keys(p)  # (its real path, then its (device, inode) where it exists)
         for key in keys:

@@ -5,7 +5,6 @@ from typing import Any
 
 import typer
 
-from ..errors import InputError
 from .options import emit_report, note_closed_form, parse_assignments
 
 
@@ -19,7 +18,7 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
     import dataclasses
 
     from ..analysis.convergence import analyze
-    from ..arguments import check_fd_step, parse_motion
+    from ..arguments import check_fd_step, check_method, parse_motion
     from ..kinematics.loading import load
     from ..problems.closed_form import fourbar_facts
     from ..problems.start import start_on_branch
@@ -27,9 +26,7 @@ def solve_file(file: Path, method: str, set_: list[str], guess: list[str], tol: 
     from ..solve import SYSTEM_METHODS, solve_system
     from ..solve.system import check_assembles
 
-    if method not in SYSTEM_METHODS:
-        raise InputError(f"unknown method {method!r} for a mechanism file; choose from "
-                         f"{', '.join(SYSTEM_METHODS)}")
+    check_method("--method", method, SYSTEM_METHODS, "for a mechanism file")
     if fd_step is not None:
         fd_step = check_fd_step("--fd-step", fd_step)  # named as the command line names it
     mechanism = load(file).with_values(parse_assignments("--set", set_),

@@ -32,14 +32,14 @@ def stress(
 
     Example: linkage stress --quick
     """
+    from ..arguments import check_method
     from ..measure.stress import SUMMARY_HEADERS, run, stress_tables, summary_rows, totals
     from ..methods import SCALAR_METHODS
     from ..solve import SYSTEM_METHODS
 
-    known = set(SCALAR_METHODS) | set(SYSTEM_METHODS)
+    known = tuple(dict.fromkeys((*SCALAR_METHODS, *SYSTEM_METHODS)))  # scalar's, then the systems' new ones
     for m in method or []:
-        if m not in known:
-            raise InputError(f"unknown method {m!r}; choose from {', '.join(sorted(known))}")
+        check_method("--method", m, known)
     out_fmt = choose_format(fmt, output)
     check_paths([], [("--output", output)])
     methods = method or None

@@ -6,6 +6,8 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import InputError
+from ..methods import SCALAR_METHODS
+from ..solve import SYSTEM_METHODS  # (a sweep imports it in any case: kinematics.sweep's criteria)
 from .options import (
     PICTURES,
     AccelOpt,
@@ -50,7 +52,8 @@ def sweep(
     step: Annotated[Optional[float], typer.Option(help="Driver increment (default 1).")] = None,
     points: Annotated[Optional[int], typer.Option(help="Number of evenly spaced positions "
                       "instead of --step.")] = None,
-    method: Annotated[str, typer.Option("--method", "-m", help="newton, newton-fd or lm.")] = "newton",
+    method: Annotated[str, typer.Option("--method", "-m", help=f"With FILE: {', '.join(SYSTEM_METHODS)}; "
+                      f"without (the four-bar equation): {', '.join(SCALAR_METHODS)}.")] = "newton",
     branch: Annotated[Optional[str], typer.Option(help="Assembly branch to follow (mechanisms "
                       "whose loops have a closed form), by name or signs as in solve --branch: open, "
                       "crossed, open/crossed for a six-bar, 'open (mirror)', +-; default: the "
@@ -91,13 +94,13 @@ def sweep(
 
     Example: linkage sweep --from 10 --to 160 --step 30
     """
-    from ..arguments import check_number, driver_span, parse_motion
+    from ..arguments import check_method, check_number, driver_span, parse_motion
     from ..kinematics.loading import load
     from ..kinematics.positions import check_assembles_somewhere, driver_range_text
     from ..kinematics.sweep import BATCH_ABOVE, driver_values, sweep_mechanism
     from ..render.sweep import sweep_report
     from ..render.writers import data_formats, is_data, prefetch
-    from ..solve import SYSTEM_METHODS, check_criteria
+    from ..solve import check_criteria
 
     out_fmt = choose_format(fmt, output)
     check_paths([file], [("--output", output), ("--plot", plot), ("--torque-plot", torque_plot)],
@@ -121,8 +124,7 @@ def sweep(
         raise InputError("give --step or --points, not both")
     if step is not None:
         check_number("--step", step)
-    if method not in SYSTEM_METHODS:
-        raise InputError(f"unknown method {method!r}; choose from {', '.join(SYSTEM_METHODS)}")
+    check_method("--method", method, SYSTEM_METHODS, "for a mechanism file")
     mechanism = load(file).with_values(parse_assignments("--set", set_ or []), {})
     a, b = driver_span(mechanism, start, stop)
     if points is None and step is None:
@@ -216,15 +218,15 @@ def sweep_equation(a: float, b: float, step: float | None, points: int | None, m
     """The four-bar input-output equation over alpha (the student report's table,
     docs/worked_examples.md P2): the options
     checked here, the walk in :func:`linkage.kinematics.equation_sweep.equation_sweep`."""
+    from ..arguments import check_method
     from ..kinematics.equation_sweep import equation_sweep
     from ..kinematics.positions import check_assembles_somewhere
     from ..kinematics.sweep import driver_values
-    from ..methods import SCALAR_METHODS
+    from ..methods import METHODS
     from ..problems.seed_equation import fourbar_coefficients, scalar_problem
     from ..render.sweep import equation_report
 
-    if method not in SCALAR_METHODS:
-        raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")
+    check_method("--method", method, METHODS, "for the four-bar equation (sweep without FILE)")
     if plot is not None:
         raise InputError("--plot draws mechanism sweeps; without FILE use --format csv")
     if step is not None and points is not None:

@@ -51,7 +51,8 @@ class Circuit:
     """One closed curve of configurations, and the assemblies at the start value on it."""
 
     members: tuple[int, ...]  # indices into Assemblies.real (0-based)
-    status: str  # "closed", "unfinished" (MAX_STEPS), "failed" (steps below MIN_STEP), "unbounded"
+    status: str  # "closed", "unfinished" (MAX_STEPS), "failed" (steps below MIN_STEP), "unbounded",
+    # "unlocated" (a crossing of the start value beside a limit position not placed: CrossingNotLocated)
     driver_low: float  # internal units: the smallest and largest driver value on the curve
     driver_high: float
     full_turn: bool  # an angle driver turns a full revolution on this circuit
@@ -214,11 +215,22 @@ def _start_crossings(curve: _Curve, start: Assemblies, a: np.ndarray, ta: np.nda
     return out
 
 
+class CrossingNotLocated(ArithmeticError):
+    """No point inside a monotone piece of an arc step through a limit position corrected
+    onto the curve, so the crossing of the start value on that piece has no point of its own
+    side to be solved from. The piece's fold end is no substitute: both sides meet there and
+    the Jacobian at a fixed driver is singular, so solved at the start value from it, Newton
+    may reach the other side's assembly. Reached only where the corrector fails inside a step
+    whose end it corrected (no sample mechanism does: tests/test_circuit_crossing_unlocated.py
+    makes it fail); the circuit is then reported "unlocated", never matched by a guess."""
+
+
 def _crossing_on_arc(curve: _Curve, start: Assemblies, a: np.ndarray, ta: np.ndarray, s_lo: float,
                      s_hi: float, p_lo: float) -> tuple[float, np.ndarray]:
     """The point of the arc from ``a`` along ``ta`` nearest the start value between arc
     coordinates ``s_lo`` (start-relative driver ``p_lo``) and ``s_hi``, the driver monotone
-    between them: bisection on s, each trial corrected onto the curve."""
+    between them: bisection on s, each trial corrected onto the curve (the first trial is
+    the piece's midpoint; :class:`CrossingNotLocated` if it does not correct)."""
     m = start.mechanism
     s_best, best = s_hi, None
     for _ in range(64):
@@ -234,9 +246,9 @@ def _crossing_on_arc(curve: _Curve, start: Assemblies, a: np.ndarray, ta: np.nda
             s_lo = s
         else:
             s_hi = s
-    if best is None:  # no trial corrected: the piece's end, solved at the start value by the caller
-        best = a if s_best == 0.0 else _correct(curve, a + s_best * ta, ta)[0]
-    return s_best, (a if best is None else best)
+    if best is None:
+        raise CrossingNotLocated(f"no point of the arc from s = {s_lo!r} to {s_hi!r} corrects onto the curve")
+    return s_best, best
 
 
 def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
@@ -283,7 +295,13 @@ def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
             limits.extend(float(f[0][-1] * curve.scale[-1]) for f in (fold,) if f is not None)
             status = "unbounded"
             break
-        for s_cross, at in _start_crossings(curve, start, ys[-2], ts[-2], y_new, fold):
+        try:
+            crossed = _start_crossings(curve, start, ys[-2], ts[-2], y_new, fold)
+        except CrossingNotLocated:
+            limits.extend(float(f[0][-1] * curve.scale[-1]) for f in (fold,) if f is not None)
+            status = "unlocated"
+            break
+        for s_cross, at in crossed:
             # crossed the start value: which assembly is this?
             q = list(at[:-1] * curve.scale[:-1])
             i = next((i for i, a in enumerate(start.real) if same_configuration(q, a.q, m, MATCH)), None)

@@ -13,10 +13,10 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from ..arguments import check_callable, check_flag, check_motion, check_reals, check_text
+from ..arguments import check_callable, check_flag, check_method, check_motion, check_reals, check_text
 from ..errors import InputError
 from ..problems.loops import Mechanism
-from ..solve import check_criteria
+from ..solve import SYSTEM_METHODS, check_criteria
 from .pose import POSE_MEETS, file_branch, pose_meets, step_words
 from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
 from .stepwise import sweep
@@ -90,8 +90,7 @@ def sweep_mechanism(
     if batch is not None:
         check_flag("batch", batch)
     speed, accel = check_motion(speed, accel, m.driver.kind, m.length_unit)
-    if method not in ("newton", "newton-fd", "lm"):
-        raise InputError(f"unknown method {method!r}; choose from newton, newton-fd, lm")
+    check_method("method", method, SYSTEM_METHODS, "for a mechanism")
     if loads is not None:  # the sweep, then its forces (kinematics.forces)
         from .bodies import checked_loads
         from .force_sweeps import with_forces

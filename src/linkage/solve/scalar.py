@@ -10,10 +10,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any
 
-from ..arguments import check_callable, check_number, check_reals, guarded
+from ..arguments import check_callable, check_method, check_number, check_reals, guarded
 from ..errors import InputError
 from ..iterate import Criteria, Rows, explain, run
-from ..methods import METHODS, SCALAR_METHODS, MethodEntry, method_class
+from ..methods import METHODS, MethodEntry, method_class
 from ..methods.common import history_of
 from ..problems.scalar import ScalarProblem
 from ..result import History, Result, Status
@@ -98,9 +98,7 @@ def solve_checked(f: Callable[[float], float] | ScalarProblem, method: str, x0: 
     """:func:`solve_scalar`'s general front door: every argument checked, then the method
     run. Its own function: the fast path's frame then holds only the arguments (a frame's
     every local is set up and cleared on each call)."""
-    entry = METHODS.get(method)
-    if entry is None:
-        raise InputError(f"unknown method {method!r}; choose from {', '.join(SCALAR_METHODS)}")
+    entry = METHODS[check_method("method", method, METHODS)]  # the registry itself: registered later too
     crit = check_criteria(tol, rtol, ftol, max_iter)
     check_callable("fprime", fprime)
     check_callable("g", g)

@@ -9,7 +9,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any
 
-from ..arguments import check_callable, check_fd_step, check_reals, real_vector
+from ..arguments import check_callable, check_fd_step, check_method, check_reals, real_vector
 from ..errors import InputError
 from ..iterate import Criteria, run
 from ..result import FAST_NAMES, History, Raw, Result, Status, fast_source, given
@@ -212,8 +212,7 @@ def solve_general(F: Any, x0: Any, *, jac: Any, method: str, tol: float, rtol: f
     """:func:`solve_system` by the general path, every argument checked; a TypeError or
     IndexError from F or jac is named (:func:`~linkage.solve.diagnose.names_bad_callables`)."""
     NewtonSystem, max_abs, newton_system, SystemProblem, generic_system = _system_solvers()
-    if method not in SYSTEM_METHODS:
-        raise InputError(f"unknown method {method!r} for a system; choose from {', '.join(SYSTEM_METHODS)}")
+    check_method("method", method, SYSTEM_METHODS, "for a system")
     crit = check_criteria(tol, rtol, ftol, max_iter)
     if fd_step is not None:
         fd_step = check_fd_step("fd_step", fd_step)
