@@ -272,8 +272,8 @@ def check_outputs(inputs: Sequence[Path | None], outputs: Sequence[tuple[str, Pa
                 raise InputError(f"{opt} {p} and {seen[key]} name the same file; give each output "
                                  "its own path")
         seen.update(dict.fromkeys(keys, f"{opt} {p}"))
-        if RUNNING:
-            RUNNING[-1].planned.update(dict.fromkeys(keys, f"{opt} {p}"))
+        if RUNNING is not None:
+            RUNNING.planned.update(dict.fromkeys(keys, f"{opt} {p}"))
         real = keys[0]
         if os.path.isdir(real):
             raise InputError(f"{opt} {p} is a directory; give a file name")
@@ -288,7 +288,7 @@ def check_more_outputs(outputs: Sequence[tuple[str, Path]]) -> None:
     work is done (the tables a one-table format writes beside -o) where one is an input or
     one of the outputs the command named at its start (its --plot, say), by
     :func:`check_outputs`' rule; outside a command, only among themselves."""
-    planned = dict(RUNNING[-1].planned) if RUNNING else {}
+    planned = dict(RUNNING.planned) if RUNNING is not None else {}
     for opt, p in outputs:
         for key in _keys(p):
             if key in planned:
