@@ -2,7 +2,9 @@
 every engine and the mechanism files share it).
 
 Mechanism systems have 2 to ~8 unknowns; at that size a Python LU beats numpy's
-per-call overhead, and a single solve keeps numpy out of the import graph.
+per-call overhead, and a single solve keeps numpy out of the import graph. The numpy twins
+(:func:`lu_np`, :func:`back_substitute_np`, :func:`pivot_ratio_np`), for stacks of such
+systems (a block of positions, a scan's designs), import it when called.
 """
 
 from __future__ import annotations
@@ -221,6 +223,17 @@ def pivot_ratio(factors: tuple[Matrix, list[int], int]) -> float:
     diag = [abs(m[i][i]) for i in range(len(m))]
     top = max(diag)
     return min(diag) / top if top > 0.0 else 0.0
+
+
+def pivot_ratio_np(t: Any) -> Any:
+    """:func:`pivot_ratio` of each matrix of a stack as :func:`lu_np` leaves it, (n, n, N)."""
+    import numpy as np
+
+    n = t.shape[0]
+    diag = np.abs(t[range(n), range(n)])
+    top = np.maximum.reduce(diag)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(top > 0.0, np.minimum.reduce(diag) / top, 0.0)
 
 
 def hadamard_ratio(a: Sequence[Sequence[float]]) -> float:

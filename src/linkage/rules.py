@@ -125,9 +125,9 @@ def invertible_array(det: Any, size: Any) -> Any:
     return np.abs(det) > SINGULAR_RATIO * size
 
 
-def pivots_invertible(ratio: float) -> bool:
+def pivots_invertible(ratio: Any) -> Any:
     """An n x n J is usable: the equilibrated LU's smallest/largest |pivot| is at least
-    SINGULAR_RATIO (NaN fails)."""
+    SINGULAR_RATIO (NaN fails); on a float, or on numpy arrays position by position."""
     return ratio >= SINGULAR_RATIO
 
 

@@ -27,11 +27,11 @@ def direction_np(jac: Any, phi: Any) -> tuple[Any, Any]:
     """``newton_direction`` over a stack: (dq with J dq = -phi, usable) for ``jac``
     (..., rows, n) and ``phi`` (..., rows), usable where it gives a finite dq. Two unknowns:
     its closed form and singularity test; more: the pivot ratio of the equilibrated LU
-    against SINGULAR_RATIO, then the LU of J as given."""
+    (``pivots_invertible``), then the LU of J as given."""
     import numpy as np
 
-    from ..linalg import back_substitute_np, lu_np
-    from ..rules import SINGULAR_RATIO, invertible_array
+    from ..linalg import back_substitute_np, lu_np, pivot_ratio_np
+    from ..rules import invertible_array, pivots_invertible
 
     n = jac.shape[-1]
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
@@ -48,10 +48,7 @@ def direction_np(jac: Any, phi: Any) -> tuple[Any, Any]:
             t = np.ascontiguousarray(np.moveaxis(jac.reshape(-1, n, n), 0, -1))
             scaled = equilibrate_np(t)
             ok = lu_np(scaled)
-            diag = np.abs(scaled[range(n), range(n)])
-            top = np.maximum.reduce(diag)
-            ratio = np.where(top > 0.0, np.minimum.reduce(diag) / top, 0.0)
-            ok &= ratio >= SINGULAR_RATIO
+            ok &= pivots_invertible(pivot_ratio_np(scaled))
             y = np.ascontiguousarray(np.moveaxis(-phi.reshape(-1, n), 0, -1))
             ok &= lu_np(t, y)
             dq = np.moveaxis(back_substitute_np(t, y), 0, -1).reshape(*shape, n)
