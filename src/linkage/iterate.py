@@ -140,7 +140,6 @@ def explain(exc: BaseException) -> tuple[Status, str]:
     return Status.DOMAIN_ERROR, str(exc) or type(exc).__name__
 
 
-
 # --- the ordered stopping rule, and the loops generated from it ----------------------------------
 #
 # Tests 2-8 above are written once, here, as source text (:func:`stopping_tests`). Every loop -
