@@ -15,10 +15,10 @@ import pytest
 from linkage.kinematics import load_matrix
 from linkage.kinematics.force_sweeps import batch_forces
 from linkage.kinematics.forces import TOGGLE_COND
-from linkage.kinematics.load_matrix import eliminate_np, first_largest, solve_bounded_np
+from linkage.kinematics.load_matrix import solve_bounded_np
 from linkage.kinematics.loading import load
 from linkage.kinematics.sweep import sweep_mechanism
-from linkage.linalg import cond1, lu, lu_solve
+from linkage.linalg import cond1, first_largest, lu, lu_np, lu_solve
 from linkage.problems.loads import Loads
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -67,7 +67,7 @@ def test_the_elimination_is_the_scalar_lu_bit_for_bit() -> None:
     a = stack(60, 9, 2)[8:]
     t = np.ascontiguousarray(a.transpose(1, 2, 0))
     y = np.zeros(t.shape[1:])
-    eliminate_np(t, y)
+    lu_np(t, y)
     for k in range(len(a)):
         packed = np.array(lu(a[k].tolist())[0])
         got = t[:, :, k]

@@ -3,7 +3,7 @@ and its loads' path) against the scalar definition (kinematics.rates.position_ra
 position by position: the same status, the same flags and the same numbers to their last
 bits (tests/ulps.py), at random positions, speeds and accelerations and up to a toggle,
 where the rates must carry their flag or be undefined on both paths. And the block's
-pieces against theirs: the LU and Newton direction twins (kinematics.block_linalg), the
+pieces against theirs: the LU twin (linalg.lu_np) and Newton direction twin (kinematics.block_linalg), the
 Neumann series, polish."""
 
 from __future__ import annotations
@@ -14,13 +14,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from linkage.kinematics.block_linalg import direction_np, lu_np, lu_solve_np
+from linkage.kinematics.block_linalg import direction_np
 from linkage.kinematics.loading import load
 from linkage.kinematics.rate_blocks import block_rates
 from linkage.kinematics.rate_bounds import through_inverse, through_inverse_np
 from linkage.kinematics.rates import polish, polish_np, position_rates
 from linkage.kinematics.sweep import sweep_mechanism
-from linkage.linalg import SingularMatrix, lu, lu_solve
+from linkage.linalg import SingularMatrix, back_substitute_np, lu, lu_np, lu_solve
 from linkage.methods.newton_system import newton_direction
 from linkage.units import radians
 from ulps import assert_ulps
@@ -98,8 +98,9 @@ def test_lu_and_newton_direction_twins_give_the_scalar_bits() -> None:
         a = rng.normal(size=(200, n, n)) * rng.choice([1e-3, 1.0, 1e3], size=(200, 1, n))
         a[:5, 0, :] = 0.0  # singular: a zero row
         b = rng.normal(size=(200, n))
-        f, perm, ok = lu_np([[a[:, i, j] for j in range(n)] for i in range(n)])
-        x = lu_solve_np(f, perm, [b[:, i] for i in range(n)])
+        t, y = np.ascontiguousarray(a.transpose(1, 2, 0)), np.ascontiguousarray(b.T)
+        ok = lu_np(t, y)
+        x = back_substitute_np(t, y)
         dq, usable = direction_np(a, b)
         for k in range(200):
             try:

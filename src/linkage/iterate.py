@@ -47,7 +47,7 @@ from typing import Any
 
 from .records import NamedTuple
 from .result import STATUS_MEMBERS, Status
-from .rules import step_limit, system_converged_source, worse_than_seen
+from .rules import counts_after, state_after, step_limit, system_converged_source, worse_than_seen
 
 UNCERTIFIED_LIMIT = 4
 """Small steps without evidence of a root after which an open scalar method stops."""
@@ -197,6 +197,9 @@ class Loop(NamedTuple):
     limit: str = "_step_limit(tol, rtol, ax) if rtol else tol"
     failure: str = ""
     """When given, every stop other than convergence runs this line instead (``return None``)."""
+    on_raise: str = ""
+    """Source run where the step raised (``exc``), before the run ends as ``explain`` names
+    it: the loop's counts after it (:data:`linkage.rules.COUNTS_ON_RAISE`)."""
     quiet: bool = False
     """Emit :func:`quiet_path` before the tests (needs ``tol`` and ``rtol`` as names, and
     ``ftol`` with ``residual_test``)."""
@@ -459,7 +462,8 @@ def loop_source(loop: Loop) -> str:
     if loop.failure:
         lines.append("            " + loop.failure)
     else:
-        lines += ["            status, detail = _explain(exc)", "            k -= 1", "            break"]
+        lines += [*_block(loop.on_raise, 3), "            status, detail = _explain(exc)",
+                  "            k -= 1", "            break"]
     lines += _block(loop.after, 2)
     lines += [*stopping_tests(loop), "    else:  # test 8, the cap: every other stop breaks",
               '        status, detail = _S.MAX_ITER, ""']
@@ -495,7 +499,7 @@ def build_loop(loop: Loop, names: dict[str, Any] | None = None, *,
         "_stall": rounding_stall, "_worse": worse_than_seen, "_step_limit": step_limit,
         "_DIVERGE": DIVERGE_STREAK, "_ROUNDING": ROUNDING, "_PER_ROUNDING": 1.0 / ROUNDING,
         "_BIG": sys.float_info.max, "_RUNAWAY": RUNAWAY, "_STEPS": STEPS, "_CAP": STEPS[-1],
-        **(names or {})}
+        "_counts_after": counts_after, "_state_after": state_after, **(names or {})}
     name = loop.signature.split("(", 1)[0]
     exec(compiled(loop_source(loop), f"<linkage-loop {name}>", fixed_source), namespace)
     return namespace[name]  # type: ignore[no-any-return]
@@ -521,6 +525,7 @@ def generic_loop(can_diverge: bool, needs_residual: bool, minimizes: bool, plaus
             x, fx, err = state.x, state.fx, state.err
             """,
         result="state, status, detail, k",
+        on_raise="state = _state_after(exc, state)",
         fx_optional=True,
         residual_test=not needs_residual,
         plausible="plausible(state)" if plausible else "",

@@ -2,7 +2,9 @@
 every engine and the mechanism files share it).
 
 Mechanism systems have 2 to ~8 unknowns; at that size a Python LU beats numpy's
-per-call overhead, and a single solve keeps numpy out of the import graph.
+per-call overhead, and a single solve keeps numpy out of the import graph. The numpy twins
+(:func:`lu_np`, :func:`back_substitute_np`, :func:`pivot_ratio_np`), for stacks of such
+systems (a block of positions, a scan's designs), import it when called.
 """
 
 from __future__ import annotations
@@ -82,6 +84,105 @@ def lu_solve(factors: tuple[Matrix, list[int], int], b: Sequence[float]) -> list
     return y
 
 
+def lu_np(t: Any, y: Any = None) -> Any:
+    """:func:`lu` of every matrix of a stack ``t`` (n, n, N), the N systems last, in place:
+    U on and above the diagonal, L's multipliers below; its row swaps and forward
+    elimination applied alongside to ``y`` (n, N) or (n, m, N), m right-hand sides, where
+    given (so :func:`back_substitute_np` then finishes :func:`lu_solve`). Returns where each
+    matrix is usable (N,): no zero pivot, where ``lu`` raises SingularMatrix.
+
+    ``lu``'s pivots (the first largest, :func:`first_largest`) and numbers bit for bit, and
+    ``lu_solve``'s forward substitution, but for a zero's sign (and NaN for inf): the
+    multiplier is the quotient as divided (0 / pivot: -0.0 under a negative pivot, where
+    ``lu`` writes +0.0 and skips the row), and a row or column zero in every system is not
+    updated (``lu`` subtracts 0 times it). Neither changes a non-zero number.
+
+    One pivot step at a time over all N systems: a step's row swap is a whole-row copy
+    where every system swaps the same rows, a masked one where some do; its update covers
+    the rows and columns that are non-zero in some system (a force matrix is mostly zeros
+    and ones), row by row through one scratch row (no fresh (n, n, N) temporary per step):
+    numpy's LAPACK calls cost more per 9 x 9 system than its arithmetic."""
+    import numpy as np
+
+    n, _, count = t.shape
+    with np.errstate(all="ignore"):  # a zero pivot: inf and NaN in its system, usable False
+        return _eliminate(t, y, n, count)
+
+
+def _eliminate(t: Any, y: Any, n: int, count: int) -> Any:
+    """:func:`lu_np`'s steps."""
+    import numpy as np
+
+    usable = np.ones(count, dtype=bool)
+    pairs = [(t, np.empty((n, count)))]
+    if y is not None:
+        pairs.append((y, np.empty(y.shape[1:])))
+    scratch = pairs[0][1]
+    for k in range(n):
+        # the candidate rows: those non-zero in some system (the first largest wins, as in lu)
+        rows = np.flatnonzero(t[k:, k].any(axis=1)) + k
+        if rows.size == 0:
+            usable[:] = False  # zero in every system: singular, and nothing to eliminate
+            continue
+        p = first_largest(t[:, k], rows)
+        chosen = np.bincount(p - k, minlength=n - k)
+        for r in np.flatnonzero(chosen[1:]) + 1:
+            other = k + r
+            swap = None if chosen[r] == count else p == other
+            for m, spare in pairs:
+                if swap is None:
+                    m[[k, other]] = m[[other, k]]
+                    continue
+                np.copyto(spare, m[k])
+                np.copyto(m[k], m[other], where=swap)
+                np.copyto(m[other], spare, where=swap)
+        usable &= t[k, k] != 0.0
+        cols = np.flatnonzero(t[k, k + 1:].any(axis=1)) + k + 1
+        c0, c1 = (cols[0], cols[-1] + 1) if cols.size else (k + 1, k + 1)
+        for i in np.flatnonzero(t[k + 1:, k].any(axis=1)) + k + 1:
+            mult = t[i, k]
+            np.divide(mult, t[k, k], out=mult)
+            np.multiply(mult, t[k, c0:c1], out=scratch[:c1 - c0])
+            t[i, c0:c1] -= scratch[:c1 - c0]
+            if y is not None:
+                y[i] -= mult * y[k]
+    return usable
+
+
+def first_largest(column: Any, rows: Any) -> Any:
+    """Each system's pivot row among ``rows`` of ``column`` (n, N): the first of the largest
+    in magnitude, as :func:`lu`'s ``max`` picks it (a later row wins only where it is
+    strictly larger, so a NaN never wins nor loses its place). Row by row, element-wise:
+    an ``argmax`` across rows makes a transposed copy of its rows and runs a short loop
+    per system, about five times the time of this, all of it holding the GIL."""
+    import numpy as np
+
+    p = np.full(column.shape[1], rows[0])
+    best = np.abs(column[rows[0]])
+    for r in rows[1:]:
+        size = np.abs(column[r])
+        larger = size > best
+        np.copyto(p, r, where=larger)
+        np.copyto(best, size, where=larger)
+    return p
+
+
+def back_substitute_np(t: Any, y: Any) -> Any:
+    """:func:`lu_solve`'s back substitution over a stack, its operations in its order: the
+    solutions (n, N) or (n, m, N) of U x = y, ``t`` and ``y`` as :func:`lu_np` leaves them
+    (``y`` is overwritten). NaN or inf where U has a zero pivot."""
+    import numpy as np
+
+    n = t.shape[0]
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        for i in range(n - 1, -1, -1):
+            s = y[i]
+            for j in range(i + 1, n):
+                s -= t[i, j] * y[j]
+            s /= t[i, i]
+    return y
+
+
 def det_from_lu(factors: tuple[Matrix, list[int], int]) -> float:
     m, _, sign = factors
     d = float(sign)
@@ -122,6 +223,17 @@ def pivot_ratio(factors: tuple[Matrix, list[int], int]) -> float:
     diag = [abs(m[i][i]) for i in range(len(m))]
     top = max(diag)
     return min(diag) / top if top > 0.0 else 0.0
+
+
+def pivot_ratio_np(t: Any) -> Any:
+    """:func:`pivot_ratio` of each matrix of a stack as :func:`lu_np` leaves it, (n, n, N)."""
+    import numpy as np
+
+    n = t.shape[0]
+    diag = np.abs(t[range(n), range(n)])
+    top = np.maximum.reduce(diag)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(top > 0.0, np.minimum.reduce(diag) / top, 0.0)
 
 
 def hadamard_ratio(a: Sequence[Sequence[float]]) -> float:

@@ -125,9 +125,9 @@ def invertible_array(det: Any, size: Any) -> Any:
     return np.abs(det) > SINGULAR_RATIO * size
 
 
-def pivots_invertible(ratio: float) -> bool:
+def pivots_invertible(ratio: Any) -> Any:
     """An n x n J is usable: the equilibrated LU's smallest/largest |pivot| is at least
-    SINGULAR_RATIO (NaN fails)."""
+    SINGULAR_RATIO (NaN fails); on a float, or on numpy arrays position by position."""
     return ratio >= SINGULAR_RATIO
 
 
@@ -364,3 +364,47 @@ class SystemStops:
             kept[...] = value
         else:
             kept[rows] = value
+
+
+# --- the counts of a step that raised -----------------------------------------------------------
+
+RAISED_COUNTS = "linkage_counts"
+"""The attribute of an exception that carries the counts of the step it ended (:func:`counts_made`)."""
+
+
+def counts_made(exc: BaseException, nfev: int, njev: int) -> BaseException:
+    """The one counting rule of every loop: an evaluation of F or J counts once it has
+    returned, those of a step that then raises among them (a reader of "3 Jacobian
+    evaluations" reads how many were made); the one that raised made nothing and does not.
+    A method's step that raises after evaluating says so here, on the exception it re-raises
+    (returned: its counts so far, ``nfev`` and ``njev``), and the loop it ends reads them
+    back (:data:`COUNTS_ON_RAISE`, :func:`state_after`): a generated loop that counts in its
+    own names and the generic one, which counts in a method's state, report the same numbers."""
+    setattr(exc, RAISED_COUNTS, (nfev, njev))
+    return exc
+
+
+def counts_after(exc: BaseException, nfev: int, njev: int) -> tuple[int, int]:
+    """The counts a loop reports after a step raised ``exc``: those :func:`counts_made` put
+    on it (taken off, so an exception object raised again carries none into another run),
+    else the loop's own ``nfev`` and ``njev`` (its step's evaluations, counted as they
+    returned)."""
+    made = getattr(exc, RAISED_COUNTS, None)
+    if made is None:
+        return nfev, njev
+    delattr(exc, RAISED_COUNTS)
+    return made  # type: ignore[no-any-return]
+
+
+COUNTS_ON_RAISE = "nfev, njev = _counts_after(exc, nfev, njev)"
+""":func:`counts_after` in a generated loop that counts in ``nfev`` and ``njev`` (its
+``Loop.on_raise``; ``_counts_after`` is the function)."""
+
+
+def state_after(exc: BaseException, state: Any) -> Any:
+    """:func:`counts_after` for the generic loop, whose counts are its state's fields (a
+    state whose method puts none on the exception, a scalar method's, is left as it is)."""
+    if getattr(exc, RAISED_COUNTS, None) is None or not hasattr(state, "njev"):
+        return state
+    nfev, njev = counts_after(exc, state.nfev, state.njev)
+    return state._replace(nfev=nfev, njev=njev)

@@ -13,6 +13,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from ..errors import InputError
+from ..linalg import back_substitute_np, lu_np
 from ..problems.loads import Loads, load_link
 from ..records import NamedTuple, frozen
 from ..units import radians
@@ -398,15 +399,12 @@ def condition_np(a: Any, rhs: Any) -> tuple[Any, Any]:
 
 def solve_bounded_np(a: Any, rhs: Any, overwrite_a: bool = False) -> tuple[Any, Any]:
     """Each system of a stack, ``a`` (n, n, N) and ``rhs`` (n, N) with the N systems last:
-    its solution (N, n) by LU with partial pivoting, and a certified upper bound (N,) of
+    its solution (N, n) by LU with partial pivoting (linalg's :func:`~linkage.linalg.lu_np`,
+    ``lu``'s twin, and its ``lu_solve``'s back substitution), and a certified upper bound (N,) of
     its 1-norm condition number ||A||_1 ||A^-1||_1 (NaN or inf where none is found: a
     zero pivot, a non-finite entry). ``rhs`` is left as it is, and ``a`` unless
     ``overwrite_a`` (then its elimination is done in ``a``, which is spent: a copy of a
     large stack costs a tenth of a loaded scan's time on two threads).
-
-    The elimination runs over all N systems at once, one pivot step at a time, skipping
-    the rows and columns that are zero in every system (a force matrix is mostly zeros
-    and ones); numpy's LAPACK calls cost more per 9 x 9 system than its arithmetic.
 
     The bound (Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed.): the
     computed factors satisfy L U = P A + E with |E| <= gamma_n |L| |U| (theorem 9.3), and
@@ -428,10 +426,8 @@ def solve_bounded_np(a: Any, rhs: Any, overwrite_a: bool = False) -> tuple[Any, 
             sums += np.abs(a[i], out=row)
         norm = sums.max(axis=0)
         t, y = (a if overwrite_a else a.copy()), rhs.copy()
-        eliminate_np(t, y)
-        x = np.empty_like(y)
-        for k in range(n - 1, -1, -1):
-            x[k] = (y[k] - np.einsum("jN,jN->N", t[k, k + 1:], x[k + 1:])) / t[k, k]
+        lu_np(t, y)
+        x = back_substitute_np(t, y)
         g, lu_norm = inverse_bound_np(np.abs(t, out=t))
         safety = 1.0 + 2.0 * (n + 2) ** 2 * EPS
         gamma = n * EPS / (1.0 - n * EPS)
@@ -441,67 +437,8 @@ def solve_bounded_np(a: Any, rhs: Any, overwrite_a: bool = False) -> tuple[Any, 
     return x.T, upper
 
 
-def eliminate_np(t: Any, y: Any) -> None:
-    """LU with partial pivoting of every matrix of ``t`` (n, n, N) in place (U on and above
-    the diagonal, L's multipliers below), its row swaps and forward elimination applied to
-    ``y`` (n, N). A step's row swap is a whole-row copy where every system swaps the same
-    rows, a masked one where some do; its update covers the rows and columns that are
-    non-zero in some system (the others' update is zero). ``linalg.lu``'s numbers bit for bit
-    but for a zero's sign: a multiplier that is zero in one system and not in all is 0 /
-    pivot there (-0.0 under a negative pivot, where lu writes +0.0 and skips the row), which
-    the bound, reading |L| and |U|, does not see."""
-    import numpy as np
-
-    n, _, count = t.shape
-    keep = (np.empty((n, count)), np.empty(count))
-    for k in range(n):
-        # the candidate rows: those non-zero in some system (the first largest wins, as in lu)
-        rows = np.flatnonzero(t[k:, k].any(axis=1)) + k
-        if rows.size == 0:
-            continue  # zero in every system: singular, and nothing to eliminate
-        p = first_largest(t[:, k], rows)
-        chosen = np.bincount(p - k, minlength=n - k)
-        for r in np.flatnonzero(chosen[1:]) + 1:
-            other = k + r
-            if chosen[r] == count:
-                t[[k, other]], y[[k, other]] = t[[other, k]], y[[other, k]]
-                continue
-            swap = p == other
-            for m, spare in zip((t, y), keep):
-                np.copyto(spare, m[k])
-                np.copyto(m[k], m[other], where=swap)
-                np.copyto(m[other], spare, where=swap)
-        cols = np.flatnonzero(t[k, k + 1:].any(axis=1)) + k + 1
-        c0, c1 = (cols[0], cols[-1] + 1) if cols.size else (k + 1, k + 1)
-        for i in np.flatnonzero(t[k + 1:, k].any(axis=1)) + k + 1:
-            # row by row through one scratch row: no fresh (n, n, N) temporary per step
-            mult = t[i, k]
-            np.divide(mult, t[k, k], out=mult)
-            np.multiply(mult, t[k, c0:c1], out=keep[0][:c1 - c0])
-            t[i, c0:c1] -= keep[0][:c1 - c0]
-            y[i] -= mult * y[k]
-
-
-def first_largest(column: Any, rows: Any) -> Any:
-    """Each system's pivot row among ``rows`` of ``column`` (n, N): the first of the largest
-    in magnitude, as ``linalg.lu``'s ``max`` picks it (a later row wins only where it is
-    strictly larger, so a NaN never wins nor loses its place). Row by row, element-wise:
-    an ``argmax`` across rows makes a transposed copy of its rows and runs a short loop
-    per system, about five times the time of this, all of it holding the GIL."""
-    import numpy as np
-
-    p = np.full(column.shape[1], rows[0])
-    best = np.abs(column[rows[0]])
-    for r in rows[1:]:
-        size = np.abs(column[r])
-        larger = size > best
-        np.copyto(p, r, where=larger)
-        np.copyto(best, size, where=larger)
-    return p
-
-
 def inverse_bound_np(lu_abs: Any) -> tuple[Any, Any]:
-    """From |L| and |U| packed as :func:`eliminate_np` leaves them (n, n, N): the largest
+    """From |L| and |U| packed as :func:`~linkage.linalg.lu_np` leaves them (n, n, N): the largest
     column sum of M(U)^-1 M(L)^-1, by e^T M(U)^-1 (M(U)^T v = e, forward) then
     v^T M(L)^-1 (M(L)^T w = v, backward); and the largest column sum of |L| |U|, by
     (e^T |L|) |U|. Both (N,)."""

@@ -16,10 +16,9 @@ import math
 from operator import mul
 from typing import Any
 
-from ..linalg import SingularMatrix, lu, lu_solve
+from ..linalg import SingularMatrix, back_substitute_np, lu, lu_np, lu_solve
 from ..problems.loops import DRIVER, LoopModel
 from ..records import NamedTuple
-from .block_linalg import lu_np, lu_solve_np
 from .vectors import EPS, SCALAR, rate_of, value_of
 
 SAFETY = 2.0
@@ -287,7 +286,7 @@ def solve_two_np(a: Any, b: Any, usable: Any) -> tuple[Any, Any, Any]:
 def abs_inverse_np(jac: list[list[Any]]) -> tuple[list[list[Any]], Any]:
     """:func:`abs_inverse` over a block (``jac`` rows of columns of arrays): (|J^-1| enlarged
     by its rounding, usable), the same tests position by position (an LU of each by numpy,
-    :func:`~.block_linalg.lu_np`, ``lu``'s twin, beyond two unknowns)."""
+    :func:`~linkage.linalg.lu_np`, ``lu``'s twin, beyond two unknowns)."""
     import numpy as np
 
     n = len(jac)
@@ -299,10 +298,13 @@ def abs_inverse_np(jac: list[list[Any]]) -> tuple[list[list[Any]], Any]:
             ok = (det != 0.0) & np.isfinite(det) & ~(EPS * size > 1e-3 * np.abs(det))
             grow = (1.0 + 4.0 * EPS * size / np.abs(det)) / np.abs(det)
             return [[np.abs(d) * grow, np.abs(b) * grow], [np.abs(c) * grow, np.abs(a) * grow]], ok
-        f, perm, ok = lu_np(jac)
-        cols = [lu_solve_np(f, perm, [1.0 if i == j else 0.0 for i in range(n)]) for j in range(n)]
-        inv = [[np.abs(cols[j][i]) for j in range(n)] for i in range(n)]
-        ok &= np.logical_and.reduce([np.isfinite(v) for row in inv for v in row])
+        shape = np.broadcast_shapes(*(np.shape(v) for row in jac for v in row))
+        t = np.stack([np.stack([np.broadcast_to(np.asarray(v, dtype=float), shape) for v in row])
+                      for row in jac]).reshape(n, n, -1)
+        unit = np.broadcast_to(np.eye(n)[:, :, None], t.shape).copy()  # column j: e_j
+        ok = lu_np(t, unit)
+        inv = np.abs(back_substitute_np(t, unit)).reshape(n, n, *shape)  # [i][j]: (J^-1)_ij
+        ok = ok.reshape(shape) & np.isfinite(inv).all(axis=(0, 1))
         # Skeel's condition number, as abs_inverse bounds the inverse's error
         jrow = [sum(np.abs(v) for v in row) for row in jac]
         kappa = np.maximum.reduce([sum(inv[i][k] * jrow[k] for k in range(n)) for i in range(n)])

@@ -19,6 +19,7 @@ from ..linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve
 from ..problems.system import SystemProblem
 from ..records import NamedTuple, frozen
 from ..result import Column, Status
+from ..rules import counts_made
 from .common import new_state
 from .newton_system import (
     fd_jacobian,
@@ -89,61 +90,64 @@ class LevenbergMarquardt:
         else:
             jac = problem.J(q)  # type: ignore[misc]
             njev += 1
-        n = len(q)
-        jtj, g = normal_equations(jac, phi)
-        try:
-            fj = lu(jac)
-            det, cond = det_from_lu(fj), (cond1(jac, fj) if self.diagnostics else math.nan)
-            # the error estimate is the undamped (Gauss-Newton) step, as Newton's: a damped
-            # step is small wherever mu is large, at a local minimum too, and bounds nothing;
-            # nor does the undamped one where J is singular by Newton's own test (a tiny
-            # residual over a vanishing pivot: Hypothesis found r1 = r2, r3 = r4 at theta2 =
-            # 4e-94 rad stopped 45 deg from every root with "error 2.3e-13")
-            direction = newton_direction(jac, phi)[0]
-            newton = step_measure(direction if direction is not None else lu_solve(fj, [-v for v in phi]),
-                                  problem.step_scales)
-        except SingularMatrix:
-            det, cond, newton, direction = 0.0, math.inf, math.inf, None
-        if direction is None and max_abs(phi) <= ROUNDING_RESIDUAL * problem.length_scale:
-            # the loops close to rounding where J is singular: no step can certify a root
-            # here, and none can lower |Phi| further; stopped, the verdict is the residual's
-            return new_state(LMState, (
-                tuple(q), max_abs(phi), newton,
-                (Status.SINGULAR_JACOBIAN, "J is singular here and the loops close to rounding level: "
-                                           "a small step bounds no distance to a root"),
-                tuple(q), tuple(phi), tuple(map(tuple, jac)), tuple(0.0 for _ in q), det, cond, s.mu, s.cost,
-                tuple(phi), nfev, njev, False))
-        mu = s.mu
-        while True:
-            a = [row[:] for row in jtj]
-            for i in range(n):
-                a[i][i] += mu * max(jtj[i][i], 1e-12)
+        try:  # an evaluation counts once it returned, in a step that raises too (iterate.counts_made)
+            n = len(q)
+            jtj, g = normal_equations(jac, phi)
             try:
-                dq = lu_solve(lu(a), [-v for v in g])
+                fj = lu(jac)
+                det, cond = det_from_lu(fj), (cond1(jac, fj) if self.diagnostics else math.nan)
+                # the error estimate is the undamped (Gauss-Newton) step, as Newton's: a damped
+                # step is small wherever mu is large, at a local minimum too, and bounds nothing;
+                # nor does the undamped one where J is singular by Newton's own test (a tiny
+                # residual over a vanishing pivot: Hypothesis found r1 = r2, r3 = r4 at theta2 =
+                # 4e-94 rad stopped 45 deg from every root with "error 2.3e-13")
+                direction = newton_direction(jac, phi)[0]
+                newton = step_measure(direction if direction is not None else lu_solve(fj, [-v for v in phi]),
+                                      problem.step_scales)
             except SingularMatrix:
-                dq = None
-            if dq is not None:
-                trial = [qi + di for qi, di in zip(q, dq)]
-                phi_t = problem.F(trial)
-                nfev += 1
-                cost_t = sum(v * v for v in phi_t)
-                if cost_t < s.cost:
-                    return new_state(LMState, (
-                        tuple(trial), max_abs(phi_t), max(step_measure(dq, problem.step_scales), newton),
-                        None,
-                        tuple(q), tuple(phi),
-                        tuple(map(tuple, jac)), tuple(dq), det, cond, max(mu / 3.0, 1e-12), cost_t,
-                        tuple(phi_t), nfev, njev, direction is not None))
-            mu *= 2.0
-            if mu > MU_MAX:
-                # No step lowers the residual: a local minimum of |Phi|^2.
+                det, cond, newton, direction = 0.0, math.inf, math.inf, None
+            if direction is None and max_abs(phi) <= ROUNDING_RESIDUAL * problem.length_scale:
+                # the loops close to rounding where J is singular: no step can certify a root
+                # here, and none can lower |Phi| further; stopped, the verdict is the residual's
                 return new_state(LMState, (
                     tuple(q), max_abs(phi), newton,
-                    (Status.LOCAL_MINIMUM, f"no step lowers |Phi|^2 below {s.cost:.3g} from here "
-                                           f"(mu above {MU_MAX:g})"),
-                    tuple(q), tuple(phi), tuple(map(tuple, jac)),
-                    tuple(0.0 for _ in q), det, cond, mu, s.cost, tuple(phi), nfev, njev,
-                    direction is not None))
+                    (Status.SINGULAR_JACOBIAN, "J is singular here and the loops close to rounding level: "
+                                               "a small step bounds no distance to a root"),
+                    tuple(q), tuple(phi), tuple(map(tuple, jac)), tuple(0.0 for _ in q), det, cond, s.mu,
+                    s.cost, tuple(phi), nfev, njev, False))
+            mu = s.mu
+            while True:
+                a = [row[:] for row in jtj]
+                for i in range(n):
+                    a[i][i] += mu * max(jtj[i][i], 1e-12)
+                try:
+                    dq = lu_solve(lu(a), [-v for v in g])
+                except SingularMatrix:
+                    dq = None
+                if dq is not None:
+                    trial = [qi + di for qi, di in zip(q, dq)]
+                    phi_t = problem.F(trial)
+                    nfev += 1
+                    cost_t = sum(v * v for v in phi_t)
+                    if cost_t < s.cost:
+                        return new_state(LMState, (
+                            tuple(trial), max_abs(phi_t), max(step_measure(dq, problem.step_scales), newton),
+                            None,
+                            tuple(q), tuple(phi),
+                            tuple(map(tuple, jac)), tuple(dq), det, cond, max(mu / 3.0, 1e-12), cost_t,
+                            tuple(phi_t), nfev, njev, direction is not None))
+                mu *= 2.0
+                if mu > MU_MAX:
+                    # No step lowers the residual: a local minimum of |Phi|^2.
+                    return new_state(LMState, (
+                        tuple(q), max_abs(phi), newton,
+                        (Status.LOCAL_MINIMUM, f"no step lowers |Phi|^2 below {s.cost:.3g} from here "
+                                               f"(mu above {MU_MAX:g})"),
+                        tuple(q), tuple(phi), tuple(map(tuple, jac)),
+                        tuple(0.0 for _ in q), det, cond, mu, s.cost, tuple(phi), nfev, njev,
+                        direction is not None))
+        except (ArithmeticError, ValueError) as exc:
+            raise counts_made(exc, nfev, njev)  # noqa: B904 (the same exception, its traceback kept)
 
     @staticmethod
     def plausible(s: LMState) -> bool:

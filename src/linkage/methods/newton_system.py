@@ -1,11 +1,9 @@
 """Newton-Raphson for loop-closure systems: solve J(q_k) dq = -Phi(q_k), q_k+1 = q_k + dq.
 
-Quadratic convergence near a solution where J is nonsingular (the textbook section 3.9,
-eq. 7; worked example P3, docs/worked_examples.md). One residual and one Jacobian evaluation per step;
-with the
+Quadratic convergence near a solution where J is nonsingular (the textbook section 3.9, eq. 7; worked
+example P3, docs/worked_examples.md). One residual and one Jacobian evaluation per step; with the
 Jacobian by forward differences (``newton-fd``, the course notes' recipe, docs/worked_examples.md P3:
-perturb one
-coordinate by h, take (Phi(q + h e_j) - Phi(q)) / h as column j, restore it), n + 1
+perturb one coordinate by h, take (Phi(q + h e_j) - Phi(q)) / h as column j, restore it), n + 1
 residual evaluations and order falling toward linear as h grows. By default the step
 is globalised (``damped``, see :class:`NewtonSystem`): taken whole when it lowers
 |Phi|^2, else shortened, else replaced by a Levenberg-Marquardt step. The textbook
@@ -26,7 +24,7 @@ from ..linalg import SingularMatrix, cond1, det_from_lu, lu, lu_solve, pivot_rat
 from ..problems.system import SystemProblem
 from ..records import NamedTuple, frozen
 from ..result import Column, Status
-from ..rules import invertible, invertible_source, pivots_invertible, step_size
+from ..rules import COUNTS_ON_RAISE, counts_made, invertible, invertible_source, pivots_invertible, step_size
 from ..units import degrees
 from .common import new_state
 
@@ -238,64 +236,67 @@ class NewtonSystem:
         else:
             jac = problem.J(q)  # type: ignore[misc]
             njev += 1
-        resid = max_abs(phi)
-        scales = problem.step_scales
-        dq, det, _ = newton_direction(jac, phi)
-        cond = (cond1(jac) if dq is None or self.diagnostics else math.nan)
-        tjac = tuple(map(tuple, jac))
+        try:  # an evaluation counts once it returned, in a step that raises too (iterate.counts_made)
+            resid = max_abs(phi)
+            scales = problem.step_scales
+            dq, det, _ = newton_direction(jac, phi)
+            cond = (cond1(jac) if dq is None or self.diagnostics else math.nan)
+            tjac = tuple(map(tuple, jac))
 
-        def state(step: list[float], alpha: float, phi_new: Any, stop: Any = None) -> NewtonSystemState:
-            x = tuple(qi + di for qi, di in zip(q, step))
-            err = step_measure(step, scales)
-            return new_state(NewtonSystemState, (
-                x, resid, err if stop is None else math.nan, stop, tuple(q), tuple(phi), tjac,
-                tuple(step), det, cond, alpha, nfev, njev, tuple(phi_new)))
+            def state(step: list[float], alpha: float, phi_new: Any, stop: Any = None) -> NewtonSystemState:
+                x = tuple(qi + di for qi, di in zip(q, step))
+                err = step_measure(step, scales)
+                return new_state(NewtonSystemState, (
+                    x, resid, err if stop is None else math.nan, stop, tuple(q), tuple(phi), tjac,
+                    tuple(step), det, cond, alpha, nfev, njev, tuple(phi_new)))
 
-        if not self.damped:
+            if not self.damped:
+                if dq is None:
+                    return state([0.0] * len(q), 1.0, phi,
+                                 (Status.SINGULAR_JACOBIAN, singular_detail(det, cond)))
+                trial = [qi + di for qi, di in zip(q, dq)]
+                phi_t = problem.F(trial)
+                nfev += 1
+                return state(dq, 1.0, phi_t)
+
+            base = _sumsq(phi)
+            if dq is not None and max_abs(dq) <= 64.0 * EPS * (1.0 + max_abs(q)):
+                # a step at rounding level: |Phi| is noise there, no decrease can be asked of it
+                phi_t = problem.F([qi + di for qi, di in zip(q, dq)])
+                nfev += 1
+                return state(dq, 1.0, phi_t)
+            if dq is not None:
+                alpha = 1.0
+                while alpha >= 1.0 / 64.0:
+                    step = dq if alpha == 1.0 else [alpha * d for d in dq]
+                    phi_t = problem.F([qi + di for qi, di in zip(q, step)])
+                    nfev += 1
+                    if _sumsq(phi_t) <= (1.0 - 1e-4 * alpha) * base:
+                        return state(step, alpha, phi_t)
+                    alpha *= 0.5
+            # Newton's direction failed (or J is singular): damped steps toward lower |Phi|^2
+            mu = 1e-3
+            normal = normal_equations(jac, phi)
+            while mu <= 1e12:
+                d = lm_direction(normal, mu)
+                if d is not None and all(map(math.isfinite, d)):
+                    phi_t = problem.F([qi + di for qi, di in zip(q, d)])
+                    nfev += 1
+                    if _sumsq(phi_t) < base:
+                        return state(d, 0.0, phi_t)
+                    if max(abs(di) for di in d) <= 1e-15 * (1.0 + max_abs(q)):
+                        break  # the steps no longer move q: nothing lower is reachable
+                mu *= 10.0
+            grad = max(abs(v) for v in normal[1])
             if dq is None:
-                return state([0.0] * len(q), 1.0, phi,
-                             (Status.SINGULAR_JACOBIAN, singular_detail(det, cond)))
-            trial = [qi + di for qi, di in zip(q, dq)]
-            phi_t = problem.F(trial)
-            nfev += 1
-            return state(dq, 1.0, phi_t)
-
-        base = _sumsq(phi)
-        if dq is not None and max_abs(dq) <= 64.0 * EPS * (1.0 + max_abs(q)):
-            # a step at rounding level: |Phi| is noise there, no decrease can be asked of it
-            phi_t = problem.F([qi + di for qi, di in zip(q, dq)])
-            nfev += 1
-            return state(dq, 1.0, phi_t)
-        if dq is not None:
-            alpha = 1.0
-            while alpha >= 1.0 / 64.0:
-                step = dq if alpha == 1.0 else [alpha * d for d in dq]
-                phi_t = problem.F([qi + di for qi, di in zip(q, step)])
-                nfev += 1
-                if _sumsq(phi_t) <= (1.0 - 1e-4 * alpha) * base:
-                    return state(step, alpha, phi_t)
-                alpha *= 0.5
-        # Newton's direction failed (or J is singular): damped steps toward lower |Phi|^2
-        mu = 1e-3
-        normal = normal_equations(jac, phi)
-        while mu <= 1e12:
-            d = lm_direction(normal, mu)
-            if d is not None and all(map(math.isfinite, d)):
-                phi_t = problem.F([qi + di for qi, di in zip(q, d)])
-                nfev += 1
-                if _sumsq(phi_t) < base:
-                    return state(d, 0.0, phi_t)
-                if max(abs(di) for di in d) <= 1e-15 * (1.0 + max_abs(q)):
-                    break  # the steps no longer move q: nothing lower is reachable
-            mu *= 10.0
-        grad = max(abs(v) for v in normal[1])
-        if dq is None:
-            why = (Status.SINGULAR_JACOBIAN, f"{singular_detail(det, cond)}; no damped step lowers "
-                                             f"max|Phi| = {resid:.3g}")
-        else:
-            why = (Status.LOCAL_MINIMUM, f"max|Phi| = {resid:.3g} cannot be lowered from here "
-                                         f"(|J^T Phi| = {grad:.3g}); try another start")
-        return state([0.0] * len(q), 0.0, phi, why)
+                why = (Status.SINGULAR_JACOBIAN, f"{singular_detail(det, cond)}; no damped step lowers "
+                                                 f"max|Phi| = {resid:.3g}")
+            else:
+                why = (Status.LOCAL_MINIMUM, f"max|Phi| = {resid:.3g} cannot be lowered from here "
+                                             f"(|J^T Phi| = {grad:.3g}); try another start")
+            return state([0.0] * len(q), 0.0, phi, why)
+        except (ArithmeticError, ValueError) as exc:
+            raise counts_made(exc, nfev, njev)  # noqa: B904 (the same exception, its traceback kept)
 
     def initial_row(self, problem: SystemProblem, s: NewtonSystemState) -> None:
         return None
@@ -432,7 +433,7 @@ NEWTON_SYSTEM_LOOP = Loop(
         q, phi = trial, phi_t
         size_q = _max_abs(q)
         """,
-    result="q, phi, err, status, detail, k, nfev, njev",
+    result="q, phi, err, status, detail, k, nfev, njev", on_raise=COUNTS_ON_RAISE,
     residual_test=False, step_test="system", diverge="runaway", diverge_when="not damped",
     magnitude="size_q", quiet=True)
 """Newton-Raphson for a system with recording off: the stopping rule of
@@ -527,7 +528,7 @@ NEWTON_2X2_LOOP = Loop(
         e1 = x1 if x1 > 0.0 else 0.0 - x1
         size_q = """ + larger_of("e0", "e1") + """
         """),
-    result="[x0, x1], [p0, p1], err, status, detail, k, nfev, njev",
+    result="[x0, x1], [p0, p1], err, status, detail, k, nfev, njev", on_raise=COUNTS_ON_RAISE,
     residual_test=False, step_test="system", diverge="runaway", diverge_when="not damped",
     magnitude="size_q", quiet=True,
     # damped: the old phi's sum of squares finite and positive says max|Phi| is (it may be
