@@ -7,6 +7,7 @@ import typer
 
 from ..errors import InputError
 from ..methods import METHODS
+from ..solve.system import SYSTEM_METHODS
 from .options import (
     PICTURES,
     AccelOpt,
@@ -38,8 +39,8 @@ def solve(
         metavar="[FILE]", help="A mechanism file (TOML, see sample_inputs/; - reads standard input): "
         "solve its loop-closure equations.", show_default=False)] = None,
     *,
-    method: Annotated[str, typer.Option("--method", "-m", help=f"{', '.join(METHODS)}, several "
-                      "of them separated by commas, or all; with FILE: newton, newton-fd, lm.")] = "newton",
+    method: Annotated[str, typer.Option("--method", "-m", help=f"{', '.join(METHODS)}, several of them "
+                      f"separated by commas, or all; with FILE: {', '.join(SYSTEM_METHODS)}.")] = "newton",
     alpha: Annotated[Optional[float], typer.Option(help="Four-bar input angle alpha (deg); "
                      "default 70.")] = None,
     r1: Annotated[Optional[str], typer.Option("--r1", help="R1 (default 5/3).")] = None,

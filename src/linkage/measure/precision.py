@@ -173,11 +173,11 @@ def scipy_keywords(entry: Any, spec: dict[str, Any]) -> dict[str, Any]:
 def system_contenders(
     name: str, spec: dict[str, Any], tol: float
 ) -> list[tuple[str, Callable[[], Any], Callable[[Any], Any]]]:
-    from ..solve import solve_system
+    from ..solve import SYSTEM_METHODS, solve_system
 
     p = spec["problem"]
     out: list[tuple[str, Callable[[], Any], Callable[[Any], Any]]] = []
-    for m in ("newton", "newton-fd", "lm"):
+    for m in SYSTEM_METHODS:
         for record in (False, True):
             out.append(
                 (

@@ -39,6 +39,7 @@ from typing import Any
 from ..errors import InputError
 from ..methods import SCALAR_METHODS
 from ..problems.catalog import Case, classic_cases, mgh_cases
+from ..solve.system import SYSTEM_METHODS
 from ..units import degrees
 from .stress_cases import (
     bad_start_cases,
@@ -296,9 +297,7 @@ def run(
     rng = random.Random(seed)
     t0 = time.perf_counter()
     scalar_methods = scalar_methods_of(methods)
-    system_methods = [
-        m for m in (methods or ("newton", "newton-fd", "lm")) if m in ("newton", "newton-fd", "lm")
-    ]
+    system_methods = [m for m in (methods or SYSTEM_METHODS) if m in SYSTEM_METHODS]
     classic = classic_cases()
     if quick:
         classic = classic[::3] + classic[-3:]
