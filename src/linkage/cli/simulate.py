@@ -124,7 +124,7 @@ def simulate(
     from ..kinematics.bodies import command_loads
     from ..kinematics.loading import load as load_file
     from ..kinematics.simulation import simulate as run
-    from ..render.simulate import simulate_plot, simulate_report
+    from ..render.simulate import simulate_plot, simulate_report, simulation_checks
 
     out_fmt = choose_format(fmt, output)
     check_paths([file], [("--output", output), ("--plot", plot)], {"--plot": (plot, PICTURES)})
@@ -145,5 +145,5 @@ def simulate(
     if plot is not None:
         simulate_plot(sim, mechanism, plot)
         typer.echo(f"wrote {plot}", err=True)
-    if sim.event is not None or sim.balance > energy_tol or sim.drive_check > drive_tol:
+    if sim.event is not None or not simulation_checks(sim, energy_tol, drive_tol, target_cs).passed:
         raise typer.Exit(1)

@@ -30,8 +30,8 @@ Headers = list[tuple[str, str]]
 
 
 @frozen
-class _Checks:
-    """The run's verdicts and the numbers its lines quote."""
+class SimulationChecks:
+    """The run's verdicts and the numbers its lines quote (:func:`simulation_checks`)."""
 
     energy_ok: bool | None
     """None: nothing to compare (one output time)."""
@@ -40,6 +40,22 @@ class _Checks:
     energy_tol: float
     drive_tol: float
     target_cs: float
+
+    @property
+    def passed(self) -> bool:
+        """No check missed (one with nothing to compare is not missed): with no event, exit 0."""
+        return self.energy_ok is not False and self.drive_ok is not False
+
+
+def simulation_checks(sim: Any, energy_tol: float, drive_tol: float, target_cs: float) -> SimulationChecks:
+    """The energy balance within ``energy_tol`` of the largest energy and the kinetostatic
+    input within ``drive_tol`` of the drive, each None where there is nothing to judge: one
+    output time, or no output time with forces (a run that stopped at its start). A NaN
+    figure is a miss."""
+    forced = any(f is not None and f.input is not None for f in sim.forces)
+    return SimulationChecks(bool(sim.balance <= energy_tol) if len(sim.t) > 1 else None,
+                            bool(sim.drive_check <= drive_tol) if forced else None, energy_tol, drive_tol,
+                            target_cs)
 
 
 def simulate_report(sim: Any, mechanism: Any, digits: int, energy_tol: float, drive_tol: float,
@@ -56,10 +72,7 @@ def simulate_report(sim: Any, mechanism: Any, digits: int, energy_tol: float, dr
                         force_rows))
     title = (f"{mechanism.name or mechanism.source}: simulated from t = {fmt(sim.t[0], digits)} to "
              f"{fmt(sim.t[-1], digits)} s")
-    # a check with nothing to compare is neither met nor missed (a run that stopped at its start)
-    forced = any(f is not None and f.input is not None for f in sim.forces)
-    checks = _Checks(bool(sim.balance <= energy_tol) if len(sim.t) > 1 else None,
-                     bool(sim.drive_check <= drive_tol) if forced else None, energy_tol, drive_tol, target_cs)
+    checks = simulation_checks(sim, energy_tol, drive_tol, target_cs)
 
     def blocks() -> list[Block]:
         head = [f"{a} ({b})" for a, b in motion_headers]
@@ -138,7 +151,7 @@ def _force_blocks(sim: Any, pins: list[tuple[str, str]], force_rows: list[tuple[
     return out
 
 
-def _lines(sim: Any, checks: _Checks, digits: int) -> list[str]:
+def _lines(sim: Any, checks: SimulationChecks, digits: int) -> list[str]:
     """The checks, the flywheel, the integrator and the event, one line each."""
     verdict = {True: "within", False: "BEYOND"}
     out = [f"energy balance: {verdict[checks.energy_ok]} {checks.energy_tol:.2g} (kinetic + potential - "
@@ -174,7 +187,7 @@ def _lines(sim: Any, checks: _Checks, digits: int) -> list[str]:
     return out
 
 
-def _document(sim: Any, title: str, checks: _Checks) -> dict[str, Any]:
+def _document(sim: Any, title: str, checks: SimulationChecks) -> dict[str, Any]:
     """The json document's summary."""
     c = sim.cycle
     return {"title": title, "event": sim.event, "event_time": sim.event_time, "message": sim.message,
