@@ -382,3 +382,19 @@ def test_a_drive_beyond_the_solvers_rates_leaves_those_forces_undefined_not_an_e
     doc = json.loads(cli("simulate", str(LOADED), "--time", "0:0.4", "--drive", "1e300*omega",
                          "--omega0", "1", "-f", "json").out)
     assert doc["energy_ok"] is None and doc["drive_ok"] is None
+
+
+def test_a_nan_check_figure_is_a_miss_in_the_report_and_the_exit_alike():
+    """The command's exit and the report's check lines read one verdict
+    (render.simulate.simulation_checks): a NaN energy balance or kinetostatic figure is a
+    miss (BEYOND, exit 1), never "within"; a run's real figures pass."""
+    import dataclasses
+
+    from linkage.render.simulate import simulation_checks
+
+    sim = linkage.simulate(linkage.load_mechanism(str(LOADED)), drive="1", time=(0.0, 0.05), samples=11)
+    ok = simulation_checks(sim, 1e-8, 1e-10, 0.02)
+    assert ok.energy_ok and ok.drive_ok and ok.passed
+    for field in ("balance", "drive_check"):
+        bad = simulation_checks(dataclasses.replace(sim, **{field: math.nan}), 1e-8, 1e-10, 0.02)
+        assert not bad.passed
