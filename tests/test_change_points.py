@@ -268,3 +268,35 @@ def test_change_point_on_branch_twin_reads_meetings_as_its_scalar_rule(text):
         assert twin[0] and twin[-1]  # the meeting: on either branch
         interiors.append(bool(twin[1:-1].all()) if twin[1:-1].all() or not twin[1:-1].any() else None)
     assert sorted(interiors) == [False, True]  # elsewhere one assembly is the branch, the other not
+
+
+@pytest.mark.parametrize("scale", [1e-6, 1.0, 1e3])
+def test_a_rhombus_sweep_through_its_indeterminate_pose_is_no_internal_error(tmp_path, scale):
+    """Every link equal (a rhombus, s + l = p + q): at theta2 = 0 the crank pin A lies on O4,
+    so B may be anywhere on its circle and the closed form has no one answer there
+    (problems.assembly.Indeterminate): every theta3 = theta4 closes the loop. The sweep
+    reports a root of that family there, flagged as a meeting, and the parallelogram
+    assembly the file draws elsewhere (theta3 = 0, theta4 = theta2, by hand). Before, the
+    meeting's exact closed form raised (an internal error from the command), and at 1e3 the
+    position was failed: the closed form's path tried no Newton step where it was
+    indeterminate."""
+    from typer.testing import CliRunner
+
+    from linkage.cli import app
+
+    path = tmp_path / "rhombus.toml"
+    r = f"{scale:g}"
+    made = CliRunner().invoke(app, ["new", "fourbar", "--links", r, r, r, r, "-o", str(path)])
+    assert made.exit_code == 0, made.output
+    values = [0.0, 45.0, 90.0, 135.0]
+    result = linkage.sweep(linkage.load_mechanism(str(path)), values)
+    assert [p.status for p in result.positions] == ["converged"] * 4
+    for p in result.positions:
+        t3, t4 = p.solution["theta_coupler"], p.solution["theta_rocker"]
+        if p.input == 0.0:
+            assert abs(t3 - t4) <= 1e-9 and MEETS_NOTE in p.note
+        else:
+            assert abs(t3) <= 1e-9 and abs(t4 - p.input) <= 1e-9
+    assert result.meetings == (0.0,)
+    run = CliRunner().invoke(app, ["sweep", str(path), "--from", "0", "--to", "90", "--step", "45"])
+    assert run.exit_code == 0 and "internal error" not in run.output

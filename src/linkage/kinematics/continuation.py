@@ -274,7 +274,9 @@ def solve_position(solver: Solver, v: float, last_q: tuple[float, ...] | None, l
         if pos.status == "converged":
             return pos, q
     # 3. re-entry (or first position): the closed form on the target branch, else anchors
-    if have_closed:
+    # (also where the closed form is indeterminate, ref None: a change point where every
+    # value of an unknown closes a loop, so Newton from the branch's anchor picks one)
+    if have_closed and ref is not None:
         if ref:
             if target is None:
                 # first position: keep the branch nearest the file's guess
