@@ -1,0 +1,143 @@
+"""The bracketing methods at the ends of the double range: brackets as wide as the doubles
+(a width, f(b) - f(a) and the interpolation's products beyond the largest double), on one
+side only, and f values whose product f(a) f(b) overflows. Each root against the exact one
+or 40-digit mpmath; "converged" only with the root within the tolerance, and no inf or NaN
+in any row's point or width."""
+
+from __future__ import annotations
+
+import json
+import math
+import random
+import sys
+
+import mpmath as mp
+import pytest
+
+from linkage import Status, solve_scalar
+from linkage.methods.hybrid import scaled_interpolation
+from linkage.methods.regula_falsi import inside_or_midpoint
+
+mp.mp.dps = 40
+
+BIG = sys.float_info.max
+EPS = sys.float_info.epsilon
+CONVERGED = (Status.CONVERGED_STEP, Status.CONVERGED_EXACT, Status.CONVERGED_RESIDUAL)
+TOL, RTOL = 1e-6, 1e-12
+
+
+def signed_sqrt(x: float) -> float:
+    return math.copysign(math.sqrt(abs(x)), x)
+
+
+WIDE = [
+    # (name, f, bracket, the root: exact, or 40-digit mpmath)
+    ("x - 1 on [-1e308, 1e308]", lambda x: x - 1.0, (-1e308, 1e308), mp.mpf(1)),
+    ("x - 1 on the widest bracket", lambda x: x - 1.0, (-BIG, BIG), mp.mpf(1)),
+    ("0.5 x - 3e307: f(b) - f(a) overflows", lambda x: 0.5 * x - 3e307, (-BIG, BIG), 2 * mp.mpf(3e307)),
+    ("sqrt|x| - 3, signed", lambda x: signed_sqrt(x) - 3.0, (-1e308, 1e308), mp.mpf(9)),
+    ("atan(x) - 1", lambda x: math.atan(x) - 1.0, (-1e308, 1e308), mp.tan(1)),
+    ("x - 1 on [0, 1e308]", lambda x: x - 1.0, (0.0, 1e308), mp.mpf(1)),
+    ("x - 1 on [-1e308, 5]", lambda x: x - 1.0, (-1e308, 5.0), mp.mpf(1)),
+    ("x - 1.5e308 near the top", lambda x: x - 1.5e308, (-1e307, BIG), mp.mpf(1.5e308)),
+    ("1e200 (x - 2): f(a) f(b) overflows", lambda x: 1e200 * (x - 2.0), (-1.0, 10.0), mp.mpf(2)),
+]
+
+
+def rows_finite(r) -> bool:
+    return all(isinstance(v, str) or v is None or math.isfinite(v) for row in r.history.rows for v in row)
+
+
+@pytest.mark.parametrize("method", ["regula-falsi", "hybrid"])
+@pytest.mark.parametrize("name,f,bracket,root", WIDE, ids=[w[0] for w in WIDE])
+def test_interpolating_bracket_methods_converge_on_brackets_at_the_ends_of_the_doubles(
+        method, name, f, bracket, root):
+    """The hybrid failed 'a value became infinite' on [-1e308, 1e308] (its width and
+    f(b) - f(a) overflowed) and regula falsi bisected to its cap (its secant's product
+    overflowed): both now converge to the root, with every row finite."""
+    r = solve_scalar(f, method=method, bracket=bracket, tol=TOL, rtol=RTOL, max_iter=2000)
+    assert r.status in CONVERGED, (name, r.status, r.message)
+    assert abs(mp.mpf(r.root) - root) <= TOL + RTOL * abs(root), (name, r.root)
+    assert rows_finite(r), name
+
+
+@pytest.mark.parametrize("method", ["regula-falsi", "hybrid"])
+def test_a_bracket_as_wide_as_the_doubles_needs_a_few_steps_not_a_thousand(method):
+    """The brief's command: x - 1 on [-1e308, 1e308] within the default cap of 100 (regula
+    falsi needed 1,026 halvings before; the hybrid failed at its first step)."""
+    r = solve_scalar(lambda x: x - 1.0, method=method, bracket=(-1e308, 1e308))
+    assert r.converged and abs(r.root - 1.0) <= 1e-6 and r.iterations <= 5, (r.status, r.iterations)
+
+
+def test_hybrid_on_the_widest_bracket_bisects_first_then_interpolates():
+    """The first step's bracket is wider than the largest double: it bisects (halving the
+    bracket in halves), and interpolates once the width is finite."""
+    r = solve_scalar(lambda x: x - 1.0, method="hybrid", bracket=(-BIG, BIG))
+    kinds = [row[1] for row in r.history.rows]
+    assert kinds[0] == "bisection" and "secant" in kinds[1:], kinds
+    assert r.history.rows[0][6] == BIG  # the width after halving [-BIG, BIG] at 0
+
+
+@pytest.mark.parametrize("method", ["regula-falsi", "hybrid"])
+def test_cli_solves_x_minus_1_on_the_widest_brackets(cli, method):
+    run = cli("solve", "-e", "x - 1", "--method", method, "--bracket", "-1e308", "1e308", "--format", "json")
+    assert run.code == 0, run.out + run.err
+    doc = json.loads(run.out)
+    assert doc["converged"] is True and abs(doc["solution"]["x"] - 1.0) <= 1e-6
+
+
+def ordinary_interpolation(xcur, fcur, xpre, fpre, xblk, fblk):
+    """The hybrid's interpolation step as its loop computes it (hybrid.Hybrid.step)."""
+    if xpre == xblk:
+        return -fcur * (xcur - xpre) / (fcur - fpre)
+    dpre = (fpre - fcur) / (xpre - xcur)
+    dblk = (fblk - fcur) / (xblk - xcur)
+    return -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+
+
+def test_scaled_interpolation_is_the_ordinary_step_bit_for_bit_in_range():
+    """Scaling by powers of two is exact, so where nothing over- or underflows the
+    overflow-safe step is the ordinary one, bit for bit (2,000 random secant and
+    inverse-quadratic steps at scales from 1e-40 to 1e40)."""
+    rng = random.Random(7)
+    for k in range(2000):
+        sx, sf = 10.0 ** rng.uniform(-40, 40), 10.0 ** rng.uniform(-40, 40)
+        xcur, xpre = rng.uniform(-1, 1) * sx, rng.uniform(-1, 1) * sx
+        xblk = xpre if k % 2 else rng.uniform(-1, 1) * sx
+        fcur, fpre, fblk = (rng.uniform(-1, 1) * sf for _ in range(3))
+        if xcur in (xpre, xblk) or fblk == fpre:
+            continue
+        want = ordinary_interpolation(xcur, fcur, xpre, fpre, xblk, fblk)
+        assert scaled_interpolation(xcur, fcur, xpre, fpre, xblk, fblk) == want, k
+
+
+def test_scaled_interpolation_where_the_ordinary_overflows_is_the_exact_step():
+    """Where the ordinary secant and inverse-quadratic steps are inf or NaN (f values near
+    the largest double), the scaled step is the exact one (40-digit mpmath) to a few ulps."""
+    cases = [(1.0, -1e308, 9e307, 1.5e308, 9e307, 1.5e308),     # secant: f(cur) - f(pre) overflows
+             (0.0, -1e300, 2.0, 1e308, 5.0, 1.7e308)]          # inverse quadratic: f products overflow
+    for xcur, fcur, xpre, fpre, xblk, fblk in cases:
+        ordinary = ordinary_interpolation(xcur, fcur, xpre, fpre, xblk, fblk)
+        assert not math.isfinite(ordinary)
+        m = [mp.mpf(v) for v in (xcur, fcur, xpre, fpre, xblk, fblk)]
+        xc, fc, xp, fp, xb, fb = m
+        if xpre == xblk:
+            exact = -fc * (xc - xp) / (fc - fp)
+        else:  # the inverse quadratic through the three points, at f = 0, less xcur
+            exact = (xc * fp * fb / ((fc - fp) * (fc - fb)) + xp * fc * fb / ((fp - fc) * (fp - fb))
+                     + xb * fc * fp / ((fb - fc) * (fb - fp))) - xc
+        got = scaled_interpolation(xcur, fcur, xpre, fpre, xblk, fblk)
+        assert abs(mp.mpf(got) - exact) <= 8 * EPS * abs(exact), (got, exact)
+
+
+def test_regula_falsi_point_where_the_secant_overflows_is_the_exact_one():
+    """The overflow-safe secant point of regula falsi against 40-digit mpmath, on brackets
+    where F(b) (b - a) or F(b) - F(a) overflow; the midpoint where the width itself does."""
+    for a, fa, b, fb in [(0.0, -1.0, 1e308, 1e308), (-1e308, -1e308, 1e307, 1.5e308),
+                         (1.0, -1e308, 2.0, 1e308), (0.0, -3.0, 1e300, 1.7e308)]:
+        den = fb - fa
+        c = b - fb * (b - a) / den
+        got = inside_or_midpoint(a, fa, b, fb, c, den)
+        exact = mp.mpf(b) - mp.mpf(fb) * (mp.mpf(b) - mp.mpf(a)) / (mp.mpf(fb) - mp.mpf(fa))
+        assert a < got < b and abs(mp.mpf(got) - exact) <= 4 * EPS * (b - a), (a, b, got, exact)
+    assert inside_or_midpoint(-BIG, -1.0, BIG, 1.0, math.nan, 2.0) == 0.0
