@@ -17,6 +17,7 @@ import pytest
 from linkage import Status, solve_scalar
 from linkage.methods.hybrid import scaled_interpolation
 from linkage.methods.regula_falsi import inside_or_midpoint
+from linkage.methods.secant import chord_slope
 
 mp.mp.dps = 40
 
@@ -141,3 +142,39 @@ def test_regula_falsi_point_where_the_secant_overflows_is_the_exact_one():
         exact = mp.mpf(b) - mp.mpf(fb) * (mp.mpf(b) - mp.mpf(a)) / (mp.mpf(fb) - mp.mpf(fa))
         assert a < got < b and abs(mp.mpf(got) - exact) <= 4 * EPS * (b - a), (a, b, got, exact)
     assert inside_or_midpoint(-BIG, -1.0, BIG, 1.0, math.nan, 2.0) == 0.0
+
+
+FAR_SECANT = [
+    ("x - 1 from -1e308, 1e308", lambda x: x - 1.0, -1e308, 1e308, mp.mpf(1)),
+    ("x - 1 from the largest doubles", lambda x: x - 1.0, BIG, -BIG, mp.mpf(1)),
+    ("0.5 x - 3e307: a false zero slope", lambda x: 0.5 * x - 3e307, -BIG, BIG, 2 * mp.mpf(3e307)),
+    ("sqrt|x| - 3, signed", lambda x: signed_sqrt(x) - 3.0, -1e308, 1e308, mp.mpf(9)),
+]
+
+
+@pytest.mark.parametrize("record", [True, False])
+@pytest.mark.parametrize("name,f,x0,x1,root", FAR_SECANT, ids=[c[0] for c in FAR_SECANT])
+def test_secant_from_two_far_points_follows_the_chord(record, name, f, x0, x1, root):
+    """From points of opposite signs near the largest double, x - x_p overflowed: the
+    slope was inf/inf = NaN ('a value became infinite') or a finite difference over inf =
+    0 (a false 'the secant slope is zero'). The chord's slope is now computed on halves
+    where the quotient is not finite or zero, in the generated loop as in the step."""
+    r = solve_scalar(f, method="secant", x0=x0, x1=x1, tol=TOL, rtol=RTOL, max_iter=200, record=record)
+    assert r.status in CONVERGED, (name, r.status, r.message)
+    assert abs(mp.mpf(r.root) - root) <= TOL + RTOL * abs(root), (name, r.root)
+
+
+def test_chord_slope_is_the_ordinary_quotient_bit_for_bit_in_range():
+    """Halving is exact: where no difference overflows, the guarded slope is the ordinary
+    quotient, bit for bit, including a flat chord's 0 and an underflowed quotient's 0."""
+    rng = random.Random(11)
+    for k in range(3000):
+        x, xp = (rng.uniform(-1, 1) * 10.0 ** rng.uniform(-300, 300) for _ in range(2))
+        fx, fxp = (rng.uniform(-1, 1) * 10.0 ** rng.uniform(-300, 300) for _ in range(2))
+        if k % 5 == 0:
+            fxp = fx
+        if x == xp:
+            continue
+        want = (fx - fxp) / (x - xp)
+        if (math.isfinite(want) and abs(want) >= 4 * sys.float_info.min) or want == 0.0:
+            assert chord_slope(x, fx, xp, fxp) == want, (x, fx, xp, fxp)
