@@ -15,6 +15,7 @@ import mpmath as mp
 import pytest
 
 from linkage import Status, solve_scalar
+from linkage.methods.bisection import halvings_needed
 from linkage.methods.hybrid import scaled_interpolation
 from linkage.methods.regula_falsi import inside_or_midpoint
 from linkage.methods.secant import chord_slope
@@ -178,3 +179,34 @@ def test_chord_slope_is_the_ordinary_quotient_bit_for_bit_in_range():
         want = (fx - fxp) / (x - xp)
         if (math.isfinite(want) and abs(want) >= 4 * sys.float_info.min) or want == 0.0:
             assert chord_slope(x, fx, xp, fxp) == want, (x, fx, xp, fxp)
+
+
+def test_bisection_cap_message_says_how_many_halvings_the_bracket_needs(cli):
+    """x - 1 on [-1e308, 1e308] needs ceil(log2(2e308 / 1e-6)) = 1,045 halvings (40-digit
+    mpmath), beyond the default cap of 100: the cap's message said only '100 iterations,
+    last error 1.58e+278'. It now names the count, and that cap is enough."""
+    need = int(mp.ceil(mp.log(2 * mp.mpf(1e308) / mp.mpf(1e-6), 2)))
+    run = cli("solve", "-e", "x - 1", "--method", "bisection", "--bracket", "-1e308", "1e308")
+    assert run.code == 1 and f"this bracket needs {need:,} halvings to reach tol = 1e-06" in run.out
+    r = solve_scalar(lambda x: x - 1.0, method="bisection", bracket=(-1e308, 1e308), max_iter=need)
+    assert r.converged and abs(r.root - 1.0) <= 1e-6 and r.iterations == need
+    short = solve_scalar(lambda x: x - 1.0, method="bisection", bracket=(-1e308, 1e308), max_iter=need - 1)
+    assert short.status is Status.MAX_ITER
+
+
+def test_halvings_needed_is_the_count_bisection_takes():
+    """The a-priori count against runs to the tolerance: random brackets up to the widest,
+    and dyadic ones whose error lands exactly on the tolerance."""
+    rng = random.Random(5)
+    for k in range(300):
+        if k % 2:
+            a, b = -(10.0 ** rng.uniform(-5, 308)), 10.0 ** rng.uniform(-5, 308)
+            tol = 10.0 ** rng.uniform(-12, 3)
+            root = 0.3 * min(b, 1.0)  # where the spacing of doubles is below every tol
+        else:
+            a, b, tol = 1.0, 1.0 + 2.0 ** -rng.randint(0, 30), 2.0 ** -rng.randint(1, 45)
+            root = 1.0 + 2.0 ** -31 + 2.0 ** -50  # inside every bracket, never a midpoint
+        r = solve_scalar(lambda x, root=root: x - root, method="bisection", bracket=(a, b), tol=tol,
+                         record=False, max_iter=5000)
+        assert r.status is Status.CONVERGED_STEP, (a, b, tol, r.status)
+        assert r.iterations == halvings_needed(a, b, tol), (a, b, tol, r.iterations)
