@@ -210,3 +210,31 @@ def test_halvings_needed_is_the_count_bisection_takes():
                          record=False, max_iter=5000)
         assert r.status is Status.CONVERGED_STEP, (a, b, tol, r.status)
         assert r.iterations == halvings_needed(a, b, tol), (a, b, tol, r.iterations)
+
+
+TINY = [
+    # (name, f, bracket, tol, the exact root)
+    ("x - 1e-300 on [0, 3e-300]", lambda x: x - 1e-300, (0.0, 3e-300), 1e-310, 1e-300),
+    ("x - 1e-300 on [-1, 3e-300]", lambda x: x - 1e-300, (-1.0, 3e-300), 1e-310, 1e-300),
+    ("(x - 1) 1e-300, products underflow", lambda x: (x - 1.0) * 1e-300, (0.0, 3.0), 1e-12, 1.0),
+    ("(x^3 - 1) 1e-300", lambda x: (x**3 - 1.0) * 1e-300, (0.0, 3.0), 1e-12, 1.0),
+]
+
+
+@pytest.mark.parametrize("name,f,bracket,tol,root", TINY, ids=[c[0] for c in TINY])
+def test_regula_falsi_on_tiny_brackets_and_values_does_not_underflow_into_bisection(
+        name, f, bracket, tol, root):
+    """Products of values near 1e-300 underflowed to 0: regula falsi's secant point fell on
+    an end and it bisected (35 steps on [0, 3e-300] at tol 1e-310). It now takes the
+    point from the ratio of the end values, and finds a linear f's root in a few steps."""
+    r = solve_scalar(f, method="regula-falsi", bracket=bracket, tol=tol, max_iter=200)
+    assert r.status in CONVERGED and abs(r.root - root) <= tol, (name, r.status, r.root)
+    assert r.iterations <= (16 if "^3" in name else 3), (name, r.iterations)
+
+
+@pytest.mark.parametrize("name,f,bracket,tol,root", TINY, ids=[c[0] for c in TINY])
+def test_hybrid_on_tiny_brackets_and_values_converges_within_the_tolerance(name, f, bracket, tol, root):
+    """The hybrid's interpolation underflows there too (a zero step, lengthened to its
+    tolerance, or a zero denominator: it bisects); it converges, to the root."""
+    r = solve_scalar(f, method="hybrid", bracket=bracket, tol=tol, max_iter=400)
+    assert r.status in CONVERGED and abs(r.root - root) <= tol, (name, r.status, r.root)

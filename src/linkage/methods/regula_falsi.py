@@ -41,15 +41,16 @@ class RegulaFalsiState(NamedTuple):
 def inside_or_midpoint(a: float, fa: float, b: float, fb: float, c: float, denominator: float) -> float:
     """The step's point where the secant c = b - F(b) (b - a) / (F(b) - F(a)) fell outside the
     open bracket (a, b). Where that came of an overflow (c inf or NaN, or c = b from a
-    difference F(b) - F(a) beyond the largest double) on a bracket of finite width, the
-    same point from the end with the smaller |F|, as a + (b - a) / (1 - F(b) / F(a)) (or
-    its mirror from b): F(b) / F(a) < 0, so the divisor is at least 1 and nothing
-    overflows (a ratio beyond the largest double gives the end itself). Otherwise
-    (rounding put c at an end, or a weight underflowed), or where that point is not
-    strictly inside either, the midpoint: so a bracket wider than the largest double is
-    bisected, and its width is finite from then on."""
+    difference F(b) - F(a) beyond the largest double) or an underflow (F(b) (b - a) = 0:
+    tiny values on a tiny bracket) on a bracket of finite width, the same point from the
+    end with the smaller |F|, as a + (b - a) / (1 - F(b) / F(a)) (or its mirror from b):
+    F(b) / F(a) < 0, so the divisor is at least 1, and no product of small values is
+    formed (a ratio beyond the largest double gives the end itself). Otherwise (rounding
+    put c at an end, or a weight underflowed), or where that point is not strictly inside
+    either, the midpoint: so a bracket wider than the largest double is bisected, and its
+    width is finite from then on."""
     width = b - a
-    if width - width == 0.0 and (c - c != 0.0 or denominator - denominator != 0.0):
+    if width - width == 0.0 and (c - c != 0.0 or denominator - denominator != 0.0 or fb * width == 0.0):
         c = a + width / (1.0 - fb / fa) if abs(fa) <= abs(fb) else b - width / (1.0 - fa / fb)
         if a < c < b:
             return c
