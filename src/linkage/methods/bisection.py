@@ -63,10 +63,11 @@ def init_bracket(problem: ScalarProblem, a: float,
 def halvings_needed(a: float, b: float, tol: float) -> int:
     """The steps bisection takes to bring its error within ``tol``: step k's error is half
     the bracket it halves, (b - a) / 2^k, so the least k with (b - a) / 2^k <= tol (the
-    a-priori count above), from h = b/2 - a/2 (no overflow) and exact scalings of it by
-    powers of two. Exact where the midpoints are (brackets far wider than their spacing
-    of doubles); an upper bound where the run stops earlier: at an exact zero, with
-    rtol > 0, or at the rounding level."""
+    a-priori count above, whose n is the table's last row, k - 1: rows are numbered from
+    0), from h = b/2 - a/2 (no overflow) and exact scalings of it by powers of two.
+    Exact where the midpoints are (brackets far wider than their spacing of doubles); an
+    upper bound where the run stops earlier: at an exact zero, with rtol > 0, or at the
+    rounding level."""
     lo, hi = (a, b) if a <= b else (b, a)
     h = 0.5 * hi - 0.5 * lo
     if h <= tol:
