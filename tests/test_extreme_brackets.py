@@ -17,7 +17,7 @@ import pytest
 from linkage import Status, solve_scalar
 from linkage.methods.bisection import halvings_needed
 from linkage.methods.hybrid import scaled_interpolation
-from linkage.methods.regula_falsi import inside_or_midpoint
+from linkage.methods.regula_falsi import secant_from_ratio
 from linkage.methods.secant import chord_slope
 
 mp.mp.dps = 40
@@ -137,12 +137,13 @@ def test_regula_falsi_point_where_the_secant_overflows_is_the_exact_one():
     where F(b) (b - a) or F(b) - F(a) overflow; the midpoint where the width itself does."""
     for a, fa, b, fb in [(0.0, -1.0, 1e308, 1e308), (-1e308, -1e308, 1e307, 1.5e308),
                          (1.0, -1e308, 2.0, 1e308), (0.0, -3.0, 1e300, 1.7e308)]:
-        den = fb - fa
-        c = b - fb * (b - a) / den
-        got = inside_or_midpoint(a, fa, b, fb, c, den)
+        c = b - fb * (b - a) / (fb - fa)
+        assert not a < c < b or not math.isfinite(fb - fa)  # the ordinary point overflowed
+        got = secant_from_ratio(a, fa, b, fb)
         exact = mp.mpf(b) - mp.mpf(fb) * (mp.mpf(b) - mp.mpf(a)) / (mp.mpf(fb) - mp.mpf(fa))
         assert a < got < b and abs(mp.mpf(got) - exact) <= 4 * EPS * (b - a), (a, b, got, exact)
-    assert inside_or_midpoint(-BIG, -1.0, BIG, 1.0, math.nan, 2.0) == 0.0
+    r = solve_scalar(lambda x: x - 1.0, method="regula-falsi", bracket=(-BIG, BIG))
+    assert r.history.rows[0][5] == 0.0  # the first point: the midpoint of the widest bracket
 
 
 FAR_SECANT = [

@@ -118,11 +118,11 @@ class Hybrid:
             s.x, s.fx, s.xpre, s.fpre, s.xblk, s.fblk, s.spre, s.scur)
         delta = 0.5 * (self.tol + self.rtol * abs(xcur)) + _EPS * abs(xcur)
         sbis = 0.5 * (xblk - xcur)
-        wide = sbis - sbis != 0.0
-        if wide:  # a bracket wider than the largest double: halve it in halves, and bisect
+        if sbis - sbis != 0.0:  # a bracket wider than the largest double: halve it in halves,
             sbis = 0.5 * xblk - 0.5 * xcur
+            spre = 0.0  # and bisect
         kind = "bisection"
-        if abs(spre) > delta and abs(fcur) < abs(fpre) and not wide:
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
             try:
                 if xpre == xblk:
                     stry = -fcur * (xcur - xpre) / (fcur - fpre)

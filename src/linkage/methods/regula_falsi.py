@@ -38,23 +38,17 @@ class RegulaFalsiState(NamedTuple):
     row_fb: float
 
 
-def inside_or_midpoint(a: float, fa: float, b: float, fb: float, c: float, denominator: float) -> float:
-    """The step's point where the secant c = b - F(b) (b - a) / (F(b) - F(a)) fell outside the
-    open bracket (a, b). Where that came of an overflow (c inf or NaN, or c = b from a
-    difference F(b) - F(a) beyond the largest double) or an underflow (F(b) (b - a) = 0:
-    tiny values on a tiny bracket) on a bracket of finite width, the same point from the
-    end with the smaller |F|, as a + (b - a) / (1 - F(b) / F(a)) (or its mirror from b):
-    F(b) / F(a) < 0, so the divisor is at least 1, and no product of small values is
-    formed (a ratio beyond the largest double gives the end itself). Otherwise (rounding
-    put c at an end, or a weight underflowed), or where that point is not strictly inside
-    either, the midpoint: so a bracket wider than the largest double is bisected, and its
-    width is finite from then on."""
+def secant_from_ratio(a: float, fa: float, b: float, fb: float) -> float:
+    """Regula falsi's point c = b - F(b) (b - a) / (F(b) - F(a)) where that overflowed (c inf
+    or NaN, or c = b from a difference F(b) - F(a) beyond the largest double) or underflowed
+    (F(b) (b - a) = 0: tiny values on a tiny bracket), on a bracket of finite width: the
+    same point from the end with the smaller |F|, as a + (b - a) / (1 - F(b) / F(a)) (or
+    its mirror from b). F(b) / F(a) < 0, so the divisor is at least 1 and no product of
+    values is formed; a ratio beyond the largest double gives the end itself, which the
+    step replaces by the midpoint, as it does where the width itself overflows (so that
+    a bracket wider than the largest double is bisected, and is finite from then on)."""
     width = b - a
-    if width - width == 0.0 and (c - c != 0.0 or denominator - denominator != 0.0 or fb * width == 0.0):
-        c = a + width / (1.0 - fb / fa) if abs(fa) <= abs(fb) else b - width / (1.0 - fa / fb)
-        if a < c < b:
-            return c
-    return 0.5 * a + 0.5 * b
+    return a + width / (1.0 - fb / fa) if abs(fa) <= abs(fb) else b - width / (1.0 - fa / fb)
 
 
 @frozen
@@ -93,8 +87,14 @@ class RegulaFalsi:
         denominator = big_fb - big_fa
         # (weights halved many times can underflow: then the secant is undefined)
         c = b - big_fb * (b - a) / denominator if denominator != 0.0 else a
-        if not a < c < b:  # rounding, an underflowed weight, or an overflow: see inside_or_midpoint
-            c = inside_or_midpoint(a, big_fa, b, big_fb, c, denominator)
+        if not a < c < b:  # rounding put c at or past an end, a weight underflowed, or:
+            if c != a and (c - c != 0.0 or (c == b and (denominator - denominator != 0.0
+                                                       or big_fb * (b - a) == 0.0))):
+                c = secant_from_ratio(a, big_fa, b, big_fb)  # an overflow or underflow on the way
+                if not a < c < b:  # (the width itself overflowed: bisect)
+                    c = 0.5 * a + 0.5 * b
+            else:
+                c = 0.5 * a + 0.5 * b
         fc = problem.f(c)
         if same_sign(fc, fb):
             b, fb, wb = c, fc, 1.0
