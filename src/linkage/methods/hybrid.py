@@ -9,6 +9,10 @@ Order about 1.84 on smooth simple roots, never worse than about twice bisection'
 count (R. P. Brent, Algorithms for Minimization without Derivatives, 1973, ch. 4;
 the loop follows the layout of scipy's brentq). One evaluation per step, two to start.
 Error measure: the bracket width |x_block - x|, which bounds |x - r|.
+At the ends of the double range: a bracket wider than the largest double is halved in
+halves (x_block/2 - x/2) and bisected, and an interpolation that overflowed (inf or NaN)
+is recomputed on scaled values (:func:`scaled_interpolation`), so [-1e308, 1e308] is
+solved (tests/test_extreme_brackets.py).
 """
 
 from __future__ import annotations

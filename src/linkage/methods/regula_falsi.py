@@ -7,6 +7,10 @@ which restores superlinear convergence of order 3^(1/3) = 1.442 (Dowell and Jarr
 BIT 11, 1971). One evaluation per step, two to start. A candidate that rounding puts
 outside the open bracket is replaced by the midpoint, so the bracket always holds.
 Error measure: the bracket width |b - a|, which bounds |c - r| because c is an end.
+Where the secant's products over- or underflow (brackets as wide as [-1e308, 1e308],
+values near 1e-300) its point comes from the ratio of the end values instead
+(:func:`secant_from_ratio`), and a bracket wider than the largest double is bisected
+(tests/test_extreme_brackets.py).
 """
 
 from __future__ import annotations
