@@ -14,6 +14,7 @@ and no overflow for a bracket as wide as [-1e308, 1e308]).
 
 from __future__ import annotations
 
+import math
 from typing import Any, ClassVar
 
 from ..iterate import Loop, build_loop
@@ -59,6 +60,26 @@ def init_bracket(problem: ScalarProblem, a: float,
     return fa, fb, None
 
 
+def halvings_needed(a: float, b: float, tol: float) -> int:
+    """The steps bisection takes to bring its error within ``tol``: step k's error is half
+    the bracket it halves, (b - a) / 2^k, so the least k with (b - a) / 2^k <= tol (the
+    a-priori count above, whose n is the table's last row, k - 1: rows are numbered from
+    0), from h = b/2 - a/2 (no overflow) and exact scalings of it by powers of two.
+    Exact where the midpoints are (brackets far wider than their spacing of doubles); an
+    upper bound where the run stops earlier: at an exact zero, with rtol > 0, or at the
+    rounding level."""
+    lo, hi = (a, b) if a <= b else (b, a)
+    h = 0.5 * hi - 0.5 * lo
+    if h <= tol:
+        return 1 if h > 0.0 else 0
+    k = max(1, math.ceil(math.log2(h) - math.log2(tol)) + 1)
+    while k > 1 and math.ldexp(h, 2 - k) <= tol:  # log2 rounded up past an exact power of two
+        k -= 1
+    while math.ldexp(h, 1 - k) > tol:
+        k += 1
+    return k
+
+
 @frozen
 class Bisection:
     name: ClassVar[str] = "bisection"
@@ -98,6 +119,15 @@ class Bisection:
 
     def initial_row(self, problem: ScalarProblem, s: BisectionState) -> None:
         return None
+
+    def cap_detail(self, bracket: tuple[float, float], tol: float, rtol: float, iterations: int,
+                   err: float) -> str:
+        """The iteration cap's message for bisection: it says how many halvings the bracket
+        needed, known before the first (:func:`halvings_needed`), and what to raise."""
+        n = halvings_needed(*bracket, tol)
+        bound = "at most " if rtol else ""
+        return (f"{iterations} iterations, last error {err:.3g}; this bracket needs {bound}{n:,} "
+                f"halvings to reach tol = {tol:g}: raise --max-iter / max_iter to that")
 
     def row(self, problem: ScalarProblem, s: BisectionState, i: int) -> tuple[Any, ...]:
         return (i, s.row_a, s.row_fa, s.row_b, s.row_fb, s.x, s.err)

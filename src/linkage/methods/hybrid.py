@@ -9,6 +9,10 @@ Order about 1.84 on smooth simple roots, never worse than about twice bisection'
 count (R. P. Brent, Algorithms for Minimization without Derivatives, 1973, ch. 4;
 the loop follows the layout of scipy's brentq). One evaluation per step, two to start.
 Error measure: the bracket width |x_block - x|, which bounds |x - r|.
+At the ends of the double range: a bracket wider than the largest double is halved in
+halves (x_block/2 - x/2) and bisected, and an interpolation that overflowed (inf or NaN)
+is recomputed on scaled values (:func:`scaled_interpolation`), so [-1e308, 1e308] is
+solved (tests/test_extreme_brackets.py).
 """
 
 from __future__ import annotations
@@ -52,6 +56,33 @@ def _settle(xpre: float, fpre: float, xcur: float, fcur: float, xblk: float, fbl
     return xpre, fpre, xcur, fcur, xblk, fblk, spre, scur
 
 
+def scaled_interpolation(xcur: float, fcur: float, xpre: float, fpre: float, xblk: float,
+                         fblk: float) -> float:
+    """The hybrid's interpolation step where the ordinary formula overflowed (f values or
+    their products beyond the largest double): the same formula on f scaled by a power of
+    two to a largest |f| in [0.5, 1), and on the x differences scaled to a largest one in
+    [0.5, 1), unscaled at the end. The step is homogeneous of degree 0 in f and 1 in x, and
+    scaling by a power of two is exact, so this is the ordinary formula's value wherever
+    neither computation leaves the range of normal doubles (an overflow left is inf or NaN,
+    which the safeguard rejects: the step bisects)."""
+    ef = math.frexp(max(abs(fcur), abs(fpre), abs(fblk)))[1]
+    dxp, dxb = xpre - xcur, xblk - xcur
+    ex = math.frexp(max(abs(dxp), abs(dxb)))[1]
+    ldexp = math.ldexp
+    fcur, fpre, fblk = ldexp(fcur, -ef), ldexp(fpre, -ef), ldexp(fblk, -ef)
+    dxp, dxb = ldexp(dxp, -ex), ldexp(dxb, -ex)
+    try:
+        if xpre == xblk:
+            step = fcur * dxp / (fcur - fpre)
+        else:
+            dpre = (fpre - fcur) / dxp
+            dblk = (fblk - fcur) / dxb
+            step = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+        return ldexp(step, ex)
+    except (ZeroDivisionError, OverflowError):
+        return math.inf
+
+
 @frozen
 class Hybrid:
     """``tol``/``rtol``: the shortest step taken, which should match the stopping test."""
@@ -91,6 +122,9 @@ class Hybrid:
             s.x, s.fx, s.xpre, s.fpre, s.xblk, s.fblk, s.spre, s.scur)
         delta = 0.5 * (self.tol + self.rtol * abs(xcur)) + _EPS * abs(xcur)
         sbis = 0.5 * (xblk - xcur)
+        if sbis - sbis != 0.0:  # a bracket wider than the largest double: halve it in halves,
+            sbis = 0.5 * xblk - 0.5 * xcur
+            spre = 0.0  # and bisect
         kind = "bisection"
         if abs(spre) > delta and abs(fcur) < abs(fpre):
             try:
@@ -102,6 +136,8 @@ class Hybrid:
                     dblk = (fblk - fcur) / (xblk - xcur)
                     stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
                     trial = "inverse quadratic"
+                if stry - stry != 0.0:  # inf or NaN: a product or difference of f values overflowed
+                    stry = scaled_interpolation(xcur, fcur, xpre, fpre, xblk, fblk)
             except ZeroDivisionError:
                 # Products of tiny f values underflow to 0 (x^9 near its root): bisect.
                 stry, trial = math.inf, "bisection"

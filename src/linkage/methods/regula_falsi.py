@@ -7,6 +7,10 @@ which restores superlinear convergence of order 3^(1/3) = 1.442 (Dowell and Jarr
 BIT 11, 1971). One evaluation per step, two to start. A candidate that rounding puts
 outside the open bracket is replaced by the midpoint, so the bracket always holds.
 Error measure: the bracket width |b - a|, which bounds |c - r| because c is an end.
+Where the secant's products over- or underflow (brackets as wide as [-1e308, 1e308],
+values near 1e-300) its point comes from the ratio of the end values instead
+(:func:`secant_from_ratio`), and a bracket wider than the largest double is bisected
+(tests/test_extreme_brackets.py).
 """
 
 from __future__ import annotations
@@ -36,6 +40,19 @@ class RegulaFalsiState(NamedTuple):
     row_fa: float
     row_b: float
     row_fb: float
+
+
+def secant_from_ratio(a: float, fa: float, b: float, fb: float) -> float:
+    """Regula falsi's point c = b - F(b) (b - a) / (F(b) - F(a)) where that overflowed (c inf
+    or NaN, or c = b from a difference F(b) - F(a) beyond the largest double) or underflowed
+    (F(b) (b - a) = 0: tiny values on a tiny bracket), on a bracket of finite width: the
+    same point from the end with the smaller |F|, as a + (b - a) / (1 - F(b) / F(a)) (or
+    its mirror from b). F(b) / F(a) < 0, so the divisor is at least 1 and no product of
+    values is formed; a ratio beyond the largest double gives the end itself, which the
+    step replaces by the midpoint, as it does where the width itself overflows (so that
+    a bracket wider than the largest double is bisected, and is finite from then on)."""
+    width = b - a
+    return a + width / (1.0 - fb / fa) if abs(fa) <= abs(fb) else b - width / (1.0 - fa / fb)
 
 
 @frozen
@@ -74,8 +91,14 @@ class RegulaFalsi:
         denominator = big_fb - big_fa
         # (weights halved many times can underflow: then the secant is undefined)
         c = b - big_fb * (b - a) / denominator if denominator != 0.0 else a
-        if not a < c < b:
-            c = 0.5 * a + 0.5 * b
+        if not a < c < b:  # rounding put c at or past an end, a weight underflowed, or:
+            if c != a and (c - c != 0.0 or (c == b and (denominator - denominator != 0.0
+                                                       or big_fb * (b - a) == 0.0))):
+                c = secant_from_ratio(a, big_fa, b, big_fb)  # an overflow or underflow on the way
+                if not a < c < b:  # (the width itself overflowed: bisect)
+                    c = 0.5 * a + 0.5 * b
+            else:
+                c = 0.5 * a + 0.5 * b
         fc = problem.f(c)
         if same_sign(fc, fb):
             b, fb, wb = c, fc, 1.0

@@ -34,6 +34,16 @@ class SecantState(NamedTuple):
     slope_before: float
 
 
+def chord_slope(x: float, fx: float, xp: float, fxp: float) -> float:
+    """The secant's slope where (f(x) - f(x_p)) / (x - x_p) came out inf, NaN or 0: the same
+    quotient of halves, (f(x)/2 - f(x_p)/2) / (x/2 - x_p/2). Halving is exact, so this is
+    the ordinary quotient wherever no difference overflowed (a flat chord, f(x) = f(x_p),
+    is still 0, an underflowed quotient still 0); where one did (points or values of
+    opposite signs near the largest double: inf/inf is NaN, a finite difference over an
+    infinite one 0, a false "zero slope") it is the chord's slope, finite."""
+    return (0.5 * fx - 0.5 * fxp) / (0.5 * x - 0.5 * xp)
+
+
 @frozen
 class Secant:
     name: ClassVar[str] = "secant"
@@ -78,6 +88,8 @@ class Secant:
                                          f"({problem.var} = {x!r}): no chord to follow"),
                 x, fx, _NAN, s.slope))
         slope = (fx - s.fxp) / (x - s.xp)
+        if slope - slope != 0.0 or slope == 0.0:  # an overflow on the way, or a flat chord: see chord_slope
+            slope = chord_slope(x, fx, s.xp, s.fxp)
         if slope == 0.0:
             return new_state(SecantState, (
                 x, fx, _NAN,
@@ -127,6 +139,8 @@ SECANT_LOOP = Loop(
             detail = f"the last two points are equal in double precision ({v} = {x!r}): no chord to follow"
             break
         new_slope = (fx - fxp) / (x - xp)
+        if new_slope - new_slope != 0.0 or new_slope == 0.0:
+            new_slope = _chord_slope(x, fx, xp, fxp)
         if new_slope == 0.0:
             xp, fxp, err, slope_before, slope = x, fx, _nan, slope, new_slope
             status, detail = _S.ZERO_DERIVATIVE, f"the secant slope is zero at {v} = {x!r}"
@@ -144,4 +158,4 @@ SECANT_LOOP = Loop(
     guard=True, step_test="certify", diverge="streak")
 """The secant method's loop: the stopping rule of :mod:`linkage.iterate` around its step."""
 
-secant_lean = build_loop(SECANT_LOOP, {"_State": SecantState}, fixed_source=True)
+secant_lean = build_loop(SECANT_LOOP, {"_State": SecantState, "_chord_slope": chord_slope}, fixed_source=True)

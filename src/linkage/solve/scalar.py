@@ -258,6 +258,8 @@ def finish(m: Any, problem: ScalarProblem, state: Any, crit: Criteria, record: b
             nfev += 1
         except (ArithmeticError, ValueError):
             residual = math.nan
+    if status is Status.MAX_ITER and hasattr(m, "cap_detail"):  # bisection: the halvings it needed
+        detail = m.cap_detail(start["bracket"], crit.tol, crit.rtol, iterations, final.err)
     if status is Status.CONVERGED_STEP and m.bracketing and "f_ends" in start:
         lo, hi = final_bracket(final)
         status, detail, more = check_sign_change(problem, x, residual, lo, hi, start["f_ends"], detail)
