@@ -398,3 +398,14 @@ def test_a_nan_check_figure_is_a_miss_in_the_report_and_the_exit_alike():
     for field in ("balance", "drive_check"):
         bad = simulation_checks(dataclasses.replace(sim, **{field: math.nan}), 1e-8, 1e-10, 0.02)
         assert not bad.passed
+
+
+def test_a_run_that_stops_at_its_start_has_its_start_once(cli):
+    """Coulomb friction of 100 N m against a drive of 0 stops the crank at its start (the
+    'stopped' event at t = 0): the output time 0 is the event's row, once, and the energy
+    balance has nothing to compare (it read 'within' over two copies of one row before)."""
+    sim = linkage.simulate(linkage.load_mechanism(str(LOADED)), drive="0", time=(0.0, 0.2), samples=5,
+                           friction_coulomb={"O2": 100.0})
+    assert sim.event == "stopped" and list(sim.t) == [0.0]
+    run = cli("simulate", str(LOADED), "--time", "0:0.2", "--samples", "5", "--friction-coulomb", "100")
+    assert "energy balance: nothing to compare" in run.out

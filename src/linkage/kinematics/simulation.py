@@ -393,8 +393,9 @@ def _at_event(dyn: Dynamics, eq: Equation, sol: Any, rtol: float, atol: float
         last = solve_ivp(eq.rhs, (before, event_time), sol.sol(before), method="DOP853", rtol=rtol,
                          atol=[atol] * 5)
     ye = last.y[:, -1] if last.status == 0 else sol.y_events[which][0]
-    t_out = np.append(sol.t, event_time)
-    y_out = np.column_stack([sol.y, ye])
+    keep = sol.t < event_time  # an output time at the event itself is the event's row, once
+    t_out = np.append(sol.t[keep], event_time)
+    y_out = np.column_stack([sol.y[:, keep], ye])
     if which == 1:
         return t_out, y_out, "stopped", event_time, \
             "the driver came to rest under Coulomb friction (sticking is not modelled)"
