@@ -34,7 +34,7 @@ from .angles import nearest_turn, nearest_turn_array
 from .continuation import Solver, classify_gap, continue_step, solve_position, solver_q
 from .half_angle import cos_sin
 from .limits import solved_ranges_array
-from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
+from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values, sweep_result
 from .stepwise import sweep
 from .vector_loops import LoopPlan, VectorLoops, loop_plan, singular_of, solve_linear
 from .warm_starts import Coarse, coarse_intervals, warm_starts
@@ -67,9 +67,9 @@ class BatchResult:
         (a million positions cost nothing until a caller asks for one)."""
         c = self.coarse
         motion = self.rates if self.rates is not None and self.rates[0] is not None else None
-        return SweepResult(c.mechanism, c.driver, c.driver_unit, c.names, c.units, BatchPositions(self),
-                           c.feasible_ranges, c.toggles, c.branch, c.classification, c.method,
-                           motion=motion, length_unit=c.length_unit, meetings=BatchMeetings(self))
+        return sweep_result(c.mechanism, c.driver, c.driver_unit, c.names, c.units, BatchPositions(self),
+                            c.feasible_ranges, c.toggles, c.branch, c.classification, c.method, motion,
+                            c.length_unit, BatchMeetings(self))
 
     def meetings(self) -> tuple[float, ...]:
         """The driver values of solved positions where two assemblies meet to rounding

@@ -69,9 +69,9 @@ from .batch import STATUS_CODES, BatchResult
 from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
 from .pose import implied, implied_recent, step_words
-from .positions import SweepResult, check_driver_values
+from .positions import check_driver_values, sweep_result
 from .stepwise import classification_of
-from .vector_loops import VectorLoops, loop_plan, per_position, singular_of, solve_linear
+from .vector_loops import LoopPlan, VectorLoops, loop_plan, per_position, singular_of, solve_linear
 
 MARGIN_FLOOR = 1e-8
 """The smallest relative margin of a step at a grid point for this engine: closer to a
@@ -108,6 +108,10 @@ class ClosedPlan:
     """Each two-way step's two names (:func:`~.pose.step_words`)."""
     units: tuple[str, ...]
     """Each unknown's display unit."""
+    names: tuple[str, ...]
+    """Each unknown's name."""
+    loops: LoopPlan
+    """The loop model's terms as the evidence reads them (:func:`~.vector_loops.loop_plan`)."""
 
 
 def closed_plan(m: Mechanism) -> ClosedPlan:
@@ -124,7 +128,8 @@ def _closed_plan(m: Mechanism) -> ClosedPlan:
                       driver_turn(m.driver.unit), kinds, angles,
                       step_scales(kinds, m.length_scale), bool(applies and d.names_are_signs),
                       tuple(step_words(m)) if applies else (),
-                      tuple("deg" if k == "angle" else m.length_unit for k in kinds))
+                      tuple("deg" if k == "angle" else m.length_unit for k in kinds),
+                      tuple(u.name for u in m.unknowns), loop_plan(m))
 
 
 def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: float = 1e-12,
@@ -154,7 +159,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     if got is None:
         return None
     cols, det, iters, ratio, words = got
-    closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn, diff)
+    closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn, diff, ascending=True)
     if _touch_candidate(closes, det, ratio):
         return None
     shown = _display(m, plan, tol, max_iter, vals, cols, closes)
@@ -162,9 +167,9 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     # the followed branch as the one-at-a-time engine reports it: its name where each name
     # is one sign branch, else its signs (each position still carries its name)
     followed = label if plan.names_are_signs else sign_text(signs)
-    meta = SweepResult(m.name, m.driver.name, m.driver.unit, tuple(u.name for u in m.unknowns),
-                       plan.units, (), ((float(vals[0]), float(vals[-1])),), (), followed,
-                       classification_of(m), "newton (closed form)", length_unit=m.length_unit)
+    meta = sweep_result(m.name, m.driver.name, m.driver.unit, plan.names, plan.units, (),
+                        ((float(vals[0]), float(vals[-1])),), (), followed, classification_of(m),
+                        "newton (closed form)", None, m.length_unit, ())
     rates = (speed, accel) if speed is not None or joints else None
     return BatchResult(vals, np.full(n_pos, STATUS_CODES["converged"], dtype=np.int8),
                        np.ascontiguousarray(shown.T), det, iters, label, meta, 0, m, rates)
@@ -249,7 +254,7 @@ def _block(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, signs: tuple[float, 
     where the engine does not apply."""
     d = m.derivation
     # the driver's cosine and sine, taken once for the closed form and the loop equations
-    plan_loops = loop_plan(m)
+    plan_loops = plan.loops
     trig = (np.cos(drv), np.sin(drv)) if plan_loops.driver_angle else None
     q, ok, margins = d.solve_margins_np(drv, signs, driver_trig=trig)  # (fresh arrays, this block's own)
     if not _every(ok) or not all(_every(margin > MARGIN_FLOOR) for margin in margins):  # (NaN too)

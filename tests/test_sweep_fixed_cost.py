@@ -1,0 +1,111 @@
+"""The closed-form sweep's fixed cost per call, cut without changing a result: the
+results built without the frozen dataclasses' ``__init__`` equal the constructors', what
+is cached on a mechanism can serve no other, and a sweep equals, field for field and bit
+for bit, the one the uncached path (a fresh mechanism, nothing implied yet) gives, on
+random four-bars over ranges that cross their limits, on both branches, at length scales
+from 1e-6 to 1e3. No timings: benchmarks/sweep_floor.py measures them."""
+
+from __future__ import annotations
+
+import random
+import re
+from dataclasses import fields
+
+import numpy as np
+import pytest
+
+import linkage
+from linkage.kinematics.loading import parse_mechanism
+from linkage.kinematics.positions import SweepResult, sweep_result
+
+
+def test_a_sweep_result_built_fast_equals_the_constructor():
+    assert [f.name for f in fields(SweepResult)] == [
+        "mechanism", "driver", "driver_unit", "names", "units", "positions", "feasible_ranges", "toggles",
+        "branch", "classification", "method", "motion", "length_unit", "meetings", "branch_note", "forces"]
+    args = ("m", "theta2", "deg", ("theta3",), ("deg",), (), ((0.0, 1.0),), (2.0,), "open",
+            {"grashof": "crank-rocker"}, "newton (closed form)", (1.0, 0.0), "mm", (0.5,))
+    fast = sweep_result(*args)
+    slow = SweepResult(*args[:11], motion=args[11], length_unit=args[12], meetings=args[13])
+    assert fast == slow and repr(fast) == repr(slow) and vars(fast) == vars(slow)
+
+
+def _bits(x):
+    """A value as text that tells every float's bits apart (-0.0, NaN), containers element by element."""
+    if isinstance(x, float):
+        return x.hex()
+    if isinstance(x, (list, tuple)):
+        return "(" + ",".join(_bits(v) for v in x) + ")"
+    if isinstance(x, dict):
+        return "{" + ",".join(f"{k}:{_bits(v)}" for k, v in x.items()) + "}"
+    return repr(x)
+
+
+def _every_field(s: SweepResult) -> list[str]:
+    """Every field of a sweep and of each of its positions, and its columns, as :func:`_bits`."""
+    kept = [getattr(s, f.name) for f in fields(SweepResult) if f.name not in ("positions", "meetings")]
+    out = [_bits(kept),
+           _bits(tuple(s.meetings)), _bits(s.summary), _bits(s.inputs)]
+    out += [_bits([getattr(p, f.name) for f in fields(p)]) for p in s.positions]
+    out += [_bits([None if v is None else float(v) for v in s.column(name)]) for name in s.names]
+    return out
+
+
+def _fourbar(r, scale, guesses, drawn):
+    """A four-bar (ground r1 on x, crank r2 driving, coupler r3, rocker r4), lengths times ``scale``."""
+    return parse_mechanism({
+        "name": "random four-bar", "length_unit": "mm",
+        "parameters": {**{f"r{i + 1}": {"value": r[i] * scale, "unit": "mm"} for i in range(4)},
+                       "theta1": {"value": 0, "unit": "deg"}},
+        "driver": {"name": "theta2", "value": drawn, "unit": "deg"},
+        "unknowns": {"theta3": {"guess": guesses[0], "unit": "deg"},
+                     "theta4": {"guess": guesses[1], "unit": "deg"}},
+        "loops": [{"name": "O2-A-B-O4", "vectors": [
+            {"length": "r2", "angle": "theta2"}, {"length": "r3", "angle": "theta3"},
+            {"length": "r4", "angle": "theta4", "sign": -1},
+            {"length": "r1", "angle": "theta1", "sign": -1}]}]})
+
+
+def _random_cases(seed: int, count: int):
+    """(links, scale, guesses, drawn driver value, [(values, branch, tol)]): Grashof crank-rockers
+    (crank shortest) and any four-bars (limits inside many ranges), at scales 1e-6 to 1e3."""
+    rng = random.Random(seed)
+    for _ in range(count):
+        r = [rng.uniform(0.3, 3.0) for _ in range(4)]
+        if rng.random() < 0.6:
+            s, *others = sorted(r)
+            rng.shuffle(others)
+            r = [others[0], s, others[1], others[2]]
+        sweeps = []
+        for _ in range(3):
+            lo = rng.choice([0.0, rng.uniform(-200.0, 200.0)])
+            span = rng.choice([360.0, rng.uniform(1.0, 400.0)])
+            values = [float(v) for v in np.linspace(lo, lo + span, rng.choice([2, 3, 7, 73, 361]))]
+            branch = rng.choice([None, None, "open", "crossed"])
+            sweeps.append((values, branch, rng.choice([1e-12, 1e-10, 1e-14])))
+        yield (r, 10.0 ** rng.uniform(-6.0, 3.0), (rng.uniform(-180, 180), rng.uniform(-180, 180)),
+               rng.uniform(0.0, 360.0), sweeps)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_mechanism_swept_again_gives_what_a_fresh_one_gives(seed):
+    """What a sweep keeps on a mechanism (its plan, branch, anchor, loop plan, the first
+    value's signs) changes no field of a later sweep: each sweep of a mechanism that has
+    been swept before, over other values, branches and tolerances, equals bit for bit the
+    same sweep of a fresh copy of it (nothing kept yet), on whichever engine it takes."""
+    engines = set()
+    for links, scale, guesses, drawn, sweeps in _random_cases(seed, 14):
+        warm = _fourbar(links, scale, guesses, drawn)
+        for values, branch, tol in sweeps:
+            for again in range(2):
+                try:
+                    got = linkage.sweep(warm, values, branch=branch, tol=tol)
+                except linkage.InputError as exc:
+                    with pytest.raises(linkage.InputError, match=re.escape(str(exc))):
+                        linkage.sweep(_fourbar(links, scale, guesses, drawn), values, branch=branch,
+                                      tol=tol)
+                    continue
+                fresh = linkage.sweep(_fourbar(links, scale, guesses, drawn), values, branch=branch, tol=tol)
+                assert _every_field(got) == _every_field(fresh), (links, scale, values[0], branch, again)
+                engines.add(got.method)
+    assert engines == {"newton", "newton (closed form)"}  # both engines were compared
