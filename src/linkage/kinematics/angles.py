@@ -174,6 +174,8 @@ def unwrap_turns_array(values: Any, closes: bool, all_solved: bool = False) -> A
         step -= a
         step /= TURN
         np.floor(step, out=step)
+        if not np.count_nonzero(step):
+            return step  # no turn anywhere (a rocker, a coupler): the running sum of +0.0s is itself
         return np.add.accumulate(step, axis=1, out=step)
     start = circular_start_array(solved, closes)
     idx = (np.arange(n)[None, :] + start[:, None]) % n

@@ -146,7 +146,9 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     n_pos = len(vals)
     if vals.ndim != 1 or n_pos < 2:
         return None
-    diff = np.diff(vals)  # (b - a > 0 exactly where b > a: IEEE subtraction underflows gradually)
+    # np.diff's subtraction without its wrapper (b - a > 0 exactly where b > a: IEEE
+    # subtraction underflows gradually)
+    diff = vals[1:] - vals[:-1]
     if not _every(diff > 0.0):
         return None
     # the driver's magnitude, refused as the one-at-a-time engine refuses it

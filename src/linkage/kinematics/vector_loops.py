@@ -30,6 +30,9 @@ class LoopPlan:
     driver_angle: bool
     """Whether a term's angle is the driver itself (no offset): where the cosine and sine
     of the driver values are worth taking once for several readers (``driver_trig``)."""
+    driven: tuple[tuple[int, int], ...]
+    """(loop, term) of each term that reads the driver (its length or angle), which
+    :class:`VectorLoops` gives the driver values; every other term is read as it is."""
 
     @classmethod
     def of(cls, model: LoopModel) -> LoopPlan:
@@ -44,7 +47,9 @@ class LoopPlan:
                     out.append((sign, lc, lidx, ac, aidx, off))
             loops.append(tuple(out))
         driver_angle = any(len(t) == 6 and t[4] == DRIVER and t[5] == 0.0 for loop in loops for t in loop)
-        return cls(model.n, tuple(loops), driver_angle)
+        driven = tuple((li, ti) for li, loop in enumerate(loops) for ti, t in enumerate(loop)
+                       if len(t) == 6 and DRIVER in (t[2], t[4]))
+        return cls(model.n, tuple(loops), driver_angle, driven)
 
 
 def numpy_cos_sin(x: Any) -> tuple[Any, Any]:
@@ -77,9 +82,13 @@ class VectorLoops:
         if cos_sin is not None:
             self.cos_sin = cos_sin
         plan = model if isinstance(model, LoopPlan) else LoopPlan.of(model)
-        terms = [[t if len(t) == 2 else (t[0], drv if t[2] == DRIVER else t[1], t[2] if t[2] >= 0 else -1,
-                                         drv if t[4] == DRIVER else t[3], t[4] if t[4] >= 0 else -1, t[5])
-                  for t in loop] for loop in plan.loops]
+        terms: Sequence[Sequence[Any]] = plan.loops
+        if plan.driven:  # those terms with the driver values in place (an index -1: a given value)
+            terms = [list(loop) for loop in terms]
+            for li, ti in plan.driven:
+                t = terms[li][ti]
+                terms[li][ti] = (t[0], drv if t[2] == DRIVER else t[1], -1 if t[2] < 0 else t[2],
+                                 drv if t[4] == DRIVER else t[3], -1 if t[4] < 0 else t[4], t[5])
         self.setup(terms, plan.n, len(drv), None if driver_trig is None else (drv, *driver_trig))
 
     @classmethod
