@@ -109,3 +109,43 @@ def test_a_mechanism_swept_again_gives_what_a_fresh_one_gives(seed):
                 assert _every_field(got) == _every_field(fresh), (links, scale, values[0], branch, again)
                 engines.add(got.method)
     assert engines == {"newton", "newton (closed form)"}  # both engines were compared
+
+
+SAMPLES_WITH_A_CLOSED_FORM = ["crank_rocker.toml", "crank_rocker_joints.toml", "fourbar_me581_theta4.toml",
+                              "slider_crank.toml", "watt_sixbar.toml", "stephenson_sixbar_joints.toml",
+                              "inverted_slider_crank.toml", "rapier_drive.toml"]
+
+
+@pytest.mark.parametrize("name", SAMPLES_WITH_A_CLOSED_FORM)
+def test_far_from_touch_is_the_product_of_the_column_lengths_at_every_position(name):
+    """The closed engine's bound (far_from_touch) stands for the ratio |det J| / (product of
+    J's columns' lengths) only where that product is the same at every position: at random
+    unknowns and driver values it is that product (to rounding) times TOUCH_CANDIDATE, and
+    |det J| above it means the ratio is above TOUCH_CANDIDATE; where a column's length
+    varies (the inverted slider's slide on a turning line) there is no bound."""
+    from linkage.kinematics.closed import TOUCH_SLACK, closed_plan
+    from linkage.kinematics.limits import TOUCH_CANDIDATE
+    from linkage.kinematics.vector_loops import VectorLoops, solve_linear
+    from linkage.samples import sample_path
+
+    m = linkage.load_mechanism(sample_path(name))
+    plan = closed_plan(m)
+    rng = np.random.default_rng(7)
+    k = 2000
+    drv = rng.uniform(-7.0, 7.0, k) if m.driver.kind == "angle" else rng.uniform(0.5, 2.0, k) * m.length_scale
+    q = [rng.uniform(-7.0, 7.0, k) if u.kind == "angle" else rng.uniform(-2.0, 2.0, k) * m.length_scale
+         for u in m.unknowns]
+    phi, jac = VectorLoops(plan.loops, drv).evaluate(q, None)
+    _, det = solve_linear(jac, phi, k)
+    product = np.ones(k)
+    for j in range(len(q)):
+        product *= np.sqrt(sum(np.square(np.broadcast_to(row[j], (k,))) for row in jac))
+    if name == "inverted_slider_crank.toml":
+        assert plan.far_from_touch is None
+        assert np.ptp(product) > 1e-3 * product.max()  # (its slide's column does vary)
+        return
+    assert plan.far_from_touch is not None
+    exact = plan.far_from_touch / (TOUCH_CANDIDATE * (1.0 + TOUCH_SLACK))
+    assert np.max(np.abs(product / exact - 1.0)) < 1e-13
+    ratio = np.abs(det) / product
+    assert ((np.abs(det) <= plan.far_from_touch) | (ratio > TOUCH_CANDIDATE)).all()

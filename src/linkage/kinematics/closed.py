@@ -112,6 +112,9 @@ class ClosedPlan:
     """Each unknown's name."""
     loops: LoopPlan
     """The loop model's terms as the evidence reads them (:func:`~.vector_loops.loop_plan`)."""
+    far_from_touch: float | None
+    """A bound on |det J| above which J is not near singular at any position
+    (:func:`far_from_touch`), or None where J's column lengths vary."""
 
 
 def closed_plan(m: Mechanism) -> ClosedPlan:
@@ -129,7 +132,41 @@ def _closed_plan(m: Mechanism) -> ClosedPlan:
                       step_scales(kinds, m.length_scale), bool(applies and d.names_are_signs),
                       tuple(step_words(m)) if applies else (),
                       tuple("deg" if k == "angle" else m.length_unit for k in kinds),
-                      tuple(u.name for u in m.unknowns), loop_plan(m))
+                      tuple(u.name for u in m.unknowns), loop_plan(m), far_from_touch(loop_plan(m)))
+
+
+TOUCH_SLACK = 1e-9
+"""The relative slack of :func:`far_from_touch`'s bound: far above the rounding of J's
+entries and column lengths (a few ulp, 1e-15), so the bound never claims a position that
+the ratio itself would call near singular."""
+
+
+def far_from_touch(loops: LoopPlan) -> float | None:
+    """A number B such that |det J| > B at a position means the ratio :func:`_touch_candidate`
+    reads there (|det J| over the product of J's columns' lengths) is above TOUCH_CANDIDATE,
+    without computing the ratio: TOUCH_CANDIDATE times that product (and ``TOUCH_SLACK``),
+    where the product is the same at every position. It is where each unknown appears at
+    most once in each loop, as an angle on a fixed length r (its column gets r (-sin, cos)
+    there: length |r|) or as a length (sign (cos, sin): length 1), and never as an angle on
+    an unknown or driven length; else None (the ratio is then computed). Derived once per
+    mechanism (:class:`ClosedPlan`)."""
+    squares = [0.0] * loops.n
+    seen: set[tuple[int, int]] = set()
+    for li, loop in enumerate(loops.loops):
+        for term in loop:
+            if len(term) == 2:
+                continue
+            _, r, lidx, _, aidx, _ = term
+            for j, part in ((aidx, r if lidx == -1 else None), (lidx, 1.0)):
+                if j < 0:
+                    continue
+                if (li, j) in seen or part.__class__ is not float:
+                    return None  # two terms on one unknown, or an angle on a varying length
+                seen.add((li, j))
+                squares[j] += part * part
+    if not all(squares):
+        return None
+    return TOUCH_CANDIDATE * math.prod(math.sqrt(x) for x in squares) * (1.0 + TOUCH_SLACK)
 
 
 def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: float = 1e-12,
@@ -178,7 +215,7 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
 
 
 def _blocks(m: Mechanism, plan: ClosedPlan, vals: np.ndarray, signs: tuple[float, ...], tol: float,
-            max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[str]] | None:
+            max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None, list[str]] | None:
     """:func:`_block` over every ``BLOCK`` of the driver values (display units), joined:
     None where a block is None or two name the branch or sign det J differently. One block
     (up to ``BLOCK`` positions) is its own answer, not copied."""
@@ -204,7 +241,7 @@ def _blocks(m: Mechanism, plan: ClosedPlan, vals: np.ndarray, signs: tuple[float
         cols[:, lo:lo + BLOCK] = q
         det[lo:lo + BLOCK] = dt
         iters[lo:lo + BLOCK] = it
-        ratio[lo:lo + BLOCK] = rt
+        ratio[lo:lo + BLOCK] = np.inf if rt is None else rt  # (None: every ratio above the bar)
     assert words is not None
     return cols, det, iters, ratio, words
 
@@ -250,10 +287,11 @@ def followed_signs_uncached(m: Mechanism, tol: float, max_iter: int, first: floa
 
 
 def _block(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, signs: tuple[float, ...], tol: float,
-           max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[str]] | None:
+           max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None, list[str]] | None:
     """One block of driver values (internal units): (unknowns (n, k) internal, det J,
-    Newton steps taken, |det J| over J's columns' lengths, the branch's words), or None
-    where the engine does not apply."""
+    Newton steps taken, |det J| over J's columns' lengths (None where
+    :func:`far_from_touch` shows it above TOUCH_CANDIDATE everywhere), the branch's words),
+    or None where the engine does not apply."""
     d = m.derivation
     # the driver's cosine and sine, taken once for the closed form and the loop equations
     plan_loops = plan.loops
@@ -271,11 +309,16 @@ def _block(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, signs: tuple[float, 
     with np.errstate(invalid="ignore"):  # (NaN: not certified)
         certified = system_converged_array(step_size_array(dq, plan.steps), step_size_array(phi, None),
                                            tol, gate)
-    ratio = np.abs(det) / _column_lengths(jac, k)
     iters = np.zeros(k, dtype=np.int32)
-    if not _every(certified) and not _polish(loops, q, det, ratio, iters, np.flatnonzero(~certified),
-                                           plan.steps, tol, gate, max_iter):
-        return None
+    ratio: np.ndarray | None = None
+    if not _every(certified):
+        ratio = np.abs(det) / _column_lengths(jac, k)
+        if not _polish(loops, q, det, ratio, iters, np.flatnonzero(~certified), plan.steps, tol, gate,
+                       max_iter):
+            return None
+    elif plan.far_from_touch is None or not np.abs(det).min() > plan.far_from_touch:
+        ratio = np.abs(det) / _column_lengths(jac, k)
+    # else every position's ratio is above TOUCH_CANDIDATE (far_from_touch): None says so
     if not (_every(det > 0.0) or _every(det < 0.0)):
         return None  # det J changes sign: a toggle, the one-at-a-time engine's to locate
     words = _words(m, plan, drv, q)
@@ -324,11 +367,14 @@ def _every(mask: np.ndarray) -> bool:
     return bool(np.count_nonzero(mask) == mask.size)
 
 
-def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray) -> bool:
+def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray | None) -> bool:
     """Whether the one-at-a-time engine would search for a touch of det J = 0 here
     (:func:`~.limits.toggles`): a local minimum of |det J| where J is near singular, the
     neighbours taken around the circle where the grid closes it (more often than that
-    engine: a candidate only sends the sweep to it)."""
+    engine: a candidate only sends the sweep to it). ``ratio`` None: J is near singular
+    nowhere (:func:`far_from_touch`)."""
+    if ratio is None:
+        return False
     close = ~(ratio > TOUCH_CANDIDATE)  # J near singular (NaN too): rare, so tested first
     if not np.count_nonzero(close if closes else close[1:-1]):
         return False
