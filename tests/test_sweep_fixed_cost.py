@@ -149,3 +149,36 @@ def test_far_from_touch_is_the_product_of_the_column_lengths_at_every_position(n
     assert np.max(np.abs(product / exact - 1.0)) < 1e-13
     ratio = np.abs(det) / product
     assert ((np.abs(det) <= plan.far_from_touch) | (ratio > TOUCH_CANDIDATE)).all()
+
+
+def test_the_closed_engines_columns_are_shown_when_first_read():
+    """The closed engine's display columns (each angle unwrapped and anchored) are worked
+    out at the first read of ``solution``, and are what the constructor would have held:
+    the same array whether read first through the result, a position, a column, a pickle
+    or a deep copy, and the work is not kept once done."""
+    import copy
+    import pickle
+
+    from linkage.kinematics.batch import BatchResult
+    from linkage.kinematics.closed import closed_sweep
+    from linkage.samples import sample_path
+
+    m = linkage.load_mechanism(sample_path("crank_rocker.toml"))
+    values = [float(v) for v in range(0, 361, 5)]
+    reference = closed_sweep(m, values)
+    assert "solution" not in vars(reference)
+    shown = reference.solution
+    assert "solution_work" not in vars(reference) and reference.solution is shown
+    built = BatchResult(**{f.name: getattr(reference, f.name) for f in fields(BatchResult)})
+    for f in fields(BatchResult):
+        a, b = getattr(built, f.name), getattr(reference, f.name)
+        assert np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b, f.name
+    reads = [lambda b: b.solution, lambda b: pickle.loads(pickle.dumps(b)).solution,
+             lambda b: copy.deepcopy(b).solution,
+             lambda b: np.column_stack([b.to_sweep().column(u.name) for u in m.unknowns])]
+    for read in reads:
+        got = read(closed_sweep(m, values))
+        assert got.dtype == shown.dtype and got.shape == shown.shape
+        assert got.tobytes() == shown.tobytes()
+    with pytest.raises(AttributeError, match="no attribute 'nothing'"):
+        reference.nothing  # noqa: B018

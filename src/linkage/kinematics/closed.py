@@ -65,7 +65,7 @@ from .angles import (
     turn_shift,
     unwrap_turns_array,
 )
-from .batch import STATUS_CODES, BatchResult
+from .batch import STATUS_CODES, BatchResult, batch_result_to_show
 from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
 from .pose import implied, implied_recent, step_words
@@ -201,7 +201,6 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn, diff, ascending=True)
     if _touch_candidate(closes, det, ratio):
         return None
-    shown = _display(m, plan, tol, max_iter, vals, cols, closes)
     label = "/".join(words)
     # the followed branch as the one-at-a-time engine reports it: its name where each name
     # is one sign branch, else its signs (each position still carries its name)
@@ -210,8 +209,18 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
                         ((float(vals[0]), float(vals[-1])),), (), followed, classification_of(m),
                         "newton (closed form)", None, m.length_unit, ())
     rates = (speed, accel) if speed is not None or joints else None
-    return BatchResult(vals, np.full(n_pos, STATUS_CODES["converged"], dtype=np.int8),
-                       np.ascontiguousarray(shown.T), det, iters, label, meta, 0, m, rates)
+    # the columns in display units when first read (unwrapped and anchored: _display); the
+    # anchor, a Newton solve once per mechanism and criteria, now, as the sweep's own work
+    ref = implied(m, ("closed_anchor", tol, max_iter), lambda m: _anchor(m, tol, max_iter))
+    return batch_result_to_show(vals, np.full(n_pos, STATUS_CODES["converged"], dtype=np.int8),
+                                partial(_shown, m, plan, ref, vals, cols, closes), det, iters,
+                                label, meta, 0, m, rates)
+
+
+def _shown(m: Mechanism, plan: ClosedPlan, ref: tuple[float, ...] | None, vals: np.ndarray, cols: np.ndarray,
+           closes: bool) -> np.ndarray:
+    """:func:`_display` as the result keeps it: one row per position."""
+    return np.ascontiguousarray(_display(m, plan, ref, vals, cols, closes).T)
 
 
 def _blocks(m: Mechanism, plan: ClosedPlan, vals: np.ndarray, signs: tuple[float, ...], tol: float,
@@ -419,10 +428,11 @@ def _words(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, q: list[np.ndarray])
     return out
 
 
-def _display(m: Mechanism, plan: ClosedPlan, tol: float, max_iter: int, vals: np.ndarray, cols: np.ndarray,
-             closes: bool) -> np.ndarray:
+def _display(m: Mechanism, plan: ClosedPlan, ref: tuple[float, ...] | None, vals: np.ndarray,
+             cols: np.ndarray, closes: bool) -> np.ndarray:
     """The unknowns in display units, each angle continuous along the cycle and anchored to
-    what ``solve FILE`` gives (the rule of :mod:`.angles`, as the one-at-a-time engine)."""
+    what ``solve FILE`` gives (``ref``: :func:`_anchor`; the rule of :mod:`.angles`, as the
+    one-at-a-time engine)."""
     kinds, angles = plan.kinds, list(plan.angles)
     every = len(angles) == len(kinds)
     if every:
@@ -437,7 +447,6 @@ def _display(m: Mechanism, plan: ClosedPlan, tol: float, max_iter: int, vals: np
     # (every position solved: the anchor is the grid point nearest the file's driver value)
     near = int(anchor_index_array(vals, True, m.driver.value / plan.scale, closes, plan.turn)[0])
     shift = np.zeros(len(angles))
-    ref = implied(m, ("closed_anchor", tol, max_iter), lambda m: _anchor(m, tol, max_iter))
     if ref is not None:
         for a, j in enumerate(angles):
             at = continuous(float(out[j, near]), float(turns[a, near]))
