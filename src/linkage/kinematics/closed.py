@@ -33,7 +33,13 @@ a sweep that stays on one branch needs no continuation:
 Anything else (a limit inside the sweep, a gap, a position the rule does not accept, a
 name or det sign that changes) returns None, and the caller runs the one-at-a-time
 engine unchanged. The result is a :class:`~.batch.BatchResult`: columns, with a position
-built only when it is read.
+built only when it is read, and the columns in display units (each angle unwrapped and
+anchored to ``solve FILE``'s answer, :mod:`.angles`) worked out when first read.
+
+What depends on the mechanism alone is derived once per mechanism (:class:`ClosedPlan`,
+:func:`~.pose.implied`): its loop plan, names and units, the bound that spares the ratio of
+J's near-singularity (:func:`far_from_touch`), the anchor; the branch to follow is kept per
+first driver value (:func:`followed_signs`).
 """
 
 from __future__ import annotations

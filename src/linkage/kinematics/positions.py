@@ -148,8 +148,9 @@ def sweep_result(mechanism: str, driver: str, driver_unit: str, names: tuple[str
                  motion: tuple[float, float] | None, length_unit: str,
                  meetings: Sequence[float]) -> SweepResult:
     """``SweepResult(...)`` of these fields (no branch note, no forces) without the frozen
-    dataclass's ``__init__`` (as :func:`converged_position`: its sixteen fields through
-    ``object.__setattr__`` are a tenth of a short closed-form sweep's fixed cost).
+    dataclass's ``__init__``, which sets its sixteen fields through ``object.__setattr__``
+    (as :func:`converged_position`; a closed-form sweep makes two per call, and
+    ``benchmarks/sweep_floor.py --positions 3`` measures that fixed cost).
     tests/test_sweep_fixed_cost.py checks that both give equal results and that the fields are
     still these."""
     out = _new(SweepResult)
