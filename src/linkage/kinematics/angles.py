@@ -65,9 +65,11 @@ def closes_circle(values: Sequence[float], turn: float = TURN) -> bool:
     return -slack <= closing <= largest + slack
 
 
-def closes_circle_array(values: Any, turn: float = TURN, diff: Any = None) -> bool:
+def closes_circle_array(values: Any, turn: float = TURN, diff: Any = None, ascending: bool = False) -> bool:
     """:func:`closes_circle` of a 1-D array of driver values (one grid, read at C speed).
-    ``diff``: np.diff of the values, where the caller took it; taken here when not given."""
+    ``diff``: np.diff of the values, where the caller took it; taken here when not given.
+    ``ascending``: the caller has found every entry of ``diff`` above 0 (values strictly
+    ascending, as the closed-form engine requires), so that is not tested again."""
     import numpy as np
 
     v = np.asarray(values, dtype=float)
@@ -75,9 +77,12 @@ def closes_circle_array(values: Any, turn: float = TURN, diff: Any = None) -> bo
         return False
     if diff is None:
         diff = np.diff(v)
-    steps = diff if v[1] > v[0] else -diff
-    if not (steps > 0.0).all():
-        return False
+    if ascending:
+        steps = diff
+    else:
+        steps = diff if v[1] > v[0] else -diff
+        if not (steps > 0.0).all():
+            return False
     closing = turn - abs(float(v[-1]) - float(v[0]))
     slack = 1e-9 * turn
     return bool(-slack <= closing <= float(steps.max()) + slack)
@@ -169,6 +174,8 @@ def unwrap_turns_array(values: Any, closes: bool, all_solved: bool = False) -> A
         step -= a
         step /= TURN
         np.floor(step, out=step)
+        if not np.count_nonzero(step):
+            return step  # no turn anywhere (a rocker, a coupler): the running sum of +0.0s is itself
         return np.add.accumulate(step, axis=1, out=step)
     start = circular_start_array(solved, closes)
     idx = (np.arange(n)[None, :] + start[:, None]) % n

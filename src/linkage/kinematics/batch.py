@@ -34,7 +34,7 @@ from .angles import nearest_turn, nearest_turn_array
 from .continuation import Solver, classify_gap, continue_step, solve_position, solver_q
 from .half_angle import cos_sin
 from .limits import solved_ranges_array
-from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values
+from .positions import MAX_POSITIONS, Position, SweepResult, check_driver_values, driver_values, sweep_result
 from .stepwise import sweep
 from .vector_loops import LoopPlan, VectorLoops, loop_plan, singular_of, solve_linear
 from .warm_starts import Coarse, coarse_intervals, warm_starts
@@ -62,14 +62,32 @@ class BatchResult:
     its rates) were asked for: computed by the one-at-a-time sweep's own
     :func:`~linkage.kinematics.sweep.with_rates` as positions are read."""
 
+    def __getattr__(self, name: str) -> Any:
+        """``solution`` of a result made by :func:`batch_result_to_show`: its work done at the
+        first read and kept (a result whose columns no one reads does not unwrap and anchor
+        them, as its positions are built only when read). Called only where the instance has
+        no such attribute."""
+        if name == "solution":
+            work = self.__dict__.get("solution_work")
+            if work is not None:
+                value = self.__dict__["solution"] = work()
+                self.__dict__.pop("solution_work", None)  # (its inputs freed)
+                return value
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The fields, ``solution`` done first (its work is a closure: not pickled)."""
+        self.solution  # noqa: B018 (done and kept by __getattr__ where it is pending)
+        return {k: v for k, v in self.__dict__.items() if k != "solution_work"}
+
     def to_sweep(self) -> SweepResult:
         """The same result as a SweepResult whose positions are built only when read
         (a million positions cost nothing until a caller asks for one)."""
         c = self.coarse
         motion = self.rates if self.rates is not None and self.rates[0] is not None else None
-        return SweepResult(c.mechanism, c.driver, c.driver_unit, c.names, c.units, BatchPositions(self),
-                           c.feasible_ranges, c.toggles, c.branch, c.classification, c.method,
-                           motion=motion, length_unit=c.length_unit, meetings=BatchMeetings(self))
+        return sweep_result(c.mechanism, c.driver, c.driver_unit, c.names, c.units, BatchPositions(self),
+                            c.feasible_ranges, c.toggles, c.branch, c.classification, c.method, motion,
+                            c.length_unit, BatchMeetings(self))
 
     def meetings(self) -> tuple[float, ...]:
         """The driver values of solved positions where two assemblies meet to rounding
@@ -86,6 +104,23 @@ class BatchResult:
         for step in m.derivation.meets_np(q, self.values * scale):
             hit |= np.broadcast_to(step, hit.shape)
         return tuple(float(v) for v in self.values[meet & hit])
+
+
+def batch_result_to_show(values: np.ndarray, status: np.ndarray, solution: Callable[[], np.ndarray],
+                         det: np.ndarray, iterations: np.ndarray, branch: str | None, coarse: SweepResult,
+                         fallback: int, source: Mechanism | None,
+                         rates: tuple[float | None, float] | None) -> BatchResult:
+    """``BatchResult(values, status, solution(), ...)`` with ``solution()`` called when the
+    field is first read (:meth:`BatchResult.__getattr__`), and without the frozen
+    dataclass's ``__init__`` (as :func:`~.positions.sweep_result`). ``solution`` must give
+    the same array whenever it is called (a function of its arguments alone)."""
+    out = _new(BatchResult)
+    out.__dict__.update(values=values, status=status, solution_work=solution, det=det, iterations=iterations,
+                        branch=branch, coarse=coarse, fallback=fallback, source=source, rates=rates)
+    return out
+
+
+_new = object.__new__
 
 
 class BatchMeetings(Sequence):  # type: ignore[type-arg]

@@ -33,7 +33,13 @@ a sweep that stays on one branch needs no continuation:
 Anything else (a limit inside the sweep, a gap, a position the rule does not accept, a
 name or det sign that changes) returns None, and the caller runs the one-at-a-time
 engine unchanged. The result is a :class:`~.batch.BatchResult`: columns, with a position
-built only when it is read.
+built only when it is read, and the columns in display units (each angle unwrapped and
+anchored to ``solve FILE``'s answer, :mod:`.angles`) worked out when first read.
+
+What depends on the mechanism alone is derived once per mechanism (:class:`ClosedPlan`,
+:func:`~.pose.implied`): its loop plan, names and units, the bound that spares the ratio of
+J's near-singularity (:func:`far_from_touch`), the anchor; the branch to follow is kept per
+first driver value (:func:`followed_signs`).
 """
 
 from __future__ import annotations
@@ -65,13 +71,13 @@ from .angles import (
     turn_shift,
     unwrap_turns_array,
 )
-from .batch import STATUS_CODES, BatchResult
+from .batch import STATUS_CODES, BatchResult, batch_result_to_show
 from .continuation import Solver
 from .limits import TOUCH_CANDIDATE
 from .pose import implied, implied_recent, step_words
-from .positions import SweepResult, check_driver_values
+from .positions import check_driver_values, sweep_result
 from .stepwise import classification_of
-from .vector_loops import VectorLoops, loop_plan, per_position, singular_of, solve_linear
+from .vector_loops import LoopPlan, VectorLoops, loop_plan, per_position, singular_of, solve_linear
 
 MARGIN_FLOOR = 1e-8
 """The smallest relative margin of a step at a grid point for this engine: closer to a
@@ -108,6 +114,13 @@ class ClosedPlan:
     """Each two-way step's two names (:func:`~.pose.step_words`)."""
     units: tuple[str, ...]
     """Each unknown's display unit."""
+    names: tuple[str, ...]
+    """Each unknown's name."""
+    loops: LoopPlan
+    """The loop model's terms as the evidence reads them (:func:`~.vector_loops.loop_plan`)."""
+    far_from_touch: float | None
+    """A bound on |det J| above which J is not near singular at any position
+    (:func:`far_from_touch`), or None where J's column lengths vary."""
 
 
 def closed_plan(m: Mechanism) -> ClosedPlan:
@@ -124,7 +137,42 @@ def _closed_plan(m: Mechanism) -> ClosedPlan:
                       driver_turn(m.driver.unit), kinds, angles,
                       step_scales(kinds, m.length_scale), bool(applies and d.names_are_signs),
                       tuple(step_words(m)) if applies else (),
-                      tuple("deg" if k == "angle" else m.length_unit for k in kinds))
+                      tuple("deg" if k == "angle" else m.length_unit for k in kinds),
+                      tuple(u.name for u in m.unknowns), loop_plan(m), far_from_touch(loop_plan(m)))
+
+
+TOUCH_SLACK = 1e-9
+"""The relative slack of :func:`far_from_touch`'s bound: far above the rounding of J's
+entries and column lengths (a few ulp, 1e-15), so the bound never claims a position that
+the ratio itself would call near singular."""
+
+
+def far_from_touch(loops: LoopPlan) -> float | None:
+    """A number B such that |det J| > B at a position means the ratio :func:`_touch_candidate`
+    reads there (|det J| over the product of J's columns' lengths) is above TOUCH_CANDIDATE,
+    without computing the ratio: TOUCH_CANDIDATE times that product (and ``TOUCH_SLACK``),
+    where the product is the same at every position. It is where each unknown appears at
+    most once in each loop, as an angle on a fixed length r (its column gets r (-sin, cos)
+    there: length |r|) or as a length (sign (cos, sin): length 1), and never as an angle on
+    an unknown or driven length; else None (the ratio is then computed). Derived once per
+    mechanism (:class:`ClosedPlan`)."""
+    squares = [0.0] * loops.n
+    seen: set[tuple[int, int]] = set()
+    for li, loop in enumerate(loops.loops):
+        for term in loop:
+            if len(term) == 2:
+                continue
+            _, r, lidx, _, aidx, _ = term
+            for j, part in ((aidx, r if lidx == -1 else None), (lidx, 1.0)):
+                if j < 0:
+                    continue
+                if (li, j) in seen or part.__class__ is not float:
+                    return None  # two terms on one unknown, or an angle on a varying length
+                seen.add((li, j))
+                squares[j] += part * part
+    if not all(squares):
+        return None
+    return TOUCH_CANDIDATE * math.prod(math.sqrt(x) for x in squares) * (1.0 + TOUCH_SLACK)
 
 
 def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: float = 1e-12,
@@ -141,7 +189,9 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     n_pos = len(vals)
     if vals.ndim != 1 or n_pos < 2:
         return None
-    diff = np.diff(vals)  # (b - a > 0 exactly where b > a: IEEE subtraction underflows gradually)
+    # np.diff's subtraction without its wrapper (b - a > 0 exactly where b > a: IEEE
+    # subtraction underflows gradually)
+    diff = vals[1:] - vals[:-1]
     if not _every(diff > 0.0):
         return None
     # the driver's magnitude, refused as the one-at-a-time engine refuses it
@@ -154,24 +204,33 @@ def closed_sweep(m: Mechanism, values: Any, *, branch: str | None = None, tol: f
     if got is None:
         return None
     cols, det, iters, ratio, words = got
-    closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn, diff)
+    closes = m.driver.kind == "angle" and closes_circle_array(vals, plan.turn, diff, ascending=True)
     if _touch_candidate(closes, det, ratio):
         return None
-    shown = _display(m, plan, tol, max_iter, vals, cols, closes)
     label = "/".join(words)
     # the followed branch as the one-at-a-time engine reports it: its name where each name
     # is one sign branch, else its signs (each position still carries its name)
     followed = label if plan.names_are_signs else sign_text(signs)
-    meta = SweepResult(m.name, m.driver.name, m.driver.unit, tuple(u.name for u in m.unknowns),
-                       plan.units, (), ((float(vals[0]), float(vals[-1])),), (), followed,
-                       classification_of(m), "newton (closed form)", length_unit=m.length_unit)
+    meta = sweep_result(m.name, m.driver.name, m.driver.unit, plan.names, plan.units, (),
+                        ((float(vals[0]), float(vals[-1])),), (), followed, classification_of(m),
+                        "newton (closed form)", None, m.length_unit, ())
     rates = (speed, accel) if speed is not None or joints else None
-    return BatchResult(vals, np.full(n_pos, STATUS_CODES["converged"], dtype=np.int8),
-                       np.ascontiguousarray(shown.T), det, iters, label, meta, 0, m, rates)
+    # the columns in display units when first read (unwrapped and anchored: _display); the
+    # anchor, a Newton solve once per mechanism and criteria, now, as the sweep's own work
+    ref = implied(m, ("closed_anchor", tol, max_iter), lambda m: _anchor(m, tol, max_iter))
+    return batch_result_to_show(vals, np.full(n_pos, STATUS_CODES["converged"], dtype=np.int8),
+                                partial(_shown, m, plan, ref, vals, cols, closes), det, iters,
+                                label, meta, 0, m, rates)
+
+
+def _shown(m: Mechanism, plan: ClosedPlan, ref: tuple[float, ...] | None, vals: np.ndarray, cols: np.ndarray,
+           closes: bool) -> np.ndarray:
+    """:func:`_display` as the result keeps it: one row per position."""
+    return np.ascontiguousarray(_display(m, plan, ref, vals, cols, closes).T)
 
 
 def _blocks(m: Mechanism, plan: ClosedPlan, vals: np.ndarray, signs: tuple[float, ...], tol: float,
-            max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[str]] | None:
+            max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None, list[str]] | None:
     """:func:`_block` over every ``BLOCK`` of the driver values (display units), joined:
     None where a block is None or two name the branch or sign det J differently. One block
     (up to ``BLOCK`` positions) is its own answer, not copied."""
@@ -197,7 +256,7 @@ def _blocks(m: Mechanism, plan: ClosedPlan, vals: np.ndarray, signs: tuple[float
         cols[:, lo:lo + BLOCK] = q
         det[lo:lo + BLOCK] = dt
         iters[lo:lo + BLOCK] = it
-        ratio[lo:lo + BLOCK] = rt
+        ratio[lo:lo + BLOCK] = np.inf if rt is None else rt  # (None: every ratio above the bar)
     assert words is not None
     return cols, det, iters, ratio, words
 
@@ -243,13 +302,14 @@ def followed_signs_uncached(m: Mechanism, tol: float, max_iter: int, first: floa
 
 
 def _block(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, signs: tuple[float, ...], tol: float,
-           max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[str]] | None:
+           max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None, list[str]] | None:
     """One block of driver values (internal units): (unknowns (n, k) internal, det J,
-    Newton steps taken, |det J| over J's columns' lengths, the branch's words), or None
-    where the engine does not apply."""
+    Newton steps taken, |det J| over J's columns' lengths (None where
+    :func:`far_from_touch` shows it above TOUCH_CANDIDATE everywhere), the branch's words),
+    or None where the engine does not apply."""
     d = m.derivation
     # the driver's cosine and sine, taken once for the closed form and the loop equations
-    plan_loops = loop_plan(m)
+    plan_loops = plan.loops
     trig = (np.cos(drv), np.sin(drv)) if plan_loops.driver_angle else None
     q, ok, margins = d.solve_margins_np(drv, signs, driver_trig=trig)  # (fresh arrays, this block's own)
     if not _every(ok) or not all(_every(margin > MARGIN_FLOOR) for margin in margins):  # (NaN too)
@@ -264,11 +324,16 @@ def _block(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, signs: tuple[float, 
     with np.errstate(invalid="ignore"):  # (NaN: not certified)
         certified = system_converged_array(step_size_array(dq, plan.steps), step_size_array(phi, None),
                                            tol, gate)
-    ratio = np.abs(det) / _column_lengths(jac, k)
     iters = np.zeros(k, dtype=np.int32)
-    if not _every(certified) and not _polish(loops, q, det, ratio, iters, np.flatnonzero(~certified),
-                                           plan.steps, tol, gate, max_iter):
-        return None
+    ratio: np.ndarray | None = None
+    if not _every(certified):
+        ratio = np.abs(det) / _column_lengths(jac, k)
+        if not _polish(loops, q, det, ratio, iters, np.flatnonzero(~certified), plan.steps, tol, gate,
+                       max_iter):
+            return None
+    elif plan.far_from_touch is None or not np.abs(det).min() > plan.far_from_touch:
+        ratio = np.abs(det) / _column_lengths(jac, k)
+    # else every position's ratio is above TOUCH_CANDIDATE (far_from_touch): None says so
     if not (_every(det > 0.0) or _every(det < 0.0)):
         return None  # det J changes sign: a toggle, the one-at-a-time engine's to locate
     words = _words(m, plan, drv, q)
@@ -317,11 +382,14 @@ def _every(mask: np.ndarray) -> bool:
     return bool(np.count_nonzero(mask) == mask.size)
 
 
-def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray) -> bool:
+def _touch_candidate(closes: bool, det: np.ndarray, ratio: np.ndarray | None) -> bool:
     """Whether the one-at-a-time engine would search for a touch of det J = 0 here
     (:func:`~.limits.toggles`): a local minimum of |det J| where J is near singular, the
     neighbours taken around the circle where the grid closes it (more often than that
-    engine: a candidate only sends the sweep to it)."""
+    engine: a candidate only sends the sweep to it). ``ratio`` None: J is near singular
+    nowhere (:func:`far_from_touch`)."""
+    if ratio is None:
+        return False
     close = ~(ratio > TOUCH_CANDIDATE)  # J near singular (NaN too): rare, so tested first
     if not np.count_nonzero(close if closes else close[1:-1]):
         return False
@@ -366,10 +434,11 @@ def _words(m: Mechanism, plan: ClosedPlan, drv: np.ndarray, q: list[np.ndarray])
     return out
 
 
-def _display(m: Mechanism, plan: ClosedPlan, tol: float, max_iter: int, vals: np.ndarray, cols: np.ndarray,
-             closes: bool) -> np.ndarray:
+def _display(m: Mechanism, plan: ClosedPlan, ref: tuple[float, ...] | None, vals: np.ndarray,
+             cols: np.ndarray, closes: bool) -> np.ndarray:
     """The unknowns in display units, each angle continuous along the cycle and anchored to
-    what ``solve FILE`` gives (the rule of :mod:`.angles`, as the one-at-a-time engine)."""
+    what ``solve FILE`` gives (``ref``: :func:`_anchor`; the rule of :mod:`.angles`, as the
+    one-at-a-time engine)."""
     kinds, angles = plan.kinds, list(plan.angles)
     every = len(angles) == len(kinds)
     if every:
@@ -384,7 +453,6 @@ def _display(m: Mechanism, plan: ClosedPlan, tol: float, max_iter: int, vals: np
     # (every position solved: the anchor is the grid point nearest the file's driver value)
     near = int(anchor_index_array(vals, True, m.driver.value / plan.scale, closes, plan.turn)[0])
     shift = np.zeros(len(angles))
-    ref = implied(m, ("closed_anchor", tol, max_iter), lambda m: _anchor(m, tol, max_iter))
     if ref is not None:
         for a, j in enumerate(angles):
             at = continuous(float(out[j, near]), float(turns[a, near]))

@@ -9,7 +9,7 @@ from dataclasses import field
 from typing import Any
 
 from ..errors import InputError
-from ..problems.loops import Mechanism
+from ..problems.loops import Mechanism, magnitude_problem
 from ..records import frozen
 from ..rules import grid_resolved
 from ..units import RAD_PER_DEG
@@ -141,6 +141,26 @@ def with_position_rates(p: Position, rates: Any) -> Position:
     return out
 
 
+def sweep_result(mechanism: str, driver: str, driver_unit: str, names: tuple[str, ...],
+                 units: tuple[str, ...], positions: Sequence[Position],
+                 feasible_ranges: tuple[tuple[float, float], ...], toggles: tuple[float, ...],
+                 branch: str | None, classification: dict[str, Any], method: str,
+                 motion: tuple[float, float] | None, length_unit: str,
+                 meetings: Sequence[float]) -> SweepResult:
+    """``SweepResult(...)`` of these fields (no branch note, no forces) without the frozen
+    dataclass's ``__init__``, which sets its sixteen fields through ``object.__setattr__``
+    (as :func:`converged_position`; a closed-form sweep makes two per call, and
+    ``benchmarks/sweep_floor.py --positions 3`` measures that fixed cost).
+    tests/test_sweep_fixed_cost.py checks that both give equal results and that the fields are
+    still these."""
+    out = _new(SweepResult)
+    out.__dict__.update(mechanism=mechanism, driver=driver, driver_unit=driver_unit, names=names, units=units,
+                        positions=positions, feasible_ranges=feasible_ranges, toggles=toggles, branch=branch,
+                        classification=classification, method=method, motion=motion,
+                        length_unit=length_unit, meetings=meetings, branch_note="", forces=None)
+    return out
+
+
 MAX_POSITIONS = 2_000_000
 """The most positions one sweep may ask for (the batch engine holds them all in memory)."""
 
@@ -148,9 +168,6 @@ MAX_POSITIONS = 2_000_000
 def check_driver_values(m: Mechanism, values: Sequence[float]) -> list[float]:
     """The values as floats, or InputError: too many, not finite, or beyond what the
     driver's kind can represent (see :func:`~linkage.problems.loops.magnitude_problem`)."""
-    from ..errors import InputError
-    from ..problems.loops import magnitude_problem
-
     if len(values) > MAX_POSITIONS:
         raise InputError(f"{len(values):,} driver values is more than {MAX_POSITIONS:,}; sweep in parts")
     out = [float(v) for v in values]

@@ -13,6 +13,7 @@ from ..problems.loops import Mechanism
 from .angles import anchor_index, closes_circle, continuous, driver_turn, turn_shift, unwrap_turns
 from .continuation import Solver, classify_gap, follow, q_of, solve_position, solver_q
 from .limits import closed_form_limits, solved_ranges, toggles
+from .pose import implied
 from .positions import Position, SweepResult, check_driver_values
 
 
@@ -230,8 +231,6 @@ def classification_of(m: Mechanism) -> dict[str, Any]:
     the ground last: input, coupler, output (:func:`~linkage.problems.closed_form.fourbar_class`).
     One such loop: its class; several: the first's, with every loop's under ``loops``.
     Computed once per mechanism (:func:`~.pose.implied`); each caller gets its own copy."""
-    from .pose import implied
-
     c = implied(m, "classification", _classification)
     return {k: [dict(x) for x in v] if k == "loops" else v for k, v in c.items()}
 

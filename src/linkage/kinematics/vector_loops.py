@@ -11,6 +11,7 @@ import numpy as np
 
 from ..problems.loops import DRIVER, LoopModel, Mechanism
 from ..records import frozen
+from .pose import implied
 
 Term = tuple[float, Any, int, Any, int, float]
 """(sign, length, length index, angle, angle index, offset): an index >= 0 names an
@@ -26,12 +27,12 @@ class LoopPlan:
 
     n: int
     loops: tuple[tuple[tuple[Any, Any] | Term, ...], ...]
-
-    @property
-    def driver_angle(self) -> bool:
-        """Whether a term's angle is the driver itself (no offset): where the cosine and sine
-        of the driver values are worth taking once for several readers (``driver_trig``)."""
-        return any(len(t) == 6 and t[4] == DRIVER and t[5] == 0.0 for loop in self.loops for t in loop)
+    driver_angle: bool
+    """Whether a term's angle is the driver itself (no offset): where the cosine and sine
+    of the driver values are worth taking once for several readers (``driver_trig``)."""
+    driven: tuple[tuple[int, int], ...]
+    """(loop, term) of each term that reads the driver (its length or angle), which
+    :class:`VectorLoops` gives the driver values; every other term is read as it is."""
 
     @classmethod
     def of(cls, model: LoopModel) -> LoopPlan:
@@ -45,7 +46,10 @@ class LoopPlan:
                 else:
                     out.append((sign, lc, lidx, ac, aidx, off))
             loops.append(tuple(out))
-        return cls(model.n, tuple(loops))
+        driver_angle = any(len(t) == 6 and t[4] == DRIVER and t[5] == 0.0 for loop in loops for t in loop)
+        driven = tuple((li, ti) for li, loop in enumerate(loops) for ti, t in enumerate(loop)
+                       if len(t) == 6 and DRIVER in (t[2], t[4]))
+        return cls(model.n, tuple(loops), driver_angle, driven)
 
 
 def numpy_cos_sin(x: Any) -> tuple[Any, Any]:
@@ -55,8 +59,6 @@ def numpy_cos_sin(x: Any) -> tuple[Any, Any]:
 
 def loop_plan(m: Mechanism) -> LoopPlan:
     """The :class:`LoopPlan` of ``m``'s loop model, made once per mechanism (:func:`~.pose.implied`)."""
-    from .pose import implied
-
     return implied(m, "loop_plan", lambda m: LoopPlan.of(m.model))
 
 
@@ -80,9 +82,13 @@ class VectorLoops:
         if cos_sin is not None:
             self.cos_sin = cos_sin
         plan = model if isinstance(model, LoopPlan) else LoopPlan.of(model)
-        terms = [[t if len(t) == 2 else (t[0], drv if t[2] == DRIVER else t[1], t[2] if t[2] >= 0 else -1,
-                                         drv if t[4] == DRIVER else t[3], t[4] if t[4] >= 0 else -1, t[5])
-                  for t in loop] for loop in plan.loops]
+        terms: Sequence[Sequence[Any]] = plan.loops
+        if plan.driven:  # those terms with the driver values in place (an index -1: a given value)
+            terms = [list(loop) for loop in terms]
+            for li, ti in plan.driven:
+                t = terms[li][ti]
+                terms[li][ti] = (t[0], drv if t[2] == DRIVER else t[1], -1 if t[2] < 0 else t[2],
+                                 drv if t[4] == DRIVER else t[3], -1 if t[4] < 0 else t[4], t[5])
         self.setup(terms, plan.n, len(drv), None if driver_trig is None else (drv, *driver_trig))
 
     @classmethod
@@ -125,7 +131,8 @@ class VectorLoops:
                     continue
                 fixed[2 * li] = fixed[2 * li] + x
                 fixed[2 * li + 1] = fixed[2 * li + 1] + y
-        self.fixed = [f if np.shape(f) == (size,) else np.full(size, f) for f in fixed]
+        self.fixed = [f if f.__class__ is np.ndarray and f.shape == (size,) else np.full(size, f)
+                      for f in fixed]
 
     def evaluate(self, q: list[np.ndarray],
                  rows: np.ndarray | None) -> tuple[list[np.ndarray], list[list[Any]]]:
@@ -133,8 +140,10 @@ class VectorLoops:
         def sub(a: Any) -> Any:
             return a if rows is None or not isinstance(a, np.ndarray) else a[rows]
 
-        phi: list[Any] = [sub(f) for f in self.fixed]  # replaced, never modified in place
-        jac: list[list[Any]] = [[0.0] * self.n for _ in range(self.m)]
+        # replaced, never modified in place
+        phi: list[Any] = list(self.fixed) if rows is None else [f[rows] for f in self.fixed]
+        n = self.n
+        jac: list[list[Any]] = [[0.0] * n for _ in range(self.m)]
         trig: dict[tuple[int, float], tuple[Any, Any]] = {}
         for li, sign, r, lidx, th, aidx, off in self.moving:
             rr = q[lidx] if lidx >= 0 else sub(r)
@@ -169,7 +178,8 @@ class VectorLoops:
 def solve_linear(jac: list[list[Any]], phi: list[np.ndarray], k: int) -> tuple[list[np.ndarray], np.ndarray]:
     """dq with J dq = -Phi at every position, and det J. Cramer's rule for 2x2."""
     if len(jac) == 2 and len(jac[0]) == 2:
-        (a, b), (c, d) = ((per_position(v, k) for v in row) for row in jac)
+        (a, b), (c, d) = jac
+        a, b, c, d = per_position(a, k), per_position(b, k), per_position(c, k), per_position(d, k)
         det = a * d - b * c
         with np.errstate(divide="ignore", invalid="ignore"):
             inv = 1.0 / det
@@ -193,7 +203,7 @@ def per_position(v: Any, k: int) -> Any:
     """An entry of J at every position: itself where it is already (a constant entry, 0.0
     or a fixed length's cosine, broadcast; without numpy's broadcast_to where it is not
     needed, microseconds a call)."""
-    return v if np.shape(v) == (k,) else np.broadcast_to(v, (k,))
+    return v if v.__class__ is np.ndarray and v.shape == (k,) else np.broadcast_to(v, (k,))
 
 
 def singular_of(jac: list[list[Any]], det: np.ndarray) -> np.ndarray:
