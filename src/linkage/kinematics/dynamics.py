@@ -49,6 +49,12 @@ FOLLOW_STEP = 0.2
 each move at most this (rad; lengths as this fraction of the mechanism's size); farther,
 the position is reached in such steps, each predicted along the last one's rates."""
 
+MAX_WALK_STEPS = 4096
+"""The most FOLLOW_STEPs the equation of motion walks to a trial position (about 130 turns
+of a crank): a farther one is not reached (None), so the integrator refuses and shortens
+its step; no step that long could meet its tolerance. Without it a runaway motion's trial
+step, 1e40 rad on, was walked without end (a hang, not a failure)."""
+
 ASSEMBLY_RTOL = 1e-9
 """A position closes its loops to this, relative to the mechanism's size, or it is not
 assembled there."""
@@ -156,9 +162,10 @@ class Dynamics:
                       default=0.0)
         return fastest * (self.size if self.sliding else 1.0)
 
-    def position(self, theta: float) -> list[float] | None:
+    def position(self, theta: float, walk_limit: int | None = None) -> list[float] | None:
         """The unknowns at driver ``theta`` (SI) on the followed assembly, or None where the
-        loops do not close there."""
+        loops do not close there, or (with ``walk_limit``) where reaching it takes more than
+        that many FOLLOW_STEPs."""
         if not math.isfinite(theta):
             return None
         start = self._last
@@ -166,8 +173,14 @@ class Dynamics:
         # another assembly (each step moves the fastest unknown at most FOLLOW_STEP); where
         # Newton does not close the loops, again in steps half as long, down to 1/64
         moved = abs(theta - start[0]) / self.follow_step  # the driver's move, in FOLLOW_STEPs
-        steps = max(1, math.ceil(moved * max(self.sensitivity(start[2]), 1.0)))
+        reach = moved * max(self.sensitivity(start[2]), 1.0)
+        limit = math.inf if walk_limit is None else walk_limit
+        if not reach <= limit:
+            return None
+        steps = max(1, math.ceil(reach))
         for _ in range(7):
+            if steps > limit:
+                return None
             q = self._walk(start, theta, steps)
             if q is not None:
                 return q
@@ -197,15 +210,16 @@ class Dynamics:
                 t0, q0, qd0 = at, q, rates[0]
         return q
 
-    def at(self, theta: float) -> Point | None:
+    def at(self, theta: float, walk_limit: int | None = None) -> Point | None:
         """The equation's terms at driver ``theta`` (SI), or None where the mechanism is
-        not assembled or its rates are undefined (J singular)."""
+        not assembled or its rates are undefined (J singular), or beyond ``walk_limit``
+        (:meth:`position`)."""
         from .load_matrix import body_motion, cg_motion
         from .rates import place, rates_from_jacobian
 
         if self._memo is not None and self._memo[0] == theta:  # the event's call after the step's
             return self._memo[1]
-        q = self.position(theta)
+        q = self.position(theta, walk_limit)
         if q is None:
             return None
         d = theta / self.c

@@ -17,10 +17,10 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from ..errors import InputError
-from ..problems.loads import Loads
+from ..problems.loads import MAX_LOAD, Loads
 from ..records import frozen
 from ..units import radians
-from .dynamics import DEAD_POINT_SENSITIVITY, Drive, Dynamics, Friction
+from .dynamics import DEAD_POINT_SENSITIVITY, MAX_WALK_STEPS, Drive, Dynamics, Friction
 
 STEADY_RTOL = 0.01
 """The last turn is a steady-state cycle where the turn before's mean speed is within this
@@ -285,14 +285,17 @@ class Equation:
                     f"{MAX_EVALUATIONS:,}: shorten --time (or --omega0)")
         theta, omega = float(y[0]), float(y[1])
         dyn = self.dyn
-        p = dyn.at(theta)
+        p = dyn.at(theta, MAX_WALK_STEPS)
         if p is None or not p.inertia > 0.0:
-            return np.full(5, np.nan)  # not assembled: the step is refused and shortened
+            return np.full(5, np.nan)  # not assembled (or out of a step's reach): refused and shortened
         try:
             tau = float(self.drive(t, theta, omega))
         except (ArithmeticError, ValueError) as exc:
             raise _TooLong(f"the drive cannot be evaluated at t = {t:.6g} s, theta = {theta:.6g} rad, "
                            f"omega = {omega:.6g} rad/s ({exc})") from None
+        if not abs(tau) <= MAX_LOAD:  # a load's bound (problems.loads): beyond it the motion overflows
+            raise _TooLong(f"the drive is {tau:g} at t = {t:.6g} s, theta = {theta:.6g} rad, omega = "
+                           f"{omega:.6g} rad/s: beyond {MAX_LOAD:g} (N m or N), a load's bound")
         self.last_t = t
         fr = dyn.friction_force(p, omega)
         q = tau + p.loads + p.weight + fr
@@ -354,6 +357,7 @@ def integrate(dyn: Dynamics, drive: Callable[[float, float, float], float], thet
             if not stop > start:
                 raise InputError(f"drive: {exc}") from None
             eq.calls = -MAX_EVALUATIONS
+            dyn.restart()  # followed from the start again, not from the last trial position
             sol = solve_ivp(eq.rhs, (start, stop), y0, method="DOP853",
                             t_eval=np.append(t_eval[t_eval < stop], stop), rtol=rtol, atol=[atol] * 5,
                             dense_output=True)

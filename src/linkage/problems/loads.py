@@ -77,14 +77,19 @@ def applied_rows(loads: Loads, drawing: Any) -> list[tuple[str, str, str, float 
 # --- the loads of a file ---------------------------------------------------------------------
 
 
+MAX_LOAD = 1e100
+"""The largest magnitude of a load, a torque or a drive (N, N m): beyond it a number means
+nothing physical, and its products with lengths and speeds overflow."""
+
+
 def _finite(key: str, v: Any) -> float:
     """A load's number: a number by the one rule (arguments.finite_real: not a bool, not a
-    string, finite), within 1e100."""
+    string, finite), within MAX_LOAD."""
     from ..arguments import describe, finite_real
 
     x = finite_real(v)
-    if x is None or abs(x) > 1e100:
-        raise InputError(f"{key}: must be a finite number (within 1e100), got {describe(v)}")
+    if x is None or abs(x) > MAX_LOAD:
+        raise InputError(f"{key}: must be a finite number (within {MAX_LOAD:g}), got {describe(v)}")
     return x
 
 
