@@ -45,11 +45,11 @@ point, :data:`linkage.synthesis.path.ON_POINT`)."""
 MOST_ON_A_LINE = 6
 """A four-bar's coupler curve is a tricircular sextic (S. Roberts, "On three-bar motion in
 plane space", Proc. London Math. Soc. 7, 1875; Hartenberg and Denavit, *Kinematic Synthesis
-of Linkages*, 1964, ch. 6), and no four-bar traces an exact straight line, so no line is
-part of it: by Bezout's theorem a line meets it in at most 6 points. Nine points with more
-on one line lie on no proper coupler curve, and every path of the homotopy ends degenerate
-(at infinity, or singular): the solve would spend its whole step budget on each path for
-nothing."""
+of Linkages*, 1964), and no four-bar traces an exact straight line, so no line is part of
+it: by Bezout's theorem a line meets it in at most 6 points. Nine points with more on one
+line lie on no proper coupler curve, and the homotopy's paths end degenerate (five
+collinear points, whose extra points fell on their line, tracked for more than 400 s;
+tests/test_path_synthesis_points.py holds the refusal)."""
 
 
 def as_points(name: str, points: object) -> list[complex]:
