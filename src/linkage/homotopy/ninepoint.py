@@ -261,7 +261,7 @@ def polish(Z: np.ndarray, d: np.ndarray, db: np.ndarray) -> tuple[np.ndarray, np
     last = np.full(len(Z), np.inf)
     for _ in range(POLISH_STEPS):
         E, J, _, _ = equations(Z, d, db)
-        good = np.all(np.isfinite(J.reshape(len(J), -1)), axis=1) & np.all(np.isfinite(E), axis=1)
+        good = np.isfinite(J).all(axis=(1, 2)) & np.all(np.isfinite(E), axis=1)  # 0 rows: no reshape
         step = np.full(Z.shape, np.nan + 0j)
         if good.any():
             from .tracker import solve_batched
@@ -271,7 +271,7 @@ def polish(Z: np.ndarray, d: np.ndarray, db: np.ndarray) -> tuple[np.ndarray, np
         last = np.linalg.norm(step, axis=1) / np.maximum(1.0, np.linalg.norm(Z, axis=1))
     _, J, _, _ = equations(Z, d, db)
     cond = np.full(len(Z), np.inf)
-    fin = np.all(np.isfinite(J.reshape(len(J), -1)), axis=1)
+    fin = np.isfinite(J).all(axis=(1, 2))
     if fin.any():
         cond[fin] = np.linalg.cond(J[fin])
     return Z, np.where(np.isfinite(last), last, np.inf), cond

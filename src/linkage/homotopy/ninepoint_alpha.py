@@ -16,6 +16,7 @@ with A = I (:mod:`.alpha`, module docstring).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -104,12 +105,13 @@ def _exact(values: np.ndarray) -> np.ndarray:
     return np.array(flat, dtype=object).reshape(np.shape(values))
 
 
-def certify(z: np.ndarray, d: np.ndarray, db: np.ndarray, terms: Terms, real_points: bool = True
-            ) -> Certificate:
+def certify(z: np.ndarray, d: np.ndarray, db: np.ndarray, terms: Terms, real_points: bool = True,
+            unit: float = 1.0) -> Certificate:
     """Smale's alpha test at the solution ``z`` of the points (d, db) (``terms``:
     :func:`norm_terms`), on g(u) = E(T u) with T = :func:`.alpha.stretch` (z) and each
     equation scaled to Bombieri-Weyl norm 1; realness judged when the points are real
-    (deltabar = conj(delta))."""
+    (deltabar = conj(delta)). ``z``, ``d`` and ``db`` are in lengths of ``unit``
+    (:func:`unit_of_length`; the radius is in the caller's lengths, times ``unit``)."""
     T = stretch(z, MIRROR)
     u = z / T
     with mpmath.workdps(DIGITS):
@@ -122,7 +124,7 @@ def certify(z: np.ndarray, d: np.ndarray, db: np.ndarray, terms: Terms, real_poi
         F = [E[0, j] * scale[j] for j in range(8)]
         rows = [[J[0, j, k] * Tm[k] * scale[j] for k in range(8)] for j in range(8)]
         found = constants_at(F, rows, list(_exact(u)), [deg for _, _, deg in terms], [mpmath.mpf(1)] * 8)
-    return verdict(found, u, MIRROR if real_points else None, float(T.max()))
+    return verdict(found, u, MIRROR if real_points else None, float(T.max()) * unit)
 
 
 def residuals(system: PolySystem, Z: np.ndarray, d: np.ndarray, db: np.ndarray) -> np.ndarray:
@@ -141,17 +143,44 @@ def residuals(system: PolySystem, Z: np.ndarray, d: np.ndarray, db: np.ndarray) 
     return out
 
 
+def unit_of_length(d: np.ndarray) -> float:
+    """The length the alpha test measures in: the largest power of two at most the points'
+    spread (max |delta_j|), so that the points' spread in it is from 1 to 2.
+
+    Why: the equations are homogeneous in length. P, Pb and R (:func:`_dyad`) are sums of
+    products of two lengths, N1, N2 and D of four, and E_j = N1 N2 - D^2 of eight, so
+    E_j(s z; s d, s db) = s^8 E_j(z; d, db): the points s times as large have the roots s
+    times as large, one problem in two units. Smale's alpha test is not invariant under that
+    change of variables. Its bound on gamma (Shub and Smale, "Complexity of Bezout's theorem
+    I", J. AMS 6(2), 1993; Hauenstein and Sottile 2012, sec. 2, :mod:`.alpha`) is taken in
+    the affine chart, through ||(1, x)||, and through the Bombieri-Weyl norm of E_j as a
+    polynomial in the unknowns alone, whose terms of degree k carry the points' size to the
+    power 8 - k. So the same four-bar, drawn in metres or in nanometres, got opposite
+    verdicts (Problem 3's first 60 orbits' two real four-bars, the points at 1e-9 of their
+    size: alpha near 1e32, neither certified; at their size, alpha near 1e-9;
+    tests/test_nine_point_alpha_units.py). Measured in this unit instead, the verdict
+    is the problem's, not its unit's. Division by a power of two is exact in binary (away
+    from underflow), so the scaled points' roots and Newton's iterates are exactly the
+    given ones scaled: the certificate of the scaled problem is one of the problem given
+    (the radius times the unit). Problems a power of two apart in size get the same
+    verdicts bit for bit; Problem 3 (spread 1.74) is tested in its own unit, as before."""
+    size = float(np.abs(d).max())
+    return math.ldexp(1.0, math.frexp(size)[1] - 1) if 0.0 < size < math.inf else 1.0
+
+
 def certify_rows(Z: np.ndarray, points: tuple[complex, ...] | np.ndarray,
                  progress: Callable[[int], None] | None = None) -> tuple[Certificate, ...]:
     """The certificate of each row of ``Z`` (solutions of the nine ``points``, P_0 at the
-    origin, as :class:`.ninepoint_track.NinePointSolutions` has them)."""
+    origin, as :class:`.ninepoint_track.NinePointSolutions` has them), tested in the unit
+    of :func:`unit_of_length` (the same verdict at any unit of length)."""
     p = np.asarray(points, dtype=complex)
-    d = p[1:] - p[0]
+    unit = unit_of_length(p[1:] - p[0])
+    d = (p[1:] - p[0]) / unit
     db = np.conj(d)
     terms = norm_terms(d, db)
     out = []
     for k, z in enumerate(Z):
-        out.append(certify(z, d, db, terms))
+        out.append(certify(np.asarray(z) / unit, d, db, terms, unit=unit))
         if progress is not None:
             progress(k + 1)
     return tuple(out)

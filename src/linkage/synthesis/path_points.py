@@ -38,6 +38,18 @@ ACROSS = 0.15
 """...and across the gap by up to this fraction of the gap's chord."""
 FARTHEST = 1e150
 """Points at most about this far apart (their squares stay finite in double precision)."""
+APART = 1e-9
+"""Two points closer than this, relative to the points' spread, coincide; a point nearer a
+line than this is on it (the resolution at which a design is judged to pass through a
+point, :data:`linkage.synthesis.path.ON_POINT`)."""
+MOST_ON_A_LINE = 6
+"""A four-bar's coupler curve is a tricircular sextic (S. Roberts, "On three-bar motion in
+plane space", Proc. London Math. Soc. 7, 1875; Hartenberg and Denavit, *Kinematic Synthesis
+of Linkages*, 1964), and no four-bar traces an exact straight line, so no line is part of
+it: by Bezout's theorem a line meets it in at most 6 points. Nine points with more on one
+line lie on no proper coupler curve, and the homotopy's paths end degenerate (five
+collinear points, whose extra points fell on their line, tracked for more than 400 s;
+tests/test_path_synthesis_points.py holds the refusal)."""
 
 
 def as_points(name: str, points: object) -> list[complex]:
@@ -61,31 +73,74 @@ def as_points(name: str, points: object) -> list[complex]:
             for k, (x, y) in enumerate(rows)]
 
 
+def spread(pts: list[complex]) -> float:
+    """The points' size, the scale of every tolerance on them: the largest distance from the
+    first point."""
+    return max(abs(p - pts[0]) for p in pts)
+
+
+def on_one_line(pts: list[complex]) -> list[int]:
+    """The most points (indices, in order) within :data:`APART` of their :func:`spread` of
+    one line, the line through some two of them: a tolerance relative to the points' size,
+    so the same at any unit of length (the distance |Im((p - p_i) conj(u))|, u the line's
+    unit direction, is exact to rounding of the points' size)."""
+    size = spread(pts)
+    best: list[int] = []
+    for i, j in itertools.combinations(range(len(pts)), 2):
+        u = (pts[j] - pts[i]) / abs(pts[j] - pts[i])
+        near = [k for k, p in enumerate(pts) if abs(((p - pts[i]) * u.conjugate()).imag) <= APART * size]
+        if len(near) > len(best):
+            best = near
+    return best
+
+
+def check_off_line(nine: NinePoints, via: bool) -> None:
+    """InputError when more than :data:`MOST_ON_A_LINE` of the nine points lie on one line
+    (:func:`on_one_line`): then no four-bar's coupler curve passes through them. The message
+    says that the points lie on one line when every given point does (``via``: the extra
+    points were the user's, else the curve's, which then lie on that line too)."""
+    on = on_one_line(list(nine.points))
+    if len(on) <= MOST_ON_A_LINE:
+        return
+    why = (f"a four-bar's coupler curve (a tricircular sextic, never a straight line) meets a line in at "
+           f"most {MOST_ON_A_LINE} points")
+    given = [k for k in range(len(nine.points)) if k not in nine.extra]
+    if set(given) <= set(on):
+        extra = ("" if not nine.extra else ", and so do the via points" if via else
+                 ", and so would the extra points on the curve through them (via: give "
+                 f"{len(nine.extra)} off the line)")
+        raise InputError(f"points: the points lie on one line (to {APART:.0e} of their spread){extra}: "
+                         f"{why}".replace("e-0", "e-"))
+    names = [f"{'via' if via else 'extra'} point {nine.extra.index(k) + 1}" if k in nine.extra
+             else f"point {given.index(k) + 1}" for k in on]
+    raise InputError(f"points: {len(on)} of the nine points lie on one line ({', '.join(names)}): {why}")
+
+
 def check_distinct(name: str, pts: list[complex], labels: list[str]) -> None:
     """InputError (its message starting with ``name``) when two points coincide (to 1e-9 of
     their spread, naming both by ``labels``) or the points are more than FARTHEST apart."""
-    size = max(abs(p - pts[0]) for p in pts)
+    size = spread(pts)
     if size > FARTHEST or size == 0.0:
         raise InputError(f"{name}: the points must be distinct and at most about 1e150 apart")
     for i in range(len(pts)):
         for j in range(i):
-            if abs(pts[i] - pts[j]) <= 1e-9 * size:
+            if abs(pts[i] - pts[j]) <= APART * size:
                 raise InputError(f"{name}: {labels[j]} and {labels[i]} coincide: "
                                  f"{pts[i].real:g}, {pts[i].imag:g}")
 
 
 def check_via(via: object, given: list[complex]) -> list[complex]:
     """The extra points a user gives (``via``): 9 - len(given) finite pairs, distinct from
-    the given points and each other, or InputError."""
-    if via is None:
-        return []
-    extra = as_points("via", via)
+    the given points and each other, or InputError; and the nine points solved with them (or
+    with the curve's first sample, without ``via``) checked by :func:`nine_points`."""
+    extra = [] if via is None else as_points("via", via)
     want = POINTS - len(given)
     if extra and len(extra) != want:
         raise InputError(f"via: {len(given)} points need {want} extra point{'s' if want != 1 else ''} "
                          f"to make nine, got {len(extra)}")
     labels = [f"point {k + 1}" for k in range(len(given))] + [f"via point {k + 1}" for k in range(len(extra))]
     check_distinct("via", given + extra, labels)
+    nine_points(given, extra, 0, 0)  # its checks, before any tracking (sample 0 does not use the seed)
     return extra
 
 
@@ -170,9 +225,12 @@ def inserted(pts: list[complex], via: list[complex]) -> NinePoints:
 
 def nine_points(given: list[complex], via: list[complex], seed: int, sample: int) -> NinePoints:
     """The nine points solved for ``given`` (checked, 5 to 9): the user's extra points
-    ``via`` when given, else sample ``sample`` of the curve's."""
+    ``via`` when given, else sample ``sample`` of the curve's; InputError when they are
+    not distinct or more than :data:`MOST_ON_A_LINE` lie on one line (:func:`check_off_line`)."""
     if len(given) == POINTS or via:
-        return inserted(given, via)
-    nine = sampled(given, seed, sample)
-    check_distinct("points", list(nine.points), [f"point {k + 1} of the nine" for k in range(POINTS)])
+        nine = inserted(given, via)
+    else:
+        nine = sampled(given, seed, sample)
+        check_distinct("points", list(nine.points), [f"point {k + 1} of the nine" for k in range(POINTS)])
+    check_off_line(nine, bool(via))
     return nine
