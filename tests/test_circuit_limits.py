@@ -5,6 +5,7 @@ section 4.12: the diagonal A-O4 is r3 + r4), evaluated at 40 digits with mpmath.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
@@ -69,3 +70,56 @@ def test_double_rocker_started_near_either_limit_reports_both(gap_deg, at_low):
     (circ,) = circuits(m, radians(start)).circuits
     assert circ.status == "closed" and circ.members == (0, 1)
     assert sorted(degrees(v) for v in circ.limits) == pytest.approx([low, high], abs=1e-9)
+
+
+def _ulps(x: float, n: int) -> float:
+    for _ in range(abs(n)):
+        x = math.nextafter(x, math.inf if n > 0 else -math.inf)
+    return x
+
+
+@pytest.mark.parametrize("side", [1.0, -1.0])
+@pytest.mark.parametrize("offset", ["-1ulp", "0", "+1ulp", "-1e-12deg", "+1e-12deg"])
+def test_circuit_started_exactly_at_a_limit_is_that_limit_counted_once(side, offset):
+    """Started at the limit crank angle itself (the double assembly where both branches
+    meet), the trace once went round the circuit forever (+limit: 37 limits, or unfinished)
+    or never counted the start's own limit (-limit: 1 limit), both 'closed' with exit 0."""
+    limit = _me581_limit_deg()
+    start = {"-1ulp": _ulps(limit, -1), "0": limit, "+1ulp": _ulps(limit, 1),
+             "-1e-12deg": limit - 1e-12, "+1e-12deg": limit + 1e-12}[offset]
+    m = load(SAMPLES / "fourbar_me581.toml")
+    c = circuits(m, radians(side * start))
+    (circ,) = c.circuits
+    assert circ.status == "closed" and circ.members == tuple(range(len(c.assemblies.real)))
+    assert sorted(degrees(v) for v in circ.limits) == pytest.approx([-limit, limit], abs=1e-9)
+    assert degrees(circ.driver_low) == pytest.approx(-limit, abs=1e-9)
+    assert degrees(circ.driver_high) == pytest.approx(limit, abs=1e-9)
+
+
+@pytest.mark.parametrize("scale", [1e-6, 1e3])
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_circuit_started_at_a_limit_is_the_same_at_any_scale(scale, side):
+    limit = _me581_limit_deg()
+    m = load(SAMPLES / "fourbar_me581.toml").with_values(
+        {"r1": 90 * scale, "r2": 30 * scale, "r3": 60 * scale, "r4": 45 * scale}, {})
+    (circ,) = circuits(m, radians(side * limit)).circuits
+    assert circ.status == "closed"
+    assert sorted(degrees(v) for v in circ.limits) == pytest.approx([-limit, limit], abs=1e-9)
+
+
+@pytest.mark.parametrize("which", ["low", "high", "-low", "-high"])
+def test_double_rocker_started_exactly_at_either_limit_reports_both(which):
+    low, high = _limit_deg(100, 80, 60), _limit_deg(100, 80, 120)
+    sign = -1.0 if which.startswith("-") else 1.0
+    start = sign * (low if which.endswith("low") else high)
+    m = load(SAMPLES / "crank_rocker.toml").with_values({"r2": 80, "r3": 30, "r4": 90}, {})
+    (circ,) = circuits(m, radians(start)).circuits
+    assert circ.status == "closed"
+    assert sorted(abs(degrees(v)) for v in circ.limits) == pytest.approx([low, high], abs=1e-9)
+
+
+@pytest.mark.parametrize("start", ["112.02431283704216", "-112.02431283704216"])
+def test_assemblies_sweep_exactly_at_the_limit_prints_two_limit_positions(cli, start):
+    out = cli("assemblies", str(SAMPLES / "fourbar_me581.toml"), "--sweep", "--set", f"theta2={start}")
+    assert out.code == 0, out.err
+    assert "theta2 from -112.024313 to 112.024313 deg, 2 limit positions" in out.out

@@ -251,6 +251,55 @@ def _crossing_on_arc(curve: _Curve, start: Assemblies, a: np.ndarray, ta: np.nda
     return s_best, best
 
 
+def _fold_start(curve: _Curve, y: np.ndarray,
+                t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """A start at a limit position to rounding (a double assembly, where the two assemblies
+    meet): the limit position itself, refined as every limit is (:func:`_limit`) between two
+    points of the curve on either side of it along ``t``, and the point past it to leave
+    from, with its tangent oriented along ``t``. None where no such pair brackets a turn of
+    the driver (the curve does not turn back here: a change point, where curves cross)."""
+    h = MAX_STEP / 4
+    while h >= 1e-6:
+        a, _ka = _correct(curve, y - h * t, t)
+        b, _kb = _correct(curve, y + h * t, t)
+        if a is not None and b is not None:
+            ta, tb = _tangent(curve.at(a)[1], t), _tangent(curve.at(b)[1], t)
+            if ta[-1] * tb[-1] < 0.0 and float(ta @ t) >= 0.9 and float(tb @ t) >= 0.9:
+                fold, _s = _limit(curve, a, ta, float((b - a) @ ta), float(tb[-1]))
+                return fold, b, tb
+        h *= 0.5
+    return None
+
+
+def _double(start: Assemblies, member: int) -> bool:
+    """Whether the assembly is double (two that meet, to rounding: :mod:`.assemblies`)."""
+    return member < len(start.multiplicity) and start.multiplicity[member] >= 2
+
+
+def _same_point(curve: _Curve, m: Mechanism, a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two points of the curve (scaled) are one, driver included, to MATCH."""
+    xa, xb = a * curve.scale, b * curve.scale
+    return (same_configuration(list(xa[:-1]), tuple(xb[:-1]), m, MATCH)
+            and abs(_phase(m, float(xa[-1]), float(xb[-1]))) <= MATCH * float(curve.scale[-1]))
+
+
+def _meet(curve: _Curve, start: Assemblies, first: int, crossed: list[tuple[float, np.ndarray]],
+          members: set[int], closing: bool) -> tuple[float, np.ndarray] | None:
+    """The assemblies the step's crossings of the start value meet, in order, join
+    ``members``, up to the crossing that meets ``first`` again when ``closing``: that one
+    (arc coordinate, configuration), or None."""
+    m = start.mechanism
+    for s_cross, at in crossed:
+        q = list(at[:-1] * curve.scale[:-1])
+        i = next((i for i, a in enumerate(start.real) if same_configuration(q, a.q, m, MATCH)), None)
+        if i is None:
+            continue
+        members.add(i)
+        if i == first and closing:
+            return s_cross, at
+    return None
+
+
 def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
     m = start.mechanism
     y = np.array([*list(start.real[first].q), start.driver]) / curve.scale
@@ -261,6 +310,13 @@ def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
     ys, ts = [y], [t]
     members, limits = {first}, []
     h, steps, rejected, crossings = MAX_STEP / 4, 0, 0, 0
+    # a start at a limit position to rounding is that limit, counted once: the curve leaves it
+    # and comes back to it from the other side, touching the start value without crossing it
+    at_fold = _fold_start(curve, y, t) if _double(start, first) else None
+    if at_fold is not None:
+        ys, ts = [at_fold[0], at_fold[1]], [t, at_fold[2]]
+        limits.append(float(at_fold[0][-1] * curve.scale[-1]))
+        jac, t = curve.at(at_fold[1])[1], at_fold[2]
     sign = np.sign(np.linalg.det(np.vstack([jac, t])))
     travelled = 0.0
     size_bound = 1e4 * max(1.0, float(np.max(np.abs(y[:-1]))))
@@ -301,19 +357,17 @@ def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
             limits.extend(float(f[0][-1] * curve.scale[-1]) for f in (fold,) if f is not None)
             status = "unlocated"
             break
-        for s_cross, at in crossed:
-            # crossed the start value: which assembly is this?
-            q = list(at[:-1] * curve.scale[:-1])
-            i = next((i for i, a in enumerate(start.real) if same_configuration(q, a.q, m, MATCH)), None)
-            if i is None:
-                continue
-            members.add(i)
-            if i == first and travelled > 4.0 * MAX_STEP:
-                status = "closed"
-                ys[-1] = at  # end on the start configuration, not past it
-                if fold is not None and s_cross < fold[1]:
-                    fold = None  # closed before this step's limit: the first step's, met again
-                break
+        closing = travelled > 4.0 * MAX_STEP
+        met = _meet(curve, start, first, crossed, members, closing)
+        back = at_fold is not None and fold is not None and _same_point(curve, m, fold[0], at_fold[0])
+        if met is not None:
+            status = "closed"
+            ys[-1] = met[1]  # end on the start configuration, not past it
+            if fold is not None and (met[0] < fold[1] or back):
+                fold = None  # closed before this step's limit: the first step's, met again
+        elif closing and back:
+            status = "closed"  # back at the limit position started from, from its other side
+            ys[-1], fold = at_fold[0], None
         if fold is not None:
             limits.append(float(fold[0][-1] * curve.scale[-1]))
         if status == "closed":
