@@ -9,7 +9,7 @@ import math
 from pathlib import Path
 
 import pytest
-from mpmath import acos, mp, mpf
+from mpmath import acos, asin, mp, mpf
 from mpmath import degrees as mp_degrees
 
 from linkage.kinematics.circuits import circuits
@@ -123,3 +123,35 @@ def test_assemblies_sweep_exactly_at_the_limit_prints_two_limit_positions(cli, s
     out = cli("assemblies", str(SAMPLES / "fourbar_me581.toml"), "--sweep", "--set", f"theta2={start}")
     assert out.code == 0, out.err
     assert "theta2 from -112.024313 to 112.024313 deg, 2 limit positions" in out.out
+
+
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_circuit_started_exactly_at_a_limit_passes_both_branches(side):
+    """At the limit the one (double) assembly is where the two branches meet, its own name a
+    matter of rounding; the circuit passes both, as the two assemblies 1e-6 deg inside say."""
+    limit = _me581_limit_deg()
+    m = load(SAMPLES / "fourbar_me581.toml")
+    inside = circuits(m, radians(side * (limit - 1e-6)))
+    (circ,) = circuits(m, radians(side * limit)).circuits
+    assert len(inside.assemblies.real) == 2
+    assert circ.branches == tuple(sorted(a.branch for a in inside.assemblies.real))
+    assert len(set(circ.branches)) == 2
+
+
+def _slider_limits_deg(r2: float, r3: float, e: float) -> tuple[float, float]:
+    """An in-line-offset slider-crank with the crank r2 longer than the coupler r3 + |e|
+    turns back where |r2 sin(theta2) - e| = r3: theta2 = asin((e + r3) / r2) and
+    asin((e - r3) / r2) on the right-hand circuit (40 digits)."""
+    with mp.workdps(40):
+        return (float(mp_degrees(asin((mpf(e) - mpf(r3)) / mpf(r2)))),
+                float(mp_degrees(asin((mpf(e) + mpf(r3)) / mpf(r2)))))
+
+
+@pytest.mark.parametrize("at", [0, 1])
+def test_slider_crank_started_exactly_at_a_limit_reports_both(at):
+    low, high = _slider_limits_deg(120, 40, 10)
+    m = load(SAMPLES / "slider_crank.toml").with_values({"r2": 120, "r3": 40}, {})
+    c = circuits(m, radians((low, high)[at]))
+    (circ,) = c.circuits
+    assert circ.status == "closed" and len(set(circ.branches)) == 2
+    assert sorted(degrees(v) for v in circ.limits) == pytest.approx([low, high], abs=1e-9)

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..problems.loops import Mechanism
 from ..records import frozen
-from .assemblies import Assemblies, assemblies, same_configuration
+from .assemblies import Assemblies, assemblies, branch_names, same_configuration
 
 MAX_STEP = 0.05
 """Largest arc step (rad, or of the mechanism's size): a picture needs about 1/20 rad."""
@@ -62,6 +62,7 @@ class Circuit:
     rejected: int
     drivers: tuple[float, ...]  # the curve, for a picture (internal units, unwrapped)
     configurations: tuple[tuple[float, ...], ...]
+    branches: tuple[str, ...]  # the branches it passes at the start value (:func:`_branches`)
 
 
 @frozen
@@ -300,6 +301,21 @@ def _meet(curve: _Curve, start: Assemblies, first: int, crossed: list[tuple[floa
     return None
 
 
+def _branches(curve: _Curve, start: Assemblies, members: set[int], first: int,
+              sides: tuple[np.ndarray, ...]) -> tuple[str, ...]:
+    """The branches a circuit passes at the start value: its assemblies' names. Started at
+    a limit position, where two branches meet and the start's own name is a matter of
+    rounding, the two met there instead: each named (as sweeps name it, by
+    :func:`.assemblies.branch_names`) at the curve's point next to the limit on its side,
+    ``sides`` (scaled)."""
+    m = start.mechanism
+    names = {start.real[i].branch for i in members if i != first or not sides}
+    for y in sides:
+        x = y * curve.scale
+        names.add(branch_names(m, float(x[-1]), [[float(v) for v in x[:-1]]])[0][0])
+    return tuple(sorted(n for n in names if n))
+
+
 def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
     m = start.mechanism
     y = np.array([*list(start.real[first].q), start.driver]) / curve.scale
@@ -377,8 +393,10 @@ def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
     configurations = [tuple(float(x) for x in v[:-1] * curve.scale[:-1]) for v in ys]
     full = m.driver.kind == "angle" and max(drivers) - min(drivers) >= 2.0 * math.pi - 1e-9
     low, high = min(drivers + limits), max(drivers + limits)  # a limit is refined, a sample is not
-    return Circuit(tuple(sorted(members)), status, low, high, full, tuple(limits),
-                   crossings, steps, rejected, tuple(drivers), tuple(configurations))
+    sides = (ys[1], ys[-2]) if at_fold is not None and status == "closed" else ()
+    branches = _branches(curve, start, members, first, sides)
+    return Circuit(tuple(sorted(members)), status, low, high, full, tuple(limits), crossings, steps,
+                   rejected, tuple(drivers), tuple(configurations), branches)
 
 
 def circuits(m: Mechanism, driver: float | None = None, seed: int = 0,
