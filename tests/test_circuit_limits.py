@@ -155,3 +155,31 @@ def test_slider_crank_started_exactly_at_a_limit_reports_both(at):
     (circ,) = c.circuits
     assert circ.status == "closed" and len(set(circ.branches)) == 2
     assert sorted(degrees(v) for v in circ.limits) == pytest.approx([low, high], abs=1e-9)
+
+
+def test_circuit_started_one_ulp_past_a_limit_where_no_double_assembly_is_found():
+    """The drawn ME581 (joints and links) one ulp past its limit has one real assembly that
+    the homotopy found as an ordinary root, not a double one: the trace went round 94 limits
+    and stopped unfinished."""
+    limit = _me581_limit_deg()
+    m = load(SAMPLES / "fourbar_me581_joints.toml")
+    (circ,) = circuits(m, radians(_ulps(limit, 1))).circuits
+    assert circ.status == "closed" and len(set(circ.branches)) == 2
+    assert sorted(degrees(v) for v in circ.limits) == pytest.approx([-limit, limit], abs=1e-9)
+
+
+@pytest.mark.parametrize("which", [2, 4])
+def test_a_circuit_touching_the_start_value_at_a_limit_has_the_double_assembly_there(which):
+    """The six-limit circuit of the offset slider, started at one of its limits: the other
+    assemblies' circuit touches the start value there without crossing it, and the double
+    assembly at the limit is on it, not traced again as a second circuit (it was, unfinished).
+    The reference: the same circuit traced from the file's start value, away from any limit."""
+    m = load(SAMPLES / "offset_slider.toml")
+    (ref,) = circuits(m).circuits
+    assert ref.status == "closed" and len(ref.limits) == 6
+    c = circuits(m, ref.limits[which])
+    assert c.assemblies.multiplicity.count(2) == 1  # the start is a limit: else the test tests nothing
+    (circ,) = c.circuits
+    assert circ.status == "closed" and circ.members == tuple(range(len(c.assemblies.real)))
+    assert sorted(degrees(v) for v in circ.limits) == pytest.approx(sorted(degrees(v) for v in ref.limits),
+                                                                     abs=1e-9)

@@ -273,15 +273,21 @@ def _fold_start(curve: _Curve, y: np.ndarray,
 
 
 def _double(start: Assemblies, member: int) -> bool:
-    """Whether the assembly is double (two that meet, to rounding: :mod:`.assemblies`)."""
+    """Whether the assembly is double (two that meet, to rounding: :mod:`.assemblies`): at a
+    limit position, or beside one closer than the two assemblies' own uncertainty."""
     return member < len(start.multiplicity) and start.multiplicity[member] >= 2
 
 
-def _same_point(curve: _Curve, m: Mechanism, a: np.ndarray, b: np.ndarray) -> bool:
-    """Whether two points of the curve (scaled) are one, driver included, to MATCH."""
-    xa, xb = a * curve.scale, b * curve.scale
-    return (same_configuration(list(xa[:-1]), tuple(xb[:-1]), m, MATCH)
-            and abs(_phase(m, float(xa[-1]), float(xb[-1]))) <= MATCH * float(curve.scale[-1]))
+def _at_limit(curve: _Curve, start: Assemblies, point: np.ndarray) -> list[int]:
+    """The assemblies at the start value that are the limit position ``point`` (scaled),
+    to MATCH, driver included: where the curve touches the start value without crossing it
+    (the start within rounding of a limit, where the two assemblies that meet are one)."""
+    m = start.mechanism
+    x = point * curve.scale
+    if abs(_phase(m, float(x[-1]), float(start.driver))) > MATCH * float(curve.scale[-1]):
+        return []
+    q = [float(v) for v in x[:-1]]
+    return [i for i, a in enumerate(start.real) if same_configuration(q, a.q, m, MATCH)]
 
 
 def _meet(curve: _Curve, start: Assemblies, first: int, crossed: list[tuple[float, np.ndarray]],
@@ -304,10 +310,10 @@ def _meet(curve: _Curve, start: Assemblies, first: int, crossed: list[tuple[floa
 def _branches(curve: _Curve, start: Assemblies, members: set[int], first: int,
               sides: tuple[np.ndarray, ...]) -> tuple[str, ...]:
     """The branches a circuit passes at the start value: its assemblies' names. Started at
-    a limit position, where two branches meet and the start's own name is a matter of
-    rounding, the two met there instead: each named (as sweeps name it, by
-    :func:`.assemblies.branch_names`) at the curve's point next to the limit on its side,
-    ``sides`` (scaled)."""
+    a limit position (or a double assembly beside one), where two branches meet and the
+    start's own name is a matter of rounding, the two met there instead: each named (as
+    sweeps name it, by :func:`.assemblies.branch_names`) at the curve's point next to the
+    start on its side, ``sides`` (scaled)."""
     m = start.mechanism
     names = {start.real[i].branch for i in members if i != first or not sides}
     for y in sides:
@@ -317,7 +323,6 @@ def _branches(curve: _Curve, start: Assemblies, members: set[int], first: int,
 
 
 def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
-    m = start.mechanism
     y = np.array([*list(start.real[first].q), start.driver]) / curve.scale
     _f, jac = curve.at(y)
     t = _tangent(jac, None)
@@ -328,8 +333,11 @@ def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
     h, steps, rejected, crossings = MAX_STEP / 4, 0, 0, 0
     # a start at a limit position to rounding is that limit, counted once: the curve leaves it
     # and comes back to it from the other side, touching the start value without crossing it
-    at_fold = _fold_start(curve, y, t) if _double(start, first) else None
+    at_fold = _fold_start(curve, y, t) if _double(start, first) or start.real[first].singular else None
+    if at_fold is not None and first not in _at_limit(curve, start, at_fold[0]):
+        at_fold = None  # near a limit, not at it: its start value is crossed, not touched
     if at_fold is not None:
+        members.update(_at_limit(curve, start, at_fold[0]))
         ys, ts = [at_fold[0], at_fold[1]], [t, at_fold[2]]
         limits.append(float(at_fold[0][-1] * curve.scale[-1]))
         jac, t = curve.at(at_fold[1])[1], at_fold[2]
@@ -375,7 +383,9 @@ def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
             break
         closing = travelled > 4.0 * MAX_STEP
         met = _meet(curve, start, first, crossed, members, closing)
-        back = at_fold is not None and fold is not None and _same_point(curve, m, fold[0], at_fold[0])
+        touched = _at_limit(curve, start, fold[0]) if fold is not None else []
+        members.update(touched)
+        back = at_fold is not None and first in touched
         if met is not None:
             status = "closed"
             ys[-1] = met[1]  # end on the start configuration, not past it
@@ -389,15 +399,21 @@ def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
         if status == "closed":
             break
         h = min(MAX_STEP, h * (1.5 if k <= 2 else 1.0))
+    # a limit position started from, or a double start beside one: one curve point either side
+    sides = (ys[1], ys[-2]) if (at_fold is not None or _double(start, first)) and status == "closed" else ()
+    return _circuit(curve, start.mechanism, members, status, limits, (crossings, steps, rejected), ys,
+                    _branches(curve, start, members, first, sides))
+
+
+def _circuit(curve: _Curve, m: Mechanism, members: set[int], status: str, limits: list[float],
+             counts: tuple[int, int, int], ys: list[np.ndarray], branches: tuple[str, ...]) -> Circuit:
+    """The traced curve ``ys`` (scaled) as a Circuit; ``counts``: crossings, steps, rejected."""
     drivers = [float(v[-1] * curve.scale[-1]) for v in ys]
     configurations = [tuple(float(x) for x in v[:-1] * curve.scale[:-1]) for v in ys]
     full = m.driver.kind == "angle" and max(drivers) - min(drivers) >= 2.0 * math.pi - 1e-9
     low, high = min(drivers + limits), max(drivers + limits)  # a limit is refined, a sample is not
-    sides = (ys[1], ys[-2]) if at_fold is not None and status == "closed" else ()
-    branches = _branches(curve, start, members, first, sides)
-    return Circuit(tuple(sorted(members)), status, low, high, full, tuple(limits), crossings, steps,
-                   rejected, tuple(drivers), tuple(configurations), branches)
-
+    return Circuit(tuple(sorted(members)), status, low, high, full, tuple(limits), *counts,
+                   tuple(drivers), tuple(configurations), branches)
 
 def circuits(m: Mechanism, driver: float | None = None, seed: int = 0,
              found: Assemblies | None = None) -> Circuits:
