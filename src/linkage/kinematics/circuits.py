@@ -18,7 +18,10 @@ SIAM 2003, chapter 2):
   refined by fitting the driver along the arc;
 - where the curve crosses the starting driver value, the configuration is solved at that
   value exactly and matched against the assemblies; meeting the first one again closes the
-  circuit.
+  circuit;
+- a start at a limit position (to rounding) only touches the start value: the trace leaves
+  the limit, refined, counts it once and closes on meeting it again; wherever a limit
+  touches the start value, the assemblies there join the circuit.
 
 Variables are in units of the mechanism's size (angles in radians), so that a step's
 length means the same for a crank angle and a slide.
