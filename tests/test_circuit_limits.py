@@ -183,3 +183,43 @@ def test_a_circuit_touching_the_start_value_at_a_limit_has_the_double_assembly_t
     assert circ.status == "closed" and circ.members == tuple(range(len(c.assemblies.real)))
     assert sorted(degrees(v) for v in circ.limits) == pytest.approx(sorted(degrees(v) for v in ref.limits),
                                                                      abs=1e-9)
+
+
+SLIDER_DRIVEN = """
+name = "slider-driven slider-crank"
+length_unit = "mm"
+[parameters]
+r2 = { value = 40, unit = "mm" }
+r3 = { value = 120, unit = "mm" }
+e = { value = 10, unit = "mm", signed = true }
+[driver]
+name = "s"
+value = 150
+unit = "mm"
+[unknowns]
+theta2 = { guess = 45, unit = "deg" }
+theta3 = { guess = 0, unit = "deg" }
+[[loops]]
+name = "O2-A-B"
+vectors = [
+  { length = "r2", angle = "theta2" },
+  { length = "r3", angle = "theta3" },
+  { length = "s", angle = 0, sign = -1 },
+  { length = "e", angle = 90, sign = -1 },
+]
+"""
+
+
+@pytest.mark.parametrize("at", [0, 1])
+def test_slider_driven_slider_crank_started_exactly_at_a_limit_reports_both(tmp_path, at):
+    """A length driver: the slide s of an offset slider-crank (crank 40, coupler 120,
+    offset 10) turns back where crank and coupler line up, s = sqrt((r3 -+ r2)^2 - e^2)
+    (40 digits); started at either, it once reported 138 or 3 limit positions, exit 0."""
+    with mp.workdps(40):
+        low, high = (float(mp.sqrt(mpf(80) ** 2 - 100)), float(mp.sqrt(mpf(160) ** 2 - 100)))
+    path = tmp_path / "slider_driven.toml"
+    path.write_text(SLIDER_DRIVEN)
+    m = load(path)
+    (circ,) = circuits(m, (low, high)[at]).circuits
+    assert circ.status == "closed" and len(set(circ.branches)) == 2
+    assert sorted(circ.limits) == pytest.approx([low, high], abs=1e-9 * high)
