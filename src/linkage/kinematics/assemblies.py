@@ -277,7 +277,7 @@ def _local_roots(m: Mechanism, driver: float, q0: list[float]) -> tuple[list[lis
     return [], "none"
 
 
-def _names(m: Mechanism, driver: float, qs: list[list[float]]) -> list[tuple[str, str]]:
+def branch_names(m: Mechanism, driver: float, qs: list[list[float]]) -> list[tuple[str, str]]:
     """Each assembly's (branch name, signs) as sweeps and ``--branch`` name them: with a closed
     form, the key of Derivation.named_solutions it is (the mirror image of a rocker-driven
     four-bar is ``open (mirror)``), else its configuration's name; without one, the sign of
@@ -392,7 +392,7 @@ def assemblies(m: Mechanism, driver: float | None = None, seed: int = 0) -> Asse
             unresolved += k - found if found < k else 0
         else:
             nonreal += k  # g has no root and does not touch zero: a complex pair past a limit
-    named = _names(m, d, [list(a.q) for a in real])
+    named = branch_names(m, d, [list(a.q) for a in real])
     real = [replace(a, branch=n, signs=s) for a, (n, s) in zip(real, named)]
     return Assemblies(m, d, tuple(real), nonreal, sols.count("infinite"), sols.count("failed"), sols,
                       tuple(multiplicity), unresolved, continuum)

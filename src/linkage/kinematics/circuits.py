@@ -18,7 +18,10 @@ SIAM 2003, chapter 2):
   refined by fitting the driver along the arc;
 - where the curve crosses the starting driver value, the configuration is solved at that
   value exactly and matched against the assemblies; meeting the first one again closes the
-  circuit.
+  circuit;
+- a start at a limit position (to rounding) only touches the start value: the trace leaves
+  the limit, refined, counts it once and closes on meeting it again; wherever a limit
+  touches the start value, the assemblies there join the circuit.
 
 Variables are in units of the mechanism's size (angles in radians), so that a step's
 length means the same for a crank angle and a slide.
@@ -32,7 +35,7 @@ import numpy as np
 
 from ..problems.loops import Mechanism
 from ..records import frozen
-from .assemblies import Assemblies, assemblies, same_configuration
+from .assemblies import Assemblies, assemblies, branch_names, same_configuration
 
 MAX_STEP = 0.05
 """Largest arc step (rad, or of the mechanism's size): a picture needs about 1/20 rad."""
@@ -62,6 +65,7 @@ class Circuit:
     rejected: int
     drivers: tuple[float, ...]  # the curve, for a picture (internal units, unwrapped)
     configurations: tuple[tuple[float, ...], ...]
+    branches: tuple[str, ...]  # the branches it passes at the start value (:func:`_branches`)
 
 
 @frozen
@@ -251,8 +255,77 @@ def _crossing_on_arc(curve: _Curve, start: Assemblies, a: np.ndarray, ta: np.nda
     return s_best, best
 
 
-def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
+def _fold_start(curve: _Curve, y: np.ndarray,
+                t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """A start at a limit position to rounding (a double assembly, where the two assemblies
+    meet): the limit position itself, refined as every limit is (:func:`_limit`) between two
+    points of the curve on either side of it along ``t``, and the point past it to leave
+    from, with its tangent oriented along ``t``. None where no such pair brackets a turn of
+    the driver (the curve does not turn back here: a change point, where curves cross)."""
+    h = MAX_STEP / 4
+    while h >= 1e-6:
+        a, _ka = _correct(curve, y - h * t, t)
+        b, _kb = _correct(curve, y + h * t, t)
+        if a is not None and b is not None:
+            ta, tb = _tangent(curve.at(a)[1], t), _tangent(curve.at(b)[1], t)
+            if ta[-1] * tb[-1] < 0.0 and float(ta @ t) >= 0.9 and float(tb @ t) >= 0.9:
+                fold, _s = _limit(curve, a, ta, float((b - a) @ ta), float(tb[-1]))
+                return fold, b, tb
+        h *= 0.5
+    return None
+
+
+def _double(start: Assemblies, member: int) -> bool:
+    """Whether the assembly is double (two that meet, to rounding: :mod:`.assemblies`): at a
+    limit position, or beside one closer than the two assemblies' own uncertainty."""
+    return member < len(start.multiplicity) and start.multiplicity[member] >= 2
+
+
+def _at_limit(curve: _Curve, start: Assemblies, point: np.ndarray) -> list[int]:
+    """The assemblies at the start value that are the limit position ``point`` (scaled),
+    to MATCH, driver included: where the curve touches the start value without crossing it
+    (the start within rounding of a limit, where the two assemblies that meet are one)."""
     m = start.mechanism
+    x = point * curve.scale
+    if abs(_phase(m, float(x[-1]), float(start.driver))) > MATCH * float(curve.scale[-1]):
+        return []
+    q = [float(v) for v in x[:-1]]
+    return [i for i, a in enumerate(start.real) if same_configuration(q, a.q, m, MATCH)]
+
+
+def _meet(curve: _Curve, start: Assemblies, first: int, crossed: list[tuple[float, np.ndarray]],
+          members: set[int], closing: bool) -> tuple[float, np.ndarray] | None:
+    """The assemblies the step's crossings of the start value meet, in order, join
+    ``members``, up to the crossing that meets ``first`` again when ``closing``: that one
+    (arc coordinate, configuration), or None."""
+    m = start.mechanism
+    for s_cross, at in crossed:
+        q = list(at[:-1] * curve.scale[:-1])
+        i = next((i for i, a in enumerate(start.real) if same_configuration(q, a.q, m, MATCH)), None)
+        if i is None:
+            continue
+        members.add(i)
+        if i == first and closing:
+            return s_cross, at
+    return None
+
+
+def _branches(curve: _Curve, start: Assemblies, members: set[int], first: int,
+              sides: tuple[np.ndarray, ...]) -> tuple[str, ...]:
+    """The branches a circuit passes at the start value: its assemblies' names. Started at
+    a limit position (or a double assembly beside one), where two branches meet and the
+    start's own name is a matter of rounding, the two met there instead: each named (as
+    sweeps name it, by :func:`.assemblies.branch_names`) at the curve's point next to the
+    start on its side, ``sides`` (scaled)."""
+    m = start.mechanism
+    names = {start.real[i].branch for i in members if i != first or not sides}
+    for y in sides:
+        x = y * curve.scale
+        names.add(branch_names(m, float(x[-1]), [[float(v) for v in x[:-1]]])[0][0])
+    return tuple(sorted(n for n in names if n))
+
+
+def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
     y = np.array([*list(start.real[first].q), start.driver]) / curve.scale
     _f, jac = curve.at(y)
     t = _tangent(jac, None)
@@ -261,6 +334,16 @@ def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
     ys, ts = [y], [t]
     members, limits = {first}, []
     h, steps, rejected, crossings = MAX_STEP / 4, 0, 0, 0
+    # a start at a limit position to rounding is that limit, counted once: the curve leaves it
+    # and comes back to it from the other side, touching the start value without crossing it
+    at_fold = _fold_start(curve, y, t) if _double(start, first) or start.real[first].singular else None
+    if at_fold is not None and first not in _at_limit(curve, start, at_fold[0]):
+        at_fold = None  # near a limit, not at it: its start value is crossed, not touched
+    if at_fold is not None:
+        members.update(_at_limit(curve, start, at_fold[0]))
+        ys, ts = [at_fold[0], at_fold[1]], [t, at_fold[2]]
+        limits.append(float(at_fold[0][-1] * curve.scale[-1]))
+        jac, t = curve.at(at_fold[1])[1], at_fold[2]
     sign = np.sign(np.linalg.det(np.vstack([jac, t])))
     travelled = 0.0
     size_bound = 1e4 * max(1.0, float(np.max(np.abs(y[:-1]))))
@@ -301,31 +384,39 @@ def _trace(curve: _Curve, start: Assemblies, first: int) -> Circuit:
             limits.extend(float(f[0][-1] * curve.scale[-1]) for f in (fold,) if f is not None)
             status = "unlocated"
             break
-        for s_cross, at in crossed:
-            # crossed the start value: which assembly is this?
-            q = list(at[:-1] * curve.scale[:-1])
-            i = next((i for i, a in enumerate(start.real) if same_configuration(q, a.q, m, MATCH)), None)
-            if i is None:
-                continue
-            members.add(i)
-            if i == first and travelled > 4.0 * MAX_STEP:
-                status = "closed"
-                ys[-1] = at  # end on the start configuration, not past it
-                if fold is not None and s_cross < fold[1]:
-                    fold = None  # closed before this step's limit: the first step's, met again
-                break
+        closing = travelled > 4.0 * MAX_STEP
+        met = _meet(curve, start, first, crossed, members, closing)
+        touched = _at_limit(curve, start, fold[0]) if fold is not None else []
+        members.update(touched)
+        back = at_fold is not None and first in touched
+        if met is not None:
+            status = "closed"
+            ys[-1] = met[1]  # end on the start configuration, not past it
+            if fold is not None and (met[0] < fold[1] or back):
+                fold = None  # closed before this step's limit: the first step's, met again
+        elif closing and back:
+            status = "closed"  # back at the limit position started from, from its other side
+            ys[-1], fold = at_fold[0], None
         if fold is not None:
             limits.append(float(fold[0][-1] * curve.scale[-1]))
         if status == "closed":
             break
         h = min(MAX_STEP, h * (1.5 if k <= 2 else 1.0))
+    # a limit position started from, or a double start beside one: one curve point either side
+    sides = (ys[1], ys[-2]) if (at_fold is not None or _double(start, first)) and status == "closed" else ()
+    return _circuit(curve, start.mechanism, members, status, limits, (crossings, steps, rejected), ys,
+                    _branches(curve, start, members, first, sides))
+
+
+def _circuit(curve: _Curve, m: Mechanism, members: set[int], status: str, limits: list[float],
+             counts: tuple[int, int, int], ys: list[np.ndarray], branches: tuple[str, ...]) -> Circuit:
+    """The traced curve ``ys`` (scaled) as a Circuit; ``counts``: crossings, steps, rejected."""
     drivers = [float(v[-1] * curve.scale[-1]) for v in ys]
     configurations = [tuple(float(x) for x in v[:-1] * curve.scale[:-1]) for v in ys]
     full = m.driver.kind == "angle" and max(drivers) - min(drivers) >= 2.0 * math.pi - 1e-9
     low, high = min(drivers + limits), max(drivers + limits)  # a limit is refined, a sample is not
-    return Circuit(tuple(sorted(members)), status, low, high, full, tuple(limits),
-                   crossings, steps, rejected, tuple(drivers), tuple(configurations))
-
+    return Circuit(tuple(sorted(members)), status, low, high, full, tuple(limits), *counts,
+                   tuple(drivers), tuple(configurations), branches)
 
 def circuits(m: Mechanism, driver: float | None = None, seed: int = 0,
              found: Assemblies | None = None) -> Circuits:

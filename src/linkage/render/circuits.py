@@ -26,9 +26,8 @@ def circuits_table(c: Any) -> DataTable:
     unit = _driver_unit(m)
     rows = []
     for k, circ in enumerate(c.circuits):
-        names = sorted({c.assemblies.real[i].branch for i in circ.members if c.assemblies.real[i].branch})
         full = circ.full_turn
-        rows.append((k + 1, " ".join(str(i + 1) for i in circ.members), " ".join(names), circ.status,
+        rows.append((k + 1, " ".join(str(i + 1) for i in circ.members), " ".join(circ.branches), circ.status,
                      None if full else _driver_shown(m, circ.driver_low),
                      None if full else _driver_shown(m, circ.driver_high), full, len(circ.limits),
                      " ".join(f"{_driver_shown(m, v):.10g}" for v in circ.limits), circ.crossings,
