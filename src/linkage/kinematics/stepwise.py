@@ -111,7 +111,7 @@ def _at_meetings(solver: Solver, positions: list[Position], target: str | None
     from dataclasses import replace
 
     from ..methods.newton_system import max_abs
-    from ..problems.derive import parse_signs
+    from ..problems.derive import Indeterminate, parse_signs
 
     d = solver.derivation
     assert d is not None
@@ -125,7 +125,10 @@ def _at_meetings(solver: Solver, positions: list[Position], target: str | None
         q = solver_q(solver, p)
         # the step that meets gives one configuration for either sign; the others keep theirs
         signs = tuple(s if s != 0.0 else 1.0 for s in d.signs_of(q, drv))
-        exact = d.solve(drv, signs)
+        try:
+            exact = d.solve(drv, signs)
+        except Indeterminate:  # a change point: the step's two circles coincide, no one configuration
+            exact = None
         F, _, _ = solver.compiled(p.input)
         note, det = "; ".join(n for n in (p.note, MEETS_NOTE) if n), p.det
         if exact is not None and max_abs(F(exact)) <= solver.gate:
