@@ -110,6 +110,14 @@ def test_output_to_dev_full_is_one_line(cli):
     one_line_exit_2(cli("solve", "-o", "/dev/full"))
 
 
+def test_a_path_with_a_line_break_is_still_one_error_line(cli, tmp_path):
+    """A file name holding a newline is quoted with \\n, not broken over lines (docs/output.md: one line)."""
+    run = cli("solve", str(tmp_path / "no\nfile.toml"))
+    one_line_exit_2(run)
+    assert "no\\nfile.toml" in run.err
+    one_line_exit_2(cli("solve", "-e", "x - 1", "-o", str(tmp_path / "no\ndir" / "x.json")))
+
+
 # --- false convergence ------------------------------------------------------------------------
 
 @pytest.mark.parametrize("equation,x0", [
