@@ -59,6 +59,10 @@ def motion_command(pose: list[str], poses_file: Optional[Path], circle: list[str
     if plot is not None and len(poses) != 4:
         raise InputError("--plot with --motion draws four poses' centre-point and circle-point curves: "
                          f"give 4 poses, not {len(poses)}")
+    if write_file and output is not None and len(poses) == 4:
+        raise InputError(f"-o {output} writes a four-bar: 4 poses give the centre-point and circle-point "
+                         "curves, not a design (-f csv lists their points); give 5 poses, or 3 with "
+                         "--circle X,Y twice")
     if len(poses) == 3 and points is None:
         raise InputError(f"{THREE_FREE}: give them as --circle X,Y twice")
     try:
