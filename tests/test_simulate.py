@@ -377,3 +377,19 @@ def test_a_drive_beyond_the_solvers_rates_leaves_those_forces_undefined_not_an_e
     # one row without forces: neither check has anything to compare, and says so (not "within")
     assert "energy balance: nothing to compare" in run.out
     assert "kinetostatic check: nothing to check" in run.out
+
+
+@pytest.mark.parametrize("drive,omega0", [("1e308", 0.0), ("1e308*1e308", 0.0), ("0", 1e308)])
+def test_an_acceleration_that_overflows_is_refused_not_a_runtime_warning_and_inf(cli, drive, omega0):
+    """A drive of 1e308 N m (or inf) on 2.6e-4 kg m^2, or a start at 1e308 rad/s, overflows
+    theta'': it printed numpy's RuntimeWarning and d2theta = inf (exit 1); the one line now
+    names the overflow, and the library raises InputError without a warning."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InputError, match="the acceleration overflows at the start, t = 0 s"):
+            linkage.simulate(str(LOADED), drive=drive, time=(0.0, 0.01), omega0=omega0)
+    if omega0 == 0.0:
+        run = cli("simulate", str(LOADED), "--time", "0:0.01", "--drive", drive)
+        assert run.code == 2 and run.err.count("\n") == 1 and "acceleration overflows" in run.err

@@ -293,11 +293,14 @@ class Equation:
         except (ArithmeticError, ValueError) as exc:
             raise _TooLong(f"the drive cannot be evaluated at t = {t:.6g} s, theta = {theta:.6g} rad, "
                            f"omega = {omega:.6g} rad/s ({exc})") from None
-        self.last_t = t
         fr = dyn.friction_force(p, omega)
         q = tau + p.loads + p.weight + fr
-        return np.array([omega, (q - p.half_slope * omega * omega) / p.inertia,
-                         tau * omega, fr * omega, p.loads * omega])
+        with np.errstate(all="ignore"):
+            alpha = (q - p.half_slope * omega * omega) / p.inertia
+        if not math.isfinite(alpha):  # a trial step beyond the doubles: refused and shortened
+            return np.full(5, np.nan)
+        self.last_t = t
+        return np.array([omega, alpha, tau * omega, fr * omega, p.loads * omega])
 
     def events(self) -> list[Any]:
         """The terminal events: a dead point (the sensitivity reaching DEAD_POINT_SENSITIVITY),
@@ -338,9 +341,13 @@ def integrate(dyn: Dynamics, drive: Callable[[float, float, float], float], thet
     y0 = [theta0, omega0, 0.0, 0.0, 0.0]
     t_eval = np.linspace(start, end, samples)
     try:
-        eq.rhs(start, np.array(y0))
+        first = eq.rhs(start, np.array(y0))
     except _TooLong as exc:
         raise InputError(f"drive: {exc}") from None
+    if not np.isfinite(first[1]):  # the start is assembled (p0): its theta'' overflowed
+        tau = drive(start, theta0, omega0)
+        raise InputError(f"the acceleration overflows at the start, t = {start:g} s (drive {tau:g}, speed "
+                         f"{omega0:g}, inertia {p0.inertia:g}): no step can follow it")
     with np.errstate(all="ignore"):
         try:
             sol = solve_ivp(eq.rhs, (start, end), y0, method="DOP853", t_eval=t_eval, rtol=rtol,
