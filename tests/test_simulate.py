@@ -393,3 +393,14 @@ def test_an_acceleration_that_overflows_is_refused_not_a_runtime_warning_and_inf
     if omega0 == 0.0:
         run = cli("simulate", str(LOADED), "--time", "0:0.01", "--drive", drive)
         assert run.code == 2 and run.err.count("\n") == 1 and "acceleration overflows" in run.err
+
+
+def test_a_run_stopped_at_its_start_has_its_start_once_and_nothing_to_compare(cli):
+    """At rest, the file's loads turn the crank against 100 N m of Coulomb friction: the
+    driver stops at t = 0. The start was printed twice (the output time and the event's row)
+    and the energy balance read 'within ... by 0' of two copies of one state."""
+    sim = linkage.simulate(str(LOADED), "0", (0.0, 0.2), samples=5, friction_coulomb=100.0)
+    assert sim.event == "stopped" and sim.event_time == 0.0 and list(sim.t) == [0.0]
+    run = cli("simulate", str(LOADED), "--time", "0:0.2", "--samples", "5", "--friction-coulomb", "100",
+              "-f", "plain")
+    assert run.code == 1 and "energy balance: nothing to compare (one output time)" in run.out

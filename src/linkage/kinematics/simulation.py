@@ -400,8 +400,11 @@ def _at_event(dyn: Dynamics, eq: Equation, sol: Any, rtol: float, atol: float
         last = solve_ivp(eq.rhs, (before, event_time), sol.sol(before), method="DOP853", rtol=rtol,
                          atol=[atol] * 5)
     ye = last.y[:, -1] if last.status == 0 else sol.y_events[which][0]
-    t_out = np.append(sol.t, event_time)
-    y_out = np.column_stack([sol.y, ye])
+    if len(sol.t) and event_time <= float(sol.t[-1]):  # at an output time (the start): that row, once
+        t_out, y_out = sol.t, np.column_stack([sol.y[:, :-1], ye])
+    else:
+        t_out = np.append(sol.t, event_time)
+        y_out = np.column_stack([sol.y, ye])
     if which == 1:
         return t_out, y_out, "stopped", event_time, \
             "the driver came to rest under Coulomb friction (sticking is not modelled)"
