@@ -435,3 +435,18 @@ def test_the_performance_tables_are_written_from_one_bench_json_between_their_ma
     assert "| six-bar | 4 | 1.11e-16 | 0 | 1.68e-16 | 0 | 0 | yes |" in text
     with pytest.raises(SystemExit):
         table.replace(tmp_path / "page.md", "x", "<!-- none: begin -->", "<!-- none: end -->")
+
+
+@pytest.mark.parametrize("repeats", ["0", "100000000"])
+def test_bench_repeats_beyond_its_range_are_refused_at_once(cli, monkeypatch, repeats):
+    """--repeats 100000000 was accepted and ran until killed; every other count has a ceiling.
+    (Refused before any timing: a run that starts fails the test at once instead.)"""
+    import linkage.cli.bench as bench_cli
+
+    def ran(*args: object) -> None:
+        raise AssertionError("the benchmark ran")
+
+    monkeypatch.setattr(bench_cli, "work_precision", ran)
+    run = cli("bench", "--quick", "--repeats", repeats, "--no-cold")
+    assert run.code == 2 and run.err.count("\n") == 1
+    assert "--repeats must be a whole number from 1 to" in run.err
