@@ -287,3 +287,19 @@ def test_four_poses_with_a_mechanism_file_output_are_refused(tmp_path, capsys) -
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "4 poses give the centre-point and circle-point curves" in err[0]
     assert not out.exists()
+
+
+@pytest.mark.parametrize("text, said", [
+    ("x,y,angle\n0,0,0\n", "line 1 ('x,y,angle'): must be a finite number"),
+    ("0,0,0\n# a comment\n1,2\n", "line 3 ('1,2'): write X,Y,DEG"),
+])
+def test_a_poses_file_refusal_names_its_line_not_a_pose_option(tmp_path, capsys, text, said) -> None:
+    """A header line said "--pose 1 must be a finite number ... got 'x'" (an option nobody gave)."""
+    from linkage.cli import run_cli
+
+    path = tmp_path / "poses.txt"
+    path.write_text(text)
+    capsys.readouterr()
+    assert run_cli(["synthesize", "--motion", "--poses", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"error: --poses {path} ") and said in err[0]
