@@ -404,3 +404,25 @@ def test_a_run_stopped_at_its_start_has_its_start_once_and_nothing_to_compare(cl
     run = cli("simulate", str(LOADED), "--time", "0:0.2", "--samples", "5", "--friction-coulomb", "100",
               "-f", "plain")
     assert run.code == 1 and "energy balance: nothing to compare (one output time)" in run.out
+
+
+@pytest.mark.parametrize("args, said", [
+    (["--theta0", "nan"], "error: --theta0 must be finite"),
+    (["--flywheel", "nan"], "error: --flywheel must be finite"),
+    (["--rtol", "1"], "error: --rtol: give a tolerance"),
+])
+def test_simulate_refusals_name_the_command_line_options(cli, args, said):
+    """They named the library's arguments (theta0, flywheel), not the options given."""
+    run = cli("simulate", str(LOADED), "--time", "0:0.1", *args)
+    assert run.code == 2 and run.err.count("\n") == 1 and run.err.startswith(said)
+
+
+def test_simulate_refusals_say_what_the_start_or_the_file_lacks(cli):
+    """1.3e-5 deg inside the ME581's limit is assembled: the refusal names the dead-point rule
+    (an unknown 300 times as fast as the driver), not "a dead point or not assembled"; a loops
+    file lacks bodies and masses, not loads (none were given)."""
+    run = cli("simulate", str(ROOT / "docs" / "me581_masses.toml"), "--time", "0:1", "--theta0", "112.0243")
+    assert run.code == 2 and "times as fast as the driver there (a run starts below 300)" in run.err
+    run = cli("simulate", str(ROOT / "sample_inputs" / "crank_rocker.toml"), "--time", "0:1")
+    assert run.code == 2 and "the dynamics need links as bodies with masses" in run.err
+    assert "loads need" not in run.err

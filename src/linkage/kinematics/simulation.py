@@ -185,6 +185,10 @@ def simulate(
     from .loading import mechanism_of
 
     mechanism = mechanism_of("mechanism", mechanism)
+    if mechanism.extra.get("drawing") is None:  # Frame.of's refusal speaks of loads, which need not be given
+        raise InputError(f"{mechanism.source}: the dynamics need links as bodies with masses: give the "
+                         "mechanism in the joints form (linkage convert --form joints FILE writes it) "
+                         "with a [mass] table")
     frame = Frame.of(mechanism)
     if isinstance(drive, str):
         consts = {}
@@ -332,8 +336,12 @@ def integrate(dyn: Dynamics, drive: Callable[[float, float, float], float], thet
     from scipy.integrate import solve_ivp
 
     p0 = dyn.at(theta0)
-    if p0 is None or not p0.sensitivity < DEAD_POINT_SENSITIVITY:
-        raise InputError("theta0: the mechanism is at a dead point or not assembled there")
+    if p0 is None:
+        raise InputError("theta0: the mechanism is not assembled there (or is at a limit of its assembly)")
+    if not p0.sensitivity < DEAD_POINT_SENSITIVITY:
+        raise InputError(f"theta0: at or next to a dead point or limit: an unknown moves "
+                         f"{p0.sensitivity:.3g} times as fast as the driver there (a run starts below "
+                         f"{DEAD_POINT_SENSITIVITY:g})")
     if not p0.inertia > 0.0:
         raise InputError("the mechanism has no inertia to move: give its links a mass or an inertia in "
                          "[mass], or a flywheel (--flywheel)")
