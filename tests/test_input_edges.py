@@ -118,6 +118,7 @@ def test_a_too_fine_driver_grid_is_refused_with_the_spacing_it_needs(cli):
     """1e-8 deg apart at 112 deg is 700,000 doubles apart: the refusal said "double precision
     resolves only 1.42e-14 there", which reads as if 1e-8 were fine; the rule (a spacing of at
     least GRID_RESOLUTION doubles) is now what it says, with the smallest spacing allowed."""
-    run = cli("sweep", str(SAMPLES / "fourbar_me581.toml"), "--from", "112.0243128", "--to", "112.0243129", "--step", "1e-8")
+    run = cli("sweep", str(SAMPLES / "fourbar_me581.toml"), "--from", "112.0243128", "--to", "112.0243129",
+              "--step", "1e-8")
     assert run.code == 2 and run.err.count("\n") == 1
     assert "it must be at least 1.42e-08 there" in run.err and "resolves only" not in run.err
