@@ -122,3 +122,16 @@ def test_a_too_fine_driver_grid_is_refused_with_the_spacing_it_needs(cli):
               "--step", "1e-8")
     assert run.code == 2 and run.err.count("\n") == 1
     assert "it must be at least 1.42e-08 there" in run.err and "resolves only" not in run.err
+
+
+@pytest.mark.parametrize("args", [("sweep", "--from", "0", "--to", "1e308", "--points", "361"),
+                                  ("sweep", "--from", "-1e308", "--to", "1e308", "--points", "3"),
+                                  ("draw", "-o", "sheet.dxf", "--from", "0", "--to", "1e308")])
+def test_a_driver_span_near_the_largest_double_meets_the_drivers_bound(cli, tmp_path, monkeypatch, args):
+    """The grid's (stop - start) * k overflowed before its division: "values[2] must be finite,
+    got inf" named an internal list; the values are now finite and the driver's bound refuses them."""
+    monkeypatch.chdir(tmp_path)
+    if args[0] == "draw":
+        pytest.importorskip("ezdxf")
+    run = cli(args[0], str(SAMPLES / "crank_rocker.toml"), *args[1:])
+    assert run.code == 2 and run.err.count("\n") == 1 and "an angle must be within +-1e+06 deg" in run.err

@@ -205,6 +205,9 @@ def driver_values(start: float, stop: float, step: float | None, points: int | N
     if points is not None:
         if points == 1:
             return [start]
+        if not math.isfinite((stop - start) * (points - 1)):  # a span near the largest double: the
+            # usual order's product overflows; these values are refused by the driver's own bound next
+            return [start * (1.0 - k / (points - 1)) + stop * (k / (points - 1)) for k in range(points)]
         if array_above is not None and points > array_above:
             import numpy as np
 
