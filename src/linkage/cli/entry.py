@@ -134,7 +134,14 @@ _terminated: list[int] = []
 def _on_sigterm(signum: int, frame: Any) -> None:
     """SIGTERM is handled as Ctrl-C is: the KeyboardInterrupt unwinds every open output
     (files.atomic_target removes its partial file), then one line and 128 + 15."""
+    import signal
+
+    if _terminated:
+        return  # a second SIGTERM (timeout(1) signals the child and then its group): already unwinding
     _terminated.append(signum)
+    # once: the exit that follows joins the worker threads, and a KeyboardInterrupt raised there
+    # is a traceback ("Exception ignored in: <module 'threading'>"), not the one line
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     raise KeyboardInterrupt
 
 
