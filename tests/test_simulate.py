@@ -426,3 +426,14 @@ def test_simulate_refusals_say_what_the_start_or_the_file_lacks(cli):
     run = cli("simulate", str(ROOT / "sample_inputs" / "crank_rocker.toml"), "--time", "0:1")
     assert run.code == 2 and "the dynamics need links as bodies with masses" in run.err
     assert "loads need" not in run.err
+
+
+def test_a_run_ending_at_an_event_says_it_on_stderr_when_the_tables_go_to_csv(cli, tmp_path):
+    """With -o FILE.csv only "wrote ..." reached stderr and the CSVs hold no event: exit 1
+    without its reason anywhere. The event is now a note (JSON holds it already)."""
+    args = ("simulate", str(ROOT / "docs" / "me581_masses.toml"), "--time", "0:2", "--drive", "5",
+            "--samples", "5")
+    run = cli(*args, "-o", str(tmp_path / "e.csv"))
+    assert run.code == 1 and "note: event: limit_of_assembly at t = 0.19222" in run.err
+    run = cli(*args, "-o", str(tmp_path / "e.json"))
+    assert run.code == 1 and "note: event" not in run.err

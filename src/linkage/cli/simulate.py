@@ -7,7 +7,9 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
+from ..render.writers import is_data
 from .options import (
+    NOTED,
     PICTURES,
     ColumnsOpt,
     DigitsOpt,
@@ -151,4 +153,7 @@ def simulate(
         simulate_plot(sim, mechanism, plot)
         typer.echo(f"wrote {plot}", err=True)
     if sim.event is not None or sim.balance > energy_tol or sim.drive_check > drive_tol:
+        if is_data(out_fmt) and out_fmt != "json":  # tables only: the exit's reason would be nowhere
+            NOTED.append(f"event: {sim.event} at t = {sim.event_time:.10g} s: {sim.message}"
+                         if sim.event is not None else "a check failed: --format json or plain shows which")
         raise typer.Exit(1)
