@@ -303,3 +303,18 @@ def test_a_poses_file_refusal_names_its_line_not_a_pose_option(tmp_path, capsys,
     assert run_cli(["synthesize", "--motion", "--poses", str(path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(f"error: --poses {path} ") and said in err[0]
+
+
+def test_poses_within_the_pose_tolerance_of_each_other_are_one_pose(capsys) -> None:
+    """A fifth pose 1e-9 deg from the first (the same place) is the first again: four poses,
+    a continuum of cranks. It was solved as five (exit 1, "1 real Burmester cranks" beside
+    two certified real roots); exactly equal poses were already refused."""
+    from linkage.cli import run_cli
+
+    five = [*FIVE[:4], (FIVE[0][0], FIVE[0][1], FIVE[0][2] + 1e-9)]
+    with pytest.raises(InputError, match=r"poses\[0\] and poses\[4\] are the same pose"):
+        synthesize_motion(five)
+    capsys.readouterr()
+    assert run_cli(["synthesize", "--motion", *cli_poses(five)]) == 2
+    assert "are the same pose" in capsys.readouterr().err
+    synthesize_motion([*FIVE[:4], (FIVE[0][0], FIVE[0][1], FIVE[0][2] + 1e-3)])  # 1.7e-5 rad: a pose
