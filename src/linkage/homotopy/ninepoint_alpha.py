@@ -145,13 +145,21 @@ def certify_rows(Z: np.ndarray, points: tuple[complex, ...] | np.ndarray,
                  progress: Callable[[int], None] | None = None) -> tuple[Certificate, ...]:
     """The certificate of each row of ``Z`` (solutions of the nine ``points``, P_0 at the
     origin, as :class:`.ninepoint_track.NinePointSolutions` has them)."""
+    from dataclasses import replace
+
     p = np.asarray(points, dtype=complex)
     d = p[1:] - p[0]
+    # the problem is the same at every scale (the pivots scale with the points, as
+    # ninepoint_track.solve_points solves it): certified at the points' unit size, where the
+    # Bombieri-Weyl norms are what the test is posed for, its distances scaled back
+    size = float(np.max(np.abs(d))) or 1.0
+    d = d / size
     db = np.conj(d)
     terms = norm_terms(d, db)
     out = []
     for k, z in enumerate(Z):
-        out.append(certify(z, d, db, terms))
+        c = certify(np.asarray(z) / size, d, db, terms)
+        out.append(replace(c, beta=c.beta * size, gamma=c.gamma / size, radius=c.radius * size))
         if progress is not None:
             progress(k + 1)
     return tuple(out)
