@@ -437,3 +437,10 @@ def test_a_run_ending_at_an_event_says_it_on_stderr_when_the_tables_go_to_csv(cl
     assert run.code == 1 and "note: event: limit_of_assembly at t = 0.19222" in run.err
     run = cli(*args, "-o", str(tmp_path / "e.json"))
     assert run.code == 1 and "note: event" not in run.err
+
+
+def test_a_run_too_stiff_to_integrate_names_what_makes_it_so_not_only_the_span(cli):
+    """1e308 N m s/rad of viscous friction makes the first steps 5.6e-308 s: the refusal said
+    only "shorten --time (or --omega0)", which cannot help; it names friction among the causes."""
+    run = cli("simulate", str(LOADED), "--time", "0:0.2", "--samples", "5", "--friction-viscous", "1e308")
+    assert run.code == 2 and run.err.count("\n") == 1 and "friction" in run.err

@@ -286,7 +286,8 @@ class Equation:
                 raise SpanTooLong(
                     f"time: {self.start:g} to {self.end:g} s needs about {projected:.2g} evaluations of the "
                     f"equation of motion at the rate of its first {t - self.start:.3g} s, more than "
-                    f"{MAX_EVALUATIONS:,}: shorten --time (or --omega0)")
+                    f"{MAX_EVALUATIONS:,}: shorten --time, or lower what makes the motion that fast or "
+                    "stiff (--omega0, the drive, friction, loads)")
         theta, omega = float(y[0]), float(y[1])
         dyn = self.dyn
         p = dyn.at(theta)
