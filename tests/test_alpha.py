@@ -207,3 +207,22 @@ def test_a_root_far_from_the_origin_is_tested_in_stretched_variables():
     # unstretched, the bound grows with ||(1, x)||: the same point tests worse
     a, _, _ = alpha.constants(alpha.normalised(f), x)
     assert a > c.alpha
+
+
+@pytest.mark.parametrize("scale", [1e-9, 1e6])
+def test_the_nine_point_alpha_test_is_the_same_at_every_scale(scale):
+    """The docs' nine points in nanometres found the same four-bars but certified none of them
+    (the Bombieri-Weyl norms of the unscaled equations are posed for unit size); the test now
+    runs at the points' unit size, as the tracking does, its radius scaled back."""
+    from linkage.homotopy import ninepoint_track
+    from linkage.homotopy.ninepoint_alpha import certify_rows
+
+    pts = [0.25, 0.52 + 0.1j, 0.8 + 0.7j, 1.2 + 1j, 1.4 + 1.3j, 1.1 + 1.48j, 0.7 + 1.4j, 0.2 + 1j,
+           0.02 + 0.4j]
+    found = ninepoint_track.solve_points(pts, orbits=3)
+    unit = certify_rows(found.solutions, found.points)
+    scaled = certify_rows(found.solutions * scale, np.asarray(found.points) * scale)
+    assert all(c.certified for c in unit)
+    assert [c.certified for c in scaled] == [True] * len(unit)
+    for a, b in zip(unit, scaled):  # the radius: the rounding of the scaled point's, in its units
+        assert b.radius <= 1e-12 * scale and a.real == b.real and a.not_real == b.not_real

@@ -330,6 +330,19 @@ def test_a_linkage_that_moves_with_its_driver_held_is_not_isolated():
     assert a.continuum and a.real == ()
 
 
+def test_a_linkage_that_moves_with_its_driver_held_is_not_called_unassemblable():
+    """Its report said "not isolated: the loops close all along a curve here" and then "no real
+    assembly: the mechanism cannot be assembled here", which the first line contradicts."""
+    from linkage.render.assemblies import assemblies_report
+    from linkage.render.report import Text
+
+    m = load(SAMPLES / "crank_rocker.toml").with_values({"r1": 1, "r2": 1, "r3": 1, "r4": 1}, {})
+    lines = [b.text for b in assemblies_report(linkage.assemblies(m, 0.0), 6, False).blocks()
+             if isinstance(b, Text)]
+    assert any(line.startswith("not isolated") for line in lines)
+    assert not any("cannot be assembled" in line for line in lines)
+
+
 def test_a_rocker_driven_four_bars_mirror_assembly_is_named_as_branch_takes_it():
     """Both assemblies of the rocker-driven ME581 at theta4 = 120 are open; the second is
     'open (mirror)', the name --branch takes (both printed 'open')."""

@@ -478,3 +478,18 @@ def test_the_file_floor_writes_the_cli_s_varying_columns(tmp_path, suffix):
                                                                                   f"{base} (mm)",
                                                                                   f"{base} (mm^2/rad^2)"))))
         assert np.asarray(hand.column(k)) == pytest.approx(want, rel=1e-12, abs=1e-9), k
+
+
+@pytest.mark.parametrize("repeats", ["0", "100000000"])
+def test_bench_repeats_beyond_its_range_are_refused_at_once(cli, monkeypatch, repeats):
+    """--repeats 100000000 was accepted and ran until killed; every other count has a ceiling.
+    (Refused before any timing: a run that starts fails the test at once instead.)"""
+    import linkage.cli.bench as bench_cli
+
+    def ran(*args: object) -> None:
+        raise AssertionError("the benchmark ran")
+
+    monkeypatch.setattr(bench_cli, "work_precision", ran)
+    run = cli("bench", "--quick", "--repeats", repeats, "--no-cold")
+    assert run.code == 2 and run.err.count("\n") == 1
+    assert "--repeats must be a whole number from 1 to" in run.err

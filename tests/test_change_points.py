@@ -300,3 +300,20 @@ def test_a_rhombus_sweep_through_its_indeterminate_pose_is_no_internal_error(tmp
     assert result.meetings == (0.0,)
     run = CliRunner().invoke(app, ["sweep", str(path), "--from", "0", "--to", "90", "--step", "45"])
     assert run.exit_code == 0 and "internal error" not in run.output
+
+
+def test_sweep_through_a_change_point_where_the_closed_form_is_indeterminate():
+    """A rhombus four-bar (r1 = r2 = r3 = r4) at theta2 = 0 has its crank pin on O4: the
+    coupler and rocker turn about one point, and the closed form's circles coincide
+    (problems.assembly.Indeterminate). The sweep through it is an answer, not an internal
+    error: each position's joints checked by hand (|AB| = r3, |O4 B| = r4), the meeting flagged."""
+    m = load(CRANK_ROCKER).with_values({"r2": 100.0, "r3": 100.0, "r4": 100.0}, {})
+    result = linkage.sweep(m, [0.0, 45.0, 90.0])
+    assert [p.status for p in result.positions] == ["converged"] * 3
+    for p in result.positions:
+        t2, t3, t4 = (math.radians(v) for v in (p.input, p.solution["theta3"], p.solution["theta4"]))
+        a = (100 * math.cos(t2), 100 * math.sin(t2))
+        b_from_a = (a[0] + 100 * math.cos(t3), a[1] + 100 * math.sin(t3))
+        b_from_o4 = (100 + 100 * math.cos(t4), 100 * math.sin(t4))
+        assert math.dist(b_from_a, b_from_o4) <= 1e-9
+    assert MEETS_NOTE in result.positions[0].note

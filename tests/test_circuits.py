@@ -142,3 +142,17 @@ def test_cli_plot_draws_the_circuits(cli, tmp_path):
     out = cli("assemblies", str(SAMPLES / "watt_sixbar.toml"), "--sweep", "--plot", str(target))
     assert out.code == 0, out.err
     assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_cli_plot_without_a_real_assembly_draws_no_legend_warning(cli, tmp_path):
+    """The ME581 four-bar at theta2 = 180 has no real assembly, so no circuit: the picture is
+    drawn (exit 1) without matplotlib's "No artists with labels" warning on stderr."""
+    import warnings
+
+    pytest.importorskip("matplotlib")
+    target = tmp_path / "none.png"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = cli("assemblies", str(SAMPLES / "fourbar_me581.toml"), "--set", "theta2=180", "--sweep",
+                  "--plot", str(target))
+    assert out.code == 1 and "Warning" not in out.err and target.read_bytes()[:4] == b"\x89PNG"

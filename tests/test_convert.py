@@ -47,3 +47,17 @@ def test_convert_refuses_what_it_cannot_do(cli, tmp_path) -> None:
     assert r.code == 2 and "already in the loops form" in r.err
     r = cli("convert", str(path), "-o", str(tmp_path / "out.toml"))
     assert r.code == 0 and (tmp_path / "out.toml").read_text() == loops.read_text()
+
+
+def test_converting_a_loaded_file_to_loops_says_the_loads_and_masses_are_not_carried(cli, tmp_path):
+    """docs/crank_rocker_loads.toml's [loads] and [mass] need links as bodies: the loops form
+    written from it (exit 0) lacks them, and a note says so instead of nothing."""
+    from pathlib import Path
+
+    loaded = Path(__file__).resolve().parents[1] / "docs" / "crank_rocker_loads.toml"
+    out = tmp_path / "loops.toml"
+    run = cli("convert", str(loaded), "--form", "loops", "-o", str(out))
+    assert run.code == 0 and "[loads]" not in out.read_text() and "[mass]" not in out.read_text()
+    assert "note: [loads] and [mass] of" in run.err and "not written" in run.err
+    plain = cli("convert", str(loaded.parent.parent / "sample_inputs" / "crank_rocker_joints.toml"))
+    assert plain.code == 0 and "note:" not in plain.err

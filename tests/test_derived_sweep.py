@@ -460,3 +460,16 @@ def test_a_command_line_sweep_of_a_derived_closed_form_does_not_import_numpy(nam
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert "HEAVY []" in proc.stdout
+
+
+@pytest.mark.parametrize("values", [[0.0, 90.0, 180.0, 270.0, 360.0], [-360.0 + 90.0 * k for k in range(9)]])
+def test_a_coarse_grid_reports_no_limit_where_the_linkage_does_not_assemble(values):
+    """The ME581 four-bar (90, 30, 60, 45 cm) reaches theta2 = +-acos(-3/8) only (r3 and r4 in
+    line: 30^2 + 90^2 - 5400 cos = 105^2). Swept every 90 deg, the unassembled 180 was searched
+    for a dip as if it assembled: 180, 214.38 (and -180, -145.62) were reported as limits."""
+    limit = math.degrees(math.acos(-3.0 / 8.0))
+    expected = sorted(t + 360.0 * k for t in (limit, 360.0 - limit) for k in (-2, -1, 0, 1)
+                      if values[0] <= t + 360.0 * k <= values[-1])
+    result = linkage.sweep(str(SAMPLES / "fourbar_me581.toml"), values)
+    assert len(result.toggles) == len(expected)
+    assert all(abs(a - b) <= 1e-9 for a, b in zip(result.toggles, expected))

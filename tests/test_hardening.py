@@ -110,6 +110,14 @@ def test_output_to_dev_full_is_one_line(cli):
     one_line_exit_2(cli("solve", "-o", "/dev/full"))
 
 
+def test_a_path_with_a_line_break_is_still_one_error_line(cli, tmp_path):
+    """A file name holding a newline is quoted with \\n, not broken over lines (docs/output.md: one line)."""
+    run = cli("solve", str(tmp_path / "no\nfile.toml"))
+    one_line_exit_2(run)
+    assert "no\\nfile.toml" in run.err
+    one_line_exit_2(cli("solve", "-e", "x - 1", "-o", str(tmp_path / "no\ndir" / "x.json")))
+
+
 # --- false convergence ------------------------------------------------------------------------
 
 @pytest.mark.parametrize("equation,x0", [
@@ -501,3 +509,24 @@ def test_criteria_of_any_type_are_refused_with_input_error():
             solve_scalar(f, method="bisection", bracket=(0.0, 2.0), tol=bad)
         with pytest.raises(InputError):
             solve_system(lambda q: [q[0] - 1, q[1] - 2], (0.0, 0.0), jac=lambda q: [[1, 0], [0, 1]], tol=bad)
+
+
+def test_a_second_sigterm_while_terminating_is_ignored_not_a_traceback(monkeypatch):
+    """timeout(1) signals its child and then the child's group: the second SIGTERM reached
+    the interpreter's exit while it joined the worker threads and printed a traceback after
+    "error: terminated". The first raises KeyboardInterrupt (the one line, exit 143); the
+    handler then ignores SIGTERM, and a second call does nothing."""
+    import signal
+
+    from linkage.cli import entry
+
+    monkeypatch.setattr(entry, "_terminated", [])
+    before = signal.getsignal(signal.SIGTERM)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            entry._on_sigterm(signal.SIGTERM, None)
+        assert signal.getsignal(signal.SIGTERM) == signal.SIG_IGN
+        entry._on_sigterm(signal.SIGTERM, None)  # a second one, already unwinding: nothing
+        assert entry._terminated == [signal.SIGTERM]
+    finally:
+        signal.signal(signal.SIGTERM, before)

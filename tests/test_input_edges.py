@@ -112,3 +112,26 @@ def test_refusals_name_the_option_the_command_line_has():
     assert err("solve", str(ME581), "--method", "newton-fd", "--fd-step", "2").startswith("error: --fd-step ")
     loaded = SAMPLES.parent / "docs" / "crank_rocker_loads.toml"
     assert err("simulate", str(loaded), "--time", "0:1", "--omega0", "1e300").startswith("error: --omega0 ")
+
+
+def test_a_too_fine_driver_grid_is_refused_with_the_spacing_it_needs(cli):
+    """1e-8 deg apart at 112 deg is 700,000 doubles apart: the refusal said "double precision
+    resolves only 1.42e-14 there", which reads as if 1e-8 were fine; the rule (a spacing of at
+    least GRID_RESOLUTION doubles) is now what it says, with the smallest spacing allowed."""
+    run = cli("sweep", str(SAMPLES / "fourbar_me581.toml"), "--from", "112.0243128", "--to", "112.0243129",
+              "--step", "1e-8")
+    assert run.code == 2 and run.err.count("\n") == 1
+    assert "it must be at least 1.42e-08 there" in run.err and "resolves only" not in run.err
+
+
+@pytest.mark.parametrize("args", [("sweep", "--from", "0", "--to", "1e308", "--points", "361"),
+                                  ("sweep", "--from", "-1e308", "--to", "1e308", "--points", "3"),
+                                  ("draw", "-o", "sheet.dxf", "--from", "0", "--to", "1e308")])
+def test_a_driver_span_near_the_largest_double_meets_the_drivers_bound(cli, tmp_path, monkeypatch, args):
+    """The grid's (stop - start) * k overflowed before its division: "values[2] must be finite,
+    got inf" named an internal list; the values are now finite and the driver's bound refuses them."""
+    monkeypatch.chdir(tmp_path)
+    if args[0] == "draw":
+        pytest.importorskip("ezdxf")
+    run = cli(args[0], str(SAMPLES / "crank_rocker.toml"), *args[1:])
+    assert run.code == 2 and run.err.count("\n") == 1 and "an angle must be within +-1e+06 deg" in run.err

@@ -255,3 +255,66 @@ def test_the_curves_are_drawn_with_plot_and_only_for_four_poses(tmp_path, capsys
     assert lines[0] == "centre_x,centre_y,circle_x,circle_y,spread" and len(lines) > 100
     assert run_cli(["synthesize", "--motion", *cli_poses(FIVE), "--plot", str(tmp_path / "x.png")]) == 2
     assert "give 4 poses" in capsys.readouterr().err and not (tmp_path / "x.png").exists()
+
+
+def test_a_design_written_with_defects_says_them_not_that_it_runs_through_the_poses(tmp_path, capsys) -> None:
+    """--design K of a design with defects is written as asked, its defects named on stderr; the
+    defect-free one still says that its sweep runs through the poses."""
+    from linkage.cli import run_cli
+
+    o2, o4 = 0j, 4 + 0j
+    poses = poses_of(o2, o4, 1.5, 4.0, 3.5, [30.0, 80.0, 140.0, 200.0, 290.0], complex(1.0, 0.8), 10.0)
+    m = synthesize_motion(poses)
+    bad = next(k for k, d in enumerate(m.designs) if d.defects)
+    out = tmp_path / "bad.toml"
+    capsys.readouterr()
+    args = ["synthesize", "--motion", *cli_poses(poses), "--design", str(bad + 1), "-o", str(out)]
+    assert run_cli(args) == 0
+    err = capsys.readouterr().err
+    assert out.exists() and "with defects: " + ", ".join(m.designs[bad].defect_names) in err
+    assert "runs it through the poses" not in err
+
+
+def test_four_poses_with_a_mechanism_file_output_are_refused(tmp_path, capsys) -> None:
+    """Four poses give the centre-point and circle-point curves, no four-bar: -o FILE.toml is
+    refused with one line (it was ignored, exit 0) and no file is written."""
+    from linkage.cli import run_cli
+
+    out = tmp_path / "four.toml"
+    four = FIVE[:4]
+    capsys.readouterr()
+    assert run_cli(["synthesize", "--motion", *cli_poses(four), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "4 poses give the centre-point and circle-point curves" in err[0]
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("text, said", [
+    ("x,y,angle\n0,0,0\n", "line 1 ('x,y,angle'): must be a finite number"),
+    ("0,0,0\n# a comment\n1,2\n", "line 3 ('1,2'): write X,Y,DEG"),
+])
+def test_a_poses_file_refusal_names_its_line_not_a_pose_option(tmp_path, capsys, text, said) -> None:
+    """A header line said "--pose 1 must be a finite number ... got 'x'" (an option nobody gave)."""
+    from linkage.cli import run_cli
+
+    path = tmp_path / "poses.txt"
+    path.write_text(text)
+    capsys.readouterr()
+    assert run_cli(["synthesize", "--motion", "--poses", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"error: --poses {path} ") and said in err[0]
+
+
+def test_poses_within_the_pose_tolerance_of_each_other_are_one_pose(capsys) -> None:
+    """A fifth pose 1e-9 deg from the first (the same place) is the first again: four poses,
+    a continuum of cranks. It was solved as five (exit 1, "1 real Burmester cranks" beside
+    two certified real roots); exactly equal poses were already refused."""
+    from linkage.cli import run_cli
+
+    five = [*FIVE[:4], (FIVE[0][0], FIVE[0][1], FIVE[0][2] + 1e-9)]
+    with pytest.raises(InputError, match=r"poses\[0\] and poses\[4\] are the same pose"):
+        synthesize_motion(five)
+    capsys.readouterr()
+    assert run_cli(["synthesize", "--motion", *cli_poses(five)]) == 2
+    assert "are the same pose" in capsys.readouterr().err
+    synthesize_motion([*FIVE[:4], (FIVE[0][0], FIVE[0][1], FIVE[0][2] + 1e-3)])  # 1.7e-5 rad: a pose

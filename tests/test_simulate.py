@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import math
 import random
+import re
 from pathlib import Path
 
 import numpy as np
@@ -436,3 +437,75 @@ def test_a_runaway_motion_ends_instead_of_walking_to_its_trial_position():
             "except linkage.InputError as e:\n    print('refused', e)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0 and out.stdout.startswith(("refused", "event")), out.stderr
+
+
+OVERFLOWS = [("1e308", 0.0, "beyond 1e+100"), ("1e308*1e308", 0.0, "beyond 1e+100"),
+             ("0", 1e308, "the acceleration overflows at the start, t = 0 s")]
+
+
+@pytest.mark.parametrize("drive,omega0,said", OVERFLOWS)
+def test_an_acceleration_that_overflows_is_refused_not_a_runtime_warning_and_inf(cli, drive, omega0, said):
+    """A drive of 1e308 N m (or inf) on 2.6e-4 kg m^2, or a start at 1e308 rad/s, overflows
+    theta'': it printed numpy's RuntimeWarning and d2theta = inf (exit 1); the one line now
+    says why (a drive beyond the loads' bound, or the overflow), and the library raises
+    InputError without a warning."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InputError, match=re.escape(said)):
+            linkage.simulate(str(LOADED), drive=drive, time=(0.0, 0.01), omega0=omega0)
+    if omega0 == 0.0:
+        run = cli("simulate", str(LOADED), "--time", "0:0.01", "--drive", drive)
+        assert run.code == 2 and run.err.count("\n") == 1 and said in run.err
+
+
+def test_a_run_stopped_at_its_start_has_its_start_once_and_nothing_to_compare(cli):
+    """At rest, the file's loads turn the crank against 100 N m of Coulomb friction: the
+    driver stops at t = 0. The start was printed twice (the output time and the event's row)
+    and the energy balance read 'within ... by 0' of two copies of one state."""
+    sim = linkage.simulate(str(LOADED), "0", (0.0, 0.2), samples=5, friction_coulomb=100.0)
+    assert sim.event == "stopped" and sim.event_time == 0.0 and list(sim.t) == [0.0]
+    run = cli("simulate", str(LOADED), "--time", "0:0.2", "--samples", "5", "--friction-coulomb", "100",
+              "-f", "plain")
+    assert run.code == 1 and "energy balance: nothing to compare (one output time)" in run.out
+
+
+@pytest.mark.parametrize("args, said", [
+    (["--theta0", "nan"], "error: --theta0 must be finite"),
+    (["--flywheel", "nan"], "error: --flywheel must be finite"),
+    (["--rtol", "1"], "error: --rtol: give a tolerance"),
+])
+def test_simulate_refusals_name_the_command_line_options(cli, args, said):
+    """They named the library's arguments (theta0, flywheel), not the options given."""
+    run = cli("simulate", str(LOADED), "--time", "0:0.1", *args)
+    assert run.code == 2 and run.err.count("\n") == 1 and run.err.startswith(said)
+
+
+def test_simulate_refusals_say_what_the_start_or_the_file_lacks(cli):
+    """1.3e-5 deg inside the ME581's limit is assembled: the refusal names the dead-point rule
+    (an unknown 300 times as fast as the driver), not "a dead point or not assembled"; a loops
+    file lacks bodies and masses, not loads (none were given)."""
+    run = cli("simulate", str(ROOT / "docs" / "me581_masses.toml"), "--time", "0:1", "--theta0", "112.0243")
+    assert run.code == 2 and "times as fast as the driver there (a run starts below 300)" in run.err
+    run = cli("simulate", str(ROOT / "sample_inputs" / "crank_rocker.toml"), "--time", "0:1")
+    assert run.code == 2 and "the dynamics need links as bodies with masses" in run.err
+    assert "loads need" not in run.err
+
+
+def test_a_run_ending_at_an_event_says_it_on_stderr_when_the_tables_go_to_csv(cli, tmp_path):
+    """With -o FILE.csv only "wrote ..." reached stderr and the CSVs hold no event: exit 1
+    without its reason anywhere. The event is now a note (JSON holds it already)."""
+    args = ("simulate", str(ROOT / "docs" / "me581_masses.toml"), "--time", "0:2", "--drive", "5",
+            "--samples", "5")
+    run = cli(*args, "-o", str(tmp_path / "e.csv"))
+    assert run.code == 1 and "note: event: limit_of_assembly at t = 0.19222" in run.err
+    run = cli(*args, "-o", str(tmp_path / "e.json"))
+    assert run.code == 1 and "note: event" not in run.err
+
+
+def test_a_run_too_stiff_to_integrate_names_what_makes_it_so_not_only_the_span(cli):
+    """1e308 N m s/rad of viscous friction makes the first steps 5.6e-308 s: the refusal said
+    only "shorten --time (or --omega0)", which cannot help; it names friction among the causes."""
+    run = cli("simulate", str(LOADED), "--time", "0:0.2", "--samples", "5", "--friction-viscous", "1e308")
+    assert run.code == 2 and run.err.count("\n") == 1 and "friction" in run.err

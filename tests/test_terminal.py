@@ -84,6 +84,20 @@ def test_columns_picks_what_a_table_and_the_csv_show(cli):
     assert cli("solve", "--columns", "nothing-like-this").code == 2
 
 
+def test_columns_refuses_a_name_that_matches_nothing_beside_one_that_matches(cli):
+    """A misspelt name was dropped silently when another name matched (theta3,zzz showed
+    theta3): each name must begin some column (of a table or of the display; the first too)."""
+    me581 = str(SAMPLES / "fourbar_me581.toml")
+    run = cli("sweep", me581, "--step", "90", "--columns", "theta3,zzz")
+    assert run.code == 2 and run.err.count("\n") == 1 and "'zzz': matches no column" in run.err
+    tol = ("tolerance", me581, "--tol", "r2=0.01", "--samples", "20", "--step", "90", "--columns")
+    run = cli(*tol, "status,worst")
+    assert run.code == 2 and "'worst': matches no column" in run.err and "theta3_worst_case" in run.err
+    assert cli("sweep", me581, "--step", "90", "--columns", "theta2,theta3").code == 0  # the first column
+    shown = cli(*tol, "status,nominal", "-f", "plain")  # a display header ("nominal")
+    assert shown.code == 0 and "nominal" in shown.out
+
+
 def test_sentences_wrap_only_when_a_table_is_too_wide():
     """A cell of words (a benchmark target) wraps between words, read from the left,
     when the table would not fit the terminal; numbers never wrap."""

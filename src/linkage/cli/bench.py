@@ -16,6 +16,11 @@ BENCH_TABLES = ("measurements", "sweeps", "cold_start", "targets", "continuation
 measure.continuation_targets), known before it runs."""
 
 
+MAX_REPEATS = 1000
+"""Timed batches per measurement at most: each batch times every method on every problem, so
+a thousand already runs for hours; more was accepted and ran until killed."""
+
+
 @app.command(
     epilog="Examples:  linkage bench --quick  |  linkage bench --full  |  "
     "linkage bench --problem fourbar --plot wp.png  |  linkage bench --format csv -o bench.csv",
@@ -55,8 +60,8 @@ def bench(
         if name not in PROBLEMS:
             raise InputError(f"unknown problem {name!r}; choose from {', '.join(PROBLEMS)}")
     n_repeats = repeats if repeats is not None else (3 if quick else 5)
-    if n_repeats < 1:
-        raise InputError(f"--repeats must be >= 1, got {n_repeats}")
+    if not 1 <= n_repeats <= MAX_REPEATS:
+        raise InputError(f"--repeats must be a whole number from 1 to {MAX_REPEATS:,}, got {n_repeats}")
     try:
         import mpmath  # noqa: F401
     except ImportError:

@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from .options import ForceOpt, MechanismFile, mechanism_output, stdout_errors, write_mechanism
+from .options import NOTED, ForceOpt, MechanismFile, mechanism_output, stdout_errors, write_mechanism
 from .root import app
 
 
@@ -51,6 +51,10 @@ def convert(
     mechanism = parse_mechanism(doc, str(file))  # refuse what solve refuses: the printed file solves
     if wanted == "loops":
         text = loops_text(doc, str(file), mechanism)
+        dropped = [f"[{k}]" for k in ("loads", "mass") if k in doc]
+        if dropped:  # loads and masses act on links as bodies, which the loops form has not
+            NOTED.append(f"{' and '.join(dropped)} of {file} not written: the loops form has no links as "
+                         "bodies to carry them (keep the joints file for forces and simulate)")
     else:
         from ..kinematics.to_joints import joints_text
 

@@ -46,9 +46,17 @@ def run_cli(argv: list[str] | None = None) -> int:
     return code
 
 
+def one_line(text: str) -> str:
+    """A message as one line whatever it quotes: a line break in a path or a value (a file
+    named ``a<newline>b``) is written as ``\\n`` (``\\r``), so an error stays the one line
+    docs/output.md promises."""
+    return text.replace("\r", "\\r").replace("\n", "\\n")
+
+
 def _for_stderr(line: str) -> str:
     """A message as one line, or wrapped at words to a terminal's width (a person's
     terminal would otherwise fold it anywhere, mid-word or mid-path)."""
+    line = one_line(line)
     if not sys.stderr.isatty():
         return line
     import shutil
@@ -87,7 +95,7 @@ def _run_command(args: list[str]) -> int:
         typer.echo("error: aborted", err=True)
         return 1
     except LinkageError as exc:
-        typer.echo(f"error: {exc}", err=True)
+        typer.echo(one_line(f"error: {exc}"), err=True)
         return 2
     except KeyboardInterrupt:
         return _interrupted()
@@ -111,7 +119,7 @@ def _run_command(args: list[str]) -> int:
             message = " ".join(exc.format_message().split())
             typer.echo(f"error: {message}", err=True)
             return 2
-        typer.echo(f"internal error: {type(exc).__name__}: {exc} (please report this)", err=True)
+        typer.echo(one_line(f"internal error: {type(exc).__name__}: {exc} (please report this)"), err=True)
         return 1
     if rv == 130:
         # typer turns Ctrl-C into a silent return of 130 (no command returns a number)
@@ -126,7 +134,14 @@ _terminated: list[int] = []
 def _on_sigterm(signum: int, frame: Any) -> None:
     """SIGTERM is handled as Ctrl-C is: the KeyboardInterrupt unwinds every open output
     (files.atomic_target removes its partial file), then one line and 128 + 15."""
+    import signal
+
+    if _terminated:
+        return  # a second SIGTERM (timeout(1) signals the child and then its group): already unwinding
     _terminated.append(signum)
+    # once: the exit that follows joins the worker threads, and a KeyboardInterrupt raised there
+    # is a traceback ("Exception ignored in: <module 'threading'>"), not the one line
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     raise KeyboardInterrupt
 
 

@@ -3,6 +3,7 @@ modules stay short; docs/motion_synthesis.md)."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Optional
 
@@ -28,8 +29,17 @@ def read_poses(pose: list[str], poses_file: Optional[Path]) -> list[tuple[float,
         text = read_input(poses_file, "poses file")
     except ParseError as exc:
         raise InputError(f"--poses: {exc}") from None
-    lines = [ln.split("#", 1)[0].strip() for ln in text.splitlines()]
-    return pose_list([",".join(ln.replace(",", " ").split()) for ln in lines if ln])
+    out = []
+    for number, line in enumerate(text.splitlines(), 1):
+        line = line.split("#", 1)[0].strip()
+        if not line:
+            continue
+        try:  # each line by the --pose rule, its refusal naming the file's line (not "--pose 1")
+            out += pose_list([",".join(line.replace(",", " ").split())])
+        except InputError as exc:
+            said = re.sub(r"^--pose (\d+ |'[^']*': )", "", str(exc))
+            raise InputError(f"--poses {poses_file} line {number} ({line!r}): {said}") from None
+    return out
 
 
 def read_circle_points(circle: list[str]) -> list[tuple[float, float]] | None:
@@ -59,6 +69,10 @@ def motion_command(pose: list[str], poses_file: Optional[Path], circle: list[str
     if plot is not None and len(poses) != 4:
         raise InputError("--plot with --motion draws four poses' centre-point and circle-point curves: "
                          f"give 4 poses, not {len(poses)}")
+    if write_file and output is not None and len(poses) == 4:
+        raise InputError(f"-o {output} writes a four-bar: 4 poses give the centre-point and circle-point "
+                         "curves, not a design (-f csv lists their points); give 5 poses, or 3 with "
+                         "--circle X,Y twice")
     if len(poses) == 3 and points is None:
         raise InputError(f"{THREE_FREE}: give them as --circle X,Y twice")
     try:

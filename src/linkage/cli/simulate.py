@@ -1,12 +1,15 @@
 """linkage simulate."""
 
+import re
 from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
 
 from ..errors import InputError
+from ..render.writers import is_data
 from .options import (
+    NOTED,
     PICTURES,
     ColumnsOpt,
     DigitsOpt,
@@ -136,9 +139,13 @@ def simulate(
     mechanism = load_file(file)
     loads = command_loads(mechanism, load or [], torque or [], gravity)
     speed = parse_motion(omega0, None, mechanism, ("--omega0", "--accel"))[0] or 0.0
-    sim = run(mechanism, drive, span, constants=_constants(const or []), theta0=theta0, omega0=speed,
-              loads=loads, friction_viscous=fv, friction_coulomb=fc, flywheel=flywheel, samples=samples,
-              rtol=rtol, atol=rtol * 1e-2)
+    try:
+        sim = run(mechanism, drive, span, constants=_constants(const or []), theta0=theta0, omega0=speed,
+                  loads=loads, friction_viscous=fv, friction_coulomb=fc, flywheel=flywheel, samples=samples,
+                  rtol=rtol, atol=rtol * 1e-2)
+    except InputError as exc:  # the library's argument names, as the command's options
+        raise InputError(re.sub(r"^(theta0|flywheel|rtol|samples|friction_viscous|friction_coulomb)\b",
+                                lambda m: "--" + m.group(1).replace("_", "-"), str(exc))) from None
     energy_tol, drive_tol = max(100.0 * rtol, 1e-12), max(rtol, 1e-12)
     emit_report(simulate_report(sim, mechanism, digits, energy_tol, drive_tol, target_cs), out_fmt, output,
                 columns=columns, table=table)
@@ -146,4 +153,7 @@ def simulate(
         simulate_plot(sim, mechanism, plot)
         typer.echo(f"wrote {plot}", err=True)
     if sim.event is not None or not simulation_checks(sim, energy_tol, drive_tol, target_cs).passed:
+        if is_data(out_fmt) and out_fmt != "json":  # tables only: the exit's reason would be nowhere
+            NOTED.append(f"event: {sim.event} at t = {sim.event_time:.10g} s: {sim.message}"
+                         if sim.event is not None else "a check failed: --format json or plain shows which")
         raise typer.Exit(1)

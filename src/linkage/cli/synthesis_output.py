@@ -47,5 +47,9 @@ def write_motion_design(m: object, chosen: int, output: Path, unit: str, force: 
     made_by = (" ".join(shlex.quote(w) for w in ["linkage", *sys.argv[1:]])
                if len(sys.argv) > 1 and sys.argv[1] == "synthesize" else "linkage synthesize --motion")
     text = motion_design_text(m, chosen, unit, made_by)
-    write_mechanism(output, text, force, said=f" (design {chosen + 1}): linkage sweep "
-                    f"{shlex.quote(str(output))} runs it through the poses")
+    defects = m.designs[chosen].defect_names  # type: ignore[attr-defined]
+    # a design with defects (--design K) is written as asked, its defects said: sweeping it does
+    # not carry the body through every pose as the synthesis asked
+    said = (f" (design {chosen + 1}, with defects: {', '.join(defects)})" if defects else
+            f" (design {chosen + 1}): linkage sweep {shlex.quote(str(output))} runs it through the poses")
+    write_mechanism(output, text, force, said=said)

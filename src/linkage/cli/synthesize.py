@@ -116,10 +116,10 @@ def synthesize(
         typer.Option(
             "--output",
             "-o",
-            help="FILE.toml: the linkage as a "
-            "mechanism file (joints form, its driver range the alpha range), the report "
-            "still printed, written only for a design without defects and kept if it exists "
-            "unless --force; any other suffix: the report in that format.",
+            help="FILE.toml: the linkage as a mechanism file (joints form, its driver range the alpha "
+            "range), the report still printed, written only for a design without defects (or --design "
+            "K's, its defects said) and kept if it exists unless --force; any other suffix: the report "
+            "in that format.",
         ),
     ] = None,
     force: ForceOpt = False,

@@ -171,7 +171,10 @@ def closed_form_limits(solver: Solver, positions: Sequence[Position], lo: float,
     else:
         found = [limit_between(d, float(ring[i]), float(ring[i + 1]), branches, scale) for i in change]
     for i in range(1, len(ring) - 1):
-        if ok[i - 1] and ok[i + 1] and g[i] <= g[i - 1] and g[i] <= g[i + 1] and g[i] < LIMIT_CANDIDATE:
+        # a sliver between grid points that all three assemble at: where the middle one does not,
+        # its sign changes were bracketed above, and a "dip" would end at that grid point
+        if ok[i - 1] and ok[i] and ok[i + 1] and g[i] <= g[i - 1] and g[i] <= g[i + 1] \
+                and g[i] < LIMIT_CANDIDATE:
             for a, c in ((ring[i - 1], ring[i]), (ring[i], ring[i + 1])):
                 dip = dip_between(d, a, c, branches, scale)
                 if dip is not None:

@@ -11,7 +11,7 @@ from typing import Any
 from ..errors import InputError
 from ..problems.loops import Mechanism, magnitude_problem
 from ..records import frozen
-from ..rules import grid_resolved
+from ..rules import GRID_RESOLUTION, grid_resolved
 from ..units import RAD_PER_DEG
 
 
@@ -216,10 +216,15 @@ def driver_values(start: float, stop: float, step: float | None, points: int | N
     resolved, ulp = grid_resolved(start, stop, spacing)
     if points != 1 and not resolved:
         raise InputError(f"--from {start:g} and --to {stop:g} are too large for a spacing of "
-                         f"{spacing:g}: double precision resolves only {ulp:.3g} there")
+                         f"{spacing:g}: it must be at least {GRID_RESOLUTION * ulp:.3g} there, "
+                         f"{GRID_RESOLUTION:,.0f} times the {ulp:.3g} between doubles (so that rounding "
+                         f"moves each value by at most 1/{GRID_RESOLUTION:,.0f} of the spacing)")
     if points is not None:
         if points == 1:
             return [start]
+        if not math.isfinite((stop - start) * (points - 1)):  # a span near the largest double: the
+            # usual order's product overflows; these values are refused by the driver's own bound next
+            return [start * (1.0 - k / (points - 1)) + stop * (k / (points - 1)) for k in range(points)]
         if array_above is not None and points > array_above:
             import numpy as np
 

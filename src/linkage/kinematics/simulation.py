@@ -185,6 +185,10 @@ def simulate(
     from .loading import mechanism_of
 
     mechanism = mechanism_of("mechanism", mechanism)
+    if mechanism.extra.get("drawing") is None:  # Frame.of's refusal speaks of loads, which need not be given
+        raise InputError(f"{mechanism.source}: the dynamics need links as bodies with masses: give the "
+                         "mechanism in the joints form (linkage convert --form joints FILE writes it) "
+                         "with a [mass] table")
     frame = Frame.of(mechanism)
     if isinstance(drive, str):
         consts = {}
@@ -282,7 +286,8 @@ class Equation:
                 raise SpanTooLong(
                     f"time: {self.start:g} to {self.end:g} s needs about {projected:.2g} evaluations of the "
                     f"equation of motion at the rate of its first {t - self.start:.3g} s, more than "
-                    f"{MAX_EVALUATIONS:,}: shorten --time (or --omega0)")
+                    f"{MAX_EVALUATIONS:,}: shorten --time, or lower what makes the motion that fast or "
+                    "stiff (--omega0, the drive, friction, loads)")
         theta, omega = float(y[0]), float(y[1])
         dyn = self.dyn
         p = dyn.at(theta, MAX_WALK_STEPS)
@@ -296,11 +301,14 @@ class Equation:
         if not abs(tau) <= MAX_LOAD:  # a load's bound (problems.loads): beyond it the motion overflows
             raise _TooLong(f"the drive is {tau:g} at t = {t:.6g} s, theta = {theta:.6g} rad, omega = "
                            f"{omega:.6g} rad/s: beyond {MAX_LOAD:g} (N m or N), a load's bound")
-        self.last_t = t
         fr = dyn.friction_force(p, omega)
         q = tau + p.loads + p.weight + fr
-        return np.array([omega, (q - p.half_slope * omega * omega) / p.inertia,
-                         tau * omega, fr * omega, p.loads * omega])
+        with np.errstate(all="ignore"):
+            alpha = (q - p.half_slope * omega * omega) / p.inertia
+        if not math.isfinite(alpha):  # a trial step beyond the doubles: refused and shortened
+            return np.full(5, np.nan)
+        self.last_t = t
+        return np.array([omega, alpha, tau * omega, fr * omega, p.loads * omega])
 
     def events(self) -> list[Any]:
         """The terminal events: a dead point (the sensitivity reaching DEAD_POINT_SENSITIVITY),
@@ -332,8 +340,12 @@ def integrate(dyn: Dynamics, drive: Callable[[float, float, float], float], thet
     from scipy.integrate import solve_ivp
 
     p0 = dyn.at(theta0)
-    if p0 is None or not p0.sensitivity < DEAD_POINT_SENSITIVITY:
-        raise InputError("theta0: the mechanism is at a dead point or not assembled there")
+    if p0 is None:
+        raise InputError("theta0: the mechanism is not assembled there (or is at a limit of its assembly)")
+    if not p0.sensitivity < DEAD_POINT_SENSITIVITY:
+        raise InputError(f"theta0: at or next to a dead point or limit: an unknown moves "
+                         f"{p0.sensitivity:.3g} times as fast as the driver there (a run starts below "
+                         f"{DEAD_POINT_SENSITIVITY:g})")
     if not p0.inertia > 0.0:
         raise InputError("the mechanism has no inertia to move: give its links a mass or an inertia in "
                          "[mass], or a flywheel (--flywheel)")
@@ -341,9 +353,13 @@ def integrate(dyn: Dynamics, drive: Callable[[float, float, float], float], thet
     y0 = [theta0, omega0, 0.0, 0.0, 0.0]
     t_eval = np.linspace(start, end, samples)
     try:
-        eq.rhs(start, np.array(y0))
+        first = eq.rhs(start, np.array(y0))
     except _TooLong as exc:
         raise InputError(f"drive: {exc}") from None
+    if not np.isfinite(first[1]):  # the start is assembled (p0): its theta'' overflowed
+        tau = drive(start, theta0, omega0)
+        raise InputError(f"the acceleration overflows at the start, t = {start:g} s (drive {tau:g}, speed "
+                         f"{omega0:g}, inertia {p0.inertia:g}): no step can follow it")
     with np.errstate(all="ignore"):
         try:
             sol = solve_ivp(eq.rhs, (start, end), y0, method="DOP853", t_eval=t_eval, rtol=rtol,

@@ -13,7 +13,6 @@ from ..problems.loops import Mechanism
 from .angles import anchor_index, closes_circle, continuous, driver_turn, turn_shift, unwrap_turns
 from .continuation import Solver, classify_gap, follow, q_of, solve_position, solver_q
 from .limits import closed_form_limits, solved_ranges, toggles
-from .pose import implied
 from .positions import Position, SweepResult, check_driver_values
 
 
@@ -112,8 +111,7 @@ def _at_meetings(solver: Solver, positions: list[Position], target: str | None
     from dataclasses import replace
 
     from ..methods.newton_system import max_abs
-    from ..problems.assembly import Indeterminate
-    from ..problems.derive import parse_signs
+    from ..problems.derive import Indeterminate, parse_signs
 
     d = solver.derivation
     assert d is not None
@@ -129,7 +127,7 @@ def _at_meetings(solver: Solver, positions: list[Position], target: str | None
         signs = tuple(s if s != 0.0 else 1.0 for s in d.signs_of(q, drv))
         try:
             exact = d.solve(drv, signs)
-        except Indeterminate:  # a change point: every value of an unknown closes the loop there
+        except Indeterminate:  # a change point: the step's two circles coincide, no one configuration
             exact = None
         F, _, _ = solver.compiled(p.input)
         note, det = "; ".join(n for n in (p.note, MEETS_NOTE) if n), p.det
@@ -231,6 +229,8 @@ def classification_of(m: Mechanism) -> dict[str, Any]:
     the ground last: input, coupler, output (:func:`~linkage.problems.closed_form.fourbar_class`).
     One such loop: its class; several: the first's, with every loop's under ``loops``.
     Computed once per mechanism (:func:`~.pose.implied`); each caller gets its own copy."""
+    from .pose import implied
+
     c = implied(m, "classification", _classification)
     return {k: [dict(x) for x in v] if k == "loops" else v for k, v in c.items()}
 

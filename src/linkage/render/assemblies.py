@@ -144,6 +144,8 @@ def assemblies_report(a: Any, digits: int, show_paths: bool) -> Report:
         out: list[Block] = [Text(title_of(a), "bold"), *[Text(line) for line in summary_lines(a)], Text("")]
         if tables[0].row_count:
             out.append(_display(tables[0], digits, hide=quiet_columns(a)))
+        elif a.continuum:  # the loops close along a curve: assembled, but no isolated assembly to list
+            out.append(Text("no isolated assembly to list: the assemblies here form a curve"))
         else:
             out.append(Text("no real assembly: the mechanism cannot be assembled here"))
         if any(s.singular for s in a.real):

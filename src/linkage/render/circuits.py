@@ -156,7 +156,8 @@ def circuits_plot(c: Any, path: Path) -> None:
         unit = u.unit if u.kind == "angle" else m.length_unit
         ax.set_ylabel(f"{u.name} ({unit})")
         ax.grid(True, alpha=0.3)
-    axes[0][0].legend(loc="best", fontsize=8)
+    if axes[0][0].get_legend_handles_labels()[0]:  # no circuit (no real assembly): no legend to draw
+        axes[0][0].legend(loc="best", fontsize=8)
     axes[-1][0].set_xlabel(f"{m.driver.name} ({_driver_unit(m)}); dashed: limit positions")
     axes[0][0].set_title(f"{m.name}: circuits (dots: the assemblies at {m.driver.name} = "
                          f"{_driver_shown(m, c.assemblies.driver):g})")

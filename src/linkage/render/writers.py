@@ -329,6 +329,17 @@ def pick_table(report: Report, fmt: str, name: str) -> Report:
     return report._replace(tables=kept)
 
 
+def _matching_nothing(report: Report, wanted: Sequence[str]) -> list[str]:
+    """The names of ``--columns`` that begin no column's name or header, in the tables or in
+    the display's tables (whose headers may differ: tolerance's "nominal"), first columns too."""
+    from .report import Table
+
+    heads = {h.lower() for t in report.tables for c in t.columns for h in (c.name, c.header)}
+    if any(not any(h.startswith(w) for h in heads) for w in wanted):
+        heads |= {h.lower() for b in report.blocks() if isinstance(b, Table) for h in b.headers}
+    return [w for w in wanted if not any(h.startswith(w) for h in heads)]
+
+
 def pick_columns(report: Report, names: str) -> Report:
     """``--columns``: keep each table's first column and the columns whose name (or
     header) begins with one of ``names`` (comma-separated, case-insensitive), in the tables
@@ -347,9 +358,13 @@ def pick_columns(report: Report, names: str) -> Report:
         cols = t.columns[:1] + tuple(c for c in t.columns[1:] if keep(c))
         matched = matched or len(cols) > 1
         tables.append(t._replace(columns=cols) if len(cols) > 1 else t)
+    there = sorted({c.name for t in report.tables for c in t.columns[1:]})
     if not matched:
-        there = sorted({c.name for t in report.tables for c in t.columns[1:]})
         raise InputError(f"--columns {names!r} matches no column; the columns are {', '.join(there)}")
+    unmatched = _matching_nothing(report, wanted)
+    if unmatched:  # one name that matches nothing is a mistake, even beside one that matches
+        raise InputError(f"--columns {', '.join(repr(w) for w in unmatched)}: matches no column; the "
+                         f"columns are {', '.join(there)}")
     blocks = report.blocks
 
     def picked() -> Any:

@@ -60,6 +60,11 @@ class Burmester:
     unresolved: int = 0  # real roots of the polynomials that are not rigid cranks after Newton
 
 
+POSE_TOL = 1e-9
+"""A body within this (of the poses' size, and in radians) of a pose is at the pose; two poses
+that close are one pose."""
+
+
 def checked_poses(poses: Any, count: int = 5) -> tuple[Pose, ...]:
     """``count`` poses of finite real numbers (x, y, angle in degrees), each pose its own:
     every misuse an InputError naming it (arguments.check_number, the one rule for numbers)."""
@@ -79,11 +84,15 @@ def checked_poses(poses: Any, count: int = 5) -> tuple[Pose, ...]:
     if len(out) != count:
         raise InputError(f"Burmester's points need exactly 5 poses, got {len(out)}" if count == 5
                          else f"this needs exactly {count} poses, got {len(out)}")
+    centre = sum(complex(p.x, p.y) for p in out) / count
+    size = max(abs(complex(p.x, p.y) - centre) for p in out) or 1.0
     for i in range(count):
         for j in range(i):
             a, b = out[i], out[j]
-            if math.hypot(a.x - b.x, a.y - b.y) == 0 and math.remainder(a.angle_deg - b.angle_deg, 360) == 0:
-                raise InputError(f"poses[{j}] and poses[{i}] are the same pose")
+            if math.hypot(a.x - b.x, a.y - b.y) <= POSE_TOL * size and \
+                    abs(radians(math.remainder(a.angle_deg - b.angle_deg, 360))) <= POSE_TOL:
+                raise InputError(f"poses[{j}] and poses[{i}] are the same pose (to {POSE_TOL:g} of the "
+                                 "poses' size and in radians, the tolerance a pose is met to)")
     if all(math.remainder(p.angle_deg - out[0].angle_deg, 360) == 0 for p in out):
         raise InputError("poses: the body does not turn between them (every angle the same): every "
                          "body point moves alike, and Burmester's construction needs rotation")

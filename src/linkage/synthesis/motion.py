@@ -25,13 +25,11 @@ from typing import Any
 from ..errors import InputError
 from ..records import frozen
 from ..units import degrees, radians
-from .burmester import Burmester, Crank, Pose, burmester_points, checked_poses
+from .burmester import POSE_TOL, Burmester, Crank, Pose, burmester_points, checked_poses
 from .defects import Defect
 from .motion_curves import Curves, four_pose_curves
 from .request import MIN_TRANSMISSION_DEG
 
-POSE_TOL = 1e-9
-"""A body within this (of the poses' size, and in radians) of a pose is at the pose."""
 STEP_DEG = 1.0
 """The sweep's largest input step between poses."""
 
