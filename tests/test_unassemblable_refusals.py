@@ -95,3 +95,18 @@ def test_draw_at_a_pose_that_cannot_be_assembled_is_refused(cli, tmp_path):
     _refused(cli("draw", ME581, "-o", str(out), "--set", "theta2=200"),
              "cannot be assembled at theta2 = 200 deg")
     assert not out.exists()
+
+
+@pytest.mark.parametrize("command", [["tolerance", "--tol", "r2=0.1", "--samples", "10", "--step", "10"],
+                                     ["centres", "--centrodes"]])
+def test_a_tolerance_study_or_centrodes_wholly_past_the_limit_are_refused(cli, tmp_path, command):
+    """tolerance and centres --centrodes over a range where the ME581 assembles nowhere
+    (theta2 150..200, past its limit) exited 0 with every row not_assembled or no_solution;
+    they are refused as a sweep is. A range that reaches the limit is an answer (exit 0)."""
+    assert LIMIT_DEG < 150 and _diagonal(150) > R3 + R4
+    name, *options = command
+    out = tmp_path / "t.json"
+    run = cli(name, ME581, *options, "--from", "150", "--to", "200", "-o", str(out))
+    _refused(run, "cannot be assembled at any theta2 from 150 to 200 deg")
+    assert not out.exists()
+    assert cli(name, ME581, *options, "--from", "100", "--to", "200", "-f", "json").code == 0

@@ -80,8 +80,11 @@ def centres(
     ic = as_given(centres_at(pose), mechanism, converted)
     cd = None
     if centrodes:
+        from collections import Counter
+
         from ..arguments import check_number, driver_span
         from ..kinematics.centrodes import centrodes as run_centrodes
+        from ..kinematics.positions import check_assembles_somewhere
         from ..kinematics.sweep import driver_values
 
         a, b = driver_span(mechanism, start, stop)
@@ -89,6 +92,10 @@ def centres(
             raise InputError("--step must be > 0")
         values = driver_values(a, b, 1.0 if step is None else step, None)
         cd = run_centrodes(mechanism, values, body, branch=branch)
+        # the one rule of a linkage that assembles at no position of the range
+        check_assembles_somewhere(Counter(p.status for p in cd.points), str(file),
+                                  lambda: f"{mechanism.driver.name} from {a:.12g} to {b:.12g} "
+                                          f"{mechanism.driver.unit}")
     emit_report(centres_report(ic, digits, cd), out_fmt, output, columns=columns, table=table)
     if plot is not None:
         from ..render.centres import centres_plot
