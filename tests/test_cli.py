@@ -327,3 +327,14 @@ def test_plain_numbers_parse_as_fractions_do():
     for text in ("1e400", "-1e999", "nan", "inf", "-inf", "1e", ".", "", "1 5", "+-1", "0x10", "1/0"):
         with pytest.raises(InputError):
             parse_number("x", text)
+
+
+def test_a_solve_that_exits_1_to_a_table_file_says_why_on_stderr(cli, tmp_path):
+    """A table file (csv) holds the iterations but not the verdict: a run that ends exit 1
+    says its status and reason on stderr, one note per method that did not converge (the
+    reason was nowhere but in -f json or the display)."""
+    out = tmp_path / "s.csv"
+    run = cli("solve", "-e", "x**2+1", "--x0", "1", "-o", str(out))
+    assert run.code == 1 and out.exists()
+    assert "note: newton: zero_derivative: stalled: the derivative (or slope) is zero" in run.err
+    assert cli("solve", "-e", "x**2+1", "--x0", "1", "-o", str(tmp_path / "s.json")).err.count("note:") == 0

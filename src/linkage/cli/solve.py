@@ -166,6 +166,8 @@ def solve(
         runs.append((result, conv, seconds))
 
     from ..render.scalar import scalar_report, summary_report
+    from ..render.writers import is_data
+    from .options import NOTED
 
     fourbar = None
     if equation is None and not summary:
@@ -179,4 +181,6 @@ def solve(
     if plot is not None:
         convergence_plot([r for r, _, _ in runs], plot, report.title, problem.unit)
     if not all(r.converged for r, _, _ in runs):
+        if is_data(out_fmt) and out_fmt != "json":  # tables only: the exit's reason would be nowhere
+            NOTED.extend(f"{r.method}: {r.status.value}: {r.message}" for r, _, _ in runs if not r.converged)
         raise typer.Exit(1)
