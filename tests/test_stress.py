@@ -544,3 +544,11 @@ def test_cli_fuzz_rates_points_and_scan_options(cli, tmp_path, monkeypatch):
                                ["solve", str(path)]])
         codes[well_behaved(cli(*args), args)] += 1
     assert codes[0] and codes[2], codes
+
+
+def test_stress_seed_has_every_seed_s_range(cli):
+    """--seed -1 ran (exit 0) where every other command's --seed refuses it: one line,
+    exit 2, the same words (arguments.check_whole with MAX_SEED)."""
+    run = cli("stress", "--quick", "--seed", "-1")
+    said = "error: --seed must be a whole number from 0 to 2**64 - 1, got -1"
+    assert run.code == 2 and run.err.strip() == said

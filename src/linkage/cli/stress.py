@@ -32,7 +32,7 @@ def stress(
 
     Example: linkage stress --quick
     """
-    from ..arguments import check_method
+    from ..arguments import MAX_SEED, check_method, check_whole
     from ..measure.stress import SUMMARY_HEADERS, run, stress_tables, summary_rows, totals
     from ..methods import SCALAR_METHODS
     from ..solve import SYSTEM_METHODS
@@ -40,6 +40,7 @@ def stress(
     known = tuple(dict.fromkeys((*SCALAR_METHODS, *SYSTEM_METHODS)))  # scalar's, then the systems' new ones
     for m in method or []:
         check_method("--method", m, known)
+    check_whole("--seed", seed, 0, MAX_SEED)  # every --seed's range (arguments.check_scan_options)
     out_fmt = choose_format(fmt, output)
     check_paths([], [("--output", output)])
     methods = method or None
