@@ -84,7 +84,7 @@ def centres(
 
         from ..arguments import check_number, driver_span
         from ..kinematics.centrodes import centrodes as run_centrodes
-        from ..kinematics.positions import check_assembles_somewhere
+        from ..kinematics.positions import check_assembles_somewhere, span_text
         from ..kinematics.sweep import driver_values
 
         a, b = driver_span(mechanism, start, stop)
@@ -94,8 +94,7 @@ def centres(
         cd = run_centrodes(mechanism, values, body, branch=branch)
         # the one rule of a linkage that assembles at no position of the range
         check_assembles_somewhere(Counter(p.status for p in cd.points), str(file),
-                                  lambda: f"{mechanism.driver.name} from {a:.12g} to {b:.12g} "
-                                          f"{mechanism.driver.unit}")
+                                  lambda: span_text(mechanism.driver.name, a, b, mechanism.driver.unit))
     emit_report(centres_report(ic, digits, cd), out_fmt, output, columns=columns, table=table)
     if plot is not None:
         from ..render.centres import centres_plot

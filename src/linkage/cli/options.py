@@ -1,7 +1,7 @@
 """What every command shares: the options, the output format and writer, path checks,
 --set/--guess parsing and the closed-form notes."""
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Annotated, Any, Optional
 
@@ -185,3 +185,12 @@ def note_closed_form(mechanism: Any) -> None:
 NOTED: list[str] = []
 """The notes of this command, printed by :func:`run_cli` after its output (emptied as each
 command starts: tests run many commands in one process)."""
+
+
+def note_exit_reasons(fmt: str, reasons: Iterable[str]) -> None:
+    """The reasons a command exits 1, as notes where its output is a table format (csv,
+    parquet, xlsx): the tables hold the rows, not the verdict, which would be nowhere."""
+    from ..render.writers import is_data
+
+    if is_data(fmt) and fmt != "json":
+        NOTED.extend(reasons)

@@ -7,9 +7,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
-from ..render.writers import is_data
 from .options import (
-    NOTED,
     PICTURES,
     ColumnsOpt,
     DigitsOpt,
@@ -23,6 +21,7 @@ from .options import (
     check_paths,
     choose_format,
     emit_report,
+    note_exit_reasons,
 )
 from .root import app
 
@@ -153,7 +152,7 @@ def simulate(
         simulate_plot(sim, mechanism, plot)
         typer.echo(f"wrote {plot}", err=True)
     if sim.event is not None or not simulation_checks(sim, energy_tol, drive_tol, target_cs).passed:
-        if is_data(out_fmt) and out_fmt != "json":  # tables only: the exit's reason would be nowhere
-            NOTED.append(f"event: {sim.event} at t = {sim.event_time:.10g} s: {sim.message}"
-                         if sim.event is not None else "a check failed: --format json or plain shows which")
+        note_exit_reasons(out_fmt, [f"event: {sim.event} at t = {sim.event_time:.10g} s: {sim.message}"
+                                    if sim.event is not None else
+                                    "a check failed: --format json or plain shows which"])
         raise typer.Exit(1)

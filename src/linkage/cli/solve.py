@@ -166,8 +166,7 @@ def solve(
         runs.append((result, conv, seconds))
 
     from ..render.scalar import scalar_report, summary_report
-    from ..render.writers import is_data
-    from .options import NOTED
+    from .options import note_exit_reasons
 
     fourbar = None
     if equation is None and not summary:
@@ -181,6 +180,6 @@ def solve(
     if plot is not None:
         convergence_plot([r for r, _, _ in runs], plot, report.title, problem.unit)
     if not all(r.converged for r, _, _ in runs):
-        if is_data(out_fmt) and out_fmt != "json":  # tables only: the exit's reason would be nowhere
-            NOTED.extend(f"{r.method}: {r.status.value}: {r.message}" for r, _, _ in runs if not r.converged)
+        note_exit_reasons(out_fmt, (f"{r.method}: {r.status.value}: {r.message}" for r, _, _ in runs
+                                    if not r.converged))
         raise typer.Exit(1)

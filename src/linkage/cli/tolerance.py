@@ -86,7 +86,7 @@ def tolerance(
     from ..arguments import check_scan_options, driver_span
     from ..files import parse_toml, read_input
     from ..kinematics.loading import from_text
-    from ..kinematics.positions import check_assembles_somewhere
+    from ..kinematics.positions import check_assembles_somewhere, span_text
     from ..kinematics.sweep import driver_values
     from ..render.tolerance import tolerance_report
     from ..scan.tolerance import MAX_SAMPLES, outputs_of, parse_tolerance, prepare, study
@@ -120,9 +120,9 @@ def tolerance(
                        distribution=distribution, job=job, scheduler=scheduler, workers=workers,
                        progress=advance)
     # the one rule of a linkage that assembles at no position of the range (the nominal's)
+    driver = mechanism.driver
     check_assembles_somewhere(Counter("no_solution" if s == "not_assembled" else s for s in result.status),
-                              str(file), lambda: f"{mechanism.driver.name} from {a:.12g} to {b:.12g} "
-                                                 f"{mechanism.driver.unit}")
+                              str(file), lambda: span_text(driver.name, a, b, driver.unit))
     emit_report(tolerance_report(result, digits), out_fmt, output, columns=columns, table=table)
     if plot is not None:
         from ..render.tolerance import tolerance_plot

@@ -255,6 +255,9 @@ def check_assembles_somewhere(summary: dict[str, int], what: str, span: Callable
 def driver_range_text(result: SweepResult) -> str:
     """The driver range of a sweep's positions, as a refusal names it (display units)."""
     inputs = result.inputs
-    low, high = min(inputs), max(inputs)
-    unit = f" {result.driver_unit}" if result.driver_unit else ""
-    return f"{result.driver} from {low:.12g} to {high:.12g}{unit}"
+    return span_text(result.driver, min(inputs), max(inputs), result.driver_unit)
+
+
+def span_text(driver: str, low: float, high: float, unit: str) -> str:
+    """A driver range as a refusal names it: "theta2 from 150 to 200 deg"."""
+    return f"{driver} from {low:.12g} to {high:.12g}{f' {unit}' if unit else ''}"
