@@ -156,3 +156,20 @@ def test_cli_plot_without_a_real_assembly_draws_no_legend_warning(cli, tmp_path)
         out = cli("assemblies", str(SAMPLES / "fourbar_me581.toml"), "--set", "theta2=180", "--sweep",
                   "--plot", str(target))
     assert out.code == 1 and "Warning" not in out.err and target.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_a_plot_without_a_circuit_says_why_on_its_axes(monkeypatch, tmp_path):
+    """Empty axes said nothing (a student sees a blank 0..1 grid): each says there is no real
+    assembly at the start value, so no circuit to draw."""
+    pytest.importorskip("matplotlib")
+    from linkage.render import circuits as render
+
+    texts: list[str] = []
+
+    def keep(fig, path):
+        texts.extend(t.get_text() for ax in fig.axes for t in ax.texts)
+
+    monkeypatch.setattr("linkage.render.plots.save_figure", keep)
+    m = load(SAMPLES / "fourbar_me581.toml").with_values({"theta2": 180.0}, {})
+    render.circuits_plot(circuits(m), tmp_path / "none.png")
+    assert texts == ["no real assembly at theta2 = 180 deg: no circuit to draw"] * 2

@@ -156,8 +156,13 @@ def circuits_plot(c: Any, path: Path) -> None:
         unit = u.unit if u.kind == "angle" else m.length_unit
         ax.set_ylabel(f"{u.name} ({unit})")
         ax.grid(True, alpha=0.3)
-    if axes[0][0].get_legend_handles_labels()[0]:  # no circuit (no real assembly): no legend to draw
+    if axes[0][0].get_legend_handles_labels()[0]:
         axes[0][0].legend(loc="best", fontsize=8)
+    else:  # no circuit (no real assembly): the empty axes say why, not nothing
+        why = (f"no real assembly at {m.driver.name} = {_driver_shown(m, c.assemblies.driver):g} "
+               f"{_driver_unit(m)}: no circuit to draw")
+        for row in axes:
+            row[0].text(0.5, 0.5, why, transform=row[0].transAxes, ha="center", va="center", color="0.4")
     axes[-1][0].set_xlabel(f"{m.driver.name} ({_driver_unit(m)}); dashed: limit positions")
     axes[0][0].set_title(f"{m.name}: circuits (dots: the assemblies at {m.driver.name} = "
                          f"{_driver_shown(m, c.assemblies.driver):g})")
